@@ -1,0 +1,106 @@
+"""Command line: `mount-twin replay|demo|generate|import-csv`."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from mount_twin.errors import MountTwinError
+from mount_twin.io.bag import write_bag
+from mount_twin.io.messages import IMU, imu_messages
+from mount_twin.io.signals import Signal, half_sine_shock, read_csv, ship_motion
+from mount_twin.replay import replay
+from mount_twin.scene.loader import load_scene_file
+
+DEFAULT_SCENE = "pump_8_mounts.scene.yaml"
+DEFAULT_BAG = "ship_motion_1khz"
+
+
+def share_dir() -> Path:
+    """Where config/ and bags/ are: the source tree, or share/mount_twin of an install."""
+    here = Path(__file__).resolve().parent
+    # An editable or source checkout has config/ beside the package; a colcon install has
+    # <prefix>/share/mount_twin above <prefix>/lib/pythonX.Y/site-packages/mount_twin.
+    for candidate in (here.parent, *(p / "share" / "mount_twin" for p in here.parents)):
+        if (candidate / "config" / DEFAULT_SCENE).exists():
+            return candidate
+    msg = "cannot find mount_twin's config/ and bags/ (source tree or share/mount_twin)"
+    raise MountTwinError(msg)
+
+
+def _write_signal(sig: Signal, out: str, topic: str, frame_id: str, start_ns: int, storage: str) -> int:
+    stamps = start_ns + np.rint(sig.t * 1e9).astype(np.int64)
+    return write_bag(out, topic, IMU, iter(imu_messages(stamps, sig.accel, sig.gyro, frame_id)), storage)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point; returns the exit status."""
+    parser = argparse.ArgumentParser(prog="mount-twin", description=__doc__)
+    sub = parser.add_subparsers(dest="cmd", required=True)
+    rp = sub.add_parser("replay", help="replay a bag through the twin into an mcap bag")
+    rp.add_argument("input", help="input bag (mcap or sqlite3)")
+    rp.add_argument("--scene", required=True, help="scene YAML")
+    rp.add_argument("-o", "--output", required=True, help="output bag directory (new)")
+    rp.add_argument("--chunk", type=int, default=2000, help="messages per engine batch")
+    rp.add_argument("--no-progress", action="store_true")
+    dm = sub.add_parser("demo", help="replay the bundled bag through the bundled default scene")
+    dm.add_argument("-o", "--output", default="demo_out", help="output bag directory (new)")
+    gen = sub.add_parser("generate", help="write a bag of a generated foundation motion")
+    gen.add_argument("kind", choices=["half-sine", "ship-motion"])
+    gen.add_argument("-o", "--output", required=True)
+    gen.add_argument("--topic", default="/imu/data")
+    gen.add_argument("--frame-id", default="deck_imu")
+    gen.add_argument("--rate", type=float, help="sampling rate, Hz")
+    gen.add_argument("--duration", type=float, help="record length, s")
+    gen.add_argument("--peak", type=float, default=150.0, help="half-sine peak, m/s²")
+    gen.add_argument("--pulse", type=float, default=0.008, help="half-sine duration, s")
+    gen.add_argument("--start", type=int, default=1_700_000_000_000_000_000, help="first stamp, ns")
+    gen.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    imp = sub.add_parser("import-csv", help="CSV t,ax,ay,az,wx,wy,wz → sensor_msgs/Imu bag")
+    imp.add_argument("csv")
+    imp.add_argument("-o", "--output", required=True)
+    imp.add_argument("--topic", default="/imu/data")
+    imp.add_argument("--frame-id", default="imu_link")
+    imp.add_argument("--offset", type=int, default=0, help="added to t·1e9 for the stamp, ns")
+    imp.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    args = parser.parse_args(argv)
+    try:
+        return _run(args)
+    except (MountTwinError, ValueError, OSError) as err:
+        print(f"mount-twin: error: {err}", file=sys.stderr)
+        return 2
+
+
+def _run(args: argparse.Namespace) -> int:
+    if args.cmd in ("replay", "demo"):
+        if args.cmd == "demo":
+            share = share_dir()
+            scene_path, bag = share / "config" / DEFAULT_SCENE, share / "bags" / DEFAULT_BAG
+            chunk, progress = 2000, True
+        else:
+            scene_path, bag, chunk, progress = args.scene, args.input, args.chunk, not args.no_progress
+        summary = replay(load_scene_file(scene_path), bag, args.output, chunk=chunk, progress=progress)
+        print(summary.text())
+        return 0
+    if args.cmd == "generate":
+        if args.kind == "half-sine":
+            sig = half_sine_shock(
+                peak=args.peak, duration=args.pulse, rate_hz=args.rate or 10000.0,
+                total=args.duration or 0.4,
+            )
+        else:
+            sig = ship_motion(rate_hz=args.rate or 1000.0, total=args.duration or 5.0)
+        n = _write_signal(sig, args.output, args.topic, args.frame_id, args.start, args.storage)
+    else:
+        sig = read_csv(args.csv)
+        n = _write_signal(sig, args.output, args.topic, args.frame_id, args.offset, args.storage)
+    print(f"wrote {n} sensor_msgs/msg/Imu messages on {args.topic} to {args.output}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

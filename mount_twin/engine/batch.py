@@ -1,0 +1,79 @@
+"""Data crossing the engine boundary: input samples in, outputs and health reports out."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+OK, WARN, ERROR = 0, 1, 2
+"""Health levels, as diagnostic_msgs/DiagnosticStatus uses them."""
+
+
+@dataclass
+class SampleBatch:
+    """Input samples in arrival order, in the sensor frame.
+
+    Attributes:
+        stamps: (n,) header stamps, s.
+        accel: (n, 3) acceleration, m/s², sensor frame (specific force if it includes gravity).
+        gyro: (n, 3) angular velocity, rad/s, sensor frame.
+        frame_ids: header.frame_id of each sample.
+    """
+
+    stamps: np.ndarray
+    accel: np.ndarray
+    gyro: np.ndarray
+    frame_ids: list[str]
+
+    def __len__(self) -> int:
+        return int(self.stamps.shape[0])
+
+    @classmethod
+    def concat(cls, parts: list[SampleBatch]) -> SampleBatch:
+        """One batch of several, in order."""
+        return cls(
+            np.concatenate([p.stamps for p in parts]),
+            np.concatenate([p.accel for p in parts]).reshape(-1, 3),
+            np.concatenate([p.gyro for p in parts]).reshape(-1, 3),
+            [fid for p in parts for fid in p.frame_ids],
+        )
+
+
+@dataclass
+class HealthStatus:
+    """One diagnostic status: name, level (OK/WARN/ERROR), message, key/value figures."""
+
+    name: str
+    level: int
+    message: str
+    values: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass
+class HealthReport:
+    """Diagnostics at one stamp (s)."""
+
+    stamp: float
+    statuses: list[HealthStatus]
+
+
+@dataclass
+class OutputBatch:
+    """Published outputs, one row per published sample.
+
+    Attributes:
+        stamps: (k,) input stamps the rows answer, s.
+        pose: (k, 10) CG position in F (m), quaternion (x, y, z, w) of R, (α, γ, δ) rad.
+        wrenches: (k, n_mounts, 6) force (N) and couple (N·m) on the body in mount axes; with
+            decimation, each component's largest magnitude since the previous row.
+        health: diagnostics due in this batch.
+    """
+
+    stamps: np.ndarray
+    pose: np.ndarray
+    wrenches: np.ndarray
+    health: list[HealthReport] = field(default_factory=list)
+
+    def __len__(self) -> int:
+        return int(self.stamps.shape[0])

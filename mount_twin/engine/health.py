@@ -1,0 +1,120 @@
+"""Health of the running twin over a diagnostics period: input, integration, attitude."""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+
+import numpy as np
+
+from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus
+from mount_twin.scene.description import Scene
+
+PREFIX = "mount_twin"
+
+
+def tilt_from_quaternions(quat: np.ndarray) -> np.ndarray:
+    """Tilt θ of body z from the vertical of F, rad, for (k, 4) quaternions (x, y, z, w)."""
+    r33 = 1.0 - 2.0 * (quat[:, 0] ** 2 + quat[:, 1] ** 2)
+    return np.arccos(np.clip(r33, -1.0, 1.0))
+
+
+class HealthWindow:
+    """Accumulates figures between diagnostics and builds the reports when one is due."""
+
+    def __init__(self, scene: Scene, method: str) -> None:
+        self.scene = scene
+        self.method = method
+        self.period = scene.outputs.diagnostics_period_s
+        self._next_due: float | None = None
+        self._reset()
+        self._last_counts: Counter[str] = Counter()
+
+    def _reset(self) -> None:
+        self.t_first = math.nan
+        self.t_last = math.nan
+        self.wall = 0.0
+        self.err_max = 0.0
+        self.substeps = 0
+        self.samples = 0
+        self.tilt_max = 0.0
+        self.failures: list[tuple[float, str]] = []
+
+    def add_steps(self, step_log: np.ndarray) -> None:
+        """Per-sample stepper figures: (error norm, accepted, rejected substeps)."""
+        if step_log.shape[0]:
+            self.err_max = max(self.err_max, float(step_log[:, 0].max()))
+            self.substeps += int(step_log[:, 1].sum() + step_log[:, 2].sum())
+            self.samples += step_log.shape[0]
+
+    def add_outputs(self, stamps: np.ndarray, pose: np.ndarray) -> None:
+        """Published rows: their stamps (s) and poses."""
+        if stamps.shape[0] == 0:
+            return
+        if math.isnan(self.t_first):
+            self.t_first = float(stamps[0])
+        self.t_last = float(stamps[-1])
+        self.tilt_max = max(self.tilt_max, float(tilt_from_quaternions(pose[:, 3:7]).max()))
+        if self._next_due is None:
+            self._next_due = float(stamps[0]) + self.period
+
+    def failure(self, stamp: float, text: str) -> None:
+        """A stepper failure at `stamp` (s)."""
+        self.failures.append((stamp, text))
+
+    def due(self, wall_s: float, counts: Counter[str]) -> list[HealthReport]:
+        """Reports due after a batch that took `wall_s` of wall time (at most one per batch)."""
+        self.wall += wall_s
+        if self._next_due is None or math.isnan(self.t_last) or self.t_last < self._next_due:
+            return []
+        report = self.report(counts)
+        self._next_due = self.t_last + self.period
+        self._reset()
+        return [report]
+
+    def report(self, counts: Counter[str]) -> HealthReport:
+        """Statuses for the window so far (cumulative counts plus this window's figures)."""
+        new = counts - self._last_counts
+        self._last_counts = counts.copy()
+        span = self.t_last - self.t_first
+        rejected = {k: v for k, v in counts.items() if k.startswith("rejected_")}
+        new_rejected = sum(v for k, v in new.items() if k.startswith("rejected_"))
+        inp = HealthStatus(
+            f"{PREFIX}: input",
+            WARN if new_rejected or new["gaps"] else OK,
+            f"{new_rejected} samples rejected, {new['gaps']} gaps in this period"
+            if new_rejected or new["gaps"] else "ok",
+            {
+                "topic": self.scene.input.topic,
+                "rate_hz": f"{new['accepted'] / span:.1f}" if span > 0 else "n/a",
+                **{k: str(counts[k]) for k in ("received", "accepted", "gaps", "restarts")},
+                **{k: str(v) for k, v in sorted(rejected.items())},
+                "reset_stamp_jumped_back": str(counts["reset_stamp_jumped_back"]),
+            },
+        )
+        integ = self.scene.integration
+        rtf = span / self.wall if self.wall > 0 and span > 0 else math.nan
+        fail_text = "; ".join(f"{t:.6f} s: {m}" for t, m in self.failures)
+        step = HealthStatus(
+            f"{PREFIX}: integration",
+            ERROR if self.failures else OK,
+            f"stepper failed and the twin restarted: {fail_text}" if self.failures else "ok",
+            {
+                "method": self.method,
+                "rtol": f"{integ.rtol:g}",
+                "atol": f"{integ.atol:g}",
+                "error_norm_max": f"{self.err_max:.3g}",
+                "substeps_per_sample": f"{self.substeps / self.samples:.2f}" if self.samples else "n/a",
+                "real_time_factor": f"{rtf:.1f}",
+                "failures_total": str(counts["integration_failures"]),
+            },
+        )
+        warn = self.scene.outputs.tilt_warn_rad
+        att = HealthStatus(
+            f"{PREFIX}: attitude",
+            WARN if self.tilt_max > warn else OK,
+            f"tilt {math.degrees(self.tilt_max):.1f}° past {math.degrees(warn):.1f}°: the α/γ/δ "
+            "chart degrades toward 90°" if self.tilt_max > warn else "ok",
+            {"tilt_max_rad": f"{self.tilt_max:.6g}"},
+        )
+        return HealthReport(self.t_last, [inp, step, att])

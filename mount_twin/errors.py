@@ -1,0 +1,22 @@
+"""Errors raised by mount_twin; each message names the file, key path or message at fault."""
+
+
+class MountTwinError(Exception):
+    """Base class of every error mount_twin raises on purpose."""
+
+
+class SceneError(MountTwinError):
+    """A scene or parameter set is invalid; the message names the source and key path."""
+
+    def __init__(self, source: str, path: str, msg: str) -> None:
+        self.source = source
+        self.path = path
+        super().__init__(f"{source}: {path}: {msg}")
+
+
+class ModelError(MountTwinError):
+    """The assembled model cannot be used (e.g. no static equilibrium exists)."""
+
+
+class BagError(MountTwinError):
+    """A bag cannot be read or written, or lacks the configured input topic."""

@@ -1,0 +1,113 @@
+"""Dormand–Prince 5(4) with error control, advancing across one input-sample interval.
+
+The method is its coefficient table and one free compiled function (scipy `integrate/_ivp`
+shape). It calls the model's right-hand side `dynamics.rhs` directly: a compiled function passed
+as an argument would make it and every caller uncacheable. The state advances with the 5th-order solution; the
+embedded 4th-order one estimates the local error. Error norm: RMS of err / (atol + rtol·|y|).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from mount_twin.physics.dynamics import rhs
+
+C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0, 1.0])
+A = np.array(
+    [
+        [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [1 / 5, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [3 / 40, 9 / 40, 0.0, 0.0, 0.0, 0.0],
+        [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0, 0.0],
+        [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0, 0.0],
+        [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0.0],
+        [35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84],
+    ]
+)
+B = A[6].copy()
+E = np.array([71 / 57600, 0.0, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40])
+"""5th-order weights minus the embedded 4th-order weights (the last stage is FSAL)."""
+ORDER = 4
+SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
+OFF_CHART_SHRINK = 0.25
+MIN_STEP_FRACTION = 1e-12
+"""A step shorter than this fraction of the interval is a failure."""
+
+SUCCESS, TOO_MANY_STEPS, STEP_TOO_SMALL, LEFT_CHART = 0, 1, 2, 3
+
+
+@njit(cache=True)
+def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:  # noqa: ANN001
+    """Advance y (in place) from t0 to t1 s with input u held over the interval.
+
+    The signature is every stepper's: (y, t0, t1, settings, model arrays, scratch, input,
+    2-D work, 1-D work, result).
+
+    Args:
+        settings: [first trial step s (0: the whole interval; updated to the next proposal),
+            rtol, atol, most substeps].
+        k: (7, n) stage work array; y_new: (n,) work array.
+        result: out (3,): largest accepted error norm, accepted and rejected step counts.
+
+    Returns:
+        SUCCESS, TOO_MANY_STEPS, STEP_TOO_SMALL, or LEFT_CHART (the steps shrank because the
+        right-hand side kept failing); y is left at the last accepted time on failure.
+    """
+    h, rtol, atol, max_steps = settings[0], settings[1], settings[2], settings[3]
+    n = y.shape[0]
+    span = t1 - t0
+    h = span if h <= 0.0 else h
+    t = t0
+    err_max, n_acc, n_rej = 0.0, 0, 0
+    rhs_failed = rhs(t, y, m, s, u, k[0]) != 0
+    while t < t1:
+        if n_acc + n_rej >= max_steps:
+            settings[0], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
+            return TOO_MANY_STEPS
+        if h < MIN_STEP_FRACTION * span or (rhs_failed and n_acc == 0 and t == t0):
+            settings[0], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
+            return LEFT_CHART if rhs_failed else STEP_TOO_SMALL
+        last = t + h >= t1 - 1e-12 * span
+        step = t1 - t if last else h
+        ok = True
+        for stage in range(1, 7):
+            for i in range(n):
+                acc = y[i]
+                for j in range(stage):
+                    acc += step * A[stage, j] * k[j, i]
+                y_new[i] = acc
+            if rhs(t + C[stage] * step, y_new, m, s, u, k[stage]) != 0:
+                ok = False
+                break
+        rhs_failed = not ok
+        if rhs_failed:
+            h = step * OFF_CHART_SHRINK
+            n_rej += 1
+            continue
+        # y_new holds the 5th-order solution (the last stage row equals B).
+        err = 0.0
+        for i in range(n):
+            e = 0.0
+            for j in range(7):
+                e += E[j] * k[j, i]
+            scale = atol + rtol * max(abs(y[i]), abs(y_new[i]))
+            err += (step * e / scale) ** 2
+        err = math.sqrt(err / n)
+        factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err ** (-1.0 / (ORDER + 1))))
+        if err <= 1.0:
+            t = t1 if last else t + step
+            for i in range(n):
+                y[i] = y_new[i]
+                k[0, i] = k[6, i]
+            err_max = max(err_max, err)
+            n_acc += 1
+            # keep the proposal from a full step, not from a last step clipped to the interval
+            h = step * factor if (not last or step >= h) else h
+        else:
+            h = step * min(1.0, factor)
+            n_rej += 1
+    settings[0], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
+    return SUCCESS

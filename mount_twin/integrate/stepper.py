@@ -1,0 +1,81 @@
+"""Steppers behind one interface: advance the state across one input interval.
+
+A stepper is a compiled free function with the uniform signature of `dopri54.advance` plus this
+small holder of its settings and work arrays (scipy `integrate/_ivp` shape). Numerical failure is
+returned as a status; misuse raises. `advance` below switches on the method id: compiled
+functions passed as arguments would make every caller uncacheable (numba would recompile them in
+each process, seconds each), so a new stepper adds a branch here and a factory in `STEPPERS`,
+and the engine is untouched.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+
+from mount_twin.integrate import dopri54
+from mount_twin.physics.dynamics import ModelArrays, Scratch
+
+DOPRI54 = 0
+
+STATUS_TEXT = {
+    dopri54.SUCCESS: "ok",
+    dopri54.TOO_MANY_STEPS: "too many substeps in one input interval",
+    dopri54.STEP_TOO_SMALL: "step size underflow",
+    dopri54.LEFT_CHART: "attitude left the α/γ/δ chart (tilt reached 90°)",
+    -1: "unknown stepper",
+}
+
+
+@dataclass
+class Stepper:
+    """A compiled stepper with its settings and work arrays for one state length.
+
+    Attributes:
+        name: scene name of the method.
+        method: its id for `advance`.
+        settings: [step proposal s, rtol, atol, most substeps per interval].
+        work2d, work1d: the method's work arrays.
+        result: last advance's [largest accepted error norm, accepted, rejected substeps].
+    """
+
+    name: str
+    method: int
+    settings: np.ndarray
+    work2d: np.ndarray
+    work1d: np.ndarray
+    result: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+    def reset(self) -> None:
+        """Forget the step-size history (after a restart of the state)."""
+        self.settings[0] = 0.0
+
+
+def dormand_prince(n: int, rtol: float, atol: float, max_substeps: int) -> Stepper:
+    """Adaptive explicit Runge–Kutta 5(4) for non-stiff scenes (rubber mounts).
+
+    atol is in the state's units (m, rad, m/s, rad/s).
+    """
+    if n <= 0 or not rtol > 0.0 or not atol > 0.0 or max_substeps < 1:
+        msg = f"bad stepper settings: n={n}, rtol={rtol}, atol={atol}, max={max_substeps}"
+        raise ValueError(msg)
+    settings = np.array([0.0, rtol, atol, float(max_substeps)])
+    return Stepper("dopri54", DOPRI54, settings, np.zeros((7, n)), np.zeros(n))
+
+
+@njit(cache=True)
+def advance(
+    method: int, y: np.ndarray, t0: float, t1: float, settings: np.ndarray, m: ModelArrays,
+    s: Scratch, u: np.ndarray, work2d: np.ndarray, work1d: np.ndarray, result: np.ndarray,
+) -> int:
+    """Advance y from t0 to t1 (s) with the stepper `method`; returns its status (0 = success)."""
+    if method == DOPRI54:
+        return dopri54.advance(y, t0, t1, settings, m, s, u, work2d, work1d, result)
+    return -1
+
+
+STEPPERS: dict[str, Callable[[int, float, float, int], Stepper]] = {"dopri54": dormand_prince}
+"""Stepper factories by scene name (integration.method)."""

@@ -1,0 +1,122 @@
+"""Rosbag2 input (mcap or sqlite3, any rosbags can read) and mcap output."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from types import TracebackType
+
+from rosbags.highlevel import AnyReader
+from rosbags.rosbag2 import StoragePlugin, Writer
+
+from mount_twin.errors import BagError
+from mount_twin.io.messages import TYPESTORE
+
+
+class InputBag:
+    """The input topic of a bag, read in chunks of raw CDR messages.
+
+    Args:
+        path: bag directory (or file rosbags accepts).
+        topic: input topic.
+        msgtype: expected message type; a different one is an error naming both.
+    """
+
+    def __init__(self, path: str | Path, topic: str, msgtype: str) -> None:
+        self.path = Path(path)
+        self.topic = topic
+        self.msgtype = msgtype
+        try:
+            self._reader = AnyReader([self.path], default_typestore=TYPESTORE)
+            self._reader.open()
+        except Exception as err:
+            msg = f"{self.path}: cannot open bag: {err}"
+            raise BagError(msg) from err
+        conns = [c for c in self._reader.connections if c.topic == topic]
+        if not conns:
+            self._reader.close()
+            have = ", ".join(sorted({f"{c.topic} ({c.msgtype})" for c in self._reader.connections}))
+            msg = f"{self.path}: no topic {topic!r} (input.topic); the bag has: {have}"
+            raise BagError(msg)
+        wrong = [c.msgtype for c in conns if c.msgtype != msgtype]
+        if wrong:
+            self._reader.close()
+            msg = f"{self.path}: topic {topic!r} has type {wrong[0]}, input.msg_type says {msgtype}"
+            raise BagError(msg)
+        self._conns = conns
+        self.count = sum(c.msgcount for c in conns)
+
+    def chunks(self, size: int) -> Iterator[list[bytes]]:
+        """Raw messages of the topic in log-time order, `size` at a time."""
+        chunk: list[bytes] = []
+        for _, _, raw in self._reader.messages(connections=self._conns):
+            chunk.append(raw)
+            if len(chunk) == size:
+                yield chunk
+                chunk = []
+        if chunk:
+            yield chunk
+
+    def close(self) -> None:
+        """Close the bag."""
+        self._reader.close()
+
+    def __enter__(self) -> InputBag:
+        return self
+
+    def __exit__(
+        self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        self.close()
+
+
+class OutputBag:
+    """An mcap bag written topic by topic; log time = the message's stamp.
+
+    Args:
+        path: new bag directory (must not exist: rosbags refuses to overwrite).
+        topics: resolved topic → message type.
+    """
+
+    def __init__(self, path: str | Path, topics: dict[str, str]) -> None:
+        self.path = Path(path)
+        if self.path.exists():
+            msg = f"{self.path}: output bag exists; choose another path or remove it"
+            raise BagError(msg)
+        self._writer = Writer(self.path, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP)
+        self._writer.open()
+        self._conns = {
+            topic: self._writer.add_connection(topic, msgtype, typestore=TYPESTORE)
+            for topic, msgtype in topics.items()
+        }
+        self.written = 0
+
+    def write(self, topic: str, stamp_ns: int, raw: bytes | memoryview) -> None:
+        """Write one serialized message."""
+        self._writer.write(self._conns[topic], stamp_ns, raw)
+        self.written += 1
+
+    def close(self) -> None:
+        """Finish the bag (writes its metadata)."""
+        self._writer.close()
+
+    def __enter__(self) -> OutputBag:
+        return self
+
+    def __exit__(
+        self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        self.close()
+
+
+def write_bag(path: str | Path, topic: str, msgtype: str, messages: Iterator[tuple[int, bytes]],
+              storage: str = "mcap") -> int:
+    """Write one topic's (stamp ns, CDR bytes) messages into a new bag; return the count."""
+    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+    n = 0
+    with Writer(Path(path), version=Writer.VERSION_LATEST, storage_plugin=plugin) as writer:
+        conn = writer.add_connection(topic, msgtype, typestore=TYPESTORE)
+        for stamp, raw in messages:
+            writer.write(conn, stamp, raw)
+            n += 1
+    return n

@@ -1,0 +1,73 @@
+"""Foundation-motion signals for bundled bags and benchmarks, as an IMU at the origin of F sees
+them: specific force (m/s², gravity included: +g up at rest) and angular velocity (rad/s)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Signal:
+    """Samples: t (n,) s from 0; accel (n, 3) specific force, m/s²; gyro (n, 3) rad/s."""
+
+    t: np.ndarray
+    accel: np.ndarray
+    gyro: np.ndarray
+
+
+def half_sine_shock(
+    peak: float = 150.0, duration: float = 0.008, rate_hz: float = 10000.0,
+    pre: float = 0.05, total: float = 0.4, g: float = 9.80665,
+) -> Signal:
+    """Vertical half-sine deck acceleration a(t) = peak·sin(π(t − pre)/duration) during the pulse.
+
+    Args:
+        peak: m/s² (150 ≈ 15 g); duration: pulse length, s; rate_hz: sampling rate;
+        pre: rest before the pulse, s; total: record length, s; g: m/s².
+    """
+    t = np.arange(round(total * rate_hz)) / rate_hz
+    tau = t - pre
+    a = np.where((tau >= 0.0) & (tau <= duration), peak * np.sin(math.pi * tau / duration), 0.0)
+    accel = np.zeros((t.size, 3))
+    accel[:, 2] = g + a
+    return Signal(t, accel, np.zeros((t.size, 3)))
+
+
+def ship_motion(
+    rate_hz: float = 1000.0, total: float = 5.0, roll_amp: float = 0.09, roll_period: float = 8.0,
+    heave_amp: float = 0.5, heave_period: float = 6.0, vib_amp: float = 0.8, vib_hz: float = 23.0,
+    g: float = 9.80665,
+) -> Signal:
+    """Rolling, heaving deck with hull vibration, sensed at the roll axis (origin of F).
+
+    Roll φ = roll_amp·sin(2πt/roll_period) rad about x of F; heave z = heave_amp·sin(2πt/heave_period)
+    m in the earth frame; vertical vibration vib_amp·sin(2π·vib_hz·t) m/s² along z of F.
+    """
+    t = np.arange(round(total * rate_hz)) / rate_hz
+    wr, wh, wv = 2 * math.pi / roll_period, 2 * math.pi / heave_period, 2 * math.pi * vib_hz
+    phi = roll_amp * np.sin(wr * t)
+    phi_dot = roll_amp * wr * np.cos(wr * t)
+    heave_acc = -heave_amp * wh**2 * np.sin(wh * t)
+    up = g + heave_acc  # earth-vertical specific force
+    accel = np.zeros((t.size, 3))
+    # Earth vertical seen from F rolled by φ about x: (0, sin φ, cos φ).
+    accel[:, 1] = up * np.sin(phi)
+    accel[:, 2] = up * np.cos(phi) + vib_amp * np.sin(wv * t)
+    gyro = np.zeros((t.size, 3))
+    gyro[:, 0] = phi_dot
+    return Signal(t, accel, gyro)
+
+
+def read_csv(path: str) -> Signal:
+    """A CSV with header t,ax,ay,az,wx,wy,wz (s, m/s², rad/s); t kept as given."""
+    with open(path, encoding="utf-8") as fh:
+        header = fh.readline().strip().split(",")
+    expected = ["t", "ax", "ay", "az", "wx", "wy", "wz"]
+    if header != expected:
+        msg = f"{path}: header is {','.join(header)}; expected {','.join(expected)}"
+        raise ValueError(msg)
+    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    return Signal(data[:, 0], data[:, 1:4], data[:, 4:7])

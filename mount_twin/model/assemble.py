@@ -1,0 +1,131 @@
+"""Assemble a Scene into the flat arrays the compiled kernels read, and find its start state."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from mount_twin.errors import ModelError
+from mount_twin.physics.dynamics import INPUT_SIZE, OK, ModelArrays, Scratch, new_scratch, rhs
+from mount_twin.physics.rotations import rpy_matrix
+from mount_twin.scene.description import DOF_NAMES, Scene
+
+
+@dataclass(frozen=True)
+class Model:
+    """A scene ready to integrate.
+
+    Attributes:
+        scene: the description it was built from.
+        arrays: kernel arrays.
+        state_names: name of each state entry (q of free DOFs, then their rates).
+        sensor_rotation: 3×3 rotation of the input sensor frame into F.
+    """
+
+    scene: Scene
+    arrays: ModelArrays
+    state_names: tuple[str, ...]
+    sensor_rotation: np.ndarray
+
+    @property
+    def n_state(self) -> int:
+        """Length of the state vector."""
+        return len(self.state_names)
+
+    @property
+    def n_mounts(self) -> int:
+        """Number of mounts."""
+        return len(self.scene.mounts)
+
+    def new_scratch(self) -> Scratch:
+        """Work arrays for the kernels."""
+        return new_scratch()
+
+
+def assemble(scene: Scene) -> Model:
+    """Build the kernel arrays of `scene` (done once, at load)."""
+    body = scene.body
+    ixx, iyy, izz, ixy, ixz, iyz = body.inertia
+    inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+    cg = np.array(body.cg)
+    mounts = scene.mounts
+    axes = np.array([rpy_matrix(*mt.orientation_rpy) for mt in mounts]).reshape(-1, 3, 3)
+
+    def in_f(values: np.ndarray) -> np.ndarray:
+        # Q·diag(values)·Qᵀ per mount: the diagonal local law expressed in F.
+        return np.einsum("nij,nj,nkj->nik", axes, values, axes)
+
+    stiffness = np.array([mt.stiffness for mt in mounts]).reshape(-1, 6)
+    damping = np.array([mt.damping for mt in mounts]).reshape(-1, 6)
+    free = [DOF_NAMES.index(d) for d in scene.dofs]
+    arrays = ModelArrays(
+        mass=float(body.mass),
+        inertia=inertia,
+        cg_ref=cg,
+        sensor_position=np.array(scene.input.sensor_position),
+        free_trans=np.array([i for i in free if i < 3], dtype=np.int64),
+        free_rot=np.array([i - 3 for i in free if i >= 3], dtype=np.int64),
+        q_fixed=np.array(scene.initial.pose, dtype=float),
+        lin_point=np.array([mt.position for mt in mounts]).reshape(-1, 3) - cg,
+        lin_axes=axes,
+        lin_k_t=in_f(stiffness[:, :3]),
+        lin_c_t=in_f(damping[:, :3]),
+        lin_k_r=in_f(stiffness[:, 3:]),
+        lin_c_r=in_f(damping[:, 3:]),
+    )
+    names = tuple(scene.dofs) + tuple(f"{d}_dot" for d in scene.dofs)
+    return Model(scene, arrays, names, rpy_matrix(*scene.input.sensor_rpy))
+
+
+def gravity_input(t0: float, specific_force: np.ndarray) -> np.ndarray:
+    """Input vector u of a foundation at rest with the given specific force (m/s², F)."""
+    u = np.zeros(INPUT_SIZE)
+    u[0] = t0
+    u[1:4] = specific_force
+    return u
+
+
+def initial_state(model: Model, specific_force: np.ndarray) -> np.ndarray:
+    """Start state: the scene's given pose and velocity, or static equilibrium.
+
+    In equilibrium mode the free coordinates are those where all generalized accelerations vanish
+    with the foundation at rest under `specific_force` (m/s², F; +g·z for gravity).
+    """
+    scene = model.scene
+    nf = len(scene.dofs)
+    idx = [DOF_NAMES.index(d) for d in scene.dofs]
+    y0 = np.concatenate(
+        [np.array(scene.initial.pose)[idx], np.array(scene.initial.velocity)[idx]]
+    )
+    if scene.initial.mode == "given":
+        return y0
+    return static_equilibrium(model, y0[:nf], specific_force)
+
+
+def static_equilibrium(model: Model, q_guess: np.ndarray, specific_force: np.ndarray) -> np.ndarray:
+    """State at rest where the free generalized accelerations vanish (least squares on them)."""
+    nf = q_guess.shape[0]
+    m, s = model.arrays, model.new_scratch()
+    u = gravity_input(0.0, specific_force)
+    y = np.zeros(2 * nf)
+    dydt = np.zeros(2 * nf)
+
+    def accelerations(q: np.ndarray) -> np.ndarray:
+        y[:nf] = q
+        if rhs(0.0, y, m, s, u, dydt) != OK:
+            return np.full(nf, 1e6)
+        return dydt[nf:].copy()
+
+    sol = least_squares(accelerations, q_guess, xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    residual = np.max(np.abs(sol.fun))
+    g = float(np.linalg.norm(specific_force))
+    if residual > 1e-9 * max(g, 1.0):
+        msg = (
+            f"{model.scene.source}: no static equilibrium found (residual {residual:.3g} m/s² "
+            "or rad/s²): check that the mounts hold every free DOF"
+        )
+        raise ModelError(msg)
+    y[:nf] = sol.x
+    return y.copy()

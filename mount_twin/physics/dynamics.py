@@ -1,0 +1,337 @@
+"""Equations of motion on the free generalized coordinates, in the moving foundation frame F.
+
+State y = [q_f, q_f'] where q_f is the free subset of q = (X, Y, Z, α, γ, δ) (m, rad) in the
+order of `DOF_NAMES`; frozen coordinates keep the values in `ModelArrays.q_fixed`. The CG velocity
+is r' = (X', Y', Z') and the body angular velocity relative to F is ω = B(α, γ)·(α', γ', δ'), both
+linear in q'. Projecting Newton–Euler on q_f (Kane's method) gives, exactly for any subset,
+
+    translation:  q_t'' = F/m − f_s − [2Ω×r' + Ω'×(r − s) + Ω×(Ω×(r − s))]   (physics notes §6)
+    rotation:     (Jᵀ I J) q_r'' = Jᵀ [M − ω_a × I ω_a − I(B' q_r' − ω×Ωᴮ + RᵀΩ')],  J = B[:, free]
+
+with f_s the specific force at sensor point s, Ω the foundation angular velocity (in F),
+Ωᴮ = RᵀΩ, ω_a = ω + Ωᴮ the absolute angular velocity and M the mount moment about the CG (in B).
+
+Input over one sample interval is u = [t0, f0, ḟ, Ω0, Ω̇] (13 floats): f(t) = f0 + ḟ·(t − t0) and
+Ω(t) = Ω0 + Ω̇·(t − t0); a zero-order hold passes zero slopes.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from mount_twin.physics.chart import kinematic_matrix, kinematic_matrix_rate, rotation_from_chart
+from mount_twin.physics.linear_mount import linear_mount_load
+from mount_twin.physics.rotations import rotation_vector
+
+OK = 0
+OFF_CHART = 1
+"""Right-hand-side status: the attitude left the chart (cos θ ≤ 0)."""
+
+INPUT_SIZE = 13
+
+
+class ModelArrays(NamedTuple):
+    """Flat arrays of an assembled scene, as the compiled kernels read them (SI, frames as named).
+
+    Each mount kind owns a group of arrays with its prefix; a scene without that kind has
+    zero-length arrays there, so the kernels' loops over it do nothing.
+    """
+
+    mass: float  # kg
+    inertia: np.ndarray  # (3, 3) kg·m², about the CG, in B
+    cg_ref: np.ndarray  # (3,) m, CG at the reference pose, in F
+    sensor_position: np.ndarray  # (3,) m, in F
+    free_trans: np.ndarray  # int64 (nt,): free indices among X, Y, Z
+    free_rot: np.ndarray  # int64 (nr,): free indices among α, γ, δ
+    q_fixed: np.ndarray  # (6,) values of the frozen coordinates (free ones overwritten)
+    lin_point: np.ndarray  # (n, 3) m, attachment point from the CG, in B
+    lin_axes: np.ndarray  # (n, 3, 3) mount axes Q (columns) in F
+    lin_k_t: np.ndarray  # (n, 3, 3) N/m in F
+    lin_c_t: np.ndarray  # (n, 3, 3) N·s/m in F
+    lin_k_r: np.ndarray  # (n, 3, 3) N·m/rad in F
+    lin_c_r: np.ndarray  # (n, 3, 3) N·m·s/rad in F
+
+
+class Scratch(NamedTuple):
+    """Preallocated work arrays, so the kernels allocate nothing per call."""
+
+    q: np.ndarray  # (6,)
+    trig: np.ndarray  # (6,) sin α, sin γ, sin δ, cos α, cos γ, cos δ
+    qd: np.ndarray  # (6,)
+    rot: np.ndarray  # (3, 3)
+    kin: np.ndarray  # (3, 3) B
+    kin_rate: np.ndarray  # (3, 3) dB/dt
+    omega: np.ndarray  # (3,) ω in B
+    omega_f: np.ndarray  # (3,) R·ω in F
+    phi: np.ndarray  # (3,)
+    quat: np.ndarray  # (4,)
+    arm: np.ndarray  # (3,)
+    force: np.ndarray  # (3,)
+    couple: np.ndarray  # (3,)
+    total_force: np.ndarray  # (3,) N, in F
+    total_moment: np.ndarray  # (3,) N·m about the CG, in F
+    f_s: np.ndarray  # (3,) specific force at the sensor, F
+    big_w: np.ndarray  # (3,) foundation angular velocity Ω, F
+    big_w_dot: np.ndarray  # (3,) Ω', F
+    rel: np.ndarray  # (3,) r − s, F
+    w_x_rel: np.ndarray  # (3,) Ω × (r − s), F
+    moment_b: np.ndarray  # (3,) mount moment, B
+    w_b: np.ndarray  # (3,) Ωᴮ = RᵀΩ
+    w_dot_b: np.ndarray  # (3,) RᵀΩ'
+    acc: np.ndarray  # (3,) ω_a' − B q''
+    w_abs: np.ndarray  # (3,) ω_a, B
+    h: np.ndarray  # (3,) projected moment residual, B
+    i_w: np.ndarray  # (3,) I·ω_a, B
+    mass_rot: np.ndarray  # (3, 3) reduced rotational mass matrix
+    rhs_rot: np.ndarray  # (3,)
+
+
+def new_scratch() -> Scratch:
+    """Fresh work arrays for one model."""
+    return Scratch(
+        q=np.zeros(6),
+        trig=np.zeros(6),
+        qd=np.zeros(6),
+        rot=np.eye(3),
+        kin=np.zeros((3, 3)),
+        kin_rate=np.zeros((3, 3)),
+        omega=np.zeros(3),
+        omega_f=np.zeros(3),
+        phi=np.zeros(3),
+        quat=np.zeros(4),
+        arm=np.zeros(3),
+        force=np.zeros(3),
+        couple=np.zeros(3),
+        total_force=np.zeros(3),
+        total_moment=np.zeros(3),
+        f_s=np.zeros(3),
+        big_w=np.zeros(3),
+        big_w_dot=np.zeros(3),
+        rel=np.zeros(3),
+        w_x_rel=np.zeros(3),
+        moment_b=np.zeros(3),
+        w_b=np.zeros(3),
+        w_dot_b=np.zeros(3),
+        acc=np.zeros(3),
+        w_abs=np.zeros(3),
+        h=np.zeros(3),
+        i_w=np.zeros(3),
+        mass_rot=np.zeros((3, 3)),
+        rhs_rot=np.zeros(3),
+    )
+
+
+@njit(cache=True, inline="always")
+def body_motion(y: np.ndarray, m: ModelArrays, s: Scratch) -> float:
+    """Fill s.q, s.qd, s.trig, s.rot, s.kin, s.omega, s.omega_f, s.phi from y.
+
+    Returns cos θ (NaN off the chart). Kernels bind scratch arrays to locals once: every
+    attribute access on a tuple of arrays costs a reference-count round trip in numba.
+    """
+    q, qd, trig, rot, kin, omega, omega_f = s.q, s.qd, s.trig, s.rot, s.kin, s.omega, s.omega_f
+    free_trans, free_rot, q_fixed = m.free_trans, m.free_rot, m.q_fixed
+    nt, nr = free_trans.shape[0], free_rot.shape[0]
+    nf = nt + nr
+    for i in range(6):  # explicit loops: numba's slice assignment costs ~100 ns each
+        q[i] = q_fixed[i]
+        qd[i] = 0.0
+    for k in range(nt):
+        q[free_trans[k]] = y[k]
+        qd[free_trans[k]] = y[nf + k]
+    for k in range(nr):
+        q[3 + free_rot[k]] = y[nt + k]
+        qd[3 + free_rot[k]] = y[nf + nt + k]
+    for i in range(3):
+        trig[i] = math.sin(q[3 + i])
+        trig[3 + i] = math.cos(q[3 + i])
+    sa, sg, sd, ca, cg, cd = trig[0], trig[1], trig[2], trig[3], trig[4], trig[5]
+    ct = rotation_from_chart(sa, sg, cg, sd, cd, rot)
+    if not ct > 0.0:
+        return math.nan
+    kinematic_matrix(sa, ca, sg, cg, ct, kin)
+    for i in range(3):
+        omega[i] = kin[i, 0] * qd[3] + kin[i, 1] * qd[4] + kin[i, 2] * qd[5]
+    for i in range(3):
+        omega_f[i] = rot[i, 0] * omega[0] + rot[i, 1] * omega[1] + rot[i, 2] * omega[2]
+    rotation_vector(rot, s.quat, s.phi)
+    return ct
+
+
+@njit(cache=True, inline="always")
+def mount_loads(m: ModelArrays, s: Scratch) -> None:
+    """Sum the mount loads on the body into s.total_force and s.total_moment (F, about the CG)."""
+    total_f, total_m = s.total_force, s.total_moment
+    arm, f, c = s.arm, s.force, s.couple
+    rot, q, qd, omega_f, phi = s.rot, s.q, s.qd, s.omega_f, s.phi
+    point, k_t, c_t, k_r, c_r = m.lin_point, m.lin_k_t, m.lin_c_t, m.lin_k_r, m.lin_c_r
+    for j in range(3):
+        total_f[j] = 0.0
+        total_m[j] = 0.0
+    for i in range(point.shape[0]):
+        linear_mount_load(i, point, k_t, c_t, k_r, c_r, rot, q, qd, omega_f, phi, arm, f, c)
+        total_f[0] += f[0]
+        total_f[1] += f[1]
+        total_f[2] += f[2]
+        total_m[0] += arm[1] * f[2] - arm[2] * f[1] + c[0]
+        total_m[1] += arm[2] * f[0] - arm[0] * f[2] + c[1]
+        total_m[2] += arm[0] * f[1] - arm[1] * f[0] + c[2]
+
+
+@njit(cache=True)
+def mount_wrenches(m: ModelArrays, s: Scratch, wrenches: np.ndarray) -> None:
+    """Each mount's force (N) and own couple (N·m) on the body in its axes: wrenches[i] = (F, M)."""
+    arm, f, c = s.arm, s.force, s.couple
+    rot, q, qd, omega_f, phi = s.rot, s.q, s.qd, s.omega_f, s.phi
+    point, k_t, c_t, k_r, c_r = m.lin_point, m.lin_k_t, m.lin_c_t, m.lin_k_r, m.lin_c_r
+    axes = m.lin_axes
+    for i in range(point.shape[0]):
+        linear_mount_load(i, point, k_t, c_t, k_r, c_r, rot, q, qd, omega_f, phi, arm, f, c)
+        for j in range(3):
+            wrenches[i, j] = axes[i, 0, j] * f[0] + axes[i, 1, j] * f[1] + axes[i, 2, j] * f[2]
+            wrenches[i, 3 + j] = (
+                axes[i, 0, j] * c[0] + axes[i, 1, j] * c[1] + axes[i, 2, j] * c[2]
+            )
+
+
+@njit(cache=True)
+def rhs(t: float, y: np.ndarray, m: ModelArrays, s: Scratch, u: np.ndarray, dydt: np.ndarray) -> int:
+    """dy/dt at time t (s); returns OK or OFF_CHART."""
+    ct = body_motion(y, m, s)
+    if not ct > 0.0:
+        return OFF_CHART
+    mount_loads(m, s)
+    nt, nr = m.free_trans.shape[0], m.free_rot.shape[0]
+    nf = nt + nr
+    for k in range(nf):
+        dydt[k] = y[nf + k]
+    tau = t - u[0]
+    f_s, big_w, big_w_dot = s.f_s, s.big_w, s.big_w_dot
+    for i in range(3):
+        f_s[i] = u[1 + i] + u[4 + i] * tau
+        big_w[i] = u[7 + i] + u[10 + i] * tau
+        big_w_dot[i] = u[10 + i]
+    if nt > 0:
+        _translational(m, s, dydt, nf)
+    if nr > 0:
+        _rotational(m, s, ct, dydt, nf + nt)
+    return OK
+
+
+@njit(cache=True, inline="always")
+def _cross(a: np.ndarray, b: np.ndarray, i: int) -> float:
+    if i == 0:
+        return a[1] * b[2] - a[2] * b[1]
+    if i == 1:
+        return a[2] * b[0] - a[0] * b[2]
+    return a[0] * b[1] - a[1] * b[0]
+
+
+@njit(cache=True, inline="always")
+def _translational(m: ModelArrays, s: Scratch, dydt: np.ndarray, nf: int) -> None:
+    """Free translational accelerations (physics notes §6) into dydt[nf:nf + nt]."""
+    q, qd, f_s, w, w_dot = s.q, s.qd, s.f_s, s.big_w, s.big_w_dot
+    rel, wxr, total_f = s.rel, s.w_x_rel, s.total_force
+    cg_ref, sensor, free_trans = m.cg_ref, m.sensor_position, m.free_trans
+    for i in range(3):
+        rel[i] = cg_ref[i] + q[i] - sensor[i]
+    for i in range(3):
+        wxr[i] = _cross(w, rel, i)
+    inv_mass = 1.0 / m.mass
+    for k in range(free_trans.shape[0]):
+        i = free_trans[k]
+        frame = 2.0 * _cross(w, qd, i) + _cross(w_dot, rel, i) + _cross(w, wxr, i)
+        dydt[nf + k] = total_f[i] * inv_mass - f_s[i] - frame
+
+
+@njit(cache=True, inline="always")
+def _rotational(m: ModelArrays, s: Scratch, ct: float, dydt: np.ndarray, first: int) -> None:
+    """Free rotational accelerations (projected Euler equations) into dydt[first:first + nr]."""
+    rot, kin, kin_rate, qd, omega, trig = s.rot, s.kin, s.kin_rate, s.qd, s.omega, s.trig
+    w, w_dot, total_m = s.big_w, s.big_w_dot, s.total_moment
+    moment_b, w_b, w_dot_b, acc = s.moment_b, s.w_b, s.w_dot_b, s.acc
+    w_abs, h, i_w, mass_rot, rhs_rot = s.w_abs, s.h, s.i_w, s.mass_rot, s.rhs_rot
+    inertia, free_rot = m.inertia, m.free_rot
+    kinematic_matrix_rate(trig[0], trig[3], trig[1], trig[4], ct, qd[3], qd[4], kin_rate)
+    # In B: mount moment, Ωᴮ = RᵀΩ and RᵀΩ'.
+    for i in range(3):
+        moment_b[i] = rot[0, i] * total_m[0] + rot[1, i] * total_m[1] + rot[2, i] * total_m[2]
+        w_b[i] = rot[0, i] * w[0] + rot[1, i] * w[1] + rot[2, i] * w[2]
+        w_dot_b[i] = rot[0, i] * w_dot[0] + rot[1, i] * w_dot[1] + rot[2, i] * w_dot[2]
+    # ω_a' = B q'' + acc, with acc = B'q' − ω × Ωᴮ + RᵀΩ'
+    for i in range(3):
+        bdq = kin_rate[i, 0] * qd[3] + kin_rate[i, 1] * qd[4] + kin_rate[i, 2] * qd[5]
+        acc[i] = bdq - _cross(omega, w_b, i) + w_dot_b[i]
+        w_abs[i] = omega[i] + w_b[i]
+    for i in range(3):
+        i_w[i] = inertia[i, 0] * w_abs[0] + inertia[i, 1] * w_abs[1] + inertia[i, 2] * w_abs[2]
+    for i in range(3):
+        i_acc = inertia[i, 0] * acc[0] + inertia[i, 1] * acc[1] + inertia[i, 2] * acc[2]
+        h[i] = moment_b[i] - _cross(w_abs, i_w, i) - i_acc
+    # Reduced mass matrix Jᵀ I J and right side Jᵀ h, J = the free columns of B.
+    nr = free_rot.shape[0]
+    for a in range(nr):
+        ca = free_rot[a]
+        rhs_rot[a] = kin[0, ca] * h[0] + kin[1, ca] * h[1] + kin[2, ca] * h[2]
+        for b in range(nr):
+            cb = free_rot[b]
+            total = 0.0
+            for i in range(3):
+                for j in range(3):
+                    total += kin[i, ca] * inertia[i, j] * kin[j, cb]
+            mass_rot[a, b] = total
+    _solve_spd(mass_rot, rhs_rot, nr)
+    for a in range(nr):
+        dydt[first + a] = rhs_rot[a]
+
+
+@njit(cache=True, inline="always")
+def _solve_spd(a: np.ndarray, b: np.ndarray, n: int) -> None:
+    """Solve a[:n, :n] x = b[:n] in place (Cholesky; a is symmetric positive definite)."""
+    for j in range(n):
+        d = a[j, j]
+        for k in range(j):
+            d -= a[j, k] ** 2
+        d = math.sqrt(d)
+        a[j, j] = d
+        for i in range(j + 1, n):
+            e = a[i, j]
+            for k in range(j):
+                e -= a[i, k] * a[j, k]
+            a[i, j] = e / d
+    for i in range(n):
+        e = b[i]
+        for k in range(i):
+            e -= a[i, k] * b[k]
+        b[i] = e / a[i, i]
+    for i in range(n - 1, -1, -1):
+        e = b[i]
+        for k in range(i + 1, n):
+            e -= a[k, i] * b[k]
+        b[i] = e / a[i, i]
+
+
+@njit(cache=True)
+def evaluate(
+    y: np.ndarray, m: ModelArrays, s: Scratch, pose: np.ndarray, wrenches: np.ndarray
+) -> float:
+    """Outputs at state y; returns cos θ (NaN off the chart, outputs then untouched).
+
+    Args:
+        pose: out (10,): CG position in F (m), quaternion (x, y, z, w) of R, and (α, γ, δ) rad.
+        wrenches: out (n, 6): each mount's force (N) and couple (N·m) on the body, in its axes.
+    """
+    ct = body_motion(y, m, s)
+    if not ct > 0.0:
+        return math.nan
+    mount_wrenches(m, s, wrenches)
+    q, quat, cg_ref = s.q, s.quat, m.cg_ref
+    for i in range(3):
+        pose[i] = cg_ref[i] + q[i]
+        pose[7 + i] = q[3 + i]
+    for i in range(4):
+        pose[3 + i] = quat[i]
+    return ct

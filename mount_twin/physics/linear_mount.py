@@ -1,0 +1,63 @@
+"""Six-component linear Kelvin–Voigt mount (physics notes §7).
+
+Parameters, per mount i, are pre-rotated at scene load into F: K_t = Q·diag(kx, ky, kz)·Qᵀ,
+C_t, K_r, C_r likewise, with Q the mount axes in F. Deformation is measured from the reference
+pose, where the mount is unstressed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def linear_mount_load(
+    i: int,
+    point: np.ndarray,
+    k_t: np.ndarray,
+    c_t: np.ndarray,
+    k_r: np.ndarray,
+    c_r: np.ndarray,
+    rot: np.ndarray,
+    r: np.ndarray,
+    v: np.ndarray,
+    omega_f: np.ndarray,
+    phi: np.ndarray,
+    arm: np.ndarray,
+    force: np.ndarray,
+    couple: np.ndarray,
+) -> None:
+    """Load of mount i on the body, in F (the arrays hold every mount; indexing them, rather
+    than slicing, keeps this free of array-view bookkeeping on the hot path).
+
+    Args:
+        i: mount index.
+        point: (n, 3) attachment points p from the CG, m, in B.
+        k_t, c_t, k_r, c_r: (n, 3, 3) stiffness (N/m, N·m/rad), damping (N·s/m, N·m·s/rad) in F.
+        rot: R, body attitude relative to F.
+        r, v: (6,) generalized coordinates and rates; r = q[:3] is the CG displacement from the reference pose (m) and its rate (m/s), in F.
+        omega_f: body angular velocity relative to F, expressed in F (R·ω), rad/s.
+        phi: rotation vector of R, rad, in F.
+        arm: out, R·p (m, F), the lever arm of `force` about the CG.
+        force: out, force on the body at the attachment point, N, in F.
+        couple: out, the mount's own couple on the body, N·m, in F.
+    """
+    for j in range(3):
+        arm[j] = rot[j, 0] * point[i, 0] + rot[j, 1] * point[i, 1] + rot[j, 2] * point[i, 2]
+    d0 = r[0] + arm[0] - point[i, 0]
+    d1 = r[1] + arm[1] - point[i, 1]
+    d2 = r[2] + arm[2] - point[i, 2]
+    # ḋ = ṙ + (R ω) × (R p)
+    e0 = v[0] + omega_f[1] * arm[2] - omega_f[2] * arm[1]
+    e1 = v[1] + omega_f[2] * arm[0] - omega_f[0] * arm[2]
+    e2 = v[2] + omega_f[0] * arm[1] - omega_f[1] * arm[0]
+    for j in range(3):
+        force[j] = -(
+            k_t[i, j, 0] * d0 + k_t[i, j, 1] * d1 + k_t[i, j, 2] * d2
+            + c_t[i, j, 0] * e0 + c_t[i, j, 1] * e1 + c_t[i, j, 2] * e2
+        )
+        couple[j] = -(
+            k_r[i, j, 0] * phi[0] + k_r[i, j, 1] * phi[1] + k_r[i, j, 2] * phi[2]
+            + c_r[i, j, 0] * omega_f[0] + c_r[i, j, 1] * omega_f[1] + c_r[i, j, 2] * omega_f[2]
+        )

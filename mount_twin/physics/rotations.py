@@ -1,0 +1,66 @@
+"""Rotation helpers: fixed-axis roll-pitch-yaw, rotation vector, quaternion (x, y, z, w)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+def rpy_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """Rotation Rz(yaw)·Ry(pitch)·Rx(roll), rad (REP-103 fixed-axis roll, pitch, yaw)."""
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+@njit(cache=True)
+def quaternion_from_matrix(rot: np.ndarray, out: np.ndarray) -> None:
+    """Unit quaternion (x, y, z, w), w ≥ 0, of a rotation matrix (Shepperd's method)."""
+    tr = rot[0, 0] + rot[1, 1] + rot[2, 2]
+    if tr > max(rot[0, 0], rot[1, 1], rot[2, 2]):
+        s = 2.0 * math.sqrt(1.0 + tr)
+        out[3] = 0.25 * s
+        out[0] = (rot[2, 1] - rot[1, 2]) / s
+        out[1] = (rot[0, 2] - rot[2, 0]) / s
+        out[2] = (rot[1, 0] - rot[0, 1]) / s
+    elif rot[0, 0] >= rot[1, 1] and rot[0, 0] >= rot[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + rot[0, 0] - rot[1, 1] - rot[2, 2])
+        out[3] = (rot[2, 1] - rot[1, 2]) / s
+        out[0] = 0.25 * s
+        out[1] = (rot[0, 1] + rot[1, 0]) / s
+        out[2] = (rot[0, 2] + rot[2, 0]) / s
+    elif rot[1, 1] >= rot[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + rot[1, 1] - rot[0, 0] - rot[2, 2])
+        out[3] = (rot[0, 2] - rot[2, 0]) / s
+        out[0] = (rot[0, 1] + rot[1, 0]) / s
+        out[1] = 0.25 * s
+        out[2] = (rot[1, 2] + rot[2, 1]) / s
+    else:
+        s = 2.0 * math.sqrt(1.0 + rot[2, 2] - rot[0, 0] - rot[1, 1])
+        out[3] = (rot[1, 0] - rot[0, 1]) / s
+        out[0] = (rot[0, 2] + rot[2, 0]) / s
+        out[1] = (rot[1, 2] + rot[2, 1]) / s
+        out[2] = 0.25 * s
+    if out[3] < 0.0:
+        for i in range(4):
+            out[i] = -out[i]
+
+
+@njit(cache=True)
+def rotation_vector(rot: np.ndarray, quat: np.ndarray, out: np.ndarray) -> None:
+    """Rotation vector (axis × angle, rad) of `rot`; `quat` is scratch of length 4."""
+    quaternion_from_matrix(rot, quat)
+    sin_half = math.sqrt(quat[0] ** 2 + quat[1] ** 2 + quat[2] ** 2)
+    # angle / sin(angle/2), with its limit 2 as the angle goes to zero
+    scale = 2.0 * math.atan2(sin_half, quat[3]) / sin_half if sin_half > 1e-12 else 2.0
+    for i in range(3):
+        out[i] = scale * quat[i]

@@ -1,0 +1,161 @@
+"""Plain, frozen description of a scene: a rigid body on compliant mounts.
+
+Frames (see shared physics notes §1): the foundation frame F (REP-103, z up) and the body frame B
+(origin at the centre of gravity, aligned with F at the reference pose). All positions given in a
+scene are coordinates in F at the reference pose, in metres; angles are radians.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+DOF_NAMES: tuple[str, ...] = ("x", "y", "z", "alpha", "gamma", "delta")
+"""Generalized coordinates: CG displacement X, Y, Z (m, F) and the chart angles α, γ, δ (rad)."""
+
+Vec3 = tuple[float, float, float]
+Vec6 = tuple[float, float, float, float, float, float]
+
+
+@dataclass(frozen=True)
+class Body:
+    """Rigid body.
+
+    Attributes:
+        mass: kg.
+        cg: centre of gravity at the reference pose, m, in F.
+        inertia: tensor elements about the CG in B, kg·m², ordered (Ixx, Iyy, Izz, Ixy, Ixz, Iyz)
+            as in URDF (off-diagonal entries are the tensor's, i.e. minus the products of inertia).
+    """
+
+    mass: float
+    cg: Vec3
+    inertia: Vec6
+
+
+@dataclass(frozen=True)
+class LinearMount:
+    """Six-component Kelvin–Voigt mount (physics notes §7).
+
+    Attributes:
+        name: unique name; also the mount's frame name.
+        position: attachment point, m, in F at the reference pose, where the body point and the
+            foundation point coincide and the mount is unstressed.
+        orientation_rpy: mount axes relative to F as fixed-axis roll, pitch, yaw, rad.
+        stiffness: (kx, ky, kz) N/m and (krx, kry, krz) N·m/rad along the mount axes.
+        damping: (cx, cy, cz) N·s/m and (crx, cry, crz) N·m·s/rad along the mount axes.
+    """
+
+    name: str
+    position: Vec3
+    orientation_rpy: Vec3
+    stiffness: Vec6
+    damping: Vec6
+    kind: str = "linear"
+
+
+Mount = LinearMount
+"""Union of the mount kinds; later kinds join here."""
+
+
+@dataclass(frozen=True)
+class InputSpec:
+    """Foundation motion input.
+
+    Attributes:
+        msg_type: 'sensor_msgs/msg/Imu' or 'geometry_msgs/msg/AccelStamped'.
+        topic: input topic name.
+        frame_id: expected header.frame_id; empty accepts any.
+        sensor_rpy: rotation of the sensor frame into F as fixed-axis roll, pitch, yaw, rad.
+        sensor_position: accelerometer position, m, in F.
+        includes_gravity: True if the acceleration is specific force (Imu: +g up at rest).
+        g: gravity magnitude, m/s², added along +z of F when includes_gravity is False.
+        hold: input between samples, 'first_order' (linear) or 'zero_order'.
+        max_gap_s: a larger stamp gap is a gap, handled per gap_policy.
+        gap_policy: 'reset' (restart at equilibrium) or 'bridge' (integrate across the gap).
+        back_jump_reset_s: a stamp going back by more than this resets the twin (bag --loop);
+            smaller steps back are skipped.
+    """
+
+    msg_type: str = "sensor_msgs/msg/Imu"
+    topic: str = "/imu/data"
+    frame_id: str = ""
+    sensor_rpy: Vec3 = (0.0, 0.0, 0.0)
+    sensor_position: Vec3 = (0.0, 0.0, 0.0)
+    includes_gravity: bool = True
+    g: float = 9.80665
+    hold: str = "first_order"
+    max_gap_s: float = 0.5
+    gap_policy: str = "reset"
+    back_jump_reset_s: float = 1.0
+
+
+@dataclass(frozen=True)
+class InitialState:
+    """Start of a run.
+
+    Attributes:
+        mode: 'equilibrium' (static equilibrium under gravity) or 'given' (pose and velocity).
+        gravity: for 'equilibrium', 'first_sample' (the first measured specific force) or
+            'nominal' (g along +z of F).
+        pose: (X, Y, Z) m and (α, γ, δ) rad, for 'given'; also the values of frozen DOFs.
+        velocity: (X', Y', Z') m/s and (α', γ', δ') rad/s, for 'given'.
+    """
+
+    mode: str = "equilibrium"
+    gravity: str = "first_sample"
+    pose: Vec6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    velocity: Vec6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Integration:
+    """Stepper settings: method name, relative and absolute tolerance, substep limit per sample."""
+
+    method: str = "dopri54"
+    rtol: float = 1.0e-6
+    atol: float = 1.0e-9
+    max_substeps: int = 10000
+
+
+@dataclass(frozen=True)
+class Outputs:
+    """What is published.
+
+    Attributes:
+        pose, angles, wrenches: publish PoseStamped, α/γ/δ Vector3Stamped, per-mount WrenchStamped.
+        decimation: publish every Nth accepted input sample; wrench components hold their peak
+            (largest magnitude, with sign) over the interval.
+        diagnostics_period_s: stamp-time period of DiagnosticArray messages, s.
+        tilt_warn_rad: tilt of body z from vertical past which diagnostics warn.
+    """
+
+    pose: bool = True
+    angles: bool = True
+    wrenches: bool = True
+    decimation: int = 1
+    diagnostics_period_s: float = 1.0
+    tilt_warn_rad: float = 1.3089969389957472  # 75°
+
+
+@dataclass(frozen=True)
+class Frames:
+    """Frame ids written into output headers."""
+
+    foundation: str = "foundation"
+    body: str = "body"
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A complete scene; `source` names the file or parameter set it came from."""
+
+    name: str
+    body: Body
+    mounts: tuple[Mount, ...]
+    dofs: tuple[str, ...] = DOF_NAMES
+    input: InputSpec = field(default_factory=InputSpec)
+    initial: InitialState = field(default_factory=InitialState)
+    integration: Integration = field(default_factory=Integration)
+    outputs: Outputs = field(default_factory=Outputs)
+    frames: Frames = field(default_factory=Frames)
+    source: str = "<memory>"

@@ -1,0 +1,206 @@
+"""Build a validated `Scene` from a nested mapping (a scene YAML file or ROS parameters)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from mount_twin.errors import SceneError
+from mount_twin.scene.description import (
+    DOF_NAMES,
+    Body,
+    Frames,
+    InitialState,
+    InputSpec,
+    Integration,
+    LinearMount,
+    Mount,
+    Outputs,
+    Scene,
+)
+from mount_twin.scene.reader import Reader
+
+INPUT_TYPES = ("sensor_msgs/msg/Imu", "geometry_msgs/msg/AccelStamped")
+MOUNT_KINDS = ("linear",)
+STEPPERS = ("dopri54",)
+
+
+def load_scene_file(path: str | Path) -> Scene:
+    """Read and validate a scene YAML file; errors name the file and key path."""
+    path = Path(path)
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except OSError as err:
+        raise SceneError(str(path), "<file>", f"cannot read: {err.strerror}") from err
+    except yaml.YAMLError as err:
+        raise SceneError(str(path), "<file>", f"not valid YAML: {err}") from err
+    return scene_from_dict(data, str(path))
+
+
+def scene_from_dict(
+    data: Any, source: str, *, strict_floats: bool = False, mount_paths: list[str] | None = None
+) -> Scene:
+    """Validate a scene mapping (the layout of config/*.scene.yaml).
+
+    Args:
+        data: the mapping.
+        source: file or parameter set, named in errors.
+        strict_floats: reject integers for floats (ROS parameters).
+        mount_paths: key path of each mount in errors (default mounts[i]).
+    """
+    top = Reader(data, source, strict_floats=strict_floats)
+    body = _body(top.sub("body", optional=False))
+    dofs = _dofs(top)
+    mounts_raw = top.raw("mounts")
+    if not isinstance(mounts_raw, list) or not mounts_raw:
+        raise top.error("mounts", f"expected a non-empty list of mounts, got {mounts_raw!r}")
+    paths = mount_paths or [f"mounts[{i}]" for i in range(len(mounts_raw))]
+    mounts = tuple(
+        _mount(Reader(m, source, path, strict_floats=strict_floats))
+        for path, m in zip(paths, mounts_raw, strict=True)
+    )
+    names = [m.name for m in mounts]
+    for i, name in enumerate(names):
+        if names.index(name) != i:
+            raise SceneError(source, f"{paths[i]}.name", f"duplicate mount name {name!r}")
+    scene = Scene(
+        name=top.string("name", "scene"),
+        body=body,
+        mounts=mounts,
+        dofs=dofs,
+        input=_input(top.sub("input")),
+        initial=_initial(top.sub("initial_state")),
+        integration=_integration(top.sub("integration")),
+        outputs=_outputs(top.sub("outputs")),
+        frames=_frames(top.sub("frames")),
+        source=source,
+    )
+    top.finish()
+    return scene
+
+
+def _body(r: Reader) -> Body:
+    mass = r.number("mass", lo=0.0, lo_open=True)
+    cg = r.vector("cg", 3)
+    inertia = r.vector("inertia", 6)
+    ixx, iyy, izz, ixy, ixz, iyz = inertia
+    tensor = [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]
+    if not _is_positive_definite(tensor):
+        raise r.error("inertia", f"tensor is not positive definite: {list(inertia)!r}")
+    if ixx + iyy < izz or iyy + izz < ixx or izz + ixx < iyy:
+        raise r.error("inertia", f"violates the triangle inequality of a rigid body: {inertia!r}")
+    r.finish()
+    return Body(mass=mass, cg=cg, inertia=inertia)  # type: ignore[arg-type]
+
+
+def _is_positive_definite(a: list[list[float]]) -> bool:
+    # Sylvester's criterion on the 3×3 leading minors.
+    m1 = a[0][0]
+    m2 = a[0][0] * a[1][1] - a[0][1] * a[1][0]
+    m3 = (
+        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+        - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+        + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+    )
+    return m1 > 0.0 and m2 > 0.0 and m3 > 0.0
+
+
+def _dofs(top: Reader) -> tuple[str, ...]:
+    dofs = top.strings("dofs", DOF_NAMES)
+    for i, d in enumerate(dofs):
+        if d not in DOF_NAMES:
+            raise top.error(f"dofs[{i}]", f"unknown DOF {d!r}; choose from {', '.join(DOF_NAMES)}")
+        if dofs.index(d) != i:
+            raise top.error(f"dofs[{i}]", f"DOF {d!r} listed twice")
+    if not dofs:
+        raise top.error("dofs", "at least one DOF must be free")
+    return tuple(d for d in DOF_NAMES if d in dofs)
+
+
+def _mount(r: Reader) -> Mount:
+    kind = r.choice("kind", MOUNT_KINDS, "linear")
+    name = r.string("name")
+    if not name or not name.replace("_", "a").isalnum() or name[0].isdigit():
+        raise r.error("name", f"must be a ROS name token (letters, digits, _), got {name!r}")
+    mount = LinearMount(
+        name=name,
+        position=r.vector("position", 3),  # type: ignore[arg-type]
+        orientation_rpy=r.vector("orientation_rpy", 3, (0.0, 0.0, 0.0)),  # type: ignore[arg-type]
+        stiffness=r.vector("stiffness", 6, lo=0.0),  # type: ignore[arg-type]
+        damping=r.vector("damping", 6, (0.0,) * 6, lo=0.0),  # type: ignore[arg-type]
+        kind=kind,
+    )
+    r.finish()
+    return mount
+
+
+def _input(r: Reader) -> InputSpec:
+    d = InputSpec()
+    spec = InputSpec(
+        msg_type=r.choice("msg_type", INPUT_TYPES, d.msg_type),
+        topic=r.string("topic", d.topic),
+        frame_id=r.string("frame_id", d.frame_id),
+        sensor_rpy=r.vector("sensor_rpy", 3, d.sensor_rpy),  # type: ignore[arg-type]
+        sensor_position=r.vector("sensor_position", 3, d.sensor_position),  # type: ignore[arg-type]
+        includes_gravity=r.boolean("includes_gravity", d.includes_gravity),
+        g=r.number("g", d.g, lo=0.0),
+        hold=r.choice("hold", ("first_order", "zero_order"), d.hold),
+        max_gap_s=r.number("max_gap_s", d.max_gap_s, lo=0.0, lo_open=True),
+        gap_policy=r.choice("gap_policy", ("reset", "bridge"), d.gap_policy),
+        back_jump_reset_s=r.number("back_jump_reset_s", d.back_jump_reset_s, lo=0.0),
+    )
+    r.finish()
+    return spec
+
+
+def _initial(r: Reader) -> InitialState:
+    d = InitialState()
+    state = InitialState(
+        mode=r.choice("mode", ("equilibrium", "given"), d.mode),
+        gravity=r.choice("gravity", ("first_sample", "nominal"), d.gravity),
+        pose=r.vector("pose", 6, d.pose),  # type: ignore[arg-type]
+        velocity=r.vector("velocity", 6, d.velocity),  # type: ignore[arg-type]
+    )
+    tilt_cos_sq = math.cos(state.pose[4]) ** 2 - math.sin(state.pose[3]) ** 2
+    if tilt_cos_sq <= 0.0:
+        raise r.error("pose", f"α, γ outside the chart (|α| + |γ| must be < π/2): {state.pose!r}")
+    r.finish()
+    return state
+
+
+def _integration(r: Reader) -> Integration:
+    d = Integration()
+    spec = Integration(
+        method=r.choice("method", STEPPERS, d.method),
+        rtol=r.number("rtol", d.rtol, lo=1.0e-13, hi=0.1),
+        atol=r.number("atol", d.atol, lo=0.0, lo_open=True),
+        max_substeps=r.integer("max_substeps", d.max_substeps, lo=1),
+    )
+    r.finish()
+    return spec
+
+
+def _outputs(r: Reader) -> Outputs:
+    d = Outputs()
+    spec = Outputs(
+        pose=r.boolean("pose", d.pose),
+        angles=r.boolean("angles", d.angles),
+        wrenches=r.boolean("wrenches", d.wrenches),
+        decimation=r.integer("decimation", d.decimation, lo=1),
+        diagnostics_period_s=r.number(
+            "diagnostics_period_s", d.diagnostics_period_s, lo=0.0, lo_open=True
+        ),
+        tilt_warn_rad=r.number("tilt_warn_rad", d.tilt_warn_rad, lo=0.0, hi=math.pi / 2),
+    )
+    r.finish()
+    return spec
+
+
+def _frames(r: Reader) -> Frames:
+    d = Frames()
+    frames = Frames(foundation=r.string("foundation", d.foundation), body=r.string("body", d.body))
+    r.finish()
+    return frames

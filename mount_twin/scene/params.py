@@ -1,0 +1,116 @@
+"""ROS parameters in the Nav2 style ↔ scene mapping.
+
+ROS 2 parameters are flat (dotted names, scalars and homogeneous flat arrays, no list of
+mappings). Mounts are therefore given as `mount_names: [fl, fr, ...]` plus one namespace per
+mount (`mounts.fl.position`, ...). This module turns such a flat set into the nested mapping the
+scene loader validates, so a params YAML and a scene YAML go through one loader.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from typing import Any
+
+from mount_twin.errors import SceneError
+from mount_twin.scene.description import Scene
+from mount_twin.scene.loader import load_scene_file, scene_from_dict
+
+PARAMETERS: dict[str, tuple[str, str]] = {
+    "scene_file": ("string", "Scene YAML file; when set, every other scene parameter is ignored"),
+    "name": ("string", "Scene name"),
+    "frames.foundation": ("string", "frame_id of the foundation frame F"),
+    "frames.body": ("string", "frame_id of the body frame B (origin at the CG)"),
+    "body.mass": ("double", "Body mass, kg"),
+    "body.cg": ("double_array", "CG at the reference pose [x, y, z], m, in F"),
+    "body.inertia": ("double_array", "Inertia about the CG in B [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], kg·m²"),
+    "dofs": ("string_array", "Free DOFs, a subset of [x, y, z, alpha, gamma, delta]"),
+    "mount_names": ("string_array", "Mount names; each has a namespace mounts.<name>"),
+    "input.msg_type": ("string", "sensor_msgs/msg/Imu or geometry_msgs/msg/AccelStamped"),
+    "input.topic": ("string", "Input topic"),
+    "input.frame_id": ("string", "Expected header.frame_id of the input; empty accepts any"),
+    "input.sensor_rpy": ("double_array", "Sensor frame → F as fixed-axis roll, pitch, yaw, rad"),
+    "input.sensor_position": ("double_array", "Accelerometer position [x, y, z], m, in F"),
+    "input.includes_gravity": ("bool", "Acceleration is specific force (+g up at rest)"),
+    "input.g": ("double", "Gravity added along +z of F when includes_gravity is false, m/s²"),
+    "input.hold": ("string", "Input between samples: first_order or zero_order"),
+    "input.max_gap_s": ("double", "A longer stamp gap is handled per gap_policy, s"),
+    "input.gap_policy": ("string", "reset (restart at equilibrium) or bridge"),
+    "input.back_jump_reset_s": ("double", "A stamp going back by more than this resets, s"),
+    "initial_state.mode": ("string", "equilibrium or given"),
+    "initial_state.gravity": ("string", "Equilibrium gravity: first_sample or nominal"),
+    "initial_state.pose": ("double_array", "[X, Y, Z] m, [α, γ, δ] rad: start pose, frozen DOFs"),
+    "initial_state.velocity": ("double_array", "[X', Y', Z'] m/s, [α', γ', δ'] rad/s (given)"),
+    "integration.method": ("string", "Stepper: dopri54"),
+    "integration.rtol": ("double", "Relative tolerance of the stepper"),
+    "integration.atol": ("double", "Absolute tolerance of the stepper (m, rad, m/s, rad/s)"),
+    "integration.max_substeps": ("integer", "Most substeps between two input samples"),
+    "outputs.pose": ("bool", "Publish PoseStamped"),
+    "outputs.angles": ("bool", "Publish α, γ, δ as Vector3Stamped, rad"),
+    "outputs.wrenches": ("bool", "Publish one WrenchStamped per mount"),
+    "outputs.decimation": ("integer", "Publish every Nth sample; wrenches hold their peaks"),
+    "outputs.diagnostics_period_s": ("double", "Diagnostics period in stamp time, s"),
+    "outputs.tilt_warn_rad": ("double", "Tilt from vertical past which diagnostics warn, rad"),
+}
+"""Every scene parameter the node declares: flat name → (ROS type, description)."""
+
+MOUNT_PARAMETERS: dict[str, tuple[str, str]] = {
+    "kind": ("string", "Mount kind: linear (6-component Kelvin–Voigt)"),
+    "position": ("double_array", "Attachment point [x, y, z], m, in F at the reference pose"),
+    "orientation_rpy": ("double_array", "Mount axes relative to F, roll, pitch, yaw, rad"),
+    "stiffness": ("double_array", "[kx, ky, kz] N/m, [krx, kry, krz] N·m/rad, mount axes"),
+    "damping": ("double_array", "[cx, cy, cz] N·s/m, [crx, cry, crz] N·m·s/rad, mount axes"),
+}
+"""Parameters of each mount, declared as mounts.<name>.<key>."""
+
+
+def flatten(tree: Mapping[str, Any], prefix: str = "") -> Iterator[tuple[str, Any]]:
+    """Dotted (name, value) pairs of a nested mapping, as rcl reads a params YAML."""
+    for key, value in tree.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, Mapping):
+            yield from flatten(value, f"{name}.")
+        else:
+            yield name, value
+
+
+def scene_from_params(flat: Mapping[str, Any], source: str) -> Scene:
+    """Validate a flat parameter set (dotted names → values) into a Scene.
+
+    If `scene_file` is set and non-empty, the scene comes from that file instead.
+    """
+    scene_file = flat.get("scene_file", "")
+    if scene_file:
+        return load_scene_file(scene_file)
+    tree: dict[str, Any] = {}
+    for name, value in flat.items():
+        if name == "scene_file":
+            continue
+        node = tree
+        *parents, leaf = name.split(".")
+        for part in parents:
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise SceneError(source, name, f"{part!r} is both a value and a namespace")
+        node[leaf] = value
+    tree = _mounts_as_list(tree, source)
+    paths = [f"mounts.{m['name']}" for m in tree["mounts"]]
+    return scene_from_dict(tree, source, strict_floats=True, mount_paths=paths)
+
+
+def _mounts_as_list(tree: dict[str, Any], source: str) -> dict[str, Any]:
+    names = tree.pop("mount_names", None)
+    if names is None:
+        raise SceneError(source, "mount_names", "required parameter is missing")
+    if isinstance(names, str) or not all(isinstance(n, str) for n in names):
+        raise SceneError(source, "mount_names", f"expected a list of strings, got {names!r}")
+    per_mount = tree.pop("mounts", {})
+    unknown = sorted(set(per_mount) - set(names))
+    if unknown:
+        raise SceneError(source, f"mounts.{unknown[0]}", "namespace not listed in mount_names")
+    mounts = []
+    for name in names:
+        if name not in per_mount:
+            raise SceneError(source, f"mounts.{name}", "mount listed in mount_names has no namespace")
+        mounts.append({**per_mount[name], "name": name})
+    tree["mounts"] = mounts
+    return tree

@@ -1,0 +1,151 @@
+"""Typed access to a nested mapping that reports every error with its source and key path."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from mount_twin.errors import SceneError
+
+
+class Reader:
+    """A view of one mapping in a scene document.
+
+    Args:
+        data: the mapping.
+        source: file or parameter set it came from, for messages.
+        path: key path of `data` in the document ('' at the top).
+        strict_floats: reject integers where a float is expected (rclpy's rule for doubles).
+    """
+
+    def __init__(
+        self, data: Any, source: str, path: str = "", *, strict_floats: bool = False
+    ) -> None:
+        if not isinstance(data, Mapping):
+            raise SceneError(source, path or "<top>", f"expected a mapping, got {data!r}")
+        self.data = data
+        self.source = source
+        self.path = path
+        self.strict_floats = strict_floats
+        self._used: set[str] = set()
+
+    def key_path(self, key: str | int) -> str:
+        """Dotted path of `key` below this mapping (list items as [i])."""
+        if isinstance(key, int):
+            return f"{self.path}[{key}]"
+        return f"{self.path}.{key}" if self.path else key
+
+    def error(self, key: str, msg: str) -> SceneError:
+        """An error at `key` of this mapping."""
+        return SceneError(self.source, self.key_path(key), msg)
+
+    def has(self, key: str) -> bool:
+        """True if `key` is present."""
+        return key in self.data
+
+    def raw(self, key: str, default: Any = None) -> Any:
+        """The value at `key` unchecked, or `default`; a missing key without default is an error."""
+        self._used.add(key)
+        if key in self.data:
+            return self.data[key]
+        if default is None:
+            raise self.error(key, "required key is missing")
+        return default
+
+    def sub(self, key: str, *, optional: bool = True) -> Reader:
+        """The mapping at `key` (an empty one if absent and optional)."""
+        value = self.raw(key, {} if optional else None)
+        return Reader(value, self.source, self.key_path(key), strict_floats=self.strict_floats)
+
+    def number(
+        self,
+        key: str,
+        default: float | None = None,
+        *,
+        lo: float = -math.inf,
+        hi: float = math.inf,
+        lo_open: bool = False,
+    ) -> float:
+        """A finite float in [lo, hi] (or (lo, hi] with lo_open)."""
+        return self._check_number(key, self.raw(key, default), lo, hi, lo_open)
+
+    def integer(self, key: str, default: int | None = None, *, lo: int = 0) -> int:
+        """An integer ≥ lo."""
+        value = self.raw(key, default)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise self.error(key, f"expected an integer, got {value!r}")
+        if value < lo:
+            raise self.error(key, f"must be ≥ {lo}, got {value}")
+        return value
+
+    def boolean(self, key: str, default: bool | None = None) -> bool:
+        """A boolean."""
+        value = self.raw(key, default)
+        if not isinstance(value, bool):
+            raise self.error(key, f"expected true or false, got {value!r}")
+        return value
+
+    def string(self, key: str, default: str | None = None) -> str:
+        """A string."""
+        value = self.raw(key, default)
+        if not isinstance(value, str):
+            raise self.error(key, f"expected a string, got {value!r}")
+        return value
+
+    def choice(self, key: str, options: Sequence[str], default: str | None = None) -> str:
+        """One of `options`."""
+        value = self.string(key, default)
+        if value not in options:
+            raise self.error(key, f"expected one of {', '.join(options)}, got {value!r}")
+        return value
+
+    def vector(
+        self,
+        key: str,
+        n: int,
+        default: Sequence[float] | None = None,
+        *,
+        lo: float = -math.inf,
+    ) -> tuple[float, ...]:
+        """A list of exactly `n` finite floats, each ≥ lo."""
+        value = self.raw(key, None if default is None else tuple(default))
+        if isinstance(value, (str, bytes)) or not isinstance(value, Sequence):
+            raise self.error(key, f"expected a list of {n} numbers, got {value!r}")
+        if len(value) != n:
+            raise self.error(key, f"expected {n} numbers, got {len(value)}: {list(value)!r}")
+        return tuple(
+            self._check_number(f"{key}[{i}]", v, lo, math.inf, False) for i, v in enumerate(value)
+        )
+
+    def strings(self, key: str, default: Sequence[str] | None = None) -> tuple[str, ...]:
+        """A list of strings."""
+        value = self.raw(key, None if default is None else tuple(default))
+        if isinstance(value, str) or not isinstance(value, Sequence):
+            raise self.error(key, f"expected a list of strings, got {value!r}")
+        for i, v in enumerate(value):
+            if not isinstance(v, str):
+                raise self.error(f"{key}[{i}]", f"expected a string, got {v!r}")
+        return tuple(value)
+
+    def finish(self) -> None:
+        """Reject keys nobody read (typos must not pass silently)."""
+        unknown = sorted(str(k) for k in self.data if k not in self._used)
+        if unknown:
+            raise self.error(unknown[0], f"unknown key (known here: {', '.join(sorted(self._used))})")
+
+    def _check_number(self, key: str, value: Any, lo: float, hi: float, lo_open: bool) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.error(key, f"expected a number, got {value!r}")
+        if self.strict_floats and isinstance(value, int):
+            raise self.error(
+                key, f"expected a double, got the integer {value!r}: write {value}.0 "
+                "(rclpy rejects integers for double parameters)"
+            )
+        value = float(value)
+        if not math.isfinite(value):
+            raise self.error(key, f"must be finite, got {value!r}")
+        if value < lo or value > hi or (lo_open and value == lo):
+            low = "(" if lo_open else "["
+            raise self.error(key, f"must be in {low}{lo}, {hi}], got {value!r}")
+        return value

@@ -1,0 +1,42 @@
+"""One path for every sample, live or offline: raw CDR in, raw CDR out.
+
+`TwinStream` is what both adapters drive: the rclpy node hands it each raw message it receives,
+the bag replay hands it chunks of raw messages from a bag. Only the transport differs.
+"""
+
+from __future__ import annotations
+
+from mount_twin.engine.batch import OutputBatch
+from mount_twin.engine.engine import TwinEngine
+from mount_twin.io.messages import TimeBase, decode_inputs, encode_outputs
+from mount_twin.model.assemble import assemble
+from mount_twin.scene.description import Scene
+
+
+class TwinStream:
+    """Decode → engine → encode for one scene.
+
+    Attributes:
+        engine: the streaming engine (counts, state, health).
+        last_outputs: the engine's last OutputBatch (for summaries and plots).
+    """
+
+    def __init__(self, scene: Scene) -> None:
+        self.scene = scene
+        self.engine = TwinEngine(assemble(scene))
+        self.base: TimeBase | None = None
+        self.last_outputs: OutputBatch | None = None
+
+    def process(self, raws: list[bytes]) -> list[tuple[str, int, bytes]]:
+        """Outputs for raw input messages, as (unresolved topic, stamp ns, CDR bytes)."""
+        decoded = decode_inputs(raws, self.scene.input.msg_type)
+        if decoded.undecodable:
+            self.engine.count("received", decoded.undecodable)
+            self.engine.count("rejected_undecodable", decoded.undecodable)
+        if self.base is None:
+            if not decoded.stamps_ns.shape[0]:
+                return []
+            self.base = TimeBase.at(int(decoded.stamps_ns[0]))
+        out = self.engine.push(decoded.batch(self.base))
+        self.last_outputs = out
+        return encode_outputs(self.scene, out, self.base)
