@@ -32,9 +32,13 @@ def share_dir() -> Path:
     raise MountTwinError(msg)
 
 
-def _write_signal(sig: Signal, out: str, topic: str, frame_id: str, start_ns: int, storage: str) -> int:
+def _write_signal(
+    sig: Signal, out: str, topic: str, frame_id: str, start_ns: int, storage: str
+) -> int:
     stamps = start_ns + np.rint(sig.t * 1e9).astype(np.int64)
-    return write_bag(out, topic, IMU, iter(imu_messages(stamps, sig.accel, sig.gyro, frame_id)), storage)
+    return write_bag(
+        out, topic, IMU, iter(imu_messages(stamps, sig.accel, sig.gyro, frame_id)), storage
+    )
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -58,7 +62,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     gen.add_argument("--duration", type=float, help="record length, s")
     gen.add_argument("--peak", type=float, default=150.0, help="half-sine peak, m/s²")
     gen.add_argument("--pulse", type=float, default=0.008, help="half-sine duration, s")
-    gen.add_argument("--start", type=int, default=1_700_000_000_000_000_000, help="first stamp, ns")
+    gen.add_argument(
+        "--start", type=int, default=1_700_000_000_000_000_000, help="first stamp, ns"
+    )
     gen.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
     imp = sub.add_parser("import-csv", help="CSV t,ax,ay,az,wx,wy,wz → sensor_msgs/Imu bag")
     imp.add_argument("csv")
@@ -82,14 +88,23 @@ def _run(args: argparse.Namespace) -> int:
             scene_path, bag = share / "config" / DEFAULT_SCENE, share / "bags" / DEFAULT_BAG
             chunk, progress = 2000, True
         else:
-            scene_path, bag, chunk, progress = args.scene, args.input, args.chunk, not args.no_progress
-        summary = replay(load_scene_file(scene_path), bag, args.output, chunk=chunk, progress=progress)
+            scene_path, bag, chunk, progress = (
+                args.scene,
+                args.input,
+                args.chunk,
+                not args.no_progress,
+            )
+        summary = replay(
+            load_scene_file(scene_path), bag, args.output, chunk=chunk, progress=progress
+        )
         print(summary.text())
         return 0
     if args.cmd == "generate":
         if args.kind == "half-sine":
             sig = half_sine_shock(
-                peak=args.peak, duration=args.pulse, rate_hz=args.rate or 10000.0,
+                peak=args.peak,
+                duration=args.pulse,
+                rate_hz=args.rate or 10000.0,
                 total=args.duration or 0.4,
             )
         else:

@@ -53,8 +53,7 @@ class ReplaySummary:
             f"{self.wall_s:.2f} s wall: real-time factor {self.real_time_factor:.1f}",
             f"  max CG displacement {self.displacement_max_m * 1e3:.3f} mm, "
             f"max tilt {np.degrees(self.tilt_max_rad):.4f} deg",
-            "  peak mount loads (largest magnitude, mount axes): "
-            "Fx Fy Fz [N]  Mx My Mz [N·m]",
+            "  peak mount loads (largest magnitude, mount axes): Fx Fy Fz [N]  Mx My Mz [N·m]",
         ]
         for name, peak in self.peak_wrench.items():
             lines.append(f"    {name:>12}: " + " ".join(f"{v:10.1f}" for v in peak))
@@ -63,8 +62,12 @@ class ReplaySummary:
 
 
 def replay(
-    scene: Scene, input_path: str | Path, output_path: str | Path, *,
-    chunk: int = 2000, progress: bool = True,
+    scene: Scene,
+    input_path: str | Path,
+    output_path: str | Path,
+    *,
+    chunk: int = 2000,
+    progress: bool = True,
 ) -> ReplaySummary:
     """Replay `input_path`'s scene.input.topic into a new mcap bag at `output_path`."""
     stream = TwinStream(scene)
@@ -77,11 +80,11 @@ def replay(
     cg = np.array(scene.body.cg)
     wall0 = time.perf_counter()
     last_health: list[str] = []
-    with InputBag(input_path, scene.input.topic, scene.input.msg_type) as bag, OutputBag(
-        output_path, topics
-    ) as out, tqdm(
-        total=bag.count, unit="msg", disable=not progress, desc="replay", leave=False
-    ) as bar:
+    with (
+        InputBag(input_path, scene.input.topic, scene.input.msg_type) as bag,
+        OutputBag(output_path, topics) as out,
+        tqdm(total=bag.count, unit="msg", disable=not progress, desc="replay", leave=False) as bar,
+    ):
         for raws in bag.chunks(chunk):
             for topic, stamp, raw in stream.process(raws):
                 out.write(resolved[topic], stamp, raw)
@@ -102,6 +105,14 @@ def replay(
     wall = time.perf_counter() - wall0
     span = float(last_stamp - first_stamp) if first_stamp is not None else 0.0
     return ReplaySummary(
-        str(input_path), str(output_path), dict(stream.engine.counts), written, span, wall,
-        {m.name: peak[i] for i, m in enumerate(scene.mounts)}, tilt, disp, last_health,
+        str(input_path),
+        str(output_path),
+        dict(stream.engine.counts),
+        written,
+        span,
+        wall,
+        {m.name: peak[i] for i, m in enumerate(scene.mounts)},
+        tilt,
+        disp,
+        last_health,
     )

@@ -59,6 +59,37 @@ class TwinEngine:
         self._gravity_up = np.array([0.0, 0.0, scene.input.g])
         self.counts: Counter[str] = Counter()
         self.health = HealthWindow(scene, self.stepper.name)
+        self._warm_up()
+
+    def _warm_up(self) -> None:
+        """Load (or compile) the kernels now, not at the first live sample."""
+        model, st = self.model, self.stepper
+        t = np.array([0.0, 1e-3])
+        f = np.tile(self._gravity_up, (2, 1))
+        n, nm = 2, model.n_mounts
+        y = np.zeros(model.n_state)
+        run_samples(
+            st.method,
+            st.settings.copy(),
+            st.work2d.copy(),
+            st.work1d.copy(),
+            st.result.copy(),
+            model.arrays,
+            model.new_scratch(),
+            np.zeros(INPUT_SIZE),
+            y,
+            t,
+            f,
+            np.zeros((2, 3)),
+            False,
+            1,
+            np.zeros(1, dtype=np.int64),
+            np.zeros((nm, 6)),
+            np.zeros((n, 10)),
+            np.zeros((n, nm, 6)),
+            np.zeros(n, dtype=np.bool_),
+            np.zeros((n, 3)),
+        )
 
     @property
     def state(self) -> np.ndarray:
@@ -84,7 +115,9 @@ class TwinEngine:
         stamps = np.concatenate([p[0] for p in parts]) if parts else np.zeros(0)
         pose = np.concatenate([p[1] for p in parts]) if parts else np.zeros((0, 10))
         wrenches = (
-            np.concatenate([p[2] for p in parts]) if parts else np.zeros((0, self.model.n_mounts, 6))
+            np.concatenate([p[2] for p in parts])
+            if parts
+            else np.zeros((0, self.model.n_mounts, 6))
         )
         self.health.add_outputs(stamps, pose)
         reports = self.health.due(self._clock() - wall0, self.counts)
@@ -101,7 +134,9 @@ class TwinEngine:
     def _runs(self, batch: SampleBatch, f: np.ndarray, w: np.ndarray) -> list[_Run]:
         """Classify each sample; group the accepted ones into runs split at restarts."""
         spec = self.scene.input
-        finite = np.isfinite(batch.stamps) & np.isfinite(f).all(axis=1) & np.isfinite(w).all(axis=1)
+        finite = (
+            np.isfinite(batch.stamps) & np.isfinite(f).all(axis=1) & np.isfinite(w).all(axis=1)
+        )
         runs: list[_Run] = []
         last_t = self._last[0] if self._last is not None else None
         for i in range(len(batch)):
@@ -155,11 +190,26 @@ class TwinEngine:
             publish, step_log = np.zeros(n, dtype=np.bool_), np.zeros((n, 3))
             st = self.stepper
             done, status = run_samples(
-                st.method, st.settings, st.work2d, st.work1d, st.result,
-                self.model.arrays, self._scratch, self._u, self._y,
-                t, ff, ww, self.scene.input.hold == "zero_order",
-                self.scene.outputs.decimation, self._counter, self._peak,
-                pose, wrenches, publish, step_log,
+                st.method,
+                st.settings,
+                st.work2d,
+                st.work1d,
+                st.result,
+                self.model.arrays,
+                self._scratch,
+                self._u,
+                self._y,
+                t,
+                ff,
+                ww,
+                self.scene.input.hold == "zero_order",
+                self.scene.outputs.decimation,
+                self._counter,
+                self._peak,
+                pose,
+                wrenches,
+                publish,
+                step_log,
             )
             self.health.add_steps(step_log[1 : done + 1])
             if done > 0:

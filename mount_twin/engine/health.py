@@ -83,7 +83,8 @@ class HealthWindow:
             f"{PREFIX}: input",
             WARN if new_rejected or new["gaps"] else OK,
             f"{new_rejected} samples rejected, {new['gaps']} gaps in this period"
-            if new_rejected or new["gaps"] else "ok",
+            if new_rejected or new["gaps"]
+            else "ok",
             {
                 "topic": self.scene.input.topic,
                 "rate_hz": f"{new['accepted'] / span:.1f}" if span > 0 else "n/a",
@@ -104,7 +105,9 @@ class HealthWindow:
                 "rtol": f"{integ.rtol:g}",
                 "atol": f"{integ.atol:g}",
                 "error_norm_max": f"{self.err_max:.3g}",
-                "substeps_per_sample": f"{self.substeps / self.samples:.2f}" if self.samples else "n/a",
+                "substeps_per_sample": f"{self.substeps / self.samples:.2f}"
+                if self.samples
+                else "n/a",
                 "real_time_factor": f"{rtf:.1f}",
                 "failures_total": str(counts["integration_failures"]),
             },
@@ -114,7 +117,9 @@ class HealthWindow:
             f"{PREFIX}: attitude",
             WARN if self.tilt_max > warn else OK,
             f"tilt {math.degrees(self.tilt_max):.1f}° past {math.degrees(warn):.1f}°: the α/γ/δ "
-            "chart degrades toward 90°" if self.tilt_max > warn else "ok",
+            "chart degrades toward 90°"
+            if self.tilt_max > warn
+            else "ok",
             {"tilt_max_rad": f"{self.tilt_max:.6g}"},
         )
         return HealthReport(self.t_last, [inp, step, att])

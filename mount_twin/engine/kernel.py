@@ -6,7 +6,6 @@ not per sample; a live node passes batches of one through the same function.
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 from mount_twin.integrate.stepper import advance
@@ -15,10 +14,26 @@ from mount_twin.physics.dynamics import evaluate
 
 @njit(cache=True)
 def run_samples(
-    method, settings, work2d, work1d, result,  # noqa: ANN001  (stepper)
-    m, s, u, y,  # noqa: ANN001  (model arrays, scratch, input work (13,), state)
-    t, f, w, zero_order,  # noqa: ANN001  (samples)
-    decimation, counter, peak, pose, wrenches, publish, step_log,  # noqa: ANN001  (outputs)
+    method,
+    settings,
+    work2d,
+    work1d,
+    result,
+    m,
+    s,
+    u,
+    y,
+    t,
+    f,
+    w,
+    zero_order,
+    decimation,
+    counter,
+    peak,
+    pose,
+    wrenches,
+    publish,
+    step_log,
 ) -> tuple[int, int]:
     """Advance y through samples 1..n−1 of (t, f, w); sample 0 is the last one already done.
 

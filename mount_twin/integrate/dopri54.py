@@ -2,7 +2,8 @@
 
 The method is its coefficient table and one free compiled function (scipy `integrate/_ivp`
 shape). It calls the model's right-hand side `dynamics.rhs` directly: a compiled function passed
-as an argument would make it and every caller uncacheable. The state advances with the 5th-order solution; the
+as an argument would make it and every caller uncacheable. The state advances with the
+5th-order solution; the
 embedded 4th-order one estimates the local error. Error norm: RMS of err / (atol + rtol·|y|).
 """
 
@@ -40,7 +41,7 @@ SUCCESS, TOO_MANY_STEPS, STEP_TOO_SMALL, LEFT_CHART = 0, 1, 2, 3
 
 
 @njit(cache=True)
-def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:  # noqa: ANN001
+def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
     """Advance y (in place) from t0 to t1 s with input u held over the interval.
 
     The signature is every stepper's: (y, t0, t1, settings, model arrays, scratch, input,
@@ -96,7 +97,11 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:  # noqa: ANN
             scale = atol + rtol * max(abs(y[i]), abs(y_new[i]))
             err += (step * e / scale) ** 2
         err = math.sqrt(err / n)
-        factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err ** (-1.0 / (ORDER + 1))))
+        factor = (
+            MAX_FACTOR
+            if err == 0.0
+            else min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err ** (-1.0 / (ORDER + 1))))
+        )
         if err <= 1.0:
             t = t1 if last else t + step
             for i in range(n):

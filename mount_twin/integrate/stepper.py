@@ -68,8 +68,17 @@ def dormand_prince(n: int, rtol: float, atol: float, max_substeps: int) -> Stepp
 
 @njit(cache=True)
 def advance(
-    method: int, y: np.ndarray, t0: float, t1: float, settings: np.ndarray, m: ModelArrays,
-    s: Scratch, u: np.ndarray, work2d: np.ndarray, work1d: np.ndarray, result: np.ndarray,
+    method: int,
+    y: np.ndarray,
+    t0: float,
+    t1: float,
+    settings: np.ndarray,
+    m: ModelArrays,
+    s: Scratch,
+    u: np.ndarray,
+    work2d: np.ndarray,
+    work1d: np.ndarray,
+    result: np.ndarray,
 ) -> int:
     """Advance y from t0 to t1 (s) with the stepper `method`; returns its status (0 = success)."""
     if method == DOPRI54:

@@ -35,13 +35,17 @@ class InputBag:
         conns = [c for c in self._reader.connections if c.topic == topic]
         if not conns:
             self._reader.close()
-            have = ", ".join(sorted({f"{c.topic} ({c.msgtype})" for c in self._reader.connections}))
+            have = ", ".join(
+                sorted({f"{c.topic} ({c.msgtype})" for c in self._reader.connections})
+            )
             msg = f"{self.path}: no topic {topic!r} (input.topic); the bag has: {have}"
             raise BagError(msg)
         wrong = [c.msgtype for c in conns if c.msgtype != msgtype]
         if wrong:
             self._reader.close()
-            msg = f"{self.path}: topic {topic!r} has type {wrong[0]}, input.msg_type says {msgtype}"
+            msg = (
+                f"{self.path}: topic {topic!r} has type {wrong[0]}, input.msg_type says {msgtype}"
+            )
             raise BagError(msg)
         self._conns = conns
         self.count = sum(c.msgcount for c in conns)
@@ -83,7 +87,9 @@ class OutputBag:
         if self.path.exists():
             msg = f"{self.path}: output bag exists; choose another path or remove it"
             raise BagError(msg)
-        self._writer = Writer(self.path, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP)
+        self._writer = Writer(
+            self.path, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP
+        )
         self._writer.open()
         self._conns = {
             topic: self._writer.add_connection(topic, msgtype, typestore=TYPESTORE)
@@ -109,8 +115,13 @@ class OutputBag:
         self.close()
 
 
-def write_bag(path: str | Path, topic: str, msgtype: str, messages: Iterator[tuple[int, bytes]],
-              storage: str = "mcap") -> int:
+def write_bag(
+    path: str | Path,
+    topic: str,
+    msgtype: str,
+    messages: Iterator[tuple[int, bytes]],
+    storage: str = "mcap",
+) -> int:
     """Write one topic's (stamp ns, CDR bytes) messages into a new bag; return the count."""
     plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
     n = 0

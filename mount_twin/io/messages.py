@@ -83,7 +83,7 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
     for i, raw in enumerate(raws):
         try:
             msg = TYPESTORE.deserialize_cdr(raw, msgtype)
-        except Exception:  # noqa: BLE001  (any malformed CDR is one rejected message)
+        except Exception:
             keep[i] = False
             continue
         stamps[i] = stamp_ns(msg.header)
@@ -134,9 +134,7 @@ def resolve(name: str, node_name: str, namespace: str = "/") -> str:
     return name if name.startswith("/") else f"{ns}/{name}"
 
 
-def encode_outputs(
-    scene: Scene, out: OutputBatch, base: TimeBase
-) -> list[tuple[str, int, bytes]]:
+def encode_outputs(scene: Scene, out: OutputBatch, base: TimeBase) -> list[tuple[str, int, bytes]]:
     """CDR messages for an output batch as (unresolved topic, stamp ns, bytes), in stamp order.
 
     Only the outputs the scene enables are built: unused outputs cost nothing.
@@ -150,7 +148,9 @@ def encode_outputs(
         row = out.pose[k]
         if opts.pose:
             pose = _T["geometry_msgs/msg/Pose"](
-                position=_T["geometry_msgs/msg/Point"](x=float(row[0]), y=float(row[1]), z=float(row[2])),
+                position=_T["geometry_msgs/msg/Point"](
+                    x=float(row[0]), y=float(row[1]), z=float(row[2])
+                ),
                 orientation=_T["geometry_msgs/msg/Quaternion"](
                     x=float(row[3]), y=float(row[4]), z=float(row[5]), w=float(row[6])
                 ),
@@ -158,16 +158,24 @@ def encode_outputs(
             msg = _T[POSE](header=_header(stamp, frames.foundation), pose=pose)
             msgs.append((topics.pose, stamp, ser(msg, POSE)))
         if opts.angles:
-            msg = _T[VECTOR3](header=_header(stamp, frames.foundation), vector=_vector3(*row[7:10]))
+            msg = _T[VECTOR3](
+                header=_header(stamp, frames.foundation), vector=_vector3(*row[7:10])
+            )
             msgs.append((topics.angles, stamp, ser(msg, VECTOR3)))
         if opts.wrenches:
-            for mount, topic, w in zip(scene.mounts, topics.wrenches, out.wrenches[k], strict=True):
-                wrench = _T["geometry_msgs/msg/Wrench"](force=_vector3(*w[:3]), torque=_vector3(*w[3:]))
+            for mount, topic, w in zip(
+                scene.mounts, topics.wrenches, out.wrenches[k], strict=True
+            ):
+                wrench = _T["geometry_msgs/msg/Wrench"](
+                    force=_vector3(*w[:3]), torque=_vector3(*w[3:])
+                )
                 msg = _T[WRENCH](header=_header(stamp, mount.name), wrench=wrench)
                 msgs.append((topic, stamp, ser(msg, WRENCH)))
     for report in out.health:
         stamp = int(base.nanoseconds(np.array([report.stamp]))[0])
-        msgs.append((topics.diagnostics, stamp, ser(diagnostics_message(report, stamp), DIAGNOSTICS)))
+        msgs.append(
+            (topics.diagnostics, stamp, ser(diagnostics_message(report, stamp), DIAGNOSTICS))
+        )
     msgs.sort(key=lambda m: m[1])
     return msgs
 
@@ -177,7 +185,10 @@ def diagnostics_message(report: HealthReport, stamp_ns: int) -> object:
     status_t, kv_t = _T["diagnostic_msgs/msg/DiagnosticStatus"], _T["diagnostic_msgs/msg/KeyValue"]
     statuses = [
         status_t(
-            level=s.level, name=s.name, message=s.message, hardware_id="mount_twin",
+            level=s.level,
+            name=s.name,
+            message=s.message,
+            hardware_id="mount_twin",
             values=[kv_t(key=k, value=v) for k, v in s.values.items()],
         )
         for s in report.statuses
@@ -209,9 +220,12 @@ def imu_messages(
     out = []
     for stamp, a, w in zip(stamps_ns.tolist(), accel, gyro, strict=True):
         msg = _T[IMU](
-            header=_header(stamp, frame_id), orientation=quat,
-            orientation_covariance=no_orientation, angular_velocity=_vector3(*w),
-            angular_velocity_covariance=unknown, linear_acceleration=_vector3(*a),
+            header=_header(stamp, frame_id),
+            orientation=quat,
+            orientation_covariance=no_orientation,
+            angular_velocity=_vector3(*w),
+            angular_velocity_covariance=unknown,
+            linear_acceleration=_vector3(*a),
             linear_acceleration_covariance=unknown,
         )
         out.append((stamp, bytes(TYPESTORE.serialize_cdr(msg, IMU))))

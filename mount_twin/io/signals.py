@@ -19,8 +19,12 @@ class Signal:
 
 
 def half_sine_shock(
-    peak: float = 150.0, duration: float = 0.008, rate_hz: float = 10000.0,
-    pre: float = 0.05, total: float = 0.4, g: float = 9.80665,
+    peak: float = 150.0,
+    duration: float = 0.008,
+    rate_hz: float = 10000.0,
+    pre: float = 0.05,
+    total: float = 0.4,
+    g: float = 9.80665,
 ) -> Signal:
     """Vertical half-sine deck acceleration a(t) = peak·sin(π(t − pre)/duration) during the pulse.
 
@@ -37,13 +41,20 @@ def half_sine_shock(
 
 
 def ship_motion(
-    rate_hz: float = 1000.0, total: float = 5.0, roll_amp: float = 0.09, roll_period: float = 8.0,
-    heave_amp: float = 0.5, heave_period: float = 6.0, vib_amp: float = 0.8, vib_hz: float = 23.0,
+    rate_hz: float = 1000.0,
+    total: float = 5.0,
+    roll_amp: float = 0.09,
+    roll_period: float = 8.0,
+    heave_amp: float = 0.5,
+    heave_period: float = 6.0,
+    vib_amp: float = 0.8,
+    vib_hz: float = 23.0,
     g: float = 9.80665,
 ) -> Signal:
     """Rolling, heaving deck with hull vibration, sensed at the roll axis (origin of F).
 
-    Roll φ = roll_amp·sin(2πt/roll_period) rad about x of F; heave z = heave_amp·sin(2πt/heave_period)
+    Roll φ = roll_amp·sin(2πt/roll_period) rad about x of F;
+    heave z = heave_amp·sin(2πt/heave_period)
     m in the earth frame; vertical vibration vib_amp·sin(2π·vib_hz·t) m/s² along z of F.
     """
     t = np.arange(round(total * rate_hz)) / rate_hz

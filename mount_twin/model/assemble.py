@@ -96,15 +96,15 @@ def initial_state(model: Model, specific_force: np.ndarray) -> np.ndarray:
     scene = model.scene
     nf = len(scene.dofs)
     idx = [DOF_NAMES.index(d) for d in scene.dofs]
-    y0 = np.concatenate(
-        [np.array(scene.initial.pose)[idx], np.array(scene.initial.velocity)[idx]]
-    )
+    y0 = np.concatenate([np.array(scene.initial.pose)[idx], np.array(scene.initial.velocity)[idx]])
     if scene.initial.mode == "given":
         return y0
     return static_equilibrium(model, y0[:nf], specific_force)
 
 
-def static_equilibrium(model: Model, q_guess: np.ndarray, specific_force: np.ndarray) -> np.ndarray:
+def static_equilibrium(
+    model: Model, q_guess: np.ndarray, specific_force: np.ndarray
+) -> np.ndarray:
     """State at rest where the free generalized accelerations vanish (least squares on them)."""
     nf = q_guess.shape[0]
     m, s = model.arrays, model.new_scratch()

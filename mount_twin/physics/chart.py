@@ -75,8 +75,14 @@ def kinematic_matrix(
 
 @njit(cache=True)
 def kinematic_matrix_rate(
-    sa: float, ca: float, sg: float, cg: float, ct: float,
-    alpha_dot: float, gamma_dot: float, out: np.ndarray,
+    sa: float,
+    ca: float,
+    sg: float,
+    cg: float,
+    ct: float,
+    alpha_dot: float,
+    gamma_dot: float,
+    out: np.ndarray,
 ) -> None:
     """dB/dt along the motion (entry-wise chain rule of `kinematic_matrix`), 1/s."""
     ct_dot = -(alpha_dot * sa * ca + gamma_dot * sg * cg) / ct
@@ -95,7 +101,9 @@ def kinematic_matrix_rate(
 
 
 @njit(cache=True)
-def chart_rates(alpha: float, gamma: float, ct: float, omega: np.ndarray) -> tuple[float, float, float]:
+def chart_rates(
+    alpha: float, gamma: float, ct: float, omega: np.ndarray
+) -> tuple[float, float, float]:
     """[α', γ', δ'] = B⁻¹·ω in closed form (physics notes §3)."""
     sa, ca = math.sin(alpha), math.cos(alpha)
     sg, cg = math.sin(gamma), math.cos(gamma)

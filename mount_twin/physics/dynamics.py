@@ -183,7 +183,7 @@ def mount_loads(m: ModelArrays, s: Scratch) -> None:
 
 @njit(cache=True)
 def mount_wrenches(m: ModelArrays, s: Scratch, wrenches: np.ndarray) -> None:
-    """Each mount's force (N) and own couple (N·m) on the body in its axes: wrenches[i] = (F, M)."""
+    """Each mount's force (N) and own couple (N·m) on the body, in its axes: wrenches[i]."""
     arm, f, c = s.arm, s.force, s.couple
     rot, q, qd, omega_f, phi = s.rot, s.q, s.qd, s.omega_f, s.phi
     point, k_t, c_t, k_r, c_r = m.lin_point, m.lin_k_t, m.lin_c_t, m.lin_k_r, m.lin_c_r
@@ -192,13 +192,13 @@ def mount_wrenches(m: ModelArrays, s: Scratch, wrenches: np.ndarray) -> None:
         linear_mount_load(i, point, k_t, c_t, k_r, c_r, rot, q, qd, omega_f, phi, arm, f, c)
         for j in range(3):
             wrenches[i, j] = axes[i, 0, j] * f[0] + axes[i, 1, j] * f[1] + axes[i, 2, j] * f[2]
-            wrenches[i, 3 + j] = (
-                axes[i, 0, j] * c[0] + axes[i, 1, j] * c[1] + axes[i, 2, j] * c[2]
-            )
+            wrenches[i, 3 + j] = axes[i, 0, j] * c[0] + axes[i, 1, j] * c[1] + axes[i, 2, j] * c[2]
 
 
 @njit(cache=True)
-def rhs(t: float, y: np.ndarray, m: ModelArrays, s: Scratch, u: np.ndarray, dydt: np.ndarray) -> int:
+def rhs(
+    t: float, y: np.ndarray, m: ModelArrays, s: Scratch, u: np.ndarray, dydt: np.ndarray
+) -> int:
     """dy/dt at time t (s); returns OK or OFF_CHART."""
     ct = body_motion(y, m, s)
     if not ct > 0.0:

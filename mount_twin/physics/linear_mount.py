@@ -20,8 +20,8 @@ def linear_mount_load(
     k_r: np.ndarray,
     c_r: np.ndarray,
     rot: np.ndarray,
-    r: np.ndarray,
-    v: np.ndarray,
+    q: np.ndarray,
+    qd: np.ndarray,
     omega_f: np.ndarray,
     phi: np.ndarray,
     arm: np.ndarray,
@@ -36,7 +36,8 @@ def linear_mount_load(
         point: (n, 3) attachment points p from the CG, m, in B.
         k_t, c_t, k_r, c_r: (n, 3, 3) stiffness (N/m, N·m/rad), damping (N·s/m, N·m·s/rad) in F.
         rot: R, body attitude relative to F.
-        r, v: (6,) generalized coordinates and rates; r = q[:3] is the CG displacement from the reference pose (m) and its rate (m/s), in F.
+        q, qd: (6,) generalized coordinates (m, rad) and rates; q[:3] is the CG displacement
+            from the reference pose, in F.
         omega_f: body angular velocity relative to F, expressed in F (R·ω), rad/s.
         phi: rotation vector of R, rad, in F.
         arm: out, R·p (m, F), the lever arm of `force` about the CG.
@@ -45,19 +46,27 @@ def linear_mount_load(
     """
     for j in range(3):
         arm[j] = rot[j, 0] * point[i, 0] + rot[j, 1] * point[i, 1] + rot[j, 2] * point[i, 2]
-    d0 = r[0] + arm[0] - point[i, 0]
-    d1 = r[1] + arm[1] - point[i, 1]
-    d2 = r[2] + arm[2] - point[i, 2]
+    d0 = q[0] + arm[0] - point[i, 0]
+    d1 = q[1] + arm[1] - point[i, 1]
+    d2 = q[2] + arm[2] - point[i, 2]
     # ḋ = ṙ + (R ω) × (R p)
-    e0 = v[0] + omega_f[1] * arm[2] - omega_f[2] * arm[1]
-    e1 = v[1] + omega_f[2] * arm[0] - omega_f[0] * arm[2]
-    e2 = v[2] + omega_f[0] * arm[1] - omega_f[1] * arm[0]
+    e0 = qd[0] + omega_f[1] * arm[2] - omega_f[2] * arm[1]
+    e1 = qd[1] + omega_f[2] * arm[0] - omega_f[0] * arm[2]
+    e2 = qd[2] + omega_f[0] * arm[1] - omega_f[1] * arm[0]
     for j in range(3):
         force[j] = -(
-            k_t[i, j, 0] * d0 + k_t[i, j, 1] * d1 + k_t[i, j, 2] * d2
-            + c_t[i, j, 0] * e0 + c_t[i, j, 1] * e1 + c_t[i, j, 2] * e2
+            k_t[i, j, 0] * d0
+            + k_t[i, j, 1] * d1
+            + k_t[i, j, 2] * d2
+            + c_t[i, j, 0] * e0
+            + c_t[i, j, 1] * e1
+            + c_t[i, j, 2] * e2
         )
         couple[j] = -(
-            k_r[i, j, 0] * phi[0] + k_r[i, j, 1] * phi[1] + k_r[i, j, 2] * phi[2]
-            + c_r[i, j, 0] * omega_f[0] + c_r[i, j, 1] * omega_f[1] + c_r[i, j, 2] * omega_f[2]
+            k_r[i, j, 0] * phi[0]
+            + k_r[i, j, 1] * phi[1]
+            + k_r[i, j, 2] * phi[2]
+            + c_r[i, j, 0] * omega_f[0]
+            + c_r[i, j, 1] * omega_f[1]
+            + c_r[i, j, 2] * omega_f[2]
         )

@@ -22,7 +22,10 @@ PARAMETERS: dict[str, tuple[str, str]] = {
     "frames.body": ("string", "frame_id of the body frame B (origin at the CG)"),
     "body.mass": ("double", "Body mass, kg"),
     "body.cg": ("double_array", "CG at the reference pose [x, y, z], m, in F"),
-    "body.inertia": ("double_array", "Inertia about the CG in B [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], kg·m²"),
+    "body.inertia": (
+        "double_array",
+        "Inertia about the CG in B [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], kg·m²",
+    ),
     "dofs": ("string_array", "Free DOFs, a subset of [x, y, z, alpha, gamma, delta]"),
     "mount_names": ("string_array", "Mount names; each has a namespace mounts.<name>"),
     "input.msg_type": ("string", "sensor_msgs/msg/Imu or geometry_msgs/msg/AccelStamped"),
@@ -110,7 +113,9 @@ def _mounts_as_list(tree: dict[str, Any], source: str) -> dict[str, Any]:
     mounts = []
     for name in names:
         if name not in per_mount:
-            raise SceneError(source, f"mounts.{name}", "mount listed in mount_names has no namespace")
+            raise SceneError(
+                source, f"mounts.{name}", "mount listed in mount_names has no namespace"
+            )
         mounts.append({**per_mount[name], "name": name})
     tree["mounts"] = mounts
     return tree

@@ -45,7 +45,7 @@ class Reader:
         return key in self.data
 
     def raw(self, key: str, default: Any = None) -> Any:
-        """The value at `key` unchecked, or `default`; a missing key without default is an error."""
+        """The value at `key` unchecked, or `default`; missing without default is an error."""
         self._used.add(key)
         if key in self.data:
             return self.data[key]
@@ -132,15 +132,18 @@ class Reader:
         """Reject keys nobody read (typos must not pass silently)."""
         unknown = sorted(str(k) for k in self.data if k not in self._used)
         if unknown:
-            raise self.error(unknown[0], f"unknown key (known here: {', '.join(sorted(self._used))})")
+            raise self.error(
+                unknown[0], f"unknown key (known here: {', '.join(sorted(self._used))})"
+            )
 
     def _check_number(self, key: str, value: Any, lo: float, hi: float, lo_open: bool) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise self.error(key, f"expected a number, got {value!r}")
         if self.strict_floats and isinstance(value, int):
             raise self.error(
-                key, f"expected a double, got the integer {value!r}: write {value}.0 "
-                "(rclpy rejects integers for double parameters)"
+                key,
+                f"expected a double, got the integer {value!r}: write {value}.0 "
+                "(rclpy rejects integers for double parameters)",
             )
         value = float(value)
         if not math.isfinite(value):

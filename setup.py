@@ -1,0 +1,43 @@
+"""ament_python package: `colcon build` installs the console scripts under lib/mount_twin, the
+ament index marker, package.xml, config/, launch/ and bags/ under share/mount_twin."""
+
+from glob import glob
+
+from setuptools import find_packages, setup
+
+PACKAGE = "mount_twin"
+
+setup(
+    name=PACKAGE,
+    version="0.1.0",
+    packages=find_packages(include=[PACKAGE, f"{PACKAGE}.*"]),
+    data_files=[
+        ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
+        (f"share/{PACKAGE}", ["package.xml"]),
+        (f"share/{PACKAGE}/config", glob("config/*.yaml")),
+        (f"share/{PACKAGE}/launch", glob("launch/*.launch.py")),
+        *((f"share/{PACKAGE}/{d}", glob(f"{d}/*")) for d in sorted(glob("bags/*"))),
+    ],
+    python_requires=">=3.10",
+    install_requires=[
+        "numpy>=1.24",
+        "scipy>=1.10",
+        "numba>=0.58",
+        "PyYAML>=6",
+        "tqdm>=4.60",
+        "rosbags>=0.11,<0.12",
+    ],
+    extras_require={"test": ["pytest>=7", "ruff>=0.5"], "plot": ["matplotlib>=3.6"]},
+    zip_safe=True,
+    maintainer="mount_twin maintainers",
+    maintainer_email="mount_twin@example.com",
+    description="Real-time digital twin of a rigid machine on compliant mounts",
+    license="BSD-3-Clause",
+    tests_require=["pytest"],
+    entry_points={
+        "console_scripts": [
+            "mount_twin_node = mount_twin.ros.node:main",
+            "mount-twin = mount_twin.cli:main",
+        ],
+    },
+)
