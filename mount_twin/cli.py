@@ -51,8 +51,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     rp.add_argument("-o", "--output", required=True, help="output bag directory (new)")
     rp.add_argument("--chunk", type=int, default=2000, help="messages per engine batch")
     rp.add_argument("--no-progress", action="store_true")
+    rp.add_argument("--plot", metavar="PNG", help="also plot the outputs into this PNG")
     dm = sub.add_parser("demo", help="replay the bundled bag through the bundled default scene")
     dm.add_argument("-o", "--output", default="demo_out", help="output bag directory (new)")
+    dm.add_argument("--plot", metavar="PNG", help="also plot the outputs into this PNG")
     gen = sub.add_parser("generate", help="write a bag of a generated foundation motion")
     gen.add_argument("kind", choices=["half-sine", "ship-motion"])
     gen.add_argument("-o", "--output", required=True)
@@ -98,6 +100,10 @@ def _run(args: argparse.Namespace) -> int:
             load_scene_file(scene_path), bag, args.output, chunk=chunk, progress=progress
         )
         print(summary.text())
+        if args.plot:
+            from mount_twin.plot import plot_output_bag  # matplotlib only when asked for
+
+            print(f"plot: {plot_output_bag(args.output, args.plot, Path(scene_path).name)}")
         return 0
     if args.cmd == "generate":
         if args.kind == "half-sine":

@@ -6,6 +6,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from types import TracebackType
 
+import numpy as np
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag2 import StoragePlugin, Writer
 
@@ -131,3 +132,34 @@ def write_bag(
             writer.write(conn, stamp, raw)
             n += 1
     return n
+
+
+def read_topics(
+    path: str | Path, msgtypes: set[str]
+) -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
+    """Stamps (s) and numeric rows of every topic of the given types in a bag.
+
+    Rows: PoseStamped → (x, y, z, qx, qy, qz, qw); Vector3Stamped → (x, y, z);
+    WrenchStamped → (fx, fy, fz, tx, ty, tz).
+    """
+    out: dict[str, tuple[list[float], list[tuple[float, ...]], str]] = {}
+    with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
+        conns = [c for c in reader.connections if c.msgtype in msgtypes]
+        for conn, _, raw in reader.messages(connections=conns):
+            msg = reader.deserialize(raw, conn.msgtype)
+            stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+            stamps, rows, _ = out.setdefault(conn.topic, ([], [], conn.msgtype))
+            stamps.append(stamp)
+            rows.append(_numbers(msg))
+    return {k: (np.array(s), np.array(r), t) for k, (s, r, t) in out.items()}
+
+
+def _numbers(msg: object) -> tuple[float, ...]:
+    if hasattr(msg, "pose"):
+        p, q = msg.pose.position, msg.pose.orientation  # type: ignore[attr-defined]
+        return (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
+    if hasattr(msg, "wrench"):
+        f, t = msg.wrench.force, msg.wrench.torque  # type: ignore[attr-defined]
+        return (f.x, f.y, f.z, t.x, t.y, t.z)
+    v = msg.vector  # type: ignore[attr-defined]
+    return (v.x, v.y, v.z)
