@@ -32,7 +32,7 @@ def rotation_from_chart(
     Off the chart (cos θ ≤ 0) returns NaN and leaves `out` untouched.
     """
     c2 = cg * cg - sa * sa
-    if not c2 > 0.0:
+    if not (c2 > 0.0 and cg > 0.0):  # |γ| < π/2 too: cos γ < 0 would alias another attitude
         return math.nan
     ct = math.sqrt(c2)
     sb, cb = sa / cg, ct / cg

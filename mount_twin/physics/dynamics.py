@@ -29,6 +29,10 @@ from mount_twin.physics.rotations import rotation_vector
 
 OK = 0
 OFF_CHART = 1
+
+COS_TILT_MIN = 1.0e-6
+"""cos θ below which the state counts as off the chart: B grows like 1/cos θ and the reduced
+mass matrix loses positive definiteness in floating point long before cos θ reaches zero."""
 """Right-hand-side status: the attitude left the chart (cos θ ≤ 0)."""
 
 INPUT_SIZE = 13
@@ -129,8 +133,9 @@ def new_scratch() -> Scratch:
 def body_motion(y: np.ndarray, m: ModelArrays, s: Scratch) -> float:
     """Fill s.q, s.qd, s.trig, s.rot, s.kin, s.omega, s.omega_f, s.phi from y.
 
-    Returns cos θ (NaN off the chart). Kernels bind scratch arrays to locals once: every
-    attribute access on a tuple of arrays costs a reference-count round trip in numba.
+    Returns cos θ (NaN off the chart, i.e. at or below COS_TILT_MIN). Kernels bind scratch
+    arrays to locals once: every attribute access on a tuple of arrays costs a reference-count
+    round trip in numba.
     """
     q, qd, trig, rot, kin, omega, omega_f = s.q, s.qd, s.trig, s.rot, s.kin, s.omega, s.omega_f
     free_trans, free_rot, q_fixed = m.free_trans, m.free_rot, m.q_fixed
@@ -150,7 +155,7 @@ def body_motion(y: np.ndarray, m: ModelArrays, s: Scratch) -> float:
         trig[3 + i] = math.cos(q[3 + i])
     sa, sg, sd, ca, cg, cd = trig[0], trig[1], trig[2], trig[3], trig[4], trig[5]
     ct = rotation_from_chart(sa, sg, cg, sd, cd, rot)
-    if not ct > 0.0:
+    if not ct > COS_TILT_MIN:
         return math.nan
     kinematic_matrix(sa, ca, sg, cg, ct, kin)
     for i in range(3):
@@ -216,8 +221,8 @@ def rhs(
         big_w_dot[i] = u[10 + i]
     if nt > 0:
         _translational(m, s, dydt, nf)
-    if nr > 0:
-        _rotational(m, s, ct, dydt, nf + nt)
+    if nr > 0 and not _rotational(m, s, ct, dydt, nf + nt):
+        return OFF_CHART
     return OK
 
 
@@ -248,8 +253,11 @@ def _translational(m: ModelArrays, s: Scratch, dydt: np.ndarray, nf: int) -> Non
 
 
 @njit(cache=True, inline="always")
-def _rotational(m: ModelArrays, s: Scratch, ct: float, dydt: np.ndarray, first: int) -> None:
-    """Free rotational accelerations (projected Euler equations) into dydt[first:first + nr]."""
+def _rotational(m: ModelArrays, s: Scratch, ct: float, dydt: np.ndarray, first: int) -> bool:
+    """Free rotational accelerations (projected Euler equations) into dydt[first:first + nr].
+
+    Returns False if the reduced mass matrix is numerically singular (near the chart edge).
+    """
     rot, kin, kin_rate, qd, omega, trig = s.rot, s.kin, s.kin_rate, s.qd, s.omega, s.trig
     w, w_dot, total_m = s.big_w, s.big_w_dot, s.total_moment
     moment_b, w_b, w_dot_b, acc = s.moment_b, s.w_b, s.w_dot_b, s.acc
@@ -283,18 +291,22 @@ def _rotational(m: ModelArrays, s: Scratch, ct: float, dydt: np.ndarray, first: 
                 for j in range(3):
                     total += kin[i, ca] * inertia[i, j] * kin[j, cb]
             mass_rot[a, b] = total
-    _solve_spd(mass_rot, rhs_rot, nr)
+    if not _solve_spd(mass_rot, rhs_rot, nr):
+        return False
     for a in range(nr):
         dydt[first + a] = rhs_rot[a]
+    return True
 
 
 @njit(cache=True, inline="always")
-def _solve_spd(a: np.ndarray, b: np.ndarray, n: int) -> None:
-    """Solve a[:n, :n] x = b[:n] in place (Cholesky; a is symmetric positive definite)."""
+def _solve_spd(a: np.ndarray, b: np.ndarray, n: int) -> bool:
+    """Solve a[:n, :n] x = b[:n] in place (Cholesky); False if a is not positive definite."""
     for j in range(n):
         d = a[j, j]
         for k in range(j):
             d -= a[j, k] ** 2
+        if not d > 0.0:
+            return False
         d = math.sqrt(d)
         a[j, j] = d
         for i in range(j + 1, n):
@@ -312,6 +324,7 @@ def _solve_spd(a: np.ndarray, b: np.ndarray, n: int) -> None:
         for k in range(i + 1, n):
             e -= a[k, i] * b[k]
         b[i] = e / a[i, i]
+    return True
 
 
 @njit(cache=True)

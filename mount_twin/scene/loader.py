@@ -24,6 +24,9 @@ from mount_twin.scene.description import (
 from mount_twin.scene.reader import Reader
 
 INPUT_TYPES = ("sensor_msgs/msg/Imu", "geometry_msgs/msg/AccelStamped")
+START_TILT_MAX_RAD = 1.55
+"""Largest tilt θ of a given start pose, rad (88.8°): the chart degenerates at π/2."""
+
 MOUNT_KINDS = ("linear",)
 STEPPERS = ("dopri54",)
 
@@ -164,9 +167,14 @@ def _initial(r: Reader) -> InitialState:
         pose=r.vector("pose", 6, d.pose),  # type: ignore[arg-type]
         velocity=r.vector("velocity", 6, d.velocity),  # type: ignore[arg-type]
     )
-    tilt_cos_sq = math.cos(state.pose[4]) ** 2 - math.sin(state.pose[3]) ** 2
-    if tilt_cos_sq <= 0.0:
-        raise r.error("pose", f"α, γ outside the chart (|α| + |γ| must be < π/2): {state.pose!r}")
+    alpha, gamma = state.pose[3], state.pose[4]
+    cos_tilt = math.sqrt(max(math.cos(gamma) ** 2 - math.sin(alpha) ** 2, 0.0))
+    if not (math.cos(gamma) > 0.0 and cos_tilt > math.cos(START_TILT_MAX_RAD)):
+        raise r.error(
+            "pose",
+            f"α = {alpha!r}, γ = {gamma!r} rad tilt the body past {START_TILT_MAX_RAD} rad, "
+            "where the α/γ/δ chart degenerates (it needs |α| + |γ| < π/2 with a margin)",
+        )
     r.finish()
     return state
 
