@@ -39,4 +39,4 @@ class TwinStream:
             self.base = TimeBase.at(int(decoded.stamps_ns[0]))
         out = self.engine.push(decoded.batch(self.base))
         self.last_outputs = out
-        return encode_outputs(self.scene, out, self.base)
+        return encode_outputs(self.scene, out, decoded.stamps_ns)

@@ -52,9 +52,10 @@ class HealthStatus:
 
 @dataclass
 class HealthReport:
-    """Diagnostics at one stamp (s)."""
+    """Diagnostics at one stamp (s), due once sample `sample` of the pushed batch is processed."""
 
     stamp: float
+    sample: int
     statuses: list[HealthStatus]
 
 
@@ -64,6 +65,8 @@ class OutputBatch:
 
     Attributes:
         stamps: (k,) input stamps the rows answer, s.
+        sample: (k,) position of each row's sample in the pushed SampleBatch (so adapters can
+            reuse the exact input stamps).
         pose: (k, 10) CG position in F (m), quaternion (x, y, z, w) of R, (α, γ, δ) rad.
         wrenches: (k, n_mounts, 6) force (N) and couple (N·m) on the body in mount axes; with
             decimation, each component's largest magnitude since the previous row.
@@ -71,6 +74,7 @@ class OutputBatch:
     """
 
     stamps: np.ndarray
+    sample: np.ndarray
     pose: np.ndarray
     wrenches: np.ndarray
     health: list[HealthReport] = field(default_factory=list)

@@ -11,18 +11,44 @@ import time
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from mount_twin.engine.batch import OutputBatch, SampleBatch
 from mount_twin.engine.health import HealthWindow
 from mount_twin.engine.kernel import run_samples
+from mount_twin.errors import ModelError
 from mount_twin.integrate.stepper import STATUS_TEXT, STEPPERS
 from mount_twin.model.assemble import Model, initial_state
 from mount_twin.physics.dynamics import INPUT_SIZE, evaluate
 
-ACCEPT, RESTART = "accept", "restart"
-"""Sample classes besides the rejection reasons: take it, or restart the twin at it."""
+ACCEPT, START, JUMPED_BACK, GAP_RESET, GAP_BRIDGED = (
+    "accept",
+    "start",
+    "jumped_back",
+    "gap_reset",
+    "gap_bridged",
+)
+"""Verdicts on a sample besides the rejection reasons (non_finite, wrong_frame, ...)."""
+
+_RESTARTS = frozenset((START, JUMPED_BACK, GAP_RESET))
+_COUNTS = {
+    ACCEPT: ("accepted",),
+    START: ("accepted",),
+    JUMPED_BACK: ("accepted", "reset_stamp_jumped_back"),
+    GAP_RESET: ("accepted", "gaps"),
+    GAP_BRIDGED: ("accepted", "gaps"),
+}
+"""Counters each taken verdict increments; a rejection increments rejected_<reason>."""
+
+
+class _Rows(NamedTuple):
+    """Published rows: positions of their samples in the pushed batch, poses, wrenches."""
+
+    sample: np.ndarray
+    pose: np.ndarray
+    wrenches: np.ndarray
 
 
 @dataclass
@@ -56,9 +82,12 @@ class TwinEngine:
         self._peak = np.zeros((model.n_mounts, 6))
         self._counter = np.zeros(1, dtype=np.int64)
         self._last: tuple[float, np.ndarray, np.ndarray] | None = None
+        self._last_stamp: float | None = None
         self._gravity_up = np.array([0.0, 0.0, scene.input.g])
         self.counts: Counter[str] = Counter()
         self.health = HealthWindow(scene, self.stepper.name)
+        # Fails now, at load, if the mounts cannot hold the body; and is the restart fallback.
+        self._y_nominal = initial_state(model, self._gravity_up)
         self._warm_up()
 
     def _warm_up(self) -> None:
@@ -106,22 +135,38 @@ class TwinEngine:
         self.counts[what] += n
 
     def push(self, batch: SampleBatch) -> OutputBatch:
-        """Process samples in arrival order; return what is to be published for them."""
-        wall0 = self._clock()
+        """Process samples in arrival order; return what is to be published for them.
+
+        Diagnostics come at the stamps where they would for one sample per push, so a replay in
+        chunks publishes what the live node does.
+        """
         f, w = self._to_foundation(batch)
-        parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
-        for run in self._runs(batch, f, w):
-            parts.extend(self._integrate(run, batch.stamps, f, w))
-        stamps = np.concatenate([p[0] for p in parts]) if parts else np.zeros(0)
-        pose = np.concatenate([p[1] for p in parts]) if parts else np.zeros((0, 10))
-        wrenches = (
-            np.concatenate([p[2] for p in parts])
-            if parts
-            else np.zeros((0, self.model.n_mounts, 6))
+        verdicts, due = self._classify(batch, f, w)
+        parts: list[_Rows] = []
+        reports = []
+        start = 0
+        for stop, report_due in [*((i + 1, True) for i in due), (len(batch), False)]:
+            wall0 = self._clock()
+            self._count(verdicts[start:stop])
+            first = len(parts)
+            for run in self._runs(verdicts, start, stop):
+                parts.extend(self._integrate(run, batch.stamps, f, w))
+            for rows in parts[first:]:
+                self.health.add_outputs(batch.stamps[rows.sample], rows.pose)
+            self.health.add_wall(self._clock() - wall0)
+            if report_due:
+                stamp = float(batch.stamps[stop - 1])
+                reports.append(self.health.report(stamp, stop - 1, self.counts))
+            start = stop
+        nm = self.model.n_mounts
+        sample = np.concatenate([r.sample for r in parts]) if parts else np.zeros(0, np.intp)
+        return OutputBatch(
+            batch.stamps[sample],
+            sample,
+            np.concatenate([r.pose for r in parts]) if parts else np.zeros((0, 10)),
+            np.concatenate([r.wrenches for r in parts]) if parts else np.zeros((0, nm, 6)),
+            reports,
         )
-        self.health.add_outputs(stamps, pose)
-        reports = self.health.due(self._clock() - wall0, self.counts)
-        return OutputBatch(stamps, pose, wrenches, reports)
 
     def _to_foundation(self, batch: SampleBatch) -> tuple[np.ndarray, np.ndarray]:
         """Specific force (m/s²) and Ω (rad/s) in F, per sample."""
@@ -131,49 +176,66 @@ class TwinEngine:
             f = f + self._gravity_up
         return f, batch.gyro @ rot.T
 
-    def _runs(self, batch: SampleBatch, f: np.ndarray, w: np.ndarray) -> list[_Run]:
-        """Classify each sample; group the accepted ones into runs split at restarts."""
+    def _classify(
+        self, batch: SampleBatch, f: np.ndarray, w: np.ndarray
+    ) -> tuple[list[str], list[int]]:
+        """Verdict on each sample, and the samples after which diagnostics are due."""
         spec = self.scene.input
         finite = (
             np.isfinite(batch.stamps) & np.isfinite(f).all(axis=1) & np.isfinite(w).all(axis=1)
         )
-        runs: list[_Run] = []
-        last_t = self._last[0] if self._last is not None else None
-        for i in range(len(batch)):
-            self.counts["received"] += 1
-            t = float(batch.stamps[i])
+        verdicts: list[str] = []
+        due: list[int] = []
+        last_t = self._last_stamp
+        for i, t in enumerate(batch.stamps.tolist()):
             if not finite[i]:
                 verdict = "non_finite"
             elif spec.frame_id and batch.frame_ids[i] != spec.frame_id:
                 verdict = "wrong_frame"
             elif last_t is None:
-                verdict = RESTART
+                verdict = START
             elif t == last_t:
                 verdict = "duplicate_stamp"
             elif t < last_t - spec.back_jump_reset_s:
-                self.counts["reset_stamp_jumped_back"] += 1
-                verdict = RESTART
+                verdict = JUMPED_BACK
             elif t < last_t:
                 verdict = "stamp_went_back"
             elif t - last_t > spec.max_gap_s:
-                self.counts["gaps"] += 1
-                verdict = RESTART if spec.gap_policy == "reset" else ACCEPT
+                verdict = GAP_RESET if spec.gap_policy == "reset" else GAP_BRIDGED
             else:
                 verdict = ACCEPT
-            if verdict not in (ACCEPT, RESTART):
-                self.counts[f"rejected_{verdict}"] += 1
+            verdicts.append(verdict)
+            if verdict in _COUNTS:
+                last_t = t
+                if self.health.tick(t):
+                    due.append(i)
+        self._last_stamp = last_t
+        return verdicts, due
+
+    def _count(self, verdicts: list[str]) -> None:
+        counts = self.counts
+        counts["received"] += len(verdicts)
+        for verdict, n in Counter(verdicts).items():
+            for key in _COUNTS.get(verdict, (f"rejected_{verdict}",)):
+                counts[key] += n
+
+    @staticmethod
+    def _runs(verdicts: list[str], start: int, stop: int) -> list[_Run]:
+        """Group the taken samples in [start, stop) into runs split at restarts."""
+        runs: list[_Run] = []
+        for i in range(start, stop):
+            verdict = verdicts[i]
+            if verdict not in _COUNTS:
                 continue
-            self.counts["accepted"] += 1
-            last_t = t
-            if verdict == RESTART or not runs:
-                runs.append(_Run([i], verdict == RESTART))
+            if verdict in _RESTARTS or not runs:
+                runs.append(_Run([i], verdict in _RESTARTS))
             else:
                 runs[-1].index.append(i)
         return runs
 
     def _integrate(
         self, run: _Run, stamps: np.ndarray, f: np.ndarray, w: np.ndarray
-    ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    ) -> list[_Rows]:
         """Integrate one run; on a stepper failure restart at the next sample."""
         out = []
         index = run.index
@@ -214,8 +276,8 @@ class TwinEngine:
             self.health.add_steps(step_log[1 : done + 1])
             if done > 0:
                 self._last = (float(t[done]), ff[done], ww[done])
-            keep = np.flatnonzero(publish[: done + 1])
-            out.append((t[keep], pose[keep], wrenches[keep]))
+            keep = np.flatnonzero(publish[: done + 1])  # never row 0: the previous sample
+            out.append(_Rows(np.asarray(index)[keep - 1], pose[keep], wrenches[keep]))
             if status == 0:
                 break
             self.counts["integration_failures"] += 1
@@ -228,16 +290,23 @@ class TwinEngine:
             index = rest[1:]
         return out
 
-    def _start(
-        self, i: int, stamps: np.ndarray, f: np.ndarray, w: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _start(self, i: int, stamps: np.ndarray, f: np.ndarray, w: np.ndarray) -> _Rows:
         """(Re)start the twin at sample i; its outputs are published."""
-        init = self.scene.initial
-        gravity = f[i] if init.gravity == "first_sample" else self._gravity_up
         if self._last is not None or self.counts["starts"]:
             self.counts["restarts"] += 1
         self.counts["starts"] += 1
-        self._y = initial_state(self.model, gravity)
+        self._y = self._y_nominal.copy()
+        if self.scene.initial.gravity == "first_sample":
+            try:
+                self._y = initial_state(self.model, f[i])
+            except ModelError:
+                # Restarting inside a shock: no equilibrium holds under that load.
+                self.counts["starts_at_nominal_gravity"] += 1
+                self.health.failure(
+                    float(stamps[i]),
+                    f"no static equilibrium under the start sample's specific force "
+                    f"{np.linalg.norm(f[i]):.4g} m/s²: started from rest under nominal gravity",
+                )
         self.stepper.reset()
         self._peak[:] = 0.0
         self._counter[0] = 0
@@ -247,4 +316,4 @@ class TwinEngine:
         if not math.isfinite(ct):
             msg = f"{self.scene.source}: initial_state.pose is off the α/γ/δ chart"
             raise ValueError(msg)
-        return np.array([stamps[i]]), pose, wrenches
+        return _Rows(np.array([i]), pose, wrenches)

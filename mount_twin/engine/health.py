@@ -55,25 +55,35 @@ class HealthWindow:
             self.t_first = float(stamps[0])
         self.t_last = float(stamps[-1])
         self.tilt_max = max(self.tilt_max, float(tilt_from_quaternions(pose[:, 3:7]).max()))
-        if self._next_due is None:
-            self._next_due = float(stamps[0]) + self.period
+
+    def add_wall(self, wall_s: float) -> None:
+        """Wall time spent on the samples of this window, s."""
+        self.wall += wall_s
 
     def failure(self, stamp: float, text: str) -> None:
-        """A stepper failure at `stamp` (s)."""
+        """A stepper failure (or a forced start) at `stamp` (s)."""
         self.failures.append((stamp, text))
 
-    def due(self, wall_s: float, counts: Counter[str]) -> list[HealthReport]:
-        """Reports due after a batch that took `wall_s` of wall time (at most one per batch)."""
-        self.wall += wall_s
-        if self._next_due is None or math.isnan(self.t_last) or self.t_last < self._next_due:
-            return []
-        report = self.report(counts)
-        self._next_due = self.t_last + self.period
-        self._reset()
-        return [report]
+    def tick(self, stamp: float) -> bool:
+        """An accepted sample at `stamp` (s): is a report due once it is processed?
 
-    def report(self, counts: Counter[str]) -> HealthReport:
-        """Statuses for the window so far (cumulative counts plus this window's figures)."""
+        Reports come one period of stamps apart; a stamp before the current window (a bag
+        played in a loop) starts the cadence afresh.
+        """
+        if self._next_due is None or stamp < self._next_due - self.period:
+            self._next_due = stamp + self.period
+            return False
+        if stamp < self._next_due:
+            return False
+        self._next_due = stamp + self.period
+        return True
+
+    def report(self, stamp: float, sample: int, counts: Counter[str]) -> HealthReport:
+        """Statuses at `stamp` (s), after pushed sample `sample`, for the window so far, which
+        then starts anew.
+
+        Counts are cumulative; rejections, gaps and stepper figures are this window's.
+        """
         new = counts - self._last_counts
         self._last_counts = counts.copy()
         span = self.t_last - self.t_first
@@ -122,4 +132,5 @@ class HealthWindow:
             else "ok",
             {"tilt_max_rad": f"{self.tilt_max:.6g}"},
         )
-        return HealthReport(self.t_last, [inp, step, att])
+        self._reset()
+        return HealthReport(stamp, sample, [inp, step, att])

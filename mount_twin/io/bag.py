@@ -35,10 +35,10 @@ class InputBag:
             raise BagError(msg) from err
         conns = [c for c in self._reader.connections if c.topic == topic]
         if not conns:
-            self._reader.close()
             have = ", ".join(
                 sorted({f"{c.topic} ({c.msgtype})" for c in self._reader.connections})
             )
+            self._reader.close()  # after listing: a closed reader has no connections
             msg = f"{self.path}: no topic {topic!r} (input.topic); the bag has: {have}"
             raise BagError(msg)
         wrong = [c.msgtype for c in conns if c.msgtype != msgtype]

@@ -30,7 +30,11 @@ DIAGNOSTICS = "diagnostic_msgs/msg/DiagnosticArray"
 @dataclass(frozen=True)
 class TimeBase:
     """Stamps as float seconds from an integer-second origin, so float64 keeps ~1e-11 s
-    resolution (an epoch stamp as float64 would keep only ~0.2 µs)."""
+    resolution near the origin (an epoch stamp as float64 would keep only ~0.2 µs).
+
+    The conversion is one way: outputs reuse the integer input stamps (`encode_outputs`), so
+    no stamp is ever rebuilt from float seconds.
+    """
 
     origin_ns: int
 
@@ -42,10 +46,6 @@ class TimeBase:
     def seconds(self, stamp_ns: np.ndarray) -> np.ndarray:
         """Float seconds since the origin."""
         return (stamp_ns - self.origin_ns) * 1e-9
-
-    def nanoseconds(self, seconds: np.ndarray) -> np.ndarray:
-        """Stamps back in integer nanoseconds (exact for stamps that came from `seconds`)."""
-        return self.origin_ns + np.rint(np.asarray(seconds) * 1e9).astype(np.int64)
 
 
 def stamp_ns(header: object) -> int:
@@ -134,17 +134,30 @@ def resolve(name: str, node_name: str, namespace: str = "/") -> str:
     return name if name.startswith("/") else f"{ns}/{name}"
 
 
-def encode_outputs(scene: Scene, out: OutputBatch, base: TimeBase) -> list[tuple[str, int, bytes]]:
-    """CDR messages for an output batch as (unresolved topic, stamp ns, bytes), in stamp order.
+def encode_outputs(
+    scene: Scene, out: OutputBatch, stamps_ns: np.ndarray
+) -> list[tuple[str, int, bytes]]:
+    """CDR messages for an output batch as (unresolved topic, stamp ns, bytes), in the order the
+    samples were processed; each diagnostics report follows the sample it was due at.
+
+    Args:
+        stamps_ns: (n,) header stamps of the pushed samples, integer ns; rows reuse them, so
+            output stamps equal input stamps exactly however long the twin runs.
 
     Only the outputs the scene enables are built: unused outputs cost nothing.
     """
     topics = output_topics(scene)
     frames, opts = scene.frames, scene.outputs
-    stamps = base.nanoseconds(out.stamps)
     ser = TYPESTORE.serialize_cdr
     msgs: list[tuple[str, int, bytes]] = []
-    for k, stamp in enumerate(stamps.tolist()):
+    reports = iter(out.health)
+    report = next(reports, None)
+    for k, (sample, stamp) in enumerate(
+        zip(out.sample.tolist(), stamps_ns[out.sample].tolist(), strict=True)
+    ):
+        while report is not None and report.sample < sample:
+            msgs.append(_diagnostics(report, int(stamps_ns[report.sample]), topics.diagnostics))
+            report = next(reports, None)
         row = out.pose[k]
         if opts.pose:
             pose = _T["geometry_msgs/msg/Pose"](
@@ -171,13 +184,15 @@ def encode_outputs(scene: Scene, out: OutputBatch, base: TimeBase) -> list[tuple
                 )
                 msg = _T[WRENCH](header=_header(stamp, mount.name), wrench=wrench)
                 msgs.append((topic, stamp, ser(msg, WRENCH)))
-    for report in out.health:
-        stamp = int(base.nanoseconds(np.array([report.stamp]))[0])
-        msgs.append(
-            (topics.diagnostics, stamp, ser(diagnostics_message(report, stamp), DIAGNOSTICS))
-        )
-    msgs.sort(key=lambda m: m[1])
+    while report is not None:
+        msgs.append(_diagnostics(report, int(stamps_ns[report.sample]), topics.diagnostics))
+        report = next(reports, None)
     return msgs
+
+
+def _diagnostics(report: HealthReport, stamp_ns: int, topic: str) -> tuple[str, int, bytes]:
+    msg = diagnostics_message(report, stamp_ns)
+    return topic, stamp_ns, TYPESTORE.serialize_cdr(msg, DIAGNOSTICS)
 
 
 def diagnostics_message(report: HealthReport, stamp_ns: int) -> object:
