@@ -1,0 +1,137 @@
+"""Shared helpers for the mount_twin tests (plain functions, no fixtures: there is no conftest)."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections import defaultdict
+from collections.abc import Iterable, Sequence
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from rosbags.highlevel import AnyReader
+
+from mount_twin.engine.batch import SampleBatch
+from mount_twin.engine.engine import TwinEngine
+from mount_twin.io.messages import TYPESTORE
+from mount_twin.model.assemble import Model, assemble
+from mount_twin.scene import Scene, load_scene_file
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = ROOT / "config"
+SCENE_FILE = CONFIG / "pump_8_mounts.scene.yaml"
+PARAMS_FILE = CONFIG / "params.yaml"
+REAL_DIR = ROOT.parent / "shared" / "data" / "real"
+G = 9.80665
+REST = np.array([0.0, 0.0, G])
+"""Specific force of a foundation at rest, m/s², in F (gravity included: +g up)."""
+
+
+@cache
+def default_scene() -> Scene:
+    """config/pump_8_mounts.scene.yaml, loaded once."""
+    return load_scene_file(SCENE_FILE)
+
+
+@cache
+def default_model() -> Model:
+    """The default scene assembled once (a Model is immutable)."""
+    return assemble(default_scene())
+
+
+def params_yaml() -> dict[str, Any]:
+    """config/params.yaml as rcl reads it for the node named mount_twin."""
+    return yaml.safe_load(PARAMS_FILE.read_text(encoding="utf-8"))["mount_twin"]["ros__parameters"]
+
+
+def scene_with(scene: Scene | None = None, **sections: dict[str, Any]) -> Scene:
+    """A copy of `scene` (default scene if None) with fields of its sections replaced, e.g.
+    scene_with(input={"gap_policy": "bridge"}, outputs={"decimation": 4})."""
+    scene = scene or default_scene()
+    changes = {}
+    for section, fields in sections.items():
+        changes[section] = dataclasses.replace(getattr(scene, section), **fields)
+    return dataclasses.replace(scene, **changes)
+
+
+def engine_for(scene: Scene | None = None) -> TwinEngine:
+    """A fresh engine; reuses the assembled default model when the scene is the default one."""
+    if scene is None or scene == default_scene():
+        return TwinEngine(default_model())
+    return TwinEngine(assemble(scene))
+
+
+def batch(
+    stamps: Sequence[float] | np.ndarray,
+    accel: np.ndarray | None = None,
+    gyro: np.ndarray | None = None,
+    frame_ids: Sequence[str] | str = "deck_imu",
+) -> SampleBatch:
+    """Samples at `stamps` (s); a foundation at rest unless accel/gyro are given."""
+    stamps = np.asarray(stamps, dtype=float)
+    n = stamps.shape[0]
+    accel = (
+        np.tile(REST, (n, 1)) if accel is None else np.asarray(accel, dtype=float).reshape(n, 3)
+    )
+    gyro = np.zeros((n, 3)) if gyro is None else np.asarray(gyro, dtype=float).reshape(n, 3)
+    fids = [frame_ids] * n if isinstance(frame_ids, str) else list(frame_ids)
+    return SampleBatch(stamps, accel, gyro, fids)
+
+
+def split(b: SampleBatch, sizes: Iterable[int]) -> list[SampleBatch]:
+    """Cut a batch into consecutive pieces of the given sizes (the rest is one last piece)."""
+    out, i = [], 0
+    for size in sizes:
+        if i >= len(b):
+            break
+        out.append(
+            SampleBatch(
+                b.stamps[i : i + size],
+                b.accel[i : i + size],
+                b.gyro[i : i + size],
+                b.frame_ids[i : i + size],
+            )
+        )
+        i += size
+    if i < len(b):
+        out.append(SampleBatch(b.stamps[i:], b.accel[i:], b.gyro[i:], b.frame_ids[i:]))
+    return out
+
+
+def read_bag(path: Path) -> tuple[dict[str, str], dict[str, list[tuple[int, Any]]]]:
+    """(topic → msgtype, topic → [(log time ns, deserialized message)]) of a bag."""
+    types: dict[str, str] = {}
+    msgs: dict[str, list[tuple[int, Any]]] = defaultdict(list)
+    with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
+        for conn in reader.connections:
+            types[conn.topic] = conn.msgtype
+        for conn, t, raw in reader.messages():
+            msgs[conn.topic].append((t, reader.deserialize(raw, conn.msgtype)))
+    return types, dict(msgs)
+
+
+def read_raw(
+    path: Path, topics: Sequence[str] | None = None
+) -> dict[str, list[tuple[int, bytes]]]:
+    """topic → [(log time ns, raw CDR bytes)] of a bag (optionally only some topics)."""
+    out: dict[str, list[tuple[int, bytes]]] = defaultdict(list)
+    with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
+        conns = [c for c in reader.connections if topics is None or c.topic in topics]
+        for conn, t, raw in reader.messages(connections=conns):
+            out[conn.topic].append((t, bytes(raw)))
+    return dict(out)
+
+
+def stamp_ns(msg: Any) -> int:
+    """header.stamp of a deserialized message, ns."""
+    return int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec)
+
+
+def mount_forces_in_f(scene: Scene, wrenches: np.ndarray) -> np.ndarray:
+    """(k, n_mounts, 3) mount forces rotated from mount axes into F (at the reference pose)."""
+    from mount_twin.physics.rotations import rpy_matrix
+
+    axes = np.array([rpy_matrix(*m.orientation_rpy) for m in scene.mounts])  # columns: axes in F
+    return np.einsum("nij,knj->kni", axes, wrenches[..., :3])

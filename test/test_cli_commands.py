@@ -1,0 +1,258 @@
+"""The `mount-twin` command line: demo, generate, import-csv, replay, and its error exits."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from io_helpers import REAL_DIR, SCENE_FILE, read_bag, stamp_ns
+from rosbags.highlevel import AnyReader
+
+from mount_twin.cli import main
+from mount_twin.io.messages import IMU, TYPESTORE
+
+WATER_ENTRY = REAL_DIR / "water_entry_shock_20khz.csv"
+
+
+def _scene_file(tmp_path: Path, **input_changes: object) -> Path:
+    data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
+    data["input"].update(input_changes)
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    return path
+
+
+def test_demo_replays_the_bundled_bag_and_prints_a_summary(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "demo_out"
+    assert main(["demo", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "real-time factor" in text
+    assert "5000 received, 5000 accepted" in text and "integration failures: 0" in text
+    assert "diagnostics: mount_twin: input: ok" in text
+    assert list(out.glob("*.mcap")), "demo must write an mcap bag"
+    with AnyReader([out], default_typestore=TYPESTORE) as reader:  # counts only: 50k messages
+        counts = {c.topic: c.msgcount for c in reader.connections}
+    assert counts["/mount_twin/pose"] == counts["/mount_twin/mounts/fl/wrench"] == 5000
+    assert counts["/diagnostics"] >= 1
+
+
+def test_demo_refuses_an_existing_output_with_exit_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["demo", "-o", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("mount-twin: error: ") and f"{tmp_path}: output bag exists" in err
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_generate_half_sine_writes_the_requested_bag(
+    tmp_path: Path, storage: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "hs"
+    rc = main(
+        [
+            "generate",
+            "half-sine",
+            "-o",
+            str(out),
+            "--rate",
+            "2000",
+            "--duration",
+            "0.1",
+            "--peak",
+            "100.0",
+            "--pulse",
+            "0.004",
+            "--start",
+            "5000000000",
+            "--storage",
+            storage,
+            "--topic",
+            "/t",
+            "--frame-id",
+            "f",
+        ]
+    )
+    assert rc == 0
+    assert "wrote 200 sensor_msgs/msg/Imu messages on /t" in capsys.readouterr().out
+    types, msgs = read_bag(out)
+    assert types == {"/t": IMU}
+    stamps = [stamp_ns(m) for _, m in msgs["/t"]]
+    assert stamps == [5_000_000_000 + k * 500_000 for k in range(200)]
+    az = np.array([m.linear_acceleration.z for _, m in msgs["/t"]])
+    assert az.max() == pytest.approx(9.80665 + 100.0, abs=1e-9)
+    assert {m.header.frame_id for _, m in msgs["/t"]} == {"f"}
+
+
+def test_import_csv_writes_one_imu_message_per_row(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    csv = tmp_path / "small.csv"
+    rows = np.array(
+        [
+            [0.000, 0.1, 0.2, 9.8, 0.01, 0.02, 0.03],
+            [0.001, 0.2, 0.3, 9.9, 0.02, 0.03, 0.04],
+            [0.002, -0.1, 0.0, 9.7, 0.0, -0.01, 0.0],
+            [0.0035, 1.5, -2.5, 12.25, 0.5, 0.25, -0.125],
+        ]
+    )
+    csv.write_text(
+        "t,ax,ay,az,wx,wy,wz\n"
+        + "\n".join(",".join(repr(float(v)) for v in r) for r in rows)
+        + "\n"
+    )
+    out = tmp_path / "bag"
+    assert main(["import-csv", str(csv), "-o", str(out), "--offset", "1700000000000000000"]) == 0
+    assert "wrote 4 sensor_msgs/msg/Imu messages on /imu/data" in capsys.readouterr().out
+    types, msgs = read_bag(out)
+    assert types == {"/imu/data": IMU}
+    got = msgs["/imu/data"]
+    assert [stamp_ns(m) for _, m in got] == [
+        1_700_000_000_000_000_000 + round(t * 1e9) for t in rows[:, 0]
+    ]
+    assert {m.header.frame_id for _, m in got} == {"imu_link"}
+    accel = [
+        [m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z] for _, m in got
+    ]
+    gyro = [[m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z] for _, m in got]
+    np.testing.assert_array_equal(accel, rows[:, 1:4])
+    np.testing.assert_array_equal(gyro, rows[:, 4:7])
+
+
+def test_import_csv_with_a_wrong_header_exits_2_naming_the_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    csv = tmp_path / "bad.csv"
+    csv.write_text("time,ax,ay,az\n0.0,1.0,2.0,3.0\n")
+    assert main(["import-csv", str(csv), "-o", str(tmp_path / "bag")]) == 2
+    err = capsys.readouterr().err
+    assert f"{csv}: header is time,ax,ay,az; expected t,ax,ay,az,wx,wy,wz" in err
+    assert not (tmp_path / "bag").exists()
+
+
+def test_import_csv_of_a_missing_file_exits_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["import-csv", str(tmp_path / "none.csv"), "-o", str(tmp_path / "bag")]) == 2
+    assert "mount-twin: error:" in capsys.readouterr().err
+
+
+def test_replay_with_a_bad_scene_path_exits_2_naming_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag = tmp_path / "in"
+    assert main(["generate", "ship-motion", "-o", str(bag), "--duration", "0.01"]) == 0
+    missing = tmp_path / "missing.scene.yaml"
+    rc = main(
+        ["replay", str(bag), "--scene", str(missing), "-o", str(tmp_path / "out"), "--no-progress"]
+    )
+    assert rc == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"mount-twin: error: {missing}: <file>: cannot read")
+    assert not (tmp_path / "out").exists()
+
+
+def test_replay_with_a_bad_scene_value_exits_2_naming_key_and_value(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = _scene_file(tmp_path, hold="cubic")
+    rc = main(
+        ["replay", str(tmp_path / "whatever"), "--scene", str(scene), "-o", str(tmp_path / "out")]
+    )
+    assert rc == 2
+    assert (
+        f"{scene}: input.hold: expected one of first_order, zero_order, got 'cubic'"
+        in capsys.readouterr().err
+    )
+
+
+def test_replay_of_a_bag_without_the_input_topic_exits_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag = tmp_path / "in"
+    assert (
+        main(
+            ["generate", "ship-motion", "-o", str(bag), "--duration", "0.01", "--topic", "/other"]
+        )
+        == 0
+    )
+    rc = main(
+        [
+            "replay",
+            str(bag),
+            "--scene",
+            str(SCENE_FILE),
+            "-o",
+            str(tmp_path / "out"),
+            "--no-progress",
+        ]
+    )
+    assert rc == 2
+    assert f"{bag}: no topic '/deck/imu'" in capsys.readouterr().err
+
+
+def test_unknown_subcommand_is_an_argparse_error() -> None:
+    with pytest.raises(SystemExit, match="2"):
+        main(["fly"])
+
+
+def test_imported_small_csv_replays_through_a_scene_with_matching_input(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    n = 400
+    t = np.arange(n) / 1000.0
+    accel = np.tile([0.0, 0.0, 9.80665], (n, 1))
+    accel[100:110, 2] += 50.0
+    csv = tmp_path / "shock.csv"
+    np.savetxt(
+        csv,
+        np.column_stack([t, accel, np.zeros((n, 3))]),
+        delimiter=",",
+        header="t,ax,ay,az,wx,wy,wz",
+        comments="",
+    )
+    bag = tmp_path / "bag"
+    assert main(["import-csv", str(csv), "-o", str(bag), "--offset", "1000000000"]) == 0
+    scene = _scene_file(tmp_path, topic="/imu/data", frame_id="imu_link")
+    out = tmp_path / "out"
+    assert main(["replay", str(bag), "--scene", str(scene), "-o", str(out), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert f"{n} received, {n} accepted" in text and "rejected: none" in text
+    _, msgs = read_bag(out)
+    assert [stamp_ns(m) for _, m in msgs["/mount_twin/pose"]] == [
+        1_000_000_000 + k * 1_000_000 for k in range(n)
+    ]
+
+
+@pytest.mark.skipif(not WATER_ENTRY.exists(), reason=f"{WATER_ENTRY} not present")
+def test_water_entry_csv_imports_and_replays(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag = tmp_path / "water_entry"
+    assert main(["import-csv", str(WATER_ENTRY), "-o", str(bag)]) == 0
+    assert "wrote 19999 sensor_msgs/msg/Imu messages on /imu/data" in capsys.readouterr().out
+    # Only the pose is needed here: keep the output small (20 kHz × 10 topics is 200k messages).
+    data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
+    data["input"].update(topic="/imu/data", frame_id="imu_link")
+    data["outputs"].update(angles=False, wrenches=False)
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    out = tmp_path / "out"
+    assert main(["replay", str(bag), "--scene", str(scene), "-o", str(out), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "19999 received, 19999 accepted" in text
+    assert "gaps: 0, restarts: 0, integration failures: 0" in text
+    _, msgs = read_bag(out)
+    pos = np.array(
+        [
+            [m.pose.position.x, m.pose.position.y, m.pose.position.z]
+            for _, m in msgs["/mount_twin/pose"]
+        ]
+    )
+    assert pos.shape == (19999, 3) and np.isfinite(pos).all()
+    disp = np.linalg.norm(pos - np.array(data["body"]["cg"]), axis=1).max()
+    assert disp < 0.2, f"a 47 g, ms-long shock moved the CG by {disp} m"

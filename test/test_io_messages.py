@@ -1,0 +1,288 @@
+"""Messages ↔ engine data through the Jazzy typestore: decoding, encoding, time base, frames."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from io_helpers import REST, G, batch, default_scene, engine_for, scene_with, stamp_ns
+
+from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus, OutputBatch
+from mount_twin.io.messages import (
+    ACCEL,
+    DIAGNOSTICS,
+    IMU,
+    POSE,
+    TYPESTORE,
+    VECTOR3,
+    WRENCH,
+    TimeBase,
+    decode_inputs,
+    encode_outputs,
+    imu_messages,
+    output_topics,
+    output_types,
+    resolve,
+)
+from mount_twin.stream import TwinStream
+
+T = TYPESTORE.types
+START_NS = 1_700_000_000_123_456_789
+
+
+def accel_messages(stamps: np.ndarray, linear: np.ndarray, frame_id: str) -> list[bytes]:
+    out = []
+    for stamp, a in zip(stamps.tolist(), linear, strict=True):
+        sec, nanosec = divmod(stamp, 1_000_000_000)
+        header = T["std_msgs/msg/Header"](
+            stamp=T["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec), frame_id=frame_id
+        )
+        vec = T["geometry_msgs/msg/Vector3"]
+        accel = T["geometry_msgs/msg/Accel"](
+            linear=vec(x=float(a[0]), y=float(a[1]), z=float(a[2])),
+            angular=vec(x=0.5, y=0.5, z=0.5),
+        )
+        out.append(bytes(TYPESTORE.serialize_cdr(T[ACCEL](header=header, accel=accel), ACCEL)))
+    return out
+
+
+def rng_signal(n: int, seed: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    stamps = START_NS + np.cumsum(rng.integers(900_000, 1_100_000, n)).astype(np.int64)
+    accel = REST + rng.normal(0.0, 0.5, (n, 3))
+    gyro = rng.normal(0.0, 0.05, (n, 3))
+    return stamps, accel, gyro
+
+
+# --------------------------------------------------------------------------- decoding
+
+
+def test_imu_messages_decode_back_to_the_same_stamps_vectors_and_frames() -> None:
+    stamps, accel, gyro = rng_signal(50)
+    raws = [raw for _, raw in imu_messages(stamps, accel, gyro, "deck_imu")]
+    dec = decode_inputs(raws, IMU)
+    assert dec.undecodable == 0
+    np.testing.assert_array_equal(dec.stamps_ns, stamps)
+    np.testing.assert_array_equal(dec.accel, accel)  # float64 through CDR: bit exact
+    np.testing.assert_array_equal(dec.gyro, gyro)
+    assert dec.frame_ids == ["deck_imu"] * 50
+
+
+def test_imu_messages_say_no_orientation_estimate() -> None:
+    ((_, raw),) = imu_messages(np.array([START_NS]), REST[None], np.zeros((1, 3)), "f")
+    msg = TYPESTORE.deserialize_cdr(raw, IMU)
+    assert msg.orientation_covariance[0] == -1.0
+    assert (msg.orientation.x, msg.orientation.y, msg.orientation.z, msg.orientation.w) == (
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+    )
+
+
+def test_accel_stamped_decodes_linear_acceleration_and_no_rate() -> None:
+    stamps, accel, _ = rng_signal(20)
+    dec = decode_inputs(accel_messages(stamps, accel, "deck_imu"), ACCEL)
+    assert dec.undecodable == 0
+    np.testing.assert_array_equal(dec.stamps_ns, stamps)
+    np.testing.assert_array_equal(dec.accel, accel)
+    np.testing.assert_array_equal(dec.gyro, np.zeros((20, 3)))  # accel.angular is not a rate
+
+
+def test_undecodable_bytes_are_counted_not_raised() -> None:
+    stamps, accel, gyro = rng_signal(4)
+    good = [raw for _, raw in imu_messages(stamps, accel, gyro, "deck_imu")]
+    raws = [good[0], b"", b"\x00\x01\x00\x00garbage", good[1], good[2][:20], good[3]]
+    dec = decode_inputs(raws, IMU)
+    assert dec.undecodable == 3
+    np.testing.assert_array_equal(dec.stamps_ns, stamps[[0, 1, 3]])
+    assert len(dec.frame_ids) == 3
+    np.testing.assert_array_equal(dec.accel, accel[[0, 1, 3]])
+
+
+def test_stream_counts_undecodable_messages_and_warns_on_diagnostics() -> None:
+    scene = scene_with(outputs={"diagnostics_period_s": 0.01})
+    stream = TwinStream(scene)
+    stamps, accel, gyro = rng_signal(40)
+    raws = [raw for _, raw in imu_messages(stamps, accel, gyro, "deck_imu")]
+    first = stream.process(raws[:20])
+    second = stream.process([b"not cdr", *raws[20:]])
+    counts = stream.engine.counts
+    assert (counts["received"], counts["accepted"], counts["rejected_undecodable"]) == (41, 40, 1)
+    assert len(first) > 0 and len(second) > 0
+    reports = stream.last_outputs.health
+    assert len(reports) >= 1
+    inputs = [s for r in reports for s in r.statuses if s.name == "mount_twin: input"]
+    assert [s.level for s in inputs] == [WARN] + [OK] * (len(inputs) - 1), "WARN once, then OK"
+    assert inputs[0].message == "1 samples rejected, 0 gaps in this period"
+    assert inputs[0].values["rejected_undecodable"] == "1"
+
+
+def test_stream_with_only_undecodable_input_outputs_nothing() -> None:
+    stream = TwinStream(default_scene())
+    assert stream.process([b"x", b"y"]) == []
+    assert stream.engine.counts["rejected_undecodable"] == 2
+
+
+# --------------------------------------------------------------------------- gravity
+
+
+def test_accel_stamped_without_gravity_gets_g_added_on_z_of_f() -> None:
+    n = 300
+    stamps = START_NS + np.arange(n, dtype=np.int64) * 1_000_000
+    rng = np.random.default_rng(3)
+    motion = rng.normal(0.0, 0.3, (n, 3))  # foundation acceleration, gravity removed
+    imu_scene = scene_with(outputs={"diagnostics_period_s": 100.0})
+    accel_scene = scene_with(
+        input={"msg_type": ACCEL, "includes_gravity": False, "g": G},
+        outputs={"diagnostics_period_s": 100.0},
+    )
+    imu_raws = [
+        raw for _, raw in imu_messages(stamps, motion + REST, np.zeros((n, 3)), "deck_imu")
+    ]
+    acc_raws = accel_messages(stamps, motion, "deck_imu")
+    imu_out = TwinStream(imu_scene)
+    acc_out = TwinStream(accel_scene)
+    imu_msgs = imu_out.process(imu_raws)
+    acc_msgs = acc_out.process(acc_raws)
+    assert len(imu_msgs) == len(acc_msgs) == n * (2 + 8)
+    np.testing.assert_allclose(
+        acc_out.last_outputs.pose,
+        imu_out.last_outputs.pose,
+        rtol=0,
+        atol=1e-12,
+        err_msg="AccelStamped + g on z must move the twin exactly as Imu with gravity included",
+    )
+
+
+def test_includes_gravity_false_uses_the_configured_g() -> None:
+    lunar = 1.62
+    scene = scene_with(input={"includes_gravity": False, "g": lunar})
+    engine = engine_for(scene)
+    f, _ = engine._to_foundation(batch([0.0, 0.001], accel=np.zeros((2, 3))))
+    np.testing.assert_array_equal(f, [[0.0, 0.0, lunar]] * 2)
+
+
+# --------------------------------------------------------------------------- time base
+
+
+@pytest.mark.parametrize(
+    "span_s", [1.0, 3600.0, 86400.0, 7 * 86400.0], ids=["1s", "1h", "1day", "1week"]
+)
+def test_time_base_resolves_sample_intervals(span_s: float) -> None:
+    """The engine integrates over float-second intervals: a week in, 1 kHz intervals must still be
+    exact to well under a nanosecond (an epoch stamp in float64 would be off by ~0.1 µs)."""
+    rng = np.random.default_rng(7)
+    stamps = START_NS + np.sort(rng.integers(0, int(span_s * 1e9), 100_000)).astype(np.int64)
+    base = TimeBase.at(int(stamps[0]))
+    assert base.origin_ns % 1_000_000_000 == 0 and 0 <= stamps[0] - base.origin_ns < 1_000_000_000
+    err = np.abs(np.diff(base.seconds(stamps)) - np.diff(stamps) * 1e-9)
+    assert err.max() < 2.5e-10
+
+
+def test_stream_output_stamps_stay_exact_for_a_node_running_a_year() -> None:
+    """A live node keeps the base of its first message; outputs a year later (float seconds
+    there resolve only ~4 ns) must still carry the input stamps to the nanosecond."""
+    year_ns = 365 * 86400 * 1_000_000_000
+    stream = TwinStream(scene_with(outputs={"diagnostics_period_s": 100.0}))
+    first, accel, gyro = rng_signal(1)
+    stream.process([raw for _, raw in imu_messages(first, accel, gyro, "deck_imu")])
+    stamps, accel, gyro = rng_signal(300, seed=2)
+    stamps = stamps + year_ns + np.arange(300) * 3  # odd ns everywhere
+    msgs = stream.process([raw for _, raw in imu_messages(stamps, accel, gyro, "deck_imu")])
+    assert stream.engine.counts["gaps"] == 1  # the year between them: a restart, not a failure
+    pose_stamps = [s for topic, s, _ in msgs if topic == "~/pose"]
+    assert pose_stamps == stamps.tolist()
+
+
+def test_stream_output_stamps_equal_input_stamps_exactly() -> None:
+    stamps, accel, gyro = rng_signal(200)
+    stream = TwinStream(scene_with(outputs={"diagnostics_period_s": 100.0}))
+    msgs = stream.process([raw for _, raw in imu_messages(stamps, accel, gyro, "deck_imu")])
+    pose_stamps = [s for topic, s, _ in msgs if topic == "~/pose"]
+    assert pose_stamps == stamps.tolist()
+
+
+# --------------------------------------------------------------------------- encoding
+
+
+def _one_row_batch(scene, stamp_s: float = 0.25, health=None) -> OutputBatch:
+    nm = len(scene.mounts)
+    pose = np.array(
+        [[0.051, -0.002, 0.498, 0.001, 0.002, 0.003, np.sqrt(1 - 14e-6), 0.002, 0.004, 0.006]]
+    )
+    wrenches = np.arange(nm * 6, dtype=float).reshape(1, nm, 6) * 1.5 - 20.0
+    return OutputBatch(np.array([stamp_s]), np.array([0]), pose, wrenches, health or [])
+
+
+def test_encoded_outputs_have_the_right_topics_types_frames_and_values() -> None:
+    scene = default_scene()
+    want_ns = START_NS + 123_456_789
+    out = _one_row_batch(scene, stamp_s=0.123456789)
+    msgs = encode_outputs(scene, out, np.array([want_ns]))
+    topics = output_topics(scene)
+    types = output_types(scene)
+    assert [t for t, _, _ in msgs] == [topics.pose, topics.angles, *topics.wrenches]
+    for topic, stamp, raw in msgs:
+        msg = TYPESTORE.deserialize_cdr(raw, types[topic])
+        assert stamp == want_ns and stamp_ns(msg) == want_ns
+        if topic == topics.pose:
+            assert (
+                types[topic] == POSE and msg.header.frame_id == scene.frames.foundation == "deck"
+            )
+            p, q = msg.pose.position, msg.pose.orientation
+            assert [p.x, p.y, p.z, q.x, q.y, q.z, q.w] == out.pose[0, :7].tolist()
+        elif topic == topics.angles:
+            assert types[topic] == VECTOR3 and msg.header.frame_id == "deck"
+            assert [msg.vector.x, msg.vector.y, msg.vector.z] == out.pose[0, 7:].tolist()
+        else:
+            i = topics.wrenches.index(topic)
+            assert types[topic] == WRENCH and msg.header.frame_id == scene.mounts[i].name
+            f, c = msg.wrench.force, msg.wrench.torque
+            assert [f.x, f.y, f.z, c.x, c.y, c.z] == out.wrenches[0, i].tolist()
+
+
+def test_output_names_resolve_under_the_node_name_and_namespace() -> None:
+    scene = default_scene()
+    topics = output_topics(scene)
+    assert resolve(topics.pose, "mount_twin") == "/mount_twin/pose"
+    assert resolve(topics.angles, "mount_twin") == "/mount_twin/angles"
+    assert [resolve(t, "mount_twin") for t in topics.wrenches] == [
+        f"/mount_twin/mounts/{m.name}/wrench" for m in scene.mounts
+    ]
+    assert resolve(topics.diagnostics, "mount_twin", "/ship") == "/diagnostics"
+    assert resolve(topics.pose, "mount_twin", "/ship/") == "/ship/mount_twin/pose"
+    assert resolve("rel", "mount_twin", "/ship") == "/ship/rel"
+
+
+def test_disabled_outputs_are_neither_encoded_nor_declared() -> None:
+    scene = scene_with(outputs={"pose": False, "wrenches": False})
+    msgs = encode_outputs(scene, _one_row_batch(scene), np.array([START_NS]))
+    assert [t for t, _, _ in msgs] == ["~/angles"]
+    assert output_types(scene) == {"/diagnostics": DIAGNOSTICS, "~/angles": VECTOR3}
+
+
+def test_diagnostics_are_encoded_with_levels_names_and_values() -> None:
+    scene = default_scene()
+    report = HealthReport(
+        0.25,
+        0,
+        [
+            HealthStatus("mount_twin: input", WARN, "2 samples rejected", {"received": "10"}),
+            HealthStatus("mount_twin: integration", ERROR, "failed", {}),
+            HealthStatus("mount_twin: attitude", OK, "ok", {"tilt_max_rad": "0.01"}),
+        ],
+    )
+    msgs = encode_outputs(scene, _one_row_batch(scene, 0.25, [report]), np.array([START_NS]))
+    diag = [(s, raw) for t, s, raw in msgs if t == "/diagnostics"]
+    assert len(diag) == 1
+    stamp, raw = diag[0]
+    assert stamp == START_NS
+    assert msgs[-1][0] == "/diagnostics", "a report follows the outputs of the sample it is due at"
+    msg = TYPESTORE.deserialize_cdr(raw, DIAGNOSTICS)
+    assert stamp_ns(msg) == stamp
+    assert [(s.name, s.level, s.message, s.hardware_id) for s in msg.status] == [
+        ("mount_twin: input", WARN, "2 samples rejected", "mount_twin"),
+        ("mount_twin: integration", ERROR, "failed", "mount_twin"),
+        ("mount_twin: attitude", OK, "ok", "mount_twin"),
+    ]
+    assert [(kv.key, kv.value) for kv in msg.status[0].values] == [("received", "10")]
