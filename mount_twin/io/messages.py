@@ -9,11 +9,13 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache, partial
 
 import numpy as np
 from rosbags.typesys import Stores, get_typestore
 
 from mount_twin.engine.batch import HealthReport, OutputBatch, SampleBatch
+from mount_twin.io.fixed_layout import FixedLayout
 from mount_twin.scene.description import Scene
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
@@ -74,27 +76,56 @@ class Decoded:
 def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
     """Decode sensor_msgs/Imu (linear_acceleration, angular_velocity) or
     geometry_msgs/AccelStamped (accel.linear; its accel.angular is an angular acceleration, not a
-    rate, so Ω is taken as zero)."""
+    rate, so Ω is taken as zero).
+
+    rosbags decodes the first message of each frame_id; the messages that share its fixed layout
+    are read in one numpy pass (`FixedLayout`), the rest one by one through rosbags.
+    """
     n = len(raws)
     stamps = np.zeros(n, dtype=np.int64)
     accel, gyro = np.zeros((n, 3)), np.zeros((n, 3))
-    frames: list[str] = []
-    keep = np.ones(n, dtype=bool)
-    for i, raw in enumerate(raws):
+    frames = [""] * n
+    ok = np.zeros(n, dtype=bool)
+    pending = np.ones(n, dtype=bool)
+    batched = True
+    while pending.any():
+        i = int(np.argmax(pending))
+        pending[i] = False
         try:
-            msg = TYPESTORE.deserialize_cdr(raw, msgtype)
-        except Exception:
-            keep[i] = False
+            msg = TYPESTORE.deserialize_cdr(raws[i], msgtype)
+        except Exception:  # any malformed CDR: counted, never raised
             continue
-        stamps[i] = stamp_ns(msg.header)
-        frames.append(msg.header.frame_id)
+        ok[i] = True
+        frames[i] = msg.header.frame_id
+        stamps[i], accel[i], gyro[i] = _input_values(msg, msgtype)
+        if not batched:
+            continue
+        rest = np.flatnonzero(pending)
+        layout = _layout(msgtype, msg.header.frame_id)
+        match, cols = layout.unpack([raws[j] for j in (i, *rest.tolist())], _INPUT_WANT[msgtype])
+        if not match[0]:  # this writer's padding or extras differ: no batch for it
+            batched = False
+            continue
+        got = rest[match[1:]]
+        pending[got] = False
+        ok[got] = True
+        for j in got.tolist():
+            frames[j] = frames[i]
+        stamps[got] = cols[0][1:].astype(np.int64) * 1_000_000_000 + cols[1][1:]
+        accel[got] = np.column_stack(cols[2:5])[1:]
         if msgtype == IMU:
-            a, w = msg.linear_acceleration, msg.angular_velocity
-            gyro[i] = (w.x, w.y, w.z)
-        else:
-            a = msg.accel.linear
-        accel[i] = (a.x, a.y, a.z)
-    return Decoded(stamps[keep], accel[keep], gyro[keep], frames, int(n - keep.sum()))
+            gyro[got] = np.column_stack(cols[5:8])[1:]
+    frame_list = [f for f, k in zip(frames, ok.tolist(), strict=True) if k]
+    return Decoded(stamps[ok], accel[ok], gyro[ok], frame_list, int(n - ok.sum()))
+
+
+def _input_values(msg: object, msgtype: str) -> tuple[int, tuple, tuple]:
+    """(stamp ns, acceleration, angular velocity) of one decoded input message."""
+    if msgtype == IMU:
+        a, w = msg.linear_acceleration, msg.angular_velocity  # type: ignore[attr-defined]
+        return stamp_ns(msg.header), (a.x, a.y, a.z), (w.x, w.y, w.z)  # type: ignore[attr-defined]
+    a = msg.accel.linear  # type: ignore[attr-defined]
+    return stamp_ns(msg.header), (a.x, a.y, a.z), (0.0, 0.0, 0.0)  # type: ignore[attr-defined]
 
 
 def _header(stamp_ns: int, frame_id: str) -> object:
@@ -107,6 +138,87 @@ def _header(stamp_ns: int, frame_id: str) -> object:
 def _vector3(x: float, y: float, z: float) -> object:
     # float(): rclpy's converters abort on numpy scalars or ints in float64 fields.
     return _T["geometry_msgs/msg/Vector3"](x=float(x), y=float(y), z=float(z))
+
+
+def _time_fields(v: Sequence[float]) -> object:
+    return _T["builtin_interfaces/msg/Time"](sec=int(v[0]), nanosec=int(v[1]))
+
+
+def _hdr(v: Sequence[float], frame_id: str) -> object:
+    return _T["std_msgs/msg/Header"](stamp=_time_fields(v), frame_id=frame_id)
+
+
+def _build_imu(frame_id: str, v: Sequence[float]) -> object:
+    """Imu from [sec, nanosec, a(3), ω(3), orientation xyzw(4), its 3 covariances(27)]."""
+    return _T[IMU](
+        header=_hdr(v, frame_id),
+        orientation=_T["geometry_msgs/msg/Quaternion"](
+            x=float(v[8]), y=float(v[9]), z=float(v[10]), w=float(v[11])
+        ),
+        orientation_covariance=np.array(v[12:21], dtype=np.float64),
+        angular_velocity=_vector3(*v[5:8]),
+        angular_velocity_covariance=np.array(v[21:30], dtype=np.float64),
+        linear_acceleration=_vector3(*v[2:5]),
+        linear_acceleration_covariance=np.array(v[30:39], dtype=np.float64),
+    )
+
+
+def _build_accel(frame_id: str, v: Sequence[float]) -> object:
+    """AccelStamped from [sec, nanosec, linear(3), angular(3)]."""
+    accel = _T["geometry_msgs/msg/Accel"](linear=_vector3(*v[2:5]), angular=_vector3(*v[5:8]))
+    return _T[ACCEL](header=_hdr(v, frame_id), accel=accel)
+
+
+def _build_pose(frame_id: str, v: Sequence[float]) -> object:
+    """PoseStamped from [sec, nanosec, position(3), quaternion xyzw(4)]."""
+    pose = _T["geometry_msgs/msg/Pose"](
+        position=_T["geometry_msgs/msg/Point"](x=float(v[2]), y=float(v[3]), z=float(v[4])),
+        orientation=_T["geometry_msgs/msg/Quaternion"](
+            x=float(v[5]), y=float(v[6]), z=float(v[7]), w=float(v[8])
+        ),
+    )
+    return _T[POSE](header=_hdr(v, frame_id), pose=pose)
+
+
+def _build_vector3(frame_id: str, v: Sequence[float]) -> object:
+    """Vector3Stamped from [sec, nanosec, x, y, z]."""
+    return _T[VECTOR3](header=_hdr(v, frame_id), vector=_vector3(*v[2:5]))
+
+
+def _build_wrench(frame_id: str, v: Sequence[float]) -> object:
+    """WrenchStamped from [sec, nanosec, force(3), torque(3)]."""
+    wrench = _T["geometry_msgs/msg/Wrench"](force=_vector3(*v[2:5]), torque=_vector3(*v[5:8]))
+    return _T[WRENCH](header=_hdr(v, frame_id), wrench=wrench)
+
+
+_BUILDERS = {
+    IMU: (_build_imu, 37),
+    ACCEL: (_build_accel, 6),
+    POSE: (_build_pose, 7),
+    VECTOR3: (_build_vector3, 3),
+    WRENCH: (_build_wrench, 6),
+}
+"""Builder and number of float64 fields (after sec, nanosec) of each fixed-layout type."""
+
+_INPUT_WANT = {IMU: range(8), ACCEL: range(5)}
+"""Fields an input decode reads: sec, nanosec, acceleration (and ω for Imu)."""
+
+
+@lru_cache(maxsize=256)
+def _layout(msgtype: str, frame_id: str) -> FixedLayout:
+    build, n_floats = _BUILDERS[msgtype]
+    return FixedLayout.probe(
+        partial(build, frame_id),
+        ["<i4", "<u4"] + ["<f8"] * n_floats,
+        partial(TYPESTORE.serialize_cdr, typename=msgtype),
+    )
+
+
+def _pack(
+    msgtype: str, frame_id: str, sec: np.ndarray, nsec: np.ndarray, values: np.ndarray
+) -> list[bytes]:
+    """Messages of one type and frame for stamps (sec, nanosec) and rows of float fields."""
+    return _layout(msgtype, frame_id).pack([sec, nsec, *values.T])
 
 
 @dataclass(frozen=True)
@@ -148,42 +260,24 @@ def encode_outputs(
     """
     topics = output_topics(scene)
     frames, opts = scene.frames, scene.outputs
-    ser = TYPESTORE.serialize_cdr
+    stamps = stamps_ns[out.sample]
+    sec, nsec = np.divmod(stamps, 1_000_000_000)
+    rows: list[tuple[str, list[bytes]]] = []
+    if opts.pose:
+        rows.append((topics.pose, _pack(POSE, frames.foundation, sec, nsec, out.pose[:, :7])))
+    if opts.angles:
+        rows.append((topics.angles, _pack(VECTOR3, frames.foundation, sec, nsec, out.pose[:, 7:])))
+    if opts.wrenches:
+        for i, (mount, topic) in enumerate(zip(scene.mounts, topics.wrenches, strict=True)):
+            rows.append((topic, _pack(WRENCH, mount.name, sec, nsec, out.wrenches[:, i])))
     msgs: list[tuple[str, int, bytes]] = []
     reports = iter(out.health)
     report = next(reports, None)
-    for k, (sample, stamp) in enumerate(
-        zip(out.sample.tolist(), stamps_ns[out.sample].tolist(), strict=True)
-    ):
+    for k, (sample, stamp) in enumerate(zip(out.sample.tolist(), stamps.tolist(), strict=True)):
         while report is not None and report.sample < sample:
             msgs.append(_diagnostics(report, int(stamps_ns[report.sample]), topics.diagnostics))
             report = next(reports, None)
-        row = out.pose[k]
-        if opts.pose:
-            pose = _T["geometry_msgs/msg/Pose"](
-                position=_T["geometry_msgs/msg/Point"](
-                    x=float(row[0]), y=float(row[1]), z=float(row[2])
-                ),
-                orientation=_T["geometry_msgs/msg/Quaternion"](
-                    x=float(row[3]), y=float(row[4]), z=float(row[5]), w=float(row[6])
-                ),
-            )
-            msg = _T[POSE](header=_header(stamp, frames.foundation), pose=pose)
-            msgs.append((topics.pose, stamp, ser(msg, POSE)))
-        if opts.angles:
-            msg = _T[VECTOR3](
-                header=_header(stamp, frames.foundation), vector=_vector3(*row[7:10])
-            )
-            msgs.append((topics.angles, stamp, ser(msg, VECTOR3)))
-        if opts.wrenches:
-            for mount, topic, w in zip(
-                scene.mounts, topics.wrenches, out.wrenches[k], strict=True
-            ):
-                wrench = _T["geometry_msgs/msg/Wrench"](
-                    force=_vector3(*w[:3]), torque=_vector3(*w[3:])
-                )
-                msg = _T[WRENCH](header=_header(stamp, mount.name), wrench=wrench)
-                msgs.append((topic, stamp, ser(msg, WRENCH)))
+        msgs.extend((topic, stamp, raws[k]) for topic, raws in rows)
     while report is not None:
         msgs.append(_diagnostics(report, int(stamps_ns[report.sample]), topics.diagnostics))
         report = next(reports, None)
@@ -228,20 +322,10 @@ def imu_messages(
     stamps_ns: np.ndarray, accel: np.ndarray, gyro: np.ndarray, frame_id: str
 ) -> list[tuple[int, bytes]]:
     """sensor_msgs/Imu messages (no orientation estimate: orientation_covariance[0] = −1)."""
-    no_orientation = np.zeros(9)
-    no_orientation[0] = -1.0
-    unknown = np.zeros(9)
-    quat = _T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0)
-    out = []
-    for stamp, a, w in zip(stamps_ns.tolist(), accel, gyro, strict=True):
-        msg = _T[IMU](
-            header=_header(stamp, frame_id),
-            orientation=quat,
-            orientation_covariance=no_orientation,
-            angular_velocity=_vector3(*w),
-            angular_velocity_covariance=unknown,
-            linear_acceleration=_vector3(*a),
-            linear_acceleration_covariance=unknown,
-        )
-        out.append((stamp, bytes(TYPESTORE.serialize_cdr(msg, IMU))))
-    return out
+    k = stamps_ns.shape[0]
+    extra = np.zeros((k, 31))  # orientation (x, y, z, w), then three covariances
+    extra[:, 3] = 1.0
+    extra[:, 4] = -1.0
+    sec, nsec = np.divmod(stamps_ns, 1_000_000_000)
+    values = np.hstack([accel, gyro, extra])
+    return list(zip(stamps_ns.tolist(), _pack(IMU, frame_id, sec, nsec, values), strict=True))

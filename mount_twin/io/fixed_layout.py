@@ -1,0 +1,105 @@
+"""Batches of CDR messages that differ only in their numbers, in one numpy pass.
+
+A message type with a given frame_id (and no other variable-length field) has a fixed CDR
+layout: the same length, and every stamp and float64 at the same byte offset. rosbags serializes
+a probe message once; its bytes locate each numeric field (by unique sentinel values) and serve
+as the template. Encoding a batch then writes columns of numbers into copies of the template;
+decoding reads them out of every message whose other bytes equal the template's, which proves it
+is that message (any bit pattern is a valid number). Everything else goes through rosbags.
+
+rosbags' own per-message path costs ~5–9 µs (building message objects, generic serializer);
+this costs well under 1 µs per message, and the tests hold it byte-equal to rosbags.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+Builder = Callable[[Sequence[float]], object]
+"""Builds a message object from its numeric fields, in the layout's field order."""
+
+_FORMATS = {"<i4": "<i", "<u4": "<I", "<f8": "<d"}
+
+
+def _sentinel(i: int, dtype: str) -> float | int:
+    """A value whose bytes are unlikely anywhere else in a message (field index i in them)."""
+    if dtype == "<f8":
+        return struct.unpack("<d", bytes([0xA5, i, 0x5A, 0xC3, 0x3C, 0x96, 0x69, 0x7F]))[0]
+    return struct.unpack(_FORMATS[dtype], bytes([0xA5, i, 0x5A, 0x3C]))[0]
+
+
+@dataclass(frozen=True)
+class FixedLayout:
+    """Byte layout of one message shape.
+
+    Attributes:
+        template: (L,) uint8, the message with every numeric field zero.
+        fields: (offset, dtype) of each numeric field, in the builder's order.
+        fixed: (L,) bool, True at bytes no numeric field covers.
+    """
+
+    template: np.ndarray
+    fields: tuple[tuple[int, str], ...]
+    fixed: np.ndarray
+
+    @classmethod
+    def probe(
+        cls, build: Builder, dtypes: Sequence[str], serialize: Callable[[object], bytes]
+    ) -> FixedLayout:
+        """Locate each field of `build`'s message by serializing sentinels once."""
+        sentinels = [_sentinel(i, dt) for i, dt in enumerate(dtypes)]
+        raw = bytes(serialize(build(sentinels)))
+        template = np.frombuffer(bytes(serialize(build([0] * len(dtypes)))), np.uint8)
+        if len(raw) != template.shape[0]:
+            msg = "message length depends on its numbers: not a fixed layout"
+            raise ValueError(msg)
+        fixed = np.ones(len(raw), dtype=bool)
+        fields = []
+        for value, dtype in zip(sentinels, dtypes, strict=True):
+            pattern = struct.pack(_FORMATS[dtype], value)
+            offset = raw.find(pattern)
+            if offset < 0 or raw.find(pattern, offset + 1) >= 0:
+                msg = f"field {len(fields)} ({dtype}) not found exactly once in the probe"
+                raise ValueError(msg)
+            fields.append((offset, dtype))
+            fixed[offset : offset + len(pattern)] = False
+        return cls(template.copy(), tuple(fields), fixed)
+
+    @property
+    def size(self) -> int:
+        """Message length, bytes."""
+        return int(self.template.shape[0])
+
+    def pack(self, columns: Sequence[np.ndarray]) -> list[bytes]:
+        """One message per row of the columns (one column per field)."""
+        k = len(columns[0])
+        rows = np.empty((k, self.size), dtype=np.uint8)
+        rows[:] = self.template
+        for (offset, dtype), col in zip(self.fields, columns, strict=True):
+            width = np.dtype(dtype).itemsize
+            values = np.ascontiguousarray(col, dtype=dtype)
+            rows[:, offset : offset + width] = values.view(np.uint8).reshape(k, width)
+        data, size = rows.tobytes(), self.size
+        return [data[i * size : (i + 1) * size] for i in range(k)]
+
+    def unpack(
+        self, raws: Sequence[bytes | memoryview], want: Sequence[int]
+    ) -> tuple[np.ndarray, list[np.ndarray]]:
+        """Which messages have this layout (bool mask), and their columns of fields `want`."""
+        size = self.size
+        idx = np.flatnonzero(np.fromiter((len(r) == size for r in raws), bool, len(raws)))
+        rows = np.frombuffer(b"".join(bytes(raws[i]) for i in idx), np.uint8).reshape(-1, size)
+        same = (rows[:, self.fixed] == self.template[self.fixed]).all(axis=1)
+        match = np.zeros(len(raws), dtype=bool)
+        match[idx[same]] = True
+        rows = rows[same]
+        columns = []
+        for f in want:
+            offset, dtype = self.fields[f]
+            width = np.dtype(dtype).itemsize
+            columns.append(rows[:, offset : offset + width].copy().view(dtype)[:, 0])
+        return match, columns

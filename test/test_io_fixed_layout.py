@@ -1,0 +1,123 @@
+"""The numpy fast path for CDR (mount_twin.io.fixed_layout) against rosbags message by message."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from io_helpers import default_scene
+
+from mount_twin.engine.batch import OutputBatch
+from mount_twin.io.fixed_layout import FixedLayout
+from mount_twin.io.messages import IMU, TYPESTORE, decode_inputs, encode_outputs
+
+T = TYPESTORE.types
+RNG = np.random.default_rng(11)
+
+
+def rosbags_imu(stamp: int, frame: str, v: np.ndarray) -> bytes:
+    """An Imu with every numeric field set, built and serialized by rosbags alone."""
+    sec, nsec = divmod(stamp, 1_000_000_000)
+    vec = T["geometry_msgs/msg/Vector3"]
+    msg = T[IMU](
+        header=T["std_msgs/msg/Header"](
+            stamp=T["builtin_interfaces/msg/Time"](sec=sec, nanosec=nsec), frame_id=frame
+        ),
+        orientation=T["geometry_msgs/msg/Quaternion"](x=v[0], y=v[1], z=v[2], w=v[3]),
+        orientation_covariance=v[4:13].copy(),
+        angular_velocity=vec(x=v[13], y=v[14], z=v[15]),
+        angular_velocity_covariance=v[16:25].copy(),
+        linear_acceleration=vec(x=v[25], y=v[26], z=v[27]),
+        linear_acceleration_covariance=v[28:37].copy(),
+    )
+    return bytes(TYPESTORE.serialize_cdr(msg, IMU))
+
+
+def _inputs(n: int, frames: list[str]) -> tuple[list[bytes], np.ndarray, np.ndarray, list[str]]:
+    stamps = 1_700_000_000_000_000_000 + np.cumsum(RNG.integers(1, 2_000_000, n))
+    values = RNG.normal(0.0, 10.0, (n, 37))
+    frame_of = [frames[i % len(frames)] for i in range(n)]
+    raws = [rosbags_imu(int(s), f, v) for s, f, v in zip(stamps, frame_of, values, strict=True)]
+    return raws, stamps, values, frame_of
+
+
+@pytest.mark.parametrize("frames", [["deck_imu"], ["a", "imu_link_2", "abc"]])
+def test_decoded_imu_equals_rosbags_field_by_field(frames: list[str]) -> None:
+    """Frame ids of several lengths (so several layouts) interleaved, and bad messages between."""
+    raws, stamps, values, frame_of = _inputs(300, frames)
+    raws[7] = b"\x00\x01garbage"
+    raws[50] = raws[50][:-8]  # truncated: rosbags rejects it
+    keep = [i for i in range(300) if i not in (7, 50)]
+    dec = decode_inputs(raws, IMU)
+    assert dec.undecodable == 2
+    np.testing.assert_array_equal(dec.stamps_ns, stamps[keep])
+    np.testing.assert_array_equal(dec.accel, values[keep][:, 25:28])
+    np.testing.assert_array_equal(dec.gyro, values[keep][:, 13:16])
+    assert dec.frame_ids == [frame_of[i] for i in keep]
+
+
+def test_a_writer_with_nonzero_padding_is_decoded_through_rosbags() -> None:
+    """CDR padding is unspecified: bytes there must not be taken for data, nor break decoding."""
+    raws, stamps, values, _ = _inputs(20, ["imu_x"])
+    # CDR: 4-byte encapsulation, sec, nanosec, string length, 'imu_x' + NUL ends at byte 22;
+    # the orientation's doubles align to 8 from byte 4, so bytes 22..27 are padding
+    dirty = [r[:22] + b"\xff\xee\xdd\xcc\xbb\xaa" + r[28:] for r in raws]
+    assert TYPESTORE.deserialize_cdr(dirty[0], IMU).header.frame_id == "imu_x"
+    dec = decode_inputs(dirty, IMU)
+    np.testing.assert_array_equal(dec.stamps_ns, stamps)
+    np.testing.assert_array_equal(dec.accel, values[:, 25:28])
+
+
+def test_encoded_outputs_are_byte_equal_to_rosbags() -> None:
+    scene = default_scene()
+    k, nm = 25, len(scene.mounts)
+    stamps = 1_700_000_000_000_000_000 + np.cumsum(RNG.integers(1, 2_000_000, k))
+    pose = RNG.normal(size=(k, 10))
+    wrenches = RNG.normal(0.0, 1e4, (k, nm, 6))
+    out = OutputBatch(stamps * 1e-9, np.arange(k), pose, wrenches)
+    msgs = encode_outputs(scene, out, stamps)
+    assert len(msgs) == k * (2 + nm)
+    vec = T["geometry_msgs/msg/Vector3"]
+    for j, (topic, stamp, raw) in enumerate(msgs):
+        row, slot = divmod(j, 2 + nm)
+        assert stamp == stamps[row]
+        sec, nsec = divmod(int(stamp), 1_000_000_000)
+        time = T["builtin_interfaces/msg/Time"](sec=sec, nanosec=nsec)
+        p = pose[row]
+        if slot == 0:
+            header = T["std_msgs/msg/Header"](stamp=time, frame_id=scene.frames.foundation)
+            want = T["geometry_msgs/msg/PoseStamped"](
+                header=header,
+                pose=T["geometry_msgs/msg/Pose"](
+                    position=T["geometry_msgs/msg/Point"](x=p[0], y=p[1], z=p[2]),
+                    orientation=T["geometry_msgs/msg/Quaternion"](x=p[3], y=p[4], z=p[5], w=p[6]),
+                ),
+            )
+            typename = "geometry_msgs/msg/PoseStamped"
+        elif slot == 1:
+            header = T["std_msgs/msg/Header"](stamp=time, frame_id=scene.frames.foundation)
+            want = T["geometry_msgs/msg/Vector3Stamped"](
+                header=header, vector=vec(x=p[7], y=p[8], z=p[9])
+            )
+            typename = "geometry_msgs/msg/Vector3Stamped"
+        else:
+            i = slot - 2
+            w = wrenches[row, i]
+            header = T["std_msgs/msg/Header"](stamp=time, frame_id=scene.mounts[i].name)
+            want = T["geometry_msgs/msg/WrenchStamped"](
+                header=header,
+                wrench=T["geometry_msgs/msg/Wrench"](
+                    force=vec(x=w[0], y=w[1], z=w[2]), torque=vec(x=w[3], y=w[4], z=w[5])
+                ),
+            )
+            typename = "geometry_msgs/msg/WrenchStamped"
+        assert raw == bytes(TYPESTORE.serialize_cdr(want, typename)), (topic, row)
+
+
+def test_a_layout_whose_length_depends_on_the_numbers_is_refused() -> None:
+    def build(v):
+        return T["std_msgs/msg/String"](data="x" * int(v[0] % 7))
+
+    with pytest.raises(ValueError, match="not a fixed layout"):
+        FixedLayout.probe(
+            build, ["<i4"], lambda m: TYPESTORE.serialize_cdr(m, "std_msgs/msg/String")
+        )
