@@ -114,6 +114,7 @@ EXTRA_VALUES = {
     "initial_state.pose": [0.0, 0.0, 0.0, 0.01, -0.02, 0.03],
     "initial_state.velocity": [0.0, 0.0, 0.1, 0.0, 0.0, 0.0],
     "outputs.tilt_warn_rad": 1.0,
+    "outputs.alarm_margin": 0.2,
 }
 
 

@@ -50,6 +50,18 @@ class HealthStatus:
     values: dict[str, str] = field(default_factory=dict)
 
 
+@dataclass(frozen=True)
+class MountEvent:
+    """A mount event: its interpolated time (s), mount, event name, mount force magnitude (N) at
+    the sample that revealed it, and whether it is an ERROR (a limit passed) or a WARN."""
+
+    stamp: float
+    mount: str
+    event: str
+    force: float
+    error: bool
+
+
 @dataclass
 class HealthReport:
     """Diagnostics at one stamp (s), due once sample `sample` of the pushed batch is processed."""

@@ -15,13 +15,14 @@ from typing import NamedTuple
 
 import numpy as np
 
-from mount_twin.engine.batch import OutputBatch, SampleBatch
+from mount_twin.engine.batch import MountEvent, OutputBatch, SampleBatch
 from mount_twin.engine.health import HealthWindow
-from mount_twin.engine.kernel import run_samples
+from mount_twin.engine.kernel import new_watch, run_samples
 from mount_twin.errors import ModelError
 from mount_twin.integrate.stepper import STATUS_TEXT, STEPPERS
+from mount_twin.kinds import KINDS, N_EVENTS
 from mount_twin.model.assemble import Model, initial_state
-from mount_twin.physics.dynamics import INPUT_SIZE, evaluate
+from mount_twin.physics.dynamics import INPUT_SIZE, evaluate, mount_monitors
 
 ACCEPT, START, JUMPED_BACK, GAP_RESET, GAP_BRIDGED = (
     "accept",
@@ -41,6 +42,9 @@ _COUNTS = {
     GAP_BRIDGED: ("accepted", "gaps"),
 }
 """Counters each taken verdict increments; a rejection increments rejected_<reason>."""
+
+MAX_EVENTS = 100_000
+"""Mount events kept in TwinEngine.events (later ones are counted only)."""
 
 
 class _Rows(NamedTuple):
@@ -86,6 +90,13 @@ class TwinEngine:
         self._gravity_up = np.array([0.0, 0.0, scene.input.g])
         self.counts: Counter[str] = Counter()
         self.health = HealthWindow(scene, self.stepper.name)
+        self._watch = new_watch(model.arrays.nl_kind.shape[0], N_EVENTS)
+        self._event_meta = [
+            (model.scene.mounts[slot].name, KINDS[model.scene.mounts[slot].kind])
+            for slot in model.arrays.nl_slot.tolist()
+        ]
+        self.events: list[MountEvent] = []
+        """Every mount event so far, in time order (the first MAX_EVENTS; the rest counted)."""
         # Fails now, at load, if the mounts cannot hold the body; and is the restart fallback.
         self._y_nominal = initial_state(model, self._gravity_up)
         self._warm_up()
@@ -118,6 +129,7 @@ class TwinEngine:
             np.zeros((n, nm, 6)),
             np.zeros(n, dtype=np.bool_),
             np.zeros((n, 3)),
+            new_watch(model.arrays.nl_kind.shape[0], N_EVENTS),
         )
 
     @property
@@ -152,11 +164,13 @@ class TwinEngine:
             for run in self._runs(verdicts, start, stop):
                 parts.extend(self._integrate(run, batch.stamps, f, w))
             for rows in parts[first:]:
-                self.health.add_outputs(batch.stamps[rows.sample], rows.pose)
+                self.health.add_outputs(batch.stamps[rows.sample], rows.pose, rows.wrenches)
             self.health.add_wall(self._clock() - wall0)
             if report_due:
                 stamp = float(batch.stamps[stop - 1])
-                reports.append(self.health.report(stamp, stop - 1, self.counts))
+                util = self._watch.util_peak
+                reports.append(self.health.report(stamp, stop - 1, self.counts, util.copy()))
+                util[:] = 0.0
             start = stop
         nm = self.model.n_mounts
         sample = np.concatenate([r.sample for r in parts]) if parts else np.zeros(0, np.intp)
@@ -272,7 +286,9 @@ class TwinEngine:
                 wrenches,
                 publish,
                 step_log,
+                self._watch,
             )
+            self._drain_events()
             self.health.add_steps(step_log[1 : done + 1])
             if done > 0:
                 self._last = (float(t[done]), ff[done], ww[done])
@@ -289,6 +305,26 @@ class TwinEngine:
             out.append(self._start(rest[0], stamps, f, w))
             index = rest[1:]
         return out
+
+    def _drain_events(self) -> None:
+        """Move the kernel's event log into MountEvents (health window and `events`)."""
+        watch = self._watch
+        n = int(watch.n_events[0])
+        if n == 0:
+            return
+        cap = watch.events.shape[0]
+        if n > cap:
+            self.counts["mount_events_dropped"] += n - cap
+        nl_index = {slot: k for k, slot in enumerate(self.model.arrays.nl_slot.tolist())}
+        new = []
+        for t, slot, e, force in watch.events[: min(n, cap)].tolist():
+            name, kind = self._event_meta[nl_index[int(slot)]]
+            new.append(MountEvent(t, name, kind.EVENTS[int(e)], force, kind.EVENT_ERROR[int(e)]))
+        watch.n_events[0] = 0
+        self.counts["mount_events"] += len(new)
+        room = MAX_EVENTS - len(self.events)
+        self.events.extend(new[: max(room, 0)])
+        self.health.add_events(new)
 
     def _start(self, i: int, stamps: np.ndarray, f: np.ndarray, w: np.ndarray) -> _Rows:
         """(Re)start the twin at sample i; its outputs are published."""
@@ -316,4 +352,6 @@ class TwinEngine:
         if not math.isfinite(ct):
             msg = f"{self.scene.source}: initial_state.pose is off the α/γ/δ chart"
             raise ValueError(msg)
+        watch = self._watch
+        mount_monitors(self._y, self.model.arrays, self._scratch, watch.g_prev, watch.util)
         return _Rows(np.array([i]), pose, wrenches)

@@ -7,7 +7,7 @@ from collections import Counter
 
 import numpy as np
 
-from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus
+from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus, MountEvent
 from mount_twin.scene.description import Scene
 
 PREFIX = "mount_twin"
@@ -39,6 +39,8 @@ class HealthWindow:
         self.samples = 0
         self.tilt_max = 0.0
         self.failures: list[tuple[float, str]] = []
+        self.wrench_peak = np.zeros((len(self.scene.mounts), 6))
+        self.events: list[MountEvent] = []
 
     def add_steps(self, step_log: np.ndarray) -> None:
         """Per-sample stepper figures: (error norm, accepted, rejected substeps)."""
@@ -47,10 +49,11 @@ class HealthWindow:
             self.substeps += int(step_log[:, 1].sum() + step_log[:, 2].sum())
             self.samples += step_log.shape[0]
 
-    def add_outputs(self, stamps: np.ndarray, pose: np.ndarray) -> None:
-        """Published rows: their stamps (s) and poses."""
+    def add_outputs(self, stamps: np.ndarray, pose: np.ndarray, wrenches: np.ndarray) -> None:
+        """Published rows: their stamps (s), poses and mount wrenches (N, N·m, mount axes)."""
         if stamps.shape[0] == 0:
             return
+        np.maximum(self.wrench_peak, np.abs(wrenches).max(axis=0), out=self.wrench_peak)
         if math.isnan(self.t_first):
             self.t_first = float(stamps[0])
         self.t_last = float(stamps[-1])
@@ -59,6 +62,10 @@ class HealthWindow:
     def add_wall(self, wall_s: float) -> None:
         """Wall time spent on the samples of this window, s."""
         self.wall += wall_s
+
+    def add_events(self, events: list[MountEvent]) -> None:
+        """Mount events of this window."""
+        self.events.extend(events)
 
     def failure(self, stamp: float, text: str) -> None:
         """A stepper failure (or a forced start) at `stamp` (s)."""
@@ -78,11 +85,14 @@ class HealthWindow:
         self._next_due = stamp + self.period
         return True
 
-    def report(self, stamp: float, sample: int, counts: Counter[str]) -> HealthReport:
+    def report(
+        self, stamp: float, sample: int, counts: Counter[str], utilisation: np.ndarray
+    ) -> HealthReport:
         """Statuses at `stamp` (s), after pushed sample `sample`, for the window so far, which
         then starts anew.
 
-        Counts are cumulative; rejections, gaps and stepper figures are this window's.
+        Counts are cumulative; rejections, gaps, stepper figures, mount peaks and events are
+        this window's. `utilisation`: peak per non-linear mount, in model order.
         """
         new = counts - self._last_counts
         self._last_counts = counts.copy()
@@ -132,5 +142,49 @@ class HealthWindow:
             else "ok",
             {"tilt_max_rad": f"{self.tilt_max:.6g}"},
         )
+        mounts = self._mount_statuses(utilisation)
         self._reset()
-        return HealthReport(stamp, sample, [inp, step, att])
+        return HealthReport(stamp, sample, [inp, step, att, *mounts])
+
+    def _mount_statuses(self, utilisation: np.ndarray) -> list[HealthStatus]:
+        """One status per mount: peak wrench per axis, utilisation, events by name."""
+        util = dict.fromkeys((m.name for m in self.scene.mounts), math.nan)
+        nonlinear = [m.name for m in self.scene.mounts if m.kind != "linear"]
+        util.update(zip(nonlinear, utilisation.tolist(), strict=True))
+        warn_at = 1.0 - self.scene.outputs.alarm_margin
+        out = []
+        for i, mount in enumerate(self.scene.mounts):
+            mine = [e for e in self.events if e.mount == mount.name]
+            u = util[mount.name]
+            if any(e.error for e in mine) or u > 1.0:
+                level = ERROR
+            elif mine or u >= warn_at:
+                level = WARN
+            else:
+                level = OK
+            peak = self.wrench_peak[i]
+            values = {
+                f"peak_{axis}": f"{v:.6g}"
+                for axis, v in zip(
+                    ("fx_N", "fy_N", "fz_N", "tx_Nm", "ty_Nm", "tz_Nm"), peak, strict=True
+                )
+            }
+            values["utilisation_max"] = "n/a" if math.isnan(u) else f"{u:.4g}"
+            out.append(
+                HealthStatus(f"{PREFIX}: mount {mount.name}", level, _events_text(mine, u), values)
+            )
+        return out
+
+
+def _events_text(events: list[MountEvent], utilisation: float) -> str:
+    """'joint_opened ×3 (first 1.234567 s, |F| max 4.5e+04 N); …', or the utilisation."""
+    if not events:
+        return "ok" if not utilisation > 0.0 else f"utilisation {utilisation:.3g}"
+    parts = []
+    for name in dict.fromkeys(e.event for e in events):
+        same = [e for e in events if e.event == name]
+        parts.append(
+            f"{name} ×{len(same)} (first {same[0].stamp:.6f} s, "
+            f"|F| max {max(e.force for e in same):.4g} N)"
+        )
+    return "; ".join(parts)

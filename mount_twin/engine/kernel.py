@@ -6,10 +6,66 @@ not per sample; a live node passes batches of one through the same function.
 
 from __future__ import annotations
 
+import math
+from typing import NamedTuple
+
+import numpy as np
 from numba import njit
 
 from mount_twin.integrate.stepper import advance
-from mount_twin.physics.dynamics import evaluate
+from mount_twin.physics.dynamics import evaluate, mount_monitors
+
+
+class Watch(NamedTuple):
+    """Event watch over the non-linear mounts (k of them, NE event functions each).
+
+    g_prev, g: (k, NE) event functions at the previous and this sample (≥ 0: happening).
+    util, util_peak: (k,) utilisation now and its peak since the engine last read it.
+    events: (cap, 4) log rows [crossing time s, mount index in the scene, event index, |force| N]
+    n_events: (1,) rows written (may exceed cap: the excess is counted, not stored).
+    """
+
+    g_prev: np.ndarray
+    g: np.ndarray
+    util: np.ndarray
+    util_peak: np.ndarray
+    events: np.ndarray
+    n_events: np.ndarray
+
+
+def new_watch(k: int, n_events: int, capacity: int = 4096) -> Watch:
+    """Empty watch for k mounts."""
+    return Watch(
+        np.full((k, n_events), -1.0),
+        np.full((k, n_events), -1.0),  # a kind with fewer events never writes the rest
+        np.zeros(k),
+        np.zeros(k),
+        np.zeros((capacity, 4)),
+        np.zeros(1, dtype=np.int64),
+    )
+
+
+@njit(cache=True)
+def _watch(y, m, s, watch, t0, t1, wrenches) -> None:
+    """Evaluate the event functions at t1; log each upward zero crossing since t0."""
+    g_prev, g, util, peak = watch.g_prev, watch.g, watch.util, watch.util_peak
+    events, count = watch.events, watch.n_events
+    mount_monitors(y, m, s, g, util)
+    for i in range(g.shape[0]):
+        peak[i] = max(peak[i], util[i])
+        for e in range(g.shape[1]):
+            g0, g1 = g_prev[i, e], g[i, e]
+            g_prev[i, e] = g1
+            if g0 < 0.0 <= g1:
+                k = count[0]
+                count[0] += 1
+                if k < events.shape[0]:
+                    slot = m.nl_slot[i]
+                    w = wrenches[slot]
+                    events[k, 0] = t0 + (t1 - t0) * (-g0) / (g1 - g0)
+                    events[k, 1] = slot
+                    events[k, 2] = e
+                    events[k, 3] = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
 
 
 @njit(cache=True)
@@ -34,6 +90,7 @@ def run_samples(
     wrenches,
     publish,
     step_log,
+    watch,
 ) -> tuple[int, int]:
     """Advance y through samples 1..n−1 of (t, f, w); sample 0 is the last one already done.
 
@@ -45,6 +102,8 @@ def run_samples(
         pose: out (n, 10) pose rows (see `evaluate`); wrenches: out (n, nm, 6) published wrenches.
         publish: out (n,) True where the sample is published.
         step_log: out (n, 3) per sample: error norm, accepted and rejected substeps.
+        watch: the non-linear mounts' event functions, utilisation peaks and event log
+            (`Watch`); events are located by linear interpolation inside the sample interval.
 
     Returns:
         (index of the last sample done, stepper status: 0, or the failure at the next sample).
@@ -64,6 +123,8 @@ def run_samples(
             return j - 1, status
         step_log[j, 0], step_log[j, 1], step_log[j, 2] = result[0], result[1], result[2]
         evaluate(y, m, s, pose[j], wrenches[j])
+        if m.nl_kind.shape[0] > 0:
+            _watch(y, m, s, watch, t[j - 1], t[j], wrenches[j])
         counter[0] += 1
         for a in range(nm):
             for b in range(6):

@@ -8,9 +8,10 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from mount_twin.errors import ModelError
+from mount_twin.kinds import CODES, KINDS, N_PAR
 from mount_twin.physics.dynamics import INPUT_SIZE, OK, ModelArrays, Scratch, new_scratch, rhs
 from mount_twin.physics.rotations import rpy_matrix
-from mount_twin.scene.description import DOF_NAMES, Scene
+from mount_twin.scene.description import DOF_NAMES, LinearMount, Scene
 
 
 @dataclass(frozen=True)
@@ -41,7 +42,7 @@ class Model:
 
     def new_scratch(self) -> Scratch:
         """Work arrays for the kernels."""
-        return new_scratch()
+        return new_scratch(self.n_state)
 
 
 def assemble(scene: Scene) -> Model:
@@ -53,13 +54,19 @@ def assemble(scene: Scene) -> Model:
     mounts = scene.mounts
     axes = np.array([rpy_matrix(*mt.orientation_rpy) for mt in mounts]).reshape(-1, 3, 3)
 
-    def in_f(values: np.ndarray) -> np.ndarray:
-        # Q·diag(values)·Qᵀ per mount: the diagonal local law expressed in F.
-        return np.einsum("nij,nj,nkj->nik", axes, values, axes)
-
-    stiffness = np.array([mt.stiffness for mt in mounts]).reshape(-1, 6)
-    damping = np.array([mt.damping for mt in mounts]).reshape(-1, 6)
+    lin = [i for i, mt in enumerate(mounts) if isinstance(mt, LinearMount)]
+    other = [i for i, mt in enumerate(mounts) if not isinstance(mt, LinearMount)]
+    stiffness = np.array([mounts[i].stiffness for i in lin]).reshape(-1, 6)  # type: ignore[union-attr]
+    damping = np.array([mounts[i].damping for i in lin]).reshape(-1, 6)  # type: ignore[union-attr]
+    lin_axes = axes[lin].reshape(-1, 3, 3)
     free = [DOF_NAMES.index(d) for d in scene.dofs]
+    names = [*scene.dofs, *(f"{d}_dot" for d in scene.dofs)]
+    offsets = []
+    for i in other:
+        own = KINDS[mounts[i].kind].state_names(mounts[i])
+        offsets.append(len(names) if own else -1)
+        names.extend(own)
+    points = np.array([mt.position for mt in mounts]).reshape(-1, 3) - cg
     arrays = ModelArrays(
         mass=float(body.mass),
         inertia=inertia,
@@ -68,15 +75,34 @@ def assemble(scene: Scene) -> Model:
         free_trans=np.array([i for i in free if i < 3], dtype=np.int64),
         free_rot=np.array([i - 3 for i in free if i >= 3], dtype=np.int64),
         q_fixed=np.array(scene.initial.pose, dtype=float),
-        lin_point=np.array([mt.position for mt in mounts]).reshape(-1, 3) - cg,
-        lin_axes=axes,
-        lin_k_t=in_f(stiffness[:, :3]),
-        lin_c_t=in_f(damping[:, :3]),
-        lin_k_r=in_f(stiffness[:, 3:]),
-        lin_c_r=in_f(damping[:, 3:]),
+        lin_point=points[lin].reshape(-1, 3),
+        lin_axes=lin_axes,
+        lin_k_t=in_f(lin_axes, stiffness[:, :3]),
+        lin_c_t=in_f(lin_axes, damping[:, :3]),
+        lin_k_r=in_f(lin_axes, stiffness[:, 3:]),
+        lin_c_r=in_f(lin_axes, damping[:, 3:]),
+        lin_slot=np.array(lin, dtype=np.int64),
+        nl_kind=np.array([CODES[mounts[i].kind] for i in other], dtype=np.int64),
+        nl_point=points[other].reshape(-1, 3),
+        nl_axes=axes[other].reshape(-1, 3, 3),
+        nl_slot=np.array(other, dtype=np.int64),
+        nl_state=np.array(offsets, dtype=np.int64),
+        nl_par=np.array([_padded(KINDS[mounts[i].kind].pack(mounts[i])) for i in other]).reshape(
+            -1, N_PAR
+        ),
     )
-    names = tuple(scene.dofs) + tuple(f"{d}_dot" for d in scene.dofs)
-    return Model(scene, arrays, names, rpy_matrix(*scene.input.sensor_rpy))
+    return Model(scene, arrays, tuple(names), rpy_matrix(*scene.input.sensor_rpy))
+
+
+def in_f(axes: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Q·diag(values)·Qᵀ per mount: a diagonal law in mount axes, expressed in F."""
+    return np.einsum("nij,nj,nkj->nik", axes, values, axes)
+
+
+def _padded(row: np.ndarray) -> np.ndarray:
+    out = np.zeros(N_PAR)
+    out[: row.shape[0]] = row
+    return out
 
 
 def gravity_input(t0: float, specific_force: np.ndarray) -> np.ndarray:
@@ -96,7 +122,9 @@ def initial_state(model: Model, specific_force: np.ndarray) -> np.ndarray:
     scene = model.scene
     nf = len(scene.dofs)
     idx = [DOF_NAMES.index(d) for d in scene.dofs]
-    y0 = np.concatenate([np.array(scene.initial.pose)[idx], np.array(scene.initial.velocity)[idx]])
+    y0 = np.zeros(model.n_state)  # internal mount states start at rest: no slip, no set
+    y0[:nf] = np.array(scene.initial.pose)[idx]
+    y0[nf : 2 * nf] = np.array(scene.initial.velocity)[idx]
     if scene.initial.mode == "given":
         return y0
     return static_equilibrium(model, y0[:nf], specific_force)
@@ -105,12 +133,13 @@ def initial_state(model: Model, specific_force: np.ndarray) -> np.ndarray:
 def static_equilibrium(
     model: Model, q_guess: np.ndarray, specific_force: np.ndarray
 ) -> np.ndarray:
-    """State at rest where the free generalized accelerations vanish (least squares on them)."""
+    """State at rest where the free generalized accelerations vanish (least squares on them);
+    internal mount states at their initial values (zero)."""
     nf = q_guess.shape[0]
     m, s = model.arrays, model.new_scratch()
     u = gravity_input(0.0, specific_force)
-    y = np.zeros(2 * nf)
-    dydt = np.zeros(2 * nf)
+    y = np.zeros(model.n_state)
+    dydt = np.zeros(model.n_state)
 
     def accelerations(q: np.ndarray) -> np.ndarray:
         y[:nf] = q

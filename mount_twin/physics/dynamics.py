@@ -23,6 +23,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from mount_twin.kinds import kind_load, kind_monitor, kind_update
 from mount_twin.physics.chart import kinematic_matrix, kinematic_matrix_rate, rotation_from_chart
 from mount_twin.physics.linear_mount import linear_mount_load
 from mount_twin.physics.rotations import rotation_vector
@@ -58,6 +59,13 @@ class ModelArrays(NamedTuple):
     lin_c_t: np.ndarray  # (n, 3, 3) N·s/m in F
     lin_k_r: np.ndarray  # (n, 3, 3) N·m/rad in F
     lin_c_r: np.ndarray  # (n, 3, 3) N·m·s/rad in F
+    lin_slot: np.ndarray  # int64 (n,): each linear mount's index in the scene (wrench row)
+    nl_kind: np.ndarray  # int64 (k,): kind code (mount_twin.kinds) of each other mount
+    nl_point: np.ndarray  # (k, 3) m, attachment point from the CG, in B
+    nl_axes: np.ndarray  # (k, 3, 3) mount axes Q (columns) in F
+    nl_slot: np.ndarray  # int64 (k,): index in the scene
+    nl_state: np.ndarray  # int64 (k,): offset of the mount's internal states in y (−1: none)
+    nl_par: np.ndarray  # (k, N_PAR) parameter rows, columns per kind
 
 
 class Scratch(NamedTuple):
@@ -92,10 +100,12 @@ class Scratch(NamedTuple):
     i_w: np.ndarray  # (3,) I·ω_a, B
     mass_rot: np.ndarray  # (3, 3) reduced rotational mass matrix
     rhs_rot: np.ndarray  # (3,)
+    loc: np.ndarray  # (6, 3) local deflection, rate, rotation, rate, force, couple of a mount
+    sink: np.ndarray  # (n_state,) internal-state rates nobody needs (outputs, monitors)
 
 
-def new_scratch() -> Scratch:
-    """Fresh work arrays for one model."""
+def new_scratch(n_state: int) -> Scratch:
+    """Fresh work arrays for one model with `n_state` states."""
     return Scratch(
         q=np.zeros(6),
         trig=np.zeros(6),
@@ -126,6 +136,8 @@ def new_scratch() -> Scratch:
         i_w=np.zeros(3),
         mass_rot=np.zeros((3, 3)),
         rhs_rot=np.zeros(3),
+        loc=np.zeros((6, 3)),
+        sink=np.zeros(n_state),
     )
 
 
@@ -167,8 +179,51 @@ def body_motion(y: np.ndarray, m: ModelArrays, s: Scratch) -> float:
 
 
 @njit(cache=True, inline="always")
-def mount_loads(m: ModelArrays, s: Scratch) -> None:
-    """Sum the mount loads on the body into s.total_force and s.total_moment (F, about the CG)."""
+def _local_motion(i: int, m: ModelArrays, s: Scratch) -> None:
+    """Deflection, rate, rotation and rate of non-linear mount i in its axes into s.loc[:4];
+    its lever arm R·p into s.arm."""
+    rot, q, qd, omega_f, phi, arm, loc = s.rot, s.q, s.qd, s.omega_f, s.phi, s.arm, s.loc
+    point, axes = m.nl_point, m.nl_axes
+    for j in range(3):
+        arm[j] = rot[j, 0] * point[i, 0] + rot[j, 1] * point[i, 1] + rot[j, 2] * point[i, 2]
+    d0 = q[0] + arm[0] - point[i, 0]
+    d1 = q[1] + arm[1] - point[i, 1]
+    d2 = q[2] + arm[2] - point[i, 2]
+    e0 = qd[0] + omega_f[1] * arm[2] - omega_f[2] * arm[1]
+    e1 = qd[1] + omega_f[2] * arm[0] - omega_f[0] * arm[2]
+    e2 = qd[2] + omega_f[0] * arm[1] - omega_f[1] * arm[0]
+    for j in range(3):
+        a0, a1, a2 = axes[i, 0, j], axes[i, 1, j], axes[i, 2, j]
+        loc[0, j] = a0 * d0 + a1 * d1 + a2 * d2
+        loc[1, j] = a0 * e0 + a1 * e1 + a2 * e2
+        loc[2, j] = a0 * phi[0] + a1 * phi[1] + a2 * phi[2]
+        loc[3, j] = a0 * omega_f[0] + a1 * omega_f[1] + a2 * omega_f[2]
+
+
+@njit(cache=True, inline="always")
+def _nl_load(i: int, y: np.ndarray, m: ModelArrays, s: Scratch, dydt: np.ndarray) -> None:
+    """Load of non-linear mount i in its axes into s.loc[4:6]; its state rates into dydt."""
+    _local_motion(i, m, s)
+    loc = s.loc
+    kind_load(
+        m.nl_kind[i],
+        m.nl_par[i],
+        y,
+        m.nl_state[i],
+        loc[0],
+        loc[1],
+        loc[2],
+        loc[3],
+        dydt,
+        loc[4],
+        loc[5],
+    )
+
+
+@njit(cache=True, inline="always")
+def mount_loads(y: np.ndarray, m: ModelArrays, s: Scratch, dydt: np.ndarray) -> None:
+    """Sum the mount loads on the body into s.total_force and s.total_moment (F, about the CG);
+    internal-state rates of the mounts that have them into dydt."""
     total_f, total_m = s.total_force, s.total_moment
     arm, f, c = s.arm, s.force, s.couple
     rot, q, qd, omega_f, phi = s.rot, s.q, s.qd, s.omega_f, s.phi
@@ -178,26 +233,63 @@ def mount_loads(m: ModelArrays, s: Scratch) -> None:
         total_m[j] = 0.0
     for i in range(point.shape[0]):
         linear_mount_load(i, point, k_t, c_t, k_r, c_r, rot, q, qd, omega_f, phi, arm, f, c)
-        total_f[0] += f[0]
-        total_f[1] += f[1]
-        total_f[2] += f[2]
-        total_m[0] += arm[1] * f[2] - arm[2] * f[1] + c[0]
-        total_m[1] += arm[2] * f[0] - arm[0] * f[2] + c[1]
-        total_m[2] += arm[0] * f[1] - arm[1] * f[0] + c[2]
+        _add_load(arm, f, c, total_f, total_m)
+    axes, loc = m.nl_axes, s.loc
+    for i in range(m.nl_kind.shape[0]):
+        _nl_load(i, y, m, s, dydt)
+        for j in range(3):  # back from mount axes to F
+            a0, a1, a2 = axes[i, j, 0], axes[i, j, 1], axes[i, j, 2]
+            f[j] = a0 * loc[4, 0] + a1 * loc[4, 1] + a2 * loc[4, 2]
+            c[j] = a0 * loc[5, 0] + a1 * loc[5, 1] + a2 * loc[5, 2]
+        _add_load(arm, f, c, total_f, total_m)
+
+
+@njit(cache=True, inline="always")
+def _add_load(arm, f, c, total_f, total_m) -> None:
+    total_f[0] += f[0]
+    total_f[1] += f[1]
+    total_f[2] += f[2]
+    total_m[0] += arm[1] * f[2] - arm[2] * f[1] + c[0]
+    total_m[1] += arm[2] * f[0] - arm[0] * f[2] + c[1]
+    total_m[2] += arm[0] * f[1] - arm[1] * f[0] + c[2]
 
 
 @njit(cache=True)
-def mount_wrenches(m: ModelArrays, s: Scratch, wrenches: np.ndarray) -> None:
+def mount_wrenches(y: np.ndarray, m: ModelArrays, s: Scratch, wrenches: np.ndarray) -> None:
     """Each mount's force (N) and own couple (N·m) on the body, in its axes: wrenches[i]."""
     arm, f, c = s.arm, s.force, s.couple
     rot, q, qd, omega_f, phi = s.rot, s.q, s.qd, s.omega_f, s.phi
     point, k_t, c_t, k_r, c_r = m.lin_point, m.lin_k_t, m.lin_c_t, m.lin_k_r, m.lin_c_r
-    axes = m.lin_axes
+    axes, slot = m.lin_axes, m.lin_slot
     for i in range(point.shape[0]):
         linear_mount_load(i, point, k_t, c_t, k_r, c_r, rot, q, qd, omega_f, phi, arm, f, c)
+        row = slot[i]
         for j in range(3):
-            wrenches[i, j] = axes[i, 0, j] * f[0] + axes[i, 1, j] * f[1] + axes[i, 2, j] * f[2]
-            wrenches[i, 3 + j] = axes[i, 0, j] * c[0] + axes[i, 1, j] * c[1] + axes[i, 2, j] * c[2]
+            wrenches[row, j] = axes[i, 0, j] * f[0] + axes[i, 1, j] * f[1] + axes[i, 2, j] * f[2]
+            wrenches[row, 3 + j] = (
+                axes[i, 0, j] * c[0] + axes[i, 1, j] * c[1] + axes[i, 2, j] * c[2]
+            )
+    loc = s.loc
+    for i in range(m.nl_kind.shape[0]):
+        _nl_load(i, y, m, s, s.sink)
+        row = m.nl_slot[i]
+        for j in range(3):
+            wrenches[row, j] = loc[4, j]
+            wrenches[row, 3 + j] = loc[5, j]
+
+
+@njit(cache=True)
+def mount_monitors(
+    y: np.ndarray, m: ModelArrays, s: Scratch, g: np.ndarray, util: np.ndarray
+) -> None:
+    """Event functions g[i] and utilisation util[i] of each non-linear mount at state y (whose
+    body motion `evaluate` or `rhs` has just computed); then their discrete switches."""
+    loc = s.loc
+    for i in range(m.nl_kind.shape[0]):
+        _local_motion(i, m, s)
+        code, p, o = m.nl_kind[i], m.nl_par[i], m.nl_state[i]
+        util[i] = kind_monitor(code, p, y, o, loc[0], loc[1], g[i])
+        kind_update(code, p, y, o, loc[0])
 
 
 @njit(cache=True)
@@ -208,7 +300,7 @@ def rhs(
     ct = body_motion(y, m, s)
     if not ct > 0.0:
         return OFF_CHART
-    mount_loads(m, s)
+    mount_loads(y, m, s, dydt)
     nt, nr = m.free_trans.shape[0], m.free_rot.shape[0]
     nf = nt + nr
     for k in range(nf):
@@ -340,7 +432,7 @@ def evaluate(
     ct = body_motion(y, m, s)
     if not ct > 0.0:
         return math.nan
-    mount_wrenches(m, s, wrenches)
+    mount_wrenches(y, m, s, wrenches)
     q, quat, cg_ref = s.q, s.quat, m.cg_ref
     for i in range(3):
         pose[i] = cg_ref[i] + q[i]

@@ -9,6 +9,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from mount_twin.kinds.bolted_joint import BoltedJoint
+from mount_twin.kinds.elastomer import Elastomer
+from mount_twin.kinds.shear_key import ShearKey
+
 DOF_NAMES: tuple[str, ...] = ("x", "y", "z", "alpha", "gamma", "delta")
 """Generalized coordinates: CG displacement X, Y, Z (m, F) and the chart angles α, γ, δ (rad)."""
 
@@ -53,8 +57,8 @@ class LinearMount:
     kind: str = "linear"
 
 
-Mount = LinearMount
-"""Union of the mount kinds; later kinds join here."""
+Mount = LinearMount | Elastomer | BoltedJoint | ShearKey
+"""Union of the mount kinds (mount_twin.kinds holds all but the linear one)."""
 
 
 @dataclass(frozen=True)
@@ -127,6 +131,7 @@ class Outputs:
             (largest magnitude, with sign) over the interval.
         diagnostics_period_s: stamp-time period of DiagnosticArray messages, s.
         tilt_warn_rad: tilt of body z from vertical past which diagnostics warn.
+        alarm_margin: a mount warns once its utilisation passes 1 − alarm_margin.
     """
 
     pose: bool = True
@@ -135,6 +140,7 @@ class Outputs:
     decimation: int = 1
     diagnostics_period_s: float = 1.0
     tilt_warn_rad: float = 1.3089969389957472  # 75°
+    alarm_margin: float = 0.1
 
 
 @dataclass(frozen=True)

@@ -9,6 +9,7 @@ from typing import Any
 import yaml
 
 from mount_twin.errors import SceneError
+from mount_twin.kinds import KINDS
 from mount_twin.scene.description import (
     DOF_NAMES,
     Body,
@@ -27,7 +28,7 @@ INPUT_TYPES = ("sensor_msgs/msg/Imu", "geometry_msgs/msg/AccelStamped")
 START_TILT_MAX_RAD = 1.55
 """Largest tilt θ of a given start pose, rad (88.8°): the chart degenerates at π/2."""
 
-MOUNT_KINDS = ("linear",)
+MOUNT_KINDS = ("linear", *KINDS)
 STEPPERS = ("dopri54",)
 
 
@@ -128,14 +129,19 @@ def _mount(r: Reader) -> Mount:
     name = r.string("name")
     if not name or not name.replace("_", "a").isalnum() or name[0].isdigit():
         raise r.error("name", f"must be a ROS name token (letters, digits, _), got {name!r}")
-    mount = LinearMount(
-        name=name,
-        position=r.vector("position", 3),  # type: ignore[arg-type]
-        orientation_rpy=r.vector("orientation_rpy", 3, (0.0, 0.0, 0.0)),  # type: ignore[arg-type]
-        stiffness=r.vector("stiffness", 6, lo=0.0),  # type: ignore[arg-type]
-        damping=r.vector("damping", 6, (0.0,) * 6, lo=0.0),  # type: ignore[arg-type]
-        kind=kind,
-    )
+    position = r.vector("position", 3)
+    rpy = r.vector("orientation_rpy", 3, (0.0, 0.0, 0.0))
+    if kind == "linear":
+        mount: Mount = LinearMount(
+            name=name,
+            position=position,  # type: ignore[arg-type]
+            orientation_rpy=rpy,  # type: ignore[arg-type]
+            stiffness=r.vector("stiffness", 6, lo=0.0),  # type: ignore[arg-type]
+            damping=r.vector("damping", 6, (0.0,) * 6, lo=0.0),  # type: ignore[arg-type]
+            kind=kind,
+        )
+    else:
+        mount = KINDS[kind].read(r, name, position, rpy)
     r.finish()
     return mount
 
@@ -202,6 +208,7 @@ def _outputs(r: Reader) -> Outputs:
             "diagnostics_period_s", d.diagnostics_period_s, lo=0.0, lo_open=True
         ),
         tilt_warn_rad=r.number("tilt_warn_rad", d.tilt_warn_rad, lo=0.0, hi=math.pi / 2),
+        alarm_margin=r.number("alarm_margin", d.alarm_margin, lo=0.0, hi=1.0),
     )
     r.finish()
     return spec

@@ -53,6 +53,7 @@ PARAMETERS: dict[str, tuple[str, str]] = {
     "outputs.decimation": ("integer", "Publish every Nth sample; wrenches hold their peaks"),
     "outputs.diagnostics_period_s": ("double", "Diagnostics period in stamp time, s"),
     "outputs.tilt_warn_rad": ("double", "Tilt from vertical past which diagnostics warn, rad"),
+    "outputs.alarm_margin": ("double", "A mount warns past utilisation 1 − alarm_margin"),
 }
 """Every scene parameter the node declares: flat name → (ROS type, description)."""
 

@@ -1,0 +1,220 @@
+"""Bolted joint (VDI 2230 joint diagram) with bolt plasticity, fracture, friction and bearing.
+
+Local axes: z along the bolt, positive where the machine foot lifts off the foundation (the joint
+opens); x, y span the joint face. Deflections d (m) and rates v (m/s) are the foot's motion in
+these axes from the preloaded rest position.
+
+Axial (joint diagram): bolt force F_S = F_V + k_S·(u − e_p) (never compressive), clamp force
+F_K = max(F_V − k_P·u, 0); the force on the body is F_K − F_S. While the joint is closed the
+bolt takes Φ = k_S/(k_S + k_P) of an external load F_A; it opens at F_A = F_V/(1 − Φ), after
+which the bolt alone carries it. The bolt is bilinear elasto-plastic: past F_y (hardened by
+plastic elongation e_p) only the fraction α of k_S remains, ė_p = (1 − α)·u̇; e_p stays after
+unloading and lowers the preload. At F_u, or at the ultimate plastic elongation, it breaks for
+good (a discrete state, switched between input samples).
+
+Shear: stick spring k_τ in series with a slip s_p; the friction force never exceeds μ·F_K and
+slides (ṡ_p along the stick deflection) at that bound; past the hole clearance the shank bears
+with k_b (until the bolt breaks).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from mount_twin.scene.reader import Reader
+
+KIND = "bolted_joint"
+EVENTS = ("bolt_yielded", "joint_opened", "joint_slipped", "bolt_fractured")
+"""Monitored events, in the order `monitor` fills them (signed: ≥ 0 means it happened)."""
+EVENT_ERROR = (True, True, False, True)
+"""Whether each event is an ERROR (a limit passed) rather than a WARN."""
+STATES = ("plastic_elongation", "slip_x", "slip_y", "fractured")
+
+# parameter columns
+KS, KP, FV, FY, ALPHA, FU, EPU, MU, KT, CLEAR, KB, CAX, CSH = range(13)
+N_PAR = 13
+
+
+@dataclass(frozen=True)
+class BoltedJoint:
+    """A bolted foot: see the module docstring; SI units, forces N, stiffnesses N/m.
+
+    Attributes:
+        bolt_stiffness: k_S. clamp_stiffness: k_P. preload: F_V.
+        yield_force: F_y = R_p0.2·A_s. hardening: α, post-yield tangent as a fraction of k_S.
+        ultimate_force: F_u. ultimate_plastic_elongation: e_p at fracture, m.
+        friction: μ. shear_stiffness: k_τ of the stuck joint face.
+        hole_clearance: m. bearing_stiffness: k_b of the shank in the hole.
+        axial_damping, shear_damping: N·s/m.
+    """
+
+    name: str
+    position: tuple[float, float, float]
+    orientation_rpy: tuple[float, float, float]
+    bolt_stiffness: float
+    clamp_stiffness: float
+    preload: float
+    yield_force: float
+    hardening: float
+    ultimate_force: float
+    ultimate_plastic_elongation: float
+    friction: float
+    shear_stiffness: float
+    hole_clearance: float
+    bearing_stiffness: float
+    axial_damping: float
+    shear_damping: float
+    kind: str = KIND
+
+    @property
+    def phi(self) -> float:
+        """Load factor Φ = k_S/(k_S + k_P)."""
+        return self.bolt_stiffness / (self.bolt_stiffness + self.clamp_stiffness)
+
+    @property
+    def opening_load(self) -> float:
+        """External axial load that opens the joint, F_V/(1 − Φ), N."""
+        return self.preload / (1.0 - self.phi)
+
+
+def read(r: Reader, name: str, position: tuple, rpy: tuple) -> BoltedJoint:
+    """Parse and check the kind's keys (units in `BoltedJoint`)."""
+    pos = {"lo": 0.0, "lo_open": True}
+    joint = BoltedJoint(
+        name=name,
+        position=position,
+        orientation_rpy=rpy,
+        bolt_stiffness=r.number("bolt_stiffness", **pos),
+        clamp_stiffness=r.number("clamp_stiffness", **pos),
+        preload=r.number("preload", lo=0.0),
+        yield_force=r.number("yield_force", **pos),
+        hardening=r.number("hardening", 0.02, lo=0.0, hi=0.99),
+        ultimate_force=r.number("ultimate_force", **pos),
+        ultimate_plastic_elongation=r.number("ultimate_plastic_elongation", 2.0e-3, **pos),
+        friction=r.number("friction", 0.15, lo=0.0),
+        shear_stiffness=r.number("shear_stiffness", 1.0e9, **pos),
+        hole_clearance=r.number("hole_clearance", 1.0e-3, lo=0.0),
+        bearing_stiffness=r.number("bearing_stiffness", 5.0e8, lo=0.0),
+        axial_damping=r.number("axial_damping", 0.0, lo=0.0),
+        shear_damping=r.number("shear_damping", 0.0, lo=0.0),
+    )
+    if not joint.preload < joint.yield_force < joint.ultimate_force:
+        raise r.error(
+            "yield_force",
+            f"need preload < yield_force < ultimate_force, got {joint.preload!r}, "
+            f"{joint.yield_force!r}, {joint.ultimate_force!r}",
+        )
+    return joint
+
+
+def pack(j: BoltedJoint) -> np.ndarray:
+    """Parameter row of one joint (columns as named above)."""
+    row = np.zeros(N_PAR)
+    row[[KS, KP, FV, FY, ALPHA, FU, EPU, MU, KT, CLEAR, KB, CAX, CSH]] = [
+        j.bolt_stiffness,
+        j.clamp_stiffness,
+        j.preload,
+        j.yield_force,
+        j.hardening,
+        j.ultimate_force,
+        j.ultimate_plastic_elongation,
+        j.friction,
+        j.shear_stiffness,
+        j.hole_clearance,
+        j.bearing_stiffness,
+        j.axial_damping,
+        j.shear_damping,
+    ]
+    return row
+
+
+def state_names(j: BoltedJoint) -> tuple[str, ...]:
+    """Internal states of one joint (all joints have them)."""
+    return tuple(f"{j.name}.{s}" for s in STATES)
+
+
+@njit(cache=True, inline="always")
+def bolt_force(p: np.ndarray, u: float, e_p: float, broken: float) -> float:
+    """Bolt tension F_S, N (0 once broken or slack)."""
+    if broken > 0.5:
+        return 0.0
+    return max(p[FV] + p[KS] * (u - e_p), 0.0)
+
+
+@njit(cache=True, inline="always")
+def yield_limit(p: np.ndarray, e_p: float) -> float:
+    """Current yield force, N: linear hardening with the post-yield tangent α·k_S."""
+    return p[FY] + p[ALPHA] * p[KS] / (1.0 - p[ALPHA]) * e_p
+
+
+@njit(cache=True, inline="always")
+def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
+    """Force f and couple c (N, N·m) on the body in local axes; internal state rates into dydt.
+
+    Args:
+        p: (N_PAR,) parameters; y, dydt: state and its rate, this joint's states from o.
+        d, v: (3,) local deflection (m) and rate (m/s); phi, w: local rotation (rad) and rate
+            (rad/s), unused: a single bolt carries no moment.
+    """
+    e_p, sx, sy, broken = y[o], y[o + 1], y[o + 2], y[o + 3]
+    u, ud = d[2], v[2]
+    f_s = bolt_force(p, u, e_p, broken)
+    f_k = max(p[FV] - p[KP] * u, 0.0)
+    flow = broken < 0.5 and f_s >= yield_limit(p, e_p) and ud > 0.0
+    dydt[o] = (1.0 - p[ALPHA]) * ud if flow else 0.0
+    dydt[o + 3] = 0.0
+    f[2] = f_k - f_s - p[CAX] * ud
+    # shear: stick spring in series with slip, bounded by μ·F_K
+    tx, ty = p[KT] * (d[0] - sx), p[KT] * (d[1] - sy)
+    tau = math.sqrt(tx * tx + ty * ty)
+    limit = p[MU] * f_k
+    dydt[o + 1] = 0.0
+    dydt[o + 2] = 0.0
+    scale = 1.0
+    if tau >= limit:
+        scale = limit / tau if tau > 0.0 else 0.0
+        ex, ey = d[0] - sx, d[1] - sy
+        norm2 = ex * ex + ey * ey
+        outward = ex * v[0] + ey * v[1]
+        if norm2 > 0.0 and outward > 0.0:
+            dydt[o + 1] = outward / norm2 * ex
+            dydt[o + 2] = outward / norm2 * ey
+    f[0] = -scale * tx - p[CSH] * v[0]
+    f[1] = -scale * ty - p[CSH] * v[1]
+    if broken < 0.5:
+        s = math.sqrt(d[0] * d[0] + d[1] * d[1])
+        bear = s - p[CLEAR]
+        if bear > 0.0:
+            f[0] -= p[KB] * bear * d[0] / s
+            f[1] -= p[KB] * bear * d[1] / s
+    c[0] = 0.0
+    c[1] = 0.0
+    c[2] = 0.0
+
+
+@njit(cache=True, inline="always")
+def monitor(p, y, o, d, v, g) -> float:
+    """Event functions into g (order of EVENTS; ≥ 0: happening); returns the utilisation
+    F_S/F_y (1 at first yield)."""
+    e_p, sx, sy, broken = y[o], y[o + 1], y[o + 2], y[o + 3]
+    u = d[2]
+    f_s = bolt_force(p, u, e_p, broken)
+    g[0] = f_s - yield_limit(p, e_p) if broken < 0.5 else -1.0
+    g[1] = p[KP] * u - p[FV]
+    tx, ty = p[KT] * (d[0] - sx), p[KT] * (d[1] - sy)
+    g[2] = math.sqrt(tx * tx + ty * ty) - p[MU] * max(p[FV] - p[KP] * u, 0.0)
+    g[3] = 1.0 if broken > 0.5 else max(f_s / p[FU] - 1.0, e_p / p[EPU] - 1.0)
+    return f_s / p[FY]
+
+
+@njit(cache=True, inline="always")
+def update(p, y, o, d) -> None:
+    """Between samples: a bolt at its ultimate load or elongation breaks, irreversibly."""
+    if y[o + 3] < 0.5:
+        f_s = bolt_force(p, d[2], y[o], 0.0)
+        if f_s >= p[FU] or y[o] >= p[EPU]:
+            y[o + 3] = 1.0

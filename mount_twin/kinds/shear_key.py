@@ -1,0 +1,100 @@
+"""Shear key: stiff along its shear axes, free along the others, with an optional clearance.
+
+Along each local axis with a stiffness k > 0 the key pushes back only past the clearance:
+F = −k·(|d| − clearance)·sign(d) − c·ḋ while in contact; no force along free axes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from mount_twin.scene.reader import Reader
+
+KIND = "shear_key"
+EVENTS = ("key_contact", "key_overload")
+EVENT_ERROR = (False, True)
+STATES: tuple[str, ...] = ()
+
+# parameter columns: stiffness (3), damping (3), clearance, allowable force
+K0, C0, CLEAR, FALLOW = 0, 3, 6, 7
+N_PAR = 8
+
+
+@dataclass(frozen=True)
+class ShearKey:
+    """Attributes: stiffness (N/m) and damping (N·s/m) per local axis (0: free axis), clearance
+    (m), allowable_force (N, 0: not monitored)."""
+
+    name: str
+    position: tuple[float, float, float]
+    orientation_rpy: tuple[float, float, float]
+    stiffness: tuple[float, float, float]
+    damping: tuple[float, float, float]
+    clearance: float
+    allowable_force: float
+    kind: str = KIND
+
+
+def read(r: Reader, name: str, position: tuple, rpy: tuple) -> ShearKey:
+    """Parse and check the kind's keys."""
+    key = ShearKey(
+        name=name,
+        position=position,
+        orientation_rpy=rpy,
+        stiffness=r.vector("stiffness", 3, lo=0.0),  # type: ignore[arg-type]
+        damping=r.vector("damping", 3, (0.0, 0.0, 0.0), lo=0.0),  # type: ignore[arg-type]
+        clearance=r.number("clearance", 0.0, lo=0.0),
+        allowable_force=r.number("allowable_force", 0.0, lo=0.0),
+    )
+    if not any(k > 0.0 for k in key.stiffness):
+        raise r.error("stiffness", f"a key needs at least one stiff axis, got {key.stiffness!r}")
+    return key
+
+
+def pack(k: ShearKey) -> np.ndarray:
+    """Parameter row of one key."""
+    return np.array([*k.stiffness, *k.damping, k.clearance, k.allowable_force])
+
+
+def state_names(_k: ShearKey) -> tuple[str, ...]:
+    """A key has no internal state."""
+    return ()
+
+
+@njit(cache=True, inline="always")
+def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
+    """Force f (N) on the body in local axes; a key has no couple and no states."""
+    for j in range(3):
+        f[j] = 0.0
+        c[j] = 0.0
+        k = p[K0 + j]
+        if k > 0.0:
+            pen = abs(d[j]) - p[CLEAR]
+            if pen > 0.0:
+                f[j] = -k * pen * (1.0 if d[j] > 0.0 else -1.0) - p[C0 + j] * v[j]
+
+
+@njit(cache=True, inline="always")
+def monitor(p, y, o, d, v, g) -> float:
+    """Contact (penetration past the clearance, m) and overload; returns |F|/allowable."""
+    pen = -1.0
+    force = 0.0
+    for j in range(3):
+        if p[K0 + j] > 0.0:
+            pj = abs(d[j]) - p[CLEAR]
+            pen = max(pen, pj)
+            force = max(force, p[K0 + j] * max(pj, 0.0))
+    g[0] = pen if p[CLEAR] > 0.0 else -1.0
+    if p[FALLOW] > 0.0:
+        g[1] = force / p[FALLOW] - 1.0
+        return force / p[FALLOW]
+    g[1] = -1.0
+    return 0.0
+
+
+@njit(cache=True, inline="always")
+def update(p, y, o, d) -> None:
+    """No discrete state."""
