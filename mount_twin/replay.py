@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from mount_twin.engine.batch import MountEvent
 from mount_twin.engine.health import tilt_from_quaternions
 from mount_twin.io.bag import InputBag, OutputBag
 from mount_twin.io.messages import output_types, resolve
@@ -33,6 +34,8 @@ class ReplaySummary:
     tilt_max_rad: float = 0.0
     displacement_max_m: float = 0.0
     health: list[str] = field(default_factory=list)
+    events: list[MountEvent] = field(default_factory=list)
+    utilisation_max: dict[str, float] = field(default_factory=dict)
 
     @property
     def real_time_factor(self) -> float:
@@ -57,8 +60,28 @@ class ReplaySummary:
         ]
         for name, peak in self.peak_wrench.items():
             lines.append(f"    {name:>12}: " + " ".join(f"{v:10.1f}" for v in peak))
+        if self.utilisation_max:
+            lines.append(
+                "  peak utilisation (bolt F/F_y, rubber deflection/rated, key F/allowable):"
+            )
+            lines += [f"    {n:>12}: {u:.3f}" for n, u in self.utilisation_max.items()]
+        lines.append(f"  mount events: {len(self.events) or 'none'}")
+        for (mount, event), same in _grouped(self.events).items():
+            level = "ERROR" if same[0].error else "WARN"
+            lines.append(
+                f"    {level:5} {mount:>12} {event:<16} ×{len(same):<5} "
+                f"first {same[0].stamp:.6f} s  |F| max {max(e.force for e in same):.4g} N"
+            )
         lines += [f"  diagnostics: {h}" for h in self.health]
         return "\n".join(lines)
+
+
+def _grouped(events: list[MountEvent]) -> dict[tuple[str, str], list[MountEvent]]:
+    """Events by (mount, event), in order of first occurrence."""
+    out: dict[tuple[str, str], list[MountEvent]] = {}
+    for e in events:
+        out.setdefault((e.mount, e.event), []).append(e)
+    return out
 
 
 def replay(
@@ -115,4 +138,6 @@ def replay(
         tilt,
         disp,
         last_health,
+        list(stream.engine.events),
+        stream.engine.utilisation_max,
     )

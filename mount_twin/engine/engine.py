@@ -90,12 +90,13 @@ class TwinEngine:
         self._gravity_up = np.array([0.0, 0.0, scene.input.g])
         self.counts: Counter[str] = Counter()
         self.health = HealthWindow(scene, self.stepper.name)
-        self._watch = new_watch(model.arrays.nl_kind.shape[0], N_EVENTS)
-        self._event_meta = [
-            (model.scene.mounts[slot].name, KINDS[model.scene.mounts[slot].kind])
-            for slot in model.arrays.nl_slot.tolist()
-        ]
+        self._watch = new_watch(len(model.nonlinear_slots), N_EVENTS)
+        self._event_meta = {
+            slot: (model.scene.mounts[slot].name, KINDS[model.scene.mounts[slot].kind])
+            for slot in model.nonlinear_slots
+        }
         self.events: list[MountEvent] = []
+        self._util_max = np.zeros(len(model.nonlinear_slots))
         """Every mount event so far, in time order (the first MAX_EVENTS; the rest counted)."""
         # Fails now, at load, if the mounts cannot hold the body; and is the restart fallback.
         self._y_nominal = initial_state(model, self._gravity_up)
@@ -129,7 +130,7 @@ class TwinEngine:
             np.zeros((n, nm, 6)),
             np.zeros(n, dtype=np.bool_),
             np.zeros((n, 3)),
-            new_watch(model.arrays.nl_kind.shape[0], N_EVENTS),
+            new_watch(len(model.nonlinear_slots), N_EVENTS),
         )
 
     @property
@@ -141,6 +142,14 @@ class TwinEngine:
     def running(self) -> bool:
         """True once a sample has started the twin (and no failure has stopped it since)."""
         return self._last is not None
+
+    @property
+    def utilisation_max(self) -> dict[str, float]:
+        """Peak utilisation so far of each mount that has an allowable (bolt: F_S/F_y, rubber:
+        deflection/rated, key: force/allowable), by name."""
+        peak = np.maximum(self._util_max, self._watch.util_peak)
+        names = [self.scene.mounts[i].name for i in self.model.nonlinear_slots]
+        return dict(zip(names, peak.tolist(), strict=True))
 
     def count(self, what: str, n: int = 1) -> None:
         """Count events found outside the engine (e.g. undecodable messages) with its own."""
@@ -170,6 +179,7 @@ class TwinEngine:
                 stamp = float(batch.stamps[stop - 1])
                 util = self._watch.util_peak
                 reports.append(self.health.report(stamp, stop - 1, self.counts, util.copy()))
+                np.maximum(self._util_max, util, out=self._util_max)
                 util[:] = 0.0
             start = stop
         nm = self.model.n_mounts
@@ -315,10 +325,9 @@ class TwinEngine:
         cap = watch.events.shape[0]
         if n > cap:
             self.counts["mount_events_dropped"] += n - cap
-        nl_index = {slot: k for k, slot in enumerate(self.model.arrays.nl_slot.tolist())}
         new = []
         for t, slot, e, force in watch.events[: min(n, cap)].tolist():
-            name, kind = self._event_meta[nl_index[int(slot)]]
+            name, kind = self._event_meta[int(slot)]
             new.append(MountEvent(t, name, kind.EVENTS[int(e)], force, kind.EVENT_ERROR[int(e)]))
         watch.n_events[0] = 0
         self.counts["mount_events"] += len(new)
@@ -352,6 +361,8 @@ class TwinEngine:
         if not math.isfinite(ct):
             msg = f"{self.scene.source}: initial_state.pose is off the α/γ/δ chart"
             raise ValueError(msg)
-        watch = self._watch
-        mount_monitors(self._y, self.model.arrays, self._scratch, watch.g_prev, watch.util)
+        nl = self.model.arrays.nl
+        if nl is not None:
+            watch = self._watch
+            mount_monitors(self._y, nl, self._scratch, watch.g_prev, watch.util)
         return _Rows(np.array([i]), pose, wrenches)

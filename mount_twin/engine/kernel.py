@@ -14,6 +14,7 @@ from numba import njit
 
 from mount_twin.integrate.stepper import advance
 from mount_twin.physics.dynamics import evaluate, mount_monitors
+from mount_twin.physics.gate import skip_if_none
 
 
 class Watch(NamedTuple):
@@ -46,11 +47,11 @@ def new_watch(k: int, n_events: int, capacity: int = 4096) -> Watch:
 
 
 @njit(cache=True)
-def _watch(y, m, s, watch, t0, t1, wrenches) -> None:
+def _watch(y, nl, s, watch, t0, t1, wrenches) -> None:
     """Evaluate the event functions at t1; log each upward zero crossing since t0."""
     g_prev, g, util, peak = watch.g_prev, watch.g, watch.util, watch.util_peak
     events, count = watch.events, watch.n_events
-    mount_monitors(y, m, s, g, util)
+    mount_monitors(y, nl, s, g, util)
     for i in range(g.shape[0]):
         peak[i] = max(peak[i], util[i])
         for e in range(g.shape[1]):
@@ -60,12 +61,15 @@ def _watch(y, m, s, watch, t0, t1, wrenches) -> None:
                 k = count[0]
                 count[0] += 1
                 if k < events.shape[0]:
-                    slot = m.nl_slot[i]
+                    slot = nl.slot[i]
                     w = wrenches[slot]
                     events[k, 0] = t0 + (t1 - t0) * (-g0) / (g1 - g0)
                     events[k, 1] = slot
                     events[k, 2] = e
                     events[k, 3] = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+
+
+watch_mounts = skip_if_none(_watch)
 
 
 @njit(cache=True)
@@ -123,8 +127,7 @@ def run_samples(
             return j - 1, status
         step_log[j, 0], step_log[j, 1], step_log[j, 2] = result[0], result[1], result[2]
         evaluate(y, m, s, pose[j], wrenches[j])
-        if m.nl_kind.shape[0] > 0:
-            _watch(y, m, s, watch, t[j - 1], t[j], wrenches[j])
+        watch_mounts(y, m.nl, s, watch, t[j - 1], t[j], wrenches[j])
         counter[0] += 1
         for a in range(nm):
             for b in range(6):

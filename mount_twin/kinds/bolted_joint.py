@@ -21,11 +21,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
 
-from mount_twin.scene.reader import Reader
+if TYPE_CHECKING:  # only annotations: importing mount_twin.scene here is a cycle
+    from mount_twin.scene.reader import Reader
 
 KIND = "bolted_joint"
 EVENTS = ("bolt_yielded", "joint_opened", "joint_slipped", "bolt_fractured")
@@ -33,6 +35,23 @@ EVENTS = ("bolt_yielded", "joint_opened", "joint_slipped", "bolt_fractured")
 EVENT_ERROR = (True, True, False, True)
 """Whether each event is an ERROR (a limit passed) rather than a WARN."""
 STATES = ("plastic_elongation", "slip_x", "slip_y", "fractured")
+
+PARAMETERS = {
+    "bolt_stiffness": ("double", "Bolt stiffness k_S, N/m"),
+    "clamp_stiffness": ("double", "Clamped-parts stiffness k_P, N/m"),
+    "preload": ("double", "Preload F_V, N"),
+    "yield_force": ("double", "Bolt yield force F_y = R_p0.2·A_s, N"),
+    "hardening": ("double", "Post-yield tangent as a fraction α of k_S (default 0.02)"),
+    "ultimate_force": ("double", "Bolt fracture force F_u, N"),
+    "ultimate_plastic_elongation": ("double", "Plastic elongation at fracture, m (2.0e-3)"),
+    "friction": ("double", "Joint-face friction coefficient μ (0.15)"),
+    "shear_stiffness": ("double", "Stick stiffness of the joint face, N/m (1.0e+9)"),
+    "hole_clearance": ("double", "Bolt hole clearance, m (1.0e-3)"),
+    "bearing_stiffness": ("double", "Shank bearing stiffness past the clearance, N/m (5.0e+8)"),
+    "axial_damping": ("double", "Axial damping, N·s/m (0.0)"),
+    "shear_damping": ("double", "Shear damping, N·s/m (0.0)"),
+}
+"""ROS parameters of the kind, mounts.<name>.<key>: (type, description)."""
 
 # parameter columns
 KS, KP, FV, FY, ALPHA, FU, EPU, MU, KT, CLEAR, KB, CAX, CSH = range(13)

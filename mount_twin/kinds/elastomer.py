@@ -14,12 +14,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from itertools import pairwise
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
 from scipy.interpolate import PchipInterpolator
 
-from mount_twin.scene.reader import Reader
+if TYPE_CHECKING:  # only annotations: importing mount_twin.scene here is a cycle
+    from mount_twin.scene.reader import Reader
 
 KIND = "elastomer"
 EVENTS = ("snubber_contact", "over_travel")
@@ -27,6 +29,32 @@ EVENT_ERROR = (False, True)
 AXES = ("x", "y", "z")
 TABLE_MAX = 16
 """Most points in a force–deflection table."""
+
+PARAMETERS = {
+    "stiffness_linear": ("double_array", "k1 per local axis [x, y, z], N/m"),
+    "stiffness_cubic": ("double_array", "k3 per local axis, N/m³ (zeros)"),
+    "damping": ("double_array", "Viscous damping per local axis, N·s/m (zeros)"),
+    "rotational_stiffness": ("double_array", "Per local axis, N·m/rad (zeros)"),
+    "rotational_damping": ("double_array", "Per local axis, N·m·s/rad (zeros)"),
+    "rated_deflection": ("double_array", "Allowable |deflection| per axis, m (0: none)"),
+    **{
+        f"force_table.{axis}.{key}": ("double_array", f"Force table along {axis}: {unit}")
+        for axis in ("x", "y", "z")
+        for key, unit in (("deflection", "deflections, m"), ("force", "forces, N"))
+    },
+    "hysteresis.ratio": ("double", "Bouc–Wen elastic share a, 0..1"),
+    "hysteresis.A": ("double", "Bouc–Wen A (1.0)"),
+    "hysteresis.beta": ("double", "Bouc–Wen β, 1/mⁿ"),
+    "hysteresis.gamma": ("double", "Bouc–Wen γ, 1/mⁿ"),
+    "hysteresis.n": ("double", "Bouc–Wen exponent n ≥ 1 (1.0)"),
+    "hysteresis.axes": ("string_array", "Hysteretic local axes (all)"),
+    "snubber.gap": ("double", "Snubber gap, m"),
+    "snubber.stiffness": ("double", "Snubber contact stiffness k_s, N/mᵖ"),
+    "snubber.exponent": ("double", "Contact exponent p ≥ 1 (1.5)"),
+    "snubber.damping": ("double", "Hunt–Crossley damping h, s/m (0.0)"),
+    "snubber.axes": ("string_array", "Snubbed local axes (all)"),
+}
+"""ROS parameters of the kind, mounts.<name>.<key>: (type, description)."""
 
 # parameter columns, per axis block of N_AXIS starting at j·N_AXIS
 K1, K3, C, RATIO, BW_A, BETA, GAMMA, N_EXP, K0, ZSLOT, GAP, KS, PEXP, HC, RATED, NTAB = range(16)

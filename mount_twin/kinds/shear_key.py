@@ -7,16 +7,26 @@ F = −k·(|d| − clearance)·sign(d) − c·ḋ while in contact; no force alo
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
 
-from mount_twin.scene.reader import Reader
+if TYPE_CHECKING:  # only annotations: importing mount_twin.scene here is a cycle
+    from mount_twin.scene.reader import Reader
 
 KIND = "shear_key"
 EVENTS = ("key_contact", "key_overload")
 EVENT_ERROR = (False, True)
 STATES: tuple[str, ...] = ()
+
+PARAMETERS = {
+    "stiffness": ("double_array", "[kx, ky, kz] N/m along the key axes; 0 leaves an axis free"),
+    "damping": ("double_array", "[cx, cy, cz] N·s/m in contact (zeros)"),
+    "clearance": ("double", "Clearance before the key bears, m (0.0)"),
+    "allowable_force": ("double", "Allowable key force, N (0.0: not monitored)"),
+}
+"""ROS parameters of the kind, mounts.<name>.<key>: (type, description)."""
 
 # parameter columns: stiffness (3), damping (3), clearance, allowable force
 K0, C0, CLEAR, FALLOW = 0, 3, 6, 7

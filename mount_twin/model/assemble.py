@@ -9,7 +9,15 @@ from scipy.optimize import least_squares
 
 from mount_twin.errors import ModelError
 from mount_twin.kinds import CODES, KINDS, N_PAR
-from mount_twin.physics.dynamics import INPUT_SIZE, OK, ModelArrays, Scratch, new_scratch, rhs
+from mount_twin.physics.dynamics import (
+    INPUT_SIZE,
+    OK,
+    ModelArrays,
+    NonLinearMounts,
+    Scratch,
+    new_scratch,
+    rhs,
+)
 from mount_twin.physics.rotations import rpy_matrix
 from mount_twin.scene.description import DOF_NAMES, LinearMount, Scene
 
@@ -34,6 +42,12 @@ class Model:
     def n_state(self) -> int:
         """Length of the state vector."""
         return len(self.state_names)
+
+    @property
+    def nonlinear_slots(self) -> list[int]:
+        """Scene index of each mount of a kind in mount_twin.kinds, in kernel order."""
+        nl = self.arrays.nl
+        return [] if nl is None else nl.slot.tolist()
 
     @property
     def n_mounts(self) -> int:
@@ -82,14 +96,7 @@ def assemble(scene: Scene) -> Model:
         lin_k_r=in_f(lin_axes, stiffness[:, 3:]),
         lin_c_r=in_f(lin_axes, damping[:, 3:]),
         lin_slot=np.array(lin, dtype=np.int64),
-        nl_kind=np.array([CODES[mounts[i].kind] for i in other], dtype=np.int64),
-        nl_point=points[other].reshape(-1, 3),
-        nl_axes=axes[other].reshape(-1, 3, 3),
-        nl_slot=np.array(other, dtype=np.int64),
-        nl_state=np.array(offsets, dtype=np.int64),
-        nl_par=np.array([_padded(KINDS[mounts[i].kind].pack(mounts[i])) for i in other]).reshape(
-            -1, N_PAR
-        ),
+        nl=_nonlinear(mounts, other, points, axes, offsets) if other else None,
     )
     return Model(scene, arrays, tuple(names), rpy_matrix(*scene.input.sensor_rpy))
 
@@ -99,10 +106,22 @@ def in_f(axes: np.ndarray, values: np.ndarray) -> np.ndarray:
     return np.einsum("nij,nj,nkj->nik", axes, values, axes)
 
 
-def _padded(row: np.ndarray) -> np.ndarray:
-    out = np.zeros(N_PAR)
-    out[: row.shape[0]] = row
-    return out
+def _nonlinear(
+    mounts: tuple, index: list[int], points: np.ndarray, axes: np.ndarray, offsets: list[int]
+) -> NonLinearMounts:
+    """Kernel arrays of the mounts at `index` (kinds of mount_twin.kinds)."""
+    par = np.zeros((len(index), N_PAR))
+    for row, i in enumerate(index):
+        own = KINDS[mounts[i].kind].pack(mounts[i])
+        par[row, : own.shape[0]] = own
+    return NonLinearMounts(
+        kind=np.array([CODES[mounts[i].kind] for i in index], dtype=np.int64),
+        point=points[index],
+        axes=axes[index],
+        slot=np.array(index, dtype=np.int64),
+        state=np.array(offsets, dtype=np.int64),
+        par=par,
+    )
 
 
 def gravity_input(t0: float, specific_force: np.ndarray) -> np.ndarray:

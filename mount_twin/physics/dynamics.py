@@ -25,6 +25,7 @@ from numba import njit
 
 from mount_twin.kinds import kind_load, kind_monitor, kind_update
 from mount_twin.physics.chart import kinematic_matrix, kinematic_matrix_rate, rotation_from_chart
+from mount_twin.physics.gate import skip_if_none
 from mount_twin.physics.linear_mount import linear_mount_load
 from mount_twin.physics.rotations import rotation_vector
 
@@ -42,8 +43,10 @@ INPUT_SIZE = 13
 class ModelArrays(NamedTuple):
     """Flat arrays of an assembled scene, as the compiled kernels read them (SI, frames as named).
 
-    Each mount kind owns a group of arrays with its prefix; a scene without that kind has
-    zero-length arrays there, so the kernels' loops over it do nothing.
+    Linear mounts are the lin_ arrays (zero-length if none); all other kinds are `nl`, None for
+    a scene without them, so that numba compiles no trace of them into its kernels: their mere
+    presence, even never run, made the linear right-hand side ~40 % slower (register pressure
+    and reference counting of the extra arrays).
     """
 
     mass: float  # kg
@@ -60,12 +63,18 @@ class ModelArrays(NamedTuple):
     lin_k_r: np.ndarray  # (n, 3, 3) N·m/rad in F
     lin_c_r: np.ndarray  # (n, 3, 3) N·m·s/rad in F
     lin_slot: np.ndarray  # int64 (n,): each linear mount's index in the scene (wrench row)
-    nl_kind: np.ndarray  # int64 (k,): kind code (mount_twin.kinds) of each other mount
-    nl_point: np.ndarray  # (k, 3) m, attachment point from the CG, in B
-    nl_axes: np.ndarray  # (k, 3, 3) mount axes Q (columns) in F
-    nl_slot: np.ndarray  # int64 (k,): index in the scene
-    nl_state: np.ndarray  # int64 (k,): offset of the mount's internal states in y (−1: none)
-    nl_par: np.ndarray  # (k, N_PAR) parameter rows, columns per kind
+    nl: NonLinearMounts | None  # the other kinds; None compiles their code away
+
+
+class NonLinearMounts(NamedTuple):
+    """Mounts of the kinds in mount_twin.kinds (k of them), as the kernels read them."""
+
+    kind: np.ndarray  # int64 (k,): kind code
+    point: np.ndarray  # (k, 3) m, attachment point from the CG, in B
+    axes: np.ndarray  # (k, 3, 3) mount axes Q (columns) in F
+    slot: np.ndarray  # int64 (k,): index in the scene
+    state: np.ndarray  # int64 (k,): offset of the mount's internal states in y (−1: none)
+    par: np.ndarray  # (k, N_PAR) parameter rows, columns per kind
 
 
 class Scratch(NamedTuple):
@@ -179,11 +188,11 @@ def body_motion(y: np.ndarray, m: ModelArrays, s: Scratch) -> float:
 
 
 @njit(cache=True, inline="always")
-def _local_motion(i: int, m: ModelArrays, s: Scratch) -> None:
+def _local_motion(i: int, nl: NonLinearMounts, s: Scratch) -> None:
     """Deflection, rate, rotation and rate of non-linear mount i in its axes into s.loc[:4];
     its lever arm R·p into s.arm."""
     rot, q, qd, omega_f, phi, arm, loc = s.rot, s.q, s.qd, s.omega_f, s.phi, s.arm, s.loc
-    point, axes = m.nl_point, m.nl_axes
+    point, axes = nl.point, nl.axes
     for j in range(3):
         arm[j] = rot[j, 0] * point[i, 0] + rot[j, 1] * point[i, 1] + rot[j, 2] * point[i, 2]
     d0 = q[0] + arm[0] - point[i, 0]
@@ -201,15 +210,15 @@ def _local_motion(i: int, m: ModelArrays, s: Scratch) -> None:
 
 
 @njit(cache=True, inline="always")
-def _nl_load(i: int, y: np.ndarray, m: ModelArrays, s: Scratch, dydt: np.ndarray) -> None:
+def _nl_load(i: int, y: np.ndarray, nl: NonLinearMounts, s: Scratch, dydt: np.ndarray) -> None:
     """Load of non-linear mount i in its axes into s.loc[4:6]; its state rates into dydt."""
-    _local_motion(i, m, s)
+    _local_motion(i, nl, s)
     loc = s.loc
     kind_load(
-        m.nl_kind[i],
-        m.nl_par[i],
+        nl.kind[i],
+        nl.par[i],
         y,
-        m.nl_state[i],
+        nl.state[i],
         loc[0],
         loc[1],
         loc[2],
@@ -234,9 +243,17 @@ def mount_loads(y: np.ndarray, m: ModelArrays, s: Scratch, dydt: np.ndarray) -> 
     for i in range(point.shape[0]):
         linear_mount_load(i, point, k_t, c_t, k_r, c_r, rot, q, qd, omega_f, phi, arm, f, c)
         _add_load(arm, f, c, total_f, total_m)
-    axes, loc = m.nl_axes, s.loc
-    for i in range(m.nl_kind.shape[0]):
-        _nl_load(i, y, m, s, dydt)
+    nl_loads(y, m.nl, s, dydt)
+
+
+@njit(cache=True)
+def _nl_loads(y: np.ndarray, nl: NonLinearMounts, s: Scratch, dydt: np.ndarray) -> None:
+    """Add the non-linear mounts' loads to the totals; their state rates into dydt."""
+    total_f, total_m = s.total_force, s.total_moment
+    arm, f, c = s.arm, s.force, s.couple
+    axes, loc = nl.axes, s.loc
+    for i in range(nl.kind.shape[0]):
+        _nl_load(i, y, nl, s, dydt)
         for j in range(3):  # back from mount axes to F
             a0, a1, a2 = axes[i, j, 0], axes[i, j, 1], axes[i, j, 2]
             f[j] = a0 * loc[4, 0] + a1 * loc[4, 1] + a2 * loc[4, 2]
@@ -269,10 +286,15 @@ def mount_wrenches(y: np.ndarray, m: ModelArrays, s: Scratch, wrenches: np.ndarr
             wrenches[row, 3 + j] = (
                 axes[i, 0, j] * c[0] + axes[i, 1, j] * c[1] + axes[i, 2, j] * c[2]
             )
+    nl_wrenches(y, m.nl, s, wrenches)
+
+
+@njit(cache=True)
+def _nl_wrenches(y: np.ndarray, nl: NonLinearMounts, s: Scratch, wrenches: np.ndarray) -> None:
     loc = s.loc
-    for i in range(m.nl_kind.shape[0]):
-        _nl_load(i, y, m, s, s.sink)
-        row = m.nl_slot[i]
+    for i in range(nl.kind.shape[0]):
+        _nl_load(i, y, nl, s, s.sink)
+        row = nl.slot[i]
         for j in range(3):
             wrenches[row, j] = loc[4, j]
             wrenches[row, 3 + j] = loc[5, j]
@@ -280,16 +302,20 @@ def mount_wrenches(y: np.ndarray, m: ModelArrays, s: Scratch, wrenches: np.ndarr
 
 @njit(cache=True)
 def mount_monitors(
-    y: np.ndarray, m: ModelArrays, s: Scratch, g: np.ndarray, util: np.ndarray
+    y: np.ndarray, nl: NonLinearMounts, s: Scratch, g: np.ndarray, util: np.ndarray
 ) -> None:
     """Event functions g[i] and utilisation util[i] of each non-linear mount at state y (whose
     body motion `evaluate` or `rhs` has just computed); then their discrete switches."""
     loc = s.loc
-    for i in range(m.nl_kind.shape[0]):
-        _local_motion(i, m, s)
-        code, p, o = m.nl_kind[i], m.nl_par[i], m.nl_state[i]
+    for i in range(nl.kind.shape[0]):
+        _local_motion(i, nl, s)
+        code, p, o = nl.kind[i], nl.par[i], nl.state[i]
         util[i] = kind_monitor(code, p, y, o, loc[0], loc[1], g[i])
         kind_update(code, p, y, o, loc[0])
+
+
+nl_loads = skip_if_none(_nl_loads)
+nl_wrenches = skip_if_none(_nl_wrenches)
 
 
 @njit(cache=True)

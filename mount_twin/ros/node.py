@@ -16,7 +16,12 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rosidl_runtime_py.utilities import get_message
 
 from mount_twin.io.messages import output_types
-from mount_twin.scene.params import MOUNT_PARAMETERS, PARAMETERS, scene_from_params
+from mount_twin.scene.params import (
+    COMMON_MOUNT_PARAMETERS,
+    PARAMETERS,
+    mount_parameters,
+    scene_from_params,
+)
 from mount_twin.stream import TwinStream
 
 _TYPES = {
@@ -68,12 +73,17 @@ class MountTwinNode(Node):
         mount_names = self.get_parameter("mount_names")
         if mount_names.type_ != Parameter.Type.NOT_SET:
             for mount in mount_names.value:
+                kind = self.declare_parameter(
+                    f"mounts.{mount}.kind",
+                    "linear",
+                    ParameterDescriptor(description=COMMON_MOUNT_PARAMETERS["kind"][1]),
+                ).value
                 names.update(
-                    {f"mounts.{mount}.{key}": spec for key, spec in MOUNT_PARAMETERS.items()}
+                    {f"mounts.{mount}.{key}": spec for key, spec in mount_parameters(kind).items()}
                 )
         flat: dict[str, object] = {}
         for name, (ptype, description) in names.items():
-            if name != "mount_names":
+            if name != "mount_names" and not self.has_parameter(name):
                 self.declare_parameter(
                     name,
                     _TYPES[ptype],

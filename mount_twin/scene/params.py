@@ -12,6 +12,7 @@ from collections.abc import Iterator, Mapping
 from typing import Any
 
 from mount_twin.errors import SceneError
+from mount_twin.kinds import KINDS
 from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import load_scene_file, scene_from_dict
 
@@ -57,14 +58,26 @@ PARAMETERS: dict[str, tuple[str, str]] = {
 }
 """Every scene parameter the node declares: flat name → (ROS type, description)."""
 
-MOUNT_PARAMETERS: dict[str, tuple[str, str]] = {
-    "kind": ("string", "Mount kind: linear (6-component Kelvin–Voigt)"),
+COMMON_MOUNT_PARAMETERS: dict[str, tuple[str, str]] = {
+    "kind": ("string", "Mount kind: linear, " + ", ".join(KINDS)),
     "position": ("double_array", "Attachment point [x, y, z], m, in F at the reference pose"),
     "orientation_rpy": ("double_array", "Mount axes relative to F, roll, pitch, yaw, rad"),
+}
+LINEAR_PARAMETERS: dict[str, tuple[str, str]] = {
     "stiffness": ("double_array", "[kx, ky, kz] N/m, [krx, kry, krz] N·m/rad, mount axes"),
     "damping": ("double_array", "[cx, cy, cz] N·s/m, [crx, cry, crz] N·m·s/rad, mount axes"),
 }
-"""Parameters of each mount, declared as mounts.<name>.<key>."""
+
+
+def mount_parameters(kind: str) -> dict[str, tuple[str, str]]:
+    """Parameters of a mount of `kind`, declared as mounts.<name>.<key> (unknown kinds get
+    the common ones, so the loader can name the bad kind)."""
+    own = LINEAR_PARAMETERS if kind == "linear" else getattr(KINDS.get(kind), "PARAMETERS", {})
+    return {**COMMON_MOUNT_PARAMETERS, **own}
+
+
+MOUNT_PARAMETERS = mount_parameters("linear")
+"""Parameters of a linear mount."""
 
 
 def flatten(tree: Mapping[str, Any], prefix: str = "") -> Iterator[tuple[str, Any]]:
