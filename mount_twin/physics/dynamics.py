@@ -26,7 +26,7 @@ from numba import njit
 from mount_twin.kinds import kind_load, kind_monitor, kind_update
 from mount_twin.physics.chart import kinematic_matrix, kinematic_matrix_rate, rotation_from_chart
 from mount_twin.physics.gate import skip_if_none
-from mount_twin.physics.linear_mount import linear_mount_load
+from mount_twin.physics.linear_mount import linear_mount_load, point_motion
 from mount_twin.physics.rotations import rotation_vector
 
 OK = 0
@@ -192,15 +192,8 @@ def _local_motion(i: int, nl: NonLinearMounts, s: Scratch) -> None:
     """Deflection, rate, rotation and rate of non-linear mount i in its axes into s.loc[:4];
     its lever arm R·p into s.arm."""
     rot, q, qd, omega_f, phi, arm, loc = s.rot, s.q, s.qd, s.omega_f, s.phi, s.arm, s.loc
-    point, axes = nl.point, nl.axes
-    for j in range(3):
-        arm[j] = rot[j, 0] * point[i, 0] + rot[j, 1] * point[i, 1] + rot[j, 2] * point[i, 2]
-    d0 = q[0] + arm[0] - point[i, 0]
-    d1 = q[1] + arm[1] - point[i, 1]
-    d2 = q[2] + arm[2] - point[i, 2]
-    e0 = qd[0] + omega_f[1] * arm[2] - omega_f[2] * arm[1]
-    e1 = qd[1] + omega_f[2] * arm[0] - omega_f[0] * arm[2]
-    e2 = qd[2] + omega_f[0] * arm[1] - omega_f[1] * arm[0]
+    axes = nl.axes
+    d0, d1, d2, e0, e1, e2 = point_motion(i, nl.point, rot, q, qd, omega_f, arm)
     for j in range(3):
         a0, a1, a2 = axes[i, 0, j], axes[i, 1, j], axes[i, 2, j]
         loc[0, j] = a0 * d0 + a1 * d1 + a2 * d2

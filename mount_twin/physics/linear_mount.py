@@ -12,6 +12,34 @@ from numba import njit
 
 
 @njit(cache=True, inline="always")
+def point_motion(
+    i: int,
+    point: np.ndarray,
+    rot: np.ndarray,
+    q: np.ndarray,
+    qd: np.ndarray,
+    omega_f: np.ndarray,
+    arm: np.ndarray,
+) -> tuple[float, float, float, float, float, float]:
+    """Displacement d (m) and velocity ḋ (m/s) in F of body point i from its reference position:
+    d = q + R·p − p, ḋ = q̇ + (R ω) × (R p). Writes the lever arm R·p (m, F) into `arm`.
+
+    Args: point (n, 3) points p from the CG in B; rot R; q, qd (6,) coordinates and rates;
+    omega_f body angular velocity relative to F in F, rad/s.
+    """
+    for j in range(3):
+        arm[j] = rot[j, 0] * point[i, 0] + rot[j, 1] * point[i, 1] + rot[j, 2] * point[i, 2]
+    return (
+        q[0] + arm[0] - point[i, 0],
+        q[1] + arm[1] - point[i, 1],
+        q[2] + arm[2] - point[i, 2],
+        qd[0] + omega_f[1] * arm[2] - omega_f[2] * arm[1],
+        qd[1] + omega_f[2] * arm[0] - omega_f[0] * arm[2],
+        qd[2] + omega_f[0] * arm[1] - omega_f[1] * arm[0],
+    )
+
+
+@njit(cache=True, inline="always")
 def linear_mount_load(
     i: int,
     point: np.ndarray,
@@ -44,15 +72,7 @@ def linear_mount_load(
         force: out, force on the body at the attachment point, N, in F.
         couple: out, the mount's own couple on the body, N·m, in F.
     """
-    for j in range(3):
-        arm[j] = rot[j, 0] * point[i, 0] + rot[j, 1] * point[i, 1] + rot[j, 2] * point[i, 2]
-    d0 = q[0] + arm[0] - point[i, 0]
-    d1 = q[1] + arm[1] - point[i, 1]
-    d2 = q[2] + arm[2] - point[i, 2]
-    # ḋ = ṙ + (R ω) × (R p)
-    e0 = qd[0] + omega_f[1] * arm[2] - omega_f[2] * arm[1]
-    e1 = qd[1] + omega_f[2] * arm[0] - omega_f[0] * arm[2]
-    e2 = qd[2] + omega_f[0] * arm[1] - omega_f[1] * arm[0]
+    d0, d1, d2, e0, e1, e2 = point_motion(i, point, rot, q, qd, omega_f, arm)
     for j in range(3):
         force[j] = -(
             k_t[i, j, 0] * d0
