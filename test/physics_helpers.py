@@ -12,6 +12,7 @@ import math
 from typing import Any
 
 import numpy as np
+from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from mount_twin.integrate import stepper as stepper_mod
@@ -239,3 +240,19 @@ def quaternion_euler_rhs(inertia: np.ndarray):
         return np.concatenate([dq, dw])
 
     return f
+
+
+def torque_free_reference(inertia: np.ndarray, omega0: np.ndarray, times: np.ndarray):
+    """Tight DOP853 solution of `quaternion_euler_rhs` from the identity attitude with body rate
+    omega0 (rad/s), sampled at `times` (s)."""
+    ref = solve_ivp(
+        quaternion_euler_rhs(inertia),
+        (0.0, float(times[-1])),
+        np.concatenate([[0.0, 0.0, 0.0, 1.0], omega0]),
+        t_eval=times,
+        rtol=1e-12,
+        atol=1e-14,
+        method="DOP853",
+    )
+    assert ref.success, ref.message
+    return ref
