@@ -65,6 +65,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     gen.add_argument("--peak", type=float, default=150.0, help="half-sine peak, m/s²")
     gen.add_argument("--pulse", type=float, default=0.008, help="half-sine duration, s")
     gen.add_argument(
+        "--rebound",
+        type=float,
+        default=0.0,
+        help="peak of a downward half-sine right after the pulse, m/s², lasting "
+        "peak·pulse/rebound so the deck ends at rest (naval double half-sine; 0: none)",
+    )
+    gen.add_argument(
+        "--lateral",
+        type=float,
+        default=0.0,
+        help="share of the vertical half-sine(s) also applied along +y of F (athwartships)",
+    )
+    gen.add_argument(
         "--start", type=int, default=1_700_000_000_000_000_000, help="first stamp, ns"
     )
     gen.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
@@ -112,6 +125,8 @@ def _run(args: argparse.Namespace) -> int:
                 duration=args.pulse,
                 rate_hz=args.rate or 10000.0,
                 total=args.duration or 0.4,
+                lateral=args.lateral,
+                rebound=args.rebound,
             )
         else:
             sig = ship_motion(rate_hz=args.rate or 1000.0, total=args.duration or 5.0)

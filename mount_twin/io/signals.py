@@ -25,17 +25,38 @@ def half_sine_shock(
     pre: float = 0.05,
     total: float = 0.4,
     g: float = 9.80665,
+    *,
+    lateral: float = 0.0,
+    rebound: float = 0.0,
 ) -> Signal:
-    """Vertical half-sine deck acceleration a(t) = peak·sin(π(t − pre)/duration) during the pulse.
+    """Vertical half-sine deck acceleration a(t) = peak·sin(π(t − pre)/duration) during the pulse,
+    optionally followed by a rebound and shared with a lateral axis.
+
+    With `rebound` > 0 a downward half-sine of that peak follows at once, lasting
+    peak·duration/rebound so that the deck's velocity change 2·peak·duration/π is undone and the
+    deck ends at rest, lifted: the double half-sine of naval shock specifications (an upward kick,
+    then a longer, weaker deceleration). The lateral component (+y of F, athwartships) is
+    `lateral`·a(t) throughout.
 
     Args:
         peak: m/s² (150 ≈ 15 g); duration: pulse length, s; rate_hz: sampling rate;
         pre: rest before the pulse, s; total: record length, s; g: m/s².
+        lateral: share of a(t) along +y of F, −; rebound: peak of the downward half-sine, m/s²
+            (0: none).
     """
+    if rebound < 0.0:
+        msg = f"rebound must be ≥ 0 (the peak of a downward pulse), got {rebound!r} m/s²"
+        raise ValueError(msg)
     t = np.arange(round(total * rate_hz)) / rate_hz
     tau = t - pre
     a = np.where((tau >= 0.0) & (tau <= duration), peak * np.sin(math.pi * tau / duration), 0.0)
+    if rebound > 0.0:
+        length = peak * duration / rebound
+        tau2 = tau - duration
+        inside = (tau2 > 0.0) & (tau2 <= length)
+        a = a - np.where(inside, rebound * np.sin(math.pi * tau2 / length), 0.0)
     accel = np.zeros((t.size, 3))
+    accel[:, 1] = lateral * a
     accel[:, 2] = g + a
     return Signal(t, accel, np.zeros((t.size, 3)))
 
