@@ -85,7 +85,7 @@ class Law:
         """(utilisation, event functions in the order of the module's EVENTS)."""
         y = self.states() if y is None else np.asarray(y, dtype=float)
         g = np.full(len(self.module.EVENTS), np.nan)
-        util = self.module.monitor(self.p, y, 0, _vec(d), _vec(v), g)
+        util = self.module.monitor(self.p, y, y, 0, _vec(d), _vec(v), g)  # no trial state
         return float(util), g
 
     def update(self, y: np.ndarray, d: Sequence[float]) -> None:

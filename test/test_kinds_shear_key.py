@@ -40,11 +40,13 @@ def key(stiffness, clearance=0.0, damping=(0.0, 0.0, 0.0), allowable=0.0):
 
 
 def stop_force(d: np.ndarray, v: np.ndarray, k, c, clearance: float) -> np.ndarray:
-    """Per axis: −k⟨|d| − clearance⟩ sign d − c ḋ in contact, else 0; free axes (k = 0): 0."""
+    """Per axis in contact: the push k⟨|d| − clearance⟩ + c·ḋ·sign d, never negative (a key
+    face does not pull), against sign d; else, and along free axes (k = 0), 0."""
     k, c = np.asarray(k), np.asarray(c)
     pen = np.abs(d) - clearance
     contact = (k > 0.0) & (pen > 0.0)
-    return np.where(contact, -k * np.maximum(pen, 0.0) * np.sign(d) - c * v, 0.0)
+    push = np.maximum(k * np.maximum(pen, 0.0) + c * v * np.sign(d), 0.0)
+    return np.where(contact, -np.sign(d) * push, 0.0)
 
 
 @pytest.mark.parametrize("clearance", [0.0, 5e-4])
@@ -60,6 +62,7 @@ def test_key_pushes_back_only_along_stiff_axes_and_only_past_the_clearance(case,
         f, couple, _ = law.load(d, v, phi=phi, w=w)
         ref = stop_force(d, v, k, c, clearance)
         np.testing.assert_allclose(f, ref, rtol=1e-14, atol=1e-12)
+        assert np.all(f * np.sign(d) <= 0.0), "a key face pushes the body back, never pulls"
         assert np.all(f[np.asarray(k) == 0.0] == 0.0)
         assert np.all(couple == 0.0)
     # exactly at the clearance, and a hair inside it, no force at all

@@ -19,7 +19,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
-import time
 from functools import cache
 from pathlib import Path
 
@@ -81,7 +80,6 @@ class Run:
     pose: np.ndarray
     wrenches: np.ndarray
     reports: list[HealthReport]
-    wall_s: float
     accepted_before_later: int
     later_rows: int
 
@@ -97,10 +95,8 @@ def escalation() -> Run:
         accel += sig.accel - (0.0, 0.0, G)
     engine = TwinEngine(assemble(scene()))
     outs = []
-    wall0 = time.perf_counter()
     for part in split(batch(t, accel), [500] * round(TOTAL / 0.05)):
         outs.append(engine.push(part))
-    wall = time.perf_counter() - wall0
     accepted = engine.counts["accepted"]
     later = np.arange(1, round(LATER * RATE) + 1) / RATE + t[-1]
     outs.append(engine.push(batch(later)))
@@ -111,7 +107,6 @@ def escalation() -> Run:
         np.concatenate([o.pose for o in outs]),
         np.concatenate([o.wrenches for o in outs]),
         [r for o in outs for r in o.health],
-        wall,
         accepted,
         len(outs[-1]),
     )
@@ -230,12 +225,6 @@ def test_event_forces_agree_with_the_joint_diagram() -> None:
         )
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="bolted_joint.monitor's yield function F_S − F_y(e_p) stays ≈ 0⁺ during plastic "
-    "flow, so interpolating it between samples puts bolt_yielded at the revealing sample "
-    "(0.86–0.995 of the interval) instead of where u crossed (F_y − F_V)/k_S (0.34–0.69)",
-)
 def test_first_yield_is_located_where_u_reaches_the_yield_lift() -> None:
     run = escalation()
     for foot in FEET[:4]:
@@ -267,15 +256,8 @@ def test_the_twin_keeps_running_after_the_bolts_break() -> None:
     # Loose on the deck after the rebound, the body hops (15 mm here; 45 mm once the dashpots of
     # broken, lifted feet stop pulling it down, see below) and rocks, but stays on the deck.
     assert np.abs(run.pose[:, :3] - scene().body.cg).max() < 0.1
-    assert run.wall_s < 10.0  # 0.32 s of 10 kHz stamps; about real time on a laptop
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="bolted_joint.load applies the dashpots −c_ax·u̇ and −c_sh·v also once the bolt is "
-    "broken and the foot is off the deck (F_K = 0, no bearing): they pull on a foot that "
-    "touches nothing (62 kN at u̇ ≈ 1.2 m/s here)",
-)
 def test_a_broken_bolt_whose_foot_is_off_the_deck_carries_no_force() -> None:
     run = escalation()
     names = [m.name for m in scene().mounts]

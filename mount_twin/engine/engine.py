@@ -90,7 +90,7 @@ class TwinEngine:
         self._gravity_up = np.array([0.0, 0.0, scene.input.g])
         self.counts: Counter[str] = Counter()
         self.health = HealthWindow(scene, self.stepper.name)
-        self._watch = new_watch(len(model.nonlinear_slots), N_EVENTS)
+        self._watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
         self._event_meta = {
             slot: (model.scene.mounts[slot].name, KINDS[model.scene.mounts[slot].kind])
             for slot in model.nonlinear_slots
@@ -130,7 +130,7 @@ class TwinEngine:
             np.zeros((n, nm, 6)),
             np.zeros(n, dtype=np.bool_),
             np.zeros((n, 3)),
-            new_watch(len(model.nonlinear_slots), N_EVENTS),
+            new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state),
         )
 
     @property
@@ -364,5 +364,6 @@ class TwinEngine:
         nl = self.model.arrays.nl
         if nl is not None:
             watch = self._watch
-            mount_monitors(self._y, nl, self._scratch, watch.g_prev, watch.util)
+            watch.y_prev[:] = self._y
+            mount_monitors(self._y, self._y, nl, self._scratch, watch.g_prev, watch.util)
         return _Rows(np.array([i]), pose, wrenches)

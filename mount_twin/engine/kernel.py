@@ -24,6 +24,7 @@ class Watch(NamedTuple):
     util, util_peak: (k,) utilisation now and its peak since the engine last read it.
     events: (cap, 4) log rows [crossing time s, mount index in the scene, event index, |force| N]
     n_events: (1,) rows written (may exceed cap: the excess is counted, not stored).
+    y_prev: (n_state,) the state at the previous sample (trial states of the event functions).
     """
 
     g_prev: np.ndarray
@@ -32,10 +33,11 @@ class Watch(NamedTuple):
     util_peak: np.ndarray
     events: np.ndarray
     n_events: np.ndarray
+    y_prev: np.ndarray
 
 
-def new_watch(k: int, n_events: int, capacity: int = 4096) -> Watch:
-    """Empty watch for k mounts."""
+def new_watch(k: int, n_events: int, n_state: int, capacity: int = 4096) -> Watch:
+    """Empty watch for k mounts in a model of n_state states."""
     return Watch(
         np.full((k, n_events), -1.0),
         np.full((k, n_events), -1.0),  # a kind with fewer events never writes the rest
@@ -43,6 +45,7 @@ def new_watch(k: int, n_events: int, capacity: int = 4096) -> Watch:
         np.zeros(k),
         np.zeros((capacity, 4)),
         np.zeros(1, dtype=np.int64),
+        np.zeros(n_state),
     )
 
 
@@ -51,7 +54,8 @@ def _watch(y, nl, s, watch, t0, t1, wrenches) -> None:
     """Evaluate the event functions at t1; log each upward zero crossing since t0."""
     g_prev, g, util, peak = watch.g_prev, watch.g, watch.util, watch.util_peak
     events, count = watch.events, watch.n_events
-    mount_monitors(y, nl, s, g, util)
+    mount_monitors(y, watch.y_prev, nl, s, g, util)
+    watch.y_prev[:] = y
     for i in range(g.shape[0]):
         peak[i] = max(peak[i], util[i])
         for e in range(g.shape[1]):

@@ -38,13 +38,14 @@ def kind_load(code, p, y, o, d, v, phi, w, dydt, f, c) -> None:
 
 
 @njit(cache=True, inline="always")
-def kind_monitor(code, p, y, o, d, v, g) -> float:
-    """The kind's `monitor`: event functions into g; returns the utilisation."""
+def kind_monitor(code, p, y, y0, o, d, v, g) -> float:
+    """The kind's `monitor`: event functions into g (y0: state at the previous sample);
+    returns the utilisation."""
     if code == ELASTOMER:
-        return elastomer.monitor(p, y, o, d, v, g)
+        return elastomer.monitor(p, y, y0, o, d, v, g)
     if code == BOLTED_JOINT:
-        return bolted_joint.monitor(p, y, o, d, v, g)
-    return shear_key.monitor(p, y, o, d, v, g)
+        return bolted_joint.monitor(p, y, y0, o, d, v, g)
+    return shear_key.monitor(p, y, y0, o, d, v, g)
 
 
 @njit(cache=True, inline="always")

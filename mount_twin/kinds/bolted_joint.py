@@ -186,7 +186,9 @@ def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
     flow = broken < 0.5 and f_s >= yield_limit(p, e_p) and ud > 0.0
     dydt[o] = (1.0 - p[ALPHA]) * ud if flow else 0.0
     dydt[o + 3] = 0.0
-    f[2] = f_k - f_s - p[CAX] * ud
+    # the dashpots act through the joint: not on a foot whose bolt broke and that left the deck
+    joined = 1.0 if broken < 0.5 or f_k > 0.0 else 0.0
+    f[2] = f_k - f_s - joined * p[CAX] * ud
     # shear: stick spring in series with slip, bounded by μ·F_K
     tx, ty = p[KT] * (d[0] - sx), p[KT] * (d[1] - sy)
     tau = math.sqrt(tx * tx + ty * ty)
@@ -202,8 +204,8 @@ def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
         if norm2 > 0.0 and outward > 0.0:
             dydt[o + 1] = outward / norm2 * ex
             dydt[o + 2] = outward / norm2 * ey
-    f[0] = -scale * tx - p[CSH] * v[0]
-    f[1] = -scale * ty - p[CSH] * v[1]
+    f[0] = -scale * tx - joined * p[CSH] * v[0]
+    f[1] = -scale * ty - joined * p[CSH] * v[1]
     if broken < 0.5:
         s = math.sqrt(d[0] * d[0] + d[1] * d[1])
         bear = s - p[CLEAR]
@@ -216,16 +218,23 @@ def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
 
 
 @njit(cache=True, inline="always")
-def monitor(p, y, o, d, v, g) -> float:
+def monitor(p, y, y0, o, d, v, g) -> float:
     """Event functions into g (order of EVENTS; ≥ 0: happening); returns the utilisation
-    F_S/F_y (1 at first yield)."""
-    e_p, sx, sy, broken = y[o], y[o + 1], y[o + 2], y[o + 3]
+    F_S/F_y (1 at first yield).
+
+    Yield and slip are judged on the trial state: plastic elongation and slip frozen at their
+    values y0 of the previous sample. The actual yield and slip functions stay at zero while the
+    bolt flows or the face slides, so between two samples only the trial ones, which grow with
+    the deflection, locate the onset by interpolation.
+    """
+    e_p, broken = y[o], y[o + 3]
+    e_t, sx, sy = y0[o], y0[o + 1], y0[o + 2]
     u = d[2]
-    f_s = bolt_force(p, u, e_p, broken)
-    g[0] = f_s - yield_limit(p, e_p) if broken < 0.5 else -1.0
+    g[0] = bolt_force(p, u, e_t, broken) - yield_limit(p, e_t) if broken < 0.5 else -1.0
     g[1] = p[KP] * u - p[FV]
     tx, ty = p[KT] * (d[0] - sx), p[KT] * (d[1] - sy)
     g[2] = math.sqrt(tx * tx + ty * ty) - p[MU] * max(p[FV] - p[KP] * u, 0.0)
+    f_s = bolt_force(p, u, e_p, broken)
     g[3] = 1.0 if broken > 0.5 else max(f_s / p[FU] - 1.0, e_p / p[EPU] - 1.0)
     return f_s / p[FY]
 

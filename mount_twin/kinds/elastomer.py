@@ -310,7 +310,7 @@ def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
 
 
 @njit(cache=True, inline="always")
-def monitor(p, y, o, d, v, g) -> float:
+def monitor(p, y, y0, o, d, v, g) -> float:
     """Snubber contact (|x| − gap, m) and over-travel (|x|/rated − 1); returns the largest
     |x|/rated (0 if no axis is rated)."""
     g[0] = -1.0

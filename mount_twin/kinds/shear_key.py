@@ -1,7 +1,8 @@
 """Shear key: stiff along its shear axes, free along the others, with an optional clearance.
 
 Along each local axis with a stiffness k > 0 the key pushes back only past the clearance:
-F = −k·(|d| − clearance)·sign(d) − c·ḋ while in contact; no force along free axes.
+F = −sign(d)·max(k·(|d| − clearance) + c·sign(d)·ḋ, 0) in contact (it never pulls); no force
+along free axes.
 """
 
 from __future__ import annotations
@@ -84,11 +85,13 @@ def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
         if k > 0.0:
             pen = abs(d[j]) - p[CLEAR]
             if pen > 0.0:
-                f[j] = -k * pen * (1.0 if d[j] > 0.0 else -1.0) - p[C0 + j] * v[j]
+                side = 1.0 if d[j] > 0.0 else -1.0
+                # contact pushes, never pulls: damping cannot hold a key face that separates
+                f[j] = -side * max(k * pen + p[C0 + j] * side * v[j], 0.0)
 
 
 @njit(cache=True, inline="always")
-def monitor(p, y, o, d, v, g) -> float:
+def monitor(p, y, y0, o, d, v, g) -> float:
     """Contact (penetration past the clearance, m) and overload; returns |F|/allowable."""
     pen = -1.0
     force = 0.0

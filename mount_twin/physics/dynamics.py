@@ -295,15 +295,21 @@ def _nl_wrenches(y: np.ndarray, nl: NonLinearMounts, s: Scratch, wrenches: np.nd
 
 @njit(cache=True)
 def mount_monitors(
-    y: np.ndarray, nl: NonLinearMounts, s: Scratch, g: np.ndarray, util: np.ndarray
+    y: np.ndarray,
+    y0: np.ndarray,
+    nl: NonLinearMounts,
+    s: Scratch,
+    g: np.ndarray,
+    util: np.ndarray,
 ) -> None:
     """Event functions g[i] and utilisation util[i] of each non-linear mount at state y (whose
-    body motion `evaluate` or `rhs` has just computed); then their discrete switches."""
+    body motion `evaluate` or `rhs` has just computed; y0: the state at the previous sample,
+    for trial functions); then their discrete switches."""
     loc = s.loc
     for i in range(nl.kind.shape[0]):
         _local_motion(i, nl, s)
         code, p, o = nl.kind[i], nl.par[i], nl.state[i]
-        util[i] = kind_monitor(code, p, y, o, loc[0], loc[1], g[i])
+        util[i] = kind_monitor(code, p, y, y0, o, loc[0], loc[1], g[i])
         kind_update(code, p, y, o, loc[0])
 
 
