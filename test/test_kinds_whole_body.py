@@ -258,6 +258,19 @@ def test_the_twin_keeps_running_after_the_bolts_break() -> None:
     assert np.abs(run.pose[:, :3] - scene().body.cg).max() < 0.1
 
 
+def test_a_broken_bolt_stays_an_error_in_later_periods_without_new_events() -> None:
+    """Fracture is for good: in the last period, long after the fractures were reported, every
+    foot must still be ERROR and say its bolt is broken now."""
+    run = escalation()
+    last = run.reports[-1]
+    assert last.stamp > run.stamps[round(TOTAL * RATE) - 1], "a report in the quiet tail"
+    for foot in FEET:
+        s = status(last, foot)
+        assert "bolt_fractured" in s.values["now"].split(", "), (s.name, s.values)
+        assert s.level == ERROR, (s.name, s.message)
+        assert "bolt_fractured ×" not in s.message, "the fracture itself is not reported again"
+
+
 def test_a_broken_bolt_whose_foot_is_off_the_deck_carries_no_force() -> None:
     run = escalation()
     names = [m.name for m in scene().mounts]

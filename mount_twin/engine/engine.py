@@ -178,7 +178,9 @@ class TwinEngine:
             if report_due:
                 stamp = float(batch.stamps[stop - 1])
                 util = self._watch.util_peak
-                reports.append(self.health.report(stamp, stop - 1, self.counts, util.copy()))
+                reports.append(
+                    self.health.report(stamp, stop - 1, self.counts, util.copy(), self._active())
+                )
                 np.maximum(self._util_max, util, out=self._util_max)
                 util[:] = 0.0
             start = stop
@@ -314,6 +316,19 @@ class TwinEngine:
                 break
             out.append(self._start(rest[0], stamps, f, w))
             index = rest[1:]
+        return out
+
+    def _active(self) -> dict[str, list[tuple[str, bool]]]:
+        """Conditions holding at the last sample, per mount: (event name, is an error)."""
+        g = self._watch.g
+        out = {}
+        for k, slot in enumerate(self.model.nonlinear_slots):
+            name, kind = self._event_meta[slot]
+            out[name] = [
+                (event, error)
+                for event, error, value in zip(kind.EVENTS, kind.EVENT_ERROR, g[k], strict=False)
+                if value >= 0.0
+            ]
         return out
 
     def _drain_events(self) -> None:

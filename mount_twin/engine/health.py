@@ -86,13 +86,20 @@ class HealthWindow:
         return True
 
     def report(
-        self, stamp: float, sample: int, counts: Counter[str], utilisation: np.ndarray
+        self,
+        stamp: float,
+        sample: int,
+        counts: Counter[str],
+        utilisation: np.ndarray,
+        active: dict[str, list[tuple[str, bool]]],
     ) -> HealthReport:
         """Statuses at `stamp` (s), after pushed sample `sample`, for the window so far, which
         then starts anew.
 
         Counts are cumulative; rejections, gaps, stepper figures, mount peaks and events are
-        this window's. `utilisation`: peak per non-linear mount, in model order.
+        this window's. `utilisation`: peak per non-linear mount, in model order; `active`: the
+        conditions holding now per mount (event name, is an error), e.g. a broken bolt, which
+        keep the mount's level after the events themselves have been reported.
         """
         new = counts - self._last_counts
         self._last_counts = counts.copy()
@@ -142,12 +149,15 @@ class HealthWindow:
             else "ok",
             {"tilt_max_rad": f"{self.tilt_max:.6g}"},
         )
-        mounts = self._mount_statuses(utilisation)
+        mounts = self._mount_statuses(utilisation, active)
         self._reset()
         return HealthReport(stamp, sample, [inp, step, att, *mounts])
 
-    def _mount_statuses(self, utilisation: np.ndarray) -> list[HealthStatus]:
-        """One status per mount: peak wrench per axis, utilisation, events by name."""
+    def _mount_statuses(
+        self, utilisation: np.ndarray, active: dict[str, list[tuple[str, bool]]]
+    ) -> list[HealthStatus]:
+        """One status per mount: peak wrench per axis, utilisation, events by name, and the
+        conditions holding now."""
         util = dict.fromkeys((m.name for m in self.scene.mounts), math.nan)
         nonlinear = [m.name for m in self.scene.mounts if m.kind != "linear"]
         util.update(zip(nonlinear, utilisation.tolist(), strict=True))
@@ -155,10 +165,11 @@ class HealthWindow:
         out = []
         for i, mount in enumerate(self.scene.mounts):
             mine = [e for e in self.events if e.mount == mount.name]
+            now = active.get(mount.name, [])
             u = util[mount.name]
-            if any(e.error for e in mine) or u > 1.0:
+            if any(e.error for e in mine) or any(err for _, err in now) or u > 1.0:
                 level = ERROR
-            elif mine or u >= warn_at:
+            elif mine or now or u >= warn_at:
                 level = WARN
             else:
                 level = OK
@@ -170,9 +181,11 @@ class HealthWindow:
                 )
             }
             values["utilisation_max"] = "n/a" if math.isnan(u) else f"{u:.4g}"
-            out.append(
-                HealthStatus(f"{PREFIX}: mount {mount.name}", level, _events_text(mine, u), values)
-            )
+            values["now"] = ", ".join(name for name, _ in now) or "none"
+            text = _events_text(mine, u)
+            if now:
+                text = f"now: {values['now']}" + ("" if text == "ok" else f"; {text}")
+            out.append(HealthStatus(f"{PREFIX}: mount {mount.name}", level, text, values))
         return out
 
 
