@@ -124,6 +124,10 @@ def replay(
                 for report in batch.health:
                     last_health = [f"{s.name}: {s.message}" for s in report.statuses]
             bar.update(len(raws))
+        for topic, stamp, raw in stream.finish():  # the last, partial diagnostics period
+            out.write(resolved[topic], stamp, raw)
+        if stream.final_report is not None:
+            last_health = [f"{s.name}: {s.message}" for s in stream.final_report.statuses]
         written = out.written
     wall = time.perf_counter() - wall0
     span = float(last_stamp - first_stamp) if first_stamp is not None else 0.0

@@ -6,9 +6,9 @@ the bag replay hands it chunks of raw messages from a bag. Only the transport di
 
 from __future__ import annotations
 
-from mount_twin.engine.batch import OutputBatch
+from mount_twin.engine.batch import HealthReport, OutputBatch
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.io.messages import TimeBase, decode_inputs, encode_outputs
+from mount_twin.io.messages import TimeBase, decode_inputs, encode_outputs, encode_report
 from mount_twin.model.assemble import assemble
 from mount_twin.scene.description import Scene
 
@@ -26,6 +26,8 @@ class TwinStream:
         self.engine = TwinEngine(assemble(scene))
         self.base: TimeBase | None = None
         self.last_outputs: OutputBatch | None = None
+        self._last_ns = 0
+        self.final_report: HealthReport | None = None
 
     def process(self, raws: list[bytes]) -> list[tuple[str, int, bytes]]:
         """Outputs for raw input messages, as (unresolved topic, stamp ns, CDR bytes)."""
@@ -39,4 +41,14 @@ class TwinStream:
             self.base = TimeBase.at(int(decoded.stamps_ns[0]))
         out = self.engine.push(decoded.batch(self.base))
         self.last_outputs = out
+        if len(out):
+            self._last_ns = int(decoded.stamps_ns[out.sample[-1]])
         return encode_outputs(self.scene, out, decoded.stamps_ns)
+
+    def finish(self) -> list[tuple[str, int, bytes]]:
+        """The last, partial diagnostics period (end of a bag, node shutdown), stamped with the
+        last input stamp answered; nothing if that period is empty."""
+        report = self.final_report = self.engine.flush()
+        if report is None:
+            return []
+        return [encode_report(self.scene, report, self._last_ns)]

@@ -164,6 +164,7 @@ def _live(bag: Path) -> tuple[TwinStream, list[tuple[str, int, bytes]]]:
     out: list[tuple[str, int, bytes]] = []
     for raw in raws:
         out.extend((resolve(t, NODE_NAME), s, d) for t, s, d in stream.process([raw]))
+    out.extend((resolve(t, NODE_NAME), s, d) for t, s, d in stream.finish())  # at shutdown
     return stream, out
 
 
@@ -178,6 +179,18 @@ def test_live_one_message_at_a_time_equals_the_chunked_replay(bags: dict[str, Pa
             continue
         live_topic = [(s, d) for t, s, d in live if t == topic]
         assert live_topic == replayed[topic], f"{topic}: live bytes differ from the replayed bag"
+
+
+def test_the_last_partial_diagnostics_period_is_written_at_the_last_stamp(
+    bags: dict[str, Path],
+) -> None:
+    """A bag rarely ends on a period boundary: what happened after the last report (a bolt
+    breaking, say) must still reach /diagnostics, stamped with the last sample answered."""
+    out = read_raw(bags["out_mcap"])
+    last_pose = out[f"/{NODE_NAME}/pose"][-1][0]
+    assert out["/diagnostics"][-1][0] == last_pose
+    stream, _ = _live(bags["in_mcap"])
+    assert stream.finish() == [], "nothing new after the final report"
 
 
 def test_replay_writes_diagnostics_at_the_live_cadence(bags: dict[str, Path]) -> None:

@@ -15,7 +15,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from mount_twin.engine.batch import MountEvent, OutputBatch, SampleBatch
+from mount_twin.engine.batch import HealthReport, MountEvent, OutputBatch, SampleBatch
 from mount_twin.engine.health import HealthWindow
 from mount_twin.engine.kernel import new_watch, run_samples
 from mount_twin.errors import ModelError
@@ -177,12 +177,7 @@ class TwinEngine:
             self.health.add_wall(self._clock() - wall0)
             if report_due:
                 stamp = float(batch.stamps[stop - 1])
-                util = self._watch.util_peak
-                reports.append(
-                    self.health.report(stamp, stop - 1, self.counts, util.copy(), self._active())
-                )
-                np.maximum(self._util_max, util, out=self._util_max)
-                util[:] = 0.0
+                reports.append(self._report(stamp, stop - 1))
             start = stop
         nm = self.model.n_mounts
         sample = np.concatenate([r.sample for r in parts]) if parts else np.zeros(0, np.intp)
@@ -317,6 +312,20 @@ class TwinEngine:
             out.append(self._start(rest[0], stamps, f, w))
             index = rest[1:]
         return out
+
+    def flush(self) -> HealthReport | None:
+        """The report of what happened since the last one, due or not (end of a bag, shutdown);
+        None if nothing was processed since. Its `sample` is −1: the last accepted sample."""
+        if self._last_stamp is None or not self.health.pending:
+            return None
+        return self._report(self._last_stamp, -1)
+
+    def _report(self, stamp: float, sample: int) -> HealthReport:
+        util = self._watch.util_peak
+        report = self.health.report(stamp, sample, self.counts, util.copy(), self._active())
+        np.maximum(self._util_max, util, out=self._util_max)
+        util[:] = 0.0
+        return report
 
     def _active(self) -> dict[str, list[tuple[str, bool]]]:
         """Conditions holding at the last sample, per mount: (event name, is an error)."""

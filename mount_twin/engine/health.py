@@ -42,6 +42,11 @@ class HealthWindow:
         self.wrench_peak = np.zeros((len(self.scene.mounts), 6))
         self.events: list[MountEvent] = []
 
+    @property
+    def pending(self) -> bool:
+        """Whether anything was recorded since the last report."""
+        return bool(self.samples or self.events or self.failures or not math.isnan(self.t_last))
+
     def add_steps(self, step_log: np.ndarray) -> None:
         """Per-sample stepper figures: (error norm, accepted, rejected substeps)."""
         if step_log.shape[0]:

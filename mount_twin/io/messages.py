@@ -275,18 +275,19 @@ def encode_outputs(
     report = next(reports, None)
     for k, (sample, stamp) in enumerate(zip(out.sample.tolist(), stamps.tolist(), strict=True)):
         while report is not None and report.sample < sample:
-            msgs.append(_diagnostics(report, int(stamps_ns[report.sample]), topics.diagnostics))
+            msgs.append(encode_report(scene, report, int(stamps_ns[report.sample])))
             report = next(reports, None)
         msgs.extend((topic, stamp, raws[k]) for topic, raws in rows)
     while report is not None:
-        msgs.append(_diagnostics(report, int(stamps_ns[report.sample]), topics.diagnostics))
+        msgs.append(encode_report(scene, report, int(stamps_ns[report.sample])))
         report = next(reports, None)
     return msgs
 
 
-def _diagnostics(report: HealthReport, stamp_ns: int, topic: str) -> tuple[str, int, bytes]:
+def encode_report(scene: Scene, report: HealthReport, stamp_ns: int) -> tuple[str, int, bytes]:
+    """A health report as (unresolved topic, stamp ns, DiagnosticArray CDR bytes)."""
     msg = diagnostics_message(report, stamp_ns)
-    return topic, stamp_ns, TYPESTORE.serialize_cdr(msg, DIAGNOSTICS)
+    return output_topics(scene).diagnostics, stamp_ns, TYPESTORE.serialize_cdr(msg, DIAGNOSTICS)
 
 
 def diagnostics_message(report: HealthReport, stamp_ns: int) -> object:

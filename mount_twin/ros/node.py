@@ -95,6 +95,11 @@ class MountTwinNode(Node):
                 flat[name] = list(value) if ptype.endswith("_array") else value
         return flat
 
+    def publish_final_diagnostics(self) -> None:
+        """Publish the last, partial diagnostics period (at shutdown)."""
+        for topic, _stamp, data in self.stream.finish():
+            self._pubs[topic].publish(data)
+
     def _on_input(self, raw: bytes) -> None:
         for topic, _stamp, data in self.stream.process([raw]):
             self._pubs[topic].publish(data)
@@ -111,5 +116,7 @@ def main(args: list[str] | None = None) -> None:
         pass
     finally:
         if node is not None:
+            if rclpy.ok():
+                node.publish_final_diagnostics()
             node.destroy_node()
         rclpy.try_shutdown()
