@@ -33,14 +33,15 @@ def engine_alone(scene, bag: Path) -> float:
     engine = TwinEngine(assemble(scene))
     base = None
     t0 = time.perf_counter()
-    first = last = 0.0
+    first: float | None = None
+    last = 0.0
     for raws in chunks:
         decoded = decode_inputs(raws, scene.input.msg_type)
         base = base or TimeBase.at(int(decoded.stamps_ns[0]))
         out = engine.push(decoded.batch(base))
-        first = first or float(out.stamps[0])
+        first = float(out.stamps[0]) if first is None else first  # 0.0 is a valid stamp
         last = float(out.stamps[-1])
-    return (last - first) / (time.perf_counter() - t0)
+    return (last - (first or 0.0)) / (time.perf_counter() - t0)
 
 
 def main_bench() -> None:

@@ -36,6 +36,7 @@ class ReplaySummary:
     health: list[str] = field(default_factory=list)
     events: list[MountEvent] = field(default_factory=list)
     utilisation_max: dict[str, float] = field(default_factory=dict)
+    origin_s: int = 0  # whole seconds to add to event stamps to get header stamps
 
     @property
     def real_time_factor(self) -> float:
@@ -70,7 +71,8 @@ class ReplaySummary:
             level = "ERROR" if same[0].error else "WARN"
             lines.append(
                 f"    {level:5} {mount:>12} {event:<16} ×{len(same):<5} "
-                f"first {same[0].stamp:.6f} s  |F| max {max(e.force for e in same):.4g} N"
+                f"first {self.origin_s + same[0].stamp:.6f} s  "
+                f"|F| max {max(e.force for e in same):.4g} N"
             )
         lines += [f"  diagnostics: {h}" for h in self.health]
         return "\n".join(lines)
@@ -144,4 +146,5 @@ def replay(
         last_health,
         list(stream.engine.events),
         stream.engine.utilisation_max,
+        stream.engine.health.origin_s,
     )

@@ -39,6 +39,7 @@ class TwinStream:
             if not decoded.stamps_ns.shape[0]:
                 return []
             self.base = TimeBase.at(int(decoded.stamps_ns[0]))
+            self.engine.health.origin_s = self.base.origin_ns // 1_000_000_000
         out = self.engine.push(decoded.batch(self.base))
         self.last_outputs = out
         if len(out):

@@ -26,6 +26,8 @@ class HealthWindow:
         self.scene = scene
         self.method = method
         self.period = scene.outputs.diagnostics_period_s
+        self.origin_s = 0
+        """Whole seconds to add to engine stamps in texts, so they read as header stamps."""
         self._next_due: float | None = None
         self._reset()
         self._last_counts: Counter[str] = Counter()
@@ -127,7 +129,7 @@ class HealthWindow:
         )
         integ = self.scene.integration
         rtf = span / self.wall if self.wall > 0 and span > 0 else math.nan
-        fail_text = "; ".join(f"{t:.6f} s: {m}" for t, m in self.failures)
+        fail_text = "; ".join(f"{self.origin_s + t:.6f} s: {m}" for t, m in self.failures)
         step = HealthStatus(
             f"{PREFIX}: integration",
             ERROR if self.failures else OK,
@@ -187,14 +189,14 @@ class HealthWindow:
             }
             values["utilisation_max"] = "n/a" if math.isnan(u) else f"{u:.4g}"
             values["now"] = ", ".join(name for name, _ in now) or "none"
-            text = _events_text(mine, u)
+            text = _events_text(mine, u, self.origin_s)
             if now:
                 text = f"now: {values['now']}" + ("" if text == "ok" else f"; {text}")
             out.append(HealthStatus(f"{PREFIX}: mount {mount.name}", level, text, values))
         return out
 
 
-def _events_text(events: list[MountEvent], utilisation: float) -> str:
+def _events_text(events: list[MountEvent], utilisation: float, origin_s: int) -> str:
     """'joint_opened ×3 (first 1.234567 s, |F| max 4.5e+04 N); …', or the utilisation."""
     if not events:
         return "ok" if not utilisation > 0.0 else f"utilisation {utilisation:.3g}"
@@ -202,7 +204,7 @@ def _events_text(events: list[MountEvent], utilisation: float) -> str:
     for name in dict.fromkeys(e.event for e in events):
         same = [e for e in events if e.event == name]
         parts.append(
-            f"{name} ×{len(same)} (first {same[0].stamp:.6f} s, "
+            f"{name} ×{len(same)} (first {origin_s + same[0].stamp:.6f} s, "
             f"|F| max {max(e.force for e in same):.4g} N)"
         )
     return "; ".join(parts)
