@@ -76,7 +76,9 @@ class MountTwinNode(Node):
                 kind = self.declare_parameter(
                     f"mounts.{mount}.kind",
                     "linear",
-                    ParameterDescriptor(description=COMMON_MOUNT_PARAMETERS["kind"][1]),
+                    ParameterDescriptor(
+                        description=COMMON_MOUNT_PARAMETERS["kind"][1], read_only=True
+                    ),
                 ).value
                 names.update(
                     {f"mounts.{mount}.{key}": spec for key, spec in mount_parameters(kind).items()}
