@@ -116,7 +116,14 @@ def _run(args: argparse.Namespace) -> int:
         if args.plot:
             from mount_twin.plot import plot_output_bag  # matplotlib only when asked for
 
-            print(f"plot: {plot_output_bag(args.output, args.plot, Path(scene_path).name)}")
+            png = plot_output_bag(
+                args.output,
+                args.plot,
+                Path(scene_path).name,
+                summary.events,
+                summary.origin_s,
+            )
+            print(f"plot: {png}")
         return 0
     if args.cmd == "generate":
         if args.kind == "half-sine":
