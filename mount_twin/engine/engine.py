@@ -97,6 +97,9 @@ class TwinEngine:
         }
         self.events: list[MountEvent] = []
         self._util_max = np.zeros(len(model.nonlinear_slots))
+        # Chaining the stepper's last stage into the next interval needs a continuous input
+        # (first-order hold) and no discrete switch of the state between samples (fracture).
+        self._chain = scene.input.hold == "first_order" and model.arrays.nl is None
         """Every mount event so far, in time order (the first MAX_EVENTS; the rest counted)."""
         # Fails now, at load, if the mounts cannot hold the body; and is the restart fallback.
         self._y_nominal = initial_state(model, self._gravity_up)
@@ -131,6 +134,7 @@ class TwinEngine:
             np.zeros(n, dtype=np.bool_),
             np.zeros((n, 3)),
             new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state),
+            self._chain,
         )
 
     @property
@@ -294,6 +298,7 @@ class TwinEngine:
                 publish,
                 step_log,
                 self._watch,
+                self._chain,
             )
             self._drain_events()
             self.health.add_steps(step_log[1 : done + 1])

@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 
 from mount_twin.integrate.stepper import advance
-from mount_twin.physics.dynamics import evaluate, mount_monitors
+from mount_twin.physics.dynamics import mount_monitors, outputs, rhs_after_rate_step
 from mount_twin.physics.gate import skip_if_none
 
 
@@ -99,6 +99,7 @@ def run_samples(
     publish,
     step_log,
     watch,
+    chain,
 ) -> tuple[int, int]:
     """Advance y through samples 1..n−1 of (t, f, w); sample 0 is the last one already done.
 
@@ -112,12 +113,16 @@ def run_samples(
         step_log: out (n, 3) per sample: error norm, accepted and rejected substeps.
         watch: the non-linear mounts' event functions, utilisation peaks and event log
             (`Watch`); events are located by linear interpolation inside the sample interval.
+        chain: start each interval from the previous one's last stage when the stepper says
+            it is there (settings[4]; first-order hold, no discrete switches between samples,
+            and nothing else used the scratch since: `Stepper.reset` clears it).
 
     Returns:
         (index of the last sample done, stepper status: 0, or the failure at the next sample).
     """
     n, nm = t.shape[0], peak.shape[0]
     hold = 0.0 if zero_order else 1.0
+    d_wdot = np.zeros(3)
     for j in range(1, n):
         dt = t[j] - t[j - 1]
         u[0] = t[j - 1]
@@ -125,12 +130,21 @@ def run_samples(
             u[1 + i] = f[j - 1, i]
             u[4 + i] = hold * (f[j, i] - f[j - 1, i]) / dt
             u[7 + i] = w[j - 1, i]
-            u[10 + i] = hold * (w[j, i] - w[j - 1, i]) / dt
+            w_dot = hold * (w[j, i] - w[j - 1, i]) / dt
+            d_wdot[i] = w_dot - u[10 + i]
+            u[10 + i] = w_dot
+        if chain and settings[4] == 1.0:
+            # First-order hold: the input is continuous at t[j − 1] but for Ω', so the last
+            # stage of the previous interval, moved to the new Ω', starts this one. Live (one
+            # sample per call) and replay (many) thus compute exactly the same numbers.
+            rhs_after_rate_step(m, s, d_wdot, work2d[0])
+        else:
+            settings[4] = 0.0
         status = advance(method, y, t[j - 1], t[j], settings, m, s, u, work2d, work1d, result)
         if status != 0:
             return j - 1, status
         step_log[j, 0], step_log[j, 1], step_log[j, 2] = result[0], result[1], result[2]
-        evaluate(y, m, s, pose[j], wrenches[j])
+        outputs(y, m, s, pose[j], wrenches[j])  # the stepper's last right-hand side was at y
         watch_mounts(y, m.nl, s, watch, t[j - 1], t[j], wrenches[j])
         counter[0] += 1
         for a in range(nm):

@@ -49,7 +49,10 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
 
     Args:
         settings: [first trial step s (0: the whole interval; updated to the next proposal),
-            rtol, atol, most substeps].
+            rtol, atol, most substeps, chain flag]. On success the last right-hand side
+            evaluated is the one at (t1, y), in k[0] (FSAL), and the flag is set to 1: callers
+            may take outputs from the scratch, and, having moved k[0] to the next interval's
+            input, leave the flag at 1 so that the next call starts from it; else they set 0.
         k: (7, n) stage work array; y_new: (n,) work array.
         result: out (3,): largest accepted error norm, accepted and rejected step counts.
 
@@ -63,7 +66,10 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
     h = span if h <= 0.0 else h
     t = t0
     err_max, n_acc, n_rej = 0.0, 0, 0
-    rhs_failed = rhs(t, y, m, s, u, k[0]) != 0
+    rhs_failed = False
+    if settings[4] == 0.0:  # else the caller put dy/dt at (t0, y) for this input in k[0]
+        rhs_failed = rhs(t, y, m, s, u, k[0]) != 0
+    settings[4] = 0.0  # set again below on success: k[0] is then dy/dt at (t1, y)
     while t < t1:
         if n_acc + n_rej >= max_steps:
             settings[0], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
@@ -115,4 +121,5 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
             h = step * min(1.0, factor)
             n_rej += 1
     settings[0], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
+    settings[4] = 1.0
     return SUCCESS

@@ -37,7 +37,9 @@ class Stepper:
     Attributes:
         name: scene name of the method.
         method: its id for `advance`.
-        settings: [step proposal s, rtol, atol, most substeps per interval].
+        settings: [step proposal s, rtol, atol, most substeps per interval, chain flag: 1
+            after a success, when work2d[0] holds dy/dt at the end state; a caller that changes
+            the input between calls moves it to the new input or sets 0 (see dopri54.advance)].
         work2d, work1d: the method's work arrays.
         result: last advance's [largest accepted error norm, accepted, rejected substeps].
     """
@@ -52,6 +54,7 @@ class Stepper:
     def reset(self) -> None:
         """Forget the step-size history (after a restart of the state)."""
         self.settings[0] = 0.0
+        self.settings[4] = 0.0
 
 
 def dormand_prince(n: int, rtol: float, atol: float, max_substeps: int) -> Stepper:
@@ -62,7 +65,7 @@ def dormand_prince(n: int, rtol: float, atol: float, max_substeps: int) -> Stepp
     if n <= 0 or not rtol > 0.0 or not atol > 0.0 or max_substeps < 1:
         msg = f"bad stepper settings: n={n}, rtol={rtol}, atol={atol}, max={max_substeps}"
         raise ValueError(msg)
-    settings = np.array([0.0, rtol, atol, float(max_substeps)])
+    settings = np.array([0.0, rtol, atol, float(max_substeps), 0.0])
     return Stepper("dopri54", DOPRI54, settings, np.zeros((7, n)), np.zeros(n))
 
 
