@@ -431,3 +431,19 @@ def test_diagnostics_keep_coming_after_a_loop_back_of_the_stamps() -> None:
         f"no diagnostics after the loop-back reset: reports per push in the second pass {second} "
         "(HealthWindow._next_due stays at the pre-jump stamp)"
     )
+
+
+@pytest.mark.parametrize("period", [0.05, 0.0137, 1.0])
+def test_batched_diagnostics_cadence_equals_the_per_sample_one(period: float) -> None:
+    """HealthWindow.ticks (the in-order fast path) reports after exactly the samples that
+    HealthWindow.tick, applied sample by sample, would."""
+    from mount_twin.engine.health import HealthWindow
+
+    scene = scene_with(outputs={"diagnostics_period_s": period})
+    stamps = np.cumsum(np.random.default_rng(8).uniform(1e-4, 3e-3, 3000))
+    one = HealthWindow(scene, "dopri54")
+    per_sample = [i for i, t in enumerate(stamps.tolist()) if one.tick(t)]
+    batched = HealthWindow(scene, "dopri54")
+    parts = np.split(np.arange(stamps.size), [1, 7, 500, 2999])
+    got = [int(p[0]) + k for p in parts for k in batched.ticks(stamps[p])]
+    assert got == per_sample and len(per_sample) > 1

@@ -209,9 +209,20 @@ class TwinEngine:
         finite = (
             np.isfinite(batch.stamps) & np.isfinite(f).all(axis=1) & np.isfinite(w).all(axis=1)
         )
+        last_t = self._last_stamp
+        n = len(batch)
+        if (
+            last_t is not None
+            and finite.all()
+            and (not spec.frame_id or batch.frame_ids.count(spec.frame_id) == n)
+        ):
+            steps = np.diff(batch.stamps, prepend=last_t)
+            if (steps > 0.0).all() and (steps <= spec.max_gap_s).all():
+                # The usual batch, every sample in order: no per-sample Python loop.
+                self._last_stamp = float(batch.stamps[-1])
+                return [ACCEPT] * n, self.health.ticks(batch.stamps)
         verdicts: list[str] = []
         due: list[int] = []
-        last_t = self._last_stamp
         for i, t in enumerate(batch.stamps.tolist()):
             if not finite[i]:
                 verdict = "non_finite"
@@ -247,6 +258,9 @@ class TwinEngine:
     @staticmethod
     def _runs(verdicts: list[str], start: int, stop: int) -> list[_Run]:
         """Group the taken samples in [start, stop) into runs split at restarts."""
+        segment = verdicts[start:stop]
+        if segment.count(ACCEPT) == len(segment):  # the usual case, without a Python loop
+            return [_Run(list(range(start, stop)), False)] if segment else []
         runs: list[_Run] = []
         for i in range(start, stop):
             verdict = verdicts[i]

@@ -92,6 +92,22 @@ class HealthWindow:
         self._next_due = stamp + self.period
         return True
 
+    def ticks(self, stamps: np.ndarray) -> list[int]:
+        """`tick` for accepted samples in increasing order after the last ticked one: the
+        positions after which reports are due (one search per report, not a loop per sample)."""
+        due: list[int] = []
+        start = 0
+        if self._next_due is None:
+            self._next_due = float(stamps[0]) + self.period
+            start = 1
+        while True:
+            k = start + int(np.searchsorted(stamps[start:], self._next_due, side="left"))
+            if k >= stamps.shape[0]:
+                return due
+            due.append(k)
+            self._next_due = float(stamps[k]) + self.period
+            start = k + 1
+
     def report(
         self,
         stamp: float,
