@@ -27,7 +27,8 @@ def ros_context():
     rclpy.try_shutdown()
 
 
-def test_node_publishes_wrenches_for_raw_imu_bytes(ros_context) -> None:
+@pytest.mark.parametrize("batch_period_s", [0.0, 0.005], ids=["per_message", "batched"])
+def test_node_publishes_wrenches_for_raw_imu_bytes(ros_context, batch_period_s: float) -> None:
     import yaml
     from geometry_msgs.msg import WrenchStamped
     from rclpy.qos import qos_profile_sensor_data
@@ -37,6 +38,7 @@ def test_node_publishes_wrenches_for_raw_imu_bytes(ros_context) -> None:
 
     params = yaml.safe_load((CONFIG / "params.yaml").read_text())["mount_twin"]["ros__parameters"]
     overrides = [Parameter(k, value=v) for k, v in flatten(params) if k != "scene_file"]
+    overrides.append(Parameter("batch_period_s", value=batch_period_s))
     node = MountTwinNode(parameter_overrides=overrides)
     helper = rclpy.create_node("mount_twin_test_helper")
     got: list[WrenchStamped] = []

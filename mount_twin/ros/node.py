@@ -48,10 +48,23 @@ class MountTwinNode(Node):
             for topic, msgtype in output_types(self.scene).items()
         }
         spec = self.scene.input
+        batch_period = self.declare_parameter(
+            "batch_period_s",
+            0.0,
+            ParameterDescriptor(
+                description="0.0: process each input message on arrival; > 0: queue them and "
+                "process the queue every batch_period_s (s) in one engine call, for input "
+                "rates where the per-message overhead would not keep up (e.g. 10 kHz)",
+                read_only=True,
+            ),
+        ).value
+        self._pending: list[bytes] = []
+        if batch_period > 0.0:
+            self._timer = self.create_timer(batch_period, self._drain)
         self._sub = self.create_subscription(
             get_message(spec.msg_type),
             spec.topic,
-            self._on_input,
+            self._pending.append if batch_period > 0.0 else self._on_input,
             qos_profile_sensor_data,
             raw=True,
         )
@@ -98,12 +111,21 @@ class MountTwinNode(Node):
         return flat
 
     def publish_final_diagnostics(self) -> None:
-        """Publish the last, partial diagnostics period (at shutdown)."""
-        for topic, _stamp, data in self.stream.finish():
-            self._pubs[topic].publish(data)
+        """Process what is still queued, then publish the last, partial diagnostics period."""
+        self._drain()
+        self._publish(self.stream.finish())
 
     def _on_input(self, raw: bytes) -> None:
-        for topic, _stamp, data in self.stream.process([raw]):
+        self._publish(self.stream.process([raw]))
+
+    def _drain(self) -> None:
+        if self._pending:
+            raws = self._pending[:]
+            del self._pending[:]  # the subscription appends to this very list
+            self._publish(self.stream.process(raws))
+
+    def _publish(self, messages: list[tuple[str, int, bytes]]) -> None:
+        for topic, _stamp, data in messages:
             self._pubs[topic].publish(data)
 
 
