@@ -10,9 +10,9 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
 from mount_twin.integrate.stepper import advance
+from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import mount_monitors, outputs, rhs_after_rate_step
 from mount_twin.physics.gate import skip_if_none
 
@@ -49,13 +49,15 @@ def new_watch(k: int, n_events: int, n_state: int, capacity: int = 4096) -> Watc
     )
 
 
-@njit(cache=True)
+@kernel
 def _watch(y, nl, s, watch, t0, t1, wrenches) -> None:
     """Evaluate the event functions at t1; log each upward zero crossing since t0."""
     g_prev, g, util, peak = watch.g_prev, watch.g, watch.util, watch.util_peak
     events, count = watch.events, watch.n_events
-    mount_monitors(y, watch.y_prev, nl, s, g, util)
-    watch.y_prev[:] = y
+    y_prev = watch.y_prev
+    mount_monitors(y, y_prev, nl, s, g, util)
+    for i in range(y.shape[0]):  # a loop: slice assignment may need a temporary (NRT)
+        y_prev[i] = y[i]
     for i in range(g.shape[0]):
         peak[i] = max(peak[i], util[i])
         for e in range(g.shape[1]):
@@ -76,7 +78,7 @@ def _watch(y, nl, s, watch, t0, t1, wrenches) -> None:
 watch_mounts = skip_if_none(_watch)
 
 
-@njit(cache=True)
+@kernel
 def run_samples(
     method,
     settings,
@@ -122,7 +124,7 @@ def run_samples(
     """
     n, nm = t.shape[0], peak.shape[0]
     hold = 0.0 if zero_order else 1.0
-    d_wdot = np.zeros(3)
+    d_wdot = s.rate_step
     for j in range(1, n):
         dt = t[j] - t[j - 1]
         u[0] = t[j - 1]

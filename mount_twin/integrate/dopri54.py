@@ -12,8 +12,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import rhs
 
 C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0, 1.0])
@@ -40,7 +40,7 @@ MIN_STEP_FRACTION = 1e-12
 SUCCESS, TOO_MANY_STEPS, STEP_TOO_SMALL, LEFT_CHART = 0, 1, 2, 3
 
 
-@njit(cache=True)
+@kernel
 def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
     """Advance y (in place) from t0 to t1 s with input u held over the interval.
 

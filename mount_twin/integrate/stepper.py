@@ -14,9 +14,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from mount_twin.integrate import dopri54
+from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import ModelArrays, Scratch
 
 DOPRI54 = 0
@@ -69,7 +69,7 @@ def dormand_prince(n: int, rtol: float, atol: float, max_substeps: int) -> Stepp
     return Stepper("dopri54", DOPRI54, settings, np.zeros((7, n)), np.zeros(n))
 
 
-@njit(cache=True)
+@kernel
 def advance(
     method: int,
     y: np.ndarray,

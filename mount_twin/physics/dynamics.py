@@ -25,6 +25,7 @@ from numba import njit
 
 from mount_twin.kinds import kind_load, kind_monitor, kind_update
 from mount_twin.physics.chart import kinematic_matrix, kinematic_matrix_rate, rotation_from_chart
+from mount_twin.physics.compiled import kernel
 from mount_twin.physics.gate import skip_if_none
 from mount_twin.physics.linear_mount import linear_mount_load, point_motion
 from mount_twin.physics.rotations import rotation_vector
@@ -109,6 +110,7 @@ class Scratch(NamedTuple):
     i_w: np.ndarray  # (3,) I·ω_a, B
     mass_rot: np.ndarray  # (3, 3) reduced rotational mass matrix
     rhs_rot: np.ndarray  # (3,)
+    rate_step: np.ndarray  # (3,) jump of Ω' at a sample, rad/s², F
     loc: np.ndarray  # (6, 3) local deflection, rate, rotation, rate, force, couple of a mount
     sink: np.ndarray  # (n_state,) internal-state rates nobody needs (outputs, monitors)
 
@@ -145,6 +147,7 @@ def new_scratch(n_state: int) -> Scratch:
         i_w=np.zeros(3),
         mass_rot=np.zeros((3, 3)),
         rhs_rot=np.zeros(3),
+        rate_step=np.zeros(3),
         loc=np.zeros((6, 3)),
         sink=np.zeros(n_state),
     )
@@ -239,7 +242,7 @@ def mount_loads(y: np.ndarray, m: ModelArrays, s: Scratch, dydt: np.ndarray) -> 
     nl_loads(y, m.nl, s, dydt)
 
 
-@njit(cache=True)
+@kernel
 def _nl_loads(y: np.ndarray, nl: NonLinearMounts, s: Scratch, dydt: np.ndarray) -> None:
     """Add the non-linear mounts' loads to the totals; their state rates into dydt."""
     total_f, total_m = s.total_force, s.total_moment
@@ -264,7 +267,7 @@ def _add_load(arm, f, c, total_f, total_m) -> None:
     total_m[2] += arm[0] * f[1] - arm[1] * f[0] + c[2]
 
 
-@njit(cache=True)
+@kernel
 def mount_wrenches(y: np.ndarray, m: ModelArrays, s: Scratch, wrenches: np.ndarray) -> None:
     """Each mount's force (N) and own couple (N·m) on the body, in its axes: wrenches[i]."""
     arm, f, c = s.arm, s.force, s.couple
@@ -282,7 +285,7 @@ def mount_wrenches(y: np.ndarray, m: ModelArrays, s: Scratch, wrenches: np.ndarr
     nl_wrenches(y, m.nl, s, wrenches)
 
 
-@njit(cache=True)
+@kernel
 def _nl_wrenches(y: np.ndarray, nl: NonLinearMounts, s: Scratch, wrenches: np.ndarray) -> None:
     loc = s.loc
     for i in range(nl.kind.shape[0]):
@@ -293,7 +296,7 @@ def _nl_wrenches(y: np.ndarray, nl: NonLinearMounts, s: Scratch, wrenches: np.nd
             wrenches[row, 3 + j] = loc[5, j]
 
 
-@njit(cache=True)
+@kernel
 def mount_monitors(
     y: np.ndarray,
     y0: np.ndarray,
@@ -317,7 +320,7 @@ nl_loads = skip_if_none(_nl_loads)
 nl_wrenches = skip_if_none(_nl_wrenches)
 
 
-@njit(cache=True)
+@kernel
 def rhs(
     t: float, y: np.ndarray, m: ModelArrays, s: Scratch, u: np.ndarray, dydt: np.ndarray
 ) -> int:
@@ -451,7 +454,7 @@ def _cholesky_solve(low: np.ndarray, b: np.ndarray, n: int) -> None:
         b[i] = e / low[i, i]
 
 
-@njit(cache=True)
+@kernel
 def evaluate(
     y: np.ndarray, m: ModelArrays, s: Scratch, pose: np.ndarray, wrenches: np.ndarray
 ) -> float:
@@ -468,7 +471,7 @@ def evaluate(
     return ct
 
 
-@njit(cache=True)
+@kernel
 def outputs(
     y: np.ndarray, m: ModelArrays, s: Scratch, pose: np.ndarray, wrenches: np.ndarray
 ) -> None:
@@ -482,7 +485,7 @@ def outputs(
         pose[3 + i] = quat[i]
 
 
-@njit(cache=True)
+@kernel
 def rhs_after_rate_step(m: ModelArrays, s: Scratch, d_wdot: np.ndarray, dydt: np.ndarray) -> None:
     """Move dydt, the right-hand side of the last `rhs` call (whose kinematics and factored
     reduced mass matrix s still holds), to an input whose Ω' changed by d_wdot (rad/s², F), with
