@@ -216,7 +216,9 @@ class TwinEngine:
             and finite.all()
             and (not spec.frame_id or batch.frame_ids.count(spec.frame_id) == n)
         ):
-            steps = np.diff(batch.stamps, prepend=last_t)
+            before = np.empty(n)
+            before[0], before[1:] = last_t, batch.stamps[:-1]
+            steps = batch.stamps - before
             if (steps > 0.0).all() and (steps <= spec.max_gap_s).all():
                 # The usual batch, every sample in order: no per-sample Python loop.
                 self._last_stamp = float(batch.stamps[-1])
@@ -283,11 +285,11 @@ class TwinEngine:
             index = index[1:]
         while index:
             t0, f0, w0 = self._last  # type: ignore[misc]
-            t = np.concatenate([[t0], stamps[index]])
-            ff = np.vstack([f0, f[index]])
-            ww = np.vstack([w0, w[index]])
-            n, nm = t.shape[0], self.model.n_mounts
-            pose, wrenches = np.zeros((n, 10)), np.zeros((n, nm, 6))
+            n, nm = len(index) + 1, self.model.n_mounts
+            t, ff, ww = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
+            t[0], ff[0], ww[0] = t0, f0, w0  # row 0: the last sample done
+            t[1:], ff[1:], ww[1:] = stamps[index], f[index], w[index]
+            pose, wrenches = np.empty((n, 10)), np.empty((n, nm, 6))
             publish, step_log = np.zeros(n, dtype=np.bool_), np.zeros((n, 3))
             st = self.stepper
             done, status = run_samples(
