@@ -26,7 +26,7 @@ CASES = {
 }
 
 
-def key(stiffness, clearance=0.0, damping=(0.0, 0.0, 0.0), allowable=0.0):
+def key(stiffness, clearance=0.0, damping=(0.0, 0.0, 0.0), allowable=0.0, height=0.0):
     return law_of(
         kind_mount(
             "shear_key",
@@ -35,6 +35,7 @@ def key(stiffness, clearance=0.0, damping=(0.0, 0.0, 0.0), allowable=0.0):
             damping=list(damping),
             clearance=clearance,
             allowable_force=allowable,
+            engagement_height=height,
         )
     )
 
@@ -152,3 +153,17 @@ def test_a_body_in_the_clearance_flies_freely_and_bounces_elastically_off_the_ke
     assert np.max(np.abs(out.wrenches[:, 0, 0] - force_ref)) <= 1e-6 * K_KEY * scale
     np.testing.assert_array_equal(out.wrenches[:, 0, 1:], 0.0)
     assert engine.state[1] == pytest.approx(v_ref[-1], abs=1e-6 * SPEED)
+
+
+def test_a_foot_lifted_past_the_engagement_height_has_cleared_the_key() -> None:
+    """A key is a block on the deck: the foot it holds sideways escapes once lifted over it."""
+    law = key([1e9, 0.0, 0.0], clearance=1e-4, damping=(1e4, 0.0, 0.0), height=0.02)
+    d_side, v = 5e-4, (0.3, 0.0, 0.0)
+    held, _, _ = law.load([d_side, 0.0, 0.019], v)
+    assert held[0] == pytest.approx(-(1e9 * (d_side - 1e-4) + 1e4 * 0.3), rel=1e-14)
+    free, _, _ = law.load([d_side, 0.0, 0.021], v)
+    assert np.all(free == 0.0)
+    util, g = law.monitor([d_side, 0.0, 0.021])
+    assert util == 0.0 and np.all(g < 0.0), "no contact and no overload once cleared"
+    util_held, _ = law.monitor([d_side, 0.0, 0.019])
+    assert util_held == 0.0  # no allowable given: not monitored

@@ -2,7 +2,8 @@
 
 Along each local axis with a stiffness k > 0 the key pushes back only past the clearance:
 F = −sign(d)·max(k·(|d| − clearance) + c·sign(d)·ḋ, 0) in contact (it never pulls); no force
-along free axes.
+along free axes. With an engagement height h > 0, a foot lifted along local z by more than h has
+cleared the key, which then holds nothing.
 """
 
 from __future__ import annotations
@@ -26,18 +27,19 @@ PARAMETERS = {
     "damping": ("double_array", "[cx, cy, cz] N·s/m in contact (zeros)"),
     "clearance": ("double", "Clearance before the key bears, m (0.0)"),
     "allowable_force": ("double", "Allowable key force, N (0.0: not monitored)"),
+    "engagement_height": ("double", "Lift along local z that clears the key, m (0.0: never)"),
 }
 """ROS parameters of the kind, mounts.<name>.<key>: (type, description)."""
 
-# parameter columns: stiffness (3), damping (3), clearance, allowable force
-K0, C0, CLEAR, FALLOW = 0, 3, 6, 7
-N_PAR = 8
+# parameter columns: stiffness (3), damping (3), clearance, allowable force, engagement height
+K0, C0, CLEAR, FALLOW, HEIGHT = 0, 3, 6, 7, 8
+N_PAR = 9
 
 
 @dataclass(frozen=True)
 class ShearKey:
     """Attributes: stiffness (N/m) and damping (N·s/m) per local axis (0: free axis), clearance
-    (m), allowable_force (N, 0: not monitored)."""
+    (m), allowable_force (N, 0: not monitored), engagement_height (m, 0: always engaged)."""
 
     name: str
     position: tuple[float, float, float]
@@ -46,6 +48,7 @@ class ShearKey:
     damping: tuple[float, float, float]
     clearance: float
     allowable_force: float
+    engagement_height: float = 0.0
     kind: str = KIND
 
 
@@ -59,6 +62,7 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> ShearKey:
         damping=r.vector("damping", 3, (0.0, 0.0, 0.0), lo=0.0),  # type: ignore[arg-type]
         clearance=r.number("clearance", 0.0, lo=0.0),
         allowable_force=r.number("allowable_force", 0.0, lo=0.0),
+        engagement_height=r.number("engagement_height", 0.0, lo=0.0),
     )
     if not any(k > 0.0 for k in key.stiffness):
         raise r.error("stiffness", f"a key needs at least one stiff axis, got {key.stiffness!r}")
@@ -67,7 +71,9 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> ShearKey:
 
 def pack(k: ShearKey) -> np.ndarray:
     """Parameter row of one key."""
-    return np.array([*k.stiffness, *k.damping, k.clearance, k.allowable_force])
+    return np.array(
+        [*k.stiffness, *k.damping, k.clearance, k.allowable_force, k.engagement_height]
+    )
 
 
 def state_names(_k: ShearKey) -> tuple[str, ...]:
@@ -78,11 +84,12 @@ def state_names(_k: ShearKey) -> tuple[str, ...]:
 @njit(cache=True, inline="always")
 def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
     """Force f (N) on the body in local axes; a key has no couple and no states."""
+    engaged = _engaged(p, d)
     for j in range(3):
         f[j] = 0.0
         c[j] = 0.0
         k = p[K0 + j]
-        if k > 0.0:
+        if k > 0.0 and engaged:
             pen = abs(d[j]) - p[CLEAR]
             if pen > 0.0:
                 side = 1.0 if d[j] > 0.0 else -1.0
@@ -95,8 +102,9 @@ def monitor(p, y, y0, o, d, v, g) -> float:
     """Contact (penetration past the clearance, m) and overload; returns |F|/allowable."""
     pen = -1.0
     force = 0.0
+    engaged = _engaged(p, d)
     for j in range(3):
-        if p[K0 + j] > 0.0:
+        if p[K0 + j] > 0.0 and engaged:
             pj = abs(d[j]) - p[CLEAR]
             pen = max(pen, pj)
             force = max(force, p[K0 + j] * max(pj, 0.0))
@@ -106,6 +114,12 @@ def monitor(p, y, y0, o, d, v, g) -> float:
         return force / p[FALLOW]
     g[1] = -1.0
     return 0.0
+
+
+@njit(cache=True, inline="always")
+def _engaged(p, d) -> bool:
+    """Whether the foot is still low enough for the key to hold it."""
+    return p[HEIGHT] <= 0.0 or d[2] <= p[HEIGHT]
 
 
 @njit(cache=True, inline="always")
