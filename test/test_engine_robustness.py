@@ -32,7 +32,8 @@ def stamps(n: int, t0: float = 0.0, rate: float = RATE) -> np.ndarray:
 def push_all(
     engine: TwinEngine, parts: list[SampleBatch]
 ) -> tuple[OutputBatch, list[list[HealthReport]]]:
-    """Push each part; return the concatenated outputs and the reports of each push."""
+    """Push each part; return the concatenated outputs and the reports of each push (the joined
+    `sample` column is per push, so meaningless here: tests read stamps, poses and wrenches)."""
     outs = [engine.push(p) for p in parts]
     joined = OutputBatch(
         np.concatenate([o.stamps for o in outs]),

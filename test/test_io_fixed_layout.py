@@ -121,3 +121,16 @@ def test_a_layout_whose_length_depends_on_the_numbers_is_refused() -> None:
         FixedLayout.probe(
             build, ["<i4"], lambda m: TYPESTORE.serialize_cdr(m, "std_msgs/msg/String")
         )
+
+
+def test_a_frame_id_that_defeats_the_probe_is_decoded_through_rosbags() -> None:
+    """The probe locates fields by sentinel bytes; a frame_id holding one (here the nanosec
+    sentinel A5 01 5A 3C: '¥' is C2 A5 in UTF-8) must not break decoding (bad input is never
+    raised out of the twin), only lose the fast path."""
+    frame = "imu\u00a5\x01Z<"
+    raws, stamps, values, _ = _inputs(10, [frame])
+    dec = decode_inputs(raws, IMU)
+    assert dec.undecodable == 0
+    np.testing.assert_array_equal(dec.stamps_ns, stamps)
+    np.testing.assert_array_equal(dec.accel, values[:, 25:28])
+    assert dec.frame_ids == [frame] * 10

@@ -96,11 +96,11 @@ class TwinEngine:
             for slot in model.nonlinear_slots
         }
         self.events: list[MountEvent] = []
+        """Every mount event so far, in time order (the first MAX_EVENTS; the rest counted)."""
         self._util_max = np.zeros(len(model.nonlinear_slots))
         # Chaining the stepper's last stage into the next interval needs a continuous input
         # (first-order hold) and no discrete switch of the state between samples (fracture).
         self._chain = scene.input.hold == "first_order" and model.arrays.nl is None
-        """Every mount event so far, in time order (the first MAX_EVENTS; the rest counted)."""
         # Fails now, at load, if the mounts cannot hold the body; and is the restart fallback.
         self._y_nominal = initial_state(model, self._gravity_up)
         self._warm_up()

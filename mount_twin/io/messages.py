@@ -101,7 +101,11 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
         if not batched:
             continue
         rest = np.flatnonzero(pending)
-        layout = _layout(msgtype, msg.header.frame_id)
+        try:
+            layout = _layout(msgtype, msg.header.frame_id)
+        except ValueError:  # a frame_id holding a probe's sentinel bytes: rosbags, one by one
+            batched = False
+            continue
         match, cols = layout.unpack([raws[j] for j in (i, *rest.tolist())], _INPUT_WANT[msgtype])
         if not match[0]:  # this writer's padding or extras differ: no batch for it
             batched = False

@@ -1,7 +1,8 @@
 """Equations of motion on the free generalized coordinates, in the moving foundation frame F.
 
-State y = [q_f, q_f'] where q_f is the free subset of q = (X, Y, Z, α, γ, δ) (m, rad) in the
-order of `DOF_NAMES`; frozen coordinates keep the values in `ModelArrays.q_fixed`. The CG velocity
+State y = [q_f, q_f', z] where q_f is the free subset of q = (X, Y, Z, α, γ, δ) (m, rad) in the
+order of `DOF_NAMES` and z the internal states of the mounts that have them (mount_twin.kinds);
+frozen coordinates keep the values in `ModelArrays.q_fixed`. The CG velocity
 is r' = (X', Y', Z') and the body angular velocity relative to F is ω = B(α, γ)·(α', γ', δ'), both
 linear in q'. Projecting Newton–Euler on q_f (Kane's method) gives, exactly for any subset,
 
@@ -32,11 +33,11 @@ from mount_twin.physics.rotations import rotation_vector
 
 OK = 0
 OFF_CHART = 1
+"""Right-hand-side status: the attitude left the chart (cos θ ≤ COS_TILT_MIN)."""
 
 COS_TILT_MIN = 1.0e-6
 """cos θ below which the state counts as off the chart: B grows like 1/cos θ and the reduced
 mass matrix loses positive definiteness in floating point long before cos θ reaches zero."""
-"""Right-hand-side status: the attitude left the chart (cos θ ≤ 0)."""
 
 INPUT_SIZE = 13
 
@@ -45,9 +46,9 @@ class ModelArrays(NamedTuple):
     """Flat arrays of an assembled scene, as the compiled kernels read them (SI, frames as named).
 
     Linear mounts are the lin_ arrays (zero-length if none); all other kinds are `nl`, None for
-    a scene without them, so that numba compiles no trace of them into its kernels: their mere
-    presence, even never run, made the linear right-hand side ~40 % slower (register pressure
-    and reference counting of the extra arrays).
+    a scene without them, so that numba compiles no trace of them into its kernels (measured
+    before the kernels dropped numba's runtime, their mere presence made the linear right-hand
+    side ~40 % slower).
     """
 
     mass: float  # kg
