@@ -112,7 +112,7 @@ FAULTS: list[tuple[str, Callable[[SampleBatch], int], str]] = [
 ]
 
 
-@pytest.mark.filterwarnings("ignore:invalid value encountered in matmul:RuntimeWarning")
+@pytest.mark.filterwarnings("error::RuntimeWarning")
 @pytest.mark.parametrize(("fault", "key"), [f[1:] for f in FAULTS], ids=[f[0] for f in FAULTS])
 def test_bad_sample_is_rejected_counted_reported_as_warn_and_never_yields_nan(
     fault: Callable[[SampleBatch], int], key: str
@@ -144,8 +144,11 @@ def test_bad_sample_is_rejected_counted_reported_as_warn_and_never_yields_nan(
         f"input levels per period: {levels}"
     )
     warn = status(flat[k], "input")
-    assert warn.message == "1 samples rejected, 0 gaps in this period"
+    detail = " (wrong_frame 1: expected frame_id 'deck_imu', got 'base_link')"
+    expected_message = f"1 samples rejected{detail if key == 'rejected_wrong_frame' else ''}"
+    assert warn.message == f"{expected_message}, 0 gaps in this period"
     assert warn.values[key] == "1"
+    assert warn.values["lost_in_period"] == "0", "a rejected sample was received, not lost"
     received = int(np.searchsorted(clean, flat[k].stamp, side="right"))
     assert (warn.values["received"], warn.values["accepted"]) == (str(received), str(received - 1))
     assert all(status(r, "integration").level == OK for r in flat)

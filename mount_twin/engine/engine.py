@@ -17,12 +17,12 @@ import numpy as np
 
 from mount_twin.engine.batch import HealthReport, MountEvent, OutputBatch, SampleBatch
 from mount_twin.engine.health import HealthWindow
-from mount_twin.engine.kernel import new_watch, run_samples
+from mount_twin.engine.kernel import Watch, new_watch, run_samples
 from mount_twin.errors import ModelError
 from mount_twin.integrate.stepper import STATUS_TEXT, STEPPERS
 from mount_twin.kinds import KINDS, N_EVENTS
 from mount_twin.model.assemble import Model, initial_state
-from mount_twin.physics.dynamics import INPUT_SIZE, evaluate, mount_monitors
+from mount_twin.physics.dynamics import INPUT_SIZE, Scratch, evaluate, mount_monitors
 
 ACCEPT, START, JUMPED_BACK, GAP_RESET, GAP_BRIDGED = (
     "accept",
@@ -43,6 +43,10 @@ _COUNTS = {
 }
 """Counters each taken verdict increments; a rejection increments rejected_<reason>."""
 
+READING_LIMIT = 1e150
+"""Largest |component| of an accepted reading, m/s² or rad/s: a larger one (a garbled message) is
+rejected as non_finite, and the rotation into F cannot overflow."""
+
 MAX_EVENTS = 100_000
 """Mount events kept in TwinEngine.events (later ones are counted only)."""
 
@@ -53,6 +57,21 @@ class _Rows(NamedTuple):
     sample: np.ndarray
     pose: np.ndarray
     wrenches: np.ndarray
+
+
+class _Intervals(NamedTuple):
+    """Stamp intervals of a pushed batch, for the lost-sample estimate.
+
+    steps: (n,) per sample with a plain ACCEPT verdict, the interval (s) from the previous taken
+        sample; NaN for the other samples.
+    skipped: sample → samples rejected since the previous taken one, where not 0 (plain ACCEPT
+        samples only).
+    plain: every sample has a plain ACCEPT verdict (no NaN in steps).
+    """
+
+    steps: np.ndarray
+    skipped: dict[int, int]
+    plain: bool
 
 
 @dataclass
@@ -87,6 +106,8 @@ class TwinEngine:
         self._counter = np.zeros(1, dtype=np.int64)
         self._last: tuple[float, np.ndarray, np.ndarray] | None = None
         self._last_stamp: float | None = None
+        self._skipped = 0
+        """Samples rejected since the last taken one: they fill a stamp hole, are not lost."""
         self._gravity_up = np.array([0.0, 0.0, scene.input.g])
         self.counts: Counter[str] = Counter()
         self.health = HealthWindow(scene, self.stepper.name)
@@ -136,6 +157,8 @@ class TwinEngine:
             new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state),
             self._chain,
         )
+        watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
+        self._start_outputs(self._y_nominal.copy(), model.new_scratch(), watch)
 
     @property
     def state(self) -> np.ndarray:
@@ -156,23 +179,43 @@ class TwinEngine:
         return dict(zip(names, peak.tolist(), strict=True))
 
     def count(self, what: str, n: int = 1) -> None:
-        """Count events found outside the engine (e.g. undecodable messages) with its own."""
+        """Count events found outside the engine (e.g. undecodable messages) with its own.
+
+        `rejected_*` counters (samples received but unusable) are not lost: they are credited to
+        the next stamp hole. `lost_*` counters (e.g. lost_middleware, from DDS message-lost
+        events) enter the input status' lost_in_period.
+        """
         self.counts[what] += n
+        if what.startswith("rejected_"):
+            self._skipped += n
 
     def push(self, batch: SampleBatch) -> OutputBatch:
         """Process samples in arrival order; return what is to be published for them.
 
         Diagnostics come at the stamps where they would for one sample per push, so a replay in
-        chunks publishes what the live node does.
+        chunks publishes what the live node does. An empty batch changes nothing.
         """
-        f, w = self._to_foundation(batch)
-        verdicts, due = self._classify(batch, f, w)
+        nm = self.model.n_mounts
+        if len(batch) == 0:
+            return OutputBatch(
+                np.zeros(0), np.zeros(0, np.intp), np.zeros((0, 10)), np.zeros((0, nm, 6)), []
+            )
+        f, w, finite = self._screen(batch)
+        verdicts, due, intervals = self._classify(batch, finite)
         parts: list[_Rows] = []
         reports = []
         start = 0
         for stop, report_due in [*((i + 1, True) for i in due), (len(batch), False)]:
             wall0 = self._clock()
-            self._count(verdicts[start:stop])
+            if self._count(verdicts[start:stop]).get("wrong_frame"):
+                self.health.add_wrong_frames(
+                    [
+                        batch.frame_ids[i]
+                        for i in range(start, stop)
+                        if verdicts[i] == "wrong_frame"
+                    ]
+                )
+            self._add_intervals(intervals, start, stop)
             first = len(parts)
             for run in self._runs(verdicts, start, stop):
                 parts.extend(self._integrate(run, batch.stamps, f, w))
@@ -183,7 +226,6 @@ class TwinEngine:
                 stamp = float(batch.stamps[stop - 1])
                 reports.append(self._report(stamp, stop - 1))
             start = stop
-        nm = self.model.n_mounts
         sample = np.concatenate([r.sample for r in parts]) if parts else np.zeros(0, np.intp)
         return OutputBatch(
             batch.stamps[sample],
@@ -193,22 +235,51 @@ class TwinEngine:
             reports,
         )
 
+    def _add_intervals(self, intervals: _Intervals, start: int, stop: int) -> None:
+        """Hand the stamp intervals of samples [start, stop) to the health window."""
+        steps = intervals.steps[start:stop]
+        skipped = {i - start: n for i, n in intervals.skipped.items() if start <= i < stop}
+        if not intervals.plain:
+            keep = ~np.isnan(steps)
+            position = np.cumsum(keep) - 1  # among the kept steps
+            steps = steps[keep]
+            skipped = {int(position[i]): n for i, n in skipped.items()}
+        self.health.add_intervals(steps, skipped)
+
     def _to_foundation(self, batch: SampleBatch) -> tuple[np.ndarray, np.ndarray]:
-        """Specific force (m/s²) and Ω (rad/s) in F, per sample."""
+        """Specific force (m/s²) and Ω (rad/s) in F, per sample (0 for unreadable readings)."""
+        f, w, _ = self._screen(batch)
+        return f, w
+
+    def _screen(self, batch: SampleBatch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Specific force (m/s²) and Ω (rad/s) in F per sample, and which samples are finite:
+        a finite stamp and readings within ±READING_LIMIT.
+
+        Other readings are zeroed before the rotation, which would otherwise warn (numpy
+        RuntimeWarning: inf·0, inf − inf, overflow); their samples are rejected anyway.
+        """
         rot = self.model.sensor_rotation
-        f = batch.accel @ rot.T
+        accel, gyro = batch.accel, batch.gyro
+        finite = np.isfinite(batch.stamps)
+        # NaN compares false: one test for NaN, ±inf and the absurdly large.
+        if not (np.abs(accel).max() <= READING_LIMIT and np.abs(gyro).max() <= READING_LIMIT):
+            readable = (np.abs(accel) <= READING_LIMIT).all(axis=1) & (
+                np.abs(gyro) <= READING_LIMIT
+            ).all(axis=1)
+            accel = np.where(readable[:, None], accel, 0.0)
+            gyro = np.where(readable[:, None], gyro, 0.0)
+            finite &= readable
+        f = accel @ rot.T
         if not self.scene.input.includes_gravity:
             f = f + self._gravity_up
-        return f, batch.gyro @ rot.T
+        return f, gyro @ rot.T, finite
 
     def _classify(
-        self, batch: SampleBatch, f: np.ndarray, w: np.ndarray
-    ) -> tuple[list[str], list[int]]:
-        """Verdict on each sample, and the samples after which diagnostics are due."""
+        self, batch: SampleBatch, finite: np.ndarray
+    ) -> tuple[list[str], list[int], _Intervals]:
+        """Verdict on each sample, the samples after which diagnostics are due, and the stamp
+        intervals into samples with a plain ACCEPT verdict."""
         spec = self.scene.input
-        finite = (
-            np.isfinite(batch.stamps) & np.isfinite(f).all(axis=1) & np.isfinite(w).all(axis=1)
-        )
         last_t = self._last_stamp
         n = len(batch)
         if (
@@ -222,9 +293,13 @@ class TwinEngine:
             if (steps > 0.0).all() and (steps <= spec.max_gap_s).all():
                 # The usual batch, every sample in order: no per-sample Python loop.
                 self._last_stamp = float(batch.stamps[-1])
-                return [ACCEPT] * n, self.health.ticks(batch.stamps)
+                intervals = _Intervals(steps, {0: self._skipped} if self._skipped else {}, True)
+                self._skipped = 0
+                return [ACCEPT] * n, self.health.ticks(batch.stamps), intervals
         verdicts: list[str] = []
         due: list[int] = []
+        into = np.full(n, np.nan)
+        skipped: dict[int, int] = {}
         for i, t in enumerate(batch.stamps.tolist()):
             if not finite[i]:
                 verdict = "non_finite"
@@ -243,19 +318,30 @@ class TwinEngine:
             else:
                 verdict = ACCEPT
             verdicts.append(verdict)
-            if verdict in _COUNTS:
-                last_t = t
-                if self.health.tick(t):
-                    due.append(i)
+            if verdict not in _COUNTS:
+                self._skipped += 1
+                continue
+            if verdict == ACCEPT:
+                into[i] = t - last_t  # type: ignore[operator]  # ACCEPT: last_t is set
+                if self._skipped:
+                    skipped[i] = self._skipped
+            self._skipped = 0
+            last_t = t
+            if self.health.tick(t):
+                due.append(i)
         self._last_stamp = last_t
-        return verdicts, due
+        plain = verdicts.count(ACCEPT) == n
+        return verdicts, due, _Intervals(into, skipped, plain)
 
-    def _count(self, verdicts: list[str]) -> None:
+    def _count(self, verdicts: list[str]) -> Counter[str]:
+        """Count the verdicts of samples processed; return how many of each there were."""
         counts = self.counts
         counts["received"] += len(verdicts)
-        for verdict, n in Counter(verdicts).items():
+        tally = Counter(verdicts)
+        for verdict, n in tally.items():
             for key in _COUNTS.get(verdict, (f"rejected_{verdict}",)):
                 counts[key] += n
+        return tally
 
     @staticmethod
     def _runs(verdicts: list[str], start: int, stop: int) -> list[_Run]:
@@ -341,9 +427,35 @@ class TwinEngine:
             return None
         return self._report(self._last_stamp, -1)
 
-    def _report(self, stamp: float, sample: int) -> HealthReport:
+    def report_stalled(self, waited_s: float) -> HealthReport:
+        """The report a live adapter publishes when `waited_s` (s, its clock) passed without
+        the stamps of accepted samples making a report due: the window so far, as `flush`
+        gives it, with the input status an ERROR that says why (nothing received, everything
+        rejected, or too few samples accepted). Works before any sample was accepted.
+
+        Its `stamp` is the last accepted stamp (engine seconds, NaN if none), its `sample` −1.
+        The window starts anew, and the stamp cadence restarts at the next accepted sample.
+        """
+        stamp = math.nan if self._last_stamp is None else self._last_stamp
+        report = self._report(stamp, -1, stalled_s=waited_s)
+        self.health.restart_cadence()
+        return report
+
+    def _report(self, stamp: float, sample: int, stalled_s: float | None = None) -> HealthReport:
         util = self._watch.util_peak
-        report = self.health.report(stamp, sample, self.counts, util.copy(), self._active())
+        lost, nominal = self.health.lost_estimate()
+        if lost:
+            self.counts["lost_estimated"] += lost
+        report = self.health.report(
+            stamp,
+            sample,
+            self.counts,
+            util.copy(),
+            self._active(),
+            lost_from_stamps=lost,
+            nominal_interval_s=nominal,
+            stalled_s=stalled_s,
+        )
         np.maximum(self._util_max, util, out=self._util_max)
         util[:] = 0.0
         return report
@@ -401,14 +513,20 @@ class TwinEngine:
         self._peak[:] = 0.0
         self._counter[0] = 0
         self._last = (float(stamps[i]), f[i].copy(), w[i].copy())
+        pose, wrenches = self._start_outputs(self._y, self._scratch, self._watch)
+        return _Rows(np.array([i]), pose, wrenches)
+
+    def _start_outputs(
+        self, y: np.ndarray, scratch: Scratch, watch: Watch
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Outputs (pose, wrenches rows) of a start state y; arms the mount monitors there."""
         pose, wrenches = np.zeros((1, 10)), np.zeros((1, self.model.n_mounts, 6))
-        ct = evaluate(self._y, self.model.arrays, self._scratch, pose[0], wrenches[0])
+        ct = evaluate(y, self.model.arrays, scratch, pose[0], wrenches[0])
         if not math.isfinite(ct):
             msg = f"{self.scene.source}: initial_state.pose is off the α/γ/δ chart"
             raise ValueError(msg)
         nl = self.model.arrays.nl
         if nl is not None:
-            watch = self._watch
-            watch.y_prev[:] = self._y
-            mount_monitors(self._y, self._y, nl, self._scratch, watch.g_prev, watch.util)
-        return _Rows(np.array([i]), pose, wrenches)
+            watch.y_prev[:] = y
+            mount_monitors(y, y, nl, scratch, watch.g_prev, watch.util)
+        return pose, wrenches

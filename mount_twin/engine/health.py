@@ -12,6 +12,13 @@ from mount_twin.scene.description import Scene
 
 PREFIX = "mount_twin"
 
+HOLE = 1.5
+"""A stamp interval longer than HOLE nominal intervals is a hole: samples were lost."""
+LOST_ERROR = 0.01
+"""Fraction of (accepted + lost) samples lost in a period past which the input is an ERROR."""
+NAMED_FRAMES = 3
+"""Wrong frame_ids named in a message (the rest are elided)."""
+
 
 def tilt_from_quaternions(quat: np.ndarray) -> np.ndarray:
     """Tilt θ of body z from the vertical of F, rad, for (k, 4) quaternions (x, y, z, w)."""
@@ -31,6 +38,8 @@ class HealthWindow:
         self._next_due: float | None = None
         self._reset()
         self._last_counts: Counter[str] = Counter()
+        self.last_wrong_frame_id: str | None = None
+        """header.frame_id of the last sample rejected as wrong_frame (any period)."""
 
     def _reset(self) -> None:
         self.t_first = math.nan
@@ -43,6 +52,11 @@ class HealthWindow:
         self.failures: list[tuple[float, str]] = []
         self.wrench_peak = np.zeros((len(self.scene.mounts), 6))
         self.events: list[MountEvent] = []
+        self.steps: list[np.ndarray] = []
+        self.n_steps = 0
+        self.skipped: list[tuple[int, int]] = []
+        """(position among this window's steps, samples rejected within that interval)."""
+        self.wrong_frames: dict[str, None] = {}
 
     @property
     def pending(self) -> bool:
@@ -65,6 +79,54 @@ class HealthWindow:
             self.t_first = float(stamps[0])
         self.t_last = float(stamps[-1])
         self.tilt_max = max(self.tilt_max, float(tilt_from_quaternions(pose[:, 3:7]).max()))
+
+    def add_intervals(self, steps: np.ndarray, skipped: dict[int, int]) -> None:
+        """Stamp intervals (s) into samples with a plain ACCEPT verdict, each from the previous
+        taken sample, in order; `skipped`: position in `steps` → samples received within that
+        interval but rejected (where not 0)."""
+        if steps.shape[0]:
+            self.skipped.extend((self.n_steps + i, n) for i, n in skipped.items())
+            self.steps.append(steps)
+            self.n_steps += steps.shape[0]
+
+    def add_wrong_frames(self, frame_ids: list[str]) -> None:
+        """header.frame_id of samples rejected as wrong_frame, in arrival order."""
+        self.wrong_frames.update(dict.fromkeys(frame_ids))
+        if frame_ids:
+            self.last_wrong_frame_id = frame_ids[-1]
+
+    def lost_estimate(self) -> tuple[int, float]:
+        """Samples lost in this window, estimated from its stamp intervals, and the nominal
+        interval (their median, s; NaN without intervals).
+
+        An interval of k nominal intervals (rounded; a hole past HOLE of them) lost k − 1
+        samples, less those received in it and rejected. The nominal interval is the mean of
+        the intervals within (2 − HOLE, HOLE) times their median: free of the median's
+        granularity, so that the window's whole span can be counted in it too. Stamps taken by
+        the host at sending rather than by the sensor show a hole where a sample was merely
+        late, and the held-back samples crowd in behind it; the span counts no sample lost
+        there, so the estimate is at most what the span holds beyond the window's samples.
+        Windows of the same samples give the same figures however the samples were pushed.
+        """
+        if not self.steps:
+            return 0, math.nan
+        steps = np.concatenate(self.steps)
+        median = float(np.median(steps))
+        regular = (steps > (2.0 - HOLE) * median) & (steps < HOLE * median)
+        nominal = float(steps[regular].mean()) if regular.any() else median
+        hole = steps > HOLE * nominal
+        if not hole.any():
+            return 0, nominal
+        skipped = np.zeros(steps.shape[0])
+        for i, n in self.skipped:
+            skipped[i] = n
+        missing = np.maximum(np.rint(steps[hole] / nominal) - 1.0 - skipped[hole], 0.0).sum()
+        beyond_span = np.rint(steps.sum() / nominal) - steps.shape[0] - skipped.sum()
+        return int(min(missing, max(beyond_span, 0.0))), nominal
+
+    def restart_cadence(self) -> None:
+        """Make the next accepted sample start the report cadence afresh (after a stall)."""
+        self._next_due = None
 
     def add_wall(self, wall_s: float) -> None:
         """Wall time spent on the samples of this window, s."""
@@ -115,33 +177,27 @@ class HealthWindow:
         counts: Counter[str],
         utilisation: np.ndarray,
         active: dict[str, list[tuple[str, bool]]],
+        *,
+        lost_from_stamps: int = 0,
+        nominal_interval_s: float = math.nan,
+        stalled_s: float | None = None,
     ) -> HealthReport:
         """Statuses at `stamp` (s), after pushed sample `sample`, for the window so far, which
         then starts anew.
 
-        Counts are cumulative; rejections, gaps, stepper figures, mount peaks and events are
-        this window's. `utilisation`: peak per non-linear mount, in model order; `active`: the
-        conditions holding now per mount (event name, is an error), e.g. a broken bolt, which
-        keep the mount's level after the events themselves have been reported.
+        Counts are cumulative; rejections, gaps, losses, stepper figures, mount peaks and events
+        are this window's. `utilisation`: peak per non-linear mount, in model order; `active`:
+        the conditions holding now per mount (event name, is an error), e.g. a broken bolt,
+        which keep the mount's level after the events themselves have been reported.
+        `lost_from_stamps`, `nominal_interval_s` (s): `lost_estimate` of this window (already
+        added to counts["lost_estimated"]). `stalled_s`: set by a live adapter's stall timer,
+        the clock time (s) since the last report; the input status is then an ERROR.
         """
         new = counts - self._last_counts
         self._last_counts = counts.copy()
         span = self.t_last - self.t_first
-        rejected = {k: v for k, v in counts.items() if k.startswith("rejected_")}
-        new_rejected = sum(v for k, v in new.items() if k.startswith("rejected_"))
-        inp = HealthStatus(
-            f"{PREFIX}: input",
-            WARN if new_rejected or new["gaps"] else OK,
-            f"{new_rejected} samples rejected, {new['gaps']} gaps in this period"
-            if new_rejected or new["gaps"]
-            else "ok",
-            {
-                "topic": self.scene.input.topic,
-                "rate_hz": f"{new['accepted'] / span:.1f}" if span > 0 else "n/a",
-                **{k: str(counts[k]) for k in ("received", "accepted", "gaps", "restarts")},
-                **{k: str(v) for k, v in sorted(rejected.items())},
-                "reset_stamp_jumped_back": str(counts["reset_stamp_jumped_back"]),
-            },
+        inp = self._input_status(
+            new, counts, span, lost_from_stamps, nominal_interval_s, stalled_s
         )
         integ = self.scene.integration
         rtf = span / self.wall if self.wall > 0 and span > 0 else math.nan
@@ -210,6 +266,104 @@ class HealthWindow:
                 text = f"now: {values['now']}" + ("" if text == "ok" else f"; {text}")
             out.append(HealthStatus(f"{PREFIX}: mount {mount.name}", level, text, values))
         return out
+
+    def _input_status(
+        self,
+        new: Counter[str],
+        counts: Counter[str],
+        span: float,
+        lost_from_stamps: int,
+        nominal_s: float,
+        stalled_s: float | None,
+    ) -> HealthStatus:
+        """The input status of this window: rejections and gaps (WARN), lost samples (WARN,
+        ERROR past LOST_ERROR of the samples due), a stall (ERROR)."""
+        new_rejected = {
+            k.removeprefix("rejected_"): v
+            for k, v in sorted(new.items())
+            if k.startswith("rejected_")
+        }
+        n_rejected = sum(new_rejected.values())
+        # Adapter counters (lost_middleware, ...) and stamp holes see the same lost samples (a
+        # message lost in DDS leaves a hole in the stamps): the larger figure is the estimate.
+        reported = {
+            k: v for k, v in sorted(new.items()) if k.startswith("lost_") and k != "lost_estimated"
+        }
+        lost = max(lost_from_stamps, sum(reported.values()))
+        share = lost / (new["accepted"] + lost) if lost else 0.0
+
+        parts: list[str] = []
+        level = OK
+        all_rejected = False
+        if stalled_s is not None:
+            level = ERROR
+            waited = _seconds(stalled_s)
+            if not new["received"]:
+                parts.append(f"no input received for {waited}")
+            elif not new["accepted"]:
+                all_rejected = n_rejected > 0
+                why = ", ".join(self._reason(r, n) for r, n in new_rejected.items())
+                parts.append(
+                    f"no sample accepted for {waited}: {new['received']} received, "
+                    + (f"all rejected ({why})" if all_rejected else "none accepted")
+                )
+            else:
+                parts.append(f"input stalled: only {new['accepted']} samples accepted in {waited}")
+        if (n_rejected and not all_rejected) or new["gaps"]:
+            level = max(level, WARN)
+            detail = ""
+            if "wrong_frame" in new_rejected:
+                detail = f" ({self._reason('wrong_frame', new_rejected['wrong_frame'])})"
+            parts.append(
+                f"{n_rejected} samples rejected{detail}, {new['gaps']} gaps in this period"
+            )
+        if lost:
+            level = max(level, ERROR if share > LOST_ERROR else WARN)
+            sources = []
+            if lost_from_stamps:
+                sources.append(f"from stamp gaps at a {nominal_s * 1e3:.3f} ms nominal interval")
+            if reported:
+                sources.append("reported " + ", ".join(f"{k} {v}" for k, v in reported.items()))
+            parts.append(
+                f"~{lost} samples lost in this period ({100.0 * share:.1f} %, "
+                f"{'; '.join(sources)})"
+            )
+
+        values = {
+            "topic": self.scene.input.topic,
+            "rate_hz": f"{new['accepted'] / span:.1f}" if span > 0 else "n/a",
+            **{k: str(counts[k]) for k in ("received", "accepted", "gaps", "restarts")},
+            **{k: str(v) for k, v in sorted(counts.items()) if k.startswith("rejected_")},
+            "reset_stamp_jumped_back": str(counts["reset_stamp_jumped_back"]),
+            "lost_estimated": str(counts["lost_estimated"]),
+            "lost_in_period": str(lost),
+            "nominal_interval_s": "n/a" if math.isnan(nominal_s) else f"{nominal_s:.6g}",
+            **{
+                k: str(v)
+                for k, v in sorted(counts.items())
+                if k.startswith("lost_") and k != "lost_estimated"
+            },
+        }
+        if counts["rejected_wrong_frame"] and self.last_wrong_frame_id is not None:
+            values["last_wrong_frame_id"] = self.last_wrong_frame_id
+        if stalled_s is not None:
+            values["since_last_report_s"] = f"{stalled_s:.6g}"
+        return HealthStatus(f"{PREFIX}: input", level, "; ".join(parts) or "ok", values)
+
+    def _reason(self, reason: str, n: int) -> str:
+        """'non_finite 3', or for wrong frames "wrong_frame 3: expected frame_id 'a', got 'b'"."""
+        if reason != "wrong_frame" or not self.wrong_frames:
+            return f"{reason} {n}"
+        seen = list(self.wrong_frames)
+        got = ", ".join(repr(f) for f in seen[:NAMED_FRAMES])
+        if len(seen) > NAMED_FRAMES:
+            got += f" and {len(seen) - NAMED_FRAMES} more"
+        return f"{reason} {n}: expected frame_id {self.scene.input.frame_id!r}, got {got}"
+
+
+def _seconds(t: float) -> str:
+    """A duration for a message: '1.0 s', '12.5 s', '250 ms'."""
+    return f"{t:.1f} s" if t >= 1.0 else f"{t * 1e3:.0f} ms"
 
 
 def _events_text(events: list[MountEvent], utilisation: float, origin_s: int) -> str:
