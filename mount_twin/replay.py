@@ -11,8 +11,15 @@ from tqdm import tqdm
 
 from mount_twin.engine.batch import MountEvent
 from mount_twin.engine.health import tilt_from_quaternions
-from mount_twin.io.bag import InputBag, OutputBag
-from mount_twin.io.messages import output_types, resolve
+from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag
+from mount_twin.io.messages import (
+    TF,
+    TF_STATIC_TOPIC,
+    decode_inputs,
+    output_types,
+    resolve,
+    static_transforms,
+)
 from mount_twin.scene.description import Scene
 from mount_twin.stream import TwinStream
 
@@ -86,6 +93,15 @@ def _grouped(events: list[MountEvent]) -> dict[tuple[str, str], list[MountEvent]
     return out
 
 
+def _first_stamp(raws: list[bytes], msgtype: str) -> int | None:
+    """header.stamp (ns) of the first decodable message of `raws`, None if there is none."""
+    for raw in raws:
+        decoded = decode_inputs([raw], msgtype)
+        if decoded.stamps_ns.shape[0]:
+            return int(decoded.stamps_ns[0])
+    return None
+
+
 def replay(
     scene: Scene,
     input_path: str | Path,
@@ -94,10 +110,18 @@ def replay(
     chunk: int = 2000,
     progress: bool = True,
 ) -> ReplaySummary:
-    """Replay `input_path`'s scene.input.topic into a new mcap bag at `output_path`."""
+    """Replay `input_path`'s scene.input.topic into a new mcap bag at `output_path`.
+
+    The output holds what the node publishes: the scene's outputs (`output_types`), and the mount
+    frames on /tf_static once, before anything else, stamped with the first decodable input
+    stamp and offered latched (`LATCHED_QOS`) so `ros2 bag play` republishes it to late
+    subscribers.
+    """
     stream = TwinStream(scene)
     resolved = {t: resolve(t, NODE_NAME) for t in output_types(scene)}
     topics = {resolved[t]: msgtype for t, msgtype in output_types(scene).items()}
+    topics[TF_STATIC_TOPIC] = TF
+    static_due = True
     nm = len(scene.mounts)
     peak = np.zeros((nm, 6))
     tilt, disp = 0.0, 0.0
@@ -107,10 +131,15 @@ def replay(
     last_health: list[str] = []
     with (
         InputBag(input_path, scene.input.topic, scene.input.msg_type) as bag,
-        OutputBag(output_path, topics) as out,
+        OutputBag(output_path, topics, {TF_STATIC_TOPIC: [LATCHED_QOS]}) as out,
         tqdm(total=bag.count, unit="msg", disable=not progress, desc="replay", leave=False) as bar,
     ):
         for raws in bag.chunks(chunk):
+            if static_due:
+                stamp0 = _first_stamp(raws, scene.input.msg_type)
+                if stamp0 is not None:
+                    out.write(*static_transforms(scene, stamp0))
+                    static_due = False
             for topic, stamp, raw in stream.process(raws):
                 out.write(resolved[topic], stamp, raw)
             batch = stream.last_outputs

@@ -238,7 +238,7 @@ def test_water_entry_csv_imports_and_replays(
     # Only the pose is needed here: keep the output small (20 kHz × 10 topics is 200k messages).
     data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
     data["input"].update(topic="/imu/data", frame_id="imu_link")
-    data["outputs"].update(angles=False, wrenches=False)
+    data["outputs"].update(angles=False, wrenches=False, tf=False)
     scene = tmp_path / "scene.yaml"
     scene.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
     out = tmp_path / "out"

@@ -12,6 +12,7 @@ from mount_twin.io.messages import (
     DIAGNOSTICS,
     IMU,
     POSE,
+    TF,
     TYPESTORE,
     VECTOR3,
     WRENCH,
@@ -144,7 +145,7 @@ def test_accel_stamped_without_gravity_gets_g_added_on_z_of_f() -> None:
     acc_out = TwinStream(accel_scene)
     imu_msgs = imu_out.process(imu_raws)
     acc_msgs = acc_out.process(acc_raws)
-    assert len(imu_msgs) == len(acc_msgs) == n * (2 + 8)
+    assert len(imu_msgs) == len(acc_msgs) == n * (3 + 8)  # pose, angles, /tf, 8 wrenches
     np.testing.assert_allclose(
         acc_out.last_outputs.pose,
         imu_out.last_outputs.pose,
@@ -221,10 +222,11 @@ def test_encoded_outputs_have_the_right_topics_types_frames_and_values() -> None
     msgs = encode_outputs(scene, out, np.array([want_ns]))
     topics = output_topics(scene)
     types = output_types(scene)
-    assert [t for t, _, _ in msgs] == [topics.pose, topics.angles, *topics.wrenches]
+    assert [t for t, _, _ in msgs] == [topics.pose, topics.angles, *topics.wrenches, topics.tf]
     for topic, stamp, raw in msgs:
         msg = TYPESTORE.deserialize_cdr(raw, types[topic])
-        assert stamp == want_ns and stamp_ns(msg) == want_ns
+        stamped = msg.transforms[0] if types[topic] == TF else msg
+        assert stamp == want_ns and stamp_ns(stamped) == want_ns
         if topic == topics.pose:
             assert (
                 types[topic] == POSE and msg.header.frame_id == scene.frames.foundation == "deck"
@@ -234,6 +236,12 @@ def test_encoded_outputs_have_the_right_topics_types_frames_and_values() -> None
         elif topic == topics.angles:
             assert types[topic] == VECTOR3 and msg.header.frame_id == "deck"
             assert [msg.vector.x, msg.vector.y, msg.vector.z] == out.pose[0, 7:].tolist()
+        elif topic == topics.tf:
+            assert types[topic] == TF and len(msg.transforms) == 1
+            tf = msg.transforms[0]
+            assert (tf.header.frame_id, tf.child_frame_id) == ("deck", "pump")
+            p, q = tf.transform.translation, tf.transform.rotation
+            assert [p.x, p.y, p.z, q.x, q.y, q.z, q.w] == out.pose[0, :7].tolist()
         else:
             i = topics.wrenches.index(topic)
             assert types[topic] == WRENCH and msg.header.frame_id == scene.mounts[i].name
@@ -255,7 +263,7 @@ def test_output_names_resolve_under_the_node_name_and_namespace() -> None:
 
 
 def test_disabled_outputs_are_neither_encoded_nor_declared() -> None:
-    scene = scene_with(outputs={"pose": False, "wrenches": False})
+    scene = scene_with(outputs={"pose": False, "wrenches": False, "tf": False})
     msgs = encode_outputs(scene, _one_row_batch(scene), np.array([START_NS]))
     assert [t for t, _, _ in msgs] == ["~/angles"]
     assert output_types(scene) == {"/diagnostics": DIAGNOSTICS, "~/angles": VECTOR3}

@@ -13,7 +13,16 @@ from io_helpers import read_bag, read_raw, scene_with, stamp_ns
 
 from mount_twin.cli import main
 from mount_twin.errors import BagError
-from mount_twin.io.messages import DIAGNOSTICS, IMU, POSE, VECTOR3, WRENCH, decode_inputs, resolve
+from mount_twin.io.messages import (
+    DIAGNOSTICS,
+    IMU,
+    POSE,
+    TF,
+    VECTOR3,
+    WRENCH,
+    decode_inputs,
+    resolve,
+)
 from mount_twin.replay import NODE_NAME, replay
 from mount_twin.stream import TwinStream
 
@@ -69,9 +78,18 @@ def expected_types() -> dict[str, str]:
         f"/{NODE_NAME}/pose": POSE,
         f"/{NODE_NAME}/angles": VECTOR3,
         "/diagnostics": DIAGNOSTICS,
+        "/tf": TF,
+        "/tf_static": TF,
     }
     types.update({f"/{NODE_NAME}/mounts/{m.name}/wrench": WRENCH for m in scene.mounts})
     return types
+
+
+def header_stamps(msg) -> list[int]:
+    """header.stamp (ns) of a message, or of each transform of a TFMessage."""
+    if hasattr(msg, "transforms"):
+        return [stamp_ns(t) for t in msg.transforms]
+    return [stamp_ns(msg)]
 
 
 def test_generated_input_bags_hold_the_requested_imu_messages(bags: dict[str, Path]) -> None:
@@ -99,7 +117,12 @@ def test_each_output_topic_carries_the_input_stamps(
 ) -> None:
     _, msgs = read_bag(bags["out_mcap"])
     for topic in expected_types():
-        got = [stamp_ns(m) for _, m in msgs[topic]]
+        if topic == "/tf_static":  # once, before the outputs, at the first input stamp
+            ((log_time, static),) = msgs[topic]
+            assert log_time == input_stamps[0]
+            assert set(header_stamps(static)) == {input_stamps[0]}
+            continue
+        got = [s for _, m in msgs[topic] for s in header_stamps(m)]
         assert [t for t, _ in msgs[topic]] == got, f"{topic}: log time must equal header.stamp"
         if topic == "/diagnostics":
             assert set(got) <= set(input_stamps), "diagnostics must be stamped with an input stamp"
@@ -175,7 +198,7 @@ def test_live_one_message_at_a_time_equals_the_chunked_replay(bags: dict[str, Pa
     pose_bag = decode_poses([d for _, d in replayed[f"/{NODE_NAME}/pose"]])
     np.testing.assert_allclose(pose_live, pose_bag, rtol=0, atol=1e-12)
     for topic in expected_types():
-        if topic == "/diagnostics":
+        if topic in ("/diagnostics", "/tf_static"):  # the node sends /tf_static on its own
             continue
         live_topic = [(s, d) for t, s, d in live if t == topic]
         assert live_topic == replayed[topic], f"{topic}: live bytes differ from the replayed bag"
@@ -223,7 +246,7 @@ def test_replay_summary_reports_counts_and_real_time_factor(
 ) -> None:
     summary = replay(_scene(), bags["in_sqlite3"], tmp_path / "out", progress=False)
     assert summary.counts["received"] == summary.counts["accepted"] == 500
-    assert summary.written == 500 * (2 + 8) + len(
+    assert summary.written == 500 * (3 + 8) + 1 + len(
         read_raw(tmp_path / "out", ["/diagnostics"]).get("/diagnostics", [])
     )
     assert summary.stamp_span_s == pytest.approx(0.499, abs=1e-9)

@@ -2,16 +2,42 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from types import TracebackType
 
 import numpy as np
 from rosbags.highlevel import AnyReader
+from rosbags.interfaces import (
+    Qos,
+    QosDurability,
+    QosHistory,
+    QosLiveliness,
+    QosReliability,
+    QosTime,
+)
 from rosbags.rosbag2 import StoragePlugin, Writer
 
 from mount_twin.errors import BagError
 from mount_twin.io.messages import TYPESTORE
+
+_INFINITE = QosTime(9223372036, 854775807)
+"""RMW_DURATION_INFINITE (sec, nsec), as a Jazzy recording stores a default deadline/lifespan."""
+
+LATCHED_QOS = Qos(
+    QosHistory.KEEP_LAST,
+    1,
+    QosReliability.RELIABLE,
+    QosDurability.TRANSIENT_LOCAL,
+    _INFINITE,
+    _INFINITE,
+    QosLiveliness.AUTOMATIC,
+    _INFINITE,
+    False,
+)
+"""Offered QoS of a latched topic (tf2_ros' static broadcaster: reliable, transient_local, depth
+1): stored in the bag's metadata so `ros2 bag play` offers it again and republishes /tf_static to
+late subscribers."""
 
 
 class InputBag:
@@ -81,9 +107,17 @@ class OutputBag:
     Args:
         path: new bag directory (must not exist: rosbags refuses to overwrite).
         topics: resolved topic → message type.
+        offered_qos: resolved topic → QoS profiles its publisher offered (recorded in the bag's
+            metadata, replayed by `ros2 bag play`); topics not listed record none (the player's
+            default, reliable and volatile).
     """
 
-    def __init__(self, path: str | Path, topics: dict[str, str]) -> None:
+    def __init__(
+        self,
+        path: str | Path,
+        topics: dict[str, str],
+        offered_qos: Mapping[str, Sequence[Qos]] | None = None,
+    ) -> None:
         self.path = Path(path)
         if self.path.exists():
             msg = f"{self.path}: output bag exists; choose another path or remove it"
@@ -92,8 +126,11 @@ class OutputBag:
             self.path, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP
         )
         self._writer.open()
+        qos = offered_qos or {}
         self._conns = {
-            topic: self._writer.add_connection(topic, msgtype, typestore=TYPESTORE)
+            topic: self._writer.add_connection(
+                topic, msgtype, typestore=TYPESTORE, offered_qos_profiles=qos.get(topic, ())
+            )
             for topic, msgtype in topics.items()
         }
         self.written = 0

@@ -16,6 +16,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from mount_twin.engine.batch import HealthReport, OutputBatch, SampleBatch
 from mount_twin.io.fixed_layout import FixedLayout
+from mount_twin.physics.rotations import quaternion_from_matrix, rpy_matrix
 from mount_twin.scene.description import Scene
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
@@ -27,6 +28,12 @@ POSE, VECTOR3, WRENCH = (
     "geometry_msgs/msg/WrenchStamped",
 )
 DIAGNOSTICS = "diagnostic_msgs/msg/DiagnosticArray"
+TF = "tf2_msgs/msg/TFMessage"
+"""Type of /tf and /tf_static (known to rosbags' Jazzy typestore; no tf2_msgs install needed)."""
+TF_TOPIC = "/tf"
+"""Body pose transforms, one TFMessage per published row (volatile, like tf2_ros' broadcaster)."""
+TF_STATIC_TOPIC = "/tf_static"
+"""Mount frames, one TFMessage for all mounts; publish it latched (transient_local, depth 1)."""
 
 
 @dataclass(frozen=True)
@@ -68,6 +75,13 @@ class Decoded:
     frame_ids: list[str]
     undecodable: int = 0
 
+    def select(self, keep: np.ndarray) -> Decoded:
+        """The messages where `keep` (bool, per decoded message) is True."""
+        frames = [f for f, k in zip(self.frame_ids, keep.tolist(), strict=True) if k]
+        return Decoded(
+            self.stamps_ns[keep], self.accel[keep], self.gyro[keep], frames, self.undecodable
+        )
+
     def batch(self, base: TimeBase) -> SampleBatch:
         """Engine samples with stamps in seconds from `base`."""
         return SampleBatch(base.seconds(self.stamps_ns), self.accel, self.gyro, self.frame_ids)
@@ -79,9 +93,19 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
     rate, so Ω is taken as zero).
 
     rosbags decodes the first message of each frame_id; the messages that share its fixed layout
-    are read in one numpy pass (`FixedLayout`), the rest one by one through rosbags.
+    are read in one numpy pass (`FixedLayout`), the rest one by one through rosbags. A single
+    message (the live node's usual call) is first tried against the layout of the frame_id
+    last seen, without rosbags or numpy (~200 → ~10 µs).
     """
     n = len(raws)
+    if n == 1 and msgtype in _LAST_FRAME:
+        frame = _LAST_FRAME[msgtype]
+        one = _layout(msgtype, frame).unpack_one(raws[0], _INPUT_WANT[msgtype])
+        if one is not None:
+            sec, nsec, *v = one
+            gyro = [v[3:6]] if msgtype == IMU else [(0.0, 0.0, 0.0)]
+            stamp = np.array([int(sec) * 1_000_000_000 + int(nsec)], dtype=np.int64)
+            return Decoded(stamp, np.array([v[:3]]), np.array(gyro), [frame])
     stamps = np.zeros(n, dtype=np.int64)
     accel, gyro = np.zeros((n, 3)), np.zeros((n, 3))
     frames = [""] * n
@@ -110,6 +134,7 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
         if not match[0]:  # this writer's padding or extras differ: no batch for it
             batched = False
             continue
+        _LAST_FRAME[msgtype] = msg.header.frame_id
         got = rest[match[1:]]
         pending[got] = False
         ok[got] = True
@@ -195,34 +220,63 @@ def _build_wrench(frame_id: str, v: Sequence[float]) -> object:
     return _T[WRENCH](header=_hdr(v, frame_id), wrench=wrench)
 
 
+def _transform_stamped(parent: str, child: str, v: Sequence[float]) -> object:
+    """TransformStamped parent → child from [sec, nanosec, translation(3), rotation xyzw(4)]."""
+    return _T["geometry_msgs/msg/TransformStamped"](
+        header=_hdr(v, parent),
+        child_frame_id=child,
+        transform=_T["geometry_msgs/msg/Transform"](
+            translation=_vector3(*v[2:5]),
+            rotation=_T["geometry_msgs/msg/Quaternion"](
+                x=float(v[5]), y=float(v[6]), z=float(v[7]), w=float(v[8])
+            ),
+        ),
+    )
+
+
+def _build_tf(parent: str, child: str, v: Sequence[float]) -> object:
+    """TFMessage of one transform parent → child, from the fields of `_transform_stamped`."""
+    return _T[TF](transforms=[_transform_stamped(parent, child, v)])
+
+
 _BUILDERS = {
     IMU: (_build_imu, 37),
     ACCEL: (_build_accel, 6),
     POSE: (_build_pose, 7),
     VECTOR3: (_build_vector3, 3),
     WRENCH: (_build_wrench, 6),
+    TF: (_build_tf, 7),
 }
-"""Builder and number of float64 fields (after sec, nanosec) of each fixed-layout type."""
+"""Builder and number of float64 fields (after sec, nanosec) of each fixed-layout type; the
+builders take the message's frame ids first (TF: parent, child; the others: header.frame_id)."""
 
 _INPUT_WANT = {IMU: range(8), ACCEL: range(5)}
+_LAST_FRAME: dict[str, str] = {}
+"""Input type → frame_id of the last message decoded through its layout (a cache)."""
 """Fields an input decode reads: sec, nanosec, acceleration (and ω for Imu)."""
 
 
 @lru_cache(maxsize=256)
-def _layout(msgtype: str, frame_id: str) -> FixedLayout:
+def _layout(msgtype: str, *frames: str) -> FixedLayout:
+    """Layout of `msgtype` with these frame ids (see `_BUILDERS`)."""
     build, n_floats = _BUILDERS[msgtype]
     return FixedLayout.probe(
-        partial(build, frame_id),
+        partial(build, *frames),
         ["<i4", "<u4"] + ["<f8"] * n_floats,
         partial(TYPESTORE.serialize_cdr, typename=msgtype),
     )
 
 
 def _pack(
-    msgtype: str, frame_id: str, sec: np.ndarray, nsec: np.ndarray, values: np.ndarray
+    msgtype: str,
+    frames: str | tuple[str, ...],
+    sec: np.ndarray,
+    nsec: np.ndarray,
+    values: np.ndarray,
 ) -> list[bytes]:
-    """Messages of one type and frame for stamps (sec, nanosec) and rows of float fields."""
-    return _layout(msgtype, frame_id).pack([sec, nsec, *values.T])
+    """Messages of one type and frame id(s) for stamps (sec, nanosec) and rows of float fields."""
+    frames = (frames,) if isinstance(frames, str) else frames
+    return _layout(msgtype, *frames).pack([sec, nsec, values])
 
 
 @dataclass(frozen=True)
@@ -233,6 +287,7 @@ class OutputTopics:
     angles: str
     wrenches: tuple[str, ...]
     diagnostics: str = "/diagnostics"
+    tf: str = TF_TOPIC
 
 
 def output_topics(scene: Scene) -> OutputTopics:
@@ -260,7 +315,9 @@ def encode_outputs(
         stamps_ns: (n,) header stamps of the pushed samples, integer ns; rows reuse them, so
             output stamps equal input stamps exactly however long the twin runs.
 
-    Only the outputs the scene enables are built: unused outputs cost nothing.
+    Per published row, in this order: pose, angles, one wrench per mount (header.frame_id =
+    the mount's frame, `Frames.mount_frame`), /tf (frames.foundation → frames.body, the pose's
+    numbers). Only the outputs the scene enables are built: unused outputs cost nothing.
     """
     topics = output_topics(scene)
     frames, opts = scene.frames, scene.outputs
@@ -273,7 +330,11 @@ def encode_outputs(
         rows.append((topics.angles, _pack(VECTOR3, frames.foundation, sec, nsec, out.pose[:, 7:])))
     if opts.wrenches:
         for i, (mount, topic) in enumerate(zip(scene.mounts, topics.wrenches, strict=True)):
-            rows.append((topic, _pack(WRENCH, mount.name, sec, nsec, out.wrenches[:, i])))
+            frame = frames.mount_frame(mount.name)
+            rows.append((topic, _pack(WRENCH, frame, sec, nsec, out.wrenches[:, i])))
+    if opts.tf:
+        pair = (frames.foundation, frames.body)
+        rows.append((topics.tf, _pack(TF, pair, sec, nsec, out.pose[:, :7])))
     msgs: list[tuple[str, int, bytes]] = []
     reports = iter(out.health)
     report = next(reports, None)
@@ -320,7 +381,52 @@ def output_types(scene: Scene) -> dict[str, str]:
         types[topics.angles] = VECTOR3
     if opts.wrenches:
         types.update(dict.fromkeys(topics.wrenches, WRENCH))
+    if opts.tf:
+        types[topics.tf] = TF
     return types
+
+
+def mount_quaternion(orientation_rpy: Sequence[float]) -> np.ndarray:
+    """Unit quaternion (x, y, z, w), w ≥ 0, of a mount's axes relative to F.
+
+    Args:
+        orientation_rpy: the mount's fixed-axis roll, pitch, yaw, rad.
+
+    The rotation is the model's (`rpy_matrix`, columns = mount axes in F): it takes a vector
+    expressed in the mount's axes (a WrenchStamped of that mount) to the same vector in F.
+    """
+    quat = np.empty(4)
+    quaternion_from_matrix(rpy_matrix(*orientation_rpy), quat)
+    return quat
+
+
+def static_transforms(scene: Scene, stamp_ns: int) -> tuple[str, int, bytes]:
+    """The /tf_static message of the mount frames, as (topic, stamp ns, TFMessage CDR bytes).
+
+    One TransformStamped per mount, in scene order: parent frames.foundation, child the mount's
+    frame (`Frames.mount_frame`), translation the mount's position (m, in F at the reference
+    pose), rotation its axes relative to F (`mount_quaternion`). These frames are fixed in F:
+    the mount axes of the wrench outputs are those of the reference pose.
+
+    Args:
+        stamp_ns: header stamp of every transform, ns (the replay uses the first input stamp;
+            tf2 ignores the stamps of static transforms).
+
+    Publish once, latched: TF_STATIC_TOPIC with reliable, transient_local, keep-last depth 1
+    (tf2_ros' static broadcaster QoS), so late RViz/Foxglove subscribers still get it.
+    """
+    sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
+    frames = scene.frames
+    transforms = [
+        _transform_stamped(
+            frames.foundation,
+            frames.mount_frame(m.name),
+            [sec, nanosec, *m.position, *mount_quaternion(m.orientation_rpy)],
+        )
+        for m in scene.mounts
+    ]
+    raw = bytes(TYPESTORE.serialize_cdr(_T[TF](transforms=transforms), TF))
+    return TF_STATIC_TOPIC, int(stamp_ns), raw
 
 
 def imu_messages(

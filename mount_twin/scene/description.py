@@ -41,7 +41,7 @@ class LinearMount:
     """Six-component Kelvin–Voigt mount (physics notes §7).
 
     Attributes:
-        name: unique name; also the mount's frame name.
+        name: unique name; its frame id is frames.mount_prefix + name (`Frames.mount_frame`).
         position: attachment point, m, in F at the reference pose, where the body point and the
             foundation point coincide and the mount is unstressed.
         orientation_rpy: mount axes relative to F as fixed-axis roll, pitch, yaw, rad.
@@ -127,6 +127,8 @@ class Outputs:
 
     Attributes:
         pose, angles, wrenches: publish PoseStamped, α/γ/δ Vector3Stamped, per-mount WrenchStamped.
+        tf: publish the body pose on /tf (tf2_msgs/TFMessage: frames.foundation → frames.body,
+            the CG position in m and the body attitude, the numbers of the PoseStamped).
         decimation: publish every Nth accepted input sample; wrench components hold their peak
             (largest magnitude, with sign) over the interval.
         diagnostics_period_s: stamp-time period of DiagnosticArray messages, s.
@@ -137,6 +139,7 @@ class Outputs:
     pose: bool = True
     angles: bool = True
     wrenches: bool = True
+    tf: bool = True
     decimation: int = 1
     diagnostics_period_s: float = 1.0
     tilt_warn_rad: float = 1.3089969389957472  # 75°
@@ -145,10 +148,23 @@ class Outputs:
 
 @dataclass(frozen=True)
 class Frames:
-    """Frame ids written into output headers."""
+    """Frame ids written into output headers and transforms.
+
+    Attributes:
+        foundation: the foundation frame F (parent of every transform published).
+        body: the body frame B, origin at the CG (child of F on /tf).
+        mount_prefix: a mount's frame is mount_prefix + its name (`mount_frame`): the
+            header.frame_id of its WrenchStamped and the child of F on /tf_static (origin at the
+            mount's position, axes its orientation_rpy), e.g. "pump/" gives "pump/fl".
+    """
 
     foundation: str = "foundation"
     body: str = "body"
+    mount_prefix: str = ""
+
+    def mount_frame(self, mount_name: str) -> str:
+        """Frame id of the mount named `mount_name`: mount_prefix + mount_name."""
+        return self.mount_prefix + mount_name
 
 
 @dataclass(frozen=True)
