@@ -55,6 +55,28 @@ def test_decoded_imu_equals_rosbags_field_by_field(frames: list[str]) -> None:
     assert dec.frame_ids == [frame_of[i] for i in keep]
 
 
+@pytest.mark.parametrize("frames", [["deck_imu"], ["a", "imu_link_2", "abc"]])
+def test_imu_decoded_one_message_at_a_time_equals_rosbags(frames: list[str]) -> None:
+    """The live node's single-message path (the last frame's layout, struct) against rosbags,
+    with frames switching, garbage of the right length and dirty padding between."""
+    raws, _, _, _ = _inputs(60, frames)
+    raws[5] = bytes(len(raws[4]))  # zeros, as long as a real message: not its layout
+    raws[9] = raws[9][:22] + b"\xff" * 6 + raws[9][28:] if len(frames[0]) == 8 else raws[9]
+    for raw in raws:
+        dec = decode_inputs([raw], IMU)
+        try:
+            msg = TYPESTORE.deserialize_cdr(raw, IMU)
+        except Exception:
+            assert dec.undecodable == 1 and dec.stamps_ns.shape == (0,)
+            continue
+        a, w = msg.linear_acceleration, msg.angular_velocity
+        assert dec.undecodable == 0
+        assert dec.stamps_ns.tolist() == [msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec]
+        assert dec.accel.tolist() == [[a.x, a.y, a.z]]
+        assert dec.gyro.tolist() == [[w.x, w.y, w.z]]
+        assert dec.frame_ids == [msg.header.frame_id]
+
+
 def test_a_writer_with_nonzero_padding_is_decoded_through_rosbags() -> None:
     """CDR padding is unspecified: bytes there must not be taken for data, nor break decoding."""
     raws, stamps, values, _ = _inputs(20, ["imu_x"])
@@ -67,18 +89,20 @@ def test_a_writer_with_nonzero_padding_is_decoded_through_rosbags() -> None:
     np.testing.assert_array_equal(dec.accel, values[:, 25:28])
 
 
-def test_encoded_outputs_are_byte_equal_to_rosbags() -> None:
+@pytest.mark.parametrize("k", [25, 1], ids=["batch", "one_row"])  # one row: the struct path
+def test_encoded_outputs_are_byte_equal_to_rosbags(k: int) -> None:
     scene = default_scene()
-    k, nm = 25, len(scene.mounts)
+    nm = len(scene.mounts)
     stamps = 1_700_000_000_000_000_000 + np.cumsum(RNG.integers(1, 2_000_000, k))
     pose = RNG.normal(size=(k, 10))
     wrenches = RNG.normal(0.0, 1e4, (k, nm, 6))
     out = OutputBatch(stamps * 1e-9, np.arange(k), pose, wrenches)
     msgs = encode_outputs(scene, out, stamps)
-    assert len(msgs) == k * (2 + nm)
+    per_row = 3 + nm  # pose, angles, the wrenches, /tf
+    assert len(msgs) == k * per_row
     vec = T["geometry_msgs/msg/Vector3"]
     for j, (topic, stamp, raw) in enumerate(msgs):
-        row, slot = divmod(j, 2 + nm)
+        row, slot = divmod(j, per_row)
         assert stamp == stamps[row]
         sec, nsec = divmod(int(stamp), 1_000_000_000)
         time = T["builtin_interfaces/msg/Time"](sec=sec, nanosec=nsec)
@@ -99,6 +123,23 @@ def test_encoded_outputs_are_byte_equal_to_rosbags() -> None:
                 header=header, vector=vec(x=p[7], y=p[8], z=p[9])
             )
             typename = "geometry_msgs/msg/Vector3Stamped"
+        elif slot == per_row - 1:
+            header = T["std_msgs/msg/Header"](stamp=time, frame_id=scene.frames.foundation)
+            want = T["tf2_msgs/msg/TFMessage"](
+                transforms=[
+                    T["geometry_msgs/msg/TransformStamped"](
+                        header=header,
+                        child_frame_id=scene.frames.body,
+                        transform=T["geometry_msgs/msg/Transform"](
+                            translation=vec(x=p[0], y=p[1], z=p[2]),
+                            rotation=T["geometry_msgs/msg/Quaternion"](
+                                x=p[3], y=p[4], z=p[5], w=p[6]
+                            ),
+                        ),
+                    )
+                ]
+            )
+            typename = "tf2_msgs/msg/TFMessage"
         else:
             i = slot - 2
             w = wrenches[row, i]

@@ -16,6 +16,7 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -40,11 +41,14 @@ class FixedLayout:
         template: (L,) uint8, the message with every numeric field zero.
         fields: (offset, dtype) of each numeric field, in the builder's order.
         fixed: (L,) bool, True at bytes no numeric field covers.
+        run_end: for each field f, the end of the run of fields from f that share its dtype
+            and lie back to back (one block assignment packs them).
     """
 
     template: np.ndarray
     fields: tuple[tuple[int, str], ...]
     fixed: np.ndarray
+    run_end: tuple[int, ...]
 
     @classmethod
     def probe(
@@ -67,24 +71,80 @@ class FixedLayout:
                 raise ValueError(msg)
             fields.append((offset, dtype))
             fixed[offset : offset + len(pattern)] = False
-        return cls(template.copy(), tuple(fields), fixed)
+        ends = list(range(1, len(fields) + 1))
+        for f in range(len(fields) - 2, -1, -1):
+            (offset, dtype), (after, next_dtype) = fields[f], fields[f + 1]
+            if next_dtype == dtype and after == offset + np.dtype(dtype).itemsize:
+                ends[f] = ends[f + 1]
+        return cls(template.copy(), tuple(fields), fixed, tuple(ends))
 
     @property
     def size(self) -> int:
         """Message length, bytes."""
         return int(self.template.shape[0])
 
+    @cached_property
+    def _runs(self) -> tuple[tuple[int, int, struct.Struct], ...]:
+        """(first field, end field, packer at the first field's offset) of each run."""
+        runs, f = [], 0
+        while f < len(self.fields):
+            end = self.run_end[f]
+            fmt = "<" + _FORMATS[self.fields[f][1]][1] * (end - f)
+            runs.append((f, end, struct.Struct(fmt)))
+            f = end
+        return tuple(runs)
+
     def pack(self, columns: Sequence[np.ndarray]) -> list[bytes]:
-        """One message per row of the columns (one column per field)."""
+        """One message per row of the columns: each (k,) column fills one field, each (k, m)
+        block m consecutive fields, written one run (`run_end`) at a time."""
         k = len(columns[0])
+        if k == 1:  # a live sample: struct beats numpy's per-call overhead (~3 vs ~25 µs)
+            return [self._pack_one([v for c in columns for v in c.reshape(-1).tolist()])]
         rows = np.empty((k, self.size), dtype=np.uint8)
         rows[:] = self.template
-        for (offset, dtype), col in zip(self.fields, columns, strict=True):
-            width = np.dtype(dtype).itemsize
-            values = np.ascontiguousarray(col, dtype=dtype)
-            rows[:, offset : offset + width] = values.view(np.uint8).reshape(k, width)
+        f = 0
+        for col in columns:
+            block = col if col.ndim == 2 else col[:, None]
+            j, m = 0, block.shape[1]
+            while j < m:
+                end = min(self.run_end[f + j], f + m) - f
+                offset, dtype = self.fields[f + j]
+                width = np.dtype(dtype).itemsize * (end - j)
+                values = np.ascontiguousarray(block[:, j:end], dtype=dtype)
+                rows[:, offset : offset + width] = values.view(np.uint8).reshape(k, width)
+                j = end
+            f += m
         data, size = rows.tobytes(), self.size
         return [data[i * size : (i + 1) * size] for i in range(k)]
+
+    def _pack_one(self, values: list[float | int]) -> bytes:
+        """One message of its field values, in field order."""
+        buf = bytearray(self._template_bytes)
+        for start, end, packer in self._runs:
+            packer.pack_into(buf, self.fields[start][0], *values[start:end])
+        return bytes(buf)
+
+    @cached_property
+    def _template_bytes(self) -> bytes:
+        return self.template.tobytes()
+
+    @cached_property
+    def _fixed_spans(self) -> tuple[tuple[int, int], ...]:
+        """[start, stop) of each stretch of bytes no numeric field covers."""
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], self.fixed.view(np.int8), [0]])))
+        return tuple(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
+
+    def unpack_one(self, raw: bytes | memoryview, want: Sequence[int]) -> list | None:
+        """`unpack` of one message: its fields `want`, or None if it has another layout."""
+        if len(raw) != self.size:
+            return None
+        raw, template = bytes(raw), self._template_bytes
+        if any(raw[a:b] != template[a:b] for a, b in self._fixed_spans):
+            return None
+        return [
+            struct.unpack_from(_FORMATS[self.fields[f][1]], raw, self.fields[f][0])[0]
+            for f in want
+        ]
 
     def unpack(
         self, raws: Sequence[bytes | memoryview], want: Sequence[int]
