@@ -43,7 +43,7 @@ def default_model() -> Model:
 
 def params_yaml() -> dict[str, Any]:
     """config/params.yaml as rcl reads it for the node named mount_twin."""
-    return yaml.safe_load(PARAMS_FILE.read_text(encoding="utf-8"))["mount_twin"]["ros__parameters"]
+    return yaml.safe_load(PARAMS_FILE.read_text(encoding="utf-8"))["/**"]["ros__parameters"]
 
 
 def scene_with(scene: Scene | None = None, **sections: dict[str, Any]) -> Scene:

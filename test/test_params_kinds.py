@@ -11,7 +11,7 @@ import yaml
 from io_helpers import SCENE_FILE
 
 from mount_twin.scene import scene_from_dict, scene_from_params
-from mount_twin.scene.params import flatten, mount_parameters
+from mount_twin.scene.params import as_params, effective_parameters, flatten, mount_parameters
 
 MOUNTS: list[dict[str, Any]] = [
     {
@@ -55,21 +55,18 @@ def _tree() -> dict[str, Any]:
     return tree
 
 
-def _as_params(tree: dict[str, Any]) -> dict[str, Any]:
-    """The flat parameters a Nav2-style params YAML gives the node."""
-    flat = dict(flatten({k: v for k, v in tree.items() if k != "mounts"}))
-    flat["mount_names"] = [m["name"] for m in tree["mounts"]]
-    for m in tree["mounts"]:
-        body = {k: v for k, v in m.items() if k != "name"}
-        flat.update({f"mounts.{m['name']}.{k}": v for k, v in flatten(body)})
-    return flat
-
-
 def test_params_of_every_kind_load_the_same_scene_as_the_yaml() -> None:
     tree = _tree()
-    assert scene_from_params(_as_params(tree), "params") == scene_from_dict(
+    assert scene_from_params(as_params(tree), "params") == scene_from_dict(
         copy.deepcopy(tree), "params"
     )
+
+
+def test_effective_parameters_of_every_kind_reload_to_the_same_scene() -> None:
+    """What the node declares for each kind (defaults included) is a complete parameter set."""
+    scene, effective = effective_parameters(as_params(_tree()), "params")
+    assert effective["mounts.bolt.hardening"] == 0.02  # a kind's default, declared
+    assert effective_parameters(effective, "params")[0] == scene
 
 
 @pytest.mark.parametrize("mount", MOUNTS, ids=[m["kind"] for m in MOUNTS])

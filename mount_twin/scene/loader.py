@@ -34,28 +34,36 @@ STEPPERS = ("dopri54",)
 
 def load_scene_file(path: str | Path) -> Scene:
     """Read and validate a scene YAML file; errors name the file and key path."""
+    return scene_from_dict(read_scene_yaml(path), str(path))
+
+
+def read_scene_yaml(path: str | Path) -> Any:
+    """The YAML document of a scene file, unvalidated; errors name the file."""
     path = Path(path)
     try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        return yaml.safe_load(path.read_text(encoding="utf-8"))
     except OSError as err:
         raise SceneError(str(path), "<file>", f"cannot read: {err.strerror}") from err
     except yaml.YAMLError as err:
         raise SceneError(str(path), "<file>", f"not valid YAML: {err}") from err
-    return scene_from_dict(data, str(path))
 
 
 def scene_from_dict(
-    data: Any, source: str, *, strict_floats: bool = False, mount_paths: list[str] | None = None
+    data: Any,
+    source: str,
+    *,
+    mount_paths: list[str] | None = None,
+    record: dict[str, Any] | None = None,
 ) -> Scene:
     """Validate a scene mapping (the layout of config/*.scene.yaml).
 
     Args:
         data: the mapping.
         source: file or parameter set, named in errors.
-        strict_floats: reject integers for floats (ROS parameters).
         mount_paths: key path of each mount in errors (default mounts[i]).
+        record: if given, receives every value used (given or defaulted) by key path.
     """
-    top = Reader(data, source, strict_floats=strict_floats)
+    top = Reader(data, source, record=record)
     body = _body(top.sub("body", optional=False))
     dofs = _dofs(top)
     mounts_raw = top.raw("mounts")
@@ -63,7 +71,7 @@ def scene_from_dict(
         raise top.error("mounts", f"expected a non-empty list of mounts, got {mounts_raw!r}")
     paths = mount_paths or [f"mounts[{i}]" for i in range(len(mounts_raw))]
     mounts = tuple(
-        _mount(Reader(m, source, path, strict_floats=strict_floats))
+        _mount(Reader(m, source, path, record=record))
         for path, m in zip(paths, mounts_raw, strict=True)
     )
     names = [m.name for m in mounts]
@@ -203,6 +211,7 @@ def _outputs(r: Reader) -> Outputs:
         pose=r.boolean("pose", d.pose),
         angles=r.boolean("angles", d.angles),
         wrenches=r.boolean("wrenches", d.wrenches),
+        tf=r.boolean("tf", d.tf),
         decimation=r.integer("decimation", d.decimation, lo=1),
         diagnostics_period_s=r.number(
             "diagnostics_period_s", d.diagnostics_period_s, lo=0.0, lo_open=True
@@ -216,6 +225,15 @@ def _outputs(r: Reader) -> Outputs:
 
 def _frames(r: Reader) -> Frames:
     d = Frames()
-    frames = Frames(foundation=r.string("foundation", d.foundation), body=r.string("body", d.body))
+    frames = Frames(
+        foundation=r.string("foundation", d.foundation),
+        body=r.string("body", d.body),
+        mount_prefix=r.string("mount_prefix", d.mount_prefix),
+    )
+    if frames.mount_prefix.startswith("/"):
+        # tf2 rejects frame ids with a leading slash: RViz could not place any mount frame
+        raise r.error(
+            "mount_prefix", f"tf2 frame ids cannot start with '/', got {frames.mount_prefix!r}"
+        )
     r.finish()
     return frames

@@ -14,13 +14,17 @@ from typing import Any
 from mount_twin.errors import SceneError
 from mount_twin.kinds import KINDS
 from mount_twin.scene.description import Scene
-from mount_twin.scene.loader import load_scene_file, scene_from_dict
+from mount_twin.scene.loader import load_scene_file, read_scene_yaml, scene_from_dict
 
 PARAMETERS: dict[str, tuple[str, str]] = {
     "scene_file": ("string", "Scene YAML file; when set, every other scene parameter is ignored"),
     "name": ("string", "Scene name"),
     "frames.foundation": ("string", "frame_id of the foundation frame F"),
     "frames.body": ("string", "frame_id of the body frame B (origin at the CG)"),
+    "frames.mount_prefix": (
+        "string",
+        "Prefix of the mount frame ids: a mount's frame is mount_prefix + its name",
+    ),
     "body.mass": ("double", "Body mass, kg"),
     "body.cg": ("double_array", "CG at the reference pose [x, y, z], m, in F"),
     "body.inertia": (
@@ -51,6 +55,7 @@ PARAMETERS: dict[str, tuple[str, str]] = {
     "outputs.pose": ("bool", "Publish PoseStamped"),
     "outputs.angles": ("bool", "Publish α, γ, δ as Vector3Stamped, rad"),
     "outputs.wrenches": ("bool", "Publish one WrenchStamped per mount"),
+    "outputs.tf": ("bool", "Publish the body pose on /tf (frames.foundation → frames.body)"),
     "outputs.decimation": ("integer", "Publish every Nth sample; wrenches hold their peaks"),
     "outputs.diagnostics_period_s": ("double", "Diagnostics period in stamp time, s"),
     "outputs.tilt_warn_rad": ("double", "Tilt from vertical past which diagnostics warn, rad"),
@@ -90,18 +95,69 @@ def flatten(tree: Mapping[str, Any], prefix: str = "") -> Iterator[tuple[str, An
             yield name, value
 
 
+def parameter_types(flat: Mapping[str, Any]) -> dict[str, str]:
+    """Every scene parameter a node can take for the mounts named in `flat` (their kinds read
+    from `mounts.<name>.kind`, default linear): flat name → ROS type."""
+    types = {name: ptype for name, (ptype, _) in PARAMETERS.items()}
+    names = flat.get("mount_names", ())
+    for mount in names if isinstance(names, (list, tuple)) else ():
+        kind = flat.get(f"mounts.{mount}.kind", "linear")
+        for key, (ptype, _) in mount_parameters(str(kind)).items():
+            types[f"mounts.{mount}.{key}"] = ptype
+    return types
+
+
+def as_declared_types(flat: Mapping[str, Any]) -> dict[str, Any]:
+    """`flat` with integers given for double (array) parameters taken as doubles, as a user
+    means `body.mass: 1200` (rcl would refuse it; the scene loader then checks the rest)."""
+    types = parameter_types(flat)
+    out = dict(flat)
+    for name, value in flat.items():
+        ptype = types.get(name)
+        if ptype == "double" and _is_int(value):
+            out[name] = float(value)
+        elif ptype == "double_array" and isinstance(value, (list, tuple)):
+            out[name] = [float(v) if _is_int(v) else v for v in value]
+    return out
+
+
+def _is_int(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
 def scene_from_params(flat: Mapping[str, Any], source: str) -> Scene:
     """Validate a flat parameter set (dotted names → values) into a Scene.
 
-    If `scene_file` is set and non-empty, the scene comes from that file instead.
+    If `scene_file` is set and non-empty, the scene is that file's, with the other parameters
+    given overriding its values (`effective_parameters`).
+    """
+    return effective_parameters(flat, source)[0]
+
+
+def effective_parameters(flat: Mapping[str, Any], source: str) -> tuple[Scene, dict[str, Any]]:
+    """The Scene of a flat parameter set and every parameter value it uses, defaults included
+    (what a node declares, so `ros2 param dump` shows the whole scene).
+
+    With `scene_file` set, the file is validated on its own first (errors name the file's key
+    paths), then the other parameters override its values (errors name the parameter).
     """
     scene_file = flat.get("scene_file", "")
+    given = {k: v for k, v in flat.items() if k != "scene_file"}
     if scene_file:
-        return load_scene_file(scene_file)
+        from_file = load_scene_file(scene_file)
+        source = f"{source} over {scene_file}" if given else str(scene_file)
+        in_file = as_params(read_scene_yaml(from_file.source))
+        if "mount_names" in given and list(given["mount_names"]) != in_file["mount_names"]:
+            raise SceneError(
+                source,
+                "mount_names",
+                f"{list(given['mount_names'])!r} differs from the mounts of scene_file "
+                f"{in_file['mount_names']!r}: with a scene_file, parameters only override the "
+                "values of its mounts",
+            )
+        given = {**in_file, **given}
     tree: dict[str, Any] = {}
-    for name, value in flat.items():
-        if name == "scene_file":
-            continue
+    for name, value in as_declared_types(given).items():
         node = tree
         *parents, leaf = name.split(".")
         for part in parents:
@@ -110,14 +166,37 @@ def scene_from_params(flat: Mapping[str, Any], source: str) -> Scene:
                 raise SceneError(source, name, f"{part!r} is both a value and a namespace")
         node[leaf] = value
     tree = _mounts_as_list(tree, source)
-    paths = [f"mounts.{m['name']}" for m in tree["mounts"]]
-    return scene_from_dict(tree, source, strict_floats=True, mount_paths=paths)
+    names = [m["name"] for m in tree["mounts"]]
+    used: dict[str, Any] = {}
+    scene = scene_from_dict(tree, source, mount_paths=[f"mounts.{n}" for n in names], record=used)
+    types = parameter_types({**used, "mount_names": names})
+    effective: dict[str, Any] = {"scene_file": str(scene_file), "mount_names": list(names)}
+    for name, value in used.items():
+        if name in types:
+            effective[name] = list(value) if isinstance(value, tuple) else value
+    return scene, as_declared_types(effective)
+
+
+def as_params(tree: Mapping[str, Any]) -> dict[str, Any]:
+    """A scene mapping (the layout of a scene YAML) as flat Nav2-style parameters."""
+    flat = dict(flatten({k: v for k, v in tree.items() if k != "mounts"}))
+    mounts = tree.get("mounts", [])
+    flat["mount_names"] = [m["name"] for m in mounts]
+    for m in mounts:
+        rest = {k: v for k, v in m.items() if k != "name"}
+        flat.update((f"mounts.{m['name']}.{k}", v) for k, v in flatten(rest))
+    return flat
 
 
 def _mounts_as_list(tree: dict[str, Any], source: str) -> dict[str, Any]:
     names = tree.pop("mount_names", None)
     if names is None:
-        raise SceneError(source, "mount_names", "required parameter is missing")
+        raise SceneError(
+            source,
+            "mount_names",
+            "required parameter is missing (or give scene_file: a scene YAML, see "
+            "config/params.yaml)",
+        )
     if isinstance(names, str) or not all(isinstance(n, str) for n in names):
         raise SceneError(source, "mount_names", f"expected a list of strings, got {names!r}")
     per_mount = tree.pop("mounts", {})

@@ -16,18 +16,24 @@ class Reader:
         data: the mapping.
         source: file or parameter set it came from, for messages.
         path: key path of `data` in the document ('' at the top).
-        strict_floats: reject integers where a float is expected (rclpy's rule for doubles).
+        record: if given, every value read (given or defaulted, mappings excepted) is stored
+            here under its key path: the effective parameters of a scene.
     """
 
     def __init__(
-        self, data: Any, source: str, path: str = "", *, strict_floats: bool = False
+        self,
+        data: Any,
+        source: str,
+        path: str = "",
+        *,
+        record: dict[str, Any] | None = None,
     ) -> None:
         if not isinstance(data, Mapping):
             raise SceneError(source, path or "<top>", f"expected a mapping, got {data!r}")
         self.data = data
         self.source = source
         self.path = path
-        self.strict_floats = strict_floats
+        self.record = record
         self._used: set[str] = set()
 
     def key_path(self, key: str | int) -> str:
@@ -48,15 +54,24 @@ class Reader:
         """The value at `key` unchecked, or `default`; missing without default is an error."""
         self._used.add(key)
         if key in self.data:
-            return self.data[key]
-        if default is None:
+            value = self.data[key]
+        elif default is None:
             raise self.error(key, "required key is missing")
-        return default
+        else:
+            value = default
+        if self.record is not None and not isinstance(value, Mapping):
+            self.record[self.key_path(key)] = value
+        return value
 
     def sub(self, key: str, *, optional: bool = True) -> Reader:
         """The mapping at `key` (an empty one if absent and optional)."""
         value = self.raw(key, {} if optional else None)
-        return Reader(value, self.source, self.key_path(key), strict_floats=self.strict_floats)
+        return Reader(
+            value,
+            self.source,
+            self.key_path(key),
+            record=self.record,
+        )
 
     def number(
         self,
@@ -139,12 +154,6 @@ class Reader:
     def _check_number(self, key: str, value: Any, lo: float, hi: float, lo_open: bool) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise self.error(key, f"expected a number, got {value!r}")
-        if self.strict_floats and isinstance(value, int):
-            raise self.error(
-                key,
-                f"expected a double, got the integer {value!r}: write {value}.0 "
-                "(rclpy rejects integers for double parameters)",
-            )
         value = float(value)
         if not math.isfinite(value):
             raise self.error(key, f"must be finite, got {value!r}")
