@@ -27,7 +27,20 @@ setup(
         "tqdm>=4.60",
         "rosbags>=0.11,<0.12",
     ],
-    extras_require={"test": ["pytest>=7", "ruff>=0.5"], "plot": ["matplotlib>=3.6"]},
+    extras_require={
+        "test": ["pytest>=7", "ruff>=0.5"],
+        "plot": ["matplotlib>=3.6"],
+        # Jazzy's rclpy and message packages from the package registry, for a machine without a
+        # ROS install (a sourced Jazzy has them: do not install a second rclpy there). The
+        # node reaches into rclpy 7.x in one module (ros/rclpy_private.py): pinned.
+        "ros": [
+            "ros-jazzy-rclpy[fastrtps]>=7.1,<8",
+            "ros-jazzy-sensor-msgs",
+            "ros-jazzy-geometry-msgs",
+            "ros-jazzy-diagnostic-msgs",
+            "ros-jazzy-std-msgs",
+        ],
+    },
     zip_safe=True,
     maintainer="mount_twin maintainers",
     maintainer_email="mount_twin@example.com",

@@ -6,6 +6,8 @@ the bag replay hands it chunks of raw messages from a bag. Only the transport di
 
 from __future__ import annotations
 
+import numpy as np
+
 from mount_twin.engine.batch import HealthReport, OutputBatch
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.io.messages import TimeBase, decode_inputs, encode_outputs, encode_report
@@ -24,6 +26,14 @@ class TwinStream:
     def __init__(self, scene: Scene) -> None:
         self.scene = scene
         self.engine = TwinEngine(assemble(scene))
+        # rosbags generates a type's (de)serializer at its first use and the output layouts are
+        # probed then: ~40 ms that would otherwise delay the first live sample.
+        nm = len(scene.mounts)
+        empty = OutputBatch(
+            np.zeros(0), np.zeros(0, np.intp), np.zeros((0, 10)), np.zeros((0, nm, 6))
+        )
+        encode_outputs(scene, empty, np.zeros(0, np.int64))
+        decode_inputs([], scene.input.msg_type)
         self.base: TimeBase | None = None
         self.last_outputs: OutputBatch | None = None
         self._last_ns = 0
@@ -35,6 +45,11 @@ class TwinStream:
         if decoded.undecodable:
             self.engine.count("received", decoded.undecodable)
             self.engine.count("rejected_undecodable", decoded.undecodable)
+        unset = decoded.stamps_ns == 0
+        if unset.any():  # an unset header.stamp: no time to place the sample at
+            self.engine.count("received", int(unset.sum()))
+            self.engine.count("rejected_zero_stamp", int(unset.sum()))
+            decoded = decoded.select(~unset)
         if self.base is None:
             if not decoded.stamps_ns.shape[0]:
                 return []
@@ -45,6 +60,11 @@ class TwinStream:
         if len(out):
             self._last_ns = int(decoded.stamps_ns[out.sample[-1]])
         return encode_outputs(self.scene, out, decoded.stamps_ns)
+
+    def stalled(self, waited_s: float, stamp_ns: int) -> list[tuple[str, int, bytes]]:
+        """A report now, after `waited_s` (s) of the node's clock without any (live only),
+        stamped `stamp_ns` (the clock: there is no input stamp to answer)."""
+        return [encode_report(self.scene, self.engine.report_stalled(waited_s), stamp_ns)]
 
     def finish(self) -> list[tuple[str, int, bytes]]:
         """The last, partial diagnostics period (end of a bag, node shutdown), stamped with the

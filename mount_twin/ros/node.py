@@ -1,146 +1,286 @@
-"""The rclpy shell: the only module that imports rclpy.
+"""The rclpy shell: the only module that runs an rclpy node.
 
 Moves raw CDR bytes only (raw subscription, byte publishers) so that every (de)serialization is
-the rosbags code the bag replay and the tests run. Parameters: a params YAML in the Nav2 style or
-a `scene_file`, both through `scene_from_params`.
+the rosbags code the bag replay and the tests run. Parameters: `ros/parameters.py`.
+
+Input is taken in bulk: each wake-up of the executor takes every message waiting in the
+subscription's queue (`take_waiting`) and pushes them through the engine in one call, so the
+node keeps up with kHz sensors; with `batch_period_s > 0` they are queued and processed on a
+steady-clock timer instead. Diagnostics come from the engine at each period of input stamps; a
+period of the node's clock (wall or sim time) without any report or accepted sample publishes a
+report saying why (no input, all rejected and why), and problems only the live node can see
+(a publisher of the wrong type, sim time without /clock) go out as `mount_twin: ros`.
 """
 
 from __future__ import annotations
 
-import rclpy
-from rcl_interfaces.msg import ParameterDescriptor
-from rclpy.executors import ExternalShutdownException
-from rclpy.node import Node
-from rclpy.parameter import Parameter
-from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
-from rosidl_runtime_py.utilities import get_message
+import importlib
+import math
+import signal
+import sys
+import threading
+import time
+from collections.abc import Callable
+from typing import TypeVar
 
-from mount_twin.io.messages import output_types
-from mount_twin.scene.params import (
-    COMMON_MOUNT_PARAMETERS,
-    PARAMETERS,
-    mount_parameters,
-    scene_from_params,
+import rclpy
+from rclpy.clock import Clock, ClockType
+from rclpy.duration import Duration
+from rclpy.event_handler import QoSMessageLostInfo, SubscriptionEventCallbacks
+from rclpy.exceptions import InvalidTopicNameException
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.publisher import Publisher
+from rclpy.qos import (
+    DurabilityPolicy,
+    HistoryPolicy,
+    QoSProfile,
+    ReliabilityPolicy,
 )
+from rclpy.signals import SignalHandlerOptions
+from rclpy.subscription import Subscription
+
+from mount_twin.engine.batch import ERROR, OK, HealthReport, HealthStatus
+from mount_twin.errors import MountTwinError
+from mount_twin.io.messages import (
+    TF,
+    TF_STATIC_TOPIC,
+    encode_report,
+    output_types,
+    static_transforms,
+)
+from mount_twin.ros.parameters import configure
+from mount_twin.ros.rclpy_private import take_waiting
 from mount_twin.stream import TwinStream
 
-_TYPES = {
-    "string": Parameter.Type.STRING,
-    "double": Parameter.Type.DOUBLE,
-    "double_array": Parameter.Type.DOUBLE_ARRAY,
-    "string_array": Parameter.Type.STRING_ARRAY,
-    "bool": Parameter.Type.BOOL,
-    "integer": Parameter.Type.INTEGER,
-}
+T = TypeVar("T")
+NODE_NAME = "mount_twin"
+TAKE_LIMIT = 100_000
+"""Most input messages taken in one wake-up."""
+WATCH_PERIOD_S = 1.0
+"""Steady-clock period of the checks only a live node can make (publisher types, /clock)."""
+
+
+def message_class(msgtype: str) -> type:
+    """The rclpy message class of a ROS type name ('pkg/msg/Name'), without rosidl_runtime_py."""
+    package, _, name = msgtype.split("/")
+    return getattr(importlib.import_module(f"{package}.msg"), name)
 
 
 class MountTwinNode(Node):
-    """Foundation acceleration in; pose, α/γ/δ, mount wrenches and diagnostics out."""
+    """Foundation acceleration in; pose, α/γ/δ, mount wrenches, TF and diagnostics out.
+
+    Raises:
+        MountTwinError: a parameter, scene file or topic name is wrong (the message names it).
+    """
 
     def __init__(self, **kwargs: object) -> None:
-        super().__init__("mount_twin", **kwargs)
-        flat = self._declare_and_read()
-        self.scene = scene_from_params(flat, f"parameters of {self.get_fully_qualified_name()}")
+        super().__init__(NODE_NAME, **kwargs)
+        self.options, self.scene = configure(self)
         self.stream = TwinStream(self.scene)
-        reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
-        self._pubs = {
-            topic: self.create_publisher(get_message(msgtype), topic, reliable)
-            for topic, msgtype in output_types(self.scene).items()
-        }
-        spec = self.scene.input
-        batch_period = self.declare_parameter(
-            "batch_period_s",
-            0.0,
-            ParameterDescriptor(
-                description="0.0: process each input message on arrival; > 0: queue them and "
-                "process the queue every batch_period_s (s) in one engine call, for input "
-                "rates where the per-message overhead would not keep up (e.g. 10 kHz)",
-                read_only=True,
-            ),
-        ).value
+        self._pubs = self._create_outputs()
+        self._batched = self.options.batch_period_s > 0.0
         self._pending: list[bytes] = []
-        if batch_period > 0.0:
-            self._timer = self.create_timer(batch_period, self._drain)
-        self._sub = self.create_subscription(
-            get_message(spec.msg_type),
-            spec.topic,
-            self._pending.append if batch_period > 0.0 else self._on_input,
-            qos_profile_sensor_data,
-            raw=True,
-        )
+        self._sub = self._create_input()
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        if self._batched:
+            self.create_timer(self.options.batch_period_s, self._drain, clock=steady)
+        period = self.scene.outputs.diagnostics_period_s
+        self._reports = 0
+        self._accepted_at_tick = 0
+        self.create_timer(period, self._on_diagnostics_period)
+        self._problems: dict[str, str] = {}
+        """Problems seen by events (kept); `_watch` adds the ones it finds each time."""
+        self._reported: dict[str, str] = {}
+        self._started = time.monotonic()
+        self.create_timer(WATCH_PERIOD_S, self._watch, clock=steady)
         self.get_logger().info(
             f"scene {self.scene.name!r} from {self.scene.source}: "
             f"{len(self.scene.mounts)} mounts, DOFs {list(self.scene.dofs)}; input "
-            f"{self._sub.topic_name} ({spec.msg_type}); outputs "
+            f"{self._sub.topic_name} ({self.scene.input.msg_type}, best effort, depth "
+            f"{self.options.input_queue_depth}); "
+            + (f"batches every {self.options.batch_period_s} s; " if self._batched else "")
+            + "outputs "
             + ", ".join(p.topic_name for p in self._pubs.values())
         )
 
-    def _declare_and_read(self) -> dict[str, object]:
-        """Declare every scene parameter with a descriptor; return the ones set (flat names)."""
-        names = dict(PARAMETERS)
-        self.declare_parameter(
-            "mount_names",
-            Parameter.Type.STRING_ARRAY,
-            ParameterDescriptor(description=PARAMETERS["mount_names"][1], read_only=True),
+    def _create_outputs(self) -> dict[str, Publisher]:
+        """A reliable publisher per output (unresolved topic → publisher); the mount frames on
+        latched /tf_static. Without tf2_msgs (not on the package registry) no TF, said once."""
+        reliable = QoSProfile(
+            depth=self.options.output_queue_depth,
+            reliability=ReliabilityPolicy.RELIABLE,
+            history=HistoryPolicy.KEEP_LAST,
         )
-        mount_names = self.get_parameter("mount_names")
-        if mount_names.type_ != Parameter.Type.NOT_SET:
-            for mount in mount_names.value:
-                kind = self.declare_parameter(
-                    f"mounts.{mount}.kind",
-                    "linear",
-                    ParameterDescriptor(
-                        description=COMMON_MOUNT_PARAMETERS["kind"][1], read_only=True
-                    ),
-                ).value
-                names.update(
-                    {f"mounts.{mount}.{key}": spec for key, spec in mount_parameters(kind).items()}
-                )
-        flat: dict[str, object] = {}
-        for name, (ptype, description) in names.items():
-            if name != "mount_names" and not self.has_parameter(name):
-                self.declare_parameter(
-                    name,
-                    _TYPES[ptype],
-                    ParameterDescriptor(description=description, read_only=True),
-                )
-            param = self.get_parameter(name)
-            if param.type_ != Parameter.Type.NOT_SET:
-                value = param.value
-                flat[name] = list(value) if ptype.endswith("_array") else value
-        return flat
+        pubs: dict[str, Publisher] = {}
+        for topic, msgtype in output_types(self.scene).items():
+            try:
+                cls = message_class(msgtype)
+            except ImportError:
+                continue  # tf2_msgs only
+            pubs[topic] = self._named(
+                "outputs", lambda c=cls, t=topic: self.create_publisher(c, t, reliable)
+            )
+        try:
+            tf_class = message_class(TF)
+        except ImportError:
+            self.get_logger().warning(
+                f"tf2_msgs is not importable (it comes with a ROS install): /tf and "
+                f"{TF_STATIC_TOPIC} are not published; `mount-twin replay` writes them to bags"
+            )
+            return pubs
+        latched = QoSProfile(
+            depth=1,
+            reliability=ReliabilityPolicy.RELIABLE,
+            durability=DurabilityPolicy.TRANSIENT_LOCAL,
+        )
+        topic, _, data = static_transforms(self.scene, self.get_clock().now().nanoseconds)
+        self._static = self.create_publisher(tf_class, topic, latched)
+        self._static.publish(bytes(data))
+        return pubs
 
-    def publish_final_diagnostics(self) -> None:
-        """Process what is still queued, then publish the last, partial diagnostics period."""
-        self._drain()
-        self._publish(self.stream.finish())
+    def _create_input(self) -> Subscription:
+        """The raw, best-effort input subscription with its message-lost and type events."""
+        spec = self.scene.input
+        qos = QoSProfile(
+            depth=self.options.input_queue_depth,
+            reliability=ReliabilityPolicy.BEST_EFFORT,
+            history=HistoryPolicy.KEEP_LAST,
+        )
+        events = SubscriptionEventCallbacks(
+            message_lost=self._on_lost, incompatible_type=self._on_incompatible_type
+        )
+        return self._named(
+            "input.topic",
+            lambda: self.create_subscription(
+                message_class(spec.msg_type),
+                spec.topic,
+                self._on_input,
+                qos,
+                raw=True,
+                event_callbacks=events,
+            ),
+        )
+
+    def _named(self, parameter: str, create: Callable[[], T]) -> T:
+        """Create a publisher or subscription; a name rclpy refuses names the parameter."""
+        try:
+            return create()
+        except InvalidTopicNameException as err:
+            msg = f"{self.get_fully_qualified_name()}: {parameter}: {err}".replace("\n", " ")
+            raise MountTwinError(msg) from err
 
     def _on_input(self, raw: bytes) -> None:
-        self._publish(self.stream.process([raw]))
+        raws = [raw, *take_waiting(self._sub, TAKE_LIMIT)]
+        if self._batched:
+            self._pending.extend(raws)
+        else:
+            self._publish(self.stream.process(raws))
 
     def _drain(self) -> None:
         if self._pending:
-            raws = self._pending[:]
-            del self._pending[:]  # the subscription appends to this very list
+            raws, self._pending = self._pending, []
             self._publish(self.stream.process(raws))
 
     def _publish(self, messages: list[tuple[str, int, bytes]]) -> None:
         for topic, _stamp, data in messages:
-            self._pubs[topic].publish(data)
+            pub = self._pubs.get(topic)
+            if pub is not None:
+                pub.publish(bytes(data))
+            if topic == "/diagnostics":
+                self._reports += 1
+
+    def _on_diagnostics_period(self) -> None:
+        """A period of the node's clock: if it brought no report and no accepted sample,
+        report now, saying why."""
+        accepted = self.stream.engine.counts["accepted"]
+        if self._reports == 0 and accepted == self._accepted_at_tick:
+            now = self.get_clock().now().nanoseconds
+            period = self.scene.outputs.diagnostics_period_s
+            self._publish(self.stream.stalled(period, now))
+        self._reports = 0
+        self._accepted_at_tick = accepted
+
+    def _on_lost(self, info: QoSMessageLostInfo) -> None:
+        self.stream.engine.count("lost_middleware", int(info.total_count_change))
+
+    def _on_incompatible_type(self, _info: object) -> None:
+        self._problems["incompatible_type"] = (
+            f"a publisher on {self._sub.topic_name} has a type other than "
+            f"{self.scene.input.msg_type}: it never connects"
+        )
+
+    def _watch(self) -> None:
+        """Problems only a live node sees, published as `mount_twin: ros` while they last."""
+        found = dict(self._problems)
+        expected = self.scene.input.msg_type
+        for info in self.get_publishers_info_by_topic(self._sub.topic_name):
+            if info.topic_type != expected:
+                found[f"type {info.node_name}"] = (
+                    f"publisher {info.node_namespace.rstrip('/')}/{info.node_name} sends "
+                    f"{info.topic_type} on {self._sub.topic_name}, expected {expected}: it never "
+                    "connects"
+                )
+        waited = time.monotonic() - self._started
+        sim = self.get_parameter("use_sim_time").value
+        if sim and self.get_clock().now().nanoseconds == 0 and waited > 2.0 * WATCH_PERIOD_S:
+            found["clock"] = (
+                f"use_sim_time is true and no /clock has come for {waited:.0f} s: diagnostics "
+                "wait for it (play bags with `ros2 bag play --clock`)"
+            )
+        if not found and not self._reported:
+            return
+        for key, text in found.items():
+            if self._reported.get(key) != text:
+                self.get_logger().warning(text)
+        status = HealthStatus(
+            f"{NODE_NAME}: ros", ERROR if found else OK, "; ".join(found.values()) or "ok", {}
+        )
+        report = HealthReport(math.nan, -1, [status])
+        self._publish([encode_report(self.scene, report, self.get_clock().now().nanoseconds)])
+        self._reported = found
+
+    def finish(self) -> None:
+        """Take what is still waiting, process the queue, publish the last, partial
+        diagnostics period, and give reliable subscribers a moment to receive it."""
+        self._pending.extend(take_waiting(self._sub, TAKE_LIMIT))
+        self._drain()
+        self._publish(self.stream.finish())
+        for pub in self._pubs.values():
+            pub.wait_for_all_acked(Duration(seconds=1.0))
 
 
-def main(args: list[str] | None = None) -> None:
-    """Console entry point `mount_twin_node`."""
-    rclpy.init(args=args)
+def main(args: list[str] | None = None) -> int:
+    """Console entry point `mount_twin_node`: spin until SIGINT or SIGTERM, then publish the
+    last diagnostics period and exit 0; a configuration error exits 2 with one line."""
+    stop = threading.Event()
+    try:
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    except Exception as err:  # rcl's argument and params-file errors (RCLError)
+        print(f"mount_twin_node: {str(err).splitlines()[0]}", file=sys.stderr)
+        return 2
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: stop.set())
     node = None
     try:
         node = MountTwinNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        while not stop.is_set() and rclpy.ok():
+            executor.spin_once(timeout_sec=0.1)
+    except MountTwinError as err:
+        print(f"mount_twin_node: {err}", file=sys.stderr)
+        return 2
+    except ExternalShutdownException:
         pass
     finally:
         if node is not None:
             if rclpy.ok():
-                node.publish_final_diagnostics()
+                node.finish()
             node.destroy_node()
         rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,120 @@
+"""The node's ROS parameters: read what it was given, load the scene, declare everything.
+
+Every parameter is declared with the value in force, defaults included, a description and
+`read_only` (the scene is structural: change it by restarting the node), so `ros2 param
+get/describe/dump` show the whole twin and a dump reloads as a params file. What the node was
+given is checked before anything is declared: an unknown key or a bad value ends the node with
+one line naming the parameter (`SceneError`), an integer written for a double is taken as the
+double, and a `scene_file` is loaded with the other scene parameters overriding its values.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.exceptions import InvalidParameterValueException
+from rclpy.node import Node
+
+from mount_twin.errors import SceneError
+from mount_twin.ros.rclpy_private import given_parameters
+from mount_twin.scene.description import Scene
+from mount_twin.scene.params import PARAMETERS, effective_parameters, mount_parameters
+
+
+@dataclass(frozen=True)
+class NodeOptions:
+    """How the node moves messages (not part of the scene).
+
+    Attributes:
+        batch_period_s: 0: process input as it arrives; > 0: queue it and process the queue
+            every batch_period_s (s, steady clock) in one engine call.
+        input_queue_depth: messages the input subscription keeps (best effort, keep last).
+        output_queue_depth: messages each output publisher keeps (reliable, keep last).
+    """
+
+    batch_period_s: float = 0.0
+    input_queue_depth: int = 1000
+    output_queue_depth: int = 100
+
+
+def _option(description: str, lo: float, hi: float) -> ParameterDescriptor:
+    """A read-only node option in [lo, hi]: a double if lo is a float, else an integer."""
+    if isinstance(lo, float):
+        bounds = {"floating_point_range": [FloatingPointRange(from_value=lo, to_value=hi)]}
+    else:
+        bounds = {"integer_range": [IntegerRange(from_value=int(lo), to_value=int(hi))]}
+    return ParameterDescriptor(description=description, read_only=True, **bounds)
+
+
+_OPTIONS: dict[str, ParameterDescriptor] = {
+    "batch_period_s": _option(
+        "0.0: process input messages as they arrive (every message waiting is taken at each "
+        "wake-up); > 0: queue them and process the queue every batch_period_s (s, steady "
+        "clock) in one engine call, at that much added latency",
+        0.0,
+        1.0,
+    ),
+    "input_queue_depth": _option(
+        "Input subscription history depth (best effort, keep last), messages; at 10 kHz, "
+        "1000 holds 0.1 s",
+        1,
+        1_000_000,
+    ),
+    "output_queue_depth": _option(
+        "History depth of each output publisher (reliable, keep last), messages", 1, 1_000_000
+    ),
+}
+BUILT_IN = frozenset({"use_sim_time", "start_type_description_service"})
+"""Parameters rclpy declares itself."""
+
+
+def configure(node: Node) -> tuple[NodeOptions, Scene]:
+    """Check the node's given parameters, load the scene, declare every parameter.
+
+    Raises:
+        SceneError: naming the parameter (or scene file key path) at fault.
+    """
+    source = f"parameters of {node.get_fully_qualified_name()}"
+    given = {k: v for k, v in given_parameters(node).items() if k not in BUILT_IN}
+    options = {k: given.pop(k) for k in list(given) if k in _OPTIONS}
+    scene, effective = effective_parameters(given, source)
+    values = _declare_options(node, options, source)
+    for name, value in effective.items():
+        node.declare_parameter(
+            name,
+            value,
+            ParameterDescriptor(description=_description(name, effective), read_only=True),
+            ignore_override=True,
+        )
+    return NodeOptions(**values), scene
+
+
+def _declare_options(node: Node, given: dict[str, Any], source: str) -> dict[str, Any]:
+    defaults = NodeOptions()
+    values = {}
+    for name, descriptor in _OPTIONS.items():
+        value = given.get(name, getattr(defaults, name))
+        wanted = float if descriptor.floating_point_range else int
+        if wanted is float and isinstance(value, int) and not isinstance(value, bool):
+            value = float(value)
+        if isinstance(value, bool) or not isinstance(value, wanted):
+            raise SceneError(source, name, f"expected a {wanted.__name__}, got {value!r}")
+        try:
+            values[name] = node.declare_parameter(
+                name, value, descriptor, ignore_override=True
+            ).value
+        except InvalidParameterValueException as err:
+            (bounds,) = descriptor.floating_point_range or descriptor.integer_range
+            msg = f"must be in [{bounds.from_value}, {bounds.to_value}], got {value!r}"
+            raise SceneError(source, name, msg) from err
+    return values
+
+
+def _description(name: str, effective: dict[str, Any]) -> str:
+    """The description of a scene parameter, from the tables the loader is tested against."""
+    if name in PARAMETERS:
+        return PARAMETERS[name][1]
+    _, mount, key = name.split(".", 2)
+    return mount_parameters(str(effective.get(f"mounts.{mount}.kind", "linear")))[key][1]

@@ -1,0 +1,194 @@
+"""The real node over real DDS, for tests and the node benchmark.
+
+Each run gets a DDS domain of its own (`ROS_DOMAIN_ID`) on localhost only, the node runs as its
+own process (`python -m mount_twin.ros.node`, what the console script runs), and the test side
+is one rclpy node in a context of its own that publishes raw input and takes raw outputs from
+its subscriptions without an executor (`take_waiting`), so the recorder keeps up with a node
+publishing a dozen topics at kHz rates.
+"""
+
+from __future__ import annotations
+
+import atexit
+import itertools
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any
+
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+from mount_twin.ros.node import message_class
+from mount_twin.ros.rclpy_private import take_waiting
+
+ROOT = Path(__file__).resolve().parents[1]
+PARAMS_FILE = ROOT / "config" / "params.yaml"
+_domains = itertools.count()
+_RUNNING: list[NodeProcess] = []
+
+
+@atexit.register
+def _kill_leftovers() -> None:
+    """No node outlives the test session, whatever failed."""
+    for node in _RUNNING:
+        if node.alive:
+            node.proc.kill()
+
+
+def fresh_domain() -> int:
+    """A DDS domain id for one run: differs between runs of this process and, very likely,
+    between processes (parallel CI jobs on one machine)."""
+    return 1 + (os.getpid() * 7 + next(_domains)) % 100
+
+
+def ros_env(domain: int) -> dict[str, str]:
+    """The environment of a node process in `domain`, on this machine only."""
+    return {
+        **os.environ,
+        "ROS_DOMAIN_ID": str(domain),
+        "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+        "ROS_PYTHON_CHECK_FIELDS": "1",
+    }
+
+
+class NodeProcess:
+    """`mount_twin_node --ros-args ARGS` in its own process."""
+
+    def __init__(self, domain: int, ros_args: Iterable[str]) -> None:
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "mount_twin.ros.node", "--ros-args", *ros_args],
+            env=ros_env(domain),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            cwd=ROOT,
+        )
+        self.stdout = self.stderr = ""
+        _RUNNING.append(self)
+
+    @property
+    def alive(self) -> bool:
+        """True while the process runs."""
+        return self.proc.poll() is None
+
+    def stop(self, sig: int = signal.SIGINT, timeout: float = 30.0) -> int:
+        """Send `sig`, wait for the exit, keep its output; return the exit code."""
+        if self.alive:
+            self.proc.send_signal(sig)
+        return self.wait(timeout)
+
+    def wait(self, timeout: float = 60.0) -> int:
+        """Wait for the process to end; kill it past `timeout` (s) and raise. The exit code."""
+        try:
+            self.stdout, self.stderr = self.proc.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.stdout, self.stderr = self.proc.communicate()
+            raise
+        return self.proc.returncode
+
+
+class Peer:
+    """The test side: publishers of raw input, raw subscriptions recording every output."""
+
+    def __init__(self, domain: int, name: str = "mount_twin_test_peer") -> None:
+        self.context = Context()
+        rclpy.init(context=self.context, domain_id=domain)
+        self.node = rclpy.create_node(name, context=self.context)
+        self._subs: dict[str, Any] = {}
+        self.got: dict[str, list[bytes]] = {}
+        self.arrival: dict[str, list[float]] = {}
+
+    def close(self) -> None:
+        """Destroy the node and its context."""
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+
+    def call(self, future: Any, timeout: float = 10.0) -> Any:
+        """Spin this peer until a service call's `future` completes; its result."""
+        executor = SingleThreadedExecutor(context=self.context)
+        executor.add_node(self.node)
+        executor.spin_until_future_complete(future, timeout_sec=timeout)
+        executor.remove_node(self.node)
+        return future.result()
+
+    def publisher(self, msgtype: str, topic: str, depth: int = 1000) -> Any:
+        """A publisher of `msgtype` (reliable; the node's best-effort input matches it)."""
+        return self.node.create_publisher(message_class(msgtype), topic, depth)
+
+    def record(self, topics: dict[str, str], depth: int = 10_000) -> None:
+        """Subscribe to `topics` (name → type), reliable, and keep what arrives."""
+        qos = QoSProfile(
+            depth=depth, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST
+        )
+        for topic, msgtype in topics.items():
+            self._subs[topic] = self.node.create_subscription(
+                message_class(msgtype), topic, lambda _m: None, qos, raw=True
+            )
+            self.got.setdefault(topic, [])
+            self.arrival.setdefault(topic, [])
+
+    def take(self) -> int:
+        """Take every message waiting on the recorded topics; return how many."""
+        n = 0
+        for topic, sub in self._subs.items():
+            raws = take_waiting(sub, 100_000)
+            if raws:
+                now = time.time()
+                self.got[topic].extend(raws)
+                self.arrival[topic].extend([now] * len(raws))
+                n += len(raws)
+        return n
+
+    def take_until(self, done: Callable[[], bool], timeout: float) -> bool:
+        """Take messages until `done()` or `timeout` (s); return done()."""
+        deadline = time.monotonic() + timeout
+        while not done() and time.monotonic() < deadline:
+            if not self.take():
+                time.sleep(0.002)
+        self.take()
+        return done()
+
+    def connected(self, topic: str) -> bool:
+        """True once the recorder's subscription to `topic` has a publisher."""
+        return self._subs[topic].get_publisher_count() > 0
+
+
+def wait_for(predicate: Callable[[], bool], timeout: float, step: float = 0.02) -> bool:
+    """Poll `predicate` until it holds or `timeout` (s) passes; return it."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(step)
+    return True
+
+
+def wait_for_node(pub: Any, node: NodeProcess, timeout: float = 60.0) -> bool:
+    """Wait until the node's input subscription has matched `pub` (or the node died).
+
+    The publisher sees the match when the node's reader is discovered; the reader matches the
+    writer on its own discovery a moment later, and best-effort samples sent in between are
+    dropped: hence the settling time.
+    """
+    if not wait_for(lambda: pub.get_subscription_count() > 0 or not node.alive, timeout):
+        return False
+    time.sleep(0.5)
+    return node.alive
+
+
+def publish_paced(pub: Any, raws: list[bytes], rate_hz: float, peer: Peer) -> None:
+    """Publish `raws` at `rate_hz` (wall clock), taking outputs in between."""
+    t0 = time.perf_counter()
+    for i, raw in enumerate(raws):
+        pub.publish(raw)
+        while time.perf_counter() < t0 + (i + 1) / rate_hz:
+            if not peer.take():
+                time.sleep(0.0002)
