@@ -51,8 +51,8 @@ def main() -> None:
         ref, _ = run(scene, 1e-12, 1e-15, sig)
         for rtol, atol in TOLERANCES:
             out, cost = run(scene, rtol, atol, sig)
-            pos = np.abs(out.pose[:, :3] - ref.pose[:, :3]).max()
-            ang = np.abs(out.pose[:, 7:] - ref.pose[:, 7:]).max()
+            pos = np.abs(out.position - ref.position).max()
+            ang = np.abs(out.angles - ref.angles).max()
             force = np.abs(out.wrenches - ref.wrenches).max() / np.abs(ref.wrenches).max()
             print(
                 f"  {name:17} rtol {rtol:.0e}: CG {pos:.1e} m, attitude {ang:.1e} rad, "

@@ -28,11 +28,7 @@ class TwinStream:
         self.engine = TwinEngine(assemble(scene))
         # rosbags generates a type's (de)serializer at its first use and the output layouts are
         # probed then: ~40 ms that would otherwise delay the first live sample.
-        nm = len(scene.mounts)
-        empty = OutputBatch(
-            np.zeros(0), np.zeros(0, np.intp), np.zeros((0, 10)), np.zeros((0, nm, 6))
-        )
-        encode_outputs(scene, empty, np.zeros(0, np.int64))
+        encode_outputs(scene, OutputBatch.empty(len(scene.mounts)), np.zeros(0, np.int64))
         decode_inputs([], scene.input.msg_type)
         self.base: TimeBase | None = None
         self.last_outputs: OutputBatch | None = None

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from io_helpers import REST, G, batch, default_scene, engine_for, scene_with, stamp_ns
@@ -11,6 +13,7 @@ from mount_twin.io.messages import (
     ACCEL,
     DIAGNOSTICS,
     IMU,
+    OUTPUTS,
     POSE,
     TF,
     TYPESTORE,
@@ -20,7 +23,7 @@ from mount_twin.io.messages import (
     decode_inputs,
     encode_outputs,
     imu_messages,
-    output_topics,
+    output_streams,
     output_types,
     resolve,
 )
@@ -220,45 +223,60 @@ def test_encoded_outputs_have_the_right_topics_types_frames_and_values() -> None
     want_ns = START_NS + 123_456_789
     out = _one_row_batch(scene, stamp_s=0.123456789)
     msgs = encode_outputs(scene, out, np.array([want_ns]))
-    topics = output_topics(scene)
+    wrench_topics = [f"~/mounts/{m.name}/wrench" for m in scene.mounts]
     types = output_types(scene)
-    assert [t for t, _, _ in msgs] == [topics.pose, topics.angles, *topics.wrenches, topics.tf]
+    assert [t for t, _, _ in msgs] == ["~/pose", "~/angles", *wrench_topics, "/tf"]
     for topic, stamp, raw in msgs:
         msg = TYPESTORE.deserialize_cdr(raw, types[topic])
         stamped = msg.transforms[0] if types[topic] == TF else msg
         assert stamp == want_ns and stamp_ns(stamped) == want_ns
-        if topic == topics.pose:
+        if topic == "~/pose":
             assert (
                 types[topic] == POSE and msg.header.frame_id == scene.frames.foundation == "deck"
             )
             p, q = msg.pose.position, msg.pose.orientation
             assert [p.x, p.y, p.z, q.x, q.y, q.z, q.w] == out.pose[0, :7].tolist()
-        elif topic == topics.angles:
+        elif topic == "~/angles":
             assert types[topic] == VECTOR3 and msg.header.frame_id == "deck"
             assert [msg.vector.x, msg.vector.y, msg.vector.z] == out.pose[0, 7:].tolist()
-        elif topic == topics.tf:
+        elif topic == "/tf":
             assert types[topic] == TF and len(msg.transforms) == 1
             tf = msg.transforms[0]
             assert (tf.header.frame_id, tf.child_frame_id) == ("deck", "pump")
             p, q = tf.transform.translation, tf.transform.rotation
             assert [p.x, p.y, p.z, q.x, q.y, q.z, q.w] == out.pose[0, :7].tolist()
         else:
-            i = topics.wrenches.index(topic)
+            i = wrench_topics.index(topic)
             assert types[topic] == WRENCH and msg.header.frame_id == scene.mounts[i].name
             f, c = msg.wrench.force, msg.wrench.torque
             assert [f.x, f.y, f.z, c.x, c.y, c.z] == out.wrenches[0, i].tolist()
 
 
+def test_the_output_registry_has_one_entry_per_output_flag_of_a_scene() -> None:
+    """A registry entry without its scene flag (or a flag without an entry) fails here."""
+    flags = {
+        f.name for f in dataclasses.fields(default_scene().outputs) if isinstance(f.default, bool)
+    }
+    assert set(OUTPUTS) == flags
+    for flag in flags:
+        only = scene_with(outputs={k: k == flag for k in flags})
+        names = [(st.topic, st.msgtype, st.frames) for st in output_streams(only)]
+        assert names == [(st.topic, st.msgtype, st.frames) for st in OUTPUTS[flag](only)]
+        assert names  # every flag brings at least one topic
+
+
 def test_output_names_resolve_under_the_node_name_and_namespace() -> None:
     scene = default_scene()
-    topics = output_topics(scene)
-    assert resolve(topics.pose, "mount_twin") == "/mount_twin/pose"
-    assert resolve(topics.angles, "mount_twin") == "/mount_twin/angles"
-    assert [resolve(t, "mount_twin") for t in topics.wrenches] == [
-        f"/mount_twin/mounts/{m.name}/wrench" for m in scene.mounts
+    topics = list(output_types(scene))
+    assert [resolve(t, "mount_twin") for t in topics] == [
+        "/diagnostics",
+        "/mount_twin/pose",
+        "/mount_twin/angles",
+        *(f"/mount_twin/mounts/{m.name}/wrench" for m in scene.mounts),
+        "/tf",
     ]
-    assert resolve(topics.diagnostics, "mount_twin", "/ship") == "/diagnostics"
-    assert resolve(topics.pose, "mount_twin", "/ship/") == "/ship/mount_twin/pose"
+    assert resolve("/diagnostics", "mount_twin", "/ship") == "/diagnostics"
+    assert resolve("~/pose", "mount_twin", "/ship/") == "/ship/mount_twin/pose"
     assert resolve("rel", "mount_twin", "/ship") == "/ship/rel"
 
 

@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mount_twin.physics import pose_row
+
 OK, WARN, ERROR = 0, 1, 2
 """Health levels, as diagnostic_msgs/DiagnosticStatus uses them."""
 
@@ -79,7 +81,8 @@ class OutputBatch:
         stamps: (k,) input stamps the rows answer, s.
         sample: (k,) position of each row's sample in the pushed SampleBatch (so adapters can
             reuse the exact input stamps).
-        pose: (k, 10) CG position in F (m), quaternion (x, y, z, w) of R, (α, γ, δ) rad.
+        pose: (k, pose_row.WIDTH) rows: CG position in F (m), quaternion (x, y, z, w) of R,
+            (α, γ, δ) rad (`physics/pose_row.py`; `position`, `quaternion`, `angles`).
         wrenches: (k, n_mounts, 6) force (N) and couple (N·m) on the body in mount axes; with
             decimation, each component's largest magnitude since the previous row.
         health: diagnostics due in this batch.
@@ -93,3 +96,28 @@ class OutputBatch:
 
     def __len__(self) -> int:
         return int(self.stamps.shape[0])
+
+    @classmethod
+    def empty(cls, n_mounts: int) -> OutputBatch:
+        """No rows."""
+        return cls(
+            np.zeros(0),
+            np.zeros(0, np.intp),
+            np.zeros((0, pose_row.WIDTH)),
+            np.zeros((0, n_mounts, 6)),
+        )
+
+    @property
+    def position(self) -> np.ndarray:
+        """(k, 3) CG position in F, m."""
+        return self.pose[:, pose_row.POSITION_COLS]
+
+    @property
+    def quaternion(self) -> np.ndarray:
+        """(k, 4) quaternion (x, y, z, w) of R, body → F."""
+        return self.pose[:, pose_row.QUATERNION_COLS]
+
+    @property
+    def angles(self) -> np.ndarray:
+        """(k, 3) chart angles (α, γ, δ), rad."""
+        return self.pose[:, pose_row.ANGLES_COLS]

@@ -17,11 +17,20 @@ import numpy as np
 
 from mount_twin.engine.batch import HealthReport, MountEvent, OutputBatch, SampleBatch
 from mount_twin.engine.health import HealthWindow
-from mount_twin.engine.kernel import Watch, new_watch, run_samples
+from mount_twin.engine.kernel import (
+    Integrator,
+    Published,
+    RunOptions,
+    Samples,
+    Watch,
+    new_watch,
+    run_samples,
+)
 from mount_twin.errors import ModelError
 from mount_twin.integrate.stepper import STATUS_TEXT, STEPPERS
 from mount_twin.kinds import KINDS, N_EVENTS
 from mount_twin.model.assemble import Model, initial_state
+from mount_twin.physics import pose_row
 from mount_twin.physics.dynamics import INPUT_SIZE, Scratch, evaluate, mount_monitors
 
 ACCEPT, START, JUMPED_BACK, GAP_RESET, GAP_BRIDGED = (
@@ -121,7 +130,12 @@ class TwinEngine:
         self._util_max = np.zeros(len(model.nonlinear_slots))
         # Chaining the stepper's last stage into the next interval needs a continuous input
         # (first-order hold) and no discrete switch of the state between samples (fracture).
-        self._chain = scene.input.hold == "first_order" and model.arrays.nl is None
+        chain = scene.input.hold == "first_order" and model.arrays.nl is None
+        self._options = RunOptions(
+            scene.input.hold == "zero_order", scene.outputs.decimation, bool(chain)
+        )
+        st = self.stepper
+        self._integ = Integrator(st.method, st.settings, st.work2d, st.work1d, st.result)
         # Fails now, at load, if the mounts cannot hold the body; and is the restart fallback.
         self._y_nominal = initial_state(model, self._gravity_up)
         self._warm_up()
@@ -133,32 +147,28 @@ class TwinEngine:
         f = np.tile(self._gravity_up, (2, 1))
         n, nm = 2, model.n_mounts
         y = np.zeros(model.n_state)
-        run_samples(
-            st.method,
-            st.settings.copy(),
-            st.work2d.copy(),
-            st.work1d.copy(),
-            st.result.copy(),
-            model.arrays,
-            model.new_scratch(),
-            np.zeros(INPUT_SIZE),
-            y,
-            t,
-            f,
-            np.zeros((2, 3)),
-            False,
-            1,
-            np.zeros(1, dtype=np.int64),
-            np.zeros((nm, 6)),
-            np.zeros((n, 10)),
-            np.zeros((n, nm, 6)),
-            np.zeros(n, dtype=np.bool_),
-            np.zeros((n, 3)),
-            new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state),
-            self._chain,
+        integ = Integrator(
+            st.method, st.settings.copy(), st.work2d.copy(), st.work1d.copy(), st.result.copy()
         )
+        out = self._buffers(n, np.zeros(1, dtype=np.int64), np.zeros((nm, 6)))
+        watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
+        samples = Samples(t, f, np.zeros((2, 3)))
+        u, scratch = np.zeros(INPUT_SIZE), model.new_scratch()
+        run_samples(integ, model.arrays, scratch, u, y, samples, self._options, out, watch)
         watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
         self._start_outputs(self._y_nominal.copy(), model.new_scratch(), watch)
+
+    def _buffers(self, n: int, counter: np.ndarray, peak: np.ndarray) -> Published:
+        """Output buffers for a run of n rows, with the decimation state to carry."""
+        nm = self.model.n_mounts
+        return Published(
+            counter,
+            peak,
+            np.empty((n, pose_row.WIDTH)),
+            np.empty((n, nm, 6)),
+            np.zeros(n, dtype=np.bool_),
+            np.zeros((n, 3)),
+        )
 
     @property
     def state(self) -> np.ndarray:
@@ -197,9 +207,7 @@ class TwinEngine:
         """
         nm = self.model.n_mounts
         if len(batch) == 0:
-            return OutputBatch(
-                np.zeros(0), np.zeros(0, np.intp), np.zeros((0, 10)), np.zeros((0, nm, 6)), []
-            )
+            return OutputBatch.empty(nm)
         f, w, finite = self._screen(batch)
         verdicts, due, intervals = self._classify(batch, finite)
         parts: list[_Rows] = []
@@ -226,12 +234,16 @@ class TwinEngine:
                 stamp = float(batch.stamps[stop - 1])
                 reports.append(self._report(stamp, stop - 1))
             start = stop
-        sample = np.concatenate([r.sample for r in parts]) if parts else np.zeros(0, np.intp)
+        if not parts:
+            empty = OutputBatch.empty(nm)
+            empty.health = reports
+            return empty
+        sample = np.concatenate([r.sample for r in parts])
         return OutputBatch(
             batch.stamps[sample],
             sample,
-            np.concatenate([r.pose for r in parts]) if parts else np.zeros((0, 10)),
-            np.concatenate([r.wrenches for r in parts]) if parts else np.zeros((0, nm, 6)),
+            np.concatenate([r.pose for r in parts]),
+            np.concatenate([r.wrenches for r in parts]),
             reports,
         )
 
@@ -371,37 +383,23 @@ class TwinEngine:
             index = index[1:]
         while index:
             t0, f0, w0 = self._last  # type: ignore[misc]
-            n, nm = len(index) + 1, self.model.n_mounts
+            n = len(index) + 1
             t, ff, ww = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
             t[0], ff[0], ww[0] = t0, f0, w0  # row 0: the last sample done
             t[1:], ff[1:], ww[1:] = stamps[index], f[index], w[index]
-            pose, wrenches = np.empty((n, 10)), np.empty((n, nm, 6))
-            publish, step_log = np.zeros(n, dtype=np.bool_), np.zeros((n, 3))
-            st = self.stepper
+            out_buf = self._buffers(n, self._counter, self._peak)
             done, status = run_samples(
-                st.method,
-                st.settings,
-                st.work2d,
-                st.work1d,
-                st.result,
+                self._integ,
                 self.model.arrays,
                 self._scratch,
                 self._u,
                 self._y,
-                t,
-                ff,
-                ww,
-                self.scene.input.hold == "zero_order",
-                self.scene.outputs.decimation,
-                self._counter,
-                self._peak,
-                pose,
-                wrenches,
-                publish,
-                step_log,
+                Samples(t, ff, ww),
+                self._options,
+                out_buf,
                 self._watch,
-                self._chain,
             )
+            pose, wrenches, publish, step_log = out_buf[2:]
             self._drain_events()
             self.health.add_steps(step_log[1 : done + 1])
             if done > 0:
@@ -520,7 +518,7 @@ class TwinEngine:
         self, y: np.ndarray, scratch: Scratch, watch: Watch
     ) -> tuple[np.ndarray, np.ndarray]:
         """Outputs (pose, wrenches rows) of a start state y; arms the mount monitors there."""
-        pose, wrenches = np.zeros((1, 10)), np.zeros((1, self.model.n_mounts, 6))
+        pose, wrenches = np.zeros((1, pose_row.WIDTH)), np.zeros((1, self.model.n_mounts, 6))
         ct = evaluate(y, self.model.arrays, scratch, pose[0], wrenches[0])
         if not math.isfinite(ct):
             msg = f"{self.scene.source}: initial_state.pose is off the α/γ/δ chart"

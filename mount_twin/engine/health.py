@@ -8,6 +8,7 @@ from collections import Counter
 import numpy as np
 
 from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus, MountEvent
+from mount_twin.physics import pose_row
 from mount_twin.scene.description import Scene
 
 PREFIX = "mount_twin"
@@ -78,7 +79,9 @@ class HealthWindow:
         if math.isnan(self.t_first):
             self.t_first = float(stamps[0])
         self.t_last = float(stamps[-1])
-        self.tilt_max = max(self.tilt_max, float(tilt_from_quaternions(pose[:, 3:7]).max()))
+        self.tilt_max = max(
+            self.tilt_max, float(tilt_from_quaternions(pose[:, pose_row.QUATERNION_COLS]).max())
+        )
 
     def add_intervals(self, steps: np.ndarray, skipped: dict[int, int]) -> None:
         """Stamp intervals (s) into samples with a plain ACCEPT verdict, each from the previous

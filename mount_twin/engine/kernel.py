@@ -78,52 +78,78 @@ def _watch(y, nl, s, watch, t0, t1, wrenches) -> None:
 watch_mounts = skip_if_none(_watch)
 
 
+class Integrator(NamedTuple):
+    """A stepper's id, settings and work arrays, as `integrate.stepper.advance` takes them."""
+
+    method: int
+    settings: np.ndarray
+    work2d: np.ndarray
+    work1d: np.ndarray
+    result: np.ndarray
+
+
+class Samples(NamedTuple):
+    """The input of one run: row 0 is the last sample already done.
+
+    t: (n,) stamps, s; f: (n, 3) specific force, m/s², F; w: (n, 3) foundation Ω, rad/s, F.
+    """
+
+    t: np.ndarray
+    f: np.ndarray
+    w: np.ndarray
+
+
+class RunOptions(NamedTuple):
+    """zero_order: hold each sample until the next instead of interpolating linearly.
+    decimation: publish every Nth sample. chain: start each interval from the previous one's
+    last stage when the stepper says it is there (settings[4]; first-order hold, no discrete
+    switches between samples, and nothing else used the scratch since: `Stepper.reset`
+    clears it)."""
+
+    zero_order: bool
+    decimation: int
+    chain: bool
+
+
+class Published(NamedTuple):
+    """What a run publishes, and the decimation's state carried from run to run.
+
+    counter: (1,) samples since the last publish (carried).
+    peak: (nm, 6) wrench components of largest magnitude since the last publish (carried).
+    pose: out (n, pose_row.WIDTH) pose rows; wrenches: out (n, nm, 6) published wrenches.
+    publish: out (n,) True where the sample is published.
+    step_log: out (n, 3) per sample: error norm, accepted and rejected substeps.
+    """
+
+    counter: np.ndarray
+    peak: np.ndarray
+    pose: np.ndarray
+    wrenches: np.ndarray
+    publish: np.ndarray
+    step_log: np.ndarray
+
+
 @kernel
-def run_samples(
-    method,
-    settings,
-    work2d,
-    work1d,
-    result,
-    m,
-    s,
-    u,
-    y,
-    t,
-    f,
-    w,
-    zero_order,
-    decimation,
-    counter,
-    peak,
-    pose,
-    wrenches,
-    publish,
-    step_log,
-    watch,
-    chain,
-) -> tuple[int, int]:
-    """Advance y through samples 1..n−1 of (t, f, w); sample 0 is the last one already done.
+def run_samples(integ, m, s, u, y, samples, opts, out, watch) -> tuple[int, int]:
+    """Advance y through samples 1..n−1 of `samples`; sample 0 is the last one already done.
 
     Args:
-        t: (n,) stamps, s; f: (n, 3) specific force, m/s², F; w: (n, 3) foundation Ω, rad/s, F.
-        zero_order: hold each sample until the next instead of interpolating linearly.
-        decimation: publish every Nth sample; counter[0] counts samples since the last publish.
-        peak: (nm, 6) wrench components of largest magnitude since the last publish.
-        pose: out (n, 10) pose rows (see `evaluate`); wrenches: out (n, nm, 6) published wrenches.
-        publish: out (n,) True where the sample is published.
-        step_log: out (n, 3) per sample: error norm, accepted and rejected substeps.
+        integ: the stepper (`Integrator`); m, s: the model's arrays and scratch; u: the input
+            vector the right-hand side reads (filled here per interval); y: the state.
+        samples: `Samples`; opts: `RunOptions`; out: `Published` (buffers of n rows).
         watch: the non-linear mounts' event functions, utilisation peaks and event log
             (`Watch`); events are located by linear interpolation inside the sample interval.
-        chain: start each interval from the previous one's last stage when the stepper says
-            it is there (settings[4]; first-order hold, no discrete switches between samples,
-            and nothing else used the scratch since: `Stepper.reset` clears it).
 
     Returns:
         (index of the last sample done, stepper status: 0, or the failure at the next sample).
     """
+    t, f, w = samples.t, samples.f, samples.w
+    method, settings, work2d, work1d = integ.method, integ.settings, integ.work2d, integ.work1d
+    result = integ.result
+    counter, peak, pose, wrenches = out.counter, out.peak, out.pose, out.wrenches
+    publish, step_log, decimation = out.publish, out.step_log, opts.decimation
     n, nm = t.shape[0], peak.shape[0]
-    hold = 0.0 if zero_order else 1.0
+    hold = 0.0 if opts.zero_order else 1.0
     d_wdot = s.rate_step
     for j in range(1, n):
         dt = t[j] - t[j - 1]
@@ -135,7 +161,7 @@ def run_samples(
             w_dot = hold * (w[j, i] - w[j - 1, i]) / dt
             d_wdot[i] = w_dot - u[10 + i]
             u[10 + i] = w_dot
-        if chain and settings[4] == 1.0:
+        if opts.chain and settings[4] == 1.0:
             # First-order hold: the input is continuous at t[j − 1] but for Ω', so the last
             # stage of the previous interval, moved to the new Ω', starts this one. Live (one
             # sample per call) and replay (many) thus compute exactly the same numbers.

@@ -7,7 +7,7 @@ the .msg names, the same in rosbags and rclpy.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache, partial
 
@@ -16,6 +16,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from mount_twin.engine.batch import HealthReport, OutputBatch, SampleBatch
 from mount_twin.io.fixed_layout import FixedLayout
+from mount_twin.physics import pose_row
 from mount_twin.physics.rotations import quaternion_from_matrix, rpy_matrix
 from mount_twin.scene.description import Scene
 
@@ -279,22 +280,60 @@ def _pack(
     return _layout(msgtype, *frames).pack([sec, nsec, values])
 
 
+DIAGNOSTICS_TOPIC = "/diagnostics"
+
+
 @dataclass(frozen=True)
-class OutputTopics:
-    """Output topic names before resolution ('~' is the node's namespace/name)."""
+class Stream:
+    """One topic of a per-row output.
 
-    pose: str
-    angles: str
-    wrenches: tuple[str, ...]
-    diagnostics: str = "/diagnostics"
-    tf: str = TF_TOPIC
+    Attributes:
+        topic: name before resolution ('~' is the node's namespace/name; remappable in ROS,
+            resolved by `resolve` for bags).
+        msgtype: its message type, one of the fixed-layout types of `_BUILDERS`.
+        frames: the frame id(s) its messages carry (a transform's parent and child).
+        values: the float fields of its messages from an OutputBatch, one row per message.
+    """
+
+    topic: str
+    msgtype: str
+    frames: tuple[str, ...]
+    values: Callable[[OutputBatch], np.ndarray]
 
 
-def output_topics(scene: Scene) -> OutputTopics:
-    """The node's output names; remappable in ROS, resolved by `resolve` for bags."""
-    return OutputTopics(
-        "~/pose", "~/angles", tuple(f"~/mounts/{m.name}/wrench" for m in scene.mounts)
-    )
+def _pose_fields(out: OutputBatch) -> np.ndarray:
+    return out.pose[:, pose_row.POSE_COLS]
+
+
+OUTPUTS: dict[str, Callable[[Scene], list[Stream]]] = {
+    "pose": lambda sc: [Stream("~/pose", POSE, (sc.frames.foundation,), _pose_fields)],
+    "angles": lambda sc: [
+        Stream("~/angles", VECTOR3, (sc.frames.foundation,), lambda out: out.angles)
+    ],
+    "wrenches": lambda sc: [
+        Stream(
+            f"~/mounts/{m.name}/wrench",
+            WRENCH,
+            (sc.frames.mount_frame(m.name),),
+            lambda out, i=i: out.wrenches[:, i],
+        )
+        for i, m in enumerate(sc.mounts)
+    ],
+    "tf": lambda sc: [Stream(TF_TOPIC, TF, (sc.frames.foundation, sc.frames.body), _pose_fields)],
+}
+"""The per-row outputs by their flag in `scene.outputs` (tested to be the same set), in the
+order their messages follow each other. A new output is a builder in `_BUILDERS`, an entry here
+and its flag in the scene's `Outputs`."""
+
+
+def output_streams(scene: Scene) -> list[Stream]:
+    """Every per-row output topic the scene enables, in publishing order."""
+    return [
+        st
+        for flag, streams in OUTPUTS.items()
+        if getattr(scene.outputs, flag)
+        for st in streams(scene)
+    ]
 
 
 def resolve(name: str, node_name: str, namespace: str = "/") -> str:
@@ -319,22 +358,12 @@ def encode_outputs(
     the mount's frame, `Frames.mount_frame`), /tf (frames.foundation → frames.body, the pose's
     numbers). Only the outputs the scene enables are built: unused outputs cost nothing.
     """
-    topics = output_topics(scene)
-    frames, opts = scene.frames, scene.outputs
     stamps = stamps_ns[out.sample]
     sec, nsec = np.divmod(stamps, 1_000_000_000)
-    rows: list[tuple[str, list[bytes]]] = []
-    if opts.pose:
-        rows.append((topics.pose, _pack(POSE, frames.foundation, sec, nsec, out.pose[:, :7])))
-    if opts.angles:
-        rows.append((topics.angles, _pack(VECTOR3, frames.foundation, sec, nsec, out.pose[:, 7:])))
-    if opts.wrenches:
-        for i, (mount, topic) in enumerate(zip(scene.mounts, topics.wrenches, strict=True)):
-            frame = frames.mount_frame(mount.name)
-            rows.append((topic, _pack(WRENCH, frame, sec, nsec, out.wrenches[:, i])))
-    if opts.tf:
-        pair = (frames.foundation, frames.body)
-        rows.append((topics.tf, _pack(TF, pair, sec, nsec, out.pose[:, :7])))
+    rows = [
+        (st.topic, _pack(st.msgtype, st.frames, sec, nsec, st.values(out)))
+        for st in output_streams(scene)
+    ]
     msgs: list[tuple[str, int, bytes]] = []
     reports = iter(out.health)
     report = next(reports, None)
@@ -352,7 +381,7 @@ def encode_outputs(
 def encode_report(scene: Scene, report: HealthReport, stamp_ns: int) -> tuple[str, int, bytes]:
     """A health report as (unresolved topic, stamp ns, DiagnosticArray CDR bytes)."""
     msg = diagnostics_message(report, stamp_ns)
-    return output_topics(scene).diagnostics, stamp_ns, TYPESTORE.serialize_cdr(msg, DIAGNOSTICS)
+    return DIAGNOSTICS_TOPIC, stamp_ns, TYPESTORE.serialize_cdr(msg, DIAGNOSTICS)
 
 
 def diagnostics_message(report: HealthReport, stamp_ns: int) -> object:
@@ -372,18 +401,11 @@ def diagnostics_message(report: HealthReport, stamp_ns: int) -> object:
 
 
 def output_types(scene: Scene) -> dict[str, str]:
-    """Unresolved topic → message type for every output the scene enables."""
-    topics, opts = output_topics(scene), scene.outputs
-    types = {topics.diagnostics: DIAGNOSTICS}
-    if opts.pose:
-        types[topics.pose] = POSE
-    if opts.angles:
-        types[topics.angles] = VECTOR3
-    if opts.wrenches:
-        types.update(dict.fromkeys(topics.wrenches, WRENCH))
-    if opts.tf:
-        types[topics.tf] = TF
-    return types
+    """Unresolved topic → message type for every output the scene enables (diagnostics first)."""
+    return {
+        DIAGNOSTICS_TOPIC: DIAGNOSTICS,
+        **{st.topic: st.msgtype for st in output_streams(scene)},
+    }
 
 
 def mount_quaternion(orientation_rpy: Sequence[float]) -> np.ndarray:

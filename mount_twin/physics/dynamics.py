@@ -25,6 +25,7 @@ import numpy as np
 from numba import njit
 
 from mount_twin.kinds import kind_load, kind_monitor, kind_update
+from mount_twin.physics import pose_row
 from mount_twin.physics.chart import kinematic_matrix, kinematic_matrix_rate, rotation_from_chart
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.gate import skip_if_none
@@ -80,7 +81,26 @@ class NonLinearMounts(NamedTuple):
 
 
 class Scratch(NamedTuple):
-    """Preallocated work arrays, so the kernels allocate nothing per call."""
+    """Preallocated work arrays, so the kernels allocate nothing per call.
+
+    Which call fills which fields, and who may read them after it (a field holds what its
+    last writer left; nothing else is promised):
+
+    - `body_motion(y)` fills q, qd, trig, rot, kin, omega, omega_f, phi: read by the mount
+      laws and the rest of `rhs` at that y.
+    - `mount_loads` (inside `rhs`) fills arm, force, couple, loc, total_force, total_moment,
+      sink: read by `rhs` itself.
+    - `rhs(t, y, u)` fills all of the above, then f_s, big_w, big_w_dot, rel, w_x_rel,
+      kin_rate, moment_b, w_b, w_dot_b, acc, w_abs, h, i_w, rhs_rot and mass_rot (the
+      Cholesky factor of Jᵀ I J). `outputs(y)` may follow only if that last `rhs` was at y
+      (the stepper's last stage is: first same as last); `rhs_after_rate_step` moves that
+      last stage to a new Ω' through the factored mass_rot.
+    - `run_samples` fills rate_step (the jump of Ω' at a sample): read by
+      `rhs_after_rate_step`.
+    - `mount_wrenches`, `mount_monitors`, `outputs` and `evaluate` (which calls `body_motion`
+      first) overwrite arm, force, couple, loc and sink; their results go to the caller's
+      arrays.
+    """
 
     q: np.ndarray  # (6,)
     trig: np.ndarray  # (6,) sin α, sin γ, sin δ, cos α, cos γ, cos δ
@@ -462,7 +482,7 @@ def evaluate(
     """Outputs at state y; returns cos θ (NaN off the chart, outputs then untouched).
 
     Args:
-        pose: out (10,): CG position in F (m), quaternion (x, y, z, w) of R, and (α, γ, δ) rad.
+        pose: out (pose_row.WIDTH,): a pose row (`physics/pose_row.py`).
         wrenches: out (n, 6): each mount's force (N) and couple (N·m) on the body, in its axes.
     """
     ct = body_motion(y, m, s)
@@ -480,10 +500,10 @@ def outputs(
     mount_wrenches(y, m, s, wrenches)
     q, quat, cg_ref = s.q, s.quat, m.cg_ref
     for i in range(3):
-        pose[i] = cg_ref[i] + q[i]
-        pose[7 + i] = q[3 + i]
+        pose[pose_row.POSITION + i] = cg_ref[i] + q[i]
+        pose[pose_row.ANGLES + i] = q[3 + i]
     for i in range(4):
-        pose[3 + i] = quat[i]
+        pose[pose_row.QUATERNION + i] = quat[i]
 
 
 @kernel
