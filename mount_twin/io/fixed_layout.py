@@ -17,10 +17,11 @@ import struct
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
-Builder = Callable[[Sequence[float]], object]
+Builder = Callable[[Sequence[float]], Any]
 """Builds a message object from its numeric fields, in the layout's field order."""
 
 _FORMATS = {"<i4": "<i", "<u4": "<I", "<f8": "<d"}
@@ -52,7 +53,10 @@ class FixedLayout:
 
     @classmethod
     def probe(
-        cls, build: Builder, dtypes: Sequence[str], serialize: Callable[[object], bytes]
+        cls,
+        build: Builder,
+        dtypes: Sequence[str],
+        serialize: Callable[[Any], bytes | memoryview],
     ) -> FixedLayout:
         """Locate each field of `build`'s message by serializing sentinels once."""
         sentinels = [_sentinel(i, dt) for i, dt in enumerate(dtypes)]
@@ -62,7 +66,7 @@ class FixedLayout:
             msg = "message length depends on its numbers: not a fixed layout"
             raise ValueError(msg)
         fixed = np.ones(len(raw), dtype=bool)
-        fields = []
+        fields: list[tuple[int, str]] = []
         for value, dtype in zip(sentinels, dtypes, strict=True):
             pattern = struct.pack(_FORMATS[dtype], value)
             offset = raw.find(pattern)
@@ -152,7 +156,8 @@ class FixedLayout:
         """Which messages have this layout (bool mask), and their columns of fields `want`."""
         size = self.size
         idx = np.flatnonzero(np.fromiter((len(r) == size for r in raws), bool, len(raws)))
-        rows = np.frombuffer(b"".join(bytes(raws[i]) for i in idx), np.uint8).reshape(-1, size)
+        joined = b"".join(bytes(raws[i]) for i in idx.tolist())
+        rows = np.frombuffer(joined, np.uint8).reshape(-1, size)
         same = (rows[:, self.fixed] == self.template[self.fixed]).all(axis=1)
         match = np.zeros(len(raws), dtype=bool)
         match[idx[same]] = True

@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache, partial
+from typing import Any
 
 import numpy as np
 from rosbags.typesys import Stores, get_typestore
@@ -58,7 +59,7 @@ class TimeBase:
         return (stamp_ns - self.origin_ns) * 1e-9
 
 
-def stamp_ns(header: object) -> int:
+def stamp_ns(header: Any) -> int:
     """header.stamp as integer nanoseconds."""
     return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)  # type: ignore[attr-defined]
 
@@ -104,9 +105,9 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
         one = _layout(msgtype, frame).unpack_one(raws[0], _INPUT_WANT[msgtype])
         if one is not None:
             sec, nsec, *v = one
-            gyro = [v[3:6]] if msgtype == IMU else [(0.0, 0.0, 0.0)]
+            rate = [v[3:6]] if msgtype == IMU else [[0.0, 0.0, 0.0]]
             stamp = np.array([int(sec) * 1_000_000_000 + int(nsec)], dtype=np.int64)
-            return Decoded(stamp, np.array([v[:3]]), np.array(gyro), [frame])
+            return Decoded(stamp, np.array([v[:3]]), np.array(rate), [frame])
     stamps = np.zeros(n, dtype=np.int64)
     accel, gyro = np.zeros((n, 3)), np.zeros((n, 3))
     frames = [""] * n
@@ -117,7 +118,7 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
         i = int(np.argmax(pending))
         pending[i] = False
         try:
-            msg = TYPESTORE.deserialize_cdr(raws[i], msgtype)
+            msg: Any = TYPESTORE.deserialize_cdr(raws[i], msgtype)
         except Exception:  # any malformed CDR: counted, never raised
             continue
         ok[i] = True
@@ -149,7 +150,7 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
     return Decoded(stamps[ok], accel[ok], gyro[ok], frame_list, int(n - ok.sum()))
 
 
-def _input_values(msg: object, msgtype: str) -> tuple[int, tuple, tuple]:
+def _input_values(msg: Any, msgtype: str) -> tuple[int, tuple, tuple]:
     """(stamp ns, acceleration, angular velocity) of one decoded input message."""
     if msgtype == IMU:
         a, w = msg.linear_acceleration, msg.angular_velocity  # type: ignore[attr-defined]
@@ -158,27 +159,27 @@ def _input_values(msg: object, msgtype: str) -> tuple[int, tuple, tuple]:
     return stamp_ns(msg.header), (a.x, a.y, a.z), (0.0, 0.0, 0.0)  # type: ignore[attr-defined]
 
 
-def _header(stamp_ns: int, frame_id: str) -> object:
+def _header(stamp_ns: int, frame_id: str) -> Any:
     sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
     return _T["std_msgs/msg/Header"](
         stamp=_T["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec), frame_id=frame_id
     )
 
 
-def _vector3(x: float, y: float, z: float) -> object:
+def _vector3(x: float, y: float, z: float) -> Any:
     # float(): rclpy's converters abort on numpy scalars or ints in float64 fields.
     return _T["geometry_msgs/msg/Vector3"](x=float(x), y=float(y), z=float(z))
 
 
-def _time_fields(v: Sequence[float]) -> object:
+def _time_fields(v: Sequence[float]) -> Any:
     return _T["builtin_interfaces/msg/Time"](sec=int(v[0]), nanosec=int(v[1]))
 
 
-def _hdr(v: Sequence[float], frame_id: str) -> object:
+def _hdr(v: Sequence[float], frame_id: str) -> Any:
     return _T["std_msgs/msg/Header"](stamp=_time_fields(v), frame_id=frame_id)
 
 
-def _build_imu(frame_id: str, v: Sequence[float]) -> object:
+def _build_imu(frame_id: str, v: Sequence[float]) -> Any:
     """Imu from [sec, nanosec, a(3), ω(3), orientation xyzw(4), its 3 covariances(27)]."""
     return _T[IMU](
         header=_hdr(v, frame_id),
@@ -193,13 +194,13 @@ def _build_imu(frame_id: str, v: Sequence[float]) -> object:
     )
 
 
-def _build_accel(frame_id: str, v: Sequence[float]) -> object:
+def _build_accel(frame_id: str, v: Sequence[float]) -> Any:
     """AccelStamped from [sec, nanosec, linear(3), angular(3)]."""
     accel = _T["geometry_msgs/msg/Accel"](linear=_vector3(*v[2:5]), angular=_vector3(*v[5:8]))
     return _T[ACCEL](header=_hdr(v, frame_id), accel=accel)
 
 
-def _build_pose(frame_id: str, v: Sequence[float]) -> object:
+def _build_pose(frame_id: str, v: Sequence[float]) -> Any:
     """PoseStamped from [sec, nanosec, position(3), quaternion xyzw(4)]."""
     pose = _T["geometry_msgs/msg/Pose"](
         position=_T["geometry_msgs/msg/Point"](x=float(v[2]), y=float(v[3]), z=float(v[4])),
@@ -210,18 +211,18 @@ def _build_pose(frame_id: str, v: Sequence[float]) -> object:
     return _T[POSE](header=_hdr(v, frame_id), pose=pose)
 
 
-def _build_vector3(frame_id: str, v: Sequence[float]) -> object:
+def _build_vector3(frame_id: str, v: Sequence[float]) -> Any:
     """Vector3Stamped from [sec, nanosec, x, y, z]."""
     return _T[VECTOR3](header=_hdr(v, frame_id), vector=_vector3(*v[2:5]))
 
 
-def _build_wrench(frame_id: str, v: Sequence[float]) -> object:
+def _build_wrench(frame_id: str, v: Sequence[float]) -> Any:
     """WrenchStamped from [sec, nanosec, force(3), torque(3)]."""
     wrench = _T["geometry_msgs/msg/Wrench"](force=_vector3(*v[2:5]), torque=_vector3(*v[5:8]))
     return _T[WRENCH](header=_hdr(v, frame_id), wrench=wrench)
 
 
-def _transform_stamped(parent: str, child: str, v: Sequence[float]) -> object:
+def _transform_stamped(parent: str, child: str, v: Sequence[float]) -> Any:
     """TransformStamped parent → child from [sec, nanosec, translation(3), rotation xyzw(4)]."""
     return _T["geometry_msgs/msg/TransformStamped"](
         header=_hdr(v, parent),
@@ -235,12 +236,12 @@ def _transform_stamped(parent: str, child: str, v: Sequence[float]) -> object:
     )
 
 
-def _build_tf(parent: str, child: str, v: Sequence[float]) -> object:
+def _build_tf(parent: str, child: str, v: Sequence[float]) -> Any:
     """TFMessage of one transform parent → child, from the fields of `_transform_stamped`."""
     return _T[TF](transforms=[_transform_stamped(parent, child, v)])
 
 
-_BUILDERS = {
+_BUILDERS: dict[str, tuple[Callable[..., Any], int]] = {
     IMU: (_build_imu, 37),
     ACCEL: (_build_accel, 6),
     POSE: (_build_pose, 7),
@@ -252,9 +253,9 @@ _BUILDERS = {
 builders take the message's frame ids first (TF: parent, child; the others: header.frame_id)."""
 
 _INPUT_WANT = {IMU: range(8), ACCEL: range(5)}
+"""Fields an input decode reads: sec, nanosec, acceleration (and ω for Imu)."""
 _LAST_FRAME: dict[str, str] = {}
 """Input type → frame_id of the last message decoded through its layout (a cache)."""
-"""Fields an input decode reads: sec, nanosec, acceleration (and ω for Imu)."""
 
 
 @lru_cache(maxsize=256)
@@ -305,6 +306,10 @@ def _pose_fields(out: OutputBatch) -> np.ndarray:
     return out.pose[:, pose_row.POSE_COLS]
 
 
+def _wrench_of(i: int) -> Callable[[OutputBatch], np.ndarray]:
+    return lambda out: out.wrenches[:, i]
+
+
 OUTPUTS: dict[str, Callable[[Scene], list[Stream]]] = {
     "pose": lambda sc: [Stream("~/pose", POSE, (sc.frames.foundation,), _pose_fields)],
     "angles": lambda sc: [
@@ -312,10 +317,7 @@ OUTPUTS: dict[str, Callable[[Scene], list[Stream]]] = {
     ],
     "wrenches": lambda sc: [
         Stream(
-            f"~/mounts/{m.name}/wrench",
-            WRENCH,
-            (sc.frames.mount_frame(m.name),),
-            lambda out, i=i: out.wrenches[:, i],
+            f"~/mounts/{m.name}/wrench", WRENCH, (sc.frames.mount_frame(m.name),), _wrench_of(i)
         )
         for i, m in enumerate(sc.mounts)
     ],
@@ -381,10 +383,10 @@ def encode_outputs(
 def encode_report(scene: Scene, report: HealthReport, stamp_ns: int) -> tuple[str, int, bytes]:
     """A health report as (unresolved topic, stamp ns, DiagnosticArray CDR bytes)."""
     msg = diagnostics_message(report, stamp_ns)
-    return DIAGNOSTICS_TOPIC, stamp_ns, TYPESTORE.serialize_cdr(msg, DIAGNOSTICS)
+    return DIAGNOSTICS_TOPIC, stamp_ns, bytes(TYPESTORE.serialize_cdr(msg, DIAGNOSTICS))
 
 
-def diagnostics_message(report: HealthReport, stamp_ns: int) -> object:
+def diagnostics_message(report: HealthReport, stamp_ns: int) -> Any:
     """diagnostic_msgs/DiagnosticArray of a health report (level is a byte: int in rosbags)."""
     status_t, kv_t = _T["diagnostic_msgs/msg/DiagnosticStatus"], _T["diagnostic_msgs/msg/KeyValue"]
     statuses = [

@@ -21,7 +21,8 @@ import sys
 import threading
 import time
 from collections.abc import Callable
-from typing import TypeVar
+from functools import partial
+from typing import Any, TypeVar
 
 import rclpy
 from rclpy.clock import Clock, ClockType
@@ -74,7 +75,7 @@ class MountTwinNode(Node):
         MountTwinError: a parameter, scene file or topic name is wrong (the message names it).
     """
 
-    def __init__(self, **kwargs: object) -> None:
+    def __init__(self, **kwargs: Any) -> None:
         super().__init__(NODE_NAME, **kwargs)
         self.options, self.scene = configure(self)
         self.stream = TwinStream(self.scene)
@@ -119,7 +120,7 @@ class MountTwinNode(Node):
             except ImportError:
                 continue  # tf2_msgs only
             pubs[topic] = self._named(
-                "outputs", lambda c=cls, t=topic: self.create_publisher(c, t, reliable)
+                "outputs", partial(self.create_publisher, cls, topic, reliable)
             )
         try:
             tf_class = message_class(TF)
