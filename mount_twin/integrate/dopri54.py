@@ -13,6 +13,13 @@ import math
 
 import numpy as np
 
+from mount_twin.integrate.methods import (
+    LEFT_CHART,
+    NOT_FINITE,
+    STEP_TOO_SMALL,
+    SUCCESS,
+    TOO_MANY_STEPS,
+)
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import rhs
 
@@ -31,13 +38,14 @@ A = np.array(
 B = A[6].copy()
 E = np.array([71 / 57600, 0.0, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40])
 """5th-order weights minus the embedded 4th-order weights (the last stage is FSAL)."""
+FSAL = True
+"""The last stage is evaluated at (t + h, y_new): it is the next step's first."""
 ORDER = 4
+"""Order of the error estimate (the step-size controller's exponent is −1/(ORDER + 1))."""
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 OFF_CHART_SHRINK = 0.25
 MIN_STEP_FRACTION = 1e-12
 """A step shorter than this fraction of the interval is a failure."""
-
-SUCCESS, TOO_MANY_STEPS, STEP_TOO_SMALL, LEFT_CHART = 0, 1, 2, 3
 
 
 @kernel
@@ -57,8 +65,10 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
         result: out (3,): largest accepted error norm, accepted and rejected step counts.
 
     Returns:
-        SUCCESS, TOO_MANY_STEPS, STEP_TOO_SMALL, or LEFT_CHART (the steps shrank because the
-        right-hand side kept failing); y is left at the last accepted time on failure.
+        A status of `integrate.methods`: SUCCESS, TOO_MANY_STEPS, STEP_TOO_SMALL, LEFT_CHART (the
+        steps shrank because the right-hand side kept failing) or NOT_FINITE (they shrank
+        because its values stayed NaN or infinite, e.g. a mount kind code without a law); y is
+        left at the last accepted time on failure.
     """
     h, rtol, atol, max_steps = settings[0], settings[1], settings[2], settings[3]
     n = y.shape[0]
@@ -67,15 +77,18 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
     t = t0
     err_max, n_acc, n_rej = 0.0, 0, 0
     rhs_failed = False
+    not_finite = False  # the last rejection was for NaN or inf (stage state or error norm)
     if settings[4] == 0.0:  # else the caller put dy/dt at (t0, y) for this input in k[0]
         rhs_failed = rhs(t, y, m, s, u, k[0]) != 0
     settings[4] = 0.0  # set again below on success: k[0] is then dy/dt at (t1, y)
     while t < t1:
         if n_acc + n_rej >= max_steps:
             settings[0], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
-            return TOO_MANY_STEPS
+            return NOT_FINITE if not_finite else TOO_MANY_STEPS
         if h < MIN_STEP_FRACTION * span or (rhs_failed and n_acc == 0 and t == t0):
             settings[0], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
+            if not_finite:
+                return NOT_FINITE
             return LEFT_CHART if rhs_failed else STEP_TOO_SMALL
         last = t + h >= t1 - 1e-12 * span
         step = t1 - t if last else h
@@ -91,6 +104,11 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
                 break
         rhs_failed = not ok
         if rhs_failed:
+            # a NaN stage state also reads as off the chart: tell them apart (only on failure)
+            not_finite = False
+            for i in range(n):
+                if not math.isfinite(y_new[i]):
+                    not_finite = True
             h = step * OFF_CHART_SHRINK
             n_rej += 1
             continue
@@ -103,11 +121,14 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
             scale = atol + rtol * max(abs(y[i]), abs(y_new[i]))
             err += (step * e / scale) ** 2
         err = math.sqrt(err / n)
-        factor = (
-            MAX_FACTOR
-            if err == 0.0
-            else min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err ** (-1.0 / (ORDER + 1))))
-        )
+        # NaN or inf: rejected below and shrunk by the most; if it persists, NOT_FINITE
+        not_finite = not math.isfinite(err)
+        if not_finite:
+            factor = MIN_FACTOR
+        elif err == 0.0:
+            factor = MAX_FACTOR
+        else:
+            factor = min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err ** (-1.0 / (ORDER + 1))))
         if err <= 1.0:
             t = t1 if last else t + step
             for i in range(n):

@@ -2,32 +2,34 @@
 
 A stepper is a compiled free function with the uniform signature of `dopri54.advance` plus this
 small holder of its settings and work arrays (scipy `integrate/_ivp` shape). Numerical failure is
-returned as a status; misuse raises. `advance` below switches on the method id: compiled
-functions passed as arguments would make every caller uncacheable (numba would recompile them in
-each process, seconds each), so a new stepper adds a branch here and a factory in `STEPPERS`,
-and the engine is untouched.
+returned as a status (`integrate.methods.STATUS_TEXT`); misuse raises. `advance` below switches
+on the method id: compiled functions passed as arguments would make every caller uncacheable
+(numba would recompile them in each process, seconds each), so a new method is an entry in
+`integrate.methods.METHODS` and a branch here, and the engine is untouched.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
 from mount_twin.integrate import dopri54
+from mount_twin.integrate.methods import DOPRI54, METHODS, STATUS_TEXT, UNKNOWN_METHOD
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import ModelArrays, Scratch
 
-DOPRI54 = 0
-
-STATUS_TEXT = {
-    dopri54.SUCCESS: "ok",
-    dopri54.TOO_MANY_STEPS: "too many substeps in one input interval",
-    dopri54.STEP_TOO_SMALL: "step size underflow",
-    dopri54.LEFT_CHART: "attitude left the α/γ/δ chart (tilt reached 90°)",
-    -1: "unknown stepper",
-}
+__all__ = [
+    "METHODS",
+    "STATUS_TEXT",
+    "STEPPERS",
+    "Stepper",
+    "advance",
+    "dormand_prince",
+    "new_stepper",
+]
 
 
 @dataclass
@@ -57,16 +59,23 @@ class Stepper:
         self.settings[4] = 0.0
 
 
-def dormand_prince(n: int, rtol: float, atol: float, max_substeps: int) -> Stepper:
-    """Adaptive explicit Runge–Kutta 5(4) for non-stiff scenes (rubber mounts).
-
-    atol is in the state's units (m, rad, m/s, rad/s).
-    """
+def new_stepper(method: str, n: int, rtol: float, atol: float, max_substeps: int) -> Stepper:
+    """A stepper of `method` (a name in METHODS) for n states; atol in the state's units (m,
+    rad, m/s, rad/s)."""
+    if method not in METHODS:
+        msg = f"unknown integration method {method!r}; choose from {', '.join(METHODS)}"
+        raise ValueError(msg)
     if n <= 0 or not rtol > 0.0 or not atol > 0.0 or max_substeps < 1:
         msg = f"bad stepper settings: n={n}, rtol={rtol}, atol={atol}, max={max_substeps}"
         raise ValueError(msg)
+    spec = METHODS[method]
     settings = np.array([0.0, rtol, atol, float(max_substeps), 0.0])
-    return Stepper("dopri54", DOPRI54, settings, np.zeros((7, n)), np.zeros(n))
+    return Stepper(spec.name, spec.id, settings, np.zeros((spec.stages, n)), np.zeros(n))
+
+
+def dormand_prince(n: int, rtol: float, atol: float, max_substeps: int) -> Stepper:
+    """Adaptive explicit Runge–Kutta 5(4) for non-stiff scenes (rubber mounts)."""
+    return new_stepper("dopri54", n, rtol, atol, max_substeps)
 
 
 @kernel
@@ -86,8 +95,10 @@ def advance(
     """Advance y from t0 to t1 (s) with the stepper `method`; returns its status (0 = success)."""
     if method == DOPRI54:
         return dopri54.advance(y, t0, t1, settings, m, s, u, work2d, work1d, result)
-    return -1
+    return UNKNOWN_METHOD
 
 
-STEPPERS: dict[str, Callable[[int, float, float, int], Stepper]] = {"dopri54": dormand_prince}
-"""Stepper factories by scene name (integration.method)."""
+STEPPERS: dict[str, Callable[[int, float, float, int], Stepper]] = {
+    name: partial(new_stepper, name) for name in METHODS
+}
+"""Stepper factories (n, rtol, atol, max_substeps) by scene name (integration.method)."""

@@ -1,0 +1,263 @@
+"""Integration methods: one list (`integrate.methods`) for the loader, the stepper and the
+engine's status texts, and each method's coefficient table checked like scipy's
+(`scipy/integrate/_ivp/tests`): consistency, order conditions, FSAL, and an embedded error
+estimate that bounds the true one-step error on y' = λy and on the twin's own oscillator.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from collections.abc import Iterator
+from functools import cache
+from types import ModuleType
+
+import numpy as np
+import pytest
+from physics_helpers import base_scene, build, gravity_u, mount
+
+from mount_twin.errors import SceneError
+from mount_twin.integrate import methods, stepper
+from mount_twin.integrate.methods import METHODS, STATUS_TEXT, UNKNOWN_METHOD
+from mount_twin.model.assemble import initial_state
+from mount_twin.scene import loader, scene_from_dict
+
+Tree = tuple
+"""A rooted tree: the sorted tuple of its root's subtrees (a leaf is ())."""
+
+
+def tables(name: str) -> ModuleType:
+    """The module holding the method's tables and compiled advance."""
+    return importlib.import_module(METHODS[name].module)
+
+
+def square(name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(A as an s×s matrix, b over all s stages, embedded b̂ = b − E, c) of a method."""
+    t = tables(name)
+    s = METHODS[name].stages
+    a = np.zeros((s, s))
+    a[: t.A.shape[0], : t.A.shape[1]] = t.A
+    b = np.zeros(s)
+    b[: t.B.shape[0]] = t.B
+    return a, b, b - t.E, np.asarray(t.C, dtype=float)
+
+
+@cache
+def trees(order: int) -> tuple[Tree, ...]:
+    """Every rooted tree with `order` nodes (1, 1, 2, 4, 9 of orders 1..5)."""
+    if order == 1:
+        return ((),)
+    found: set[Tree] = set()
+    for children in _forests(order - 1, order - 1):
+        found.add(tuple(sorted(children)))
+    return tuple(sorted(found))
+
+
+def _forests(nodes: int, largest: int) -> Iterator[tuple[Tree, ...]]:
+    """Multisets of trees with `nodes` nodes in all, each of at most `largest` nodes."""
+    if nodes == 0:
+        yield ()
+        return
+    for size in range(min(nodes, largest), 0, -1):
+        for tree in trees(size):
+            for rest in _forests(nodes - size, size):
+                yield (tree, *rest)
+
+
+def tree_order(t: Tree) -> int:
+    """Number of nodes."""
+    return 1 + sum(tree_order(c) for c in t)
+
+
+def density(t: Tree) -> int:
+    """γ(t): the order times the densities of the subtrees."""
+    return tree_order(t) * math.prod(density(c) for c in t)
+
+
+def stage_weights(t: Tree, a: np.ndarray) -> np.ndarray:
+    """Φ(t) per stage: the product over the subtrees of A·Φ(subtree) (ones for a leaf)."""
+    out = np.ones(a.shape[0])
+    for child in t:
+        out = out * (a @ stage_weights(child, a))
+    return out
+
+
+def order_defects(b: np.ndarray, a: np.ndarray, order: int) -> list[float]:
+    """b·Φ(t) − 1/γ(t) for every tree of exactly `order` nodes."""
+    return [float(b @ stage_weights(t, a)) - 1.0 / density(t) for t in trees(order)]
+
+
+def test_the_tree_count_is_right() -> None:
+    """The generator finds the known numbers of rooted trees (A000081)."""
+    assert [len(trees(n)) for n in range(1, 7)] == [1, 1, 2, 4, 9, 20]
+
+
+# ----------------------------------------------------------------------------- the one list
+
+
+def test_loader_stepper_and_engine_share_the_one_method_list() -> None:
+    """The loader's choices, the stepper factories and the compiled ids all come from METHODS."""
+    assert tuple(METHODS) == loader.STEPPERS
+    assert set(stepper.STEPPERS) == set(METHODS)
+    assert stepper.STATUS_TEXT is STATUS_TEXT
+    assert len({m.id for m in METHODS.values()}) == len(METHODS)
+    for name, spec in METHODS.items():
+        built = stepper.STEPPERS[name](5, 1e-6, 1e-9, 10)
+        assert (built.name, built.method, built.work2d.shape) == (name, spec.id, (spec.stages, 5))
+
+
+def test_every_status_has_its_text() -> None:
+    """Every status constant of integrate.methods has a distinct text."""
+    codes = [
+        v
+        for k, v in vars(methods).items()
+        if k.isupper() and isinstance(v, int) and k != "DOPRI54"
+    ]
+    assert sorted(codes) == sorted(STATUS_TEXT)
+    assert len(set(STATUS_TEXT.values())) == len(STATUS_TEXT)
+
+
+def test_an_unknown_method_is_refused_by_name() -> None:
+    """The loader names the key and the methods there are; the factory refuses it too."""
+    data = base_scene(10.0, [0, 0, 0], [1, 1, 1, 0, 0, 0], [mount("m", [0, 0, 0], [1e3] * 6)])
+    data["integration"]["method"] = "rk4"
+    with pytest.raises(SceneError, match=r"integration\.method.*dopri54"):
+        scene_from_dict(data, "x.yaml")
+    with pytest.raises(ValueError, match="unknown integration method 'rk4'"):
+        stepper.new_stepper("rk4", 3, 1e-6, 1e-9, 10)
+
+
+def oscillator(omega: float = 2.0 * math.pi * 50.0) -> tuple:
+    """A 1-DOF (z) body of 10 kg on one linear mount of natural frequency ω (rad/s), its
+    equilibrium state and the at-rest input."""
+    k = 10.0 * omega**2
+    data = base_scene(
+        10.0, [0.0, 0.0, 0.1], [1, 1, 1, 0, 0, 0], [mount("m", [0, 0, 0], [k] * 6)], ["z"]
+    )
+    model = build(data)
+    u = gravity_u()
+    return model, initial_state(model, u[1:4]), u
+
+
+def run_advance(method: int, model, y: np.ndarray, u, t1: float, module=None):
+    """One call of stepper.advance (or module.advance) from 0 to t1; (status, y, result)."""
+    st = stepper.new_stepper("dopri54", model.n_state, 1e-13, 1.0, 1)
+    y = y.copy()
+    s = model.new_scratch()
+    args = (y, 0.0, t1, st.settings, model.arrays, s, u, st.work2d, st.work1d, st.result)
+    status = module.advance(*args) if module else stepper.advance(method, *args)
+    return int(status), y, st.result.copy()
+
+
+@pytest.mark.parametrize("name", list(METHODS))
+def test_stepper_advance_dispatches_every_method(name: str) -> None:
+    """stepper.advance with a method's id runs that method's own advance (same numbers)."""
+    model, y0, u = oscillator()
+    y0[0] += 1e-4
+    via_switch = run_advance(METHODS[name].id, model, y0, u, 1e-3)
+    own = run_advance(-99, model, y0, u, 1e-3, module=tables(name))
+    assert via_switch[0] == own[0] == methods.SUCCESS
+    np.testing.assert_array_equal(via_switch[1], own[1])
+
+
+def test_an_unknown_method_id_is_a_status_with_its_text() -> None:
+    """The compiled switch returns UNKNOWN_METHOD for an id no method has, state untouched."""
+    model, y0, u = oscillator()
+    status, y, _ = run_advance(max(m.id for m in METHODS.values()) + 1, model, y0, u, 1e-3)
+    assert status == UNKNOWN_METHOD and STATUS_TEXT[status] == "unknown stepper"
+    np.testing.assert_array_equal(y, y0)
+
+
+# ----------------------------------------------------------------------------- the tables
+
+
+@pytest.mark.parametrize("name", list(METHODS))
+def test_tables_are_consistent(name: str) -> None:
+    """Explicit (A strictly lower triangular), c = A·1, Σb = 1, ΣE = 0 (the embedded weights sum
+    to 1 too), and the shapes match the method's stage count."""
+    t = tables(name)
+    a, b, b_hat, c = square(name)
+    s = METHODS[name].stages
+    assert t.E.shape == (s,) and t.C.shape == (s,)
+    assert np.all(np.triu(a) == 0.0)
+    np.testing.assert_allclose(a.sum(axis=1), c, rtol=0, atol=1e-14)
+    assert b.sum() == pytest.approx(1.0, abs=1e-14)
+    assert t.E.sum() == pytest.approx(0.0, abs=1e-14)
+    assert b_hat.sum() == pytest.approx(1.0, abs=1e-14)
+    assert c.min() >= 0.0 and c.max() <= 1.0
+
+
+@pytest.mark.parametrize("name", list(METHODS))
+def test_fsal(name: str) -> None:
+    """First same as last: the last stage is at (t + h, y_new), its row of A is b and its
+    weight 0, so the stepper can reuse it as the next step's first stage."""
+    t = tables(name)
+    assert t.FSAL
+    a, b, _, c = square(name)
+    assert c[-1] == 1.0 and b[-1] == 0.0
+    np.testing.assert_array_equal(a[-1], b)
+
+
+@pytest.mark.parametrize("name", list(METHODS))
+def test_order_conditions(name: str) -> None:
+    """b satisfies every order condition up to the method's order, and fails one of the next
+    (the order is exact); the embedded b̂ those up to the error estimate's order (ORDER) and
+    fails one of the next, so ‖h·E·k‖ is an O(h^(ORDER+1)) estimate."""
+    a, b, b_hat, _ = square(name)
+    p, q = METHODS[name].order, tables(name).ORDER
+    for order in range(1, p + 1):
+        np.testing.assert_allclose(order_defects(b, a, order), 0.0, atol=1e-14, err_msg=order)
+    assert max(abs(d) for d in order_defects(b, a, p + 1)) > 1e-6
+    for order in range(1, q + 1):
+        np.testing.assert_allclose(order_defects(b_hat, a, order), 0.0, atol=1e-14)
+    assert max(abs(d) for d in order_defects(b_hat, a, q + 1)) > 1e-6
+
+
+def one_step(name: str, z: complex) -> tuple[complex, complex]:
+    """One step of y' = λy from y = 1 with hλ = z: (propagated y1, estimate h·Σ E_j k_j)."""
+    a, b, _, _ = square(name)
+    e = tables(name).E
+    k = np.zeros(a.shape[0], dtype=complex)
+    for i in range(a.shape[0]):
+        k[i] = z * (1.0 + a[i, :i] @ k[:i])  # k_i = h·f(...): the step folded in
+    return 1.0 + b @ k, e @ k
+
+
+@pytest.mark.parametrize("name", list(METHODS))
+@pytest.mark.parametrize("angle", [math.pi, 0.75 * math.pi, 0.5 * math.pi, 0.55 * math.pi])
+def test_error_estimate_bounds_the_true_error_on_the_linear_test_equation(
+    name: str, angle: float
+) -> None:
+    """y' = λy (decay, damped and undamped oscillation): for |hλ| ≤ 1 the estimate exceeds the
+    true error of the propagated solution; both shrink at their orders as h halves."""
+    p, q = METHODS[name].order, tables(name).ORDER
+    radii = [2.0**-j for j in range(8)]
+    true_err, estimate = [], []
+    for r in radii:
+        z = r * complex(math.cos(angle), math.sin(angle))
+        y1, est = one_step(name, z)
+        true_err.append(abs(y1 - np.exp(z)))
+        estimate.append(abs(est))
+        assert true_err[-1] <= abs(est), (r, true_err[-1], abs(est))
+    # local orders: the estimate ~ h^(q+1); the true error ~ h^(p+1), or smaller still
+    slopes_est = np.diff(np.log2(estimate))
+    assert np.all(np.abs(slopes_est[3:] + (q + 1)) < 0.1), slopes_est
+    slopes_true = np.diff(np.log2(true_err[:6]))
+    assert np.all(slopes_true[2:] < -(p + 1) + 0.1), slopes_true
+
+
+@pytest.mark.parametrize("name", list(METHODS))
+def test_compiled_error_norm_bounds_the_true_error_of_an_oscillator_step(name: str) -> None:
+    """The compiled stepper on the twin's own 1-DOF oscillator (ω = 2π·50 rad/s), one step per
+    call: its error norm exceeds the true error norm of the step, in the same scaling."""
+    omega = 2.0 * math.pi * 50.0
+    model, y_eq, u = oscillator(omega)
+    dz = 1e-3
+    y0 = y_eq.copy()
+    y0[0] += dz
+    for h in (2e-3, 1e-3, 5e-4, 2.5e-4):
+        status, y1, result = run_advance(METHODS[name].id, model, y0, u, h)
+        assert status == methods.SUCCESS and result[1] == 1  # a single step
+        exact = np.array([y_eq[0] + dz * math.cos(omega * h), -dz * omega * math.sin(omega * h)])
+        true_norm = math.sqrt(np.mean((y1 - exact) ** 2))  # scale = atol = 1 (rtol 1e-13)
+        assert true_norm <= result[0], (h, true_norm, result[0])
