@@ -4,14 +4,31 @@ functions (`monitor`) and discrete switches between samples (`update`).
 
 The compiled dispatchers below select a kind by its code; adding a kind is a new module, a line
 in KINDS and a branch in each dispatcher. The integrator and the engine never change.
+
+The contract is checked, so a forgotten step cannot run another kind's law:
+- at import, every module in KINDS has the names of a kind (`MODULE_NAMES`);
+- a code without a branch reaches each dispatcher's final `else`, which writes NaN (the force,
+  the event functions and utilisation, the state): the stepper then fails with NOT_FINITE and
+  the engine reports it, never another kind's answer;
+- `check_dispatch` (run by `model.assemble` before the first model with such mounts) drives
+  every code through every dispatcher on a sample input and compares with the kind's own
+  `load`, `monitor` and `update`; a missing or crossed branch is a `KindContractError` at load.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Mapping
 from types import ModuleType
 
+import numpy as np
 from numba import njit
 
+# First: the cache locator must be in place before any compiled function is decorated.
+from mount_twin.physics import compiled  # noqa: F401
+
+# isort: split
+from mount_twin.errors import ModelError
 from mount_twin.kinds import bolted_joint, elastomer, shear_key
 
 KINDS: dict[str, ModuleType] = {
@@ -23,33 +40,172 @@ KINDS: dict[str, ModuleType] = {
 CODES = {name: i for i, name in enumerate(KINDS)}
 N_PAR = max(k.N_PAR for k in KINDS.values())
 N_EVENTS = max(len(k.EVENTS) for k in KINDS.values())
-ELASTOMER, BOLTED_JOINT, SHEAR_KEY = (CODES[k] for k in KINDS)
+ELASTOMER = CODES[elastomer.KIND]
+BOLTED_JOINT = CODES[bolted_joint.KIND]
+SHEAR_KEY = CODES[shear_key.KIND]
+
+MODULE_NAMES = (
+    "KIND",
+    "EVENTS",
+    "EVENT_ERROR",
+    "PARAMETERS",
+    "N_PAR",
+    "read",
+    "pack",
+    "state_names",
+    "load",
+    "monitor",
+    "update",
+)
+"""What a kind module defines (see the module docstring of any kind)."""
+
+
+class KindContractError(ModelError):
+    """A kind module or the dispatchers break the kind contract (a programming error)."""
 
 
 @njit(cache=True, inline="always")
 def kind_load(code, p, y, o, d, v, phi, w, dydt, f, c) -> None:
-    """The kind's `load`: local force f and couple c on the body; internal rates into dydt."""
+    """The kind's `load`: local force f and couple c on the body; internal rates into dydt.
+    An unknown code writes NaN into f and c."""
     if code == ELASTOMER:
         elastomer.load(p, y, o, d, v, phi, w, dydt, f, c)
     elif code == BOLTED_JOINT:
         bolted_joint.load(p, y, o, d, v, phi, w, dydt, f, c)
-    else:
+    elif code == SHEAR_KEY:
         shear_key.load(p, y, o, d, v, phi, w, dydt, f, c)
+    else:
+        for j in range(3):
+            f[j] = math.nan
+            c[j] = math.nan
 
 
 @njit(cache=True, inline="always")
 def kind_monitor(code, p, y, y0, o, d, v, g) -> float:
     """The kind's `monitor`: event functions into g (y0: state at the previous sample);
-    returns the utilisation."""
+    returns the utilisation. An unknown code writes NaN into g and returns NaN."""
     if code == ELASTOMER:
         return elastomer.monitor(p, y, y0, o, d, v, g)
     if code == BOLTED_JOINT:
         return bolted_joint.monitor(p, y, y0, o, d, v, g)
-    return shear_key.monitor(p, y, y0, o, d, v, g)
+    if code == SHEAR_KEY:
+        return shear_key.monitor(p, y, y0, o, d, v, g)
+    for e in range(g.shape[0]):
+        g[e] = math.nan
+    return math.nan
 
 
 @njit(cache=True, inline="always")
 def kind_update(code, p, y, o, d) -> None:
-    """The kind's `update`: discrete switches between samples."""
-    if code == BOLTED_JOINT:
+    """The kind's `update`: discrete switches between samples. An unknown code writes NaN into
+    the state (its own, or y[0] for a kind without states): the next step fails."""
+    if code == ELASTOMER:
+        elastomer.update(p, y, o, d)
+    elif code == BOLTED_JOINT:
         bolted_joint.update(p, y, o, d)
+    elif code == SHEAR_KEY:
+        shear_key.update(p, y, o, d)
+    else:
+        y[max(o, 0)] = math.nan
+
+
+def check_modules(kinds: Mapping[str, ModuleType]) -> None:
+    """Raise KindContractError unless every module defines `MODULE_NAMES` consistently."""
+    for name, module in kinds.items():
+        missing = [attr for attr in MODULE_NAMES if not hasattr(module, attr)]
+        if missing:
+            msg = f"kind {name!r} ({module.__name__}) lacks {', '.join(missing)}"
+            raise KindContractError(msg)
+        if name != module.KIND:
+            msg = f"KINDS maps {name!r} to {module.__name__}, whose KIND is {module.KIND!r}"
+            raise KindContractError(msg)
+        if len(module.EVENT_ERROR) != len(module.EVENTS):
+            msg = f"kind {name!r}: EVENT_ERROR and EVENTS differ in length"
+            raise KindContractError(msg)
+
+
+check_modules(KINDS)
+
+_PROBE_STATE_OFFSET, _PROBE_STATES = 3, 16
+"""Where the probe puts a kind's internal states, and the length of its state vector."""
+_LOAD_ARGS = ("p", "y", "o", "d", "v", "phi", "w", "dydt", "f", "c")
+_MONITOR_ARGS = ("p", "y", "y0", "o", "d", "v", "g")
+_UPDATE_ARGS = ("p", "y", "o", "d")
+"""Arguments of a kind's load, monitor and update (after the code, for the dispatchers)."""
+
+
+def probe_input(n_par: int, n_events: int, seed: int) -> dict[str, np.ndarray]:
+    """A generic sample input: parameters in (0.1, 0.9) (no kind reads a code or a count from
+    them as anything but 0), small deflections and rates, states in (0.1, 0.9)."""
+    rng = np.random.default_rng(seed)
+    return {
+        "p": rng.uniform(0.1, 0.9, n_par),
+        "y": rng.uniform(0.1, 0.9, _PROBE_STATES),
+        "y0": rng.uniform(0.1, 0.9, _PROBE_STATES),
+        "d": rng.uniform(-1.0e-3, 1.0e-3, 3),
+        "v": rng.uniform(-1.0e-2, 1.0e-2, 3),
+        "phi": rng.uniform(-1.0e-3, 1.0e-3, 3),
+        "w": rng.uniform(-1.0e-2, 1.0e-2, 3),
+        "dydt": np.full(_PROBE_STATES, 0.25),
+        "f": np.full(3, 0.25),
+        "c": np.full(3, 0.25),
+        "g": np.full(n_events, 0.25),
+    }
+
+
+def dispatch_results(
+    code: int, module: ModuleType, x: dict[str, np.ndarray]
+) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each dispatcher's outputs for `code` and the module's own function's outputs on the
+    sample input x (unchanged): {dispatcher name: (dispatched, own)}."""
+    found = {}
+    for name, dispatcher, own, args, outs in (
+        ("kind_load", kind_load, module.load, _LOAD_ARGS, ("f", "c", "dydt")),
+        ("kind_monitor", kind_monitor, module.monitor, _MONITOR_ARGS, ("g",)),
+        ("kind_update", kind_update, module.update, _UPDATE_ARGS, ("y",)),
+    ):
+        results = []
+        for fn, lead in ((dispatcher, (code,)), (own, ())):
+            arrays = {k: v.copy() for k, v in x.items()}
+            ret = fn(*lead, *(_PROBE_STATE_OFFSET if a == "o" else arrays[a] for a in args))
+            parts = [arrays[k] for k in outs]
+            if ret is not None:
+                parts.append(np.array([ret], dtype=float))
+            results.append(np.concatenate(parts))
+        found[name] = (results[0], results[1])
+    return found
+
+
+_checked: set[tuple[str, ...]] = set()
+"""Kind lists of KINDS already checked in this process."""
+
+
+def check_dispatch(kinds: Mapping[str, ModuleType] | None = None, samples: int = 2) -> None:
+    """Raise KindContractError unless kind_load, kind_monitor and kind_update run, for the code
+    of each kind in `kinds` (default KINDS; code = index), that kind's own function (same
+    outputs, finite, on `samples` sample inputs). Done once per process for KINDS; the first
+    call compiles the dispatchers and the laws for Python calls (cached on disk like the
+    kernels)."""
+    kinds = KINDS if kinds is None else kinds
+    key = tuple(kinds)
+    if kinds is KINDS and key in _checked:
+        return
+    check_modules(kinds)
+    n_par = max(m.N_PAR for m in kinds.values())
+    n_events = max(len(m.EVENTS) for m in kinds.values())
+    for seed in range(samples):
+        x = probe_input(n_par, n_events, seed)
+        for code, (name, module) in enumerate(kinds.items()):
+            for dispatcher, (got, own) in dispatch_results(code, module, x).items():
+                if not np.all(np.isfinite(own)):
+                    msg = f"kind {name!r}: the probe input makes its own law non-finite: {own}"
+                    raise KindContractError(msg)
+                if not np.allclose(got, own, rtol=1e-12, atol=0.0):
+                    msg = (
+                        f"{dispatcher} with the code of kind {name!r} ({code}) does not run "
+                        f"{module.__name__}: {got} instead of {own}; add or fix its branch in "
+                        "mount_twin/kinds/__init__.py"
+                    )
+                    raise KindContractError(msg)
+    if kinds is KINDS:
+        _checked.add(key)

@@ -8,7 +8,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from mount_twin.errors import ModelError
-from mount_twin.kinds import CODES, KINDS, N_PAR
+from mount_twin.kinds import CODES, KINDS, N_PAR, check_dispatch
 from mount_twin.physics.dynamics import (
     INPUT_SIZE,
     OK,
@@ -109,7 +109,9 @@ def in_f(axes: np.ndarray, values: np.ndarray) -> np.ndarray:
 def _nonlinear(
     mounts: tuple, index: list[int], points: np.ndarray, axes: np.ndarray, offsets: list[int]
 ) -> NonLinearMounts:
-    """Kernel arrays of the mounts at `index` (kinds of mount_twin.kinds)."""
+    """Kernel arrays of the mounts at `index` (kinds of mount_twin.kinds), once the compiled
+    dispatchers are known to run each kind's own law (`kinds.check_dispatch`, once a process)."""
+    check_dispatch()
     par = np.zeros((len(index), N_PAR))
     for row, i in enumerate(index):
         own = KINDS[mounts[i].kind].pack(mounts[i])
@@ -169,7 +171,7 @@ def static_equilibrium(
     sol = least_squares(accelerations, q_guess, xtol=1e-15, ftol=1e-15, gtol=1e-15)
     residual = np.max(np.abs(sol.fun))
     g = float(np.linalg.norm(specific_force))
-    if residual > 1e-9 * max(g, 1.0):
+    if not residual <= 1e-9 * max(g, 1.0):  # NaN (a non-finite load) fails too
         msg = (
             f"{model.scene.source}: no static equilibrium found (residual {residual:.3g} m/s² "
             "or rad/s²): check that the mounts hold every free DOF"

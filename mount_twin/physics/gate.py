@@ -21,7 +21,7 @@ def skip_if_none(impl: Callable[..., None]) -> Callable[..., None]:
         msg = f"{impl.__name__}: callable from compiled code only"
         raise TypeError(msg)
 
-    @overload(gate, jit_options={"cache": True})
+    @overload(gate, jit_options={"cache": True})  # type: ignore[typeddict-unknown-key]
     def _typed(*args):
         if isinstance(args[1], types.NoneType):
             return lambda *args: None

@@ -1,0 +1,285 @@
+"""The mount-kind contract: every kind code runs that kind's own law in every compiled dispatcher,
+and a code without a branch can never run another kind's law (it fails loudly instead).
+
+The dispatchers (`kinds.kind_load`, `kind_monitor`, `kind_update`) are compiled `if code == ...`
+chains; before the contract was checked, a kind registered in KINDS without its branches ran the
+shear key's law, silently.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from types import ModuleType
+
+import numpy as np
+import pytest
+from kinds_helpers import kind_mount, law_of
+from numba import njit
+
+from mount_twin import kinds
+from mount_twin.integrate import stepper
+from mount_twin.integrate.methods import NOT_FINITE, STATUS_TEXT, SUCCESS
+from mount_twin.kinds import (
+    CODES,
+    KINDS,
+    N_EVENTS,
+    N_PAR,
+    KindContractError,
+    check_dispatch,
+    check_modules,
+    dispatch_results,
+    kind_load,
+    kind_monitor,
+    kind_update,
+    probe_input,
+    shear_key,
+)
+from mount_twin.model.assemble import assemble, gravity_input, initial_state
+from mount_twin.physics.dynamics import body_motion, mount_monitors
+from mount_twin.scene.loader import load_scene_file
+
+GENSET = Path(__file__).resolve().parent.parent / "config" / "genset_bolted_keyed.scene.yaml"
+UNKNOWN = len(KINDS)
+"""A code no kind has."""
+
+REALISTIC = {
+    "elastomer": kind_mount(
+        "elastomer",
+        stiffness_linear=[2.0e5, 2.0e5, 0.0],
+        stiffness_cubic=[1.0e9, 0.0, 0.0],
+        force_table={
+            "z": {
+                "deflection": [-0.01, -0.004, 0.0, 0.004, 0.01],
+                "force": [-9e3, -1.5e3, 0.0, 1.2e3, 5e3],
+            }
+        },
+        damping=[300.0, 300.0, 500.0],
+        rotational_stiffness=[1.0e3, 1.0e3, 2.0e3],
+        rotational_damping=[1.0, 1.0, 2.0],
+        rated_deflection=[4e-3, 4e-3, 6e-3],
+        hysteresis={"ratio": 0.7, "beta": 2.0e5, "gamma": 1.0e5, "n": 1.5, "axes": ["x", "z"]},
+        snubber={"gap": 3e-3, "stiffness": 1.0e8, "exponent": 1.5, "damping": 0.2},
+    ),
+    "bolted_joint": kind_mount(
+        "bolted_joint",
+        bolt_stiffness=7.0e8,
+        clamp_stiffness=3.5e9,
+        preload=1.0e5,
+        yield_force=1.57e5,
+        ultimate_force=1.96e5,
+        axial_damping=2.0e3,
+        shear_damping=1.0e3,
+    ),
+    "shear_key": kind_mount(
+        "shear_key",
+        stiffness=[1.0e9, 0.0, 5.0e8],
+        damping=[1.0e4, 0.0, 1.0e4],
+        clearance=2.0e-4,
+        allowable_force=2.0e5,
+        engagement_height=5.0e-3,
+    ),
+}
+"""One mount of every kind with every feature on, read and packed by the package."""
+
+
+def realistic_inputs(name: str, rng: np.random.Generator) -> list[dict[str, np.ndarray]]:
+    """Sample inputs for the kind's real parameter row: deflections from rest to well past its
+    limits (contact, opening, yield, snubbing), rates, and internal states at and off rest."""
+    law = law_of(REALISTIC[name])
+    p = np.zeros(N_PAR)
+    p[: law.p.shape[0]] = law.p
+    inputs = []
+    for scale in (0.0, 1e-5, 1e-4, 5e-4, 2e-3, 8e-3):
+        for states in ("rest", "random"):
+            y = np.zeros(16)
+            if states == "random":
+                y[3 : 3 + law.n_state] = rng.uniform(-1e-4, 1e-4, law.n_state)
+            inputs.append(
+                {
+                    "p": p,
+                    "y": y,
+                    "y0": y * 0.5,
+                    "d": rng.uniform(-scale, scale, 3),
+                    "v": rng.uniform(-0.1, 0.1, 3),
+                    "phi": rng.uniform(-1e-3, 1e-3, 3),
+                    "w": rng.uniform(-1e-2, 1e-2, 3),
+                    "dydt": np.full(16, 0.25),
+                    "f": np.full(3, 0.25),
+                    "c": np.full(3, 0.25),
+                    "g": np.full(N_EVENTS, 0.25),
+                }
+            )
+    return inputs
+
+
+@pytest.mark.parametrize("name", list(KINDS))
+def test_every_code_runs_its_own_law_in_every_dispatcher(name: str) -> None:
+    """kind_load, kind_monitor and kind_update with the kind's code give exactly what the kind
+    module's own load, monitor and update give, on its real parameters over its whole range."""
+    rng = np.random.default_rng(7)
+    code, module = CODES[name], KINDS[name]
+    for x in realistic_inputs(name, rng):
+        for dispatcher, (got, own) in dispatch_results(code, module, x).items():
+            assert np.all(np.isfinite(own)), (dispatcher, own)
+            np.testing.assert_array_equal(got, own, err_msg=f"{dispatcher} for {name}")
+
+
+def test_theprobe_input_tells_every_law_apart() -> None:
+    """On the load-time probe's sample input, no two kinds' laws agree: a branch that runs
+    another kind's law cannot pass the probe."""
+    x = probe_input(N_PAR, N_EVENTS, 0)
+    for dispatcher in ("kind_load", "kind_monitor"):
+        own = {n: dispatch_results(c, KINDS[n], x)[dispatcher][1] for n, c in CODES.items()}
+        for a in KINDS:
+            for b in KINDS:
+                assert a == b or not np.allclose(own[a], own[b]), (dispatcher, a, b)
+
+
+def test_check_dispatch_passes_for_the_registered_kinds() -> None:
+    """The load-time probe accepts the package's own kinds (it runs in `assemble`)."""
+    check_dispatch(KINDS, samples=3)
+
+
+def test_an_unknown_code_writes_nan_not_the_shear_keys_answer() -> None:
+    """Each dispatcher's final else fails loudly: NaN force, couple, event functions,
+    utilisation and state, where the shear key's law (the old fallback) gives numbers."""
+    key = law_of(REALISTIC["shear_key"])
+    p = np.zeros(N_PAR)
+    p[: key.p.shape[0]] = key.p
+    d, v, z3 = np.array([5e-4, 0.0, 1e-3]), np.array([0.01, 0.0, 0.0]), np.zeros(3)
+    y = np.zeros(4)
+    f_key, c_key, f, c = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
+    shear_key.load(p, y, -1, d, v, z3, z3, y.copy(), f_key, c_key)
+    kind_load(UNKNOWN, p, y, -1, d, v, z3, z3, y.copy(), f, c)
+    assert np.all(np.isfinite(f_key)) and f_key[0] < 0.0
+    assert np.all(np.isnan(f)) and np.all(np.isnan(c))
+
+    g_key, g = np.zeros(N_EVENTS), np.zeros(N_EVENTS)
+    util_key = shear_key.monitor(p, y, y, -1, d, v, g_key)
+    util = kind_monitor(UNKNOWN, p, y, y, -1, d, v, g)
+    assert math.isfinite(util_key) and np.all(np.isfinite(g_key))
+    assert math.isnan(util) and np.all(np.isnan(g))
+
+    y_upd = np.zeros(4)
+    kind_update(UNKNOWN, p, y_upd, -1, d)
+    assert np.isnan(y_upd).any()
+
+
+def test_an_unknown_code_fails_the_step_with_a_status() -> None:
+    """In the compiled model, a mount whose code has no branch makes the stepper fail with
+    NOT_FINITE (reported by the engine with its text), instead of integrating the shear key."""
+    model = assemble(load_scene_file(GENSET))
+    g = np.array([0.0, 0.0, model.scene.input.g])
+    y0 = initial_state(model, g)
+    u = gravity_input(0.0, g)
+    kinds_row = model.arrays.nl.kind
+    key_row = int(np.flatnonzero(kinds_row == CODES["shear_key"])[0])
+
+    def step() -> int:
+        st = stepper.new_stepper("dopri54", model.n_state, 1e-6, 1e-9, 1000)
+        y = y0.copy()
+        return int(
+            stepper.advance(
+                st.method,
+                y,
+                0.0,
+                1e-4,
+                st.settings,
+                model.arrays,
+                model.new_scratch(),
+                u,
+                st.work2d,
+                st.work1d,
+                st.result,
+            )
+        )
+
+    assert step() == SUCCESS
+    kinds_row[key_row] = UNKNOWN
+    try:
+        assert step() == NOT_FINITE
+        assert "non-finite" in STATUS_TEXT[NOT_FINITE]
+        # the monitors too: NaN utilisation and events, and the state poisoned for the next step
+        nl, s = model.arrays.nl, model.new_scratch()
+        y = y0.copy()
+        model_g = np.zeros((nl.kind.shape[0], N_EVENTS))
+        util = np.zeros(nl.kind.shape[0])
+        body_motion(y, model.arrays, s)
+        mount_monitors(y, y0, nl, s, model_g, util)
+        assert math.isnan(util[key_row]) and np.all(np.isnan(model_g[key_row]))
+        assert np.isnan(y).any()
+    finally:
+        kinds_row[key_row] = CODES["shear_key"]
+
+
+# A kind registered without dispatcher branches ------------------------------------------------
+
+
+@njit
+def _stop_load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
+    for j in range(3):
+        f[j] = -p[0] * d[j] - 1.0
+        c[j] = 0.0
+
+
+@njit
+def _stop_monitor(p, y, y0, o, d, v, g) -> float:
+    g[0] = abs(d[0]) - p[1]
+    return abs(d[0]) / p[1]
+
+
+@njit
+def _stop_update(p, y, o, d) -> None:
+    pass
+
+
+def fake_kind(name: str = "end_stop") -> ModuleType:
+    """A complete kind module whose code the compiled dispatchers do not know."""
+    module = ModuleType(f"fake_kinds.{name}")
+    module.KIND = name
+    module.EVENTS = ("stop_contact",)
+    module.EVENT_ERROR = (False,)
+    module.PARAMETERS = {}
+    module.N_PAR = 2
+    module.read = lambda r, name, position, rpy: None
+    module.pack = lambda m: np.array([1.0e6, 1e-3])
+    module.state_names = lambda m: ()
+    module.load, module.monitor, module.update = _stop_load, _stop_monitor, _stop_update
+    return module
+
+
+def test_a_kind_without_dispatcher_branches_is_refused() -> None:
+    """Registered after the others (code 3) but never dispatched: the probe names it."""
+    registry = {**KINDS, "end_stop": fake_kind()}
+    with pytest.raises(
+        KindContractError, match=r"kind_load with the code of kind 'end_stop' \(3\)"
+    ):
+        check_dispatch(registry)
+
+
+def test_a_kind_without_branches_fails_at_assemble(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Added to KINDS and CODES (as a new kind module would be), any model with non-linear mounts
+    is refused at load, before a kernel runs."""
+    monkeypatch.setitem(kinds.KINDS, "end_stop", fake_kind())
+    monkeypatch.setitem(kinds.CODES, "end_stop", 3)
+    with pytest.raises(KindContractError, match="end_stop"):
+        assemble(load_scene_file(GENSET))
+
+
+def test_crossed_branches_are_refused() -> None:
+    """Codes that do not match the dispatchers' branches (a kind moved in KINDS without its
+    branch) are refused: the probe compares laws, not names."""
+    crossed = dict(reversed(KINDS.items()))
+    with pytest.raises(KindContractError, match="does not run"):
+        check_dispatch(crossed)
+
+
+def test_a_module_lacking_part_of_the_contract_is_refused() -> None:
+    """check_modules (run at import) names what a kind module lacks, and a KIND mismatch."""
+    module = fake_kind()
+    del module.update
+    with pytest.raises(KindContractError, match="lacks update"):
+        check_modules({"end_stop": module})
+    with pytest.raises(KindContractError, match="whose KIND is"):
+        check_modules({"other_name": fake_kind()})
