@@ -1,20 +1,20 @@
 """Command line: `mount-twin replay|demo|generate|import-csv`."""
 
+# Imports beyond the standard library wait until a command runs: numba, numpy and rosbags take
+# seconds to import, and `--help` or a mistyped argument must answer at once (tested).
+
 from __future__ import annotations
 
 import argparse
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from mount_twin.errors import MountTwinError
-from mount_twin.io.bag import write_bag
-from mount_twin.io.messages import IMU, imu_messages
-from mount_twin.io.signals import Signal, half_sine_shock, read_csv, ship_motion
-from mount_twin.replay import replay
-from mount_twin.scene.loader import load_scene_file
+
+if TYPE_CHECKING:
+    from mount_twin.io.signals import Signal
 
 DEFAULT_SCENE = "pump_8_mounts.scene.yaml"
 DEFAULT_BAG = "ship_motion_1khz"
@@ -35,6 +35,12 @@ def share_dir() -> Path:
 def _write_signal(
     sig: Signal, out: str, topic: str, frame_id: str, start_ns: int, storage: str
 ) -> int:
+    """Write `sig` as sensor_msgs/Imu messages stamped start_ns + t into a new bag."""
+    import numpy as np
+
+    from mount_twin.io.bag import write_bag
+    from mount_twin.io.messages import IMU, imu_messages
+
     stamps = start_ns + np.rint(sig.t * 1e9).astype(np.int64)
     return write_bag(
         out, topic, IMU, iter(imu_messages(stamps, sig.accel, sig.gyro, frame_id)), storage
@@ -97,7 +103,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
+    """Carry out a parsed command line."""
     if args.cmd in ("replay", "demo"):
+        from mount_twin.replay import replay
+        from mount_twin.scene.loader import load_scene_file
+
         if args.cmd == "demo":
             share = share_dir()
             scene_path, bag = share / "config" / DEFAULT_SCENE, share / "bags" / DEFAULT_BAG
@@ -125,6 +135,8 @@ def _run(args: argparse.Namespace) -> int:
             )
             print(f"plot: {png}")
         return 0
+    from mount_twin.io.signals import half_sine_shock, read_csv, ship_motion
+
     if args.cmd == "generate":
         if args.kind == "half-sine":
             sig = half_sine_shock(

@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
+import hashlib
+import os
+import sys
+import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -11,7 +17,7 @@ from tqdm import tqdm
 
 from mount_twin.engine.batch import MountEvent
 from mount_twin.engine.health import tilt_from_quaternions
-from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag
+from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import (
     TF,
     TF_STATIC_TOPIC,
@@ -25,6 +31,66 @@ from mount_twin.stream import TwinStream
 
 NODE_NAME = "mount_twin"
 """The node name output topics resolve against, as with `ros2 run` and the default launch."""
+
+COMPILE_NOTICE = "mount-twin: compiling kernels (first run only, 20-60 s)..."
+"""Said on stderr while numba compiles the kernels instead of loading them from its cache."""
+COMPILE_NOTICE_AFTER_S = 3.0
+"""With kernels cached, the notice still comes once loading them has taken this long (s): a
+scene needing kernels not compiled yet, or sources edited since. Loading takes < 1 s."""
+
+
+def kernel_cache_is_cold() -> bool:
+    """True if numba has no compiled kernel of mount_twin cached for this Python: building a
+    TwinEngine will then compile them (20–60 s) rather than load them (< 1 s).
+
+    Cheap (a few directory listings; numba is not imported): looks for numba's index files,
+    `<module>.<function>-<line>.py<XY>.nbi`, where numba keeps them for each subpackage: under
+    $NUMBA_CACHE_DIR if set, else in its __pycache__, or in numba's user-wide cache where that
+    is not writable. The one place that knows numba's cache layout.
+    """
+    pattern = f"*.py{sys.version_info.major}{sys.version_info.minor}.nbi"
+    package = os.path.dirname(os.path.abspath(__file__))
+    user_dir = os.environ.get("NUMBA_CACHE_DIR")
+    user_wide = os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "numba"
+    )
+    for entry in os.scandir(package):
+        if not entry.is_dir() or entry.name == "__pycache__":
+            continue
+        # numba's get_suitable_cache_subpath: <dir name>_<sha1 of the directory's path>
+        keyed = f"{entry.name}_{hashlib.sha1(entry.path.encode()).hexdigest()}"
+        dirs = (
+            [Path(user_dir, keyed)]
+            if user_dir
+            else [Path(entry.path, "__pycache__"), Path(user_wide, keyed)]
+        )
+        if any(next(d.glob(pattern), None) is not None for d in dirs):
+            return False
+    return True
+
+
+@contextmanager
+def kernels_loading(notice: bool = True) -> Iterator[None]:
+    """Around building a TwinEngine: with `notice`, say COMPILE_NOTICE on stderr at once if the
+    kernel cache is cold, else if loading the kernels takes COMPILE_NOTICE_AFTER_S."""
+    if not notice:
+        yield
+        return
+
+    def say() -> None:
+        print(COMPILE_NOTICE, file=sys.stderr, flush=True)
+
+    if kernel_cache_is_cold():
+        say()
+        yield
+        return
+    timer = threading.Timer(COMPILE_NOTICE_AFTER_S, say)
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
 
 
 @dataclass
@@ -115,9 +181,17 @@ def replay(
     The output holds what the node publishes: the scene's outputs (`output_types`), and the mount
     frames on /tf_static once, before anything else, stamped with the first decodable input
     stamp and offered latched (`LATCHED_QOS`) so `ros2 bag play` republishes it to late
-    subscribers.
+    subscribers. Both bags are checked before the kernels load (a first run compiles them:
+    with `progress`, `kernels_loading` says so on stderr).
     """
-    stream = TwinStream(scene)
+    bag = InputBag(input_path, scene.input.topic, scene.input.msg_type)
+    try:
+        check_new_bag(output_path)
+        with kernels_loading(progress):
+            stream = TwinStream(scene)
+    except BaseException:
+        bag.close()
+        raise
     resolved = {t: resolve(t, NODE_NAME) for t in output_types(scene)}
     topics = {resolved[t]: msgtype for t, msgtype in output_types(scene).items()}
     topics[TF_STATIC_TOPIC] = TF
@@ -130,7 +204,7 @@ def replay(
     wall0 = time.perf_counter()
     last_health: list[str] = []
     with (
-        InputBag(input_path, scene.input.topic, scene.input.msg_type) as bag,
+        bag,
         OutputBag(output_path, topics, {TF_STATIC_TOPIC: [LATCHED_QOS]}) as out,
         tqdm(total=bag.count, unit="msg", disable=not progress, desc="replay", leave=False) as bar,
     ):
@@ -150,8 +224,8 @@ def replay(
                 idx = np.abs(batch.wrenches).argmax(axis=0)
                 at_max = np.take_along_axis(batch.wrenches, idx[None], axis=0)[0]
                 peak = np.where(bigger, at_max, peak)
-                disp = max(disp, float(np.linalg.norm(batch.pose[:, :3] - cg, axis=1).max()))
-                tilt = max(tilt, float(tilt_from_quaternions(batch.pose[:, 3:7]).max()))
+                disp = max(disp, float(np.linalg.norm(batch.position - cg, axis=1).max()))
+                tilt = max(tilt, float(tilt_from_quaternions(batch.quaternion).max()))
                 for report in batch.health:
                     last_health = [f"{s.name}: {s.message}" for s in report.statuses]
             bar.update(len(raws))

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import dataclasses
+import subprocess
+import sys
 from collections import defaultdict
 from collections.abc import Iterable, Sequence
 from functools import cache
@@ -27,6 +29,21 @@ REAL_DIR = ROOT.parent / "shared" / "data" / "real"
 G = 9.80665
 REST = np.array([0.0, 0.0, G])
 """Specific force of a foundation at rest, m/s², in F (gravity included: +g up)."""
+
+
+def run_python(
+    *args: str, cwd: Path = ROOT, env: dict[str, str] | None = None, timeout: float = 120.0
+) -> subprocess.CompletedProcess[str]:
+    """`python ARGS` in a new interpreter (this one's executable), output captured as text."""
+    return subprocess.run(
+        [sys.executable, *args],
+        cwd=cwd,
+        env=env,
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
 
 
 @cache

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from types import TracebackType
+from typing import Any
 
 import numpy as np
 from rosbags.highlevel import AnyReader
@@ -119,9 +120,7 @@ class OutputBag:
         offered_qos: Mapping[str, Sequence[Qos]] | None = None,
     ) -> None:
         self.path = Path(path)
-        if self.path.exists():
-            msg = f"{self.path}: output bag exists; choose another path or remove it"
-            raise BagError(msg)
+        check_new_bag(self.path)
         self._writer = Writer(
             self.path, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP
         )
@@ -151,6 +150,13 @@ class OutputBag:
         self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None
     ) -> None:
         self.close()
+
+
+def check_new_bag(path: str | Path) -> None:
+    """Raise BagError if `path` exists: an output bag is always new (rosbags cannot overwrite)."""
+    if Path(path).exists():
+        msg = f"{path}: output bag exists; choose another path or remove it"
+        raise BagError(msg)
 
 
 def write_bag(
@@ -183,7 +189,7 @@ def read_topics(
     with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
         conns = [c for c in reader.connections if c.msgtype in msgtypes]
         for conn, _, raw in reader.messages(connections=conns):
-            msg = reader.deserialize(raw, conn.msgtype)
+            msg: Any = reader.deserialize(raw, conn.msgtype)  # a generated message class
             stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
             stamps, rows, _ = out.setdefault(conn.topic, ([], [], conn.msgtype))
             stamps.append(stamp)
@@ -191,12 +197,13 @@ def read_topics(
     return {k: (np.array(s), np.array(r), t) for k, (s, r, t) in out.items()}
 
 
-def _numbers(msg: object) -> tuple[float, ...]:
+def _numbers(msg: Any) -> tuple[float, ...]:
+    """The numbers of a PoseStamped, WrenchStamped or Vector3Stamped, as `read_topics` rows."""
     if hasattr(msg, "pose"):
-        p, q = msg.pose.position, msg.pose.orientation  # type: ignore[attr-defined]
+        p, q = msg.pose.position, msg.pose.orientation
         return (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
     if hasattr(msg, "wrench"):
-        f, t = msg.wrench.force, msg.wrench.torque  # type: ignore[attr-defined]
+        f, t = msg.wrench.force, msg.wrench.torque
         return (f.x, f.y, f.z, t.x, t.y, t.z)
-    v = msg.vector  # type: ignore[attr-defined]
+    v = msg.vector
     return (v.x, v.y, v.z)

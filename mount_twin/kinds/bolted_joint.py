@@ -102,20 +102,19 @@ class BoltedJoint:
 
 def read(r: Reader, name: str, position: tuple, rpy: tuple) -> BoltedJoint:
     """Parse and check the kind's keys (units in `BoltedJoint`)."""
-    pos = {"lo": 0.0, "lo_open": True}
     joint = BoltedJoint(
         name=name,
         position=position,
         orientation_rpy=rpy,
-        bolt_stiffness=r.number("bolt_stiffness", **pos),
-        clamp_stiffness=r.number("clamp_stiffness", **pos),
+        bolt_stiffness=r.positive("bolt_stiffness"),
+        clamp_stiffness=r.positive("clamp_stiffness"),
         preload=r.number("preload", lo=0.0),
-        yield_force=r.number("yield_force", **pos),
+        yield_force=r.positive("yield_force"),
         hardening=r.number("hardening", 0.02, lo=0.0, hi=0.99),
-        ultimate_force=r.number("ultimate_force", **pos),
-        ultimate_plastic_elongation=r.number("ultimate_plastic_elongation", 2.0e-3, **pos),
+        ultimate_force=r.positive("ultimate_force"),
+        ultimate_plastic_elongation=r.positive("ultimate_plastic_elongation", 2.0e-3),
         friction=r.number("friction", 0.15, lo=0.0),
-        shear_stiffness=r.number("shear_stiffness", 1.0e9, **pos),
+        shear_stiffness=r.positive("shear_stiffness", 1.0e9),
         hole_clearance=r.number("hole_clearance", 1.0e-3, lo=0.0),
         bearing_stiffness=r.number("bearing_stiffness", 5.0e8, lo=0.0),
         axial_damping=r.number("axial_damping", 0.0, lo=0.0),

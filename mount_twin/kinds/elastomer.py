@@ -154,7 +154,7 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> Elastomer:
         h = r.sub("hysteresis")
         hyst = Hysteresis(
             ratio=h.number("ratio", lo=0.0, hi=1.0),
-            a=h.number("A", 1.0, lo=0.0, lo_open=True),
+            a=h.positive("A", 1.0),
             beta=h.number("beta"),
             gamma=h.number("gamma"),
             n=h.number("n", 1.0, lo=1.0),
@@ -168,7 +168,7 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> Elastomer:
         sn = r.sub("snubber")
         snub = Snubber(
             gap=sn.number("gap", lo=0.0),
-            stiffness=sn.number("stiffness", lo=0.0, lo_open=True),
+            stiffness=sn.positive("stiffness"),
             exponent=sn.number("exponent", 1.5, lo=1.0),
             damping=sn.number("damping", 0.0, lo=0.0),
             axes=_axes(sn, "axes"),
@@ -183,13 +183,13 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> Elastomer:
         name=name,
         position=position,
         orientation_rpy=rpy,
-        stiffness_linear=k1,  # type: ignore[arg-type]
-        stiffness_cubic=r.vector("stiffness_cubic", 3, (0.0, 0.0, 0.0), lo=0.0),  # type: ignore[arg-type]
+        stiffness_linear=k1,
+        stiffness_cubic=r.vector("stiffness_cubic", 3, (0.0, 0.0, 0.0), lo=0.0),
         force_table=tuple(tables),
-        damping=r.vector("damping", 3, (0.0, 0.0, 0.0), lo=0.0),  # type: ignore[arg-type]
-        rotational_stiffness=r.vector("rotational_stiffness", 3, (0.0,) * 3, lo=0.0),  # type: ignore[arg-type]
-        rotational_damping=r.vector("rotational_damping", 3, (0.0,) * 3, lo=0.0),  # type: ignore[arg-type]
-        rated_deflection=r.vector("rated_deflection", 3, (0.0,) * 3, lo=0.0),  # type: ignore[arg-type]
+        damping=r.vector("damping", 3, (0.0, 0.0, 0.0), lo=0.0),
+        rotational_stiffness=r.vector("rotational_stiffness", 3, (0.0,) * 3, lo=0.0),
+        rotational_damping=r.vector("rotational_damping", 3, (0.0,) * 3, lo=0.0),
+        rated_deflection=r.vector("rated_deflection", 3, (0.0,) * 3, lo=0.0),
         hysteresis=hyst,
         snubber=snub,
     )

@@ -58,8 +58,8 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> ShearKey:
         name=name,
         position=position,
         orientation_rpy=rpy,
-        stiffness=r.vector("stiffness", 3, lo=0.0),  # type: ignore[arg-type]
-        damping=r.vector("damping", 3, (0.0, 0.0, 0.0), lo=0.0),  # type: ignore[arg-type]
+        stiffness=r.vector("stiffness", 3, lo=0.0),
+        damping=r.vector("damping", 3, (0.0, 0.0, 0.0), lo=0.0),
         clearance=r.number("clearance", 0.0, lo=0.0),
         allowable_force=r.number("allowable_force", 0.0, lo=0.0),
         engagement_height=r.number("engagement_height", 0.0, lo=0.0),

@@ -9,6 +9,7 @@ from typing import Any
 import yaml
 
 from mount_twin.errors import SceneError
+from mount_twin.integrate.methods import METHODS
 from mount_twin.kinds import KINDS
 from mount_twin.scene.description import (
     DOF_NAMES,
@@ -29,7 +30,7 @@ START_TILT_MAX_RAD = 1.55
 """Largest tilt θ of a given start pose, rad (88.8°): the chart degenerates at π/2."""
 
 MOUNT_KINDS = ("linear", *KINDS)
-STEPPERS = ("dopri54",)
+STEPPERS = tuple(METHODS)
 
 
 def load_scene_file(path: str | Path) -> Scene:
@@ -95,7 +96,7 @@ def scene_from_dict(
 
 
 def _body(r: Reader) -> Body:
-    mass = r.number("mass", lo=0.0, lo_open=True)
+    mass = r.positive("mass")
     cg = r.vector("cg", 3)
     inertia = r.vector("inertia", 6)
     ixx, iyy, izz, ixy, ixz, iyz = inertia
@@ -105,7 +106,7 @@ def _body(r: Reader) -> Body:
     if ixx + iyy < izz or iyy + izz < ixx or izz + ixx < iyy:
         raise r.error("inertia", f"violates the triangle inequality of a rigid body: {inertia!r}")
     r.finish()
-    return Body(mass=mass, cg=cg, inertia=inertia)  # type: ignore[arg-type]
+    return Body(mass=mass, cg=cg, inertia=inertia)
 
 
 def _is_positive_definite(a: list[list[float]]) -> bool:
@@ -142,10 +143,10 @@ def _mount(r: Reader) -> Mount:
     if kind == "linear":
         mount: Mount = LinearMount(
             name=name,
-            position=position,  # type: ignore[arg-type]
-            orientation_rpy=rpy,  # type: ignore[arg-type]
-            stiffness=r.vector("stiffness", 6, lo=0.0),  # type: ignore[arg-type]
-            damping=r.vector("damping", 6, (0.0,) * 6, lo=0.0),  # type: ignore[arg-type]
+            position=position,
+            orientation_rpy=rpy,
+            stiffness=r.vector("stiffness", 6, lo=0.0),
+            damping=r.vector("damping", 6, (0.0,) * 6, lo=0.0),
             kind=kind,
         )
     else:
@@ -160,12 +161,12 @@ def _input(r: Reader) -> InputSpec:
         msg_type=r.choice("msg_type", INPUT_TYPES, d.msg_type),
         topic=r.string("topic", d.topic),
         frame_id=r.string("frame_id", d.frame_id),
-        sensor_rpy=r.vector("sensor_rpy", 3, d.sensor_rpy),  # type: ignore[arg-type]
-        sensor_position=r.vector("sensor_position", 3, d.sensor_position),  # type: ignore[arg-type]
+        sensor_rpy=r.vector("sensor_rpy", 3, d.sensor_rpy),
+        sensor_position=r.vector("sensor_position", 3, d.sensor_position),
         includes_gravity=r.boolean("includes_gravity", d.includes_gravity),
         g=r.number("g", d.g, lo=0.0),
         hold=r.choice("hold", ("first_order", "zero_order"), d.hold),
-        max_gap_s=r.number("max_gap_s", d.max_gap_s, lo=0.0, lo_open=True),
+        max_gap_s=r.positive("max_gap_s", d.max_gap_s),
         gap_policy=r.choice("gap_policy", ("reset", "bridge"), d.gap_policy),
         back_jump_reset_s=r.number("back_jump_reset_s", d.back_jump_reset_s, lo=0.0),
     )
@@ -178,8 +179,8 @@ def _initial(r: Reader) -> InitialState:
     state = InitialState(
         mode=r.choice("mode", ("equilibrium", "given"), d.mode),
         gravity=r.choice("gravity", ("first_sample", "nominal"), d.gravity),
-        pose=r.vector("pose", 6, d.pose),  # type: ignore[arg-type]
-        velocity=r.vector("velocity", 6, d.velocity),  # type: ignore[arg-type]
+        pose=r.vector("pose", 6, d.pose),
+        velocity=r.vector("velocity", 6, d.velocity),
     )
     alpha, gamma = state.pose[3], state.pose[4]
     cos_tilt = math.sqrt(max(math.cos(gamma) ** 2 - math.sin(alpha) ** 2, 0.0))
@@ -198,7 +199,7 @@ def _integration(r: Reader) -> Integration:
     spec = Integration(
         method=r.choice("method", STEPPERS, d.method),
         rtol=r.number("rtol", d.rtol, lo=1.0e-13, hi=0.1),
-        atol=r.number("atol", d.atol, lo=0.0, lo_open=True),
+        atol=r.positive("atol", d.atol),
         max_substeps=r.integer("max_substeps", d.max_substeps, lo=1),
     )
     r.finish()
@@ -213,9 +214,7 @@ def _outputs(r: Reader) -> Outputs:
         wrenches=r.boolean("wrenches", d.wrenches),
         tf=r.boolean("tf", d.tf),
         decimation=r.integer("decimation", d.decimation, lo=1),
-        diagnostics_period_s=r.number(
-            "diagnostics_period_s", d.diagnostics_period_s, lo=0.0, lo_open=True
-        ),
+        diagnostics_period_s=r.positive("diagnostics_period_s", d.diagnostics_period_s),
         tilt_warn_rad=r.number("tilt_warn_rad", d.tilt_warn_rad, lo=0.0, hi=math.pi / 2),
         alarm_margin=r.number("alarm_margin", d.alarm_margin, lo=0.0, hi=1.0),
     )

@@ -12,6 +12,7 @@ from collections.abc import Iterator, Mapping
 from typing import Any
 
 from mount_twin.errors import SceneError
+from mount_twin.integrate.methods import METHODS
 from mount_twin.kinds import KINDS
 from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import load_scene_file, read_scene_yaml, scene_from_dict
@@ -48,7 +49,7 @@ PARAMETERS: dict[str, tuple[str, str]] = {
     "initial_state.gravity": ("string", "Equilibrium gravity: first_sample or nominal"),
     "initial_state.pose": ("double_array", "[X, Y, Z] m, [α, γ, δ] rad: start pose, frozen DOFs"),
     "initial_state.velocity": ("double_array", "[X', Y', Z'] m/s, [α', γ', δ'] rad/s (given)"),
-    "integration.method": ("string", "Stepper: dopri54"),
+    "integration.method": ("string", "Stepper: " + ", ".join(METHODS)),
     "integration.rtol": ("double", "Relative tolerance of the stepper"),
     "integration.atol": ("double", "Absolute tolerance of the stepper (m, rad, m/s, rad/s)"),
     "integration.max_substeps": ("integer", "Most substeps between two input samples"),

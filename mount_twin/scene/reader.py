@@ -4,9 +4,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, Literal, overload
 
 from mount_twin.errors import SceneError
+
+Vec3 = tuple[float, float, float]
+"""Three floats: what `Reader.vector(key, 3)` returns."""
+Vec6 = tuple[float, float, float, float, float, float]
+"""Six floats: what `Reader.vector(key, 6)` returns."""
 
 
 class Reader:
@@ -85,6 +90,10 @@ class Reader:
         """A finite float in [lo, hi] (or (lo, hi] with lo_open)."""
         return self._check_number(key, self.raw(key, default), lo, hi, lo_open)
 
+    def positive(self, key: str, default: float | None = None) -> float:
+        """A finite float > 0."""
+        return self.number(key, default, lo=0.0, lo_open=True)
+
     def integer(self, key: str, default: int | None = None, *, lo: int = 0) -> int:
         """An integer ≥ lo."""
         value = self.raw(key, default)
@@ -115,6 +124,21 @@ class Reader:
             raise self.error(key, f"expected one of {', '.join(options)}, got {value!r}")
         return value
 
+    @overload
+    def vector(
+        self, key: str, n: Literal[3], default: Sequence[float] | None = None, *, lo: float = ...
+    ) -> Vec3: ...
+
+    @overload
+    def vector(
+        self, key: str, n: Literal[6], default: Sequence[float] | None = None, *, lo: float = ...
+    ) -> Vec6: ...
+
+    @overload
+    def vector(
+        self, key: str, n: int, default: Sequence[float] | None = None, *, lo: float = ...
+    ) -> tuple[float, ...]: ...
+
     def vector(
         self,
         key: str,
@@ -123,7 +147,8 @@ class Reader:
         *,
         lo: float = -math.inf,
     ) -> tuple[float, ...]:
-        """A list of exactly `n` finite floats, each ≥ lo."""
+        """A list of exactly `n` finite floats, each ≥ lo; typed `Vec3` for a literal n = 3 and
+        `Vec6` for 6, so it fills the dataclasses' fixed-length fields as it is."""
         value = self.raw(key, None if default is None else tuple(default))
         if isinstance(value, (str, bytes)) or not isinstance(value, Sequence):
             raise self.error(key, f"expected a list of {n} numbers, got {value!r}")

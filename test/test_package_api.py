@@ -1,0 +1,113 @@
+"""The package face: `mount_twin.__all__` resolves lazily, `import mount_twin` stays light, the
+package ships py.typed, and the usage example of its docstring (the README's) runs."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+from io_helpers import run_python
+
+import mount_twin
+
+ROOT = Path(__file__).resolve().parents[1]
+HEAVY = ("numba", "numpy", "scipy", "rosbags", "yaml")
+
+
+def usage_example() -> str:
+    """The indented code block of mount_twin's docstring, dedented."""
+    lines = (mount_twin.__doc__ or "").splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("    "))
+    block = []
+    for line in lines[start:]:
+        if line.strip() and not line.startswith("    "):
+            break
+        block.append(line)
+    return textwrap.dedent("\n".join(block)).strip() + "\n"
+
+
+def test_every_name_in_all_resolves() -> None:
+    assert len(set(mount_twin.__all__)) == len(mount_twin.__all__)
+    for name in mount_twin.__all__:
+        assert getattr(mount_twin, name) is not None, name
+    assert set(mount_twin.__all__) <= set(dir(mount_twin))
+    namespace: dict[str, object] = {}
+    exec("from mount_twin import *", namespace)
+    assert set(mount_twin.__all__) <= set(namespace)
+
+
+def test_exported_names_are_the_defining_modules_objects() -> None:
+    from mount_twin.engine.batch import OutputBatch, SampleBatch
+    from mount_twin.engine.engine import TwinEngine
+    from mount_twin.errors import SceneError
+    from mount_twin.replay import ReplaySummary, replay
+    from mount_twin.scene.loader import load_scene_file
+
+    assert mount_twin.TwinEngine is TwinEngine
+    assert mount_twin.SampleBatch is SampleBatch and mount_twin.OutputBatch is OutputBatch
+    assert mount_twin.load_scene_file is load_scene_file
+    assert mount_twin.SceneError is SceneError
+    assert mount_twin.ReplaySummary is ReplaySummary
+    assert mount_twin.replay_bag is replay
+
+
+def test_an_unknown_name_is_an_attribute_error() -> None:
+    with pytest.raises(AttributeError, match="module 'mount_twin' has no attribute 'nope'"):
+        _ = mount_twin.nope  # type: ignore[attr-defined]
+
+
+def test_importing_the_package_imports_no_numba_numpy_or_rosbags() -> None:
+    done = run_python(
+        "-c",
+        "import sys, mount_twin\n"
+        "assert mount_twin.MountTwinError.__name__ == 'MountTwinError'\n"
+        f"print(sorted(m for m in {HEAVY!r} if m in sys.modules))\n",
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[]"
+
+
+def test_a_lazy_name_is_imported_on_first_use_and_replay_bag_is_the_function() -> None:
+    done = run_python(
+        "-c",
+        "import sys, mount_twin\n"
+        "engine = mount_twin.TwinEngine\n"
+        "assert 'numba' in sys.modules, 'TwinEngine imports the engine on first use'\n"
+        "import mount_twin.replay\n"
+        "assert mount_twin.replay_bag is mount_twin.replay.replay\n",
+    )
+    assert done.returncode == 0, done.stderr
+
+
+def test_the_package_ships_py_typed() -> None:
+    assert (Path(mount_twin.__file__).parent / "py.typed").is_file()
+    assert 'package_data={PACKAGE: ["py.typed"]}' in (ROOT / "setup.py").read_text("utf-8")
+
+
+def test_the_usage_example_runs_and_the_mounts_carry_the_body(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mount_twin.physics.rotations import rpy_matrix
+
+    code = usage_example()
+    assert 5 <= len(code.splitlines()) <= 10, code
+    monkeypatch.chdir(ROOT)
+    namespace: dict[str, object] = {}
+    exec(compile(code, "mount_twin.__doc__", "exec"), namespace)
+    assert capsys.readouterr().out.strip(), "the example prints the last wrenches"
+    engine, out = namespace["engine"], namespace["out"]
+    assert isinstance(engine, mount_twin.TwinEngine) and isinstance(out, mount_twin.OutputBatch)
+    assert len(out) == 100 and engine.counts["accepted"] == 100
+    scene = engine.scene
+    assert out.wrenches.shape == (100, len(scene.mounts), 6)
+    # at rest from the start: the static equilibrium holds, the mounts carry m·g
+    np.testing.assert_allclose(out.wrenches[-1], out.wrenches[0], atol=1e-6)
+    force = sum(
+        rpy_matrix(*m.orientation_rpy) @ out.wrenches[-1, i, :3]
+        for i, m in enumerate(scene.mounts)
+    )
+    np.testing.assert_allclose(
+        force, [0.0, 0.0, scene.body.mass * scene.input.g], rtol=0.0, atol=1e-6
+    )
