@@ -87,7 +87,8 @@ def run(rate_hz: float, seconds: float, options: list[str]) -> dict[str, float]:
             if status.name == "mount_twin: input":
                 values = {kv.key: kv.value for kv in status.values}
                 lost = {k: int(values.get(k, 0)) for k in lost}
-                quiet = status.message.startswith("no input received")  # before or after
+                # the clock's reports before the first sample and after the last one
+                quiet = status.message.startswith(("no input received", "input stalled"))
                 if not quiet and int(status.level) > level:
                     level, worst = int(status.level), status.message
 
