@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test"))
-from ros_harness import PARAMS_FILE, NodeProcess, Peer, fresh_domain
+from ros_harness import PARAMS_FILE, NodeProcess, Peer, fresh_domain, wait_for
 
 from mount_twin.io.messages import DIAGNOSTICS, IMU, TYPESTORE, imu_messages
 
@@ -60,6 +60,12 @@ def run(rate_hz: float, seconds: float, options: list[str]) -> dict[str, float]:
     peer = Peer(domain, "bench_recorder")
     peer.record({POSE: "geometry_msgs/msg/PoseStamped", "/diagnostics": DIAGNOSTICS})
     node = NodeProcess(domain, ["--params-file", str(PARAMS_FILE), *options])
+    # the recorder must have matched the node's publishers before the first output: a reliable,
+    # volatile subscriber that matches late misses what came before and gets the next late
+    if not wait_for(lambda: peer.connected(POSE) or not node.alive, 120.0):
+        node.stop()
+        raise RuntimeError(f"the node did not start: {node.stderr}")
+    time.sleep(0.5)
     publisher = subprocess.Popen(
         [sys.executable, __file__, "--publish", str(domain), str(rate_hz), str(seconds)],
         stdout=subprocess.PIPE,
