@@ -11,6 +11,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from mount_twin.integrate.settings import CHAINED
 from mount_twin.integrate.stepper import advance
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import mount_monitors, outputs, rhs_after_rate_step
@@ -102,7 +103,7 @@ class Samples(NamedTuple):
 class RunOptions(NamedTuple):
     """zero_order: hold each sample until the next instead of interpolating linearly.
     decimation: publish every Nth sample. chain: start each interval from the previous one's
-    last stage when the stepper says it is there (settings[4]; first-order hold, no discrete
+    last stage when the stepper says it is there (settings[CHAINED]; first-order hold, no discrete
     switches between samples, and nothing else used the scratch since: `Stepper.reset`
     clears it)."""
 
@@ -161,13 +162,13 @@ def run_samples(integ, m, s, u, y, samples, opts, out, watch) -> tuple[int, int]
             w_dot = hold * (w[j, i] - w[j - 1, i]) / dt
             d_wdot[i] = w_dot - u[10 + i]
             u[10 + i] = w_dot
-        if opts.chain and settings[4] == 1.0:
+        if opts.chain and settings[CHAINED] == 1.0:
             # First-order hold: the input is continuous at t[j − 1] but for Ω', so the last
             # stage of the previous interval, moved to the new Ω', starts this one. Live (one
             # sample per call) and replay (many) thus compute exactly the same numbers.
             rhs_after_rate_step(m, s, d_wdot, work2d[0])
         else:
-            settings[4] = 0.0
+            settings[CHAINED] = 0.0
         status = advance(method, y, t[j - 1], t[j], settings, m, s, u, work2d, work1d, result)
         if status != 0:
             return j - 1, status

@@ -20,6 +20,7 @@ from mount_twin.integrate.methods import (
     SUCCESS,
     TOO_MANY_STEPS,
 )
+from mount_twin.integrate.settings import ATOL, CHAINED, MAX_SUBSTEPS, RTOL, STEP
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import rhs
 
@@ -70,7 +71,8 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
         because its values stayed NaN or infinite, e.g. a mount kind code without a law); y is
         left at the last accepted time on failure.
     """
-    h, rtol, atol, max_steps = settings[0], settings[1], settings[2], settings[3]
+    h, rtol, atol = settings[STEP], settings[RTOL], settings[ATOL]
+    max_steps = settings[MAX_SUBSTEPS]
     n = y.shape[0]
     span = t1 - t0
     h = span if h <= 0.0 else h
@@ -78,15 +80,15 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
     err_max, n_acc, n_rej = 0.0, 0, 0
     rhs_failed = False
     not_finite = False  # the last rejection was for NaN or inf (stage state or error norm)
-    if settings[4] == 0.0:  # else the caller put dy/dt at (t0, y) for this input in k[0]
+    if settings[CHAINED] == 0.0:  # else the caller put dy/dt at (t0, y) for this input in k[0]
         rhs_failed = rhs(t, y, m, s, u, k[0]) != 0
-    settings[4] = 0.0  # set again below on success: k[0] is then dy/dt at (t1, y)
+    settings[CHAINED] = 0.0  # set again below on success: k[0] is then dy/dt at (t1, y)
     while t < t1:
         if n_acc + n_rej >= max_steps:
-            settings[0], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
+            settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
             return NOT_FINITE if not_finite else TOO_MANY_STEPS
         if h < MIN_STEP_FRACTION * span or (rhs_failed and n_acc == 0 and t == t0):
-            settings[0], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
+            settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
             if not_finite:
                 return NOT_FINITE
             return LEFT_CHART if rhs_failed else STEP_TOO_SMALL
@@ -141,6 +143,6 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
         else:
             h = step * min(1.0, factor)
             n_rej += 1
-    settings[0], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
-    settings[4] = 1.0
+    settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
+    settings[CHAINED] = 1.0
     return SUCCESS

@@ -17,7 +17,13 @@ from functools import partial
 import numpy as np
 
 from mount_twin.integrate import dopri54
-from mount_twin.integrate.methods import DOPRI54, METHODS, STATUS_TEXT, UNKNOWN_METHOD
+from mount_twin.integrate.methods import (
+    DOPRI54,
+    METHODS,
+    STATUS_TEXT,
+    UNKNOWN_METHOD,
+)
+from mount_twin.integrate.settings import ATOL, CHAINED, MAX_SUBSTEPS, N_SETTINGS, RTOL, STEP
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import ModelArrays, Scratch
 
@@ -39,9 +45,8 @@ class Stepper:
     Attributes:
         name: scene name of the method.
         method: its id for `advance`.
-        settings: [step proposal s, rtol, atol, most substeps per interval, chain flag: 1
-            after a success, when work2d[0] holds dy/dt at the end state; a caller that changes
-            the input between calls moves it to the new input or sets 0 (see dopri54.advance)].
+        settings: (N_SETTINGS,) by the slots of `integrate.settings` (STEP, RTOL, ATOL,
+            MAX_SUBSTEPS, CHAINED).
         work2d, work1d: the method's work arrays.
         result: last advance's [largest accepted error norm, accepted, rejected substeps].
     """
@@ -55,8 +60,8 @@ class Stepper:
 
     def reset(self) -> None:
         """Forget the step-size history (after a restart of the state)."""
-        self.settings[0] = 0.0
-        self.settings[4] = 0.0
+        self.settings[STEP] = 0.0
+        self.settings[CHAINED] = 0.0
 
 
 def new_stepper(method: str, n: int, rtol: float, atol: float, max_substeps: int) -> Stepper:
@@ -69,7 +74,8 @@ def new_stepper(method: str, n: int, rtol: float, atol: float, max_substeps: int
         msg = f"bad stepper settings: n={n}, rtol={rtol}, atol={atol}, max={max_substeps}"
         raise ValueError(msg)
     spec = METHODS[method]
-    settings = np.array([0.0, rtol, atol, float(max_substeps), 0.0])
+    settings = np.zeros(N_SETTINGS)
+    settings[RTOL], settings[ATOL], settings[MAX_SUBSTEPS] = rtol, atol, float(max_substeps)
     return Stepper(spec.name, spec.id, settings, np.zeros((spec.stages, n)), np.zeros(n))
 
 
