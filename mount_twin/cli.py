@@ -15,9 +15,12 @@ from mount_twin.errors import MountTwinError
 
 if TYPE_CHECKING:
     from mount_twin.io.signals import Signal
+    from mount_twin.replay import ReplaySummary
 
 DEFAULT_SCENE = "pump_8_mounts.scene.yaml"
 DEFAULT_BAG = "ship_motion_1khz"
+FAIL_ON = ("never", "warn", "error")
+"""`replay --fail-on` choices; the index of warn and error is their diagnostics level."""
 
 
 def share_dir() -> Path:
@@ -58,6 +61,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     rp.add_argument("--chunk", type=int, default=2000, help="messages per engine batch")
     rp.add_argument("--no-progress", action="store_true")
     rp.add_argument("--plot", metavar="PNG", help="also plot the outputs into this PNG")
+    rp.add_argument(
+        "--fail-on",
+        choices=FAIL_ON,
+        default="never",
+        help="exit 4 if the worst diagnostics level of the run reaches this (default: never)",
+    )
     dm = sub.add_parser("demo", help="replay the bundled bag through the bundled default scene")
     dm.add_argument("-o", "--output", default="demo_out", help="output bag directory (new)")
     dm.add_argument("--plot", metavar="PNG", help="also plot the outputs into this PNG")
@@ -102,6 +111,29 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
 
 
+def _verdict(summary: ReplaySummary, fail_on: str) -> int:
+    """The exit status of a replay: 3 if no input sample was accepted (saying why), 4 if the
+    run's worst diagnostics level reached `fail_on`, else 0."""
+    if not summary.counts.get("accepted", 0):
+        rejected = {k: v for k, v in summary.counts.items() if k.startswith("rejected_") and v}
+        why = (
+            f"{summary.counts.get('received', 0)} received, rejected: {rejected}"
+            if rejected
+            else "the input topic holds no message"
+        )
+        if summary.wrong_frame_id is not None:
+            why += f"; the bag's header.frame_id is {summary.wrong_frame_id!r}: see input.frame_id"
+        print(f"mount-twin: error: no input sample was accepted ({why})", file=sys.stderr)
+        return 3
+    if fail_on != "never" and summary.worst_level >= FAIL_ON.index(fail_on):
+        from mount_twin.replay import LEVEL_NAMES
+
+        level = LEVEL_NAMES[summary.worst_level]
+        print(f"mount-twin: diagnostics reached {level} (--fail-on {fail_on})", file=sys.stderr)
+        return 4
+    return 0
+
+
 def _run(args: argparse.Namespace) -> int:
     """Carry out a parsed command line."""
     if args.cmd in ("replay", "demo"):
@@ -134,7 +166,7 @@ def _run(args: argparse.Namespace) -> int:
                 summary.origin_s,
             )
             print(f"plot: {png}")
-        return 0
+        return _verdict(summary, getattr(args, "fail_on", "never"))
     from mount_twin.io.signals import half_sine_shock, read_csv, ship_motion
 
     if args.cmd == "generate":

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from mount_twin.engine.batch import MountEvent
+from mount_twin.engine.batch import OK, HealthReport, HealthStatus, MountEvent
 from mount_twin.engine.health import tilt_from_quaternions
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import (
@@ -29,6 +29,8 @@ from mount_twin.io.messages import (
 from mount_twin.scene.description import Scene
 from mount_twin.stream import TwinStream
 
+LEVEL_NAMES = ("OK", "WARN", "ERROR")
+"""Diagnostics levels by value."""
 NODE_NAME = "mount_twin"
 """The node name output topics resolve against, as with `ros2 run` and the default launch."""
 
@@ -106,10 +108,16 @@ class ReplaySummary:
     peak_wrench: dict[str, np.ndarray] = field(default_factory=dict)
     tilt_max_rad: float = 0.0
     displacement_max_m: float = 0.0
-    health: list[str] = field(default_factory=list)
+    worst: dict[str, HealthStatus] = field(default_factory=dict)
     events: list[MountEvent] = field(default_factory=list)
     utilisation_max: dict[str, float] = field(default_factory=dict)
     origin_s: int = 0  # whole seconds to add to event stamps to get header stamps
+    wrong_frame_id: str | None = None  # the last header.frame_id rejected as wrong, if any
+
+    @property
+    def worst_level(self) -> int:
+        """The worst diagnostics level of the whole run (OK, WARN, ERROR: 0, 1, 2)."""
+        return max((s.level for s in self.worst.values()), default=OK)
 
     @property
     def real_time_factor(self) -> float:
@@ -147,8 +155,18 @@ class ReplaySummary:
                 f"first {self.origin_s + same[0].stamp:.6f} s  "
                 f"|F| max {max(e.force for e in same):.4g} N"
             )
-        lines += [f"  diagnostics: {h}" for h in self.health]
+        lines.append(f"  diagnostics, worst over the run: {LEVEL_NAMES[self.worst_level]}")
+        lines += [
+            f"    {LEVEL_NAMES[s.level]:5} {s.name}: {s.message}" for s in self.worst.values()
+        ]
         return "\n".join(lines)
+
+
+def _keep_worst(worst: dict[str, HealthStatus], report: HealthReport) -> None:
+    """Keep, per status name, the first status of the highest level seen."""
+    for status in report.statuses:
+        if status.name not in worst or status.level > worst[status.name].level:
+            worst[status.name] = status
 
 
 def _grouped(events: list[MountEvent]) -> dict[tuple[str, str], list[MountEvent]]:
@@ -202,7 +220,7 @@ def replay(
     first_stamp = last_stamp = None
     cg = np.array(scene.body.cg)
     wall0 = time.perf_counter()
-    last_health: list[str] = []
+    worst: dict[str, HealthStatus] = {}
     with (
         bag,
         OutputBag(output_path, topics, {TF_STATIC_TOPIC: [LATCHED_QOS]}) as out,
@@ -226,13 +244,13 @@ def replay(
                 peak = np.where(bigger, at_max, peak)
                 disp = max(disp, float(np.linalg.norm(batch.position - cg, axis=1).max()))
                 tilt = max(tilt, float(tilt_from_quaternions(batch.quaternion).max()))
-                for report in batch.health:
-                    last_health = [f"{s.name}: {s.message}" for s in report.statuses]
+            for report in batch.health if batch is not None else []:
+                _keep_worst(worst, report)
             bar.update(len(raws))
         for topic, stamp, raw in stream.finish():  # the last, partial diagnostics period
             out.write(resolved[topic], stamp, raw)
         if stream.final_report is not None:
-            last_health = [f"{s.name}: {s.message}" for s in stream.final_report.statuses]
+            _keep_worst(worst, stream.final_report)
         written = out.written
     wall = time.perf_counter() - wall0
     span = float(last_stamp - first_stamp) if first_stamp is not None else 0.0
@@ -246,8 +264,9 @@ def replay(
         {m.name: peak[i] for i, m in enumerate(scene.mounts)},
         tilt,
         disp,
-        last_health,
+        worst,
         list(stream.engine.events),
         stream.engine.utilisation_max,
         stream.engine.health.origin_s,
+        stream.engine.health.last_wrong_frame_id,
     )

@@ -32,7 +32,8 @@ def test_demo_replays_the_bundled_bag_and_prints_a_summary(
     text = capsys.readouterr().out
     assert "real-time factor" in text
     assert "5000 received, 5000 accepted" in text and "integration failures: 0" in text
-    assert "diagnostics: mount_twin: input: ok" in text
+    assert "diagnostics, worst over the run: OK" in text
+    assert "    OK    mount_twin: input: ok" in text
     assert list(out.glob("*.mcap")), "demo must write an mcap bag"
     with AnyReader([out], default_typestore=TYPESTORE) as reader:  # counts only: 50k messages
         counts = {c.topic: c.msgcount for c in reader.connections}
@@ -193,6 +194,36 @@ def test_replay_of_a_bag_without_the_input_topic_exits_2(
     )
     assert rc == 2
     assert f"{bag}: no topic '/deck/imu'" in capsys.readouterr().err
+
+
+def test_replay_where_no_sample_is_accepted_exits_3_naming_the_frames(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The bag says imu_link, the scene expects deck_imu: an empty output is no success."""
+    bag = tmp_path / "in"
+    gen = ["generate", "ship-motion", "-o", str(bag), "--duration", "0.05", "--topic"]
+    assert main([*gen, "/deck/imu", "--frame-id", "imu_link"]) == 0
+    scene = _scene_file(tmp_path)
+    out = ["-o", str(tmp_path / "out"), "--no-progress"]
+    assert main(["replay", str(bag), "--scene", str(scene), *out]) == 3
+    err = capsys.readouterr().err
+    assert "no input sample was accepted (50 received" in err
+    assert "'rejected_wrong_frame': 50" in err and "frame_id is 'imu_link'" in err
+
+
+@pytest.mark.parametrize(("fail_on", "code"), [("never", 0), ("warn", 4), ("error", 4)])
+def test_replay_fail_on_sets_the_exit_code_by_the_worst_level_of_the_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], fail_on: str, code: int
+) -> None:
+    """The genset shock opens joints (ERROR): the verdict is the worst level of the run."""
+    genset = SCENE_FILE.parent / "genset_bolted_keyed.scene.yaml"
+    bag = SCENE_FILE.parents[1] / "bags" / "genset_shock_10khz"
+    args = ["replay", str(bag), "--scene", str(genset), "-o", str(tmp_path / "out")]
+    assert main([*args, "--no-progress", "--fail-on", fail_on]) == code
+    captured = capsys.readouterr()
+    assert "diagnostics, worst over the run: ERROR" in captured.out
+    assert "ERROR mount_twin: mount foot_fl: " in captured.out
+    assert ("diagnostics reached ERROR" in captured.err) == (code == 4)
 
 
 def test_unknown_subcommand_is_an_argparse_error() -> None:
