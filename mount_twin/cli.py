@@ -126,7 +126,7 @@ def _verdict(summary: ReplaySummary, fail_on: str) -> int:
         print(f"mount-twin: error: no input sample was accepted ({why})", file=sys.stderr)
         return 3
     if fail_on != "never" and summary.worst_level >= FAIL_ON.index(fail_on):
-        from mount_twin.replay import LEVEL_NAMES
+        from mount_twin.engine.batch import LEVEL_NAMES
 
         level = LEVEL_NAMES[summary.worst_level]
         print(f"mount-twin: diagnostics reached {level} (--fail-on {fail_on})", file=sys.stderr)

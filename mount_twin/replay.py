@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import hashlib
-import os
 import sys
 import threading
 import time
@@ -15,7 +13,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from mount_twin.engine.batch import OK, HealthReport, HealthStatus, MountEvent
+from mount_twin.engine.batch import LEVEL_NAMES, OK, HealthReport, HealthStatus, MountEvent
 from mount_twin.engine.health import tilt_from_quaternions
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import (
@@ -26,11 +24,10 @@ from mount_twin.io.messages import (
     resolve,
     static_transforms,
 )
+from mount_twin.physics.compiled import kernel_cache_is_cold
 from mount_twin.scene.description import Scene
 from mount_twin.stream import TwinStream
 
-LEVEL_NAMES = ("OK", "WARN", "ERROR")
-"""Diagnostics levels by value."""
 NODE_NAME = "mount_twin"
 """The node name output topics resolve against, as with `ros2 run` and the default launch."""
 
@@ -39,36 +36,6 @@ COMPILE_NOTICE = "mount-twin: compiling kernels (first run only, 20-60 s)..."
 COMPILE_NOTICE_AFTER_S = 3.0
 """With kernels cached, the notice still comes once loading them has taken this long (s): a
 scene needing kernels not compiled yet, or sources edited since. Loading takes < 1 s."""
-
-
-def kernel_cache_is_cold() -> bool:
-    """True if numba has no compiled kernel of mount_twin cached for this Python: building a
-    TwinEngine will then compile them (20–60 s) rather than load them (< 1 s).
-
-    Cheap (a few directory listings; numba is not imported): looks for numba's index files,
-    `<module>.<function>-<line>.py<XY>.nbi`, where numba keeps them for each subpackage: under
-    $NUMBA_CACHE_DIR if set, else in its __pycache__, or in numba's user-wide cache where that
-    is not writable. The one place that knows numba's cache layout.
-    """
-    pattern = f"*.py{sys.version_info.major}{sys.version_info.minor}.nbi"
-    package = os.path.dirname(os.path.abspath(__file__))
-    user_dir = os.environ.get("NUMBA_CACHE_DIR")
-    user_wide = os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "numba"
-    )
-    for entry in os.scandir(package):
-        if not entry.is_dir() or entry.name == "__pycache__":
-            continue
-        # numba's get_suitable_cache_subpath: <dir name>_<sha1 of the directory's path>
-        keyed = f"{entry.name}_{hashlib.sha1(entry.path.encode()).hexdigest()}"
-        dirs = (
-            [Path(user_dir, keyed)]
-            if user_dir
-            else [Path(entry.path, "__pycache__"), Path(user_wide, keyed)]
-        )
-        if any(next(d.glob(pattern), None) is not None for d in dirs):
-            return False
-    return True
 
 
 @contextmanager

@@ -26,10 +26,9 @@ class TwinStream:
     def __init__(self, scene: Scene) -> None:
         self.scene = scene
         self.engine = TwinEngine(assemble(scene))
-        # rosbags generates a type's (de)serializer at its first use and the output layouts are
+        # rosbags generates a type's serializer at its first use and the output layouts are
         # probed then: ~40 ms that would otherwise delay the first live sample.
         encode_outputs(scene, OutputBatch.empty(len(scene.mounts)), np.zeros(0, np.int64))
-        decode_inputs([], scene.input.msg_type)
         self.base: TimeBase | None = None
         self.last_outputs: OutputBatch | None = None
         self._last_ns = 0

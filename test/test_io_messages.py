@@ -162,7 +162,7 @@ def test_includes_gravity_false_uses_the_configured_g() -> None:
     lunar = 1.62
     scene = scene_with(input={"includes_gravity": False, "g": lunar})
     engine = engine_for(scene)
-    f, _ = engine._to_foundation(batch([0.0, 0.001], accel=np.zeros((2, 3))))
+    f, _, _ = engine._screen(batch([0.0, 0.001], accel=np.zeros((2, 3))))
     np.testing.assert_array_equal(f, [[0.0, 0.0, lunar]] * 2)
 
 

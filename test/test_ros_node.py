@@ -203,7 +203,6 @@ def test_bad_input_is_counted_and_the_node_keeps_running(tmp_path: Path) -> None
     stray warning; SIGTERM still publishes the last period and exits 0."""
     domain = fresh_domain()
     peer = Peer(domain)
-    scene = scene_from_params(dict(flatten(_params())), "p")
     peer.record({"/diagnostics": DIAGNOSTICS, "/mount_twin/pose": "geometry_msgs/msg/PoseStamped"})
     node = NodeProcess(domain, ["--params-file", str(PARAMS_FILE)])
     pub = peer.publisher(IMU, "/deck/imu")
@@ -251,7 +250,6 @@ def test_bad_input_is_counted_and_the_node_keeps_running(tmp_path: Path) -> None
     assert final["rejected_stamp_went_back"] == "1"
     assert final["rejected_wrong_frame"] == "5"
     assert final["restarts"] == "0"
-    del scene
 
 
 def test_diagnostics_go_out_every_clock_period_without_input() -> None:
@@ -360,7 +358,6 @@ def test_configuration_errors_end_the_node_with_one_line_naming_the_parameter(
 def test_a_renamed_namespaced_node_takes_the_bundled_params_file() -> None:
     domain = fresh_domain()
     peer = Peer(domain)
-    scene = scene_from_params(dict(flatten(_params())), "p")
     topic = resolve("~/pose", "twin2", "/ship")
     peer.record({topic: "geometry_msgs/msg/PoseStamped"})
     node = NodeProcess(
@@ -377,7 +374,6 @@ def test_a_renamed_namespaced_node_takes_the_bundled_params_file() -> None:
         peer.close()
     assert code == 0, node.stderr
     assert "8 mounts" in node.stderr
-    del scene
 
 
 def test_sim_time_without_clock_is_reported_and_with_clock_is_followed() -> None:

@@ -10,6 +10,8 @@ from mount_twin.physics import pose_row
 
 OK, WARN, ERROR = 0, 1, 2
 """Health levels, as diagnostic_msgs/DiagnosticStatus uses them."""
+LEVEL_NAMES = ("OK", "WARN", "ERROR")
+"""Each health level's name, by its value."""
 
 
 @dataclass

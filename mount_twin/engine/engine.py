@@ -258,11 +258,6 @@ class TwinEngine:
             skipped = {int(position[i]): n for i, n in skipped.items()}
         self.health.add_intervals(steps, skipped)
 
-    def _to_foundation(self, batch: SampleBatch) -> tuple[np.ndarray, np.ndarray]:
-        """Specific force (m/s²) and Ω (rad/s) in F, per sample (0 for unreadable readings)."""
-        f, w, _ = self._screen(batch)
-        return f, w
-
     def _screen(self, batch: SampleBatch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Specific force (m/s²) and Ω (rad/s) in F per sample, and which samples are finite:
         a finite stamp and readings within ±READING_LIMIT.

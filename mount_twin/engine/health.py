@@ -100,7 +100,7 @@ class HealthWindow:
 
     def lost_estimate(self) -> tuple[int, float]:
         """Samples lost in this window, estimated from its stamp intervals, and the nominal
-        interval (their median, s; NaN without intervals).
+        interval (s; NaN without intervals).
 
         An interval of k nominal intervals (rounded; a hole past HOLE of them) lost k − 1
         samples, less those received in it and rejected. The nominal interval is the mean of

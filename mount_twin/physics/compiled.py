@@ -29,6 +29,7 @@ override bypasses the locator list: do not set it for this package.
 from __future__ import annotations
 
 import hashlib
+import os
 import sys
 from collections.abc import Callable
 from functools import cache
@@ -166,6 +167,37 @@ def package_dispatchers() -> list[tuple[str, Dispatcher]]:
                 if isinstance(value, Dispatcher) and value.py_func.__module__ == name
             )
     return found
+
+
+def kernel_cache_is_cold() -> bool:
+    """True if numba has no compiled kernel of mount_twin cached for this Python: building a
+    TwinEngine will then compile them (20–60 s) rather than load them (< 1 s).
+
+    Cheap (a few directory listings): looks for numba's index files,
+    `<module>.<function>-<line>.py<XY>.nbi`, where the locators above keep them for each
+    subpackage: under $NUMBA_CACHE_DIR if set, else in its __pycache__, or in numba's
+    user-wide cache where that is not writable. An index of stale sources counts as warm here:
+    `replay.kernels_loading` then notices the slow load instead.
+    """
+    pattern = f"*.py{sys.version_info.major}{sys.version_info.minor}.nbi"
+    package = str(PACKAGE_DIR)
+    user_dir = os.environ.get("NUMBA_CACHE_DIR")
+    user_wide = os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "numba"
+    )
+    for entry in os.scandir(package):
+        if not entry.is_dir() or entry.name == "__pycache__":
+            continue
+        # numba's get_suitable_cache_subpath: <dir name>_<sha1 of the directory's path>
+        keyed = f"{entry.name}_{hashlib.sha1(entry.path.encode()).hexdigest()}"
+        dirs = (
+            [Path(user_dir, keyed)]
+            if user_dir
+            else [Path(entry.path, "__pycache__"), Path(user_wide, keyed)]
+        )
+        if any(next(d.glob(pattern), None) is not None for d in dirs):
+            return False
+    return True
 
 
 install()

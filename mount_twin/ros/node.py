@@ -44,6 +44,7 @@ from rclpy.subscription import Subscription
 from mount_twin.engine.batch import ERROR, OK, HealthReport, HealthStatus
 from mount_twin.errors import MountTwinError
 from mount_twin.io.messages import (
+    DIAGNOSTICS_TOPIC,
     TF,
     TF_STATIC_TOPIC,
     encode_report,
@@ -114,21 +115,22 @@ class MountTwinNode(Node):
             history=HistoryPolicy.KEEP_LAST,
         )
         pubs: dict[str, Publisher] = {}
+        try:
+            tf_class: type | None = message_class(TF)
+        except ImportError:  # tf2_msgs comes with a ROS install, not from the package registry
+            tf_class = None
+            self.get_logger().warning(
+                f"tf2_msgs is not importable: /tf and {TF_STATIC_TOPIC} are not published; "
+                "`mount-twin replay` writes them to bags"
+            )
         for topic, msgtype in output_types(self.scene).items():
-            try:
-                cls = message_class(msgtype)
-            except ImportError:
-                continue  # tf2_msgs only
+            if msgtype == TF and tf_class is None:
+                continue
+            cls = message_class(msgtype)  # the others are dependencies: missing ones raise
             pubs[topic] = self._named(
                 "outputs", partial(self.create_publisher, cls, topic, reliable)
             )
-        try:
-            tf_class = message_class(TF)
-        except ImportError:
-            self.get_logger().warning(
-                f"tf2_msgs is not importable (it comes with a ROS install): /tf and "
-                f"{TF_STATIC_TOPIC} are not published; `mount-twin replay` writes them to bags"
-            )
+        if tf_class is None:
             return pubs
         latched = QoSProfile(
             depth=1,
@@ -176,24 +178,28 @@ class MountTwinNode(Node):
         if self._batched:
             self._pending.extend(raws)
         else:
-            self._publish(self.stream.process(raws))
+            self._process(raws)
 
     def _drain(self) -> None:
         if self._pending:
             raws, self._pending = self._pending, []
-            self._publish(self.stream.process(raws))
+            self._process(raws)
+
+    def _process(self, raws: list[bytes]) -> None:
+        """Input through the twin; its outputs published, its diagnostics reports counted."""
+        messages = self.stream.process(raws)
+        self._reports += sum(topic == DIAGNOSTICS_TOPIC for topic, _, _ in messages)
+        self._publish(messages)
 
     def _publish(self, messages: list[tuple[str, int, bytes]]) -> None:
         for topic, _stamp, data in messages:
             pub = self._pubs.get(topic)
             if pub is not None:
                 pub.publish(bytes(data))
-            if topic == "/diagnostics":
-                self._reports += 1
 
     def _on_diagnostics_period(self) -> None:
-        """A period of the node's clock: if it brought no report and no accepted sample,
-        report now, saying why."""
+        """A period of the node's clock: if it brought no input report (stamp-driven) and no
+        accepted sample, report now, saying why."""
         accepted = self.stream.engine.counts["accepted"]
         if self._reports == 0 and accepted == self._accepted_at_tick:
             now = self.get_clock().now().nanoseconds
