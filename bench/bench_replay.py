@@ -15,7 +15,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from mount_twin.cli import DEFAULT_SCENE, main, share_dir
+from mount_twin.cli import main
+from mount_twin.commands.common import DEFAULT_SCENE, share_dir
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.io.bag import InputBag
 from mount_twin.io.messages import TimeBase, decode_inputs

@@ -14,7 +14,7 @@ import time
 import numpy as np
 from numba import njit
 
-from mount_twin.cli import share_dir
+from mount_twin.commands.common import share_dir
 from mount_twin.model.assemble import assemble, gravity_input, initial_state
 from mount_twin.physics.dynamics import evaluate, rhs
 from mount_twin.scene.loader import load_scene_file

@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from mount_twin.cli import DEFAULT_SCENE, share_dir
+from mount_twin.commands.common import DEFAULT_SCENE, share_dir
 from mount_twin.engine.batch import OutputBatch, SampleBatch
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.io.signals import Signal, half_sine_shock, ship_motion

@@ -1,0 +1,18 @@
+"""The `mount-twin` subcommands, one module each.
+
+A command module is imported to build the argument parser, so at module level it may import only
+the standard library and `mount_twin.errors`: numba, numpy and rosbags take seconds to import, and
+`--help` or a mistyped argument must answer at once (tested). Each module defines
+
+- ``NAME``: the subcommand, as typed;
+- ``HELP``: one line for `mount-twin --help`;
+- ``add_arguments(parser)``: its options;
+- ``run(args) -> int``: carry it out, importing what it needs; returns the exit status.
+
+A new command is a new module here and one entry in `COMMANDS`.
+"""
+
+from __future__ import annotations
+
+COMMANDS = ("replay", "demo", "generate", "import_csv")
+"""Module names under mount_twin.commands, in the order `--help` lists them."""

@@ -1,0 +1,41 @@
+"""Pieces shared by several commands: where the bundled files are, writing a signal as a bag."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from mount_twin.errors import MountTwinError
+
+if TYPE_CHECKING:
+    from mount_twin.io.signals import Signal
+
+DEFAULT_SCENE = "pump_8_mounts.scene.yaml"
+DEFAULT_BAG = "ship_motion_1khz"
+
+
+def share_dir() -> Path:
+    """Where config/ and bags/ are: the source tree, or share/mount_twin of an install."""
+    here = Path(__file__).resolve().parent.parent
+    # An editable or source checkout has config/ beside the package; a colcon install has
+    # <prefix>/share/mount_twin above <prefix>/lib/pythonX.Y/site-packages/mount_twin.
+    for candidate in (here.parent, *(p / "share" / "mount_twin" for p in here.parents)):
+        if (candidate / "config" / DEFAULT_SCENE).exists():
+            return candidate
+    msg = "cannot find mount_twin's config/ and bags/ (source tree or share/mount_twin)"
+    raise MountTwinError(msg)
+
+
+def write_signal(
+    sig: Signal, out: str, topic: str, frame_id: str, start_ns: int, storage: str
+) -> int:
+    """Write `sig` as sensor_msgs/Imu messages stamped start_ns + t into a new bag."""
+    import numpy as np
+
+    from mount_twin.io.bag import write_bag
+    from mount_twin.io.messages import IMU, imu_messages
+
+    stamps = start_ns + np.rint(sig.t * 1e9).astype(np.int64)
+    return write_bag(
+        out, topic, IMU, iter(imu_messages(stamps, sig.accel, sig.gyro, frame_id)), storage
+    )

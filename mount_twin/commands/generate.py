@@ -1,0 +1,56 @@
+"""`mount-twin generate half-sine|ship-motion -o OUT`: a bag of a generated foundation motion."""
+
+from __future__ import annotations
+
+import argparse
+
+NAME = "generate"
+HELP = "write a bag of a generated foundation motion"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("kind", choices=["half-sine", "ship-motion"])
+    parser.add_argument("-o", "--output", required=True)
+    parser.add_argument("--topic", default="/imu/data")
+    parser.add_argument("--frame-id", default="deck_imu")
+    parser.add_argument("--rate", type=float, help="sampling rate, Hz")
+    parser.add_argument("--duration", type=float, help="record length, s")
+    parser.add_argument("--peak", type=float, default=150.0, help="half-sine peak, m/s²")
+    parser.add_argument("--pulse", type=float, default=0.008, help="half-sine duration, s")
+    parser.add_argument(
+        "--rebound",
+        type=float,
+        default=0.0,
+        help="peak of a downward half-sine right after the pulse, m/s², lasting "
+        "peak·pulse/rebound so the deck ends at rest (naval double half-sine; 0: none)",
+    )
+    parser.add_argument(
+        "--lateral",
+        type=float,
+        default=0.0,
+        help="share of the vertical half-sine(s) also applied along +y of F (athwartships)",
+    )
+    parser.add_argument(
+        "--start", type=int, default=1_700_000_000_000_000_000, help="first stamp, ns"
+    )
+    parser.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+
+
+def run(args: argparse.Namespace) -> int:
+    from mount_twin.commands.common import write_signal
+    from mount_twin.io.signals import half_sine_shock, ship_motion
+
+    if args.kind == "half-sine":
+        sig = half_sine_shock(
+            peak=args.peak,
+            duration=args.pulse,
+            rate_hz=args.rate or 10000.0,
+            total=args.duration or 0.4,
+            lateral=args.lateral,
+            rebound=args.rebound,
+        )
+    else:
+        sig = ship_motion(rate_hz=args.rate or 1000.0, total=args.duration or 5.0)
+    n = write_signal(sig, args.output, args.topic, args.frame_id, args.start, args.storage)
+    print(f"wrote {n} sensor_msgs/msg/Imu messages on {args.topic} to {args.output}")
+    return 0

@@ -1,0 +1,95 @@
+"""`mount-twin replay BAG --scene SCENE -o OUT`: a bag through the twin into an output bag."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from mount_twin.replay import ReplaySummary
+
+NAME = "replay"
+HELP = "replay a bag through the twin into an mcap bag"
+FAIL_ON = ("never", "warn", "error")
+"""`--fail-on` choices; the index of warn and error is their diagnostics level."""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("input", help="input bag (mcap or sqlite3)")
+    parser.add_argument("--scene", required=True, help="scene YAML")
+    parser.add_argument("-o", "--output", required=True, help="output bag directory (new)")
+    parser.add_argument("--chunk", type=int, default=2000, help="messages per engine batch")
+    parser.add_argument("--no-progress", action="store_true")
+    add_plot_argument(parser)
+    parser.add_argument(
+        "--fail-on",
+        choices=FAIL_ON,
+        default="never",
+        help="exit 4 if the worst diagnostics level of the run reaches this (default: never)",
+    )
+
+
+def add_plot_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--plot", metavar="PNG", help="also plot the outputs into this PNG")
+
+
+def run(args: argparse.Namespace) -> int:
+    return replay_and_report(
+        args.scene,
+        args.input,
+        args.output,
+        args.chunk,
+        not args.no_progress,
+        args.plot,
+        args.fail_on,
+    )
+
+
+def replay_and_report(
+    scene_path: str | Path,
+    bag: str | Path,
+    output: str,
+    chunk: int,
+    progress: bool,
+    plot: str | None,
+    fail_on: str,
+) -> int:
+    """Replay, print the summary (and plot), and return the exit status (see `verdict`)."""
+    from mount_twin.replay import replay
+    from mount_twin.scene.loader import load_scene_file
+
+    summary = replay(load_scene_file(scene_path), bag, output, chunk=chunk, progress=progress)
+    print(summary.text())
+    if plot:
+        from mount_twin.plot import plot_output_bag  # matplotlib only when asked for
+
+        png = plot_output_bag(
+            output, plot, Path(scene_path).name, summary.events, summary.origin_s
+        )
+        print(f"plot: {png}")
+    return verdict(summary, fail_on)
+
+
+def verdict(summary: ReplaySummary, fail_on: str) -> int:
+    """The exit status of a replay: 3 if no input sample was accepted (saying why), 4 if the
+    run's worst diagnostics level reached `fail_on`, else 0."""
+    if not summary.counts.get("accepted", 0):
+        rejected = {k: v for k, v in summary.counts.items() if k.startswith("rejected_") and v}
+        why = (
+            f"{summary.counts.get('received', 0)} received, rejected: {rejected}"
+            if rejected
+            else "the input topic holds no message"
+        )
+        if summary.wrong_frame_id is not None:
+            why += f"; the bag's header.frame_id is {summary.wrong_frame_id!r}: see input.frame_id"
+        print(f"mount-twin: error: no input sample was accepted ({why})", file=sys.stderr)
+        return 3
+    if fail_on != "never" and summary.worst_level >= FAIL_ON.index(fail_on):
+        from mount_twin.engine.batch import LEVEL_NAMES
+
+        level = LEVEL_NAMES[summary.worst_level]
+        print(f"mount-twin: diagnostics reached {level} (--fail-on {fail_on})", file=sys.stderr)
+        return 4
+    return 0
