@@ -111,7 +111,7 @@ class Peer:
         self.node.destroy_node()
         rclpy.try_shutdown(context=self.context)
 
-    def call(self, future: Any, timeout: float = 10.0) -> Any:
+    def call(self, future: Any, timeout: float = 30.0) -> Any:
         """Spin this peer until a service call's `future` completes; its result."""
         executor = SingleThreadedExecutor(context=self.context)
         executor.add_node(self.node)

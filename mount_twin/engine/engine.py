@@ -15,7 +15,15 @@ from typing import NamedTuple
 
 import numpy as np
 
-from mount_twin.engine.batch import HealthReport, MountEvent, OutputBatch, SampleBatch
+from mount_twin.engine.batch import (
+    ERROR,
+    WARN,
+    HealthReport,
+    MountEvent,
+    OutputBatch,
+    SampleBatch,
+)
+from mount_twin.engine.gyro_filter import GyroConditioner
 from mount_twin.engine.health import HealthWindow
 from mount_twin.engine.kernel import (
     Integrator,
@@ -26,6 +34,7 @@ from mount_twin.engine.kernel import (
     new_watch,
     run_samples,
 )
+from mount_twin.engine.linear_rating import LinearRatings
 from mount_twin.errors import ModelError
 from mount_twin.integrate.stepper import STATUS_TEXT, STEPPERS
 from mount_twin.kinds import KINDS, N_EVENTS
@@ -118,6 +127,15 @@ class TwinEngine:
         self._skipped = 0
         """Samples rejected since the last taken one: they fill a stamp hole, are not lost."""
         self._gravity_up = np.array([0.0, 0.0, scene.input.g])
+        self._gyro = GyroConditioner(scene.input.gyro_filter, scene.input.gyro_cutoff_hz)
+        init = scene.initial
+        self._start_samples = (
+            init.gravity_samples
+            if init.mode == "equilibrium" and init.gravity == "first_sample"
+            else 1
+        )
+        self._gathered: list[np.ndarray] = []
+        """Specific forces (m/s², F) of the samples taken so far toward the next start."""
         self.counts: Counter[str] = Counter()
         self.health = HealthWindow(scene, self.stepper.name)
         self._watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
@@ -127,7 +145,11 @@ class TwinEngine:
         }
         self.events: list[MountEvent] = []
         """Every mount event so far, in time order (the first MAX_EVENTS; the rest counted)."""
-        self._util_max = np.zeros(len(model.nonlinear_slots))
+        self._ratings = LinearRatings(scene)
+        self._rated = np.array([*model.nonlinear_slots, *self._ratings.slots], dtype=np.int64)
+        """Mounts with a utilisation: the non-linear ones (their watch), then rated linear ones."""
+        self._linear_util = np.zeros(len(self._ratings.slots))
+        self._util_max = np.zeros(self._rated.shape[0])
         # Chaining the stepper's last stage into the next interval needs a continuous input
         # (first-order hold) and no discrete switch of the state between samples (fracture).
         chain = scene.input.hold == "first_order" and model.arrays.nl is None
@@ -155,6 +177,8 @@ class TwinEngine:
         samples = Samples(t, f, np.zeros((2, 3)))
         u, scratch = np.zeros(INPUT_SIZE), model.new_scratch()
         run_samples(integ, model.arrays, scratch, u, y, samples, self._options, out, watch)
+        gyro = GyroConditioner(self.scene.input.gyro_filter, self.scene.input.gyro_cutoff_hz)
+        gyro.rows(t[1:], np.zeros((1, 3)), 0.0)
         watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
         self._start_outputs(self._y_nominal.copy(), model.new_scratch(), watch)
 
@@ -184,9 +208,13 @@ class TwinEngine:
     def utilisation_max(self) -> dict[str, float]:
         """Peak utilisation so far of each mount that has an allowable (bolt: F_S/F_y, rubber:
         deflection/rated, key: force/allowable), by name."""
-        peak = np.maximum(self._util_max, self._watch.util_peak)
-        names = [self.scene.mounts[i].name for i in self.model.nonlinear_slots]
+        peak = np.maximum(self._util_max, self._window_utilisation())
+        names = [self.scene.mounts[i].name for i in self._rated]
         return dict(zip(names, peak.tolist(), strict=True))
+
+    def _window_utilisation(self) -> np.ndarray:
+        """Peak utilisation since the last report of the mounts in `_rated`, in its order."""
+        return np.concatenate([self._watch.util_peak, self._linear_util])
 
     def count(self, what: str, n: int = 1) -> None:
         """Count events found outside the engine (e.g. undecodable messages) with its own.
@@ -229,6 +257,11 @@ class TwinEngine:
                 parts.extend(self._integrate(run, batch.stamps, f, w))
             for rows in parts[first:]:
                 self.health.add_outputs(batch.stamps[rows.sample], rows.pose, rows.wrenches)
+                np.maximum(
+                    self._linear_util,
+                    self._ratings.utilisation(rows.pose, rows.wrenches),
+                    out=self._linear_util,
+                )
             self.health.add_wall(self._clock() - wall0)
             if report_due:
                 stamp = float(batch.stamps[stop - 1])
@@ -371,10 +404,13 @@ class TwinEngine:
         self, run: _Run, stamps: np.ndarray, f: np.ndarray, w: np.ndarray
     ) -> list[_Rows]:
         """Integrate one run; on a stepper failure restart at the next sample."""
-        out = []
+        out: list[_Rows] = []
         index = run.index
         if run.restart or self._last is None:
-            out.append(self._start(index[0], stamps, f, w))
+            index, gathered = self._gather(run, f)
+            if not index:
+                return out
+            out.append(self._start(index[0], stamps, f, w, gathered))
             index = index[1:]
         while index:
             t0, f0, w0 = self._last  # type: ignore[misc]
@@ -382,6 +418,7 @@ class TwinEngine:
             t, ff, ww = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
             t[0], ff[0], ww[0] = t0, f0, w0  # row 0: the last sample done
             t[1:], ff[1:], ww[1:] = stamps[index], f[index], w[index]
+            self._gyro.rows(t[1:], ww[1:], t0)
             out_buf = self._buffers(n, self._counter, self._peak)
             done, status = run_samples(
                 self._integ,
@@ -409,7 +446,7 @@ class TwinEngine:
             rest = index[done + 1 :]
             if not rest:
                 break
-            out.append(self._start(rest[0], stamps, f, w))
+            out.append(self._start(rest[0], stamps, f, w, f[rest[:1]]))
             index = rest[1:]
         return out
 
@@ -435,7 +472,9 @@ class TwinEngine:
         return report
 
     def _report(self, stamp: float, sample: int, stalled_s: float | None = None) -> HealthReport:
-        util = self._watch.util_peak
+        util = self._window_utilisation()
+        per_mount = np.full(self.model.n_mounts, math.nan)
+        per_mount[self._rated] = util
         lost, nominal = self.health.lost_estimate()
         if lost:
             self.counts["lost_estimated"] += lost
@@ -443,14 +482,15 @@ class TwinEngine:
             stamp,
             sample,
             self.counts,
-            util.copy(),
+            per_mount,
             self._active(),
             lost_from_stamps=lost,
             nominal_interval_s=nominal,
             stalled_s=stalled_s,
         )
         np.maximum(self._util_max, util, out=self._util_max)
-        util[:] = 0.0
+        self._watch.util_peak[:] = 0.0
+        self._linear_util[:] = 0.0
         return report
 
     def _active(self) -> dict[str, list[tuple[str, bool]]]:
@@ -485,29 +525,93 @@ class TwinEngine:
         self.events.extend(new[: max(room, 0)])
         self.health.add_events(new)
 
-    def _start(self, i: int, stamps: np.ndarray, f: np.ndarray, w: np.ndarray) -> _Rows:
-        """(Re)start the twin at sample i; its outputs are published."""
+    def _gather(self, run: _Run, f: np.ndarray) -> tuple[list[int], np.ndarray]:
+        """Take a run's samples toward a start (`initial.gravity_samples` of them).
+
+        Returns the run's samples from the start sample on (none while still gathering) and
+        the specific forces (m/s², F) gathered for the start, the start sample's last.
+        """
+        if run.restart:
+            self._gathered = []
+        need = self._start_samples - len(self._gathered)
+        taken = run.index[:need]
+        self._gathered.extend(f[taken])
+        if len(self._gathered) < self._start_samples:
+            return [], np.empty((0, 3))
+        gathered, self._gathered = np.array(self._gathered), []
+        return run.index[len(taken) - 1 :], gathered
+
+    def _start(
+        self, i: int, stamps: np.ndarray, f: np.ndarray, w: np.ndarray, gathered: np.ndarray
+    ) -> _Rows:
+        """(Re)start the twin at sample i, under the mean specific force of `gathered` (m/s²,
+        F; sample i's last) as gravity where the scene starts at equilibrium under the input;
+        its outputs are published."""
         if self._last is not None or self.counts["starts"]:
             self.counts["restarts"] += 1
         self.counts["starts"] += 1
+        stamp = float(stamps[i])
+        f0 = gathered.mean(axis=0)
+        self._check_start(stamp, f0, gathered)
         self._y = self._y_nominal.copy()
         if self.scene.initial.gravity == "first_sample":
             try:
-                self._y = initial_state(self.model, f[i])
+                self._y = initial_state(self.model, f0)
             except ModelError:
                 # Restarting inside a shock: no equilibrium holds under that load.
                 self.counts["starts_at_nominal_gravity"] += 1
                 self.health.failure(
-                    float(stamps[i]),
-                    f"no static equilibrium under the start sample's specific force "
-                    f"{np.linalg.norm(f[i]):.4g} m/s²: started from rest under nominal gravity",
+                    stamp,
+                    f"no static equilibrium under the start specific force "
+                    f"{np.linalg.norm(f0):.4g} m/s²: started from rest under nominal gravity",
                 )
         self.stepper.reset()
         self._peak[:] = 0.0
         self._counter[0] = 0
-        self._last = (float(stamps[i]), f[i].copy(), w[i].copy())
+        self._last = (stamp, f[i].copy(), self._gyro.start(w[i]))
         pose, wrenches = self._start_outputs(self._y, self._scratch, self._watch)
         return _Rows(np.array([i]), pose, wrenches)
+
+    def _check_start(self, stamp: float, f0: np.ndarray, gathered: np.ndarray) -> None:
+        """Start checks on the start specific force f0 (m/s², F) and the samples it is the mean
+        of: its magnitude against g, its angle from +z of F, and their spread (at rest?)."""
+        spec, init = self.scene.input, self.scene.initial
+        g, magnitude = spec.g, float(np.linalg.norm(f0))
+        tilt = math.atan2(math.hypot(f0[0], f0[1]), f0[2])
+        off = abs(magnitude - g) / g
+        spread = float(np.linalg.norm(gathered - f0, axis=1).max())
+        notes: list[tuple[int, str]] = []
+        if off > init.gravity_tolerance:
+            hint = (
+                "input.includes_gravity is false, so g was added: does the input include it?"
+                if not spec.includes_gravity and abs(magnitude - 2.0 * g) < 0.25 * g
+                else "a start on a shock or spike, free fall, or a sensor bias? "
+                "initial.gravity_samples averages the start"
+            )
+            notes.append(
+                (
+                    ERROR if off > 3.0 * init.gravity_tolerance else WARN,
+                    f"start specific force |f0| = {magnitude:.4g} m/s² is {magnitude / g:.3g} g "
+                    f"({hint})",
+                )
+            )
+        if tilt > init.tilt_tolerance_rad:
+            notes.append(
+                (
+                    ERROR if tilt > 3.0 * init.tilt_tolerance_rad else WARN,
+                    f"start specific force is {math.degrees(tilt):.1f}° from +z of F "
+                    "(is input.sensor_rpy right?)",
+                )
+            )
+        if spread > init.gravity_tolerance * g:
+            notes.append(
+                (
+                    WARN,
+                    f"not at rest over the {gathered.shape[0]} start samples: they spread "
+                    f"{spread:.3g} m/s² about their mean",
+                )
+            )
+        self.health.start_checked(stamp, magnitude, tilt, notes)
 
     def _start_outputs(
         self, y: np.ndarray, scratch: Scratch, watch: Watch

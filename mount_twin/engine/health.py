@@ -58,11 +58,19 @@ class HealthWindow:
         self.skipped: list[tuple[int, int]] = []
         """(position among this window's steps, samples rejected within that interval)."""
         self.wrong_frames: dict[str, None] = {}
+        self.starts: list[tuple[float, float, float, list[tuple[int, str]]]] = []
+        """(stamp s, |f0| m/s², tilt of f0 rad, findings (level, text)) per start."""
 
     @property
     def pending(self) -> bool:
         """Whether anything was recorded since the last report."""
-        return bool(self.samples or self.events or self.failures or not math.isnan(self.t_last))
+        return bool(
+            self.samples
+            or self.events
+            or self.failures
+            or self.starts
+            or not math.isnan(self.t_last)
+        )
 
     def add_steps(self, step_log: np.ndarray) -> None:
         """Per-sample stepper figures: (error norm, accepted, rejected substeps)."""
@@ -139,6 +147,13 @@ class HealthWindow:
         """Mount events of this window."""
         self.events.extend(events)
 
+    def start_checked(
+        self, stamp: float, magnitude: float, tilt: float, notes: list[tuple[int, str]]
+    ) -> None:
+        """A (re)start at `stamp` (s) under a specific force of `magnitude` (m/s²) at `tilt`
+        (rad) from +z of F, with the start checks' findings (level, text)."""
+        self.starts.append((stamp, magnitude, tilt, notes))
+
     def failure(self, stamp: float, text: str) -> None:
         """A stepper failure (or a forced start) at `stamp` (s)."""
         self.failures.append((stamp, text))
@@ -189,7 +204,8 @@ class HealthWindow:
         then starts anew.
 
         Counts are cumulative; rejections, gaps, losses, stepper figures, mount peaks and events
-        are this window's. `utilisation`: peak per non-linear mount, in model order; `active`:
+        are this window's. `utilisation`: peak per mount, in scene order (NaN: no rating);
+        `active`:
         the conditions holding now per mount (event name, is an error), e.g. a broken bolt,
         which keep the mount's level after the events themselves have been reported.
         `lost_from_stamps`, `nominal_interval_s` (s): `lost_estimate` of this window (already
@@ -240,9 +256,7 @@ class HealthWindow:
     ) -> list[HealthStatus]:
         """One status per mount: peak wrench per axis, utilisation, events by name, and the
         conditions holding now."""
-        util = dict.fromkeys((m.name for m in self.scene.mounts), math.nan)
-        nonlinear = [m.name for m in self.scene.mounts if m.kind != "linear"]
-        util.update(zip(nonlinear, utilisation.tolist(), strict=True))
+        util = dict(zip((m.name for m in self.scene.mounts), utilisation.tolist(), strict=True))
         warn_at = 1.0 - self.scene.outputs.alarm_margin
         out = []
         for i, mount in enumerate(self.scene.mounts):
@@ -312,6 +326,10 @@ class HealthWindow:
                 )
             else:
                 parts.append(f"input stalled: only {new['accepted']} samples accepted in {waited}")
+        for stamp, _, _, notes in self.starts:
+            for note_level, text in notes:
+                level = max(level, note_level)
+                parts.append(f"start at {self.origin_s + stamp:.6f} s: {text}")
         if (n_rejected and not all_rejected) or new["gaps"]:
             level = max(level, WARN)
             detail = ""
@@ -351,6 +369,10 @@ class HealthWindow:
             values["last_wrong_frame_id"] = self.last_wrong_frame_id
         if stalled_s is not None:
             values["since_last_report_s"] = f"{stalled_s:.6g}"
+        if self.starts:
+            _, magnitude, tilt, _ = self.starts[-1]
+            values["start_specific_force_m_s2"] = f"{magnitude:.6g}"
+            values["start_tilt_rad"] = f"{tilt:.6g}"
         return HealthStatus(f"{PREFIX}: input", level, "; ".join(parts) or "ok", values)
 
     def _reason(self, reason: str, n: int) -> str:

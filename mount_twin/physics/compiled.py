@@ -44,7 +44,14 @@ F = TypeVar("F", bound=Callable[..., object])
 
 PACKAGE_DIR = Path(__file__).resolve().parent.parent
 """The mount_twin package directory."""
-COMPILED_SOURCES = ("physics", "kinds", "integrate", "model", "engine/kernel.py")
+COMPILED_SOURCES = (
+    "physics",
+    "kinds",
+    "integrate",
+    "model",
+    "engine/kernel.py",
+    "engine/gyro_filter.py",
+)
 """Package-relative directories (their *.py files) and files that define compiled functions or
 constants that compiled code reads: their content is the cache stamp. A new file of compiled
 code outside these must be added here (test/test_compiled_cache.py checks it)."""

@@ -14,6 +14,8 @@ from mount_twin.kinds.elastomer import Elastomer
 from mount_twin.kinds.shear_key import ShearKey
 
 DOF_NAMES: tuple[str, ...] = ("x", "y", "z", "alpha", "gamma", "delta")
+GYRO_FILTERS = ("lowpass", "none", "ignore")
+"""`input.gyro_filter` choices (mount_twin.engine.gyro_filter applies them)."""
 """Generalized coordinates: CG displacement X, Y, Z (m, F) and the chart angles α, γ, δ (rad)."""
 
 Vec3 = tuple[float, float, float]
@@ -47,6 +49,11 @@ class LinearMount:
         orientation_rpy: mount axes relative to F as fixed-axis roll, pitch, yaw, rad.
         stiffness: (kx, ky, kz) N/m and (krx, kry, krz) N·m/rad along the mount axes.
         damping: (cx, cy, cz) N·s/m and (crx, cry, crz) N·m·s/rad along the mount axes.
+        rated_travel: (dx, dy, dz) m, the allowed deflection of the attachment point from its
+            unstressed position along each mount axis (bottoming, tearing); 0: unrated axis.
+        rated_load: (Fx, Fy, Fz) N, the allowed force along each mount axis; 0: unrated axis.
+            Utilisation is the largest |deflection|/rated_travel and |force|/rated_load; its
+            status is WARN from 1 − outputs.alarm_margin and ERROR past 1, as for other kinds.
     """
 
     name: str
@@ -55,6 +62,8 @@ class LinearMount:
     stiffness: Vec6
     damping: Vec6
     kind: str = "linear"
+    rated_travel: Vec3 = (0.0, 0.0, 0.0)
+    rated_load: Vec3 = (0.0, 0.0, 0.0)
 
 
 Mount = LinearMount | Elastomer | BoltedJoint | ShearKey
@@ -78,6 +87,9 @@ class InputSpec:
         gap_policy: 'reset' (restart at equilibrium) or 'bridge' (integrate across the gap).
         back_jump_reset_s: a stamp going back by more than this resets the twin (bag --loop);
             smaller steps back are skipped.
+        gyro_filter: how Ω and Ω′ are taken from the gyro: 'lowpass', 'none' or 'ignore'
+            (see mount_twin.engine.gyro_filter).
+        gyro_cutoff_hz: −3 dB frequency of the 'lowpass' gyro filter, Hz.
     """
 
     msg_type: str = "sensor_msgs/msg/Imu"
@@ -91,6 +103,8 @@ class InputSpec:
     max_gap_s: float = 0.5
     gap_policy: str = "reset"
     back_jump_reset_s: float = 1.0
+    gyro_filter: str = "lowpass"
+    gyro_cutoff_hz: float = 50.0
 
 
 @dataclass(frozen=True)
@@ -103,12 +117,22 @@ class InitialState:
             'nominal' (g along +z of F).
         pose: (X, Y, Z) m and (α, γ, δ) rad, for 'given'; also the values of frozen DOFs.
         velocity: (X', Y', Z') m/s and (α', γ', δ') rad/s, for 'given'.
+        gravity_samples: for 'first_sample', the start gravity is the mean specific force of
+            this many accepted samples from each (re)start; the twin starts at the last of them
+            (those before it are taken but not integrated).
+        gravity_tolerance: start check: | |f₀| − g | / g past this is a WARN, past three times
+            this an ERROR (a start on a shock, free fall, a bias, g added twice), −.
+        tilt_tolerance_rad: start check: the angle of f₀ from +z of F past this is a WARN,
+            past three times this an ERROR (a sensor frame turned wrong), rad.
     """
 
     mode: str = "equilibrium"
     gravity: str = "first_sample"
     pose: Vec6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     velocity: Vec6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    gravity_samples: int = 1
+    gravity_tolerance: float = 0.1
+    tilt_tolerance_rad: float = 0.35
 
 
 @dataclass(frozen=True)

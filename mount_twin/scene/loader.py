@@ -13,6 +13,7 @@ from mount_twin.integrate.methods import METHODS
 from mount_twin.kinds import KINDS
 from mount_twin.scene.description import (
     DOF_NAMES,
+    GYRO_FILTERS,
     Body,
     Frames,
     InitialState,
@@ -148,6 +149,8 @@ def _mount(r: Reader) -> Mount:
             stiffness=r.vector("stiffness", 6, lo=0.0),
             damping=r.vector("damping", 6, (0.0,) * 6, lo=0.0),
             kind=kind,
+            rated_travel=r.vector("rated_travel", 3, (0.0,) * 3, lo=0.0),
+            rated_load=r.vector("rated_load", 3, (0.0,) * 3, lo=0.0),
         )
     else:
         mount = KINDS[kind].read(r, name, position, rpy)
@@ -169,6 +172,8 @@ def _input(r: Reader) -> InputSpec:
         max_gap_s=r.positive("max_gap_s", d.max_gap_s),
         gap_policy=r.choice("gap_policy", ("reset", "bridge"), d.gap_policy),
         back_jump_reset_s=r.number("back_jump_reset_s", d.back_jump_reset_s, lo=0.0),
+        gyro_filter=r.choice("gyro_filter", GYRO_FILTERS, d.gyro_filter),
+        gyro_cutoff_hz=r.positive("gyro_cutoff_hz", d.gyro_cutoff_hz),
     )
     r.finish()
     return spec
@@ -181,6 +186,9 @@ def _initial(r: Reader) -> InitialState:
         gravity=r.choice("gravity", ("first_sample", "nominal"), d.gravity),
         pose=r.vector("pose", 6, d.pose),
         velocity=r.vector("velocity", 6, d.velocity),
+        gravity_samples=r.integer("gravity_samples", d.gravity_samples, lo=1),
+        gravity_tolerance=r.positive("gravity_tolerance", d.gravity_tolerance),
+        tilt_tolerance_rad=r.positive("tilt_tolerance_rad", d.tilt_tolerance_rad),
     )
     alpha, gamma = state.pose[3], state.pose[4]
     cos_tilt = math.sqrt(max(math.cos(gamma) ** 2 - math.sin(alpha) ** 2, 0.0))

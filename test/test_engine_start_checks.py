@@ -1,0 +1,114 @@
+"""Start checks on the specific force the twin starts under (|f₀| against g, its angle from +z
+of F, rest over the start samples) and the start gravity as the mean of N samples."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from io_helpers import REST, batch, engine_for, scene_with
+
+from mount_twin.engine.batch import ERROR, OK, WARN, HealthStatus
+from mount_twin.model.assemble import assemble, initial_state
+
+G = 9.80665
+
+
+def _input_status(accel: np.ndarray, **sections: dict) -> HealthStatus:
+    """The input status of the one report of a short run from rest readings `accel` (n, 3)."""
+    n = accel.shape[0]
+    engine = engine_for(scene_with(**sections) if sections else None)
+    engine.push(batch(1.0 + np.arange(n) * 1e-3, accel))
+    report = engine.flush()
+    assert report is not None
+    (status,) = [s for s in report.statuses if s.name == "mount_twin: input"]
+    return status
+
+
+def _steady(f0: np.ndarray, n: int = 20) -> np.ndarray:
+    return np.tile(f0, (n, 1))
+
+
+def test_a_start_at_rest_passes_and_reports_its_figures() -> None:
+    status = _input_status(_steady(REST))
+    assert (status.level, status.message) == (OK, "ok")
+    assert float(status.values["start_specific_force_m_s2"]) == pytest.approx(G)
+    assert float(status.values["start_tilt_rad"]) == 0.0
+
+
+def test_a_sensor_frame_turned_90_degrees_is_an_error_naming_sensor_rpy() -> None:
+    status = _input_status(_steady(np.array([G, 0.0, 0.0])))
+    assert status.level == ERROR
+    assert "90.0° from +z of F (is input.sensor_rpy right?)" in status.message
+    assert float(status.values["start_tilt_rad"]) == pytest.approx(math.pi / 2, rel=1e-5)
+
+
+def test_a_moderate_tilt_is_a_warning() -> None:
+    tilt = 0.5  # rad: past the 0.35 rad tolerance, within three times it
+    status = _input_status(_steady(G * np.array([0.0, math.sin(tilt), math.cos(tilt)])))
+    assert status.level == WARN
+    assert f"{math.degrees(tilt):.1f}° from +z of F" in status.message
+
+
+def test_a_start_on_a_shock_pulse_is_an_error() -> None:
+    """The first sample 7.3 g (a record that starts on a shock's rise)."""
+    accel = _steady(REST)
+    accel[0] = [0.0, 0.0, 7.3 * G]
+    status = _input_status(accel)
+    assert status.level == ERROR
+    assert "|f0| = 71.59 m/s² is 7.3 g (a start on a shock or spike" in status.message
+
+
+def test_free_fall_read_through_a_bias_is_a_warning_and_a_tilted_bias_an_error() -> None:
+    """A record that starts in free fall (true specific force 0) read through a bias: 7.7 m/s²
+    on z is 0.785 g (21 % short of g: WARN); the water-entry record's bias (6.0, −4.6, 1.7) m/s²
+    is 0.790 g and 77.3° from +z (ERROR)."""
+    status = _input_status(_steady(np.array([0.0, 0.0, 7.7])))
+    assert status.level == WARN
+    assert "|f0| = 7.7 m/s² is 0.785 g" in status.message
+    status = _input_status(_steady(np.array([6.0, -4.6, 1.7])))
+    assert status.level == ERROR
+    assert "is 0.79 g" in status.message
+    assert "77.3° from +z of F" in status.message
+
+
+def test_gravity_added_twice_is_named() -> None:
+    """An Imu record (gravity included) declared includes_gravity: false gets g added again."""
+    status = _input_status(_steady(REST), input={"includes_gravity": False})
+    assert status.level == ERROR
+    assert "input.includes_gravity is false, so g was added" in status.message
+
+
+def test_the_start_gravity_is_the_mean_of_the_first_n_samples() -> None:
+    """With gravity_samples N, nothing is published before the N-th sample, the twin starts
+    there at the static equilibrium under the mean of the N readings."""
+    rng = np.random.default_rng(5)
+    n_start = 50
+    accel = REST + rng.normal(0.0, 0.05, (200, 3))
+    scene = scene_with(initial={"gravity_samples": n_start})
+    engine = engine_for(scene)
+    out = engine.push(batch(1.0 + np.arange(200) * 1e-3, accel))
+    assert out.sample[0] == n_start - 1
+    assert out.stamps[0] == pytest.approx(1.0 + (n_start - 1) * 1e-3)
+    expected = initial_state(assemble(scene), accel[:n_start].mean(axis=0))
+    reference = engine_for(scene_with(initial={"gravity_samples": 1}))
+    reference.push(batch([1.0], accel[:n_start].mean(axis=0)[None, :]))
+    np.testing.assert_allclose(reference.state, expected, rtol=0, atol=1e-15)
+    assert engine.counts["accepted"] == 200
+
+
+def test_a_pulse_among_the_start_samples_is_flagged_not_at_rest() -> None:
+    accel = _steady(REST, 40)
+    accel[10] = [0.0, 0.0, 3.0 * G]
+    status = _input_status(accel, initial={"gravity_samples": 30})
+    assert status.level == WARN
+    assert "not at rest over the 30 start samples" in status.message
+
+
+def test_a_gap_reset_while_gathering_starts_the_gathering_again() -> None:
+    scene = scene_with(initial={"gravity_samples": 5})
+    engine = engine_for(scene)
+    stamps = np.concatenate([1.0 + np.arange(3) * 1e-3, 3.0 + np.arange(6) * 1e-3])
+    out = engine.push(batch(stamps))
+    assert out.stamps[0] == pytest.approx(3.0 + 4e-3)  # 5th sample after the gap

@@ -1,0 +1,93 @@
+"""Rated travel and load of linear mounts: utilisation against closed forms, and the mount
+status OK → WARN → ERROR like the other kinds."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from io_helpers import batch
+from physics_helpers import base_scene, mount
+
+from mount_twin.engine.batch import ERROR, OK, WARN
+from mount_twin.engine.engine import TwinEngine
+from mount_twin.model.assemble import assemble
+from mount_twin.scene.loader import scene_from_dict
+
+G = 9.80665
+MASS, K, KH = 800.0, 2.0e6, 1.0e6  # kg, N/m vertical, N/m horizontal (per mount)
+
+
+def _engine(
+    rated_travel: list[float], rated_load: list[float], tilted: bool = False
+) -> TwinEngine:
+    """800 kg on four equal mounts at the corners of a 1 m × 0.6 m rectangle about the CG; the
+    first mount rated. Tilted: the mounts lean in a V seen along y, each pitched 30° toward the
+    centre plane x = 0 (mirror images, so a vertical load moves the body straight down)."""
+
+    def rpy(x: float) -> tuple[float, float, float]:
+        return (0.0, -math.copysign(math.radians(30.0), x) if tilted else 0.0, 0.0)
+
+    corners = [(0.5, 0.3), (-0.5, 0.3), (-0.5, -0.3), (0.5, -0.3)]
+    mounts = [
+        mount(f"m{i}", (x, y, 0.0), (KH, KH, K, 0.0, 0.0, 0.0), rpy_=rpy(x))
+        for i, (x, y) in enumerate(corners)
+    ]
+    mounts[0]["rated_travel"] = rated_travel
+    mounts[0]["rated_load"] = rated_load
+    data = base_scene(MASS, [0.0, 0.0, 0.2], [100.0, 150.0, 200.0, 0.0, 0.0, 0.0], mounts)
+    data["input"]["frame_id"] = "deck_imu"
+    return TwinEngine(assemble(scene_from_dict(data, "<ratings test>")))
+
+
+def _run(engine: TwinEngine, accel: np.ndarray | None = None, n: int = 200):
+    out = engine.push(batch(1.0 + np.arange(n) * 1e-3, accel))
+    report = engine.flush()
+    assert report is not None
+    (status,) = [s for s in report.statuses if s.name == "mount_twin: mount m0"]
+    return out, status
+
+
+def test_static_sag_and_load_give_the_closed_form_utilisation() -> None:
+    """At rest the four equal vertical mounts share the weight: sag mg/(4k), load mg/4."""
+    sag, load = MASS * G / (4 * K), MASS * G / 4
+    engine = _engine([0.0, 0.0, 2.0 * sag], [0.0, 0.0, 0.0])
+    _, status = _run(engine)
+    assert engine.utilisation_max["m0"] == pytest.approx(0.5, rel=1e-9)
+    assert status.level == OK
+    engine = _engine([0.0, 0.0, 0.0], [0.0, 0.0, load / 0.25])
+    _run(engine)
+    assert engine.utilisation_max["m0"] == pytest.approx(0.25, rel=1e-9)
+    assert "m1" not in engine.utilisation_max  # unrated mounts have no utilisation
+
+
+def test_travel_along_inclined_mount_axes() -> None:
+    """Mounts in a V: the body sinks by s, so mount m0 (at x > 0, pitched −30°: its z axis is
+    (−sin 30°, 0, cos 30°) in F, its x axis (cos 30°, 0, sin 30°)) moves −s·cos 30° along its z
+    and −s·sin 30° along its x. Vertical stiffness of each mount: K cos²30° + KH sin²30°, so
+    s = mg / (4 (K cos²30° + KH sin²30°))."""
+    c, s_ = math.cos(math.radians(30.0)), math.sin(math.radians(30.0))
+    sag = MASS * G / (4 * (K * c * c + KH * s_ * s_))
+    engine = _engine([sag * s_ / 0.8, 0.0, 0.0], [0.0, 0.0, 0.0], tilted=True)
+    _run(engine)
+    assert engine.utilisation_max["m0"] == pytest.approx(0.8, rel=1e-6)
+    engine = _engine([0.0, 0.0, sag * c / 0.3], [0.0, 0.0, 0.0], tilted=True)
+    _run(engine)
+    assert engine.utilisation_max["m0"] == pytest.approx(0.3, rel=1e-6)
+
+
+def test_a_shock_past_the_rating_is_an_error_and_near_it_a_warning() -> None:
+    sag = MASS * G / (4 * K)
+    shock = np.tile([0.0, 0.0, G], (200, 1))
+    shock[20:40, 2] += 30.0 * np.sin(np.linspace(0.0, math.pi, 20))  # ~3 g half-sine, 20 ms
+    _, status = _run(_engine([0.0, 0.0, 1.5 * sag], [0.0, 0.0, 0.0]), shock)
+    assert status.level == ERROR
+    assert float(status.values["utilisation_max"]) > 1.0
+    # Rated so that the peak sits within the 10 % alarm margin below 1.
+    probe = _engine([0.0, 0.0, 1.0], [0.0, 0.0, 0.0])
+    _run(probe, shock)
+    peak = probe.utilisation_max["m0"]  # the peak travel, m
+    _, status = _run(_engine([0.0, 0.0, peak / 0.95], [0.0, 0.0, 0.0]), shock)
+    assert status.level == WARN
+    assert float(status.values["utilisation_max"]) == pytest.approx(0.95, rel=1e-6)
