@@ -31,6 +31,7 @@ from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus,
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.io.signals import half_sine_shock
 from mount_twin.kinds.bolted_joint import BoltedJoint
+from mount_twin.kinds.shear_key import ShearKey
 from mount_twin.model.assemble import assemble
 from mount_twin.replay import replay
 from mount_twin.scene import Scene, load_scene_file
@@ -282,6 +283,26 @@ def test_a_broken_bolt_whose_foot_is_off_the_deck_carries_no_force() -> None:
         assert lifted.any(), foot
         force = np.linalg.norm(run.wrenches[lifted, names.index(foot), :3], axis=1)
         assert force.max() < 1.0, (foot, force.max())
+
+
+def test_a_key_carries_no_force_once_the_frame_is_lifted_past_its_engagement_height() -> None:
+    """The bundled keys are 40 mm tall (`engagement_height`): hopping loose after its bolts
+    broke, the frame clears them, and a cleared key bears nothing, whatever the sideways
+    motion (that the keys still stop the frame below that height: the bundled bag's test)."""
+    run, sc = escalation(), scene()
+    names = [m.name for m in sc.mounts]
+    cleared_rows = 0
+    for name in KEYS:
+        key = next(m for m in sc.mounts if m.name == name)
+        assert isinstance(key, ShearKey) and key.engagement_height == 0.04
+        arm = np.array(key.position) - np.array(sc.body.cg)
+        lift = (run.pose[:, :3] + Rotation.from_quat(run.pose[:, 3:7]).apply(arm))[:, 2]
+        lift -= key.position[2]
+        cleared = lift > key.engagement_height
+        cleared_rows += int(cleared.sum())
+        force = np.abs(run.wrenches[:, names.index(name), :3]).max(axis=1)
+        assert force[cleared].max(initial=0.0) == 0.0, name
+    assert cleared_rows > 0, "the escalation lifts the frame past 40 mm"
 
 
 def test_diagnostics_name_the_events_of_each_period_at_error_for_the_affected_mounts() -> None:

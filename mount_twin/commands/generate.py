@@ -11,8 +11,12 @@ HELP = "write a bag of a generated foundation motion"
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("kind", choices=["half-sine", "ship-motion"])
     parser.add_argument("-o", "--output", required=True)
-    parser.add_argument("--topic", default="/imu/data")
-    parser.add_argument("--frame-id", default="deck_imu")
+    parser.add_argument(
+        "--topic", default="/deck/imu", help="(default: /deck/imu, the bundled scenes' input)"
+    )
+    parser.add_argument(
+        "--frame-id", default="deck_imu", help="header.frame_id (default: deck_imu)"
+    )
     parser.add_argument("--rate", type=float, help="sampling rate, Hz")
     parser.add_argument("--duration", type=float, help="record length, s")
     parser.add_argument("--peak", type=float, default=150.0, help="half-sine peak, m/s²")
