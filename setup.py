@@ -1,11 +1,42 @@
 """ament_python package: `colcon build` installs the console scripts under lib/mount_twin, the
 ament index marker, package.xml, config/, launch/ and bags/ under share/mount_twin."""
 
+import os
+import subprocess
+import sys
 from glob import glob
 
 from setuptools import find_packages, setup
+from setuptools.command.install import install
 
 PACKAGE = "mount_twin"
+
+
+class InstallAndWarmUp(install):
+    """`setup.py install` (what `colcon build` runs), then `mount-twin warm-up` on the installed
+    copy, so numba's kernel cache sits beside the installed sources and the first `ros2 run` or
+    replay starts in seconds instead of compiling for 20-60 s. Skipped for staged installs (a
+    wheel or a distribution package: `--root`) and with MOUNT_TWIN_NO_WARM_UP=1."""
+
+    def run(self) -> None:
+        super().run()
+        if self.root or os.environ.get("MOUNT_TWIN_NO_WARM_UP") == "1":
+            return
+        scenes = [os.path.abspath(p) for p in sorted(glob("config/*.scene.yaml"))]
+        lib = os.path.abspath(self.install_lib)
+        env = {
+            **os.environ,
+            "PYTHONPATH": os.pathsep.join(filter(None, [lib, os.environ.get("PYTHONPATH")])),
+        }
+        print(f"mount_twin: compiling kernels into {lib} (warm-up, 20-60 s)", flush=True)
+        # cwd: the installed copy must be the one imported, not a source tree in the cwd.
+        subprocess.run(
+            [sys.executable, "-m", "mount_twin.cli", "warm-up", *scenes],
+            cwd=lib,
+            env=env,
+            check=True,
+        )
+
 
 setup(
     name=PACKAGE,
@@ -42,7 +73,8 @@ setup(
             "ros-jazzy-std-msgs",
         ],
     },
-    zip_safe=True,
+    cmdclass={"install": InstallAndWarmUp},
+    zip_safe=False,  # numba caches the compiled kernels beside the installed sources
     maintainer="mount_twin maintainers",
     maintainer_email="mount_twin@example.com",
     description="Real-time digital twin of a rigid machine on compliant mounts",

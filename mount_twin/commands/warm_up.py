@@ -1,0 +1,39 @@
+"""`mount-twin warm-up`: compile and cache the kernels now, not at the first replay or start.
+
+numba compiles the twin's kernels on first use (20–60 s on a small machine) and caches them
+beside the sources. `colcon build` runs this after installing (setup.py), so the installed
+package starts warm; after `pip install` run it once by hand, or let the first run compile.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+NAME = "warm-up"
+HELP = "compile and cache the kernels (colcon build does it; after pip install, optional)"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "scenes",
+        nargs="*",
+        help="scene YAML files to warm for (default: the bundled scenes, which cover the "
+        "kernels' variants: linear mounts only, and with non-linear kinds)",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    from mount_twin.commands.common import share_dir
+    from mount_twin.replay import kernels_loading
+    from mount_twin.scene.loader import load_scene_file
+    from mount_twin.stream import TwinStream
+
+    scenes = args.scenes or sorted(str(p) for p in (share_dir() / "config").glob("*.scene.yaml"))
+    start = time.perf_counter()
+    for path in scenes:
+        with kernels_loading():
+            TwinStream(load_scene_file(path))  # builds the engine, which loads its kernels
+        print(f"kernels ready for {path}")
+    print(f"warm-up done in {time.perf_counter() - start:.1f} s")
+    return 0
