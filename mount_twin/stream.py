@@ -32,6 +32,8 @@ class TwinStream:
         self.base: TimeBase | None = None
         self.last_outputs: OutputBatch | None = None
         self._last_ns = 0
+        self._held_ns = 0
+        """Stamp (ns) of the sample the engine holds back (see TwinEngine.holding)."""
         self.final_report: HealthReport | None = None
 
     def process(self, raws: list[bytes]) -> list[tuple[str, int, bytes]]:
@@ -40,21 +42,32 @@ class TwinStream:
         if decoded.undecodable:
             self.engine.count("received", decoded.undecodable)
             self.engine.count("rejected_undecodable", decoded.undecodable)
-        unset = decoded.stamps_ns == 0
-        if unset.any():  # an unset header.stamp: no time to place the sample at
-            self.engine.count("received", int(unset.sum()))
-            self.engine.count("rejected_zero_stamp", int(unset.sum()))
-            decoded = decoded.select(~unset)
+        # An unset header.stamp has no time to place the sample at; one before 1970 (sec < 0,
+        # which builtin_interfaces/Time allows) cannot be written to a bag or answered.
+        for reason, bad in (
+            ("zero_stamp", decoded.stamps_ns == 0),
+            ("negative_stamp", decoded.stamps_ns < 0),
+        ):
+            if bad.any():
+                self.engine.count("received", int(bad.sum()))
+                self.engine.count(f"rejected_{reason}", int(bad.sum()))
+                decoded = decoded.select(~bad)
         if self.base is None:
             if not decoded.stamps_ns.shape[0]:
                 return []
             self.base = TimeBase.at(int(decoded.stamps_ns[0]))
             self.engine.health.origin_s = self.base.origin_ns // 1_000_000_000
+        held = self.engine.holding
         out = self.engine.push(decoded.batch(self.base))
         self.last_outputs = out
+        # Rows and reports of the sample held back from the last push come as sample −1: the
+        # stamps get its stamp appended, where index −1 finds it.
+        stamps_ns = np.append(decoded.stamps_ns, self._held_ns) if held else decoded.stamps_ns
+        if self.engine.holding and len(decoded.stamps_ns):
+            self._held_ns = int(decoded.stamps_ns[-1])
         if len(out):
-            self._last_ns = int(decoded.stamps_ns[out.sample[-1]])
-        return encode_outputs(self.scene, out, decoded.stamps_ns)
+            self._last_ns = int(stamps_ns[out.sample[-1]])
+        return encode_outputs(self.scene, out, stamps_ns)
 
     def stalled(self, waited_s: float, stamp_ns: int) -> list[tuple[str, int, bytes]]:
         """A report now, after `waited_s` (s) of the node's clock without any (live only),

@@ -50,6 +50,12 @@ ACCEPT, START, JUMPED_BACK, GAP_RESET, GAP_BRIDGED = (
     "gap_bridged",
 )
 """Verdicts on a sample besides the rejection reasons (non_finite, wrong_frame, ...)."""
+HOLD = "hold"
+"""The last sample of a push whose stamp jumped forward: kept for the next push to confirm."""
+JUMP_FACTOR = 20.0
+"""A stamp interval more than this many times the previous one is a jump to confirm: taken if
+the next stamp is later still, rejected as `stamp_glitch` if the next one falls back before it
+(one bad stamp then costs that one sample, not the samples until time catches up with it)."""
 
 _RESTARTS = frozenset((START, JUMPED_BACK, GAP_RESET))
 _COUNTS = {
@@ -124,6 +130,10 @@ class TwinEngine:
         self._counter = np.zeros(1, dtype=np.int64)
         self._last: tuple[float, np.ndarray, np.ndarray] | None = None
         self._last_stamp: float | None = None
+        self._last_step: float | None = None
+        """Interval (s) into the last taken sample from the one before (None after a start)."""
+        self._held: SampleBatch | None = None
+        """A sample held back at the end of the last push (a jump to confirm, see JUMP_FACTOR)."""
         self._skipped = 0
         """Samples rejected since the last taken one: they fill a stamp hole, are not lost."""
         self._gravity_up = np.array([0.0, 0.0, scene.input.g])
@@ -236,6 +246,26 @@ class TwinEngine:
         nm = self.model.n_mounts
         if len(batch) == 0:
             return OutputBatch.empty(nm)
+        if self._held is None:
+            return self._push(batch)
+        # The held sample goes first, now with the next one to confirm or refute it: positions
+        # in the result count from it, so it is −1 to the caller.
+        batch, self._held = SampleBatch.concat([self._held, batch]), None
+        out = self._push(batch)
+        out.sample -= 1
+        for report in out.health:
+            report.sample -= 1
+        return out
+
+    @property
+    def holding(self) -> bool:
+        """Whether the last sample pushed is held back (a stamp jump to confirm): the next push
+        gives its outputs, as sample −1."""
+        return self._held is not None
+
+    def _push(self, batch: SampleBatch) -> OutputBatch:
+        """`push` of a batch that holds any held-back sample first."""
+        nm = self.model.n_mounts
         f, w, finite = self._screen(batch)
         verdicts, due, intervals = self._classify(batch, finite)
         parts: list[_Rows] = []
@@ -330,9 +360,17 @@ class TwinEngine:
             before = np.empty(n)
             before[0], before[1:] = last_t, batch.stamps[:-1]
             steps = batch.stamps - before
-            if (steps > 0.0).all() and (steps <= spec.max_gap_s).all():
+            prev = np.empty(n)
+            prev[0] = math.inf if self._last_step is None else self._last_step
+            prev[1:] = steps[:-1]
+            if (
+                (steps > 0.0).all()
+                and (steps <= spec.max_gap_s).all()
+                and (steps <= JUMP_FACTOR * prev).all()
+            ):
                 # The usual batch, every sample in order: no per-sample Python loop.
                 self._last_stamp = float(batch.stamps[-1])
+                self._last_step = float(steps[-1])
                 intervals = _Intervals(steps, {0: self._skipped} if self._skipped else {}, True)
                 self._skipped = 0
                 return [ACCEPT] * n, self.health.ticks(batch.stamps), intervals
@@ -340,7 +378,9 @@ class TwinEngine:
         due: list[int] = []
         into = np.full(n, np.nan)
         skipped: dict[int, int] = {}
-        for i, t in enumerate(batch.stamps.tolist()):
+        stamps = batch.stamps.tolist()
+        last_step = self._last_step
+        for i, t in enumerate(stamps):
             if not finite[i]:
                 verdict = "non_finite"
             elif spec.frame_id and batch.frame_ids[i] != spec.frame_id:
@@ -353,14 +393,24 @@ class TwinEngine:
                 verdict = JUMPED_BACK
             elif t < last_t:
                 verdict = "stamp_went_back"
+            elif last_step is not None and t - last_t > JUMP_FACTOR * last_step and (
+                i + 1 == n or last_t < stamps[i + 1] < t
+            ):
+                verdict = HOLD if i + 1 == n else "stamp_glitch"
             elif t - last_t > spec.max_gap_s:
                 verdict = GAP_RESET if spec.gap_policy == "reset" else GAP_BRIDGED
             else:
                 verdict = ACCEPT
             verdicts.append(verdict)
+            if verdict == HOLD:
+                self._held = SampleBatch(
+                    batch.stamps[i:], batch.accel[i:], batch.gyro[i:], batch.frame_ids[i:]
+                )
+                break
             if verdict not in _COUNTS:
                 self._skipped += 1
                 continue
+            last_step = None if verdict in _RESTARTS else t - last_t
             if verdict == ACCEPT:
                 into[i] = t - last_t  # type: ignore[operator]  # ACCEPT: last_t is set
                 if self._skipped:
@@ -370,14 +420,17 @@ class TwinEngine:
             if self.health.tick(t):
                 due.append(i)
         self._last_stamp = last_t
+        self._last_step = last_step
         plain = verdicts.count(ACCEPT) == n
         return verdicts, due, _Intervals(into, skipped, plain)
 
     def _count(self, verdicts: list[str]) -> Counter[str]:
-        """Count the verdicts of samples processed; return how many of each there were."""
+        """Count the verdicts of samples processed; return how many of each there were. A held
+        sample is counted when the next push decides on it."""
         counts = self.counts
-        counts["received"] += len(verdicts)
         tally = Counter(verdicts)
+        tally.pop(HOLD, None)
+        counts["received"] += tally.total()
         for verdict, n in tally.items():
             for key in _COUNTS.get(verdict, (f"rejected_{verdict}",)):
                 counts[key] += n
@@ -452,7 +505,15 @@ class TwinEngine:
 
     def flush(self) -> HealthReport | None:
         """The report of what happened since the last one, due or not (end of a bag, shutdown);
-        None if nothing was processed since. Its `sample` is −1: the last accepted sample."""
+        None if nothing was processed since. Its `sample` is −1: the last accepted sample.
+
+        A sample still held back (a stamp jump that no later sample confirmed) is counted as
+        rejected_unconfirmed_jump: the record ends before it can be told from a glitch.
+        """
+        if self._held is not None:
+            self._held = None
+            self.count("received")
+            self.count("rejected_unconfirmed_jump")
         if self._last_stamp is None or not self.health.pending:
             return None
         return self._report(self._last_stamp, -1)
