@@ -24,7 +24,7 @@ from mount_twin.engine.batch import (
     SampleBatch,
 )
 from mount_twin.engine.gyro_filter import GyroConditioner
-from mount_twin.engine.health import HealthWindow
+from mount_twin.engine.health import PLATEAU_G, SATURATION_SHARE, HealthWindow
 from mount_twin.engine.kernel import (
     Integrator,
     Published,
@@ -133,6 +133,8 @@ class TwinEngine:
         self._last_step: float | None = None
         """Interval (s) into the last taken sample from the one before (None after a start)."""
         self._held: SampleBatch | None = None
+        self._last_reading = np.full(3, np.nan)
+        """The last accelerometer reading pushed and not held back (sensor frame, m/s²)."""
         """A sample held back at the end of the last push (a jump to confirm, see JUMP_FACTOR)."""
         self._skipped = 0
         """Samples rejected since the last taken one: they fill a stamp hole, are not lost."""
@@ -268,11 +270,14 @@ class TwinEngine:
         nm = self.model.n_mounts
         f, w, finite = self._screen(batch)
         verdicts, due, intervals = self._classify(batch, finite)
+        suspect = self._suspect_readings(batch)
         parts: list[_Rows] = []
         reports = []
         start = 0
         for stop, report_due in [*((i + 1, True) for i in due), (len(batch), False)]:
             wall0 = self._clock()
+            for what, flags in suspect.items():
+                self.counts[what] += int(flags[start:stop].sum())
             if self._count(verdicts[start:stop]).get("wrong_frame"):
                 self.health.add_wrong_frames(
                     [
@@ -320,6 +325,32 @@ class TwinEngine:
             steps = steps[keep]
             skipped = {int(position[i]): n for i, n in skipped.items()}
         self.health.add_intervals(steps, skipped)
+
+    def _suspect_readings(self, batch: SampleBatch) -> dict[str, np.ndarray]:
+        """Per sample (bool, not held back): 'saturated', a reading at the sensor's full scale;
+        'plateau', an accelerometer reading beyond PLATEAU_G repeated from the sample before.
+        Such samples are taken (their value is the best there is) but counted and reported."""
+        spec = self.scene.input
+        accel, n = batch.accel, len(batch)
+        saturated = np.zeros(n, dtype=bool)
+        for reading, full_scale in (
+            (accel, spec.accel_range_m_s2),
+            (batch.gyro, spec.gyro_range_rad_s),
+        ):
+            if full_scale > 0.0:
+                saturated |= (np.abs(reading) >= SATURATION_SHARE * full_scale).any(axis=1)
+        before = np.concatenate([self._last_reading[None, :], accel[:-1]])
+        with np.errstate(invalid="ignore", over="ignore"):
+            plateau = (accel == before).all(axis=1) & (
+                np.linalg.norm(accel, axis=1) > PLATEAU_G * spec.g
+            )
+        taken = np.ones(n, dtype=bool)
+        if self._held is not None:  # HOLD is only ever the last sample
+            taken[-1] = False
+        kept = np.flatnonzero(taken)
+        if kept.shape[0]:
+            self._last_reading = accel[kept[-1]].copy()
+        return {"saturated": saturated & taken, "plateau": plateau & taken}
 
     def _screen(self, batch: SampleBatch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Specific force (m/s²) and Ω (rad/s) in F per sample, and which samples are finite:
@@ -393,8 +424,10 @@ class TwinEngine:
                 verdict = JUMPED_BACK
             elif t < last_t:
                 verdict = "stamp_went_back"
-            elif last_step is not None and t - last_t > JUMP_FACTOR * last_step and (
-                i + 1 == n or last_t < stamps[i + 1] < t
+            elif (
+                last_step is not None
+                and t - last_t > JUMP_FACTOR * last_step
+                and (i + 1 == n or last_t < stamps[i + 1] < t)
             ):
                 verdict = HOLD if i + 1 == n else "stamp_glitch"
             elif t - last_t > spec.max_gap_s:

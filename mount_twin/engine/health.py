@@ -17,6 +17,11 @@ HOLE = 1.5
 """A stamp interval longer than HOLE nominal intervals is a hole: samples were lost."""
 LOST_ERROR = 0.01
 """Fraction of (accepted + lost) samples lost in a period past which the input is an ERROR."""
+SATURATION_SHARE = 0.999
+"""A reading at this share of `input.accel_range_m_s2` (or `gyro_range_rad_s`) is saturated."""
+PLATEAU_G = 2.0
+"""A reading repeated exactly, sample after sample, beyond this many g (m/s² / input.g) is a
+plateau: a clipped or stuck sensor (real vibration never repeats to the last bit)."""
 NAMED_FRAMES = 3
 """Wrong frame_ids named in a message (the rest are elided)."""
 
@@ -338,6 +343,25 @@ class HealthWindow:
             parts.append(
                 f"{n_rejected} samples rejected{detail}, {new['gaps']} gaps in this period"
             )
+        spec = self.scene.input
+        if new["saturated"]:
+            level = max(level, WARN)
+            ranges = " or ".join(
+                f"{v:g} {unit}"
+                for v, unit in ((spec.accel_range_m_s2, "m/s²"), (spec.gyro_range_rad_s, "rad/s"))
+                if v > 0.0
+            )
+            parts.append(
+                f"{new['saturated']} samples at the sensor's range ({ranges}): clipped, the true "
+                "peaks were higher"
+            )
+        if new["plateau"]:
+            level = max(level, WARN)
+            parts.append(
+                f"{new['plateau']} readings beyond {PLATEAU_G:g} g repeated exactly from the "
+                "sample before "
+                "(a clipped or stuck sensor?)"
+            )
         if lost:
             level = max(level, ERROR if share > LOST_ERROR else WARN)
             sources = []
@@ -356,6 +380,8 @@ class HealthWindow:
             **{k: str(counts[k]) for k in ("received", "accepted", "gaps", "restarts")},
             **{k: str(v) for k, v in sorted(counts.items()) if k.startswith("rejected_")},
             "reset_stamp_jumped_back": str(counts["reset_stamp_jumped_back"]),
+            "saturated": str(counts["saturated"]),
+            "plateau": str(counts["plateau"]),
             "lost_estimated": str(counts["lost_estimated"]),
             "lost_in_period": str(lost),
             "nominal_interval_s": "n/a" if math.isnan(nominal_s) else f"{nominal_s:.6g}",

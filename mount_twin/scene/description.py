@@ -90,6 +90,8 @@ class InputSpec:
         gyro_filter: how Ω and Ω′ are taken from the gyro: 'lowpass', 'none' or 'ignore'
             (see mount_twin.engine.gyro_filter).
         gyro_cutoff_hz: −3 dB frequency of the 'lowpass' gyro filter, Hz.
+        accel_range_m_s2, gyro_range_rad_s: the sensor's full scale (0: unknown); a reading at
+            it is counted as saturated (clipped: the true peak was higher).
     """
 
     msg_type: str = "sensor_msgs/msg/Imu"
@@ -105,6 +107,8 @@ class InputSpec:
     back_jump_reset_s: float = 1.0
     gyro_filter: str = "lowpass"
     gyro_cutoff_hz: float = 50.0
+    accel_range_m_s2: float = 0.0
+    gyro_range_rad_s: float = 0.0
 
 
 @dataclass(frozen=True)

@@ -174,6 +174,8 @@ def _input(r: Reader) -> InputSpec:
         back_jump_reset_s=r.number("back_jump_reset_s", d.back_jump_reset_s, lo=0.0),
         gyro_filter=r.choice("gyro_filter", GYRO_FILTERS, d.gyro_filter),
         gyro_cutoff_hz=r.positive("gyro_cutoff_hz", d.gyro_cutoff_hz),
+        accel_range_m_s2=r.number("accel_range_m_s2", d.accel_range_m_s2, lo=0.0),
+        gyro_range_rad_s=r.number("gyro_range_rad_s", d.gyro_range_rad_s, lo=0.0),
     )
     r.finish()
     return spec
