@@ -1,0 +1,48 @@
+"""Static equilibrium holds at any stiffness: stiff, light scenes load (an absolute residual
+threshold refused them), the equilibrium matches the closed form, and a DOF no mount holds is
+still refused."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from physics_helpers import base_scene, mount
+
+from mount_twin.errors import ModelError
+from mount_twin.model.assemble import assemble, initial_state
+from mount_twin.scene.loader import scene_from_dict
+
+CORNERS = [(0.4, 0.3), (-0.4, 0.3), (-0.4, -0.3), (0.4, -0.3)]
+
+
+def _model(mass: float, k: float, stiffness_axes: tuple[float, float, float] = (1, 1, 1)):
+    """`mass` on four equal isotropic (or as given) mounts in the plane of the CG."""
+    kx, ky, kz = (k * a for a in stiffness_axes)
+    mounts = [
+        mount(f"m{i}", (x, y, 0.5), (kx, ky, kz, 0, 0, 0)) for i, (x, y) in enumerate(CORNERS)
+    ]
+    data = base_scene(mass, [0.0, 0.0, 0.5], [mass * 0.1] * 3 + [0.0] * 3, mounts)
+    return assemble(scene_from_dict(data, "<equilibrium test>"))
+
+
+@pytest.mark.parametrize(("mass", "k"), [(1.0, 1e10), (10.0, 1e11), (10.0, 1e9), (1e4, 1e5)])
+@pytest.mark.parametrize(
+    ("magnitude", "tilt"), [(m, t) for m in (8.0, 9.80665, 11.5) for t in (0.0, 0.2, -0.35)]
+)
+def test_the_equilibrium_of_stiff_light_scenes_is_found_and_is_the_closed_form(
+    mass: float, k: float, magnitude: float, tilt: float
+) -> None:
+    """Isotropic mounts in the CG's plane, symmetric: the body translates by m·f/(4k) against
+    the specific force f (the mounts push it back toward f), without rotating."""
+    f = magnitude * np.array([0.0, math.sin(tilt), math.cos(tilt)])
+    y = initial_state(_model(mass, k), f)
+    np.testing.assert_allclose(y[:3], -mass * f / (4.0 * k), rtol=1e-6, atol=1e-300)
+    assert np.abs(y[3:6]).max() <= 1e-12
+
+
+def test_a_dof_no_mount_holds_is_still_refused() -> None:
+    """Mounts stiff along z only: under a tilted specific force nothing holds y."""
+    with pytest.raises(ModelError, match="no static equilibrium found"):
+        initial_state(_model(10.0, 1e9, (0.0, 0.0, 1.0)), np.array([0.0, 1.0, 9.75]))
