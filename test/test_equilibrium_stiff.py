@@ -46,3 +46,23 @@ def test_a_dof_no_mount_holds_is_still_refused() -> None:
     """Mounts stiff along z only: under a tilted specific force nothing holds y."""
     with pytest.raises(ModelError, match="no static equilibrium found"):
         initial_state(_model(10.0, 1e9, (0.0, 0.0, 1.0)), np.array([0.0, 1.0, 9.75]))
+
+
+def test_a_start_on_a_turning_deck_rests_relative_to_it() -> None:
+    """A deck turning steadily at 1.4 rad/s about z (a turntable; sensor on the axis reads g):
+    started at the equilibrium that includes the centrifugal load, the pump stays put relative
+    to the deck; the equilibrium without it differs by far more than the motion that follows."""
+    from io_helpers import batch, default_model, engine_for
+
+    omega = np.array([0.0, 0.0, 1.4])
+    n = 1000
+    gyro = np.tile(omega, (n, 1))
+    engine = engine_for()
+    out = engine.push(batch(1.0 + np.arange(n) * 1e-3, gyro=gyro))
+    drift = np.abs(out.pose[:, :3] - out.pose[0, :3]).max()
+    g_up = np.array([0.0, 0.0, 9.80665])
+    shift = np.abs(
+        initial_state(default_model(), g_up, omega)[:3] - initial_state(default_model(), g_up)[:3]
+    ).max()
+    assert shift > 1e-6  # m: the centrifugal load moves the equilibrium
+    assert drift < 1e-4 * shift

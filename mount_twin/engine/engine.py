@@ -639,8 +639,8 @@ class TwinEngine:
         self, i: int, stamps: np.ndarray, f: np.ndarray, w: np.ndarray, gathered: np.ndarray
     ) -> _Rows:
         """(Re)start the twin at sample i, under the mean specific force of `gathered` (m/s²,
-        F; sample i's last) as gravity where the scene starts at equilibrium under the input;
-        its outputs are published."""
+        F; sample i's last) as gravity and sample i's rotation rate (as the gyro policy takes
+        it) where the scene starts at equilibrium under the input; its outputs are published."""
         if self._last is not None or self.counts["starts"]:
             self.counts["restarts"] += 1
         self.counts["starts"] += 1
@@ -648,9 +648,10 @@ class TwinEngine:
         f0 = gathered.mean(axis=0)
         self._check_start(stamp, f0, gathered)
         self._y = self._y_nominal.copy()
+        w0 = self._gyro.start(w[i])
         if self.scene.initial.gravity == "first_sample":
             try:
-                self._y = initial_state(self.model, f0)
+                self._y = initial_state(self.model, f0, w0)
             except ModelError:
                 # Restarting inside a shock: no equilibrium holds under that load.
                 self.counts["starts_at_nominal_gravity"] += 1
@@ -662,7 +663,7 @@ class TwinEngine:
         self.stepper.reset()
         self._peak[:] = 0.0
         self._counter[0] = 0
-        self._last = (stamp, f[i].copy(), self._gyro.start(w[i]))
+        self._last = (stamp, f[i].copy(), w0)
         pose, wrenches = self._start_outputs(self._y, self._scratch, self._watch)
         return _Rows(np.array([i]), pose, wrenches)
 

@@ -126,19 +126,28 @@ def _nonlinear(
     )
 
 
-def gravity_input(t0: float, specific_force: np.ndarray) -> np.ndarray:
-    """Input vector u of a foundation at rest with the given specific force (m/s², F)."""
+def gravity_input(
+    t0: float, specific_force: np.ndarray, rate_rad_s: np.ndarray | None = None
+) -> np.ndarray:
+    """Input vector u of a foundation with the given specific force (m/s², F), at rest or
+    turning steadily at `rate_rad_s` (Ω, rad/s, F; Ω′ = 0)."""
     u = np.zeros(INPUT_SIZE)
     u[0] = t0
     u[1:4] = specific_force
+    if rate_rad_s is not None:
+        u[7:10] = rate_rad_s
     return u
 
 
-def initial_state(model: Model, specific_force: np.ndarray) -> np.ndarray:
+def initial_state(
+    model: Model, specific_force: np.ndarray, rate_rad_s: np.ndarray | None = None
+) -> np.ndarray:
     """Start state: the scene's given pose and velocity, or static equilibrium.
 
     In equilibrium mode the free coordinates are those where all generalized accelerations vanish
-    with the foundation at rest under `specific_force` (m/s², F; +g·z for gravity).
+    with the foundation under `specific_force` (m/s², F; +g·z for gravity), at rest or turning
+    steadily at `rate_rad_s` (Ω, rad/s, F): the body then rests relative to the foundation,
+    its mounts carrying the centrifugal load too (a deck that rolls at the first sample).
     """
     scene = model.scene
     nf = len(scene.dofs)
@@ -148,17 +157,21 @@ def initial_state(model: Model, specific_force: np.ndarray) -> np.ndarray:
     y0[nf : 2 * nf] = np.array(scene.initial.velocity)[idx]
     if scene.initial.mode == "given":
         return y0
-    return static_equilibrium(model, y0[:nf], specific_force)
+    return static_equilibrium(model, y0[:nf], specific_force, rate_rad_s)
 
 
 def static_equilibrium(
-    model: Model, q_guess: np.ndarray, specific_force: np.ndarray
+    model: Model,
+    q_guess: np.ndarray,
+    specific_force: np.ndarray,
+    rate_rad_s: np.ndarray | None = None,
 ) -> np.ndarray:
-    """State at rest where the free generalized accelerations vanish (least squares on them);
+    """State at rest relative to F where the free generalized accelerations vanish (least
+    squares on them), the foundation turning at `rate_rad_s` (rad/s, F; None: not turning);
     internal mount states at their initial values (zero)."""
     nf = q_guess.shape[0]
     m, s = model.arrays, model.new_scratch()
-    u = gravity_input(0.0, specific_force)
+    u = gravity_input(0.0, specific_force, rate_rad_s)
     y = np.zeros(model.n_state)
     dydt = np.zeros(model.n_state)
 
