@@ -85,15 +85,21 @@ class Run:
     later_rows: int
 
 
-@cache
-def escalation() -> Run:
-    """The three pulses in one engine, pushed in 0.05 s chunks, then LATER s at rest."""
+def shock_record() -> tuple[np.ndarray, np.ndarray]:
+    """Stamps (s) and specific force (m/s²) of the three pulses."""
     t = np.arange(round(TOTAL * RATE)) / RATE
     accel = np.zeros((t.size, 3))
     accel[:, 2] = G
     for onset, peak, length, rebound in PULSES:
         sig = half_sine_shock(peak, length, RATE, onset, TOTAL, G, rebound=rebound)
         accel += sig.accel - (0.0, 0.0, G)
+    return t, accel
+
+
+@cache
+def escalation() -> Run:
+    """The three pulses in one engine, pushed in 0.05 s chunks, then LATER s at rest."""
+    t, accel = shock_record()
     engine = TwinEngine(assemble(scene()))
     outs = []
     for part in split(batch(t, accel), [500] * round(TOTAL / 0.05)):
@@ -270,6 +276,29 @@ def test_a_broken_bolt_stays_an_error_in_later_periods_without_new_events() -> N
         assert "bolt_fractured" in s.values["now"].split(", "), (s.name, s.values)
         assert s.level == ERROR, (s.name, s.message)
         assert "bolt_fractured ×" not in s.message, "the fracture itself is not reported again"
+
+
+def test_a_restart_does_not_re_bolt_the_machine() -> None:
+    """After the bolts broke, a 2 s gap restarts the twin at equilibrium (gap_policy reset):
+    the bolts stay broken (no preload comes back), and the feet stay ERROR."""
+    t, accel = shock_record()
+    engine = TwinEngine(assemble(scene()))
+    engine.push(batch(t, accel))
+    assert len({e.mount for e in engine.events if e.event == "bolt_fractured"}) == len(FEET)
+    later = t[-1] + 2.0 + np.arange(2000) / RATE
+    out = engine.push(batch(later))
+    assert (engine.counts["gaps"], engine.counts["restarts"]) == (1, 1)
+    report = engine.flush()
+    assert report is not None
+    names = [m.name for m in scene().mounts]
+    for foot in FEET:
+        s = status(report, foot)
+        assert "bolt_fractured" in s.values["now"].split(", "), (foot, s.values)
+        assert s.level == ERROR
+        # Resting on its broken feet the frame is pressed down by its weight only: no foot
+        # carries the bolt preload (a re-bolted foot would clamp with preload + its share).
+        fz = out.wrenches[-1, names.index(foot), 2]
+        assert abs(fz) < joint(foot).preload / 2, (foot, fz)
 
 
 def test_a_broken_bolt_whose_foot_is_off_the_deck_carries_no_force() -> None:

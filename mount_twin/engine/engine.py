@@ -640,7 +640,11 @@ class TwinEngine:
     ) -> _Rows:
         """(Re)start the twin at sample i, under the mean specific force of `gathered` (m/s²,
         F; sample i's last) as gravity and sample i's rotation rate (as the gyro policy takes
-        it) where the scene starts at equilibrium under the input; its outputs are published."""
+        it) where the scene starts at equilibrium under the input; its outputs are published.
+        A restart keeps the mounts' internal states (fracture, plastic elongation, slip,
+        hysteresis): only the motion starts afresh."""
+        internal = self._y[2 * len(self.scene.dofs) :].copy()
+        damage = internal if self.counts["starts"] and np.isfinite(internal).all() else None
         if self._last is not None or self.counts["starts"]:
             self.counts["restarts"] += 1
         self.counts["starts"] += 1
@@ -648,10 +652,12 @@ class TwinEngine:
         f0 = gathered.mean(axis=0)
         self._check_start(stamp, f0, gathered)
         self._y = self._y_nominal.copy()
+        if damage is not None:  # a machine is not re-bolted by a restart
+            self._y[2 * len(self.scene.dofs) :] = damage
         w0 = self._gyro.start(w[i])
         if self.scene.initial.gravity == "first_sample":
             try:
-                self._y = initial_state(self.model, f0, w0)
+                self._y = initial_state(self.model, f0, w0, damage)
             except ModelError:
                 # Restarting inside a shock: no equilibrium holds under that load.
                 self.counts["starts_at_nominal_gravity"] += 1

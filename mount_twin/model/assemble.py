@@ -140,7 +140,10 @@ def gravity_input(
 
 
 def initial_state(
-    model: Model, specific_force: np.ndarray, rate_rad_s: np.ndarray | None = None
+    model: Model,
+    specific_force: np.ndarray,
+    rate_rad_s: np.ndarray | None = None,
+    internal: np.ndarray | None = None,
 ) -> np.ndarray:
     """Start state: the scene's given pose and velocity, or static equilibrium.
 
@@ -148,6 +151,8 @@ def initial_state(
     with the foundation under `specific_force` (m/s², F; +g·z for gravity), at rest or turning
     steadily at `rate_rad_s` (Ω, rad/s, F): the body then rests relative to the foundation,
     its mounts carrying the centrifugal load too (a deck that rolls at the first sample).
+    `internal`: the mounts' internal states to start with (a restart keeps a broken bolt
+    broken and a yielded one stretched); None: all zero, a new machine.
     """
     scene = model.scene
     nf = len(scene.dofs)
@@ -155,24 +160,28 @@ def initial_state(
     y0 = np.zeros(model.n_state)  # internal mount states start at rest: no slip, no set
     y0[:nf] = np.array(scene.initial.pose)[idx]
     y0[nf : 2 * nf] = np.array(scene.initial.velocity)[idx]
+    if internal is not None:
+        y0[2 * nf :] = internal
     if scene.initial.mode == "given":
         return y0
-    return static_equilibrium(model, y0[:nf], specific_force, rate_rad_s)
+    return static_equilibrium(model, y0, specific_force, rate_rad_s)
 
 
 def static_equilibrium(
     model: Model,
-    q_guess: np.ndarray,
+    y_guess: np.ndarray,
     specific_force: np.ndarray,
     rate_rad_s: np.ndarray | None = None,
 ) -> np.ndarray:
     """State at rest relative to F where the free generalized accelerations vanish (least
-    squares on them), the foundation turning at `rate_rad_s` (rad/s, F; None: not turning);
-    internal mount states at their initial values (zero)."""
-    nf = q_guess.shape[0]
+    squares on the coordinates, from those of `y_guess`), the foundation turning at
+    `rate_rad_s` (rad/s, F; None: not turning); internal mount states as in `y_guess`."""
+    nf = len(model.scene.dofs)
+    q_guess = y_guess[:nf]
     m, s = model.arrays, model.new_scratch()
     u = gravity_input(0.0, specific_force, rate_rad_s)
     y = np.zeros(model.n_state)
+    y[2 * nf :] = y_guess[2 * nf :]
     dydt = np.zeros(model.n_state)
 
     def accelerations(q: np.ndarray) -> np.ndarray:
