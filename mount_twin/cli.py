@@ -23,12 +23,23 @@ class Command(Protocol):
     def run(self, args: argparse.Namespace) -> int: ...
 
 
+def _version() -> str:
+    """The installed distribution's version (importlib.metadata: no package import)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("mount_twin")
+    except PackageNotFoundError:
+        return "(not installed)"
+
+
 def build_parser() -> tuple[argparse.ArgumentParser, dict[str, Command]]:
     """The parser of every command, and each command's module by its name as typed."""
     parser = argparse.ArgumentParser(
         prog="mount-twin",
         description="Digital twin of a machine on compliant mounts: replay bags, make inputs.",
     )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     sub = parser.add_subparsers(dest="cmd", required=True)
     modules: dict[str, Command] = {}
     for name in COMMANDS:

@@ -132,3 +132,13 @@ def test_bag_errors_come_before_the_compile_notice(
     assert err.startswith(f"mount-twin: error: {missing}: cannot open bag")
     assert replay_module.COMPILE_NOTICE not in err
     assert not (tmp_path / "o").exists()
+
+
+def test_version_is_the_package_version_without_importing_numba() -> None:
+    """`--version` answers from the installed metadata, which matches package.xml."""
+    done = _cli("--version")
+    assert done.returncode == 0, done.stderr
+    xml = (ROOT / "package.xml").read_text(encoding="utf-8")
+    (declared,) = re.findall(r"<version>([^<]+)</version>", xml)
+    assert done.stdout.strip() == f"mount-twin {declared}"
+    assert _heavy_imports(done.stderr) == []
