@@ -60,7 +60,7 @@ setup(
         "rosbags>=0.11,<0.12",
     ],
     extras_require={
-        "test": ["pytest>=7", "ruff>=0.5", "hypothesis>=6.100"],
+        "test": ["pytest>=7", "ruff>=0.5", "hypothesis>=6.100", "matplotlib>=3.6"],
         "plot": ["matplotlib>=3.6"],
         # Jazzy's rclpy and message packages from the package registry, for a machine without a
         # ROS install (a sourced Jazzy has them: do not install a second rclpy there). The

@@ -109,6 +109,13 @@ class OutputBatch:
             np.zeros((0, n_mounts, 6)),
         )
 
+    def select(self, keep: np.ndarray) -> OutputBatch:
+        """The rows where `keep` (bool, one per row) is true, without the reports (which
+        follow samples of the whole batch)."""
+        return OutputBatch(
+            self.stamps[keep], self.sample[keep], self.pose[keep], self.wrenches[keep]
+        )
+
     @property
     def position(self) -> np.ndarray:
         """(k, 3) CG position in F, m."""

@@ -520,6 +520,7 @@ class TwinEngine:
             pose, wrenches, publish, step_log = out_buf[2:]
             self._drain_events()
             self.health.add_steps(step_log[1 : done + 1])
+            self.counts["substeps"] += int(step_log[1 : done + 1, 1:3].sum())
             if done > 0:
                 self._last = (float(t[done]), ff[done], ww[done])
             keep = np.flatnonzero(publish[: done + 1])  # never row 0: the previous sample

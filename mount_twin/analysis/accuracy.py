@@ -1,0 +1,169 @@
+"""Error against run time: the twin at several tolerances against a tight reference run.
+
+For one scene and one input record, each tolerance's run is compared with a reference run of
+the same twin at a much tighter tolerance (rtol 1e-12 by default) on the same input refined
+REFINE times: the record's held input (linear between samples, or held) sampled REFINE times
+as densely, so the reference takes at least REFINE steps per interval where a run may take
+one, and its error is not the run's own (the physics tests tie the formulation itself to
+closed forms and to an independent quaternion formulation integrated by scipy). The gyro is
+conditioned once, by the scene's `input.gyro_filter`, before both: that filter is part of the
+input, not of the integration.
+Figures per run: the largest mount-force error relative to the largest reference mount force,
+the error of each mount's peak force relative to that peak (the figure a design check uses),
+the attitude (rad) and CG position (m) errors, the engine's wall time per simulated second, and
+the stepper's failures. A reference run that fails (a stepper restart) is no reference: the
+next looser reference tolerance is tried, and the one used is reported.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from mount_twin.engine.batch import OutputBatch, SampleBatch
+from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.gyro_filter import GyroConditioner
+from mount_twin.errors import MountTwinError
+from mount_twin.model.assemble import assemble
+from mount_twin.scene.description import Scene
+
+DEFAULT_RTOLS = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
+REFINE = 8
+"""Reference input samples per record interval."""
+REFERENCE_RTOLS = (1e-12, 1e-11, 1e-10)
+ATOL_PER_RTOL = 1e-3
+"""atol = rtol · this (m, rad, m/s, rad/s: the state's units)."""
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run of the twin over the record at one tolerance.
+
+    Attributes:
+        rtol, atol: the stepper's tolerances (atol in state units).
+        out: the engine's outputs (every sample published).
+        wall_s: engine wall time, s.
+        failures: stepper failures (each restarted the twin).
+        substeps_per_sample: accepted + rejected steps per input interval.
+    """
+
+    rtol: float
+    atol: float
+    out: OutputBatch
+    wall_s: float
+    failures: int
+    substeps_per_sample: float
+
+
+@dataclass(frozen=True)
+class Accuracy:
+    """Errors of one run against the reference (see the module docstring), and its cost.
+
+    Attributes:
+        rtol: the run's relative tolerance.
+        force_error: max |F − F_ref| over samples, mounts, axes / max |F_ref|, −.
+        peak_force_error: max over mounts of |peak|F| − peak|F_ref|| / peak|F_ref|, −.
+        attitude_error_rad: max |Δα|, |Δγ|, |Δδ|, rad.
+        position_error_m: max |ΔCG| component, m.
+        wall_s_per_sim_s: engine wall time per second of record, s/s.
+        substeps_per_sample, failures: from the run.
+    """
+
+    rtol: float
+    force_error: float
+    peak_force_error: float
+    attitude_error_rad: float
+    position_error_m: float
+    wall_s_per_sim_s: float
+    substeps_per_sample: float
+    failures: int
+
+
+def conditioned(scene: Scene, samples: SampleBatch) -> tuple[Scene, SampleBatch]:
+    """The scene with its gyro filter applied to `samples` once (rad/s, sensor frame; a filter
+    is linear and the sensor rotation constant, so filtering before it is the same), and
+    `gyro_filter: none` so that no run filters again."""
+    gyro = samples.gyro.copy()
+    if scene.input.gyro_filter != "none" and len(samples):
+        conditioner = GyroConditioner(scene.input.gyro_filter, scene.input.gyro_cutoff_hz)
+        gyro[0] = conditioner.start(gyro[0])
+        conditioner.rows(samples.stamps[1:], gyro[1:], float(samples.stamps[0]))
+    spec = dataclasses.replace(scene.input, gyro_filter="none")
+    batch = SampleBatch(samples.stamps, samples.accel, gyro, samples.frame_ids)
+    return dataclasses.replace(scene, input=spec), batch
+
+
+def refined(scene: Scene, samples: SampleBatch, factor: int = REFINE) -> SampleBatch:
+    """The same held input sampled `factor` times as densely: values between samples as the
+    scene's `input.hold` holds them (linear, or the previous sample's)."""
+    t = samples.stamps
+    fine = (t[:-1, None] + np.diff(t)[:, None] * (np.arange(factor) / factor)).ravel()
+    fine = np.append(fine, t[-1])
+
+    def hold(values: np.ndarray) -> np.ndarray:
+        if scene.input.hold == "zero_order":
+            return values[np.searchsorted(t, fine, side="right") - 1]
+        return np.column_stack([np.interp(fine, t, values[:, k]) for k in range(3)])
+
+    frames = [samples.frame_ids[0]] * fine.shape[0]
+    return SampleBatch(fine, hold(samples.accel), hold(samples.gyro), frames)
+
+
+def run_at(scene: Scene, samples: SampleBatch, rtol: float, max_substeps: int) -> Run:
+    """The twin over `samples` at `rtol` (atol = rtol·ATOL_PER_RTOL), every sample published
+    (the scene and samples as `conditioned` gives them)."""
+    atol = rtol * ATOL_PER_RTOL
+    integ = dataclasses.replace(scene.integration, rtol=rtol, atol=atol, max_substeps=max_substeps)
+    outputs = dataclasses.replace(scene.outputs, decimation=1)
+    engine = TwinEngine(assemble(dataclasses.replace(scene, integration=integ, outputs=outputs)))
+    t0 = time.perf_counter()
+    out = engine.push(samples)
+    wall = time.perf_counter() - t0
+    counts = engine.counts
+    intervals = max(counts["accepted"] - counts["starts"], 1)
+    return Run(
+        rtol, atol, out, wall, counts["integration_failures"], counts["substeps"] / intervals
+    )
+
+
+def reference_run(scene: Scene, samples: SampleBatch, max_substeps: int) -> Run:
+    """The tightest run of REFERENCE_RTOLS on the `refined` input that completes without a
+    stepper failure; its outputs at the record's own stamps."""
+    fine = refined(scene, samples)
+    for rtol in REFERENCE_RTOLS:
+        ref = run_at(scene, fine, rtol, max_substeps)
+        if ref.failures == 0:
+            at_samples = np.isin(ref.out.stamps, samples.stamps)
+            return dataclasses.replace(ref, out=ref.out.select(at_samples))
+    msg = (
+        f"no reference: the stepper failed at every reference tolerance {REFERENCE_RTOLS} "
+        f"with at most {max_substeps} substeps per input interval (--max-substeps). On scenes "
+        "with switches (joints opening, slip, contact, fracture) the explicit stepper steps "
+        "across them and tight tolerances make it hunt: no converged reference exists yet."
+    )
+    raise MountTwinError(msg)
+
+
+def compare(run: Run, ref: Run, duration_s: float) -> Accuracy:
+    """The errors of `run` against `ref`, both over the same samples."""
+    out, want = run.out, ref.out
+    if not np.array_equal(out.stamps, want.stamps):  # a failure skips no sample: same rows
+        msg = "runs answer different samples"
+        raise ValueError(msg)
+    force, force_ref = out.wrenches[:, :, :3], want.wrenches[:, :, :3]
+    peak = np.linalg.norm(force, axis=2).max(axis=0)
+    peak_ref = np.linalg.norm(force_ref, axis=2).max(axis=0)
+    scale = np.abs(force_ref).max()
+    return Accuracy(
+        rtol=run.rtol,
+        force_error=float(np.abs(force - force_ref).max() / scale),
+        peak_force_error=float((np.abs(peak - peak_ref) / peak_ref).max()),
+        attitude_error_rad=float(np.abs(out.angles - want.angles).max()),
+        position_error_m=float(np.abs(out.position - want.position).max()),
+        wall_s_per_sim_s=run.wall_s / duration_s,
+        substeps_per_sample=run.substeps_per_sample,
+        failures=run.failures,
+    )

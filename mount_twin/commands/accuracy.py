@@ -1,0 +1,148 @@
+"""`mount-twin accuracy SCENE BAG`: the twin's error against its run time, per tolerance."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from mount_twin.analysis.accuracy import Accuracy, Run
+    from mount_twin.engine.batch import SampleBatch
+    from mount_twin.scene.description import Scene
+
+NAME = "accuracy"
+HELP = "error against run time of the twin on a scene and bag, per tolerance (work-precision)"
+COLUMNS = (
+    "rtol",
+    "force_error",
+    "peak_force_error",
+    "attitude_error_rad",
+    "position_error_m",
+    "wall_s_per_sim_s",
+    "substeps_per_sample",
+    "failures",
+)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("scene", help="scene YAML")
+    parser.add_argument("bag", help="input bag (the scene's input.topic)")
+    parser.add_argument(
+        "--rtol",
+        type=float,
+        nargs="+",
+        help="relative tolerances to measure (default: 1e-3 to 1e-8; atol = rtol·1e-3)",
+    )
+    parser.add_argument(
+        "--max-substeps", type=int, default=100_000, help="per input interval (default: 100000)"
+    )
+    parser.add_argument("--csv", metavar="FILE", help="write the table as CSV")
+    parser.add_argument("--plot", metavar="PNG", help="work-precision diagram (the plot extra)")
+
+
+def run(args: argparse.Namespace) -> int:
+    from mount_twin.analysis.accuracy import (
+        DEFAULT_RTOLS,
+        REFINE,
+        compare,
+        conditioned,
+        reference_run,
+        run_at,
+    )
+    from mount_twin.scene.loader import load_scene_file
+
+    loaded = load_scene_file(args.scene)
+    scene, samples = conditioned(loaded, read_samples(args.bag, loaded))
+    duration = float(samples.stamps[-1] - samples.stamps[0])
+    print(
+        f"{scene.name}: {len(samples)} samples over {duration:.3f} s from {args.bag}",
+        file=sys.stderr,
+    )
+    ref = reference_run(scene, samples, args.max_substeps)
+    rows = []
+    for rtol in args.rtol or DEFAULT_RTOLS:
+        print(f"  rtol {rtol:g} ...", file=sys.stderr, flush=True)
+        rows.append(compare(run_at(scene, samples, rtol, args.max_substeps), ref, duration))
+    print(
+        f"reference: the same twin at rtol {ref.rtol:g}, atol {ref.atol:g}, on the input "
+        f"refined {REFINE}×"
+    )
+    print(_table(rows))
+    if args.csv:
+        _write_csv(rows, args.csv)
+        print(f"csv: {args.csv}")
+    if args.plot:
+        _plot(rows, ref, args.plot, f"{scene.name} on {args.bag}")
+        print(f"plot: {args.plot}")
+    return 0
+
+
+def read_samples(bag: str, scene: Scene) -> SampleBatch:
+    """Every input sample of the scene's input topic in `bag`, decoded (stamps from the first)."""
+    from mount_twin.io.bag import InputBag
+    from mount_twin.io.messages import TimeBase, decode_inputs
+
+    with InputBag(bag, scene.input.topic, scene.input.msg_type) as reader:
+        raws = [raw for chunk in reader.chunks(10_000) for raw in chunk]
+    decoded = decode_inputs(raws, scene.input.msg_type)
+    decoded = decoded.select(decoded.stamps_ns > 0)
+    if not len(decoded.stamps_ns):
+        msg = f"{bag}: no decodable sample on {scene.input.topic}"
+        raise ValueError(msg)
+    return decoded.batch(TimeBase.at(int(decoded.stamps_ns[0])))
+
+
+def _table(rows: list[Accuracy]) -> str:
+    head = (
+        f"{'rtol':>8} {'force err':>10} {'peak err':>10} {'attitude rad':>13} "
+        f"{'CG m':>10} {'wall s/s':>9} {'substeps':>9} {'failures':>8}"
+    )
+    lines = [head]
+    for r in rows:
+        lines.append(
+            f"{r.rtol:>8.0e} {r.force_error:>10.2e} {r.peak_force_error:>10.2e} "
+            f"{r.attitude_error_rad:>13.2e} {r.position_error_m:>10.2e} "
+            f"{r.wall_s_per_sim_s:>9.4f} {r.substeps_per_sample:>9.2f} {r.failures:>8d}"
+        )
+    return "\n".join(lines)
+
+
+def _write_csv(rows: list[Accuracy], path: str) -> None:
+    import csv
+    import dataclasses
+
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(COLUMNS)
+        for r in rows:
+            values = dataclasses.asdict(r)
+            writer.writerow([f"{values[c]:.6g}" for c in COLUMNS])
+
+
+def _plot(rows: list[Accuracy], ref: Run, png: str, title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for name, label in (("force_error", "max mount force"), ("peak_force_error", "peak force")):
+        err = [max(getattr(r, name), 1e-17) for r in rows]
+        ax.loglog([r.wall_s_per_sim_s for r in rows], err, "o-", label=f"{label} error")
+    for i, r in enumerate(rows):
+        ax.annotate(
+            f"rtol {r.rtol:.0e}" + (f", {r.failures} failures" if r.failures else ""),
+            (r.wall_s_per_sim_s, max(r.force_error, 1e-17)),
+            fontsize=7,
+            textcoords="offset points",
+            xytext=(4, 4 + 9 * (i % 3)),  # staggered: close points stay readable
+        )
+    ax.set_xlabel("engine wall time per simulated second [s/s]")
+    ax.set_ylabel(f"relative error against rtol {ref.rtol:.0e} [-]")
+    ax.set_title(f"work-precision: {title}", fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
