@@ -1,0 +1,147 @@
+"""A picture of a scene's layout, to check it before anything runs.
+
+Three views of the reference pose: 3-D, side (x–z of F) and end (y–z of F). Drawn: the axes of
+the foundation frame F at its origin; the CG; each mount at its position, coloured by kind,
+with its own axes (x red, y green, z blue, as RViz draws frames) and the line of action of its
+local z (dashed, through the mount, both ways), so an inclined mount pointing the wrong way,
+lines of action meeting below the mounts, or positions in millimetres show at a glance; the
+sensor with its axes. matplotlib is imported here only (the `plot` extra).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mount_twin.physics.rotations import rpy_matrix
+from mount_twin.scene.description import Scene
+
+KIND_COLOURS = {
+    "linear": "tab:blue",
+    "elastomer": "tab:purple",
+    "bolted_joint": "tab:orange",
+    "shear_key": "tab:brown",
+}
+AXIS_COLOURS = ("red", "green", "blue")
+VIEWS = (("side view (x–z of F)", 0, 2), ("end view (y–z of F)", 1, 2))
+"""2-D panels: title, horizontal and vertical axis of F."""
+
+
+def layout_size(scene: Scene) -> float:
+    """The layout's extent, m: the largest distance between the CG, the origin, the sensor
+    and the mounts (at least 0.1 m), the scale of the arrows and lines drawn."""
+    points = np.array(
+        [
+            scene.body.cg,
+            (0.0, 0.0, 0.0),
+            scene.input.sensor_position,
+            *(m.position for m in scene.mounts),
+        ]
+    )
+    return max(float(np.ptp(points, axis=0).max()), 0.1)
+
+
+def draw_layout(scene: Scene, png: str | Path) -> Path:
+    """Write the three views of `scene` to `png`; returns its path."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.lines
+    import matplotlib.pyplot as plt
+
+    size = layout_size(scene)
+    arrow, reach = 0.12 * size, 0.9 * size
+    fig = plt.figure(figsize=(15, 5.5))
+    ax3 = fig.add_subplot(1, 3, 1, projection="3d")
+    flat = [fig.add_subplot(1, 3, 2 + k) for k in range(2)]
+
+    def segment(a: np.ndarray, b: np.ndarray, **style: Any) -> None:
+        ax3.plot(*zip(a, b, strict=True), **style)
+        for ax, (_, i, j) in zip(flat, VIEWS, strict=True):
+            ax.plot([a[i], b[i]], [a[j], b[j]], **style)
+
+    labels: list[dict[tuple[float, float], list[str]]] = [{} for _ in VIEWS]
+
+    def point(p: np.ndarray, label: str, **style: Any) -> None:
+        ax3.scatter(*p, **style)
+        ax3.text(*p, f" {label}", fontsize=7)
+        for ax, (_, i, j), named in zip(flat, VIEWS, labels, strict=True):
+            ax.scatter(p[i], p[j], **style)
+            # Points that fall on one another in a view share one label.
+            named.setdefault((round(p[i], 6), round(p[j], 6)), []).append(label)
+
+    def frame(origin: np.ndarray, rot: np.ndarray, length: float, width: float) -> None:
+        for k in range(3):
+            segment(origin, origin + length * rot[:, k], color=AXIS_COLOURS[k], linewidth=width)
+
+    frame(np.zeros(3), np.eye(3), 2.0 * arrow, 2.0)
+    point(np.zeros(3), f"F ({scene.frames.foundation})", color="black", marker="+", s=60)
+    for m in scene.mounts:
+        p, rot = np.array(m.position), rpy_matrix(*m.orientation_rpy)
+        colour = KIND_COLOURS.get(m.kind, "tab:gray")
+        segment(
+            p - reach * rot[:, 2],
+            p + reach * rot[:, 2],
+            color=colour,
+            linestyle="--",
+            linewidth=0.8,
+        )
+        frame(p, rot, arrow, 1.2)
+        point(p, m.name, color=colour, s=30)
+    sensor = np.array(scene.input.sensor_position)
+    frame(sensor, rpy_matrix(*scene.input.sensor_rpy), 0.7 * arrow, 1.0)
+    point(sensor, "sensor", color="teal", marker="^", s=40)
+    point(np.array(scene.body.cg), f"CG ({scene.frames.body})", color="black", marker="o", s=70)
+
+    for ax, named in zip(flat, labels, strict=True):
+        for (u, v), names in named.items():
+            ax.annotate(
+                ", ".join(names), (u, v), fontsize=7, xytext=(3, 3), textcoords="offset points"
+            )
+    ax3.set_xlabel("x [m]")
+    ax3.set_ylabel("y [m]")
+    ax3.set_zlabel("z [m]")
+    ax3.set_box_aspect((1.0, 1.0, 1.0))
+    _equal_3d(ax3)
+    ax3.set_title("3-D (F: x red, y green, z blue)", fontsize=9)
+    for ax, (title, i, j) in zip(flat, VIEWS, strict=True):
+        ax.set_title(f"{title}; dashed: each mount's z line of action", fontsize=9)
+        ax.set_xlabel(f"{'xyz'[i]} [m]")
+        ax.set_ylabel(f"{'xyz'[j]} [m]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, alpha=0.3)
+    kinds = sorted({m.kind for m in scene.mounts})
+    flat[0].legend(
+        handles=[
+            matplotlib.lines.Line2D(
+                [], [], color=KIND_COLOURS.get(k, "tab:gray"), marker="o", linestyle="--", label=k
+            )
+            for k in kinds
+        ],
+        fontsize=7,
+        loc="lower right",
+        title="mount kind",
+        title_fontsize=7,
+    )
+    fig.suptitle(
+        f"{scene.name}: {scene.body.mass:g} kg, {len(scene.mounts)} mounts "
+        f"({', '.join(kinds)}), "
+        f"DOFs {', '.join(scene.dofs)} — {scene.source}",
+        fontsize=10,
+    )
+    fig.tight_layout()
+    out = Path(png)
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out
+
+
+def _equal_3d(ax: object) -> None:
+    """Equal scales on a 3-D axes (matplotlib keeps them independent)."""
+    limits = np.array([ax.get_xlim3d(), ax.get_ylim3d(), ax.get_zlim3d()])  # type: ignore[attr-defined]
+    centre, half = limits.mean(axis=1), (limits[:, 1] - limits[:, 0]).max() / 2.0
+    ax.set_xlim3d(centre[0] - half, centre[0] + half)  # type: ignore[attr-defined]
+    ax.set_ylim3d(centre[1] - half, centre[1] + half)  # type: ignore[attr-defined]
+    ax.set_zlim3d(centre[2] - half, centre[2] + half)  # type: ignore[attr-defined]

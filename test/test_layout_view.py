@@ -1,0 +1,54 @@
+"""`mount-twin show`: the layout picture is written, and its scale follows the scene (a scene
+written in millimetres draws a layout a thousand times too large)."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+from io_helpers import CONFIG, default_scene
+
+from mount_twin.analysis.layout_view import layout_size
+from mount_twin.cli import main
+from mount_twin.physics.rotations import rpy_matrix
+
+
+def test_the_command_writes_the_picture(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    png = tmp_path / "pump.png"
+    assert main(["show", str(CONFIG / "pump_8_mounts.scene.yaml"), "-o", str(png)]) == 0
+    assert f"layout: {png}" in capsys.readouterr().out
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 50_000
+
+
+def test_the_layout_scale_is_the_scene_extent() -> None:
+    scene = default_scene()
+    assert layout_size(scene) == pytest.approx(1.8)  # mounts from x = −0.9 to 0.9 m
+    in_mm = dataclasses.replace(
+        scene,
+        mounts=tuple(
+            dataclasses.replace(m, position=tuple(1000.0 * v for v in m.position))
+            for m in scene.mounts
+        ),
+    )
+    assert layout_size(in_mm) == pytest.approx(1800.0)
+
+
+def test_the_pump_end_mounts_lean_outward_and_their_lines_cross_below() -> None:
+    """What the picture shows and the scene comment says: fl (y = +0.4 m, roll −30°) has its
+    z axis along (0, sin 30°, cos 30°); the lines of action of fl and fr cross on the centre
+    line 0.4/tan 30° = 0.69 m below the mount plane."""
+    mounts = {m.name: m for m in default_scene().mounts}
+    fl, fr = mounts["fl"], mounts["fr"]
+    z_fl = rpy_matrix(*fl.orientation_rpy)[:, 2]
+    np.testing.assert_allclose(z_fl, [0.0, 0.5, np.sqrt(3) / 2], atol=1e-4)
+    z_fr = rpy_matrix(*fr.orientation_rpy)[:, 2]
+    # p_fl + s·z_fl = p_fr + t·z_fr, in the y–z plane
+    a = np.column_stack([z_fl[1:], -z_fr[1:]])
+    s, _ = np.linalg.solve(a, np.array(fr.position[1:]) - np.array(fl.position[1:]))
+    crossing = np.array(fl.position) + s * z_fl
+    assert crossing[1] == pytest.approx(0.0, abs=1e-9)
+    assert crossing[2] == pytest.approx(-0.4 / np.tan(np.radians(30.0)), rel=1e-4)
