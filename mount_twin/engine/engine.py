@@ -492,6 +492,11 @@ class TwinEngine:
         """Integrate one run; on a stepper failure restart at the next sample."""
         out: list[_Rows] = []
         index = run.index
+        if self.health.stopped_at is not None:
+            if not run.restart:
+                self.counts["samples_not_followed"] += len(index)
+                return out
+            self.health.stopped_at = None
         if run.restart or self._last is None:
             index, gathered = self._gather(run, f)
             if not index:
@@ -531,6 +536,12 @@ class TwinEngine:
             self.health.failure(float(t[done + 1]), STATUS_TEXT.get(status, f"status {status}"))
             self._last = None
             rest = index[done + 1 :]
+            if self.scene.initial.mode == "given":
+                # A restart would launch the given initial motion again: a motion the body is
+                # not making. The twin stops following until the record restarts.
+                self.health.stopped_at = float(t[done + 1])
+                self.counts["samples_not_followed"] += len(rest)
+                break
             if not rest:
                 break
             out.append(self._start(rest[0], stamps, f, w, f[rest[:1]]))

@@ -44,6 +44,9 @@ class HealthWindow:
         self._next_due: float | None = None
         self._reset()
         self._last_counts: Counter[str] = Counter()
+        self.stopped_at: float | None = None
+        """Stamp (s) where a scene with a given initial motion failed: the twin follows no more
+        (until the record restarts), and each report says so at ERROR."""
         self.last_wrong_frame_id: str | None = None
         """header.frame_id of the last sample rejected as wrong_frame (any period)."""
 
@@ -226,10 +229,21 @@ class HealthWindow:
         integ = self.scene.integration
         rtf = span / self.wall if self.wall > 0 and span > 0 else math.nan
         fail_text = "; ".join(f"{self.origin_s + t:.6f} s: {m}" for t, m in self.failures)
+        if self.stopped_at is not None:
+            step_text = (
+                f"not following since {self.origin_s + self.stopped_at:.6f} s: the stepper "
+                "failed, and restarting a given initial motion would replay a motion the body "
+                "is not making; no pose, angles or wrenches until the record restarts"
+                + (f" ({fail_text})" if self.failures else "")
+            )
+        elif self.failures:
+            step_text = f"stepper failed and the twin restarted: {fail_text}"
+        else:
+            step_text = "ok"
         step = HealthStatus(
             f"{PREFIX}: integration",
-            ERROR if self.failures else OK,
-            f"stepper failed and the twin restarted: {fail_text}" if self.failures else "ok",
+            ERROR if self.failures or self.stopped_at is not None else OK,
+            step_text,
             {
                 "method": self.method,
                 "rtol": f"{integ.rtol:g}",
