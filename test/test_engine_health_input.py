@@ -432,5 +432,6 @@ def test_stall_of_a_running_twin_then_reports_continue() -> None:
         accepted=1001 + 3 + 2000,
         rejected_wrong_frame=50,
         starts=1,
+        substeps=1001 + 3 + 2000 - 1,  # one step per interval: the default scene, 1 kHz
     )
     assert first.stamp == 1.0

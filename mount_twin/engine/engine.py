@@ -277,7 +277,8 @@ class TwinEngine:
         for stop, report_due in [*((i + 1, True) for i in due), (len(batch), False)]:
             wall0 = self._clock()
             for what, flags in suspect.items():
-                self.counts[what] += int(flags[start:stop].sum())
+                if n_flagged := int(flags[start:stop].sum()):
+                    self.counts[what] += n_flagged
             if self._count(verdicts[start:stop]).get("wrong_frame"):
                 self.health.add_wrong_frames(
                     [
