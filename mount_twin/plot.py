@@ -8,8 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from mount_twin.engine.batch import MountEvent
-from mount_twin.io.bag import read_topics
-from mount_twin.io.messages import POSE, VECTOR3, WRENCH
+from mount_twin.io.output_tables import read_output_bag
 
 
 def plot_output_bag(
@@ -27,19 +26,23 @@ def plot_output_bag(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    series = read_topics(bag, {POSE, VECTOR3, WRENCH})
+    tables = {t.name: t for t in read_output_bag(bag)}
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(10, 9))
-    t0 = min(float(s[0][0]) for s in series.values() if s[0].size)
-    for topic, (t, rows, msgtype) in sorted(series.items()):
-        tt = t - t0
-        if msgtype == POSE:
-            for k, axis in enumerate("xyz"):
-                axes[0].plot(tt, (rows[:, k] - rows[0, k]) * 1e3, label=f"CG {axis} - start")
-        elif msgtype == VECTOR3:
-            for k, name in enumerate(("alpha", "gamma", "delta")):
-                axes[1].plot(tt, np.degrees(rows[:, k]), label=name)
-        else:
-            axes[2].plot(tt, np.linalg.norm(rows[:, :3], axis=1), label=topic.split("/")[-2])
+    if "pose" in tables:
+        pose = tables["pose"].columns
+        for axis in "xyz":
+            rows = pose[f"{axis}_m"]
+            axes[0].plot(pose["t_s"], (rows - rows[0]) * 1e3, label=f"CG {axis} - start")
+    if "angles" in tables:
+        angles = tables["angles"].columns
+        for name in ("alpha", "gamma", "delta"):
+            axes[1].plot(angles["t_s"], np.degrees(angles[f"{name}_rad"]), label=name)
+    for name, table in tables.items():
+        if name.startswith("mount_"):
+            c = table.columns
+            force = np.sqrt(c["fx_N"] ** 2 + c["fy_N"] ** 2 + c["fz_N"] ** 2)
+            axes[2].plot(c["t_s"], force, label=name.removeprefix("mount_"))
+    t0 = min(int(t.columns["stamp_ns"][0]) for t in tables.values()) * 1e-9
     for error, marker, color in ((True, "v", "red"), (False, ".", "darkorange")):
         mine = [e for e in events if e.error == error]
         if mine:

@@ -1,0 +1,35 @@
+"""`mount-twin export OUT_BAG --csv DIR`: an output bag's series as tables."""
+
+from __future__ import annotations
+
+import argparse
+
+NAME = "export"
+HELP = "write an output bag's pose, angles, mount wrenches and diagnostics as CSV (or Parquet)"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "bag", help="output bag of `mount-twin replay` (or a recording of the node)"
+    )
+    target = parser.add_mutually_exclusive_group(required=True)
+    target.add_argument("--csv", metavar="DIR", help="one CSV per table into DIR")
+    target.add_argument(
+        "--parquet", metavar="DIR", help="one Parquet file per table into DIR (needs pyarrow)"
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    from mount_twin.io.output_tables import read_output_bag, write_tables
+
+    fmt, directory = ("parquet", args.parquet) if args.parquet else ("csv", args.csv)
+    if fmt == "parquet":
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError as err:
+            msg = "--parquet needs pyarrow (pip install pyarrow); --csv needs nothing"
+            raise ValueError(msg) from err
+    tables = read_output_bag(args.bag)
+    for path, table in zip(write_tables(tables, directory, fmt), tables, strict=True):
+        print(f"{path}: {len(table)} rows, columns {', '.join(table.columns)}")
+    return 0
