@@ -45,10 +45,17 @@ PARAMETERS: dict[str, tuple[str, str]] = {
     "input.max_gap_s": ("double", "A longer stamp gap is handled per gap_policy, s"),
     "input.gap_policy": ("string", "reset (restart at equilibrium) or bridge"),
     "input.back_jump_reset_s": ("double", "A stamp going back by more than this resets, s"),
+    "input.gyro_filter": ("string", "Ω and Ω′ from the gyro: lowpass, none or ignore"),
+    "input.gyro_cutoff_hz": ("double", "−3 dB frequency of the lowpass gyro filter, Hz"),
+    "input.accel_range_m_s2": ("double", "Accelerometer full scale (0: unknown), m/s²"),
+    "input.gyro_range_rad_s": ("double", "Gyro full scale (0: unknown), rad/s"),
     "initial_state.mode": ("string", "equilibrium or given"),
     "initial_state.gravity": ("string", "Equilibrium gravity: first_sample or nominal"),
     "initial_state.pose": ("double_array", "[X, Y, Z] m, [α, γ, δ] rad: start pose, frozen DOFs"),
     "initial_state.velocity": ("double_array", "[X', Y', Z'] m/s, [α', γ', δ'] rad/s (given)"),
+    "initial_state.gravity_samples": ("integer", "Start gravity: mean of this many samples"),
+    "initial_state.gravity_tolerance": ("double", "Start check: WARN past | |f0| − g | / g"),
+    "initial_state.tilt_tolerance_rad": ("double", "Start check: WARN past this tilt of f0, rad"),
     "integration.method": ("string", "Stepper: " + ", ".join(METHODS)),
     "integration.rtol": ("double", "Relative tolerance of the stepper"),
     "integration.atol": ("double", "Absolute tolerance of the stepper (m, rad, m/s, rad/s)"),
@@ -72,6 +79,8 @@ COMMON_MOUNT_PARAMETERS: dict[str, tuple[str, str]] = {
 LINEAR_PARAMETERS: dict[str, tuple[str, str]] = {
     "stiffness": ("double_array", "[kx, ky, kz] N/m, [krx, kry, krz] N·m/rad, mount axes"),
     "damping": ("double_array", "[cx, cy, cz] N·s/m, [crx, cry, crz] N·m·s/rad, mount axes"),
+    "rated_travel": ("double_array", "Allowed deflection [dx, dy, dz] m, mount axes (0: none)"),
+    "rated_load": ("double_array", "Allowed force [Fx, Fy, Fz] N, mount axes (0: none)"),
 }
 
 
