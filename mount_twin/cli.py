@@ -12,6 +12,21 @@ from mount_twin.commands import COMMANDS
 from mount_twin.errors import MountTwinError
 
 
+class DefaultsShown(argparse.HelpFormatter):
+    """Every option's help ends with its default, unless it has none or already says it."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if (
+            "default" in text
+            or action.default in (None, False, argparse.SUPPRESS)
+            or action.required
+            or not action.option_strings
+        ):
+            return text
+        return f"{text} (default: %(default)s)".lstrip()
+
+
 class Command(Protocol):
     """What a module of mount_twin.commands provides (see its docstring)."""
 
@@ -44,7 +59,14 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, Command]]:
     modules: dict[str, Command] = {}
     for name in COMMANDS:
         module = cast("Command", importlib.import_module(f"mount_twin.commands.{name}"))
-        module.add_arguments(sub.add_parser(module.NAME, help=module.HELP))
+        module.add_arguments(
+            sub.add_parser(
+                module.NAME,
+                help=module.HELP,
+                description=module.HELP,
+                formatter_class=DefaultsShown,
+            )
+        )
         modules[module.NAME] = module
     return parser, modules
 

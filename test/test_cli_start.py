@@ -142,3 +142,24 @@ def test_version_is_the_package_version_without_importing_numba() -> None:
     (declared,) = re.findall(r"<version>([^<]+)</version>", xml)
     assert done.stdout.strip() == f"mount-twin {declared}"
     assert _heavy_imports(done.stderr) == []
+
+
+def test_every_option_with_a_default_says_it_in_help() -> None:
+    """Like the ROS tools: `--help` of each command names every default."""
+    import argparse
+
+    from mount_twin.cli import build_parser
+
+    parser, _ = build_parser()
+    (sub,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    for name, command in sub.choices.items():
+        text = command.format_help()
+        for action in command._actions:
+            has_default = action.default not in (None, False, argparse.SUPPRESS, 0, 0.0)
+            if action.option_strings and has_default and not action.required:
+                assert (
+                    "default" in (action.help or "") or f"(default: {action.default})" in text
+                ), (
+                    name,
+                    action.dest,
+                )

@@ -17,8 +17,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--frame-id", default="deck_imu", help="header.frame_id (default: deck_imu)"
     )
-    parser.add_argument("--rate", type=float, help="sampling rate, Hz")
-    parser.add_argument("--duration", type=float, help="record length, s")
+    parser.add_argument(
+        "--rate",
+        type=float,
+        help="sampling rate, Hz (default: 10000 for half-sine, 1000 for ship-motion)",
+    )
+    parser.add_argument(
+        "--duration",
+        type=float,
+        help="record length, s (default: 0.4 for half-sine, 5 for ship-motion)",
+    )
     parser.add_argument("--peak", type=float, default=150.0, help="half-sine peak, m/s²")
     parser.add_argument("--pulse", type=float, default=0.008, help="half-sine duration, s")
     parser.add_argument(
@@ -37,7 +45,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--start", type=int, default=1_700_000_000_000_000_000, help="first stamp, ns"
     )
-    parser.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    parser.add_argument(
+        "--storage", choices=["mcap", "sqlite3"], default="mcap", help="bag storage format"
+    )
 
 
 def run(args: argparse.Namespace) -> int:

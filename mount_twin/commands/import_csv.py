@@ -11,10 +11,12 @@ HELP = "CSV t,ax,ay,az,wx,wy,wz → sensor_msgs/Imu bag"
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("csv")
     parser.add_argument("-o", "--output", required=True)
-    parser.add_argument("--topic", default="/imu/data")
-    parser.add_argument("--frame-id", default="imu_link")
+    parser.add_argument("--topic", default="/imu/data", help="topic to write")
+    parser.add_argument("--frame-id", default="imu_link", help="header.frame_id to write")
     parser.add_argument("--offset", type=int, default=0, help="added to t·1e9 for the stamp, ns")
-    parser.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    parser.add_argument(
+        "--storage", choices=["mcap", "sqlite3"], default="mcap", help="bag storage format"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
