@@ -14,5 +14,15 @@ A new command is a new module here and one entry in `COMMANDS`.
 
 from __future__ import annotations
 
-COMMANDS = ("replay", "demo", "generate", "import_csv", "export", "accuracy", "show", "warm_up")
+COMMANDS = (
+    "replay",
+    "demo",
+    "info",
+    "generate",
+    "import_csv",
+    "export",
+    "accuracy",
+    "show",
+    "warm_up",
+)
 """Module names under mount_twin.commands, in the order `--help` lists them."""

@@ -1,0 +1,58 @@
+"""`mount-twin info BAG|SCENE`: what a bag holds, or what a scene describes."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from mount_twin.scene.description import Scene
+
+NAME = "info"
+HELP = "show a bag's topics (like `ros2 bag info`) or a scene's body, mounts, input and outputs"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("path", help="a bag (directory or file), or a scene YAML (*.yaml)")
+
+
+def run(args: argparse.Namespace) -> int:
+    path = Path(args.path)
+    if path.suffix in (".yaml", ".yml"):
+        from mount_twin.scene.loader import load_scene_file
+
+        print(scene_text(load_scene_file(path)))
+    else:
+        from mount_twin.io.bag_info import bag_info
+
+        print(bag_info(path).text())
+    return 0
+
+
+def scene_text(scene: Scene) -> str:
+    """A scene in a few lines: body, DOFs, each mount, input, outputs and their topics."""
+    from mount_twin.io.messages import output_streams, resolve
+    from mount_twin.replay import NODE_NAME
+
+    b, i = scene.body, scene.input
+    lines = [
+        f"scene:   {scene.name} ({scene.source})",
+        f"body:    {b.mass:g} kg, CG {list(b.cg)} m in F, inertia {list(b.inertia)} kg·m²",
+        f"DOFs:    {', '.join(scene.dofs)}",
+        f"mounts:  {len(scene.mounts)}",
+    ]
+    width = max(len(m.name) for m in scene.mounts)
+    lines += [
+        f"  {m.name:<{width}}  {m.kind:<13} at {list(m.position)} m, rpy "
+        f"{list(m.orientation_rpy)} rad"
+        for m in scene.mounts
+    ]
+    lines += [
+        f"input:   {i.topic} ({i.msg_type}), frame_id {i.frame_id or '(any)'}, "
+        f"gyro {i.gyro_filter}"
+        + (f" {i.gyro_cutoff_hz:g} Hz" if i.gyro_filter == "lowpass" else ""),
+        f"outputs (node named {NODE_NAME}):",
+        *(f"  {resolve(s.topic, NODE_NAME):<40} {s.msgtype}" for s in output_streams(scene)),
+    ]
+    return "\n".join(lines)
