@@ -21,6 +21,7 @@ COMMANDS = (
     "generate",
     "import_csv",
     "export",
+    "report",
     "accuracy",
     "show",
     "warm_up",

@@ -8,8 +8,6 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from mount_twin.analysis.accuracy import Accuracy, Run
-    from mount_twin.engine.batch import SampleBatch
-    from mount_twin.scene.description import Scene
 
 NAME = "accuracy"
 HELP = "error against run time of the twin on a scene and bag, per tolerance (work-precision)"
@@ -50,6 +48,7 @@ def run(args: argparse.Namespace) -> int:
         reference_run,
         run_at,
     )
+    from mount_twin.io.input_samples import read_samples
     from mount_twin.scene.loader import load_scene_file
 
     loaded = load_scene_file(args.scene)
@@ -76,21 +75,6 @@ def run(args: argparse.Namespace) -> int:
         _plot(rows, ref, args.plot, f"{scene.name} on {args.bag}")
         print(f"plot: {args.plot}")
     return 0
-
-
-def read_samples(bag: str, scene: Scene) -> SampleBatch:
-    """Every input sample of the scene's input topic in `bag`, decoded (stamps from the first)."""
-    from mount_twin.io.bag import InputBag
-    from mount_twin.io.messages import TimeBase, decode_inputs
-
-    with InputBag(bag, scene.input.topic, scene.input.msg_type) as reader:
-        raws = [raw for chunk in reader.chunks(10_000) for raw in chunk]
-    decoded = decode_inputs(raws, scene.input.msg_type)
-    decoded = decoded.select(decoded.stamps_ns > 0)
-    if not len(decoded.stamps_ns):
-        msg = f"{bag}: no decodable sample on {scene.input.topic}"
-        raise ValueError(msg)
-    return decoded.batch(TimeBase.at(int(decoded.stamps_ns[0])))
 
 
 def _table(rows: list[Accuracy]) -> str:

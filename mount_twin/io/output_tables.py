@@ -2,13 +2,14 @@
 
 One table per output: `pose` (CG position m, quaternion x, y, z, w of body → F), `angles`
 (α, γ, δ rad), one `mount_<name>` per mount (force N and couple N·m on the body, mount axes)
-and `diagnostics` (one row per status per report). Every table starts with the integer header
-stamp `stamp_ns` and `t_s`, seconds from the bag's first output stamp. Column names carry
-their unit.
+and `diagnostics` (one row per status per report; `values` holds its key-values as JSON).
+Every table starts with the integer header stamp `stamp_ns` and `t_s`, seconds from the bag's
+first output stamp. Column names carry their unit.
 """
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -78,7 +79,8 @@ def read_output_bag(path: str | Path) -> list[Table]:
                     for st in msg.status:
                         stamps.setdefault(name, []).append(stamp)
                         level = LEVELS.get(int(st.level), str(st.level))
-                        rows.setdefault(name, []).append((st.name, level, st.message))
+                        pairs = json.dumps({kv.key: kv.value for kv in st.values})
+                        rows.setdefault(name, []).append((st.name, level, st.message, pairs))
                 else:
                     stamps.setdefault(name, []).append(stamp)
                     rows.setdefault(name, []).append(_row(msg))
@@ -95,7 +97,7 @@ def read_output_bag(path: str | Path) -> list[Table]:
         ns = np.array(stamps[name], dtype=np.int64)
         columns: dict[str, np.ndarray] = {"stamp_ns": ns, "t_s": (ns - origin) * 1e-9}
         if kinds[name] == DIAGNOSTICS:
-            for k, col in enumerate(("status", "level", "message")):
+            for k, col in enumerate(("status", "level", "message", "values")):
                 columns[col] = np.array([r[k] for r in rows[name]], dtype=object)
         else:
             values = np.array(rows[name], dtype=float)

@@ -1,0 +1,248 @@
+"""One self-contained HTML page of a replay: plots, peaks, utilisation and events.
+
+Built from the output bag (every series, and the diagnostics with their values), and if given
+the input bag (the foundation's specific force beside the response) and the scene (mount kinds,
+names in titles). Pictures are PNGs embedded as base64, so the page is one file that opens
+anywhere. matplotlib is imported here only (the `plot` extra).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+import re
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mount_twin.io.output_tables import Table, read_output_bag
+from mount_twin.scene.description import Scene
+
+EVENT = re.compile(r"(\w+) ×(\d+) \(first (\d+\.\d+) s, \|F\| max ([\d.e+-]+) N\)")
+"""An event group in a mount status message (engine.health._events_text)."""
+WINDOW_S = 0.05
+"""Half-width of the zoom around the first event, s."""
+
+
+@dataclass(frozen=True)
+class Event:
+    """A mount event group of one diagnostics period: time from the first output (s)."""
+
+    mount: str
+    event: str
+    count: int
+    t_s: float
+    force_n: float
+    level: str
+
+
+def events_of(diagnostics: Table, origin_ns: int) -> list[Event]:
+    """Mount event groups named in the diagnostics messages, in time order."""
+    out = []
+    c = diagnostics.columns
+    for status, level, message in zip(c["status"], c["level"], c["message"], strict=True):
+        if not status.startswith("mount_twin: mount "):
+            continue
+        for name, count, first, force in EVENT.findall(message):
+            t = float(first) - origin_ns * 1e-9
+            out.append(
+                Event(
+                    status.removeprefix("mount_twin: mount "),
+                    name,
+                    int(count),
+                    t,
+                    float(force),
+                    level,
+                )
+            )
+    return sorted(out, key=lambda e: e.t_s)
+
+
+def utilisation_of(diagnostics: Table) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Per mount with a rating: (report times s, peak utilisation in each period)."""
+    series: dict[str, tuple[list[float], list[float]]] = {}
+    c = diagnostics.columns
+    for t, status, values in zip(c["t_s"], c["status"], c["values"], strict=True):
+        u = json.loads(values).get("utilisation_max", "n/a")
+        if status.startswith("mount_twin: mount ") and u != "n/a":
+            times, utils = series.setdefault(status.removeprefix("mount_twin: mount "), ([], []))
+            times.append(float(t))
+            utils.append(float(u))
+    return {k: (np.array(t), np.array(u)) for k, (t, u) in series.items()}
+
+
+def _png(draw: Callable[[Any], None], size: tuple[float, float]) -> str:
+    """A figure drawn by `draw(fig)`, as an <img> with the PNG inline."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=size)
+    draw(fig)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=100)
+    plt.close(fig)
+    return (
+        f'<img alt="plot" src="data:image/png;base64,{base64.b64encode(buf.getvalue()).decode()}">'
+    )
+
+
+def _table(head: list[str], rows: list[list[str]]) -> str:
+    cells = "".join(f"<th>{html.escape(h)}</th>" for h in head)
+    body = "".join(
+        "<tr>" + "".join(f"<td>{html.escape(v)}</td>" for v in r) + "</tr>" for r in rows
+    )
+    return f"<table><tr>{cells}</tr>{body}</table>"
+
+
+def write_report(
+    output_bag: str | Path,
+    html_path: str | Path,
+    *,
+    input_samples: tuple[np.ndarray, np.ndarray] | None = None,
+    scene: Scene | None = None,
+    input_name: str = "",
+) -> Path:
+    """Write the report page. `input_samples`: (stamps ns, specific force (n, 3) m/s² in F) of
+    the record, to plot beside the response."""
+    tables = {t.name: t for t in read_output_bag(output_bag)}
+    mounts = {k.removeprefix("mount_"): t for k, t in tables.items() if k.startswith("mount_")}
+    origin = min(int(t.columns["stamp_ns"][0]) for t in tables.values())
+    diagnostics = tables.get("diagnostics")
+    events = events_of(diagnostics, origin) if diagnostics else []
+    utilisation = utilisation_of(diagnostics) if diagnostics else {}
+    kinds = {m.name: m.kind for m in scene.mounts} if scene else {}
+    title = f"{scene.name if scene else 'mount_twin'} — {Path(output_bag).name}"
+    if input_name:
+        title += f" (input {input_name})"
+    sections = [f"<h1>{html.escape(title)}</h1>"]
+
+    def response(fig: Any) -> None:
+        n = 3 if input_samples is not None else 2
+        axes = fig.subplots(n, 1, sharex=True)
+        k = 0
+        if input_samples is not None:
+            stamps, f = input_samples
+            t = (stamps - origin) * 1e-9
+            for i, axis in enumerate("xyz"):
+                axes[0].plot(t, f[:, i] / 9.80665, label=f"{axis} of F")
+            axes[0].set_ylabel("foundation specific force [g]")
+            axes[0].set_title(f"input {input_name}", fontsize=9)
+            k = 1
+        pose = tables["pose"].columns
+        for axis in "xyz":
+            v = pose[f"{axis}_m"]
+            axes[k].plot(pose["t_s"], (v - v[0]) * 1e3, label=f"CG {axis}")
+        axes[k].set_ylabel("CG displacement from its\nfirst published position [mm]")
+        ang = tables["angles"].columns
+        for name in ("alpha", "gamma", "delta"):
+            axes[k + 1].plot(ang["t_s"], np.degrees(ang[f"{name}_rad"]), label=name)
+        axes[k + 1].set_ylabel("attitude [deg]")
+        axes[-1].set_xlabel("time from the first output [s]")
+        for ax in axes:
+            ax.grid(True, alpha=0.3)
+            ax.legend(fontsize=7, loc="upper right")
+
+    if "pose" in tables and "angles" in tables:
+        sections += ["<h2>Input and response</h2>", _png(response, (10, 8))]
+
+    def forces(fig: Any, window: tuple[float, float] | None = None) -> None:
+        axes = fig.subplots(3, 1, sharex=True)
+        for name, table in mounts.items():
+            c = table.columns
+            keep = (
+                slice(None)
+                if window is None
+                else (c["t_s"] >= window[0]) & (c["t_s"] <= window[1])
+            )
+            for i, comp in enumerate(("fx_N", "fy_N", "fz_N")):
+                axes[i].plot(c["t_s"][keep], c[comp][keep] * 1e-3, label=name, linewidth=0.9)
+        for i, comp in enumerate("xyz"):
+            axes[i].set_ylabel(f"force along mount {comp} [kN]")
+            axes[i].grid(True, alpha=0.3)
+        if window is not None:
+            for e in (e for e in events if window[0] <= e.t_s <= window[1]):
+                for ax in axes:
+                    ax.axvline(e.t_s, color="red" if e.level == "ERROR" else "orange", alpha=0.4)
+        axes[0].legend(fontsize=7, ncol=4, loc="upper right")
+        axes[-1].set_xlabel("time from the first output [s]")
+
+    if mounts:
+        sections += [
+            "<h2>Mount forces (on the body, signed, in each mount's axes)</h2>",
+            _png(forces, (10, 8)),
+        ]
+    if events:
+        first = events[0]
+        window = (first.t_s - WINDOW_S, first.t_s + WINDOW_S)
+        sections += [
+            f"<h2>Around the first event: {html.escape(first.mount)} {html.escape(first.event)} "
+            f"at {first.t_s:.6f} s (lines: events)</h2>",
+            _png(lambda fig: forces(fig, window), (10, 8)),
+        ]
+    if utilisation:
+
+        def util(fig: Any) -> None:
+            ax = fig.subplots()
+            for name, (t, u) in utilisation.items():
+                # Each report holds the peak of the period that ends at it.
+                ax.step(
+                    np.r_[0.0, t],
+                    np.r_[u[0], u],
+                    where="pre",
+                    label=f"{name} ({kinds.get(name, '?')})",
+                )
+            ax.axhline(1.0, color="red", linestyle="--", label="rated (1)")
+            ax.set_ylabel("peak utilisation per diagnostics period [-]")
+            ax.set_xlabel("time from the first output [s]")
+            ax.grid(True, alpha=0.3)
+            ax.legend(fontsize=7, ncol=3)
+
+        sections += ["<h2>Utilisation</h2>", _png(util, (10, 4))]
+    rows = []
+    for name, table in mounts.items():
+        c = table.columns
+        peaks = [float(np.abs(c[k]).max()) for k in ("fx_N", "fy_N", "fz_N")]
+        u = utilisation.get(name)
+        rows.append(
+            [
+                name,
+                kinds.get(name, ""),
+                *(f"{p:.4g}" for p in peaks),
+                f"{float(np.sqrt(c['fx_N'] ** 2 + c['fy_N'] ** 2 + c['fz_N'] ** 2).max()):.4g}",
+                "n/a" if u is None else f"{float(u[1].max()):.3g}",
+            ]
+        )
+    sections += [
+        "<h2>Peaks</h2>",
+        _table(["mount", "kind", "|Fx| N", "|Fy| N", "|Fz| N", "|F| N", "utilisation max"], rows),
+        "<h2>Events</h2>",
+        _table(
+            ["time s", "mount", "event", "count in period", "|F| max N", "level"],
+            [
+                [f"{e.t_s:.6f}", e.mount, e.event, str(e.count), f"{e.force_n:.4g}", e.level]
+                for e in events
+            ],
+        )
+        if events
+        else "<p>none</p>",
+    ]
+    page = (
+        "<!DOCTYPE html><html><head><meta charset='utf-8'>"
+        f"<title>{html.escape(title)}</title><style>"
+        "body{font-family:sans-serif;margin:2em;max-width:1100px}"
+        "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:3px 8px;"
+        "text-align:right}img{max-width:100%}</style></head><body>"
+        + "\n".join(sections)
+        + "</body></html>"
+    )
+    out = Path(html_path)
+    out.write_text(page, encoding="utf-8")
+    return out

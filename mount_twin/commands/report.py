@@ -1,0 +1,43 @@
+"""`mount-twin report OUT_BAG -o report.html`: one self-contained HTML page of a replay."""
+
+from __future__ import annotations
+
+import argparse
+
+NAME = "report"
+HELP = "one HTML page of a replay: input and response, signed mount forces, utilisation, events"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("bag", help="output bag of `mount-twin replay`")
+    parser.add_argument("-o", "--output", default="report.html", help="HTML file to write")
+    parser.add_argument("--scene", help="the replay's scene YAML (mount kinds, names)")
+    parser.add_argument(
+        "--input", metavar="BAG", help="the replay's input bag (plotted beside the response)"
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from mount_twin.analysis.report import write_report
+    from mount_twin.scene.loader import load_scene_file
+
+    scene = load_scene_file(args.scene) if args.scene else None
+    samples = None
+    if args.input:
+        if scene is None:
+            msg = "--input needs --scene (its input topic, sensor frame and gravity convention)"
+            raise ValueError(msg)
+        from mount_twin.io.input_samples import read_input
+        from mount_twin.physics.rotations import rpy_matrix
+
+        decoded = read_input(args.input, scene)
+        f = decoded.accel @ rpy_matrix(*scene.input.sensor_rpy).T
+        if not scene.input.includes_gravity:
+            f[:, 2] += scene.input.g
+        samples = (decoded.stamps_ns, f)
+    name = Path(args.input).name if args.input else ""
+    out = write_report(args.bag, args.output, input_samples=samples, scene=scene, input_name=name)
+    print(f"report: {out}")
+    return 0

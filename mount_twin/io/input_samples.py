@@ -1,0 +1,29 @@
+"""A bag's input record for analyses: every sample of the scene's input topic, decoded."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from mount_twin.engine.batch import SampleBatch
+from mount_twin.io.bag import InputBag
+from mount_twin.io.messages import Decoded, TimeBase, decode_inputs
+from mount_twin.scene.description import Scene
+
+
+def read_input(bag: str | Path, scene: Scene) -> Decoded:
+    """The decodable samples of `scene.input.topic` in `bag` with a positive stamp (sensor
+    frame, as recorded); an error names the bag if there is none."""
+    with InputBag(bag, scene.input.topic, scene.input.msg_type) as reader:
+        raws = [raw for chunk in reader.chunks(10_000) for raw in chunk]
+    decoded = decode_inputs(raws, scene.input.msg_type)
+    decoded = decoded.select(decoded.stamps_ns > 0)
+    if not len(decoded.stamps_ns):
+        msg = f"{bag}: no decodable sample on {scene.input.topic}"
+        raise ValueError(msg)
+    return decoded
+
+
+def read_samples(bag: str | Path, scene: Scene) -> SampleBatch:
+    """`read_input` as engine samples, stamps (s) counted from the first one's whole second."""
+    decoded = read_input(bag, scene)
+    return decoded.batch(TimeBase.at(int(decoded.stamps_ns[0])))

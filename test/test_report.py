@@ -1,0 +1,81 @@
+"""`mount-twin report`: one self-contained page; its events and peaks are the replay's own."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from io_helpers import CONFIG, ROOT, read_bag
+
+from mount_twin.analysis.report import events_of
+from mount_twin.cli import main
+from mount_twin.io.output_tables import read_output_bag
+from mount_twin.replay import replay
+from mount_twin.scene.loader import load_scene_file
+
+GENSET = CONFIG / "genset_bolted_keyed.scene.yaml"
+BAG = ROOT / "bags" / "genset_shock_10khz"
+
+
+@pytest.fixture(scope="module")
+def genset_run(tmp_path_factory: pytest.TempPathFactory):
+    out = tmp_path_factory.mktemp("report") / "out"
+    summary = replay(load_scene_file(GENSET), BAG, out, progress=False)
+    return out, summary
+
+
+def test_events_in_the_report_are_the_engines_first_events_per_period(genset_run) -> None:
+    out, summary = genset_run
+    tables = {t.name: t for t in read_output_bag(out)}
+    origin = int(tables["pose"].columns["stamp_ns"][0])
+    events = events_of(tables["diagnostics"], origin)
+    assert events, "the genset shock opens joints"
+    # Each reported group is named by its first event: that event exists in the engine's log.
+    for e in events:
+        same = [
+            x
+            for x in summary.events
+            if x.mount == e.mount
+            and x.event == e.event
+            and abs(summary.origin_s + x.stamp - (origin * 1e-9 + e.t_s)) < 2e-6
+        ]
+        assert same, e
+
+
+def test_the_page_is_self_contained_with_plots_tables_and_names(
+    genset_run, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out, _ = genset_run
+    page = tmp_path / "r.html"
+    args = ["report", str(out), "--scene", str(GENSET), "--input", str(BAG), "-o", str(page)]
+    assert main(args) == 0
+    text = page.read_text(encoding="utf-8")
+    assert "genset_bolted_keyed" in text and "genset_shock_10khz" in text
+    assert len(re.findall(r'src="data:image/png;base64,', text)) >= 4
+    assert 'src="http' not in text and "<script" not in text  # one file, nothing fetched
+    assert "Around the first event: foot_" in text and "joint_opened" in text
+    # The peak table holds each mount's largest |F| of the bag.
+    _, msgs = read_bag(out)
+    fz = max(abs(m.wrench.force.z) for _, m in msgs["/mount_twin/mounts/foot_fl/wrench"])
+    row = re.search(
+        r"<td>foot_fl</td><td>bolted_joint</td>(?:<td>[^<]*</td>){2}<td>([^<]*)</td>", text
+    )
+    assert row and float(row.group(1)) == pytest.approx(fz, rel=1e-3)
+
+
+def test_input_without_scene_is_refused(genset_run, capsys: pytest.CaptureFixture[str]) -> None:
+    out, _ = genset_run
+    assert main(["report", str(out), "--input", str(BAG)]) == 2
+    assert "--input needs --scene" in capsys.readouterr().err
+
+
+def test_utilisation_series_come_from_the_diagnostics(genset_run) -> None:
+    from mount_twin.analysis.report import utilisation_of
+
+    out, summary = genset_run
+    tables = {t.name: t for t in read_output_bag(out)}
+    series = utilisation_of(tables["diagnostics"])
+    for name, peak in summary.utilisation_max.items():
+        assert np.max(series[name][1]) == pytest.approx(peak, rel=1e-3), name
