@@ -60,8 +60,15 @@ setup(
         "rosbags>=0.11,<0.12",
     ],
     extras_require={
-        "test": ["pytest>=7", "ruff>=0.5", "hypothesis>=6.100", "matplotlib>=3.6"],
+        "test": [
+            "pytest>=7",
+            "ruff>=0.5",
+            "hypothesis>=6.100",
+            "matplotlib>=3.6",
+            "dask[distributed]>=2024.1",
+        ],
         "plot": ["matplotlib>=3.6"],
+        "sweep": ["dask[distributed]>=2024.1"],
         # Jazzy's rclpy and message packages from the package registry, for a machine without a
         # ROS install (a sourced Jazzy has them: do not install a second rclpy there). The
         # node reaches into rclpy 7.x in one module (ros/rclpy_private.py): pinned.

@@ -33,9 +33,7 @@ REST_END_S = 0.28
 POLICIES = (("none", 50.0), ("lowpass", 200.0), ("lowpass", 50.0), ("ignore", 50.0))
 
 
-def run(
-    scene_file: str, policy: str, cutoff_hz: float, data: np.ndarray
-) -> tuple[int, float]:
+def run(scene_file: str, policy: str, cutoff_hz: float, data: np.ndarray) -> tuple[int, float]:
     """(mount events in the rest phase, peak |mount force| N) of a run."""
     scene = load_scene_file(share_dir() / "config" / scene_file)
     scene = dataclasses.replace(

@@ -4,7 +4,7 @@ The Python API, without ROS or bags: a scene (`load_scene_file`, `scene_from_dic
 `scene_from_params`), assembled into a `Model` (`assemble`), drives a streaming `TwinEngine`
 that takes `SampleBatch`es of foundation acceleration and returns `OutputBatch`es (pose, angles,
 mount wrenches, health); `TwinStream` does the same on raw CDR messages and `replay_bag` on
-bags.
+bags; `sweep` runs a design sweep file (scene variants × inputs) on a Dask cluster.
 
     import numpy as np
     from mount_twin import SampleBatch, TwinEngine, assemble, load_scene_file
@@ -42,6 +42,7 @@ if TYPE_CHECKING:
     from mount_twin.scene.loader import load_scene_file, scene_from_dict
     from mount_twin.scene.params import scene_from_params
     from mount_twin.stream import TwinStream
+    from mount_twin.sweeps.runner import sweep
 
 _LAZY = {
     "load_scene_file": "mount_twin.scene.loader",
@@ -59,6 +60,7 @@ _LAZY = {
     "TwinStream": "mount_twin.stream",
     "replay_bag": "mount_twin.replay:replay",
     "ReplaySummary": "mount_twin.replay",
+    "sweep": "mount_twin.sweeps.runner",
 }
 """Exported name → module that defines it (`module:name` where the names differ: the function
 `replay` is `replay_bag` here, since the submodule `mount_twin.replay` takes that attribute once
@@ -84,6 +86,7 @@ __all__ = [
     "replay_bag",
     "scene_from_dict",
     "scene_from_params",
+    "sweep",
 ]
 
 

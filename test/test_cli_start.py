@@ -163,3 +163,20 @@ def test_every_option_with_a_default_says_it_in_help() -> None:
                     name,
                     action.dest,
                 )
+
+
+def test_a_missing_optional_dependency_is_named_with_its_extra() -> None:
+    from mount_twin.commands.extras import EXTRAS, require
+    from mount_twin.errors import MountTwinError
+
+    EXTRAS["no_such_module_for_this_test"] = "plot"
+    try:
+        with pytest.raises(
+            MountTwinError,
+            match=r"--plot needs no_such_module_for_this_test, "
+            r"which is not installed: pip install 'mount_twin\[plot\]'",
+        ):
+            require("no_such_module_for_this_test.pyplot", "--plot")
+    finally:
+        del EXTRAS["no_such_module_for_this_test"]
+    require("numpy", "anything")  # installed: no error

@@ -23,6 +23,7 @@ COMMANDS = (
     "export",
     "report",
     "accuracy",
+    "sweep",
     "show",
     "warm_up",
 )

@@ -51,8 +51,12 @@ def run(args: argparse.Namespace) -> int:
     from mount_twin.io.input_samples import read_samples
     from mount_twin.scene.loader import load_scene_file
 
+    if args.plot:
+        from mount_twin.commands.extras import require
+
+        require("matplotlib", "--plot")
     loaded = load_scene_file(args.scene)
-    scene, samples = conditioned(loaded, read_samples(args.bag, loaded))
+    scene, samples = conditioned(loaded, read_samples(args.bag, loaded.input))
     duration = float(samples.stamps[-1] - samples.stamps[0])
     print(
         f"{scene.name}: {len(samples)} samples over {duration:.3f} s from {args.bag}",

@@ -24,11 +24,9 @@ def run(args: argparse.Namespace) -> int:
 
     fmt, directory = ("parquet", args.parquet) if args.parquet else ("csv", args.csv)
     if fmt == "parquet":
-        try:
-            import pyarrow  # noqa: F401
-        except ImportError as err:
-            msg = "--parquet needs pyarrow (pip install pyarrow); --csv needs nothing"
-            raise ValueError(msg) from err
+        from mount_twin.commands.extras import require
+
+        require("pyarrow", "--parquet")
     tables = read_output_bag(args.bag)
     for path, table in zip(write_tables(tables, directory, fmt), tables, strict=True):
         print(f"{path}: {len(table)} rows, columns {', '.join(table.columns)}")

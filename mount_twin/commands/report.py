@@ -20,6 +20,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from mount_twin.commands.extras import require
+
+    require("matplotlib", "mount-twin report")
     from mount_twin.analysis.report import write_report
     from mount_twin.scene.loader import load_scene_file
 
@@ -32,7 +35,7 @@ def run(args: argparse.Namespace) -> int:
         from mount_twin.io.input_samples import read_input
         from mount_twin.physics.rotations import rpy_matrix
 
-        decoded = read_input(args.input, scene)
+        decoded = read_input(args.input, scene.input)
         f = decoded.accel @ rpy_matrix(*scene.input.sensor_rpy).T
         if not scene.input.includes_gravity:
             f[:, 2] += scene.input.g

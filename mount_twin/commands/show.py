@@ -16,6 +16,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from mount_twin.commands.extras import require
+
+    require("matplotlib", "mount-twin show")
     from mount_twin.analysis.layout_view import draw_layout
     from mount_twin.scene.loader import load_scene_file
 

@@ -7,23 +7,23 @@ from pathlib import Path
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.io.bag import InputBag
 from mount_twin.io.messages import Decoded, TimeBase, decode_inputs
-from mount_twin.scene.description import Scene
+from mount_twin.scene.description import InputSpec
 
 
-def read_input(bag: str | Path, scene: Scene) -> Decoded:
-    """The decodable samples of `scene.input.topic` in `bag` with a positive stamp (sensor
-    frame, as recorded); an error names the bag if there is none."""
-    with InputBag(bag, scene.input.topic, scene.input.msg_type) as reader:
+def read_input(bag: str | Path, spec: InputSpec) -> Decoded:
+    """The decodable samples of the input topic `spec.topic` in `bag` with a positive stamp
+    (sensor frame, as recorded); an error names the bag if there is none."""
+    with InputBag(bag, spec.topic, spec.msg_type) as reader:
         raws = [raw for chunk in reader.chunks(10_000) for raw in chunk]
-    decoded = decode_inputs(raws, scene.input.msg_type)
+    decoded = decode_inputs(raws, spec.msg_type)
     decoded = decoded.select(decoded.stamps_ns > 0)
     if not len(decoded.stamps_ns):
-        msg = f"{bag}: no decodable sample on {scene.input.topic}"
+        msg = f"{bag}: no decodable sample on {spec.topic}"
         raise ValueError(msg)
     return decoded
 
 
-def read_samples(bag: str | Path, scene: Scene) -> SampleBatch:
+def read_samples(bag: str | Path, spec: InputSpec) -> SampleBatch:
     """`read_input` as engine samples, stamps (s) counted from the first one's whole second."""
-    decoded = read_input(bag, scene)
+    decoded = read_input(bag, spec)
     return decoded.batch(TimeBase.at(int(decoded.stamps_ns[0])))

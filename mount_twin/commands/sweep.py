@@ -1,0 +1,66 @@
+"""`mount-twin sweep SWEEP.yaml -o RESULTS.csv`: many scene variants × inputs on Dask."""
+
+from __future__ import annotations
+
+import argparse
+
+NAME = "sweep"
+HELP = "run a design sweep (scene variants × inputs) on a local or remote Dask cluster"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("sweep", help="sweep YAML (see mount_twin.sweeps.spec)")
+    parser.add_argument(
+        "-o", "--output", required=True, help="results CSV (appended; a rerun skips done cases)"
+    )
+    parser.add_argument("--scheduler", help="Dask scheduler address (default: a local cluster)")
+    parser.add_argument(
+        "--workers", type=int, help="local cluster worker processes (default: one per core)"
+    )
+    parser.add_argument("--parquet", metavar="FILE", help="also write the table as Parquet")
+    parser.add_argument(
+        "--plot",
+        metavar="PNG",
+        help="largest peak mount force against the first varied value, one line per input",
+    )
+    parser.add_argument("--no-progress", action="store_true")
+
+
+def run(args: argparse.Namespace) -> int:
+    from mount_twin.commands.extras import require
+
+    require("dask.distributed", "mount-twin sweep")
+    if args.plot:
+        require("matplotlib", "--plot")
+    if args.parquet:
+        require("pyarrow", "--parquet")
+    from tqdm import tqdm
+
+    from mount_twin.sweeps.cases import check
+    from mount_twin.sweeps.runner import FAILED, read_results, run_sweep, summary
+    from mount_twin.sweeps.spec import load_sweep
+
+    spec = load_sweep(args.sweep)
+    cases = check(spec)
+    bar = tqdm(total=len(cases), unit="case", disable=args.no_progress)
+
+    def progress(done: int, total: int) -> None:
+        bar.total = total
+        bar.update(1)
+
+    run_sweep(spec, args.output, scheduler=args.scheduler, workers=args.workers, progress=progress)
+    bar.close()
+    rows = read_results(args.output)
+    print(f"{len(rows)} cases in {args.output}")
+    print(summary(rows, spec))
+    if args.parquet:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        pq.write_table(pa.Table.from_pylist(rows), args.parquet)
+        print(f"parquet: {args.parquet}")
+    if args.plot:
+        from mount_twin.sweeps.plot import plot_sweep
+
+        print(f"plot: {plot_sweep(rows, spec, args.plot)}")
+    return 0 if all(r["verdict"] != FAILED for r in rows) else 5

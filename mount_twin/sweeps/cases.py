@@ -1,0 +1,105 @@
+"""Sweep cases: every combination of the variations × every input, applied to the base scene.
+
+Key paths: dotted keys into the scene mapping, a list selected by `[*]` (every item), `[name]`
+(the item whose `name` is that: mounts), or `[i]` (by index); e.g. `mounts[*].stiffness`,
+`mounts[fl].position`, `body.mass`.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+import re
+from dataclasses import dataclass
+from typing import Any
+
+from mount_twin.errors import SceneError
+from mount_twin.sweeps.spec import InputCase, SweepSpec
+
+SEGMENT = re.compile(r"^(\w+)(?:\[([^\]]+)\])?$")
+
+
+@dataclass(frozen=True)
+class Case:
+    """One run: the values set by key path, and the input."""
+
+    case_id: str
+    settings: tuple[tuple[str, str, Any], ...]
+    """(key path, 'set' or 'scale', value) per variation."""
+    input: InputCase
+
+
+def expand(spec: SweepSpec) -> list[Case]:
+    """Every case of the sweep, in a stable order, each with a stable id (a hash of what it
+    sets and its input: a rerun recognises finished cases)."""
+    columns = [[(v.key, v.op, x) for x in v.values] for v in spec.variations]
+    combos = (
+        itertools.product(*columns) if spec.combine == "product" else zip(*columns, strict=True)
+    )
+    cases = []
+    for combo in combos:
+        for inp in spec.inputs:
+            text = json.dumps([list(combo), inp.name], sort_keys=True, default=str)
+            cases.append(Case(hashlib.sha1(text.encode()).hexdigest()[:12], tuple(combo), inp))
+    return cases
+
+
+def apply(base: dict[str, Any], settings: tuple[tuple[str, str, Any], ...]) -> dict[str, Any]:
+    """A copy of the scene mapping `base` with each setting applied; an unknown key path or a
+    selector that matches nothing raises KeyError naming it."""
+    data = copy.deepcopy(base)
+    for key, op, value in settings:
+        _apply_one(data, key, op, value)
+    return data
+
+
+def _targets(node: Any, segments: list[str], key: str) -> list[tuple[dict[str, Any], str]]:
+    """The (mapping, key) pairs a key path designates."""
+    match = SEGMENT.match(segments[0])
+    if not match or not isinstance(node, dict) or match.group(1) not in node:
+        raise KeyError(f"{key}: no {segments[0]!r} here")
+    name, selector = match.groups()
+    if selector is None:
+        if len(segments) == 1:
+            return [(node, name)]
+        return _targets(node[name], segments[1:], key)
+    items = node[name]
+    if not isinstance(items, list):
+        raise KeyError(f"{key}: {name} is not a list")
+    if selector == "*":
+        chosen = items
+    elif selector.isdigit():
+        chosen = [items[int(selector)]] if int(selector) < len(items) else []
+    else:
+        chosen = [i for i in items if isinstance(i, dict) and i.get("name") == selector]
+    if not chosen:
+        raise KeyError(f"{key}: no item [{selector}] in {name}")
+    if len(segments) == 1:
+        raise KeyError(f"{key}: a whole list item cannot be set; name a key inside it")
+    return [t for item in chosen for t in _targets(item, segments[1:], key)]
+
+
+def _apply_one(data: dict[str, Any], key: str, op: str, value: Any) -> None:
+    for mapping, name in _targets(data, key.split("."), key):
+        if op == "set":
+            mapping[name] = copy.deepcopy(value)
+        elif isinstance(mapping.get(name), list):
+            mapping[name] = [float(v) * value for v in mapping[name]]
+        elif isinstance(mapping.get(name), (int, float)):
+            mapping[name] = float(mapping[name]) * value
+        else:
+            raise KeyError(f"{key}: {name} holds no number to scale")
+
+
+def check(spec: SweepSpec) -> list[Case]:
+    """The cases, after checking that every variation's key path exists in the base scene (an
+    error names the sweep file and the variation); scene values are checked per case, where a
+    bad one is that case's failure, not the sweep's."""
+    for i, v in enumerate(spec.variations):
+        try:
+            apply(spec.base, ((v.key, v.op, v.values[0]),))
+        except KeyError as err:
+            raise SceneError(spec.source, f"vary[{i}].key", str(err.args[0])) from err
+    return expand(spec)

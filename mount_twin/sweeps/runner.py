@@ -1,0 +1,253 @@
+"""Running a sweep: one case as a pure function of its inputs, many on a Dask cluster.
+
+`run_case` is what a worker runs: it builds the case's scene, reads (once per worker process)
+or generates its input, pushes it through a `TwinEngine` and returns one row of figures. No bag
+is written. `run_sweep` submits the unfinished cases to a `dask.distributed` client (a local
+cluster on this machine's cores by default, or a scheduler address) and appends each row to a
+CSV as it completes, so an interrupted sweep resumes where it stopped; a case that fails is a
+row with verdict FAILED and its error, and never stops the sweep.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import time
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mount_twin.engine.batch import LEVEL_NAMES, SampleBatch
+from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.health import tilt_from_quaternions
+from mount_twin.errors import MountTwinError
+from mount_twin.model.assemble import assemble
+from mount_twin.physics import pose_row
+from mount_twin.scene.description import InputSpec, Scene
+from mount_twin.scene.loader import scene_from_dict
+from mount_twin.sweeps.cases import Case, apply, expand
+from mount_twin.sweeps.spec import InputCase, SweepSpec
+
+FAILED = "FAILED"
+START_NS = 1_700_000_000_000_000_000
+"""First stamp of a generated input, as `mount-twin generate` writes it."""
+
+
+def columns(spec: SweepSpec) -> list[str]:
+    """The result table's columns: case, input, one per varied key, then the figures."""
+    names = [m["name"] for m in spec.base["mounts"]]
+    return [
+        "case",
+        "input",
+        *(v.key if v.op == "set" else f"{v.key} (scale)" for v in spec.variations),
+        "verdict",
+        "error",
+        *(f"peak_force_N.{n}" for n in names),
+        *(f"utilisation.{n}" for n in names),
+        "events",
+        "first_event",
+        "first_event_s",
+        "max_displacement_m",
+        "max_tilt_rad",
+        "wall_s",
+    ]
+
+
+@lru_cache(maxsize=8)
+def _input_samples(case: InputCase, spec: InputSpec) -> SampleBatch:
+    """The input of a case (read once per worker process, input and input spec)."""
+    if case.bag:
+        from mount_twin.io.input_samples import read_samples
+
+        return read_samples(case.bag, spec)
+    from mount_twin.io.signals import half_sine_shock, ship_motion
+
+    g = dict(case.generate)
+    if g["kind"] == "half-sine":
+        sig = half_sine_shock(
+            peak=g.get("peak", 150.0),
+            duration=g.get("pulse", 0.008),
+            rate_hz=g.get("rate", 10000.0),
+            total=g.get("duration", 0.4),
+            lateral=g.get("lateral", 0.0),
+            rebound=g.get("rebound", 0.0),
+        )
+    else:
+        sig = ship_motion(rate_hz=g.get("rate", 1000.0), total=g.get("duration", 5.0))
+    stamps = 1.0 + sig.t  # engine seconds; the record's origin is immaterial to a case
+    return SampleBatch(stamps, sig.accel, sig.gyro, [spec.frame_id] * stamps.shape[0])
+
+
+def run_case(base: dict[str, Any], source: str, case: Case) -> dict[str, Any]:
+    """One row of figures for `case` (never raises: a failure is a FAILED row)."""
+    row: dict[str, Any] = {"case": case.case_id, "input": case.input.name}
+    for key, op, value in case.settings:
+        row[key if op == "set" else f"{key} (scale)"] = json.dumps(value)
+    t0 = time.perf_counter()
+    try:
+        scene = scene_from_dict(apply(base, case.settings), f"{source} case {case.case_id}")
+        samples = _input_samples(case.input, scene.input)
+        row.update(_figures(scene, samples))
+    except (MountTwinError, ValueError, KeyError, OSError) as err:
+        row.update(verdict=FAILED, error=f"{type(err).__name__}: {err}")
+    row["wall_s"] = time.perf_counter() - t0
+    return row
+
+
+def _figures(scene: Scene, samples: SampleBatch) -> dict[str, Any]:
+    engine = TwinEngine(assemble(scene))
+    out = engine.push(samples)
+    reports = [*out.health]
+    final = engine.flush()
+    if final is not None:
+        reports.append(final)
+    worst = max((s.level for r in reports for s in r.statuses), default=0)
+    force = np.linalg.norm(out.wrenches[:, :, :3], axis=2).max(axis=0) if len(out) else None
+    util = engine.utilisation_max
+    first = engine.events[0] if engine.events else None
+    position = out.pose[:, pose_row.POSITION_COLS]
+    row: dict[str, Any] = {
+        "verdict": LEVEL_NAMES[worst],
+        "error": "",
+        "events": engine.counts["mount_events"],
+        "first_event": f"{first.mount}:{first.event}" if first else "",
+        "first_event_s": first.stamp - float(samples.stamps[0]) if first else math.nan,
+        "max_displacement_m": float(np.abs(position - position[0]).max())
+        if len(out)
+        else math.nan,
+        "max_tilt_rad": float(tilt_from_quaternions(out.quaternion).max())
+        if len(out)
+        else math.nan,
+    }
+    for i, m in enumerate(scene.mounts):
+        row[f"peak_force_N.{m.name}"] = float(force[i]) if force is not None else math.nan
+        row[f"utilisation.{m.name}"] = util.get(m.name, math.nan)
+    return row
+
+
+def finished_cases(results: Path) -> set[str]:
+    """Ids of the cases already in a results CSV (FAILED ones are run again)."""
+    if not results.exists():
+        return set()
+    with results.open(encoding="utf-8", newline="") as fh:
+        return {r["case"] for r in csv.DictReader(fh) if r.get("verdict") != FAILED}
+
+
+def run_sweep(
+    spec: SweepSpec,
+    results: str | Path,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[dict[str, Any]]:
+    """Run every unfinished case of `spec`, appending rows to the CSV `results`; returns the
+    rows run now. `scheduler`: a Dask scheduler address (default: a local cluster of
+    `workers` processes, one thread each; default one per core). `progress(done, total)` is
+    called after each case."""
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    path = Path(results)
+    todo = [c for c in expand(spec) if c.case_id not in finished_cases(path)]
+    if not todo:
+        return []
+    head = columns(spec)
+    cluster = None
+    if scheduler is None:
+        n = workers or os.cpu_count() or 1
+        cluster = LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
+        )
+    client = Client(scheduler or cluster)
+    rows = []
+    try:
+        futures = client.map(
+            run_case, [spec.base] * len(todo), [spec.source] * len(todo), todo, pure=False
+        )
+        with _appender(path, head) as append:
+            for done, future in enumerate(as_completed(futures), 1):
+                row = future.result()
+                append(row)
+                rows.append(row)
+                if progress:
+                    progress(done, len(todo))
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return rows
+
+
+@contextmanager
+def _appender(path: Path, head: list[str]) -> Iterator[Callable[[dict[str, Any]], None]]:
+    """Append rows to a CSV (header written if the file is new), flushed row by row."""
+    new = not path.exists() or path.stat().st_size == 0
+    with path.open("a", encoding="utf-8", newline="") as fh:
+        writer = csv.DictWriter(fh, head, extrasaction="raise")
+        if new:
+            writer.writeheader()
+
+        def append(row: dict[str, Any]) -> None:
+            writer.writerow({k: _cell(row.get(k, "")) for k in head})
+            fh.flush()
+
+        yield append
+
+
+def _cell(value: Any) -> Any:
+    return repr(value) if isinstance(value, float) else value
+
+
+def read_results(results: str | Path) -> list[dict[str, str]]:
+    """The rows of a results CSV."""
+    with Path(results).open(encoding="utf-8", newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
+    """The verdict counts, and the cases of the lowest and highest peak mount force."""
+    rows = list(rows)
+    names = [m["name"] for m in spec.base["mounts"]]
+    varied = columns(spec)[2 : 2 + len(spec.variations)]
+    counts: dict[str, int] = {}
+    for r in rows:
+        counts[r["verdict"]] = counts.get(r["verdict"], 0) + 1
+    lines = ["verdicts: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))]
+    done = [r for r in rows if r["verdict"] != FAILED]
+    if done:
+
+        def peak(r: dict[str, Any]) -> float:
+            return max(float(r[f"peak_force_N.{n}"]) for n in names)
+
+        for label, r in (("lowest", min(done, key=peak)), ("highest", max(done, key=peak))):
+            setting = ", ".join(f"{k} = {r[k]}" for k in varied)
+            lines.append(
+                f"{label} peak mount force: {peak(r):.4g} N, case {r['case']} "
+                f"({r['input']}; {setting}) {r['verdict']}"
+            )
+    return "\n".join(lines)
+
+
+def sweep(
+    sweep_file: str | Path,
+    results: str | Path,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+) -> list[dict[str, str]]:
+    """Load, check and run a sweep file (cases already in `results` are skipped) and return
+    every row of `results`: one dict per case, columns as `columns` names them (the
+    `pandas.DataFrame(rows)` of it is the table)."""
+    from mount_twin.sweeps.cases import check
+    from mount_twin.sweeps.spec import load_sweep
+
+    spec = load_sweep(sweep_file)
+    check(spec)
+    run_sweep(spec, results, scheduler=scheduler, workers=workers)
+    return read_results(results)

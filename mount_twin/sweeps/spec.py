@@ -1,0 +1,140 @@
+"""A sweep description (YAML), validated at load with key-path errors like scenes.
+
+base: pump_8_mounts.scene.yaml        # a scene file, relative to the sweep file
+vary:                                 # each a key path into the scene and its values
+  - key: mounts[*].stiffness          # [*]: every mount; [fl]: the mount named fl
+    scale: [0.5, 1.0, 2.0]            # multiply (element-wise for vectors)
+  - key: body.mass
+    values: [1100.0, 1300.0]          # set
+  - key: mounts[fl].position
+    values: [[0.9, 0.4, 0.0], [1.0, 0.4, 0.0]]
+  - key: input.gyro_cutoff_hz
+    range: {start: 20.0, stop: 80.0, num: 3}   # evenly spaced, both ends included
+combine: product                      # every combination (default), or zip (in step)
+inputs:                               # each case runs against every input
+  - bag: ../bags/half_sine_shock_10khz
+  - name: dhs_400                     # a generated record (mount-twin generate's options)
+    generate: {kind: half-sine, peak: 400.0, pulse: 0.005, rebound: 100.0, rate: 10000.0,
+               duration: 0.3}
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from mount_twin.errors import SceneError
+from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
+from mount_twin.scene.reader import Reader
+
+GENERATE_KINDS = ("half-sine", "ship-motion")
+GENERATE_KEYS = ("kind", "peak", "pulse", "rebound", "lateral", "rate", "duration")
+
+
+@dataclass(frozen=True)
+class Variation:
+    """One varied key path: `op` 'set' or 'scale', with its values."""
+
+    key: str
+    op: str
+    values: tuple[Any, ...]
+
+
+@dataclass(frozen=True)
+class InputCase:
+    """An input record: a bag (path) or a generated signal (`generate` options)."""
+
+    name: str
+    bag: str = ""
+    generate: tuple[tuple[str, Any], ...] = ()
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A loaded sweep: the base scene's mapping, the variations, how they combine, inputs."""
+
+    source: str
+    base_source: str
+    base: dict[str, Any]
+    variations: tuple[Variation, ...]
+    combine: str
+    inputs: tuple[InputCase, ...]
+
+
+def load_sweep(path: str | Path) -> SweepSpec:
+    """Read and validate a sweep file; errors name the file and key path (and a variation that
+    makes no valid scene, with the scene's own error)."""
+    path = Path(path)
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except OSError as err:
+        raise SceneError(str(path), "<file>", f"cannot read: {err.strerror}") from err
+    except yaml.YAMLError as err:
+        raise SceneError(str(path), "<file>", f"not valid YAML: {err}") from err
+    top = Reader(data, str(path))
+    base_path = (path.parent / top.string("base")).resolve()
+    base = read_scene_yaml(base_path)
+    scene_from_dict(base, str(base_path))  # the base itself must be a valid scene
+    raw_vary = top.raw("vary", [])
+    if not isinstance(raw_vary, list):
+        raise top.error("vary", f"expected a list of variations, got {raw_vary!r}")
+    variations = tuple(
+        _variation(Reader(v, str(path), f"vary[{i}]")) for i, v in enumerate(raw_vary)
+    )
+    combine = top.choice("combine", ("product", "zip"), "product")
+    if combine == "zip" and len({len(v.values) for v in variations}) > 1:
+        raise top.error("combine", "zip needs the same number of values in every variation")
+    raw_inputs = top.raw("inputs")
+    if not isinstance(raw_inputs, list) or not raw_inputs:
+        raise top.error("inputs", f"expected a non-empty list of inputs, got {raw_inputs!r}")
+    inputs = tuple(
+        _input(Reader(v, str(path), f"inputs[{i}]"), path.parent) for i, v in enumerate(raw_inputs)
+    )
+    if len({i.name for i in inputs}) != len(inputs):
+        raise top.error("inputs", "input names must differ (give each a `name`)")
+    top.finish()
+    return SweepSpec(str(path), str(base_path), base, variations, combine, inputs)
+
+
+def _variation(r: Reader) -> Variation:
+    key = r.string("key")
+    ops = [op for op in ("values", "scale", "range") if op in r.data]
+    if len(ops) != 1:
+        raise r.error("key", f"give exactly one of values, scale or range for {key!r}")
+    if ops[0] == "range":
+        spec = r.sub("range")
+        start, stop = spec.number("start"), spec.number("stop")
+        num = spec.integer("num", lo=1)
+        spec.finish()
+        values: tuple[Any, ...] = tuple(float(v) for v in np.linspace(start, stop, num))
+        op = "set"
+    else:
+        raw = r.raw(ops[0])
+        if not isinstance(raw, list) or not raw:
+            raise r.error(ops[0], f"expected a non-empty list, got {raw!r}")
+        values, op = tuple(raw), "scale" if ops[0] == "scale" else "set"
+        if op == "scale" and not all(isinstance(v, (int, float)) for v in values):
+            raise r.error("scale", f"expected numbers, got {raw!r}")
+    r.finish()
+    return Variation(key, op, values)
+
+
+def _input(r: Reader, folder: Path) -> InputCase:
+    if "bag" in r.data:
+        bag = str((folder / r.string("bag")).resolve())
+        case = InputCase(r.string("name", Path(bag).name), bag=bag)
+    else:
+        g = r.sub("generate", optional=False)
+        kind = g.choice("kind", GENERATE_KINDS)
+        options: dict[str, Any] = {"kind": kind}
+        for key in GENERATE_KEYS[1:]:
+            if key in g.data:
+                options[key] = g.number(key)
+        g.finish()
+        case = InputCase(r.string("name", kind), generate=tuple(sorted(options.items())))
+    r.finish()
+    return case

@@ -1,0 +1,114 @@
+"""Design sweeps: key paths, the sweep file's checks, and a sweep on a real local Dask cluster
+whose rows equal single runs of the same cases; resumable, a failing case is a row."""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import pytest
+from io_helpers import CONFIG, ROOT
+
+from mount_twin.cli import main
+from mount_twin.errors import SceneError
+from mount_twin.scene.loader import read_scene_yaml
+from mount_twin.sweeps.cases import apply, check
+from mount_twin.sweeps.runner import FAILED, columns, read_results, run_case, run_sweep
+from mount_twin.sweeps.spec import load_sweep
+
+PUMP = CONFIG / "pump_8_mounts.scene.yaml"
+SWEEP = f"""\
+base: {PUMP}
+vary:
+  - key: mounts[*].stiffness
+    scale: [0.5, 2.0]
+  - key: body.mass
+    values: [1100.0, -5.0]
+inputs:
+  - bag: {ROOT / "bags" / "half_sine_shock_10khz"}
+  - name: dhs
+    generate: {{kind: half-sine, peak: 300.0, pulse: 0.005, rebound: 100.0, rate: 4000.0,
+               duration: 0.15}}
+"""
+
+
+def _sweep_file(tmp_path: Path, text: str = SWEEP) -> Path:
+    path = tmp_path / "sweep.yaml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_key_paths_set_and_scale_what_they_name() -> None:
+    base = read_scene_yaml(PUMP)
+    data = apply(
+        base,
+        (("mounts[*].stiffness", "scale", 2.0), ("mounts[fl].position", "set", [1.0, 0.4, 0.0])),
+    )
+    for before, after in zip(base["mounts"], data["mounts"], strict=True):
+        assert after["stiffness"] == [2.0 * v for v in before["stiffness"]]
+        want = [1.0, 0.4, 0.0] if before["name"] == "fl" else before["position"]
+        assert after["position"] == want
+    assert base["mounts"][0]["stiffness"][2] == 1.2e6, "the base is not changed"
+
+
+def test_a_key_path_the_scene_lacks_fails_at_load_naming_it(tmp_path: Path) -> None:
+    spec = load_sweep(_sweep_file(tmp_path, SWEEP.replace("body.mass", "body.mas")))
+    with pytest.raises(SceneError, match=r"vary\[1\]\.key: body\.mas: no 'mas' here"):
+        check(spec)
+    with pytest.raises(SceneError, match=r"sweep.yaml: inputs: required key is missing"):
+        load_sweep(_sweep_file(tmp_path, SWEEP.split("inputs:", maxsplit=1)[0]))
+
+
+@pytest.fixture(scope="module")
+def swept(tmp_path_factory: pytest.TempPathFactory):
+    tmp = tmp_path_factory.mktemp("sweep")
+    spec = load_sweep(_sweep_file(tmp))
+    results = tmp / "results.csv"
+    rows = run_sweep(spec, results, workers=2)
+    return spec, results, rows
+
+
+def test_the_sweep_runs_every_case_on_the_cluster_as_a_single_run_would(swept) -> None:
+    spec, results, rows = swept
+    cases = check(spec)
+    assert len(rows) == len(cases) == 2 * 2 * 2
+    table = {r["case"]: r for r in read_results(results)}
+    assert list(next(iter(table.values()))) == columns(spec)
+    for case in cases:
+        single = run_case(spec.base, spec.source, case)  # in this process, no Dask
+        row = table[case.case_id]
+        assert row["verdict"] == single["verdict"]
+        for key, value in single.items():
+            if key == "wall_s" or not isinstance(value, float):
+                continue
+            got = float(row[key])
+            assert (math.isnan(got) and math.isnan(value)) or got == value, (key, got, value)
+
+
+def test_a_bad_case_is_a_failed_row_and_the_rest_still_run(swept) -> None:
+    _, results, _ = swept
+    rows = read_results(results)
+    failed = [r for r in rows if r["verdict"] == FAILED]
+    assert len(failed) == 4 and all(r["body.mass"] == "-5.0" for r in failed)
+    assert all("body.mass" in r["error"] for r in failed)
+    good = [r for r in rows if r["verdict"] != FAILED]
+    assert len(good) == 4 and all(float(r["peak_force_N.fl"]) > 1000.0 for r in good)
+
+
+def test_a_rerun_skips_finished_cases_and_reruns_failed_ones(swept) -> None:
+    spec, results, _ = swept
+    again = run_sweep(spec, results, workers=1)
+    assert len(again) == 4 and all(r["verdict"] == FAILED for r in again)
+
+
+def test_the_command_reports_and_exits_5_when_a_case_failed(
+    swept, capsys: pytest.CaptureFixture[str]
+) -> None:
+    spec, results, _ = swept
+    code = main(["sweep", spec.source, "-o", str(results), "--workers", "1", "--no-progress"])
+    assert code == 5
+    out = capsys.readouterr().out
+    assert "verdicts:" in out and "FAILED" in out and "highest peak mount force" in out
+    with results.open(encoding="utf-8") as fh:
+        assert sum(1 for _ in csv.DictReader(fh)) == 8 + 4 + 4  # appended reruns of failures
