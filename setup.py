@@ -46,7 +46,15 @@ setup(
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
-        (f"share/{PACKAGE}/config", glob("config/*.yaml")),
+        (
+            f"share/{PACKAGE}/config",
+            sorted(
+                glob("config/*.yaml")
+                + glob("config/*.xml")
+                + glob("config/*.json")
+                + glob("config/*.csv")
+            ),
+        ),
         (f"share/{PACKAGE}/launch", glob("launch/*.launch.py")),
         *((f"share/{PACKAGE}/{d}", glob(f"{d}/*")) for d in sorted(glob("bags/*"))),
     ],

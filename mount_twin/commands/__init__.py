@@ -25,6 +25,7 @@ COMMANDS = (
     "accuracy",
     "sweep",
     "show",
+    "dashboard",
     "warm_up",
 )
 """Module names under mount_twin.commands, in the order `--help` lists them."""

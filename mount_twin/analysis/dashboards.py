@@ -1,0 +1,100 @@
+"""Ready dashboards for a scene's outputs: a PlotJuggler layout (XML) and a Foxglove layout
+(JSON), each plotting the CG position, the attitude angles and every mount's force components
+from the node's topics (live) or an output bag (the same topics).
+
+Series are named the way each tool names message fields: PlotJuggler `/topic/field/sub`,
+Foxglove message paths `/topic.field.sub` (plotted against the header stamp).
+"""
+
+from __future__ import annotations
+
+import json
+from xml.etree import ElementTree as ET
+
+from mount_twin.io.messages import resolve
+from mount_twin.replay import NODE_NAME
+from mount_twin.scene.description import Scene
+
+COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f")
+
+
+def panels(scene: Scene) -> list[tuple[str, list[tuple[str, tuple[str, ...]]]]]:
+    """(panel title, [(topic, field path)]) of each plot: pose, angles, then force x, y, z."""
+    pose = resolve("~/pose", NODE_NAME)
+    angles = resolve("~/angles", NODE_NAME)
+    Series = list[tuple[str, tuple[str, ...]]]
+    out: list[tuple[str, Series]] = [
+        ("CG position in F [m]", [(pose, ("pose", "position", a)) for a in "xyz"]),
+        ("α (x), γ (y), δ (z) [rad]", [(angles, ("vector", a)) for a in "xyz"]),
+    ]
+    for axis in "xyz":
+        out.append(
+            (
+                f"mount force along mount {axis} [N]",
+                [
+                    (resolve(f"~/mounts/{m.name}/wrench", NODE_NAME), ("wrench", "force", axis))
+                    for m in scene.mounts
+                ],
+            )
+        )
+    return out
+
+
+def plotjuggler_layout(scene: Scene) -> str:
+    """A PlotJuggler layout: one tab, the panels stacked."""
+    root = ET.Element("root")
+    tabs = ET.SubElement(root, "tabbed_widget", {"parent": "main_window", "name": "Main Window"})
+    tab = ET.SubElement(tabs, "Tab", {"tab_name": scene.name, "containers": "1"})
+    container = ET.SubElement(tab, "Container")
+    items = panels(scene)
+    share = ";".join([f"{1 / len(items):.6f}"] * len(items))
+    split = ET.SubElement(
+        container, "DockSplitter", {"orientation": "-", "sizes": share, "count": str(len(items))}
+    )
+    for title, series in items:
+        area = ET.SubElement(split, "DockArea", {"name": title})
+        plot = ET.SubElement(
+            area,
+            "plot",
+            {"mode": "TimeSeries", "style": "Lines", "flip_x": "false", "flip_y": "false"},
+        )
+        ET.SubElement(plot, "limitY")
+        for k, (topic, field) in enumerate(series):
+            name = "/".join([topic, *field])
+            ET.SubElement(plot, "curve", {"name": name, "color": COLOURS[k % len(COLOURS)]})
+    ET.indent(root)
+    return (
+        "<?xml version='1.0' encoding='UTF-8'?>\n" + ET.tostring(root, encoding="unicode") + "\n"
+    )
+
+
+def foxglove_layout(scene: Scene) -> str:
+    """A Foxglove layout: the panels in one column."""
+    config: dict[str, object] = {}
+    ids = []
+    for k, (title, series) in enumerate(panels(scene)):
+        panel = f"Plot!mt{k}"
+        ids.append(panel)
+        config[panel] = {
+            "title": title,
+            "paths": [
+                {
+                    "value": f"{topic}.{'.'.join(field)}",
+                    "enabled": True,
+                    "timestampMethod": "headerStamp",
+                }
+                for topic, field in series
+            ],
+            "showLegend": True,
+            "isSynced": True,
+        }
+    layout: object = ids[-1]
+    for panel in reversed(ids[:-1]):
+        layout = {"first": panel, "second": layout, "direction": "column"}
+    return (
+        json.dumps(
+            {"configById": config, "globalVariables": {}, "userNodes": {}, "layout": layout},
+            indent=2,
+        )
+        + "\n"
+    )

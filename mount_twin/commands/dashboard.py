@@ -1,0 +1,31 @@
+"""`mount-twin dashboard SCENE`: PlotJuggler and Foxglove layouts for a scene's outputs."""
+
+from __future__ import annotations
+
+import argparse
+
+NAME = "dashboard"
+HELP = "write PlotJuggler (XML) and Foxglove (JSON) layouts plotting a scene's outputs"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("scene", help="scene YAML")
+    parser.add_argument("--plotjuggler", metavar="XML", help="PlotJuggler layout file to write")
+    parser.add_argument("--foxglove", metavar="JSON", help="Foxglove layout file to write")
+
+
+def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from mount_twin.analysis.dashboards import foxglove_layout, plotjuggler_layout
+    from mount_twin.scene.loader import load_scene_file
+
+    if not (args.plotjuggler or args.foxglove):
+        msg = "give --plotjuggler XML and/or --foxglove JSON"
+        raise ValueError(msg)
+    scene = load_scene_file(args.scene)
+    for path, text in ((args.plotjuggler, plotjuggler_layout), (args.foxglove, foxglove_layout)):
+        if path:
+            Path(path).write_text(text(scene), encoding="utf-8")
+            print(f"layout: {path}")
+    return 0

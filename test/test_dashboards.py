@@ -1,0 +1,70 @@
+"""The bundled PlotJuggler and Foxglove layouts plot fields that exist in the node's output
+messages, on the node's topics, for every mount; regenerating them gives the files in config/."""
+
+from __future__ import annotations
+
+import json
+from xml.etree import ElementTree as ET
+
+import pytest
+from io_helpers import CONFIG
+
+from mount_twin.analysis.dashboards import foxglove_layout, plotjuggler_layout
+from mount_twin.io.messages import TYPESTORE, output_streams, resolve
+from mount_twin.replay import NODE_NAME
+from mount_twin.scene.loader import load_scene_file
+
+SCENES = ("pump_8_mounts", "genset_bolted_keyed")
+
+
+def _field_exists(msgtype: str, path: list[str]) -> bool:
+    """Whether `path` names a numeric field of `msgtype`, through rosbags' type definitions."""
+    for name in path:
+        fields = dict(TYPESTORE.get_msgdef(msgtype).fields)
+        if name not in fields:
+            return False
+        kind = fields[name]
+        msgtype = kind[1] if kind[0].name == "NAME" else ""
+    return msgtype == ""  # ended on a base type
+
+
+def _series(scene_name: str) -> list[tuple[str, list[str]]]:
+    """(topic, field path) of every curve of the bundled PlotJuggler and Foxglove layouts."""
+    scene = load_scene_file(CONFIG / f"{scene_name}.scene.yaml")
+    topics = {resolve(s.topic, NODE_NAME) for s in output_streams(scene)}
+    root = ET.fromstring((CONFIG / f"{scene_name}.plotjuggler.xml").read_text(encoding="utf-8"))
+    out = []
+    for curve in root.iter("curve"):
+        name = curve.get("name", "")
+        topic = next(t for t in sorted(topics, key=len, reverse=True) if name.startswith(t + "/"))
+        out.append((topic, name[len(topic) + 1 :].split("/")))
+    fox = json.loads((CONFIG / f"{scene_name}.foxglove.json").read_text(encoding="utf-8"))
+    for panel in fox["configById"].values():
+        for p in panel["paths"]:
+            topic, _, rest = p["value"].partition(".")
+            out.append((topic, rest.split(".")))
+    return out
+
+
+@pytest.mark.parametrize("scene_name", SCENES)
+def test_every_curve_is_a_field_of_an_output_topic(scene_name: str) -> None:
+    scene = load_scene_file(CONFIG / f"{scene_name}.scene.yaml")
+    types = {resolve(s.topic, NODE_NAME): s.msgtype for s in output_streams(scene)}
+    series = _series(scene_name)
+    assert len(series) == 2 * (3 + 3 + 3 * len(scene.mounts))
+    for topic, path in series:
+        assert topic in types, topic
+        assert _field_exists(types[topic], path), (topic, path)
+    wrench_topics = {t for t, _ in series if t.endswith("/wrench")}
+    assert wrench_topics == {resolve(f"~/mounts/{m.name}/wrench", NODE_NAME) for m in scene.mounts}
+
+
+@pytest.mark.parametrize("scene_name", SCENES)
+def test_the_bundled_layouts_are_what_the_command_writes(scene_name: str) -> None:
+    scene = load_scene_file(CONFIG / f"{scene_name}.scene.yaml")
+    assert (CONFIG / f"{scene_name}.plotjuggler.xml").read_text(encoding="utf-8") == (
+        plotjuggler_layout(scene)
+    )
+    assert (CONFIG / f"{scene_name}.foxglove.json").read_text(encoding="utf-8") == (
+        foxglove_layout(scene)
+    )
