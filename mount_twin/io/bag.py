@@ -5,9 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from types import TracebackType
-from typing import Any
 
-import numpy as np
 from rosbags.highlevel import AnyReader
 from rosbags.interfaces import (
     Qos,
@@ -175,35 +173,3 @@ def write_bag(
             writer.write(conn, stamp, raw)
             n += 1
     return n
-
-
-def read_topics(
-    path: str | Path, msgtypes: set[str]
-) -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
-    """Stamps (s) and numeric rows of every topic of the given types in a bag.
-
-    Rows: PoseStamped → (x, y, z, qx, qy, qz, qw); Vector3Stamped → (x, y, z);
-    WrenchStamped → (fx, fy, fz, tx, ty, tz).
-    """
-    out: dict[str, tuple[list[float], list[tuple[float, ...]], str]] = {}
-    with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
-        conns = [c for c in reader.connections if c.msgtype in msgtypes]
-        for conn, _, raw in reader.messages(connections=conns):
-            msg: Any = reader.deserialize(raw, conn.msgtype)  # a generated message class
-            stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
-            stamps, rows, _ = out.setdefault(conn.topic, ([], [], conn.msgtype))
-            stamps.append(stamp)
-            rows.append(_numbers(msg))
-    return {k: (np.array(s), np.array(r), t) for k, (s, r, t) in out.items()}
-
-
-def _numbers(msg: Any) -> tuple[float, ...]:
-    """The numbers of a PoseStamped, WrenchStamped or Vector3Stamped, as `read_topics` rows."""
-    if hasattr(msg, "pose"):
-        p, q = msg.pose.position, msg.pose.orientation
-        return (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
-    if hasattr(msg, "wrench"):
-        f, t = msg.wrench.force, msg.wrench.torque
-        return (f.x, f.y, f.z, t.x, t.y, t.z)
-    v = msg.vector
-    return (v.x, v.y, v.z)
