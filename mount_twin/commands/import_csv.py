@@ -5,15 +5,37 @@ from __future__ import annotations
 import argparse
 
 NAME = "import-csv"
-HELP = "CSV t,ax,ay,az,wx,wy,wz → sensor_msgs/Imu bag"
+HELP = "a recorder's CSV (time, acceleration, optional gyro; units, ; and decimal comma) → Imu bag"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("csv")
-    parser.add_argument("-o", "--output", required=True)
-    parser.add_argument("--topic", default="/imu/data", help="topic to write")
-    parser.add_argument("--frame-id", default="imu_link", help="header.frame_id to write")
-    parser.add_argument("--offset", type=int, default=0, help="added to t·1e9 for the stamp, ns")
+    parser.add_argument("csv", help="CSV file (see mount_twin.io.csv_import for what is read)")
+    parser.add_argument("-o", "--output", required=True, help="output bag directory (new)")
+    parser.add_argument(
+        "--topic", default="/deck/imu", help="topic to write (the bundled scenes' input)"
+    )
+    parser.add_argument("--frame-id", default="deck_imu", help="header.frame_id to write")
+    parser.add_argument(
+        "--offset",
+        type=int,
+        default=1_700_000_000_000_000_000,
+        help="added to t·1e9 for the header stamp, ns (a stamp of 0 means unset in ROS)",
+    )
+    parser.add_argument("--delimiter", help="between cells (default: sniffed from the header)")
+    parser.add_argument("--decimal", choices=[".", ","], help="decimal mark (default: sniffed)")
+    parser.add_argument(
+        "--columns",
+        metavar="ROLE=NAME,...",
+        help="header names for t, ax, ay, az, wx, wy, wz, e.g. t=Time,ax=AccX (default: "
+        "recognised names)",
+    )
+    parser.add_argument("--time-unit", help="s, ms, us or ns (default: from the header, else s)")
+    parser.add_argument(
+        "--accel-unit", help="m/s^2, g or mm/s^2 (default: from the header, else m/s^2)"
+    )
+    parser.add_argument(
+        "--gyro-unit", help="rad/s or deg/s (default: from the header, else rad/s)"
+    )
     parser.add_argument(
         "--storage", choices=["mcap", "sqlite3"], default="mcap", help="bag storage format"
     )
@@ -21,9 +43,31 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from mount_twin.commands.common import write_signal
-    from mount_twin.io.signals import read_csv
+    from mount_twin.io.csv_import import CsvFormat, read_recorder_csv
 
-    sig = read_csv(args.csv)
-    n = write_signal(sig, args.output, args.topic, args.frame_id, args.offset, args.storage)
+    columns = {}
+    for pair in (args.columns or "").split(","):
+        if pair.strip():
+            role, sep, name = pair.partition("=")
+            if not sep or role.strip() not in ("t", "ax", "ay", "az", "wx", "wy", "wz"):
+                msg = f"--columns: {pair!r} is not ROLE=NAME with ROLE one of t, ax … wz"
+                raise ValueError(msg)
+            columns[role.strip()] = name.strip()
+    units = {
+        q: u
+        for q, u in (
+            ("time", args.time_unit),
+            ("accel", args.accel_unit),
+            ("gyro", args.gyro_unit),
+        )
+        if u
+    }
+    delimiter = "\t" if args.delimiter in ("\\t", "tab") else args.delimiter
+    imported = read_recorder_csv(args.csv, CsvFormat(delimiter, args.decimal, columns, units))
+    n = write_signal(
+        imported.signal, args.output, args.topic, args.frame_id, args.offset, args.storage
+    )
     print(f"wrote {n} sensor_msgs/msg/Imu messages on {args.topic} to {args.output}")
+    for note in imported.notes:
+        print(f"  {note}")
     return 0

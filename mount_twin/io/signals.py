@@ -91,15 +91,3 @@ def ship_motion(
     gyro = np.zeros((t.size, 3))
     gyro[:, 0] = phi_dot
     return Signal(t, accel, gyro)
-
-
-def read_csv(path: str) -> Signal:
-    """A CSV with header t,ax,ay,az,wx,wy,wz (s, m/s², rad/s); t kept as given."""
-    with open(path, encoding="utf-8") as fh:
-        header = fh.readline().strip().split(",")
-    expected = ["t", "ax", "ay", "az", "wx", "wy", "wz"]
-    if header != expected:
-        msg = f"{path}: header is {','.join(header)}; expected {','.join(expected)}"
-        raise ValueError(msg)
-    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    return Signal(data[:, 0], data[:, 1:4], data[:, 4:7])

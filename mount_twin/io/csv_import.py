@@ -1,0 +1,190 @@
+"""Accelerometer (and gyro) CSV files as recorders write them, read into a `Signal`.
+
+Accepted: `,` `;` tab or whitespace between cells (sniffed from the header line), a decimal
+comma (with `;`, tab or whitespace delimiters), a UTF-8 byte-order mark (Excel's "CSV UTF-8"),
+comment lines (`#`) and blank lines, units in the header (`t [s]`, `AccZ (g)`, `wx[deg/s]`),
+common column names (`time`, `AccX`, `gyro_x`, ...) or an explicit mapping, and files without
+gyro columns (Ω = 0). Units: time s, ms, us, ns; acceleration m/s², g (9.80665 m/s²), mm/s²;
+angular rate rad/s, deg/s. Every error names the file, the row (its line number in the file)
+and the column. The values are specific force in the sensor frame, as an IMU reports them.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from mount_twin.io.signals import Signal
+
+G = 9.80665
+ROLES = ("t", "ax", "ay", "az", "wx", "wy", "wz")
+ALIASES: dict[str, tuple[str, ...]] = {
+    "t": ("t", "time", "timestamp", "time_s", "sec", "seconds"),
+    "ax": ("ax", "accx", "acc_x", "accel_x", "acceleration_x", "a_x"),
+    "ay": ("ay", "accy", "acc_y", "accel_y", "acceleration_y", "a_y"),
+    "az": ("az", "accz", "acc_z", "accel_z", "acceleration_z", "a_z"),
+    "wx": ("wx", "gx", "gyrox", "gyro_x", "omega_x", "rate_x", "w_x"),
+    "wy": ("wy", "gy", "gyroy", "gyro_y", "omega_y", "rate_y", "w_y"),
+    "wz": ("wz", "gz", "gyroz", "gyro_z", "omega_z", "rate_z", "w_z"),
+}
+"""Header names (lower case, spaces as _) taken for each role without a mapping."""
+UNITS: dict[str, dict[str, float]] = {
+    "time": {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "ns": 1e-9},
+    "accel": {"m/s^2": 1.0, "m/s2": 1.0, "m/s²": 1.0, "mps2": 1.0, "g": G, "mm/s^2": 1e-3},
+    "gyro": {"rad/s": 1.0, "deg/s": math.pi / 180, "°/s": math.pi / 180, "dps": math.pi / 180},
+}
+"""Unit name → factor to SI, per quantity."""
+QUANTITY = {"t": "time", **dict.fromkeys(ROLES[1:4], "accel"), **dict.fromkeys(ROLES[4:], "gyro")}
+HEADER_CELL = re.compile(r"^\s*(.*?)\s*(?:[\[(]\s*(.*?)\s*[\])])?\s*$")
+
+
+@dataclass(frozen=True)
+class CsvFormat:
+    """What the file does not say itself (None: sniff it or take it from the header).
+
+    Attributes:
+        delimiter: between cells; None: `;`, tab or `,` as the header has them, else spaces.
+        decimal: '.' or ','; None: ',' if the delimiter is not ',' and the numbers have one.
+        columns: role (t, ax, ay, az, wx, wy, wz) → header name, for names not recognised.
+        units: quantity (time, accel, gyro) → unit, overriding the header's.
+    """
+
+    delimiter: str | None = None
+    decimal: str | None = None
+    columns: dict[str, str] = field(default_factory=dict)
+    units: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Imported:
+    """The signal read, and what was assumed or found, to tell the user (`notes`)."""
+
+    signal: Signal
+    notes: list[str]
+
+
+def _fail(path: Path, where: str, what: str) -> ValueError:
+    return ValueError(f"{path}: {where}: {what}")
+
+
+def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Imported:
+    """Read a recorder's CSV (see the module docstring); every error names file, row, column."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")  # utf-8-sig drops a byte-order mark
+    except OSError as err:
+        raise _fail(path, "<file>", f"cannot read: {err.strerror}") from err
+    except UnicodeDecodeError as err:
+        raise _fail(path, "<file>", f"not UTF-8 text ({err.reason} at byte {err.start})") from err
+    lines = [
+        (n, line)
+        for n, line in enumerate(text.splitlines(), 1)
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
+    if not lines:
+        raise _fail(path, "<file>", "no header line (the file is empty or only comments)")
+    header_row, header = lines[0]
+    delimiter = fmt.delimiter or next((d for d in (";", "\t", ",") if d in header), None)
+    names, header_units = _header(header, delimiter)
+    roles = _roles(path, header_row, names, fmt.columns)
+    data = lines[1:]
+    if not data:
+        raise _fail(path, f"row {header_row}", "a header but no data rows")
+    decimal = fmt.decimal or (
+        "," if delimiter != "," and any("," in line for _, line in data[:50]) else "."
+    )
+    notes = []
+    scale = {}
+    for role, col in roles.items():
+        quantity = QUANTITY[role]
+        unit = fmt.units.get(quantity) or header_units[col] or next(iter(UNITS[quantity]))
+        factor = UNITS[quantity].get(unit.lower().replace(" ", ""))
+        if factor is None:
+            known = ", ".join(UNITS[quantity])
+            where = f"row {header_row}, column {names[col]}"
+            raise _fail(path, where, f"unknown {quantity} unit {unit!r} (known: {known})")
+        scale[role] = factor
+    values = np.empty((len(data), len(roles)))
+    order = list(roles.items())
+    for i, (row, line) in enumerate(data):
+        cells = line.split(delimiter) if delimiter else line.split()
+        if len(cells) != len(names):
+            raise _fail(
+                path, f"row {row}", f"{len(cells)} cells where the header has {len(names)}"
+            )
+        for j, (role, col) in enumerate(order):
+            cell = cells[col].strip()
+            try:
+                v = float(cell.replace(decimal, ".") if decimal == "," else cell)
+            except ValueError:
+                raise _fail(
+                    path, f"row {row}, column {names[col]}", f"{cell!r} is not a number"
+                ) from None
+            if not math.isfinite(v):
+                raise _fail(path, f"row {row}, column {names[col]}", f"{cell!r} is not finite")
+            values[i, j] = v * scale[role]
+    t = values[:, 0]
+    back = np.flatnonzero(np.diff(t) <= 0.0)
+    if back.size:
+        row = data[int(back[0]) + 1][0]
+        raise _fail(path, f"row {row}, column {names[roles['t']]}", "time does not increase")
+    accel = values[:, 1:4]
+    if len(roles) == 7:
+        gyro = values[:, 4:7]
+    else:
+        gyro = np.zeros_like(accel)
+        notes.append("no gyro columns: angular velocity taken as 0")
+    units = {
+        q: fmt.units.get(q) or header_units[roles[r]] or next(iter(UNITS[q]))
+        for r, q in (("t", "time"), ("ax", "accel"), ("wx", "gyro"))
+        if r in roles
+    }
+    notes.append("units: " + ", ".join(f"{q} {u}" for q, u in units.items()))
+    if decimal == ",":
+        notes.append("decimal comma")
+    return Imported(Signal(t, accel, gyro), notes)
+
+
+def _header(line: str, delimiter: str | None) -> tuple[list[str], list[str]]:
+    """Column names (lower case, spaces as _) and units ('' where none) of the header line."""
+    names, units = [], []
+    for cell in line.split(delimiter) if delimiter else line.split():
+        match = HEADER_CELL.match(cell)
+        name, unit = (match.group(1), match.group(2) or "") if match else (cell.strip(), "")
+        names.append(name.strip().strip('"').lower().replace(" ", "_"))
+        units.append(unit)
+    return names, units
+
+
+def _roles(path: Path, row: int, names: list[str], mapping: dict[str, str]) -> dict[str, int]:
+    """Role → column index: the mapping's names, else the first alias present."""
+    roles: dict[str, int] = {}
+    for role in ROLES:
+        wanted = [mapping[role].lower().replace(" ", "_")] if role in mapping else ALIASES[role]
+        found = next((names.index(n) for n in wanted if n in names), None)
+        if found is not None:
+            roles[role] = found
+        elif role in mapping:
+            raise _fail(
+                path,
+                f"row {row}",
+                f"no column {mapping[role]!r} (for {role}); the header has {', '.join(names)}",
+            )
+    missing = [r for r in ROLES[:4] if r not in roles]
+    if missing:
+        raise _fail(
+            path,
+            f"row {row}",
+            f"no column for {', '.join(missing)}: the header has {', '.join(names)}; name "
+            "them t, ax, ay, az (wx, wy, wz) or map them with --columns t=Time,ax=...",
+        )
+    gyro = [r for r in ROLES[4:] if r in roles]
+    if gyro and len(gyro) != 3:
+        raise _fail(
+            path, f"row {row}", f"gyro columns {gyro} without the others: give all three or none"
+        )
+    return roles
