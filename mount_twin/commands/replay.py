@@ -20,6 +20,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", help="input bag (mcap or sqlite3)")
     parser.add_argument("--scene", required=True, help="scene YAML")
     parser.add_argument("-o", "--output", required=True, help="output bag directory (new)")
+    parser.add_argument("--topic", help="input topic (default: the scene's input.topic)")
+    parser.add_argument(
+        "--frame-id",
+        help="expected header.frame_id, '' for any (default: the scene's input.frame_id)",
+    )
     parser.add_argument("--chunk", type=int, default=2000, help="messages per engine batch")
     parser.add_argument("--no-progress", action="store_true")
     add_plot_argument(parser)
@@ -36,6 +41,9 @@ def add_plot_argument(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    overrides = {
+        k: v for k, v in (("topic", args.topic), ("frame_id", args.frame_id)) if v is not None
+    }
     return replay_and_report(
         args.scene,
         args.input,
@@ -44,6 +52,7 @@ def run(args: argparse.Namespace) -> int:
         not args.no_progress,
         args.plot,
         args.fail_on,
+        overrides,
     )
 
 
@@ -55,12 +64,21 @@ def replay_and_report(
     progress: bool,
     plot: str | None,
     fail_on: str,
+    input_overrides: dict[str, str] | None = None,
 ) -> int:
-    """Replay, print the summary (and plot), and return the exit status (see `verdict`)."""
+    """Replay, print the summary (and plot), and return the exit status (see `verdict`).
+    `input_overrides`: scene `input` fields replaced (topic, frame_id), checked like the
+    scene's own."""
     from mount_twin.replay import replay
-    from mount_twin.scene.loader import load_scene_file
+    from mount_twin.scene.loader import load_scene_file, read_scene_yaml, scene_from_dict
 
-    summary = replay(load_scene_file(scene_path), bag, output, chunk=chunk, progress=progress)
+    if input_overrides:
+        data = read_scene_yaml(scene_path)
+        data.setdefault("input", {}).update(input_overrides)
+        scene = scene_from_dict(data, f"{scene_path} (with --topic/--frame-id)")
+    else:
+        scene = load_scene_file(scene_path)
+    summary = replay(scene, bag, output, chunk=chunk, progress=progress)
     print(summary.text())
     if plot:
         from mount_twin.plot import plot_output_bag  # matplotlib only when asked for

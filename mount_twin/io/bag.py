@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from types import TracebackType
+from typing import Any
 
 from rosbags.highlevel import AnyReader
 from rosbags.interfaces import (
@@ -61,10 +62,18 @@ class InputBag:
         conns = [c for c in self._reader.connections if c.topic == topic]
         if not conns:
             have = ", ".join(
-                sorted({f"{c.topic} ({c.msgtype})" for c in self._reader.connections})
+                sorted(
+                    {
+                        f"{c.topic} ({c.msgtype}, {c.msgcount} messages)"
+                        for c in self._reader.connections
+                    }
+                )
             )
             self._reader.close()  # after listing: a closed reader has no connections
-            msg = f"{self.path}: no topic {topic!r} (input.topic); the bag has: {have}"
+            msg = (
+                f"{self.path}: no topic {topic!r} (input.topic; `replay --topic` overrides it); "
+                f"the bag has: {have or 'no topic'}"
+            )
             raise BagError(msg)
         wrong = [c.msgtype for c in conns if c.msgtype != msgtype]
         if wrong:
@@ -75,17 +84,55 @@ class InputBag:
             raise BagError(msg)
         self._conns = conns
         self.count = sum(c.msgcount for c in conns)
+        self.ros1 = not self._reader.is2
+        """A ROS 1 bag: its messages are converted to the ROS 2 (Jazzy) CDR the twin reads."""
 
     def chunks(self, size: int) -> Iterator[list[bytes]]:
         """Raw messages of the topic in log-time order, `size` at a time."""
         chunk: list[bytes] = []
         for _, _, raw in self._reader.messages(connections=self._conns):
-            chunk.append(raw)
+            chunk.append(self._ros1_to_cdr(raw) if self.ros1 else raw)
             if len(chunk) == size:
                 yield chunk
                 chunk = []
         if chunk:
             yield chunk
+
+    def _ros1_to_cdr(self, raw: bytes) -> bytes:
+        """A ROS 1 message as the ROS 2 message of the same name, CDR-serialized: the fields
+        the twin reads are copied (ROS 1's header.seq has no ROS 2 counterpart)."""
+        msg: Any = self._reader.deserialize(raw, self.msgtype)
+        t = TYPESTORE.types
+        header = t["std_msgs/msg/Header"](
+            stamp=t["builtin_interfaces/msg/Time"](
+                sec=msg.header.stamp.sec, nanosec=msg.header.stamp.nanosec
+            ),
+            frame_id=msg.header.frame_id,
+        )
+        ros2: Any
+        if self.msgtype == "sensor_msgs/msg/Imu":
+            ros2 = t[self.msgtype](
+                header=header,
+                orientation=t["geometry_msgs/msg/Quaternion"](
+                    x=msg.orientation.x,
+                    y=msg.orientation.y,
+                    z=msg.orientation.z,
+                    w=msg.orientation.w,
+                ),
+                orientation_covariance=msg.orientation_covariance,
+                angular_velocity=_vector3(msg.angular_velocity),
+                angular_velocity_covariance=msg.angular_velocity_covariance,
+                linear_acceleration=_vector3(msg.linear_acceleration),
+                linear_acceleration_covariance=msg.linear_acceleration_covariance,
+            )
+        else:  # geometry_msgs/msg/AccelStamped
+            ros2 = t[self.msgtype](
+                header=header,
+                accel=t["geometry_msgs/msg/Accel"](
+                    linear=_vector3(msg.accel.linear), angular=_vector3(msg.accel.angular)
+                ),
+            )
+        return bytes(TYPESTORE.serialize_cdr(ros2, self.msgtype))
 
     def close(self) -> None:
         """Close the bag."""
@@ -98,6 +145,11 @@ class InputBag:
         self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None
     ) -> None:
         self.close()
+
+
+def _vector3(v: Any) -> Any:
+    """A geometry_msgs/Vector3 of the ROS 2 typestore with v's x, y, z."""
+    return TYPESTORE.types["geometry_msgs/msg/Vector3"](x=v.x, y=v.y, z=v.z)
 
 
 class OutputBag:
