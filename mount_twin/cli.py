@@ -4,12 +4,15 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import signal
 import sys
+import threading
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Protocol, cast
 
 from mount_twin.commands import COMMANDS
-from mount_twin.errors import MountTwinError
+from mount_twin.errors import DamagedBagError, MountTwinError, Terminated
 
 
 class DefaultsShown(argparse.HelpFormatter):
@@ -71,15 +74,44 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, Command]]:
     return parser, modules
 
 
+EXIT_DAMAGED, EXIT_SIGINT, EXIT_SIGTERM = 5, 130, 143
+"""Exit statuses besides 0 and the commands' own: 2 bad input or configuration (named), 5 an
+input damaged part-way (what came before it was processed), 128 + the signal's number when
+stopped by SIGINT (Ctrl-C) or SIGTERM (output bags are finished and marked partial)."""
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point; returns the exit status (2: bad input or configuration, named)."""
+    """Entry point; returns the exit status (see EXIT_*; 2: bad input or configuration)."""
     parser, modules = build_parser()
     args = parser.parse_args(argv)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _terminate)
     try:
         return modules[args.cmd].run(args)
+    except DamagedBagError as err:
+        print(f"mount-twin: error: {err}{_partial(args)}", file=sys.stderr)
+        return EXIT_DAMAGED
     except (MountTwinError, ValueError, OSError) as err:
         print(f"mount-twin: error: {err}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(f"mount-twin: interrupted (SIGINT){_partial(args)}", file=sys.stderr)
+        return EXIT_SIGINT
+    except Terminated:
+        print(f"mount-twin: terminated (SIGTERM){_partial(args)}", file=sys.stderr)
+        return EXIT_SIGTERM
+
+
+def _partial(args: argparse.Namespace) -> str:
+    """Where a stopped command's partial output is, if it writes one."""
+    out = getattr(args, "output", None)
+    if out and Path(out).exists():
+        return f"; {out} holds the output so far, marked partial in its metadata"
+    return ""
 
 
 if __name__ == "__main__":

@@ -20,3 +20,12 @@ class ModelError(MountTwinError):
 
 class BagError(MountTwinError):
     """A bag cannot be read or written, or lacks the configured input topic."""
+
+
+class DamagedBagError(BagError):
+    """An input bag is damaged part-way: what came before the damage was processed."""
+
+
+class Terminated(BaseException):
+    """SIGTERM, raised in the main thread (like KeyboardInterrupt for SIGINT) so that the
+    command stops cleanly: output bags are finished and marked partial."""

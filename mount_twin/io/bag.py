@@ -18,7 +18,8 @@ from rosbags.interfaces import (
 )
 from rosbags.rosbag2 import StoragePlugin, Writer
 
-from mount_twin.errors import BagError
+from mount_twin.errors import BagError, DamagedBagError
+from mount_twin.io.mcap_salvage import Salvage, salvage
 from mount_twin.io.messages import TYPESTORE
 
 _INFINITE = QosTime(9223372036, 854775807)
@@ -53,12 +54,13 @@ class InputBag:
         self.path = Path(path)
         self.topic = topic
         self.msgtype = msgtype
+        self._salvage: Salvage | None = None
         try:
             self._reader = AnyReader([self.path], default_typestore=TYPESTORE)
             self._reader.open()
         except Exception as err:
-            msg = f"{self.path}: cannot open bag: {err}"
-            raise BagError(msg) from err
+            self._open_damaged(err)
+            return
         conns = [c for c in self._reader.connections if c.topic == topic]
         if not conns:
             have = ", ".join(
@@ -87,13 +89,61 @@ class InputBag:
         self.ros1 = not self._reader.is2
         """A ROS 1 bag: its messages are converted to the ROS 2 (Jazzy) CDR the twin reads."""
 
+    def _open_damaged(self, err: Exception) -> None:
+        """After rosbags could not open the bag: read what an mcap file holds before its
+        damage (`mcap_salvage`), or raise BagError naming the bag."""
+        found = [self.path] if self.path.suffix == ".mcap" else sorted(self.path.glob("*.mcap"))
+        if not found or not found[0].is_file():
+            msg = f"{self.path}: cannot open bag: {err}"
+            raise BagError(msg) from err
+        self._salvage = salvage(found[0], self.topic)
+        if not self._salvage.messages:
+            msg = (
+                f"{self.path}: cannot open bag ({err}), and no message of {self.topic} comes "
+                f"before its damage ({self._salvage.damage or 'none found'})"
+            )
+            raise BagError(msg) from err
+        if self._salvage.msgtype and self._salvage.msgtype != self.msgtype:
+            msg = (
+                f"{self.path}: topic {self.topic!r} has type {self._salvage.msgtype}, "
+                f"input.msg_type says {self.msgtype}"
+            )
+            raise BagError(msg)
+        self.count = len(self._salvage.messages)
+        self.ros1 = False
+
     def chunks(self, size: int) -> Iterator[list[bytes]]:
-        """Raw messages of the topic in log-time order, `size` at a time."""
+        """Raw messages of the topic in log-time order, `size` at a time. From a damaged bag,
+        those before the damage, then DamagedBagError."""
+        if self._salvage is not None:
+            raws = [raw for _, raw in self._salvage.messages]
+            for k in range(0, len(raws), size):
+                yield raws[k : k + size]
+            msg = (
+                f"{self.path}: damaged ({self._salvage.damage}); the {len(raws)} messages of "
+                f"{self.topic} before the damage were replayed"
+            )
+            raise DamagedBagError(msg)
         chunk: list[bytes] = []
-        for _, _, raw in self._reader.messages(connections=self._conns):
+        done = 0
+        messages = self._reader.messages(connections=self._conns)
+        while True:
+            try:
+                _, _, raw = next(messages)
+            except StopIteration:
+                break
+            except Exception as err:  # rosbags' readers raise their own types on damage
+                if chunk:
+                    yield chunk
+                msg = (
+                    f"{self.path}: damaged after {done + len(chunk)} of {self.count} messages "
+                    f"of {self.topic}: {err}"
+                )
+                raise DamagedBagError(msg) from err
             chunk.append(self._ros1_to_cdr(raw) if self.ros1 else raw)
             if len(chunk) == size:
                 yield chunk
+                done += size
                 chunk = []
         if chunk:
             yield chunk
@@ -136,7 +186,8 @@ class InputBag:
 
     def close(self) -> None:
         """Close the bag."""
-        self._reader.close()
+        if self._salvage is None:
+            self._reader.close()
 
     def __enter__(self) -> InputBag:
         return self
@@ -150,6 +201,10 @@ class InputBag:
 def _vector3(v: Any) -> Any:
     """A geometry_msgs/Vector3 of the ROS 2 typestore with v's x, y, z."""
     return TYPESTORE.types["geometry_msgs/msg/Vector3"](x=v.x, y=v.y, z=v.z)
+
+
+PARTIAL_KEY = "mount_twin.partial"
+"""custom_data key in an output bag's metadata.yaml present when the bag stops early."""
 
 
 class OutputBag:
@@ -183,11 +238,30 @@ class OutputBag:
             for topic, msgtype in topics.items()
         }
         self.written = 0
+        self.last_stamp_ns: int | None = None
+        self.partial: str | None = None
+        """Why the bag is partial (then recorded in its metadata), or None: complete."""
 
     def write(self, topic: str, stamp_ns: int, raw: bytes | memoryview) -> None:
-        """Write one serialized message."""
-        self._writer.write(self._conns[topic], stamp_ns, raw)
+        """Write one serialized message; a failed write names the bag."""
+        try:
+            self._writer.write(self._conns[topic], stamp_ns, raw)
+        except OSError as err:
+            msg = f"{self.path}: cannot write: {err.strerror or err}"
+            raise BagError(msg) from err
         self.written += 1
+        self.last_stamp_ns = stamp_ns
+
+    def mark_partial(self, reason: str) -> None:
+        """Record in the bag's metadata (custom_data `mount_twin.partial`, which `ros2 bag
+        info` shows) that it stops early, why, and at which stamp."""
+        upto = (
+            "nothing written"
+            if self.last_stamp_ns is None
+            else (f"outputs up to stamp {self.last_stamp_ns} ns")
+        )
+        self.partial = f"{reason}; {upto}"
+        self._writer.set_custom_data(PARTIAL_KEY, self.partial)
 
     def close(self) -> None:
         """Finish the bag (writes its metadata)."""
@@ -199,6 +273,8 @@ class OutputBag:
     def __exit__(
         self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None
     ) -> None:
+        if et is not None and self.partial is None:  # stopped by an error or a signal
+            self.mark_partial(f"stopped by {et.__name__}" + (f": {ev}" if str(ev) else ""))
         self.close()
 
 
