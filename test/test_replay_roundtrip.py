@@ -265,8 +265,8 @@ def test_wrong_input_topic_names_the_bag_and_the_topic(
     scene = scene_with(_scene(), input={"topic": "/imu/data"})
     with pytest.raises(
         BagError,
-        match=rf"{bags['in_mcap']}: no topic '/imu/data' \(input\.topic\); "
-        r"the bag has: /deck/imu \(sensor_msgs/msg/Imu\)",
+        match=rf"{bags['in_mcap']}: no topic '/imu/data' \(input\.topic; `replay --topic` "
+        r"overrides it\); the bag has: /deck/imu \(sensor_msgs/msg/Imu, 500 messages\)",
     ):
         replay(scene, bags["in_mcap"], tmp_path / "out", progress=False)
     assert not (tmp_path / "out").exists(), "no output bag may be left behind"

@@ -327,7 +327,7 @@ def test_parameters_are_all_set_described_and_read_only() -> None:
         (["-p", "outputs.decimaton:=2"], "outputs.decimaton: unknown key"),
         ([], "mount_names: required parameter is missing"),
         (["-p", "scene_file:=/nonexistent.yaml"], "/nonexistent.yaml: <file>: cannot read"),
-        (["-p", "input.topic:=/deck//imu"], "input.topic: Invalid topic name"),
+        (["-p", "input.topic:=/deck//imu"], "input.topic: '/deck//imu' is not a ROS topic name"),
         (["-p", "batch_period_s:=-1.0"], "batch_period_s: must be in [0.0, 1.0]"),
         (
             ["-p", f"scene_file:={GENSET}", "-p", "body.mass:=heavy"],

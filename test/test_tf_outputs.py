@@ -312,7 +312,7 @@ def _scene_file_with(tmp_path: Path, section: str, key: str, value: Any) -> Path
     [
         ("frames", "mount_prefix", 5, r"expected a string, got 5"),
         ("frames", "mount_prefix", ["a"], r"expected a string"),
-        ("frames", "mount_prefix", "/pump/", r"cannot start with '/'"),
+        ("frames", "mount_prefix", "/pump/", r"no leading '/'"),
         ("outputs", "tf", "yes", r"expected true or false, got 'yes'"),
         ("outputs", "tf", 1, r"expected true or false, got 1"),
     ],

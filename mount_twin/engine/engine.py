@@ -71,6 +71,9 @@ READING_LIMIT = 1e150
 """Largest |component| of an accepted reading, m/s² or rad/s: a larger one (a garbled message) is
 rejected as non_finite, and the rotation into F cannot overflow."""
 
+SAG_WARN_M = 0.1
+"""A start state this far (m) from the reference pose is reported: mounts sag millimetres."""
+
 MAX_EVENTS = 100_000
 """Mount events kept in TwinEngine.events (later ones are counted only)."""
 
@@ -663,7 +666,6 @@ class TwinEngine:
         self.counts["starts"] += 1
         stamp = float(stamps[i])
         f0 = gathered.mean(axis=0)
-        self._check_start(stamp, f0, gathered)
         self._y = self._y_nominal.copy()
         if damage is not None:  # a machine is not re-bolted by a restart
             self._y[2 * len(self.scene.dofs) :] = damage
@@ -679,6 +681,7 @@ class TwinEngine:
                     f"no static equilibrium under the start specific force "
                     f"{np.linalg.norm(f0):.4g} m/s²: started from rest under nominal gravity",
                 )
+        self._check_start(stamp, f0, gathered)
         self.stepper.reset()
         self._peak[:] = 0.0
         self._counter[0] = 0
@@ -688,7 +691,8 @@ class TwinEngine:
 
     def _check_start(self, stamp: float, f0: np.ndarray, gathered: np.ndarray) -> None:
         """Start checks on the start specific force f0 (m/s², F) and the samples it is the mean
-        of: its magnitude against g, its angle from +z of F, and their spread (at rest?)."""
+        of: its magnitude against g, its angle from +z of F, their spread (at rest?), and the
+        start state's sag from the reference pose (SAG_WARN_M: units?)."""
         spec, init = self.scene.input, self.scene.initial
         g, magnitude = spec.g, float(np.linalg.norm(f0))
         tilt = math.atan2(math.hypot(f0[0], f0[1]), f0[2])
@@ -715,6 +719,22 @@ class TwinEngine:
                     ERROR if tilt > 3.0 * init.tilt_tolerance_rad else WARN,
                     f"start specific force is {math.degrees(tilt):.1f}° from +z of F "
                     "(is input.sensor_rpy right?)",
+                )
+            )
+        sag = max(
+            (
+                abs(float(self._y[k]))
+                for k, d in enumerate(self.scene.dofs)
+                if d in ("x", "y", "z")
+            ),
+            default=0.0,
+        )
+        if sag > SAG_WARN_M:
+            notes.append(
+                (
+                    WARN,
+                    f"the body starts {sag:.3g} m from its reference pose: a static sag that "
+                    "large is implausible on mounts (stiffness in N/mm? mass in g?)",
                 )
             )
         if spread > init.gravity_tolerance * g:

@@ -208,5 +208,27 @@ def static_equilibrium(
             f"rounding allows {allowed[worst]:.3g}): check that the mounts hold every free DOF"
         )
         raise ModelError(msg)
+    _check_restrained(model, sol.jac)
     y[:nf] = sol.x
     return y.copy()
+
+
+def _check_restrained(model: Model, jac: np.ndarray) -> None:
+    """Refuse a free DOF that no mount holds: the equilibrium's stiffness, ∂(generalized
+    accelerations)/∂q, is then singular, and the body would drift under any input along it.
+    The message names the DOF that dominates the unrestrained direction."""
+    nf = jac.shape[0]
+    scale = np.abs(jac).max()
+    if not np.isfinite(scale) or scale == 0.0:
+        free = ", ".join(model.scene.dofs)
+        msg = f"{model.scene.source}: no mount holds the body: DOFs {free} are free"
+        raise ModelError(msg)
+    _, sigma, vt = np.linalg.svd(jac / scale)
+    if sigma[-1] < 1e-9 * sigma[0] * max(nf, 1):
+        dof = model.scene.dofs[int(np.argmax(np.abs(vt[-1])))]
+        msg = (
+            f"{model.scene.source}: DOF {dof} is not held by any mount (the mounts' stiffness "
+            "has no component along it at the static equilibrium): give a mount stiffness "
+            f"there, or leave {dof} out of `dofs`"
+        )
+        raise ModelError(msg)

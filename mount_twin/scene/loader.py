@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -23,14 +24,24 @@ from mount_twin.scene.description import (
     Mount,
     Outputs,
     Scene,
+    Vec3,
+    Vec6,
 )
 from mount_twin.scene.reader import Reader
+from mount_twin.scene.yaml_reading import SceneYamlError, load_yaml
 
 INPUT_TYPES = ("sensor_msgs/msg/Imu", "geometry_msgs/msg/AccelStamped")
 START_TILT_MAX_RAD = 1.55
 """Largest tilt θ of a given start pose, rad (88.8°): the chart degenerates at π/2."""
 
 MOUNT_KINDS = ("linear", *KINDS)
+MAX_MOUNTS = 1000
+"""Most mounts a scene takes (a machine has a few dozen; more is generated garbage)."""
+REACH_M = 1000.0
+"""Largest |coordinate| of a position, m: a machine on a deck spans metres (mm, more likely)."""
+ANGLE_LIMIT_RAD = 2.0 * math.pi
+"""Largest |angle| of an orientation or start pose, rad: beyond one turn it is degrees."""
+TOPIC_TOKEN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 STEPPERS = tuple(METHODS)
 
 
@@ -43,9 +54,11 @@ def read_scene_yaml(path: str | Path) -> Any:
     """The YAML document of a scene file, unvalidated; errors name the file."""
     path = Path(path)
     try:
-        return yaml.safe_load(path.read_text(encoding="utf-8"))
+        return load_yaml(path.read_text(encoding="utf-8"))
     except OSError as err:
         raise SceneError(str(path), "<file>", f"cannot read: {err.strerror}") from err
+    except SceneYamlError as err:
+        raise SceneError(str(path), "<file>", str(err)) from err
     except yaml.YAMLError as err:
         raise SceneError(str(path), "<file>", f"not valid YAML: {err}") from err
 
@@ -71,6 +84,8 @@ def scene_from_dict(
     mounts_raw = top.raw("mounts")
     if not isinstance(mounts_raw, list) or not mounts_raw:
         raise top.error("mounts", f"expected a non-empty list of mounts, got {mounts_raw!r}")
+    if len(mounts_raw) > MAX_MOUNTS:
+        raise top.error("mounts", f"{len(mounts_raw)} mounts: at most {MAX_MOUNTS} are accepted")
     paths = mount_paths or [f"mounts[{i}]" for i in range(len(mounts_raw))]
     mounts = tuple(
         _mount(Reader(m, source, path, record=record))
@@ -98,7 +113,7 @@ def scene_from_dict(
 
 def _body(r: Reader) -> Body:
     mass = r.positive("mass")
-    cg = r.vector("cg", 3)
+    cg = _position(r, "cg")
     inertia = r.vector("inertia", 6)
     ixx, iyy, izz, ixy, ixz, iyz = inertia
     tensor = [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]
@@ -137,10 +152,10 @@ def _dofs(top: Reader) -> tuple[str, ...]:
 def _mount(r: Reader) -> Mount:
     kind = r.choice("kind", MOUNT_KINDS, "linear")
     name = r.string("name")
-    if not name or not name.replace("_", "a").isalnum() or name[0].isdigit():
+    if not TOPIC_TOKEN.match(name):  # ASCII only: str.isalnum() takes "x²"
         raise r.error("name", f"must be a ROS name token (letters, digits, _), got {name!r}")
-    position = r.vector("position", 3)
-    rpy = r.vector("orientation_rpy", 3, (0.0, 0.0, 0.0))
+    position = _position(r, "position")
+    rpy = _angles(r, "orientation_rpy", (0.0, 0.0, 0.0))
     if kind == "linear":
         mount: Mount = LinearMount(
             name=name,
@@ -158,14 +173,55 @@ def _mount(r: Reader) -> Mount:
     return mount
 
 
+def _position(r: Reader, key: str, default: Vec3 | None = None) -> Vec3:
+    """A point in F, m, within REACH_M of the origin."""
+    p = r.vector(key, 3, default)
+    if max(abs(v) for v in p) > REACH_M:
+        raise r.error(key, f"{list(p)} m is more than {REACH_M:g} m from F's origin: millimetres?")
+    return p
+
+
+def _angles(r: Reader, key: str, default: Vec3 | None = None) -> Vec3:
+    """Roll, pitch, yaw, rad, within one turn."""
+    a = r.vector(key, 3, default)
+    if max(abs(v) for v in a) > ANGLE_LIMIT_RAD:
+        raise r.error(key, f"{list(a)} exceeds 2π: angles are in radians, not degrees")
+    return a
+
+
+def _topic(r: Reader, key: str, default: str) -> str:
+    """A ROS 2 topic name: '/'-separated tokens of letters, digits and _ (not starting with a
+    digit), absolute, relative or private (~/), as rclpy's validate_full_topic_name takes."""
+    name = r.string(key, default)
+    body = name[2:] if name.startswith("~/") else name.removeprefix("/")
+    tokens = body.split("/")
+    if not name or name.endswith("/") or not all(TOPIC_TOKEN.match(t) for t in tokens):
+        raise r.error(
+            key,
+            f"{name!r} is not a ROS topic name ('/'-separated tokens of letters, digits and "
+            "_, not starting with a digit)",
+        )
+    return name
+
+
+def _frame_id(r: Reader, key: str, default: str, *, empty_ok: bool = False) -> str:
+    """A tf2 frame id: no whitespace, no leading '/' (empty only where it means 'any')."""
+    frame = r.string(key, default)
+    if (not frame and not empty_ok) or any(c.isspace() for c in frame) or frame.startswith("/"):
+        raise r.error(
+            key, f"{frame!r} is not a tf2 frame id (non-empty, no whitespace, no leading '/')"
+        )
+    return frame
+
+
 def _input(r: Reader) -> InputSpec:
     d = InputSpec()
     spec = InputSpec(
         msg_type=r.choice("msg_type", INPUT_TYPES, d.msg_type),
-        topic=r.string("topic", d.topic),
-        frame_id=r.string("frame_id", d.frame_id),
-        sensor_rpy=r.vector("sensor_rpy", 3, d.sensor_rpy),
-        sensor_position=r.vector("sensor_position", 3, d.sensor_position),
+        topic=_topic(r, "topic", d.topic),
+        frame_id=_frame_id(r, "frame_id", d.frame_id, empty_ok=True),
+        sensor_rpy=_angles(r, "sensor_rpy", d.sensor_rpy),
+        sensor_position=_position(r, "sensor_position", d.sensor_position),
         includes_gravity=r.boolean("includes_gravity", d.includes_gravity),
         g=r.number("g", d.g, lo=0.0),
         hold=r.choice("hold", ("first_order", "zero_order"), d.hold),
@@ -181,12 +237,20 @@ def _input(r: Reader) -> InputSpec:
     return spec
 
 
+def _pose(r: Reader, key: str, default: Vec6) -> Vec6:
+    """(X, Y, Z) m and (α, γ, δ) rad, in range like positions and angles."""
+    pose = r.vector(key, 6, default)
+    if max(abs(v) for v in pose[:3]) > REACH_M or max(abs(v) for v in pose[3:]) > ANGLE_LIMIT_RAD:
+        raise r.error(key, f"{list(pose)}: positions beyond {REACH_M:g} m or angles beyond 2π")
+    return pose
+
+
 def _initial(r: Reader) -> InitialState:
     d = InitialState()
     state = InitialState(
         mode=r.choice("mode", ("equilibrium", "given"), d.mode),
         gravity=r.choice("gravity", ("first_sample", "nominal"), d.gravity),
-        pose=r.vector("pose", 6, d.pose),
+        pose=_pose(r, "pose", d.pose),
         velocity=r.vector("velocity", 6, d.velocity),
         gravity_samples=r.integer("gravity_samples", d.gravity_samples, lo=1),
         gravity_tolerance=r.positive("gravity_tolerance", d.gravity_tolerance),
@@ -235,14 +299,9 @@ def _outputs(r: Reader) -> Outputs:
 def _frames(r: Reader) -> Frames:
     d = Frames()
     frames = Frames(
-        foundation=r.string("foundation", d.foundation),
-        body=r.string("body", d.body),
-        mount_prefix=r.string("mount_prefix", d.mount_prefix),
+        foundation=_frame_id(r, "foundation", d.foundation),
+        body=_frame_id(r, "body", d.body),
+        mount_prefix=_frame_id(r, "mount_prefix", d.mount_prefix, empty_ok=True),
     )
-    if frames.mount_prefix.startswith("/"):
-        # tf2 rejects frame ids with a leading slash: RViz could not place any mount frame
-        raise r.error(
-            "mount_prefix", f"tf2 frame ids cannot start with '/', got {frames.mount_prefix!r}"
-        )
     r.finish()
     return frames

@@ -14,6 +14,13 @@ Vec6 = tuple[float, float, float, float, float, float]
 """Six floats: what `Reader.vector(key, 6)` returns."""
 
 
+NUMBER_LIMIT = 1e15
+"""Largest |number| a scene takes (SI: a bolt's stiffness is ~1e9 N/m); more is a unit error or
+garbage, refused with its key path before it can overflow anything."""
+INTEGER_LIMIT = 10**9
+"""Largest integer a scene takes (decimation, substeps, sample counts)."""
+
+
 class Reader:
     """A view of one mapping in a scene document.
 
@@ -94,13 +101,15 @@ class Reader:
         """A finite float > 0."""
         return self.number(key, default, lo=0.0, lo_open=True)
 
-    def integer(self, key: str, default: int | None = None, *, lo: int = 0) -> int:
-        """An integer ≥ lo."""
+    def integer(
+        self, key: str, default: int | None = None, *, lo: int = 0, hi: int = INTEGER_LIMIT
+    ) -> int:
+        """An integer in [lo, hi]."""
         value = self.raw(key, default)
         if isinstance(value, bool) or not isinstance(value, int):
             raise self.error(key, f"expected an integer, got {value!r}")
-        if value < lo:
-            raise self.error(key, f"must be ≥ {lo}, got {value}")
+        if not lo <= value <= hi:
+            raise self.error(key, f"must be in [{lo}, {hi}], got {value}")
         return value
 
     def boolean(self, key: str, default: bool | None = None) -> bool:
@@ -182,6 +191,10 @@ class Reader:
         value = float(value)
         if not math.isfinite(value):
             raise self.error(key, f"must be finite, got {value!r}")
+        if abs(value) > NUMBER_LIMIT:
+            raise self.error(
+                key, f"{value!r} is beyond {NUMBER_LIMIT:g}: no quantity of a scene is (units?)"
+            )
         if value < lo or value > hi or (lo_open and value == lo):
             low = "(" if lo_open else "["
             raise self.error(key, f"must be in {low}{lo}, {hi}], got {value!r}")

@@ -25,9 +25,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
-from mount_twin.errors import SceneError
 from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
 from mount_twin.scene.reader import Reader
 
@@ -69,12 +67,7 @@ def load_sweep(path: str | Path) -> SweepSpec:
     """Read and validate a sweep file; errors name the file and key path (and a variation that
     makes no valid scene, with the scene's own error)."""
     path = Path(path)
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except OSError as err:
-        raise SceneError(str(path), "<file>", f"cannot read: {err.strerror}") from err
-    except yaml.YAMLError as err:
-        raise SceneError(str(path), "<file>", f"not valid YAML: {err}") from err
+    data = read_scene_yaml(path)  # the same YAML rules as scene files
     top = Reader(data, str(path))
     base_path = (path.parent / top.string("base")).resolve()
     base = read_scene_yaml(base_path)
