@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import signal
 import sys
 import threading
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Protocol, cast
 
-from mount_twin.commands import COMMANDS
+from mount_twin.commands import COMMANDS, stopping
 from mount_twin.errors import DamagedBagError, MountTwinError, Terminated
 
 
@@ -80,16 +79,15 @@ input damaged part-way (what came before it was processed), 128 + the signal's n
 stopped by SIGINT (Ctrl-C) or SIGTERM (output bags are finished and marked partial)."""
 
 
-def _terminate(signum: int, frame: object) -> None:
-    raise Terminated
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point; returns the exit status (see EXIT_*; 2: bad input or configuration)."""
     parser, modules = build_parser()
     args = parser.parse_args(argv)
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _terminate)
+        # A command that polls `checkpoint` (replay) stops between chunks, so that a signal
+        # never lands inside the writing of a bag; others stop at once.
+        polls = getattr(modules[args.cmd], "STOPS_AT_CHECKPOINTS", False)
+        stopping.install(polls)
     try:
         return modules[args.cmd].run(args)
     except DamagedBagError as err:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -160,6 +160,7 @@ def replay(
     *,
     chunk: int = 2000,
     progress: bool = True,
+    checkpoint: Callable[[], None] | None = None,
 ) -> ReplaySummary:
     """Replay `input_path`'s scene.input.topic into a new mcap bag at `output_path`.
 
@@ -167,7 +168,9 @@ def replay(
     frames on /tf_static once, before anything else, stamped with the first decodable input
     stamp and offered latched (`LATCHED_QOS`) so `ros2 bag play` republishes it to late
     subscribers. Both bags are checked before the kernels load (a first run compiles them:
-    with `progress`, `kernels_loading` says so on stderr).
+    with `progress`, `kernels_loading` says so on stderr). `checkpoint` is called between
+    chunks, where stopping is safe: it may raise to stop the replay (a signal noted by the
+    command line), and the output bag is then finished and marked partial.
     """
     bag = InputBag(input_path, scene.input.topic, scene.input.msg_type)
     try:
@@ -194,6 +197,8 @@ def replay(
         tqdm(total=bag.count, unit="msg", disable=not progress, desc="replay", leave=False) as bar,
     ):
         for raws in bag.chunks(chunk):
+            if checkpoint is not None:
+                checkpoint()
             if static_due:
                 stamp0 = _first_stamp(raws, scene.input.msg_type)
                 if stamp0 is not None:

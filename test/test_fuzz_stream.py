@@ -124,6 +124,8 @@ def test_damaged_cdr_bytes_are_counted_never_raised(damage, sizes) -> None:
     rng = np.random.default_rng(len(damage))
     for at, how, byte in damage:
         raw = raws[at]
+        if not raw:  # truncated to nothing by an earlier change
+            continue
         if how == "flip":
             raw[byte % len(raw)] ^= 0xFF
         elif how == "truncate":

@@ -9,6 +9,7 @@ from mount_twin.commands.replay import add_plot_argument, replay_and_report
 
 NAME = "demo"
 HELP = "replay the bundled bag through the bundled default scene"
+STOPS_AT_CHECKPOINTS = True
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

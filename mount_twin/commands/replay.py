@@ -12,6 +12,8 @@ if TYPE_CHECKING:
 
 NAME = "replay"
 HELP = "replay a bag through the twin into an mcap bag"
+STOPS_AT_CHECKPOINTS = True
+"""SIGINT and SIGTERM stop the replay between chunks (mount_twin.commands.stopping)."""
 FAIL_ON = ("never", "warn", "error")
 """`--fail-on` choices; the index of warn and error is their diagnostics level."""
 
@@ -78,7 +80,9 @@ def replay_and_report(
         scene = scene_from_dict(data, f"{scene_path} (with --topic/--frame-id)")
     else:
         scene = load_scene_file(scene_path)
-    summary = replay(scene, bag, output, chunk=chunk, progress=progress)
+    from mount_twin.commands.stopping import checkpoint
+
+    summary = replay(scene, bag, output, chunk=chunk, progress=progress, checkpoint=checkpoint)
     print(summary.text())
     if plot:
         from mount_twin.plot import plot_output_bag  # matplotlib only when asked for
