@@ -153,7 +153,7 @@ def test_every_option_with_a_default_says_it_in_help() -> None:
     parser, _ = build_parser()
     (sub,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
     for name, command in sub.choices.items():
-        text = command.format_help()
+        text = " ".join(command.format_help().split())  # unwrapped
         for action in command._actions:
             has_default = action.default not in (None, False, argparse.SUPPRESS, 0, 0.0)
             if action.option_strings and has_default and not action.required:
