@@ -22,6 +22,7 @@ COMMANDS = (
     "import_csv",
     "export",
     "report",
+    "srs",
     "accuracy",
     "sweep",
     "show",
