@@ -23,6 +23,7 @@ COMMANDS = (
     "export",
     "report",
     "srs",
+    "modes",
     "accuracy",
     "sweep",
     "show",
