@@ -80,6 +80,7 @@ class ReplaySummary:
     utilisation_max: dict[str, float] = field(default_factory=dict)
     origin_s: int = 0  # whole seconds to add to event stamps to get header stamps
     wrong_frame_id: str | None = None  # the last header.frame_id rejected as wrong, if any
+    start_s: float = 0.0  # engine seconds of the first output (event times count from it)
 
     @property
     def worst_level(self) -> int:
@@ -127,6 +128,46 @@ class ReplaySummary:
             f"    {LEVEL_NAMES[s.level]:5} {s.name}: {s.message}" for s in self.worst.values()
         ]
         return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, object]:
+        """The summary as JSON-ready data, units in the key names; event times `t_s` count
+        from the first output, `stamp_s` are header stamps."""
+        util = self.utilisation_max
+        return {
+            "input_bag": self.input_bag,
+            "output_bag": self.output_bag,
+            "verdict": LEVEL_NAMES[self.worst_level],
+            "counts": dict(self.counts),
+            "stamp_span_s": self.stamp_span_s,
+            "wall_s": self.wall_s,
+            "real_time_factor": self.real_time_factor,
+            "max_cg_displacement_m": self.displacement_max_m,
+            "max_tilt_rad": self.tilt_max_rad,
+            "mounts": {
+                name: {
+                    "peak_force_N": [float(v) for v in peak[:3]],
+                    "peak_couple_Nm": [float(v) for v in peak[3:]],
+                    "utilisation_max": util.get(name),
+                }
+                for name, peak in self.peak_wrench.items()
+            },
+            "events": [
+                {
+                    "mount": e.mount,
+                    "event": e.event,
+                    "level": "ERROR" if e.error else "WARN",
+                    "t_s": e.stamp - self.start_s,
+                    "stamp_s": self.origin_s + e.stamp,
+                    "force_N": e.force,
+                }
+                for e in self.events
+            ],
+            "diagnostics_worst": {
+                name: {"level": LEVEL_NAMES[st.level], "message": st.message}
+                for name, st in self.worst.items()
+            },
+            "accuracy": "not estimated live; `mount-twin accuracy SCENE BAG` measures it",
+        }
 
 
 def _keep_worst(worst: dict[str, HealthStatus], report: HealthReport) -> None:
@@ -241,4 +282,5 @@ def replay(
         stream.engine.utilisation_max,
         stream.engine.health.origin_s,
         stream.engine.health.last_wrong_frame_id,
+        float(first_stamp) if first_stamp is not None else 0.0,
     )

@@ -55,3 +55,22 @@ def test_a_bag_without_outputs_is_refused_naming_it(
     bag = ROOT / "bags" / "ship_motion_1khz"  # an input bag: no output in it
     assert main(["export", str(bag), "--csv", str(tmp_path)]) == 2
     assert f"{bag}: no mount_twin output in the bag" in capsys.readouterr().err
+
+
+def test_replay_json_summary_times_events_from_the_first_output(tmp_path: Path) -> None:
+    import json
+
+    out, summary_file = tmp_path / "g", tmp_path / "g.json"
+    args = ["replay", str(ROOT / "bags" / "genset_shock_10khz"), "--scene"]
+    args += [str(CONFIG / "genset_bolted_keyed.scene.yaml"), "-o", str(out), "--no-progress"]
+    assert main([*args, "--json", str(summary_file)]) == 0
+    doc = json.loads(summary_file.read_text(encoding="utf-8"))
+    _, msgs = read_bag(out)
+    first = msgs["/mount_twin/pose"][0][1].header.stamp
+    first_s = first.sec + first.nanosec * 1e-9
+    assert doc["verdict"] == "ERROR" and doc["events"]
+    for e in doc["events"]:
+        assert e["t_s"] == pytest.approx(e["stamp_s"] - first_s, abs=1e-6)
+    assert doc["counts"]["accepted"] == 2500
+    fz = max(abs(m.wrench.force.z) for _, m in msgs["/mount_twin/mounts/foot_fl/wrench"])
+    assert abs(doc["mounts"]["foot_fl"]["peak_force_N"][2]) == pytest.approx(fz, rel=1e-12)

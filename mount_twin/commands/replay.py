@@ -30,6 +30,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--chunk", type=int, default=2000, help="messages per engine batch")
     parser.add_argument("--no-progress", action="store_true")
     add_plot_argument(parser)
+    parser.add_argument("--json", metavar="FILE", help="also write the summary as JSON")
     parser.add_argument(
         "--fail-on",
         choices=FAIL_ON,
@@ -55,6 +56,7 @@ def run(args: argparse.Namespace) -> int:
         args.plot,
         args.fail_on,
         overrides,
+        args.json,
     )
 
 
@@ -67,6 +69,7 @@ def replay_and_report(
     plot: str | None,
     fail_on: str,
     input_overrides: dict[str, str] | None = None,
+    json_path: str | None = None,
 ) -> int:
     """Replay, print the summary (and plot), and return the exit status (see `verdict`).
     `input_overrides`: scene `input` fields replaced (topic, frame_id), checked like the
@@ -84,6 +87,11 @@ def replay_and_report(
 
     summary = replay(scene, bag, output, chunk=chunk, progress=progress, checkpoint=checkpoint)
     print(summary.text())
+    if json_path:
+        import json
+
+        Path(json_path).write_text(json.dumps(summary.to_dict(), indent=2), encoding="utf-8")
+        print(f"json: {json_path}")
     if plot:
         from mount_twin.plot import plot_output_bag  # matplotlib only when asked for
 
