@@ -56,6 +56,7 @@ def test_the_page_is_self_contained_with_plots_tables_and_names(
     assert len(re.findall(r'src="data:image/png;base64,', text)) >= 4
     assert 'src="http' not in text and "<script" not in text  # one file, nothing fetched
     assert "Around the first event: foot_" in text and "joint_opened" in text
+    assert "Shock response spectra of the input" in text and "Modes (about the static" in text
     # The peak table holds each mount's largest |F| of the bag.
     _, msgs = read_bag(out)
     fz = max(abs(m.wrench.force.z) for _, m in msgs["/mount_twin/mounts/foot_fl/wrench"])

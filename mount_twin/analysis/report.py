@@ -102,6 +102,76 @@ def _table(head: list[str], rows: list[list[str]]) -> str:
     return f"<table><tr>{cells}</tr>{body}</table>"
 
 
+def _srs_section(stamps_ns: np.ndarray, f: np.ndarray) -> list[str]:
+    """The input's shock response spectra (5 % damping, first sample removed), per axis of F."""
+    from mount_twin.analysis.srs import octave_frequencies, srs
+
+    t = (stamps_ns - stamps_ns[0]) * 1e-9
+    rate = (len(t) - 1) / float(t[-1]) if len(t) > 1 and t[-1] > 0 else 0.0
+    if rate <= 0.0:
+        return []
+    freqs = octave_frequencies(5.0, min(2000.0, rate / 10.0), 6)
+    spectra = {axis: srs(f[:, k] - f[0, k], rate, freqs, 0.05) for k, axis in enumerate("xyz")}
+
+    def draw(fig: Any) -> None:
+        ax = fig.subplots()
+        for axis, s in spectra.items():
+            if s.maximax.max() > 0.0:
+                ax.loglog(s.frequency_hz, s.maximax / 9.80665, label=f"maximax, {axis} of F")
+        ax.set_xlabel("natural frequency [Hz]")
+        ax.set_ylabel("peak absolute acceleration [g]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+
+    z = spectra["z"]
+    rows = [
+        [
+            f"{fk:.4g}",
+            *(f"{spectra[a].maximax[k] / 9.80665:.4g}" for a in "xyz"),
+            f"{z.pseudo_velocity[k]:.4g}",
+        ]
+        for k, fk in enumerate(freqs)
+        if k % 3 == 0
+    ]
+    return [
+        "<h2>Shock response spectra of the input (ζ = 5 %, first sample removed)</h2>",
+        _png(draw, (9, 4.5)),
+        _table(["f Hz", "x g", "y g", "z g", "PV z m/s"], rows),
+    ]
+
+
+def _modes_section(scene: Scene) -> list[str]:
+    """The scene's modes about its static equilibrium."""
+    from mount_twin.analysis.modes import modes
+
+    try:
+        result = modes(scene)
+    except Exception as err:  # a scene the modal analysis cannot linearise: said, not fatal
+        return ["<h2>Modes</h2>", f"<p>not computed: {html.escape(str(err))}</p>"]
+    rows = []
+    for i, m in enumerate(result.modes, 1):
+        main_dof = max(m.energy_fraction, key=lambda d: m.energy_fraction[d])
+        rows.append(
+            [
+                str(i),
+                f"{m.frequency_hz:.4g}",
+                f"{100 * m.damping_ratio:.2f}",
+                f"{main_dof} {100 * m.energy_fraction[main_dof]:.0f} %",
+                *(f"{m.effective_mass_kg.get(a, 0.0):.4g}" for a in "xyz"),
+            ]
+        )
+    head = [
+        "mode",
+        "f Hz",
+        "ζ %",
+        "dominant DOF (energy)",
+        "m_eff x kg",
+        "m_eff y kg",
+        "m_eff z kg",
+    ]
+    return ["<h2>Modes (about the static equilibrium)</h2>", _table(head, rows)]
+
+
 def write_report(
     output_bag: str | Path,
     html_path: str | Path,
@@ -206,6 +276,10 @@ def write_report(
             ax.legend(fontsize=7, ncol=3)
 
         sections += ["<h2>Utilisation</h2>", _png(util, (10, 4))]
+    if input_samples is not None:
+        sections += _srs_section(*input_samples)
+    if scene is not None:
+        sections += _modes_section(scene)
     rows = []
     for name, table in mounts.items():
         c = table.columns
