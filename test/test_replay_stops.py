@@ -10,6 +10,7 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -70,14 +71,19 @@ def test_a_signal_leaves_a_readable_bag_marked_partial(
     assert 0 < n < 120_000 * 10  # readable, and stopped early
 
 
-def test_a_truncated_mcap_is_replayed_up_to_the_damage(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    bag = tmp_path / "cut"
+def _cut_copy(bag: Path, keep: Callable[[int], int]) -> Path:
+    """A copy of the ship-motion bag at `bag` whose mcap keeps its first keep(size) bytes."""
     shutil.copytree(ROOT / "bags" / "ship_motion_1khz", bag)
     (mcap,) = bag.glob("*.mcap")
     data = mcap.read_bytes()
-    mcap.write_bytes(data[: int(len(data) * 0.6)])  # a recorder killed mid-write
+    mcap.write_bytes(data[: keep(len(data))])
+    return bag
+
+
+def test_a_truncated_mcap_is_replayed_up_to_the_damage(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag = _cut_copy(tmp_path / "cut", lambda n: int(n * 0.6))  # a recorder killed mid-write
     out = tmp_path / "out"
     assert main(["replay", str(bag), "--scene", PUMP, "-o", str(out), "--no-progress"]) == 5
     err = capsys.readouterr().err
@@ -92,9 +98,6 @@ def test_a_truncated_mcap_is_replayed_up_to_the_damage(
 def test_an_mcap_cut_before_any_message_is_an_error_naming_it(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    bag = tmp_path / "stub"
-    shutil.copytree(ROOT / "bags" / "ship_motion_1khz", bag)
-    (mcap,) = bag.glob("*.mcap")
-    mcap.write_bytes(mcap.read_bytes()[:43])
+    bag = _cut_copy(tmp_path / "stub", lambda n: 43)
     assert main(["replay", str(bag), "--scene", PUMP, "-o", str(tmp_path / "o")]) == 2
     assert f"{bag}: cannot open bag" in capsys.readouterr().err
