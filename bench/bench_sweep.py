@@ -3,8 +3,8 @@ and with two workers, against a loop of `mount-twin replay` processes over the s
 
     python3 bench/bench_sweep.py [--cases-cli 4]
 
-The sweep: the bundled pump, mount stiffness × 0.5 … 2 (8 values) × mass 1000 … 1350 kg (8),
-against the bundled 0.4 s, 10 kHz half-sine bag: 64 cases. The CLI loop replays the first
+The sweep: the bundled pump, mount stiffness × 0.5 … 2 (8 values) × mass 1000 … 1387.5 kg (32),
+against the bundled 0.4 s, 10 kHz half-sine bag: 256 cases. The CLI loop replays the first
 `--cases-cli` of them, each from its own scene file, writing its output bag as `replay` does.
 """
 
@@ -26,7 +26,7 @@ from mount_twin.sweeps.runner import run_sweep
 from mount_twin.sweeps.spec import load_sweep
 
 SCALES = [0.5, 0.6, 0.75, 0.9, 1.1, 1.3, 1.6, 2.0]
-MASSES = [1000.0, 1050.0, 1100.0, 1150.0, 1200.0, 1250.0, 1300.0, 1350.0]
+MASSES = [1000.0 + 12.5 * k for k in range(32)]
 
 
 def main() -> None:

@@ -35,6 +35,9 @@ from mount_twin.sweeps.cases import Case, apply, expand
 from mount_twin.sweeps.spec import InputCase, SweepSpec
 
 FAILED = "FAILED"
+BATCHES_PER_WORKER = 4
+"""Tasks per worker a sweep is cut into: few enough to share the scheduling cost, enough to
+balance the load and to report progress."""
 START_NS = 1_700_000_000_000_000_000
 """First stamp of a generated input, as `mount-twin generate` writes it."""
 
@@ -98,6 +101,11 @@ def run_case(base: dict[str, Any], source: str, case: Case) -> dict[str, Any]:
         row.update(verdict=FAILED, error=f"{type(err).__name__}: {err}")
     row["wall_s"] = time.perf_counter() - t0
     return row
+
+
+def run_cases(base: dict[str, Any], source: str, cases: list[Case]) -> list[dict[str, Any]]:
+    """`run_case` of each case, in order (one Dask task)."""
+    return [run_case(base, source, case) for case in cases]
 
 
 def _figures(scene: Scene, samples: SampleBatch) -> dict[str, Any]:
@@ -167,16 +175,25 @@ def run_sweep(
     client = Client(scheduler or cluster)
     rows = []
     try:
+        # Cases go out in batches, a few per worker, so that the scheduler's cost per task is
+        # shared by several cases (a case takes ~40 ms: one task each cost a third of that).
+        n_workers = max(len(client.scheduler_info()["workers"]), 1)
+        size = max(1, math.ceil(len(todo) / (BATCHES_PER_WORKER * n_workers)))
+        batches = [todo[k : k + size] for k in range(0, len(todo), size)]
         futures = client.map(
-            run_case, [spec.base] * len(todo), [spec.source] * len(todo), todo, pure=False
+            run_cases,
+            [spec.base] * len(batches),
+            [spec.source] * len(batches),
+            batches,
+            pure=False,
         )
         with _appender(path, head) as append:
-            for done, future in enumerate(as_completed(futures), 1):
-                row = future.result()
-                append(row)
-                rows.append(row)
-                if progress:
-                    progress(done, len(todo))
+            for future in as_completed(futures):
+                for row in future.result():
+                    append(row)
+                    rows.append(row)
+                    if progress:
+                        progress(len(rows), len(todo))
     finally:
         client.close()
         if cluster is not None:
