@@ -2,6 +2,7 @@
 ament index marker, package.xml, config/, launch/ and bags/ under share/mount_twin."""
 
 import os
+import site
 import subprocess
 import sys
 from glob import glob
@@ -24,17 +25,23 @@ class InstallAndWarmUp(install):
             return
         scenes = [os.path.abspath(p) for p in sorted(glob("config/*.scene.yaml"))]
         lib = os.path.abspath(self.install_lib)
+        # `python -S`: no site .pth files, so an editable install of this package elsewhere (its
+        # import hook outranks PYTHONPATH) cannot shadow the installed copy being warmed; the
+        # site directories are given back through PYTHONPATH, after the install.
+        paths = [lib, *site.getsitepackages(), site.getusersitepackages()]
         env = {
             **os.environ,
-            "PYTHONPATH": os.pathsep.join(filter(None, [lib, os.environ.get("PYTHONPATH")])),
+            "PYTHONPATH": os.pathsep.join([*paths, os.environ.get("PYTHONPATH", "")]),
         }
         print(f"mount_twin: compiling kernels into {lib} (warm-up, 20-60 s)", flush=True)
-        # cwd: the installed copy must be the one imported, not a source tree in the cwd.
+        check = (
+            "import sys, mount_twin.cli as c\n"
+            f"if not c.__file__.startswith({lib!r}):\n"
+            "    sys.exit('mount_twin: warm-up would warm ' + c.__file__ + ', not the install')\n"
+            "sys.exit(c.main(sys.argv[1:]))"
+        )
         subprocess.run(
-            [sys.executable, "-m", "mount_twin.cli", "warm-up", *scenes],
-            cwd=lib,
-            env=env,
-            check=True,
+            [sys.executable, "-S", "-c", check, "warm-up", *scenes], cwd=lib, env=env, check=True
         )
 
 
