@@ -3,9 +3,27 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import json
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from mount_twin.analysis.modes import Line, Modes
+    from mount_twin.scene.description import Scene
 
 NAME = "modes"
-HELP = "natural frequencies, mode shapes, damping, energy and effective masses of a scene"
+HELP = (
+    "natural frequencies, mode shapes, modal damping, energy shares, effective masses, static "
+    "mount loads and the stiffness centre of a scene, about its static equilibrium"
+)
+UNITS = {
+    "shape": "mass-normalised (φᵀMφ = 1): m or rad per √kg of modal mass",
+    "shape_in_f": "the same motion in F: CG translation x, y, z (m), rotation rot_x, rot_y, "
+    "rot_z about the axes of F (rad), per √kg",
+    "matrices": "SI in the generalized coordinates `dofs` (m, rad): kg, kg·m², N/m, N/rad, "
+    "N·m/rad, N·s/m, N·m·s/rad",
+    "positions": "m, in F at the reference pose",
+}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -14,59 +32,159 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--no-geometric",
         action="store_true",
-        help="linearise about the unstressed reference pose without gravity (no geometric "
-        "stiffness of the weight's preload)",
+        help="leave out the geometric stiffness of the weight's preload (elastic stiffness "
+        "of the mounts only, still at the static equilibrium)",
     )
 
 
 def run(args: argparse.Namespace) -> int:
-    import dataclasses
-    import json
-
     from mount_twin.analysis.modes import modes
     from mount_twin.scene.loader import load_scene_file
 
     scene = load_scene_file(args.scene)
     result = modes(scene, geometric=not args.no_geometric)
-    if args.json:
-        doc = {
-            "scene": scene.name,
-            "geometric_stiffness": not args.no_geometric,
-            "dofs": list(result.dofs),
-            "modes": [dataclasses.asdict(m) for m in result.modes],
-            "mounts": [dataclasses.asdict(m) for m in result.mounts],
-            "cg_m": list(result.cg_m),
-            "elastic_centre_m": None
-            if result.elastic_centre_m is None
-            else list(result.elastic_centre_m),
-        }
-        print(json.dumps(doc, indent=2))
-        return 0
-    kind = "with" if not args.no_geometric else "without"
-    print(
-        f"{scene.name}: {scene.body.mass:g} kg, DOFs {', '.join(result.dofs)}; stiffness {kind} "
-        "the weight's geometric stiffness"
-    )
-    dofs = list(result.dofs)
-    print(
-        f"{'mode':>4} {'f Hz':>8} {'ζ %':>6}  kinetic energy % by DOF"
-        + " " * 12
-        + "effective mass kg (x y z)"
-    )
-    for i, m in enumerate(result.modes, 1):
-        energy = " ".join(f"{d}:{100 * m.energy_fraction[d]:5.1f}" for d in dofs)
-        masses = " ".join(f"{m.effective_mass_kg.get(a, 0.0):8.1f}" for a in "xyz")
-        print(f"{i:>4} {m.frequency_hz:>8.3f} {100 * m.damping_ratio:>6.2f}  {energy}  {masses}")
-    print("static mount loads (mount axes): force N, deflection mm")
-    for ml in result.mounts:
-        f = " ".join(f"{v:9.1f}" for v in ml.force_n)
-        d = " ".join(f"{1e3 * v:7.3f}" for v in ml.deflection_m)
-        print(f"  {ml.name:>10}: {f}   {d}")
-    if result.elastic_centre_m is not None:
-        e = result.elastic_centre_m
-        off = [a - b for a, b in zip(e, result.cg_m, strict=True)]
-        print(
-            f"elastic centre {[round(v, 4) for v in e]} m in F; CG {list(result.cg_m)} m; "
-            f"offset {[round(v, 4) for v in off]} m"
-        )
+    print(json.dumps(document(scene, result), indent=2) if args.json else table(scene, result))
     return 0
+
+
+def document(scene: Scene, result: Modes) -> dict[str, Any]:
+    """The analysis as one JSON-ready mapping; units in the key names or under "units"."""
+    centre = result.centre
+    return {
+        "scene": scene.name,
+        "source": scene.source,
+        "gravity_m_s2": scene.input.g,
+        "geometric_stiffness": result.geometric,
+        "dofs": list(result.dofs),
+        "units": UNITS,
+        "modes": [{**dataclasses.asdict(m), "dominant_dof": m.dominant_dof} for m in result.modes],
+        "complex_modes": [dataclasses.asdict(m) for m in result.complex_modes],
+        "mounts": [dataclasses.asdict(m) for m in result.mounts],
+        "cg_m": list(result.cg_m),
+        "stiffness_centre": {
+            "force_lines_m": {a: list(v) for a, v in centre.force_lines_m.items()},
+            "elastic_centre_m": None if centre.point_m is None else list(centre.point_m),
+            "residual_m": centre.residual_m,
+        },
+        "stiffness_asymmetry": result.stiffness_asymmetry,
+        "matrices": {
+            "mass": result.mass_matrix.tolist(),
+            "stiffness": result.stiffness.tolist(),
+            "geometric_stiffness": result.geometric_stiffness.tolist(),
+            "damping": result.damping.tolist(),
+        },
+    }
+
+
+def table(scene: Scene, result: Modes) -> str:
+    """The analysis as text tables."""
+    dofs = result.dofs
+    kind = "with" if result.geometric else "without"
+    lines = [
+        f"{scene.name} ({scene.source}): {scene.body.mass:g} kg on {len(scene.mounts)} mounts, "
+        f"DOFs {' '.join(dofs)}",
+        f"about the static equilibrium under g = {scene.input.g:g} m/s², stiffness {kind} the "
+        "weight's geometric stiffness",
+        "",
+        f"{'mode':>4} {'f Hz':>9} {'ζ %':>6}  {'dominant':<13} kinetic energy % by DOF",
+        " " * 35 + "".join(f"{d:>7}" for d in dofs),
+    ]
+    for i, m in enumerate(result.modes, 1):
+        main = m.dominant_dof
+        lines.append(
+            f"{i:>4} {m.frequency_hz:>9.3f} {_fixed(100 * m.damping_ratio, 2):>6}  "
+            f"{main:<6}{_fixed(100 * m.energy_fraction[main], 0):>4} %  "
+            + "".join(f"{_fixed(100 * m.energy_fraction[d], 1):>7}" for d in dofs)
+        )
+    unstable = [str(i) for i, m in enumerate(result.modes, 1) if m.frequency_hz < 0.0]
+    if unstable:
+        lines.append(
+            f"modes {', '.join(unstable)}: negative ω² (−√|ω²|/2π shown): the static "
+            "equilibrium is unstable (the weight's geometric stiffness exceeds the mounts')"
+        )
+    exact = ", ".join(
+        f"{c.frequency_hz:.3f} ({_fixed(100 * c.damping_ratio, 2)})" for c in result.complex_modes
+    )
+    lines += [
+        "ζ: proportional-damping approximation φᵀCφ/2ω; the damped linearisation's eigenvalues",
+        f"give f Hz (ζ %): {exact}",
+        *_masses(result),
+        *_mounts(result),
+        *_centre(result),
+    ]
+    return "\n".join(lines)
+
+
+def _masses(result: Modes) -> list[str]:
+    head = "".join(f"{a:>10}" for a in "xyz")
+    lines = [
+        "",
+        f"{'mode':>4} {'f Hz':>9}  effective mass kg along, inertia kg·m² about the axes of F "
+        "through the CG",
+        f"{'':>4} {'':>9}  {head}  {head}",
+    ]
+    for i, m in enumerate(result.modes, 1):
+        masses = "".join(f"{_fixed(m.effective_mass_kg[a], 1):>10}" for a in "xyz")
+        inertias = "".join(f"{_fixed(m.effective_inertia_kg_m2[a], 2):>10}" for a in "xyz")
+        lines.append(f"{i:>4} {m.frequency_hz:>9.3f}  {masses}  {inertias}")
+    sums = "".join(
+        f"{_fixed(sum(m.effective_mass_kg[a] for m in result.modes), 1):>10}" for a in "xyz"
+    )
+    sums_i = "".join(
+        f"{_fixed(sum(m.effective_inertia_kg_m2[a] for m in result.modes), 2):>10}" for a in "xyz"
+    )
+    lines.append(f"{'sum':>4} {'':>9}  {sums}  {sums_i}")
+    return lines
+
+
+def _mounts(result: Modes) -> list[str]:
+    width = max(len("mount"), *(len(ml.name) for ml in result.mounts))
+    lines = [
+        "",
+        "static mount loads at the equilibrium, in each mount's axes: force on the body N, "
+        "deflection mm",
+        f"{'mount':<{width}}  {'kind':<13}"
+        + "".join(f"{h:>10}" for h in ("Fx", "Fy", "Fz"))
+        + "".join(f"{h:>9}" for h in ("dx", "dy", "dz")),
+    ]
+    for ml in result.mounts:
+        forces = "".join(f"{_fixed(v, 1):>10}" for v in ml.force_n)
+        travel = "".join(f"{_fixed(1e3 * v, 4):>9}" for v in ml.deflection_m)
+        lines.append(f"{ml.name:<{width}}  {ml.kind:<13}{forces}{travel}")
+    total = [sum(ml.force_in_f_n[k] for ml in result.mounts) for k in range(3)]
+    lines.append(
+        f"sum of the forces in F: {', '.join(_fixed(v, 1) for v in total)} N (the weight, up)"
+    )
+    return lines
+
+
+def _centre(result: Modes) -> list[str]:
+    centre = result.centre
+    names = {
+        "x": "fore-aft force line (a force along x there: no pitch, no yaw)",
+        "y": "lateral force line (a force along y there: no roll, no yaw)",
+        "z": "vertical stiffness centre (a vertical load there: no tilt)",
+    }
+    rows: list[tuple[str, Line]] = [("CG", result.cg_m)]
+    rows += [(names[a], line) for a, line in centre.force_lines_m.items()]
+    if centre.point_m is not None:
+        rows.append(
+            (f"elastic centre (least squares, residual {centre.residual_m:.3g} m)", centre.point_m)
+        )
+    if len(rows) == 1:
+        return []
+    lines = [
+        "",
+        "stiffness centre of the elastic stiffness, m in F at the reference pose"
+        + "".join(f"{a:>9}" for a in "xyz"),
+    ]
+    lines += [
+        f"  {label:<69}" + "".join(f"{'-' if v is None else _fixed(v, 3):>9}" for v in at)
+        for label, at in rows
+    ]
+    return lines
+
+
+def _fixed(value: float, decimals: int) -> str:
+    """`value` with `decimals` decimals, without a sign on a rounded zero (−0.0)."""
+    return f"{round(value, decimals) + 0.0:.{decimals}f}"
