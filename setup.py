@@ -81,6 +81,7 @@ setup(
             "hypothesis>=6.100",
             "matplotlib>=3.6",
             "dask[distributed]>=2024.1",
+            "pyyeti>=1.4.7",  # test_srs holds the SRS to pyyeti.srs.srs
         ],
         "plot": ["matplotlib>=3.6"],
         "sweep": ["dask[distributed]>=2024.1"],

@@ -1,38 +1,89 @@
-"""`mount-twin srs BAG_OR_CSV`: shock response spectra of a recorded foundation motion."""
+"""`mount-twin srs BAG_OR_CSV`: shock response spectra of a recorded foundation motion.
+
+The record is a bag's sensor_msgs/Imu or geometry_msgs/AccelStamped topic (mcap or sqlite3
+directory, an .mcap/.db3 file, a ROS 1 .bag) or a recorder CSV (read as `import-csv` reads it),
+one or every axis of the sensor frame. An Imu reports specific force, +g along the up axis at
+rest: gravity (and the sensor's bias) is taken out before the spectra, per axis, as the mean of
+the record's head (`--gravity mean-head`, the first `--head` seconds, which must be quiet: the
+default, averaging the noise down), its first sample (`first`), or not at all (`none`: a
+record's constant is then a step, whose spectrum is about twice the constant). The sampling must
+be uniform (the filter runs at one rate). Spectra: see `mount_twin.analysis.srs`.
+"""
 
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING, NamedTuple
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from mount_twin.analysis.srs import Spectrum
 
 NAME = "srs"
 HELP = "shock response spectra (maximax, primary, residual, pseudo-velocity) of a record"
-G = 9.80665
+AXES = ("x", "y", "z")
+SPECTRA = ("maximax", "primary", "residual", "pseudo_velocity", "positive", "negative")
+"""The CSV's columns after frequency_hz, in this order (suffixed _x, _y, _z with --axis all)."""
+TABLE = ("maximax", "primary", "residual", "pseudo_velocity")
+"""The printed table's spectra for one axis."""
+TABLE_ALL = ("maximax", "pseudo_velocity")
+"""The printed table's spectra per axis with --axis all (the CSV has them all)."""
+
+
+def _per_octave(text: str) -> float:
+    """`1/6` (or `0.1667`: a fraction of an octave) → 6 frequencies per octave."""
+    num, _, den = text.partition("/")
+    try:
+        step = float(num) / float(den) if den else float(num)
+    except (ValueError, ZeroDivisionError):
+        step = 0.0
+    if not 0.0 < step <= 1.0:
+        msg = f"{text!r} is not a fraction of an octave (1/N, e.g. 1/6, or a number in (0, 1])"
+        raise argparse.ArgumentTypeError(msg)
+    return 1.0 / step
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", help="a bag (its Imu/AccelStamped topic) or a recorder CSV")
     parser.add_argument("--topic", help="the bag's topic (default: its only Imu/AccelStamped)")
-    parser.add_argument("--axis", choices=["x", "y", "z"], default="z", help="sensor axis")
-    damping = parser.add_mutually_exclusive_group()
-    damping.add_argument("--damping", type=float, default=0.05, help="damping ratio ζ")
-    damping.add_argument("--q", type=float, help="quality factor Q = 1/(2ζ), instead of ζ")
-    parser.add_argument("--freqs", type=float, nargs="+", help="natural frequencies, Hz")
     parser.add_argument(
-        "--per-octave", type=int, default=6, help="frequencies per octave without --freqs"
+        "--axis", choices=[*AXES, "all"], default="z", help="sensor axis, or all three"
     )
-    parser.add_argument("--fmin", type=float, default=10.0, help="lowest frequency, Hz")
-    parser.add_argument("--fmax", type=float, default=2000.0, help="highest frequency, Hz")
+    damping = parser.add_mutually_exclusive_group()
+    damping.add_argument("--damping", type=float, help="damping ratio ζ (default 0.05)")
+    damping.add_argument("--q", type=float, help="quality factor Q = 1/(2ζ), instead of ζ")
+    parser.add_argument(
+        "--freqs", type=float, nargs="+", metavar="HZ", help="natural frequencies, Hz"
+    )
+    parser.add_argument(
+        "--octave",
+        type=_per_octave,
+        default="1/6",
+        metavar="1/N",
+        help="fractional-octave spacing from --fmin to --fmax, without --freqs",
+    )
+    parser.add_argument("--fmin", type=float, default=5.0, help="lowest frequency, Hz")
+    parser.add_argument(
+        "--fmax",
+        type=float,
+        help="highest frequency, Hz (default: fs/10, where the filter is accurate)",
+    )
     parser.add_argument(
         "--gravity",
-        choices=["first", "none"],
-        default="first",
-        help="subtract the first sample (a record starting at rest: gravity and sensor bias), "
-        "or nothing",
+        choices=["mean-head", "first", "none"],
+        default="mean-head",
+        help="take out gravity and bias: the mean of the first --head seconds (quiet, before "
+        "the shock), the first sample, or nothing",
+    )
+    parser.add_argument(
+        "--head", type=float, default=0.01, help="quiet head of the record for mean-head, s"
     )
     parser.add_argument(
         "--csv",
         metavar="FILE",
-        help="frequency_hz, maximax, primary, residual (g), pseudo_velocity (m/s)",
+        help="frequency_hz, then maximax, primary, residual (g), pseudo_velocity (m/s), "
+        "positive, negative (g); suffixed _x, _y, _z with --axis all",
     )
     parser.add_argument("--plot", metavar="PNG", help="the spectra in g against Hz, log-log")
     parser.add_argument(
@@ -41,65 +92,84 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import csv
-    from pathlib import Path
-
     import numpy as np
 
-    from mount_twin.analysis.srs import octave_frequencies, srs
+    from mount_twin.analysis.srs import ACCURATE_SHARE, damping_ratio, octave_frequencies, srs
+    from mount_twin.io.csv_import import G
 
     if args.plot:
         from mount_twin.commands.extras import require
 
         require("matplotlib", "--plot")
+    zeta = damping_ratio(args.damping, args.q)
+    design = _design(args.design) if args.design else None
     t, accel, name = _record(args)
-    a = accel[:, "xyz".index(args.axis)]
-    if args.gravity == "first":
-        a = a - a[0]
-    rate = (len(t) - 1) / float(t[-1] - t[0])
-    if np.ptp(np.diff(t)) > 0.01 * np.mean(np.diff(t)):
-        msg = f"{args.input}: the samples are not evenly spaced (an SRS needs a fixed rate)"
-        raise ValueError(msg)
-    zeta = 1.0 / (2.0 * args.q) if args.q else args.damping
+    rate = _rate(t, args.input)
+    offset, removed = _gravity(t, accel, args.gravity, args.head)
     freqs = (
         np.array(args.freqs)
         if args.freqs
-        else octave_frequencies(args.fmin, args.fmax, args.per_octave)
+        else octave_frequencies(args.fmin, args.fmax or ACCURATE_SHARE * rate, args.octave)
     )
-    s = srs(a, rate, freqs, zeta)
-    print(f"{name}, axis {args.axis}, {rate:.6g} Hz, ζ = {zeta:g} (Q = {1 / (2 * zeta):g})")
-    print(f"{'f Hz':>9} {'maximax g':>10} {'primary g':>10} {'residual g':>10} {'PV m/s':>9}")
-    for k in range(freqs.size):
-        flag = "" if s.accurate[k] else "  (f > fs/10: less accurate)"
-        print(
-            f"{freqs[k]:>9.4g} {s.maximax[k] / G:>10.4g} {s.primary[k] / G:>10.4g} "
-            f"{s.residual[k] / G:>10.4g} {s.pseudo_velocity[k]:>9.4g}{flag}"
+    axes = AXES if args.axis == "all" else (args.axis,)
+    spectra = {
+        axis: srs(accel[:, AXES.index(axis)] - offset[AXES.index(axis)], rate, freqs, zeta)
+        for axis in axes
+    }
+    columns = [
+        Column(
+            kind,
+            kind if len(axes) == 1 else f"{kind}_{axis}",
+            "m/s" if kind == "pseudo_velocity" else "g",
+            getattr(s, kind) / (1.0 if kind == "pseudo_velocity" else G),
         )
+        for axis, s in spectra.items()
+        for kind in SPECTRA
+    ]
+    q_text = f"{1 / (2 * zeta):g}" if zeta > 0.0 else "∞"
+    print(
+        f"{name}: {len(t)} samples at {rate:.6g} Hz, axis {args.axis}, ζ = {zeta:g} (Q = {q_text})"
+    )
+    print(f"gravity and bias taken out ({removed}): {', '.join(f'{v:.6g}' for v in offset)} m/s²")
+    shown = [c for c in columns if c.kind in (TABLE if len(axes) == 1 else TABLE_ALL)]
+    print(f"{'f Hz':>9}" + "".join(f" {c.label:>{c.width}}" for c in shown))
+    accurate = spectra[axes[0]].accurate
+    for k, fk in enumerate(freqs):
+        cells = "".join(f" {c.values[k]:>{c.width}.4g}" for c in shown)
+        print(f"{fk:>9.4g}{cells}{'' if accurate[k] else '  *'}")
+    if not accurate.all():
+        limit = ACCURATE_SHARE * rate
+        print(f"* above fs/10 = {limit:g} Hz the filter is less accurate (peaks picked low)")
     if args.csv:
-        with Path(args.csv).open("w", newline="", encoding="utf-8") as fh:
-            w = csv.writer(fh)
-            w.writerow(["frequency_hz", "maximax", "primary", "residual", "pseudo_velocity"])
-            for k in range(freqs.size):
-                w.writerow(
-                    [
-                        repr(float(v))
-                        for v in (
-                            freqs[k],
-                            s.maximax[k] / G,
-                            s.primary[k] / G,
-                            s.residual[k] / G,
-                            s.pseudo_velocity[k],
-                        )
-                    ]
-                )
+        _write_csv(args.csv, freqs, columns)
         print(f"csv: {args.csv} (accelerations in g, pseudo-velocity in m/s)")
     if args.plot:
-        _plot(s, args, name, zeta)
+        title = f"SRS of {name}, ζ = {zeta:g}, {removed} taken out"
+        _plot(args.plot, spectra, design, title, ACCURATE_SHARE * rate)
         print(f"plot: {args.plot}")
     return 0
 
 
-def _record(args: argparse.Namespace):  # type: ignore[no-untyped-def]
+class Column(NamedTuple):
+    """One spectrum of one axis as written: `values` in `unit`."""
+
+    kind: str
+    name: str
+    unit: str
+    values: np.ndarray
+
+    @property
+    def label(self) -> str:
+        """The table's heading: name (PV for pseudo_velocity) and unit."""
+        return f"{self.name.replace('pseudo_velocity', 'PV')} {self.unit}"
+
+    @property
+    def width(self) -> int:
+        """The table's column width."""
+        return max(10, len(self.label))
+
+
+def _record(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, str]:
     """(stamps s, specific force (n, 3) m/s² in the sensor frame, a name) of the input."""
     from pathlib import Path
 
@@ -114,51 +184,126 @@ def _record(args: argparse.Namespace):  # type: ignore[no-untyped-def]
     from mount_twin.io.messages import ACCEL, IMU
     from mount_twin.scene.description import InputSpec
 
-    topics = [t for t in bag_info(path).topics if t.msgtype in (IMU, ACCEL)]
-    chosen = [t for t in topics if t.name == args.topic] if args.topic else topics
+    topics = bag_info(path).topics
+    inputs = [t for t in topics if t.msgtype in (IMU, ACCEL)]
+    chosen = [t for t in inputs if t.name == args.topic] if args.topic else inputs
     if len(chosen) != 1:
         have = ", ".join(f"{t.name} ({t.msgtype})" for t in topics) or "none"
-        msg = f"{path}: give --topic: the bag's Imu/AccelStamped topics are {have}"
+        want = f"no Imu/AccelStamped topic {args.topic}" if args.topic else "give --topic"
+        msg = f"{path}: {want}; the bag's topics: {have}"
         raise ValueError(msg)
-    decoded = read_input(path, InputSpec(msg_type=chosen[0].msgtype, topic=chosen[0].name))
-    return (
-        (decoded.stamps_ns - decoded.stamps_ns[0]) * 1e-9,
-        decoded.accel,
-        f"{path.name} {chosen[0].name}",
-    )
+    (topic,) = chosen
+    decoded = read_input(path, InputSpec(msg_type=topic.msgtype, topic=topic.name))
+    t = (decoded.stamps_ns - decoded.stamps_ns[0]) * 1e-9
+    return t, decoded.accel, f"{path.name} {topic.name}"
 
 
-def _plot(s, args: argparse.Namespace, name: str, zeta: float) -> None:  # type: ignore[no-untyped-def]
+def _rate(t: np.ndarray, source: str) -> float:
+    """The sampling rate (Hz) of uniformly spaced stamps `t` (s); an error otherwise."""
+    import numpy as np
+
+    if len(t) < 2:
+        msg = f"{source}: {len(t)} sample(s): an SRS needs a record"
+        raise ValueError(msg)
+    steps = np.diff(t)
+    mean = float(t[-1] - t[0]) / (len(t) - 1)
+    worst = float(np.abs(steps - mean).max())
+    if worst > 0.01 * mean:
+        msg = (
+            f"{source}: the samples are not evenly spaced (steps {steps.min():.6g} to "
+            f"{steps.max():.6g} s): an SRS runs at one rate"
+        )
+        raise ValueError(msg)
+    return 1.0 / mean
+
+
+def _gravity(t: np.ndarray, accel: np.ndarray, mode: str, head_s: float) -> tuple[np.ndarray, str]:
+    """The per-axis constant (m/s²) to take out of the record, and how it was found."""
+    import numpy as np
+
+    if mode == "none":
+        return np.zeros(3), "nothing"
+    if mode == "first":
+        return accel[0], "the first sample"
+    if not head_s > 0.0:
+        msg = f"--head {head_s} s: the quiet head must be longer than 0"
+        raise ValueError(msg)
+    count = int(np.count_nonzero(t - t[0] < head_s))
+    return accel[:count].mean(axis=0), f"the mean of the first {count} samples"
+
+
+def _design(path: str) -> tuple[list[float], list[float]]:
+    """A design spectrum's (frequencies Hz, accelerations g) from its `frequency_hz,accel_g`
+    CSV."""
     import csv
 
+    with open(path, encoding="utf-8-sig") as fh:
+        reader = csv.DictReader(fh)
+        if not {"frequency_hz", "accel_g"} <= set(reader.fieldnames or ()):
+            msg = f"{path}: a design spectrum needs the columns frequency_hz and accel_g"
+            raise ValueError(msg)
+        rows = list(reader)
+    try:
+        return [float(r["frequency_hz"]) for r in rows], [float(r["accel_g"]) for r in rows]
+    except (TypeError, ValueError) as err:
+        msg = f"{path}: a design spectrum's values must be numbers ({err})"
+        raise ValueError(msg) from None
+
+
+def _write_csv(path: str, freqs: np.ndarray, columns: list[Column]) -> None:
+    """`frequency_hz` and one column per spectrum, every value to full precision."""
+    import csv
+
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(["frequency_hz", *(c.name for c in columns)])
+        w.writerows(
+            [repr(float(fk)), *(repr(float(c.values[k])) for c in columns)]
+            for k, fk in enumerate(freqs)
+        )
+
+
+def _plot(
+    png: str,
+    spectra: dict[str, Spectrum],
+    design: tuple[list[float], list[float]] | None,
+    title: str,
+    accurate_hz: float,
+) -> None:
+    """Maximax, primary and residual of one axis (maximax of each with all) in g, log-log,
+    against the design spectrum; the frequencies above fs/10 shaded."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from mount_twin.io.csv_import import G
+
     fig, ax = plt.subplots(figsize=(8, 5.5))
-    for label, values in (
-        ("maximax", s.maximax),
-        ("primary", s.primary),
-        ("residual", s.residual),
-    ):
-        ax.loglog(s.frequency_hz, values / G, label=label)
-    if args.design:
-        with open(args.design, encoding="utf-8") as fh:
-            rows = list(csv.DictReader(fh))
-        ax.loglog(
-            [float(r["frequency_hz"]) for r in rows],
-            [float(r["accel_g"]) for r in rows],
-            "k--",
-            label=f"design ({args.design})",
-        )
-    top = float(s.maximax.max()) / G
+    # maximax wide and pale under the primary and residual that make it up
+    styles: dict[str, dict[str, float | str]] = {
+        "maximax": {"lw": 4.0, "alpha": 0.4},
+        "primary": {"ls": "--"},
+        "residual": {"ls": ":"},
+    }
+    for axis, s in spectra.items():
+        for kind in styles if len(spectra) == 1 else ("maximax",):
+            ax.loglog(
+                s.frequency_hz, getattr(s, kind) / G, label=f"{kind}, {axis}", **styles[kind]
+            )
+    top = max(float(s.maximax.max()) for s in spectra.values()) / G
+    if design is not None:
+        ax.loglog(*design, "k--", label="design")
+        top = max(top, *design[1])
+    f_top = float(max(s.frequency_hz.max() for s in spectra.values()))
+    if f_top > accurate_hz:
+        ax.axvspan(accurate_hz, f_top, color="0.9", label="f > fs/10: less accurate")
     ax.set_ylim(top * 1e-3, top * 2.0)  # the residual of a short record falls off to nothing
     ax.set_xlabel("natural frequency [Hz]")
     ax.set_ylabel("peak absolute acceleration [g]")
-    ax.set_title(f"SRS of {name}, axis {args.axis}, ζ = {zeta:g}", fontsize=9)
+    ax.set_title(title, fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(args.plot, dpi=110)
+    fig.savefig(png, dpi=110)
     plt.close(fig)
