@@ -196,8 +196,29 @@ class Frames:
 
 
 @dataclass(frozen=True)
+class SceneWarning:
+    """A scene value that loads but is likely a mistake (units, a message type's convention),
+    found at load and kept on the Scene for the command or node to report.
+
+    Attributes:
+        source: file or parameter set, as in SceneError.
+        path: key path of the value.
+        message: what is implausible and the likely mistake.
+    """
+
+    source: str
+    path: str
+    message: str
+
+    def __str__(self) -> str:
+        return f"{self.source}: {self.path}: {self.message}"
+
+
+@dataclass(frozen=True)
 class Scene:
-    """A complete scene; `source` names the file or parameter set it came from."""
+    """A complete scene; `source` names the file or parameter set it came from, `warnings` what
+    the loader found implausible in it (not part of its value: two scenes that differ only in
+    their warnings are equal)."""
 
     name: str
     body: Body
@@ -209,3 +230,4 @@ class Scene:
     outputs: Outputs = field(default_factory=Outputs)
     frames: Frames = field(default_factory=Frames)
     source: str = "<memory>"
+    warnings: tuple[SceneWarning, ...] = field(default=(), compare=False)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from pathlib import Path
@@ -12,6 +13,7 @@ import yaml
 from mount_twin.errors import SceneError
 from mount_twin.integrate.methods import METHODS
 from mount_twin.kinds import KINDS
+from mount_twin.scene.checks import check_scene
 from mount_twin.scene.description import (
     DOF_NAMES,
     GYRO_FILTERS,
@@ -27,7 +29,7 @@ from mount_twin.scene.description import (
     Vec3,
     Vec6,
 )
-from mount_twin.scene.reader import Reader
+from mount_twin.scene.reader import Reader, shown
 from mount_twin.scene.yaml_reading import SceneYamlError, load_yaml
 
 INPUT_TYPES = ("sensor_msgs/msg/Imu", "geometry_msgs/msg/AccelStamped")
@@ -41,13 +43,19 @@ REACH_M = 1000.0
 """Largest |coordinate| of a position, m: a machine on a deck spans metres (mm, more likely)."""
 ANGLE_LIMIT_RAD = 2.0 * math.pi
 """Largest |angle| of an orientation or start pose, rad: beyond one turn it is degrees."""
-TOPIC_TOKEN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+NAME_TOKEN = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,99}")
+"""A mount name: it becomes a token of topic names and a frame id (ASCII: str.isalnum() takes
+"x²", which rclpy refuses), at most 100 characters (its topic ~/mounts/<name>/wrench, with the
+node's namespace and name, must stay within TOPIC_MAX_CHARS)."""
+TOPIC_MAX_CHARS = 247
+"""Longest ROS 2 topic name (rmw: 255 less 8 reserved for the DDS prefix)."""
 STEPPERS = tuple(METHODS)
 
 
 def load_scene_file(path: str | Path) -> Scene:
-    """Read and validate a scene YAML file; errors name the file and key path."""
-    return scene_from_dict(read_scene_yaml(path), str(path))
+    """Read and validate a scene YAML file; errors name the file and key path, and what looks
+    mistaken is in the Scene's `warnings`."""
+    return scene_from_dict(read_scene_yaml(path), str(path), refuse_unheld=True)
 
 
 def read_scene_yaml(path: str | Path) -> Any:
@@ -57,6 +65,9 @@ def read_scene_yaml(path: str | Path) -> Any:
         return load_yaml(path.read_text(encoding="utf-8"))
     except OSError as err:
         raise SceneError(str(path), "<file>", f"cannot read: {err.strerror}") from err
+    except UnicodeDecodeError as err:
+        msg = f"not UTF-8 text: byte {err.start} is {err.object[err.start : err.start + 1]!r}"
+        raise SceneError(str(path), "<file>", msg) from err
     except SceneYamlError as err:
         raise SceneError(str(path), "<file>", str(err)) from err
     except yaml.YAMLError as err:
@@ -69,21 +80,27 @@ def scene_from_dict(
     *,
     mount_paths: list[str] | None = None,
     record: dict[str, Any] | None = None,
+    refuse_unheld: bool = False,
 ) -> Scene:
-    """Validate a scene mapping (the layout of config/*.scene.yaml).
+    """Validate a scene mapping (the layout of config/*.scene.yaml), then the scene as a whole
+    (`mount_twin.scene.checks`): what cannot work is a SceneError, what looks mistaken is in
+    the returned Scene's `warnings`.
 
     Args:
         data: the mapping.
         source: file or parameter set, named in errors.
         mount_paths: key path of each mount in errors (default mounts[i]).
         record: if given, receives every value used (given or defaulted) by key path.
+        refuse_unheld: a free DOF no mount holds is a SceneError (for a start at equilibrium)
+            instead of a warning: what scene files and parameter sets get. Off for scenes built
+            in code, such as tests of a single mount's law.
     """
     top = Reader(data, source, record=record)
     body = _body(top.sub("body", optional=False))
     dofs = _dofs(top)
     mounts_raw = top.raw("mounts")
     if not isinstance(mounts_raw, list) or not mounts_raw:
-        raise top.error("mounts", f"expected a non-empty list of mounts, got {mounts_raw!r}")
+        raise top.error("mounts", f"expected a non-empty list of mounts, got {shown(mounts_raw)}")
     if len(mounts_raw) > MAX_MOUNTS:
         raise top.error("mounts", f"{len(mounts_raw)} mounts: at most {MAX_MOUNTS} are accepted")
     paths = mount_paths or [f"mounts[{i}]" for i in range(len(mounts_raw))]
@@ -94,7 +111,7 @@ def scene_from_dict(
     names = [m.name for m in mounts]
     for i, name in enumerate(names):
         if names.index(name) != i:
-            raise SceneError(source, f"{paths[i]}.name", f"duplicate mount name {name!r}")
+            raise SceneError(source, f"{paths[i]}.name", f"duplicate mount name {shown(name)}")
     scene = Scene(
         name=top.string("name", "scene"),
         body=body,
@@ -108,7 +125,8 @@ def scene_from_dict(
         source=source,
     )
     top.finish()
-    return scene
+    warnings = check_scene(scene, paths, refuse_unheld=refuse_unheld)
+    return dataclasses.replace(scene, warnings=warnings)
 
 
 def _body(r: Reader) -> Body:
@@ -118,7 +136,7 @@ def _body(r: Reader) -> Body:
     ixx, iyy, izz, ixy, ixz, iyz = inertia
     tensor = [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]
     if not _is_positive_definite(tensor):
-        raise r.error("inertia", f"tensor is not positive definite: {list(inertia)!r}")
+        raise r.error("inertia", f"tensor is not positive definite: {list(inertia)}")
     if ixx + iyy < izz or iyy + izz < ixx or izz + ixx < iyy:
         raise r.error("inertia", f"violates the triangle inequality of a rigid body: {inertia!r}")
     r.finish()
@@ -141,7 +159,9 @@ def _dofs(top: Reader) -> tuple[str, ...]:
     dofs = top.strings("dofs", DOF_NAMES)
     for i, d in enumerate(dofs):
         if d not in DOF_NAMES:
-            raise top.error(f"dofs[{i}]", f"unknown DOF {d!r}; choose from {', '.join(DOF_NAMES)}")
+            raise top.error(
+                f"dofs[{i}]", f"unknown DOF {shown(d)}; choose from {', '.join(DOF_NAMES)}"
+            )
         if dofs.index(d) != i:
             raise top.error(f"dofs[{i}]", f"DOF {d!r} listed twice")
     if not dofs:
@@ -152,8 +172,12 @@ def _dofs(top: Reader) -> tuple[str, ...]:
 def _mount(r: Reader) -> Mount:
     kind = r.choice("kind", MOUNT_KINDS, "linear")
     name = r.string("name")
-    if not TOPIC_TOKEN.match(name):  # ASCII only: str.isalnum() takes "x²"
-        raise r.error("name", f"must be a ROS name token (letters, digits, _), got {name!r}")
+    if not NAME_TOKEN.fullmatch(name):
+        raise r.error(
+            "name",
+            "must be a ROS name token (an ASCII letter, then up to 99 letters, digits and _), "
+            f"got {shown(name)}",
+        )
     position = _position(r, "position")
     rpy = _angles(r, "orientation_rpy", (0.0, 0.0, 0.0))
     if kind == "linear":
@@ -190,18 +214,39 @@ def _angles(r: Reader, key: str, default: Vec3 | None = None) -> Vec3:
 
 
 def _topic(r: Reader, key: str, default: str) -> str:
-    """A ROS 2 topic name: '/'-separated tokens of letters, digits and _ (not starting with a
-    digit), absolute, relative or private (~/), as rclpy's validate_full_topic_name takes."""
+    """A ROS 2 topic name as rclpy's validate_topic_name takes it (rcl_validate_topic_name),
+    that also expands to a valid full name (no '//', at most TOPIC_MAX_CHARS), without
+    substitutions: a {node} or {ns} would not match the topic of a recorded bag."""
     name = r.string(key, default)
-    body = name[2:] if name.startswith("~/") else name.removeprefix("/")
-    tokens = body.split("/")
-    if not name or name.endswith("/") or not all(TOPIC_TOKEN.match(t) for t in tokens):
-        raise r.error(
-            key,
-            f"{name!r} is not a ROS topic name ('/'-separated tokens of letters, digits and "
-            "_, not starting with a digit)",
-        )
+    problem = topic_name_problem(name)
+    if problem:
+        raise r.error(key, f"{shown(name)} is not a ROS topic name: {problem}")
     return name
+
+
+def topic_name_problem(name: str) -> str:
+    """What makes `name` an unusable topic name ('' if nothing): the rules of
+    rcl_validate_topic_name (alphanumerics, '_' and '/'; '~' only first and followed by '/';
+    no token starting with a digit; not empty, not ending with '/'), rmw's full-name rules that
+    apply to it (no '//', length), and no {substitution}."""
+    tokens = (name[2:] if name.startswith("~/") else name.removeprefix("/")).split("/")
+    rules = (
+        (not name, "it is empty"),
+        (len(name) > TOPIC_MAX_CHARS, f"longer than {TOPIC_MAX_CHARS} characters"),
+        (name.endswith("/"), "it ends with '/'"),
+        ("{" in name or "}" in name, "{substitutions} are not accepted in a scene"),
+        (
+            "~" in name[1:] or (name.startswith("~") and name[:2] != "~/"),
+            "'~' only as the '~/' that begins a private name",
+        ),
+        ("" in tokens, "it has an empty token ('//')"),
+        (
+            not all(re.fullmatch(r"[A-Za-z0-9_]*", t) for t in tokens),
+            "only ASCII letters, digits, '_' and '/' are allowed",
+        ),
+        (any(t[:1].isdigit() for t in tokens), "a token starts with a digit"),
+    )
+    return next((why for broken, why in rules if broken), "")
 
 
 def _frame_id(r: Reader, key: str, default: str, *, empty_ok: bool = False) -> str:
@@ -209,7 +254,8 @@ def _frame_id(r: Reader, key: str, default: str, *, empty_ok: bool = False) -> s
     frame = r.string(key, default)
     if (not frame and not empty_ok) or any(c.isspace() for c in frame) or frame.startswith("/"):
         raise r.error(
-            key, f"{frame!r} is not a tf2 frame id (non-empty, no whitespace, no leading '/')"
+            key,
+            f"{shown(frame)} is not a tf2 frame id (non-empty, no whitespace, no leading '/')",
         )
     return frame
 

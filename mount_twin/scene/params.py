@@ -178,7 +178,13 @@ def effective_parameters(flat: Mapping[str, Any], source: str) -> tuple[Scene, d
     tree = _mounts_as_list(tree, source)
     names = [m["name"] for m in tree["mounts"]]
     used: dict[str, Any] = {}
-    scene = scene_from_dict(tree, source, mount_paths=[f"mounts.{n}" for n in names], record=used)
+    scene = scene_from_dict(
+        tree,
+        source,
+        mount_paths=[f"mounts.{n}" for n in names],
+        record=used,
+        refuse_unheld=True,
+    )
     types = parameter_types({**used, "mount_names": names})
     effective: dict[str, Any] = {"scene_file": str(scene_file), "mount_names": list(names)}
     for name, value in used.items():

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import reprlib
 from collections.abc import Mapping, Sequence
 from typing import Any, Literal, overload
 
@@ -19,6 +20,20 @@ NUMBER_LIMIT = 1e15
 garbage, refused with its key path before it can overflow anything."""
 INTEGER_LIMIT = 10**9
 """Largest integer a scene takes (decimation, substeps, sample counts)."""
+
+_SHOWN = reprlib.Repr()
+_SHOWN.maxlevel, _SHOWN.maxlist, _SHOWN.maxdict = 3, 8, 6
+_SHOWN.maxstring, _SHOWN.maxother, _SHOWN.maxlong = 60, 60, 40
+
+
+def shown(value: object) -> str:
+    """`repr(value)` bounded for a message: nesting, length and digits cut with '...' (a value
+    read from a hostile file may be nested deep enough to exhaust repr's recursion, or be an
+    integer too long for str())."""
+    try:
+        return _SHOWN.repr(value)
+    except ValueError:  # an int beyond sys.get_int_max_str_digits()
+        return f"<{type(value).__name__} too long to show>"
 
 
 class Reader:
@@ -41,7 +56,7 @@ class Reader:
         record: dict[str, Any] | None = None,
     ) -> None:
         if not isinstance(data, Mapping):
-            raise SceneError(source, path or "<top>", f"expected a mapping, got {data!r}")
+            raise SceneError(source, path or "<top>", f"expected a mapping, got {shown(data)}")
         self.data = data
         self.source = source
         self.path = path
@@ -107,30 +122,30 @@ class Reader:
         """An integer in [lo, hi]."""
         value = self.raw(key, default)
         if isinstance(value, bool) or not isinstance(value, int):
-            raise self.error(key, f"expected an integer, got {value!r}")
+            raise self.error(key, f"expected an integer, got {shown(value)}")
         if not lo <= value <= hi:
-            raise self.error(key, f"must be in [{lo}, {hi}], got {value}")
+            raise self.error(key, f"must be in [{lo}, {hi}], got {shown(value)}")
         return value
 
     def boolean(self, key: str, default: bool | None = None) -> bool:
         """A boolean."""
         value = self.raw(key, default)
         if not isinstance(value, bool):
-            raise self.error(key, f"expected true or false, got {value!r}")
+            raise self.error(key, f"expected true or false, got {shown(value)}")
         return value
 
     def string(self, key: str, default: str | None = None) -> str:
         """A string."""
         value = self.raw(key, default)
         if not isinstance(value, str):
-            raise self.error(key, f"expected a string, got {value!r}")
+            raise self.error(key, f"expected a string, got {shown(value)}")
         return value
 
     def choice(self, key: str, options: Sequence[str], default: str | None = None) -> str:
         """One of `options`."""
         value = self.string(key, default)
         if value not in options:
-            raise self.error(key, f"expected one of {', '.join(options)}, got {value!r}")
+            raise self.error(key, f"expected one of {', '.join(options)}, got {shown(value)}")
         return value
 
     @overload
@@ -160,9 +175,9 @@ class Reader:
         `Vec6` for 6, so it fills the dataclasses' fixed-length fields as it is."""
         value = self.raw(key, None if default is None else tuple(default))
         if isinstance(value, (str, bytes)) or not isinstance(value, Sequence):
-            raise self.error(key, f"expected a list of {n} numbers, got {value!r}")
+            raise self.error(key, f"expected a list of {n} numbers, got {shown(value)}")
         if len(value) != n:
-            raise self.error(key, f"expected {n} numbers, got {len(value)}: {list(value)!r}")
+            raise self.error(key, f"expected {n} numbers, got {len(value)}: {shown(list(value))}")
         return tuple(
             self._check_number(f"{key}[{i}]", v, lo, math.inf, False) for i, v in enumerate(value)
         )
@@ -171,10 +186,10 @@ class Reader:
         """A list of strings."""
         value = self.raw(key, None if default is None else tuple(default))
         if isinstance(value, str) or not isinstance(value, Sequence):
-            raise self.error(key, f"expected a list of strings, got {value!r}")
+            raise self.error(key, f"expected a list of strings, got {shown(value)}")
         for i, v in enumerate(value):
             if not isinstance(v, str):
-                raise self.error(f"{key}[{i}]", f"expected a string, got {v!r}")
+                raise self.error(f"{key}[{i}]", f"expected a string, got {shown(v)}")
         return tuple(value)
 
     def finish(self) -> None:
@@ -187,14 +202,15 @@ class Reader:
 
     def _check_number(self, key: str, value: Any, lo: float, hi: float, lo_open: bool) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise self.error(key, f"expected a number, got {value!r}")
-        value = float(value)
-        if not math.isfinite(value):
+            raise self.error(key, f"expected a number, got {shown(value)}")
+        if isinstance(value, float) and not math.isfinite(value):
             raise self.error(key, f"must be finite, got {value!r}")
-        if abs(value) > NUMBER_LIMIT:
+        if abs(value) > NUMBER_LIMIT:  # before float(): an int may be too large for one
             raise self.error(
-                key, f"{value!r} is beyond {NUMBER_LIMIT:g}: no quantity of a scene is (units?)"
+                key,
+                f"{shown(value)} is beyond {NUMBER_LIMIT:g}: no quantity of a scene is (units?)",
             )
+        value = float(value)
         if value < lo or value > hi or (lo_open and value == lo):
             low = "(" if lo_open else "["
             raise self.error(key, f"must be in {low}{lo}, {hi}], got {value!r}")

@@ -2,10 +2,15 @@
 
 - A key given twice in one mapping is an error naming the line (PyYAML keeps the last: a
   second `mounts:` silently replaced eight mounts with one).
-- `3e5`, `-2E+4`, `1e-3` are floats (YAML 1.1 reads an exponent without a dot as a string).
+- `3e5`, `-2E+4`, `1e-3`, `1.5e3`, `.5e3` are floats (YAML 1.1 reads an exponent without a dot
+  and a sign as a string).
 - Aliases (`*name`) are refused: nested aliases expand exponentially ("billion laughs") and a
   scene is small enough to write out.
 - Nesting deeper than MAX_DEPTH is refused instead of exhausting the recursion.
+- A text longer than MAX_CHARS is refused before it is parsed (PyYAML reads ~0.3 MB/s: a 20 000
+  mount file took 8 s only to be refused for its mount count), and an integer written with more
+  than MAX_INT_CHARS characters is refused (Python refuses to convert one of 4300 digits, and no
+  scene value needs 10³⁰).
 """
 
 from __future__ import annotations
@@ -14,11 +19,20 @@ import re
 from typing import Any
 
 import yaml
-from yaml.nodes import MappingNode, Node
+from yaml.nodes import MappingNode, Node, ScalarNode
+
+from mount_twin.scene.reader import shown
 
 MAX_DEPTH = 50
 """Deepest nesting of mappings and lists accepted (a scene needs 4)."""
-FLOAT_WITH_EXPONENT = re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$")
+MAX_CHARS = 1_000_000
+"""Longest scene text accepted, characters (1000 mounts written as in the bundled scenes take
+0.4 MB; PyYAML parses 1 MB in ~4 s)."""
+MAX_INT_CHARS = 30
+"""Longest integer scalar accepted, characters."""
+FLOAT_WITH_EXPONENT = re.compile(
+    r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9][0-9_]*)[eE][-+]?[0-9]+$"
+)
 
 
 class SceneYamlError(yaml.YAMLError):
@@ -49,20 +63,43 @@ class SceneLoader(yaml.SafeLoader):
         for key_node, _ in node.value:
             key = self.construct_object(key_node, deep=deep)  # type: ignore[no-untyped-call]
             line = key_node.start_mark.line + 1
+            if not _hashable(key):
+                continue  # SafeLoader refuses it below ("found unhashable key")
             if key in seen:
                 raise SceneYamlError(
-                    f"line {line}: key {key!r} given twice in one mapping (first on line "
+                    f"line {line}: key {shown(key)} given twice in one mapping (first on line "
                     f"{seen[key]}): YAML would keep the last one only"
                 )
             seen[key] = line
         return super().construct_mapping(node, deep=deep)
 
+    def construct_yaml_int(self, node: ScalarNode) -> int:
+        if len(node.value) > MAX_INT_CHARS:
+            raise SceneYamlError(
+                f"line {node.start_mark.line + 1}: an integer of {len(node.value)} characters "
+                f"(at most {MAX_INT_CHARS} are accepted)"
+            )
+        return super().construct_yaml_int(node)  # type: ignore[no-any-return]
+
+
+def _hashable(key: Any) -> bool:
+    try:
+        hash(key)
+    except TypeError:
+        return False
+    return True
+
+
+SceneLoader.add_constructor("tag:yaml.org,2002:int", SceneLoader.construct_yaml_int)
 
 SceneLoader.add_implicit_resolver(
-    "tag:yaml.org,2002:float", FLOAT_WITH_EXPONENT, list("-+0123456789")
+    "tag:yaml.org,2002:float", FLOAT_WITH_EXPONENT, list("-+.0123456789")
 )
 
 
 def load_yaml(text: str) -> Any:
     """The document in `text`, read by `SceneLoader`."""
+    if len(text) > MAX_CHARS:
+        msg = f"{len(text)} characters: a scene file has at most {MAX_CHARS}"
+        raise SceneYamlError(msg)
     return yaml.load(text, Loader=SceneLoader)

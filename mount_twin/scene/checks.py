@@ -1,0 +1,236 @@
+"""Load-time checks of a whole scene: what no single key shows, from its small-motion statics
+(`mount_twin.scene.statics`) under the nominal weight m·input.g.
+
+Errors (SceneError naming the key path):
+- a mount's nominal stiffness beyond STIFFNESS_LIMIT;
+- mounts too soft to carry the weight at all (the static sag overflows);
+- a free DOF that nothing holds (zero stiffness, the weight's geometric stiffness included),
+  when the twin starts at equilibrium (`initial_state.mode: equilibrium`) and the caller asks
+  (`refuse_unheld`: scene files and parameter sets do): the body would drift along it under
+  any input (0.51 m in 2 s, as reported). Reduced scenes only need their free DOFs held. A
+  scene built in code (tests of one mount's law, of the model's own refusal) gets a warning,
+  and `model.assemble.static_equilibrium` refuses it at the start.
+
+Warnings (SceneWarning, kept on `Scene.warnings`): values that load but are likely mistakes.
+- a free DOF nothing holds, when it is not refused: from a given start
+  (`initial_state.mode: given`) a free body is what torque-free and free-flight studies want;
+- a DOF the weight overturns (negative stiffness: a CG high above soft mounts);
+- a static sag of the CG or of a mount's attachment point beyond SAG_WARN_M (stiffness in N/mm
+  sags a thousand times more), and a mount's static load or deflection beyond its rated values;
+- a mount farther from the CG than FAR_FACTOR times the body's largest radius of gyration, and
+  a radius of gyration beyond GYRATION_WARN_M (positions in mm, inertia in kg·mm²);
+- an Imu input declared without gravity: sensor_msgs/Imu linear_acceleration is specific force.
+
+Angles beyond 2π are refused when read (`loader.ANGLE_LIMIT_RAD`), not warned of: no
+orientation needs more than a turn, a value in degrees corrupts every output without any other
+sign, and the fix is one edit.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from mount_twin.errors import SceneError
+from mount_twin.kinds.elastomer import Elastomer
+from mount_twin.scene.description import LinearMount, Scene, SceneWarning
+from mount_twin.scene.statics import AXES, Statics, loose_dofs, statics
+
+STIFFNESS_LIMIT = 1.0e13
+"""Largest nominal stiffness of a mount, N/m or N·m/rad: a steel block 1 m² in section and
+20 mm thick (bolted steel joints are ~1e9 N/m); more is a unit error."""
+SAG_WARN_M = 0.1
+"""Static sag under the weight, m, past which a scene is implausible: mounts sag millimetres
+(a 1.6 Hz bounce sags 0.1 m); the engine's start check uses the same figure."""
+FAR_FACTOR = 10.0
+"""A mount farther from the CG than this many radii of gyration lies outside the body."""
+GYRATION_WARN_M = 30.0
+"""Largest plausible radius of gyration √(I/m) of a machine on mounts, m."""
+INPUT_IMU = "sensor_msgs/msg/Imu"
+
+
+def check_scene(
+    scene: Scene, mount_paths: Sequence[str], *, refuse_unheld: bool
+) -> tuple[SceneWarning, ...]:
+    """Raise SceneError for a scene that cannot work; return what looks mistaken in it.
+
+    Args:
+        scene: a scene whose every value passed its own checks.
+        mount_paths: key path of each mount, for messages.
+        refuse_unheld: a free DOF nothing holds is an error if the start is at equilibrium
+            (else it is a warning).
+    """
+    st = statics(scene)
+    _check_stiffness_limits(scene, st, mount_paths)
+    if not st.finite:
+        raise SceneError(
+            scene.source,
+            "mounts",
+            "the mounts are too soft to carry the weight: its static sag overflows (a "
+            "stiffness near 1e-300?)",
+        )
+    return (
+        *_restraint(scene, st, refuse_unheld),
+        *_sag(scene, st, mount_paths),
+        *_ratings(scene, st, mount_paths),
+        *_geometry(scene, mount_paths),
+        *_gravity_convention(scene),
+    )
+
+
+def _check_stiffness_limits(scene: Scene, st: Statics, mount_paths: Sequence[str]) -> None:
+    for tangent, path in zip(st.tangents, mount_paths, strict=True):
+        for k, key in zip(tangent.stiffness, tangent.keys, strict=True):
+            if k > STIFFNESS_LIMIT:
+                raise SceneError(
+                    scene.source,
+                    f"{path}.{key}",
+                    f"nominal stiffness {k:.4g} is beyond {STIFFNESS_LIMIT:g} N/m (N·m/rad): "
+                    "stiffer than a solid steel block; units?",
+                )
+
+
+def _named(shares: dict[str, float]) -> str:
+    """'x, y, delta' for DOFs free alone, 'gamma (92 %), x (8 %)' for a coupled direction."""
+    if all(s > 0.99 for s in shares.values()):
+        return ", ".join(shares)
+    return ", ".join(f"{d} ({s:.0%})" for d, s in shares.items())
+
+
+def _restraint(scene: Scene, st: Statics, refuse_unheld: bool) -> list[SceneWarning]:
+    zero, negative = loose_dofs(st, scene.dofs)
+    found = []
+    if zero:
+        them = _named(zero)
+        if refuse_unheld and scene.initial.mode == "equilibrium":
+            raise SceneError(
+                scene.source,
+                "mounts",
+                f"no mount holds {them}: the mounts' stiffness about the reference pose (with "
+                "the weight's) has no component there, so the body would drift under any "
+                f"input; give a mount stiffness there, or leave {them} out of `dofs`",
+            )
+        found.append(
+            SceneWarning(
+                scene.source,
+                "mounts",
+                f"no mount holds {them}: the body moves freely there (a start at "
+                "equilibrium refuses it)",
+            )
+        )
+    if negative:
+        found.append(
+            SceneWarning(
+                scene.source,
+                "body.cg",
+                f"the weight overturns the body in {_named(negative)}: its moment on the CG's "
+                "height above the mounts outweighs their rocking stiffness (the reference pose "
+                "is unstable)",
+            )
+        )
+    return found
+
+
+def _sag(scene: Scene, st: Statics, mount_paths: Sequence[str]) -> list[SceneWarning]:
+    cg = float(np.linalg.norm(st.sag[:3]))
+    point = np.linalg.norm(st.deflection, axis=1)
+    worst = int(np.argmax(point))
+    if max(cg, float(point[worst])) <= SAG_WARN_M:
+        return []
+    weight = scene.body.mass * scene.input.g
+    return [
+        SceneWarning(
+            scene.source,
+            "mounts",
+            f"under its weight ({weight:.4g} N) the CG sags {cg:.3g} m and {mount_paths[worst]} "
+            f"deflects {point[worst]:.3g} m (statics of the nominal stiffness): more than "
+            f"{SAG_WARN_M:g} m is implausible on mounts; stiffness in N/mm, or mass in g?",
+        )
+    ]
+
+
+def _ratings(scene: Scene, st: Statics, mount_paths: Sequence[str]) -> list[SceneWarning]:
+    """Static load and deflection of each mount against its rated values, where it has any:
+    one warning per rated key, at the mount most over its rating."""
+    over: dict[str, list[tuple[float, int, int, float, float]]] = {}
+    for i, mount in enumerate(scene.mounts):
+        rated: list[tuple[str, np.ndarray, tuple[float, ...]]] = []
+        if isinstance(mount, LinearMount):
+            rated = [
+                ("rated_load", st.force[i], mount.rated_load),
+                ("rated_travel", st.deflection[i], mount.rated_travel),
+            ]
+        elif isinstance(mount, Elastomer):
+            rated = [("rated_deflection", st.deflection[i], mount.rated_deflection)]
+        for key, value, limit in rated:
+            for j, (v, r) in enumerate(zip(value, limit, strict=True)):
+                if abs(v) > r > 0.0:
+                    over.setdefault(key, []).append((abs(v) / r, i, j, abs(v), r))
+    found = []
+    for key, cases in over.items():
+        ratio, i, j, static, rating = max(cases)
+        what, unit = ("load", "N") if key == "rated_load" else ("deflection", "m")
+        found.append(
+            SceneWarning(
+                scene.source,
+                f"{mount_paths[i]}.{key}",
+                f"the static {what} under the weight, {static:.4g} {unit} along local "
+                f"{AXES[j]}, is {ratio:.3g} times the rated {rating:.4g} {unit}"
+                f"{_others(len({c[1] for c in cases}) - 1)}: stiffness or mass in the wrong "
+                "units, or the wrong mount?",
+            )
+        )
+    return found
+
+
+def _others(n: int) -> str:
+    """' (and n more mounts)', or '' for none."""
+    return f" (and {n} more mounts)" if n else ""
+
+
+def _geometry(scene: Scene, mount_paths: Sequence[str]) -> list[SceneWarning]:
+    """Mount positions against the body's size as its inertia tells it."""
+    body = scene.body
+    gyration = math.sqrt(max(body.inertia[:3]) / body.mass)
+    found = []
+    if gyration > GYRATION_WARN_M:
+        found.append(
+            SceneWarning(
+                scene.source,
+                "body.inertia",
+                f"the body's radius of gyration √(I/m) is {gyration:.3g} m: implausible for a "
+                "machine on mounts; inertia in kg·mm², or mass in t?",
+            )
+        )
+    arms = np.linalg.norm(np.array([m.position for m in scene.mounts]) - body.cg, axis=1)
+    far = np.flatnonzero(arms > FAR_FACTOR * gyration)
+    if far.size:
+        i = int(far[np.argmax(arms[far])])
+        found.append(
+            SceneWarning(
+                scene.source,
+                f"{mount_paths[i]}.position",
+                f"{arms[i]:.4g} m from the CG{_others(far.size - 1)}, {arms[i] / gyration:.3g} "
+                f"times the body's largest radius of gyration ({gyration:.3g} m): outside the "
+                "body; "
+                "positions in millimetres?",
+            )
+        )
+    return found
+
+
+def _gravity_convention(scene: Scene) -> list[SceneWarning]:
+    spec = scene.input
+    if spec.msg_type != INPUT_IMU or spec.includes_gravity:
+        return []
+    return [
+        SceneWarning(
+            scene.source,
+            "input.includes_gravity",
+            "false for a sensor_msgs/Imu input, whose linear_acceleration is specific force "
+            "(gravity included, +g up at rest): the twin adds g again unless this driver "
+            "removes it",
+        )
+    ]
