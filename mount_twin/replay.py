@@ -16,14 +16,7 @@ from tqdm import tqdm
 from mount_twin.engine.batch import LEVEL_NAMES, OK, HealthReport, HealthStatus, MountEvent
 from mount_twin.engine.health import tilt_from_quaternions
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
-from mount_twin.io.messages import (
-    TF,
-    TF_STATIC_TOPIC,
-    decode_inputs,
-    output_types,
-    resolve,
-    static_transforms,
-)
+from mount_twin.io.messages import TF, TF_STATIC_TOPIC, output_types, resolve, static_transforms
 from mount_twin.physics.compiled import kernel_cache_is_cold
 from mount_twin.scene.description import Scene
 from mount_twin.stream import TwinStream
@@ -185,15 +178,6 @@ def _grouped(events: list[MountEvent]) -> dict[tuple[str, str], list[MountEvent]
     return out
 
 
-def _first_stamp(raws: list[bytes], msgtype: str) -> int | None:
-    """header.stamp (ns) of the first decodable message of `raws`, None if there is none."""
-    for raw in raws:
-        decoded = decode_inputs([raw], msgtype)
-        if decoded.stamps_ns.shape[0]:
-            return int(decoded.stamps_ns[0])
-    return None
-
-
 def replay(
     scene: Scene,
     input_path: str | Path,
@@ -206,18 +190,21 @@ def replay(
     """Replay `input_path`'s scene.input.topic into a new mcap bag at `output_path`.
 
     The output holds what the node publishes: the scene's outputs (`output_types`), and the mount
-    frames on /tf_static once, before anything else, stamped with the first decodable input
-    stamp and offered latched (`LATCHED_QOS`) so `ros2 bag play` republishes it to late
-    subscribers. Both bags are checked before the kernels load (a first run compiles them:
-    with `progress`, `kernels_loading` says so on stderr). `checkpoint` is called between
-    chunks, where stopping is safe: it may raise to stop the replay (a signal noted by the
-    command line), and the output bag is then finished and marked partial.
+    frames on /tf_static once, before anything else, stamped with the first output's stamp (that
+    of the first input sample the stream took: never an unset or pre-1970 one) and offered
+    latched (`LATCHED_QOS`) so `ros2 bag play` republishes it to late subscribers. Both bags are
+    checked before the kernels load (a first run compiles them: with `progress`,
+    `kernels_loading` says so on stderr). `checkpoint` is called once the kernels are loaded and
+    between chunks, where stopping is safe: it may raise to stop the replay (a signal noted by
+    the command line); once the output bag exists, it is then finished and marked partial.
     """
     bag = InputBag(input_path, scene.input.topic, scene.input.msg_type)
     try:
         check_new_bag(output_path)
         with kernels_loading(progress):
             stream = TwinStream(scene)
+        if checkpoint is not None:  # a signal while the kernels compiled: no output bag yet
+            checkpoint()
     except BaseException:
         bag.close()
         raise
@@ -240,12 +227,11 @@ def replay(
         for raws in bag.chunks(chunk):
             if checkpoint is not None:
                 checkpoint()
-            if static_due:
-                stamp0 = _first_stamp(raws, scene.input.msg_type)
-                if stamp0 is not None:
-                    out.write(*static_transforms(scene, stamp0))
-                    static_due = False
-            for topic, stamp, raw in stream.process(raws):
+            outputs = stream.process(raws)
+            if static_due and outputs:
+                out.write(*static_transforms(scene, outputs[0][1]))
+                static_due = False
+            for topic, stamp, raw in outputs:
                 out.write(resolved[topic], stamp, raw)
             batch = stream.last_outputs
             if batch is not None and len(batch):

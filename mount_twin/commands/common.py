@@ -29,12 +29,14 @@ def share_dir() -> Path:
 def write_signal(
     sig: Signal, out: str, topic: str, frame_id: str, start_ns: int, storage: str
 ) -> int:
-    """Write `sig` as sensor_msgs/Imu messages stamped start_ns + t into a new bag."""
+    """Write `sig` as sensor_msgs/Imu messages stamped start_ns + t into a new bag; stamps a
+    bag cannot hold are refused before it is created."""
     import numpy as np
 
-    from mount_twin.io.bag import write_bag
+    from mount_twin.io.bag import check_stamp, write_bag
     from mount_twin.io.messages import IMU, imu_messages
 
+    check_stamp(out, topic, start_ns)  # sig.t counts from 0
     stamps = start_ns + np.rint(sig.t * 1e9).astype(np.int64)
     return write_bag(
         out, topic, IMU, iter(imu_messages(stamps, sig.accel, sig.gyro, frame_id)), storage

@@ -16,10 +16,23 @@ STOPS_AT_CHECKPOINTS = True
 """SIGINT and SIGTERM stop the replay between chunks (mount_twin.commands.stopping)."""
 FAIL_ON = ("never", "warn", "error")
 """`--fail-on` choices; the index of warn and error is their diagnostics level."""
+EXIT_STATUS = (
+    "exit status: 0 done; 2 bad input or configuration, or a failed write (the message names "
+    "the file); 3 no input sample accepted; 4 diagnostics reached --fail-on; 5 input bag "
+    "damaged part-way (the messages before the damage are replayed); 130 SIGINT (Ctrl-C), 143 "
+    "SIGTERM. On 5, 130 and 143 the output bag is finished and marked partial in its metadata "
+    "(custom_data mount_twin.partial: why, and up to which stamp)."
+)
+"""The replay's exit statuses (mount_twin.cli's EXIT_* and `verdict`), in its --help."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("input", help="input bag (mcap or sqlite3)")
+    parser.epilog = EXIT_STATUS
+    parser.add_argument(
+        "input",
+        help="input bag: a rosbag2 directory (mcap or sqlite3), one .mcap or .db3 file, or a "
+        "ROS 1 .bag",
+    )
     parser.add_argument("--scene", required=True, help="scene YAML")
     parser.add_argument("-o", "--output", required=True, help="output bag directory (new)")
     parser.add_argument("--topic", help="input topic (default: the scene's input.topic)")
@@ -103,15 +116,12 @@ def replay_and_report(
 
 
 def verdict(summary: ReplaySummary, fail_on: str) -> int:
-    """The exit status of a replay: 3 if no input sample was accepted (saying why), 4 if the
-    run's worst diagnostics level reached `fail_on`, else 0."""
+    """The exit status of a replay: 3 if no input sample was accepted (saying why: the bag
+    holds some, `InputBag` saw to it), 4 if the run's worst diagnostics level reached
+    `fail_on`, else 0."""
     if not summary.counts.get("accepted", 0):
         rejected = {k: v for k, v in summary.counts.items() if k.startswith("rejected_") and v}
-        why = (
-            f"{summary.counts.get('received', 0)} received, rejected: {rejected}"
-            if rejected
-            else "the input topic holds no message"
-        )
+        why = f"{summary.counts.get('received', 0)} received, rejected: {rejected}"
         if summary.wrong_frame_id is not None:
             why += f"; the bag's header.frame_id is {summary.wrong_frame_id!r}: see input.frame_id"
         print(f"mount-twin: error: no input sample was accepted ({why})", file=sys.stderr)

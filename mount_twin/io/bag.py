@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
+import dataclasses
+import re
+import sqlite3
+import struct
+from collections import Counter
 from collections.abc import Iterator, Mapping, Sequence
+from contextlib import suppress
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -44,8 +50,11 @@ late subscribers."""
 class InputBag:
     """The input topic of a bag, read in chunks of raw CDR messages.
 
+    A bag rosbags cannot open (a recorder killed mid-write leaves its last file cut short and no
+    metadata.yaml) is read from its storage files directly, in order, up to the first damage.
+
     Args:
-        path: bag directory (or file rosbags accepts).
+        path: bag directory, or one storage file (.mcap, .db3, ROS 1 .bag).
         topic: input topic.
         msgtype: expected message type; a different one is an error naming both.
     """
@@ -56,24 +65,24 @@ class InputBag:
         self.msgtype = msgtype
         self._salvage: Salvage | None = None
         try:
-            self._reader = AnyReader([self.path], default_typestore=TYPESTORE)
-            self._reader.open()
+            self._reader = _open_reader([self.path])
         except Exception as err:
-            self._open_damaged(err)
-            return
+            files = _storage_files(self.path)
+            if not files:
+                raise _not_a_bag(self.path, err) from err
+            try:  # the storage files of a directory without (a readable) metadata.yaml
+                self._reader = _open_reader(files)
+            except Exception:
+                self._open_damaged(files, err)
+                return
         conns = [c for c in self._reader.connections if c.topic == topic]
-        if not conns:
-            have = ", ".join(
-                sorted(
-                    {
-                        f"{c.topic} ({c.msgtype}, {c.msgcount} messages)"
-                        for c in self._reader.connections
-                    }
-                )
-            )
+        self.count = sum(c.msgcount for c in conns)
+        if not self.count:
+            have = _topic_list(self._reader)
             self._reader.close()  # after listing: a closed reader has no connections
+            what = "no message on topic" if conns else "no topic"
             msg = (
-                f"{self.path}: no topic {topic!r} (input.topic; `replay --topic` overrides it); "
+                f"{self.path}: {what} {topic!r} (input.topic; `replay --topic` overrides it); "
                 f"the bag has: {have or 'no topic'}"
             )
             raise BagError(msg)
@@ -85,23 +94,22 @@ class InputBag:
             )
             raise BagError(msg)
         self._conns = conns
-        self.count = sum(c.msgcount for c in conns)
         self.ros1 = not self._reader.is2
         """A ROS 1 bag: its messages are converted to the ROS 2 (Jazzy) CDR the twin reads."""
 
-    def _open_damaged(self, err: Exception) -> None:
-        """After rosbags could not open the bag: read what an mcap file holds before its
-        damage (`mcap_salvage`), or raise BagError naming the bag."""
-        found = [self.path] if self.path.suffix == ".mcap" else sorted(self.path.glob("*.mcap"))
-        if not found or not found[0].is_file():
-            msg = f"{self.path}: cannot open bag: {err}"
-            raise BagError(msg) from err
-        self._salvage = salvage(found[0], self.topic)
+    def _open_damaged(self, files: list[Path], err: Exception) -> None:
+        """After rosbags could not open the bag: read the topic's messages from its storage files
+        up to the first damage, or raise BagError naming the bag."""
+        self._salvage = _salvage(files, self.topic)
         if not self._salvage.messages:
-            msg = (
-                f"{self.path}: cannot open bag ({err}), and no message of {self.topic} comes "
-                f"before its damage ({self._salvage.damage or 'none found'})"
+            why = (
+                f"no message of {self.topic} comes before its damage ({self._salvage.damage})"
+                if self._salvage.damage
+                else f"its storage files hold no message of {self.topic}"
             )
+            unmarked = self.path.is_dir() and not (self.path / "metadata.yaml").exists()
+            cause = "no metadata.yaml" if unmarked else err  # rosbags names the directory
+            msg = f"{self.path}: cannot open bag ({cause}), and {why}"
             raise BagError(msg) from err
         if self._salvage.msgtype and self._salvage.msgtype != self.msgtype:
             msg = (
@@ -114,74 +122,76 @@ class InputBag:
 
     def chunks(self, size: int) -> Iterator[list[bytes]]:
         """Raw messages of the topic in log-time order, `size` at a time. From a damaged bag,
-        those before the damage, then DamagedBagError."""
+        those before the damage, then DamagedBagError saying how many and up to which log
+        time."""
         if self._salvage is not None:
-            raws = [raw for _, raw in self._salvage.messages]
-            for k in range(0, len(raws), size):
-                yield raws[k : k + size]
-            msg = (
-                f"{self.path}: damaged ({self._salvage.damage}); the {len(raws)} messages of "
-                f"{self.topic} before the damage were replayed"
-            )
-            raise DamagedBagError(msg)
+            yield from self._salvaged_chunks(self._salvage, 0, size)
+            return
         chunk: list[bytes] = []
-        done = 0
+        read, last = 0, None
         messages = self._reader.messages(connections=self._conns)
         while True:
             try:
-                _, _, raw = next(messages)
+                _, log_time, raw = next(messages)
             except StopIteration:
                 break
             except Exception as err:  # rosbags' readers raise their own types on damage
                 if chunk:
                     yield chunk
+                rest = self._salvage_after(read)
+                if rest is not None:
+                    yield from self._salvaged_chunks(rest, read, size)
                 msg = (
-                    f"{self.path}: damaged after {done + len(chunk)} of {self.count} messages "
-                    f"of {self.topic}: {err}"
+                    f"{self.path}: damaged after {read} of {self.count} messages of "
+                    f"{self.topic}{_up_to(last)}: {err}"
                 )
                 raise DamagedBagError(msg) from err
             chunk.append(self._ros1_to_cdr(raw) if self.ros1 else raw)
+            read, last = read + 1, log_time
             if len(chunk) == size:
                 yield chunk
-                done += size
                 chunk = []
         if chunk:
             yield chunk
+        if read < self.count:  # records lost without an error: zeroed or overwritten bytes
+            msg = (
+                f"{self.path}: damaged: its index lists {self.count} messages of {self.topic}, "
+                f"only {read} could be read: those lost inside the file were skipped"
+            )
+            raise DamagedBagError(msg)
+
+    def _salvage_after(self, read: int) -> Salvage | None:
+        """After rosbags failed past `read` messages: the messages after those (in file order,
+        the order rosbags read them in) that the mcap files hold before a damage found record
+        by record (rosbags reads an mcap chunk whole, so a damaged record loses the chunk's
+        messages before it), or None if no damage is found that way."""
+        files = [f for f in _storage_files(self.path) if f.suffix == ".mcap"]
+        found = _salvage(files, self.topic)
+        if not found.damage or len(found.messages) <= read:
+            return None
+        return Salvage(found.messages[read:], found.msgtype, found.damage)
+
+    def _salvaged_chunks(self, salvaged: Salvage, before: int, size: int) -> Iterator[list[bytes]]:
+        """The salvaged messages, `size` at a time, then DamagedBagError if they end at a
+        damage (`before`: messages of the topic read before them)."""
+        raws = [raw for _, raw in salvaged.messages]
+        for k in range(0, len(raws), size):
+            yield raws[k : k + size]
+        if salvaged.damage:
+            msg = (
+                f"{self.path}: damaged ({salvaged.damage}); the {before + len(raws)} messages "
+                f"of {self.topic} before the damage{_up_to(salvaged.messages[-1][0])} were "
+                "processed"
+            )
+            raise DamagedBagError(msg)
 
     def _ros1_to_cdr(self, raw: bytes) -> bytes:
-        """A ROS 1 message as the ROS 2 message of the same name, CDR-serialized: the fields
-        the twin reads are copied (ROS 1's header.seq has no ROS 2 counterpart)."""
-        msg: Any = self._reader.deserialize(raw, self.msgtype)
-        t = TYPESTORE.types
-        header = t["std_msgs/msg/Header"](
-            stamp=t["builtin_interfaces/msg/Time"](
-                sec=msg.header.stamp.sec, nanosec=msg.header.stamp.nanosec
-            ),
-            frame_id=msg.header.frame_id,
-        )
-        ros2: Any
-        if self.msgtype == "sensor_msgs/msg/Imu":
-            ros2 = t[self.msgtype](
-                header=header,
-                orientation=t["geometry_msgs/msg/Quaternion"](
-                    x=msg.orientation.x,
-                    y=msg.orientation.y,
-                    z=msg.orientation.z,
-                    w=msg.orientation.w,
-                ),
-                orientation_covariance=msg.orientation_covariance,
-                angular_velocity=_vector3(msg.angular_velocity),
-                angular_velocity_covariance=msg.angular_velocity_covariance,
-                linear_acceleration=_vector3(msg.linear_acceleration),
-                linear_acceleration_covariance=msg.linear_acceleration_covariance,
-            )
-        else:  # geometry_msgs/msg/AccelStamped
-            ros2 = t[self.msgtype](
-                header=header,
-                accel=t["geometry_msgs/msg/Accel"](
-                    linear=_vector3(msg.accel.linear), angular=_vector3(msg.accel.angular)
-                ),
-            )
+        """A ROS 1 message as CDR of the ROS 2 message of the same name; one that cannot be
+        read becomes empty, which the stream counts as undecodable."""
+        try:
+            ros2 = _as_ros2(self._reader.deserialize(raw, self.msgtype))
+        except Exception:  # any malformed ROS 1 message: counted downstream, never raised
+            return b""
         return bytes(TYPESTORE.serialize_cdr(ros2, self.msgtype))
 
     def close(self) -> None:
@@ -198,9 +208,129 @@ class InputBag:
         self.close()
 
 
-def _vector3(v: Any) -> Any:
-    """A geometry_msgs/Vector3 of the ROS 2 typestore with v's x, y, z."""
-    return TYPESTORE.types["geometry_msgs/msg/Vector3"](x=v.x, y=v.y, z=v.z)
+def _open_reader(paths: list[Path]) -> AnyReader:
+    reader = AnyReader(paths, default_typestore=TYPESTORE)
+    reader.open()
+    return reader
+
+
+def _topic_list(reader: AnyReader) -> str:
+    """The reader's topics as 'topic (type, N messages)', sorted."""
+    counts: Counter[tuple[str, str]] = Counter()
+    for c in reader.connections:
+        counts[c.topic, c.msgtype] += c.msgcount
+    return ", ".join(f"{t} ({m}, {n} messages)" for (t, m), n in sorted(counts.items()))
+
+
+def _up_to(log_time_ns: int | None) -> str:
+    return "" if log_time_ns is None else f" (up to log time {log_time_ns} ns)"
+
+
+STORAGE_SUFFIXES = (".mcap", ".db3")
+"""rosbag2 storage files that can be read without the bag's metadata.yaml."""
+
+
+def _storage_files(path: Path) -> list[Path]:
+    """The rosbag2 storage files of the bag at `path` (itself, if it is one) in recording order:
+    rosbag2 numbers split files NAME_0, NAME_1, ..."""
+    if path.is_dir():
+        return sorted(
+            (f for f in path.iterdir() if f.suffix in STORAGE_SUFFIXES), key=_split_index
+        )
+    return [path] if path.suffix in STORAGE_SUFFIXES and path.is_file() else []
+
+
+def _not_a_bag(path: Path, err: Exception) -> BagError:
+    """Why `path`, which rosbags could not open (`err`) and which has no storage file, is no
+    bag."""
+    if path.is_dir():
+        why = (
+            f"no metadata.yaml and no {' or '.join(STORAGE_SUFFIXES)} file"
+            if any(path.iterdir())
+            else "an empty directory"
+        )
+    elif not path.exists():
+        why = "no such file or directory"
+    elif path.suffix == ".bag":
+        why = f"{err} (`rosbag reindex` rebuilds a ROS 1 bag's index)"
+    else:
+        why = str(err)
+    return BagError(f"{path}: cannot open bag: {why}")
+
+
+def _split_index(file: Path) -> tuple[int, str]:
+    number = re.search(r"_(\d+)$", file.stem)
+    return (int(number.group(1)) if number else -1, file.name)
+
+
+def _salvage(files: list[Path], topic: str) -> Salvage:
+    """`topic`'s messages from storage files read in order, up to the first damage."""
+    out = Salvage()
+    for file in files:
+        part = salvage(file, topic) if file.suffix == ".mcap" else _salvage_sqlite(file, topic)
+        out.messages += part.messages
+        out.msgtype = out.msgtype or part.msgtype
+        if part.damage:
+            out.damage = part.damage
+            break
+    return out
+
+
+def _salvage_sqlite(db: Path, topic: str) -> Salvage:
+    """`topic`'s messages from a rosbag2 sqlite3 file in the order they were written (row id),
+    up to the first unreadable row. The file is read into memory and zero-filled to the size its
+    header gives: sqlite refuses a file cut short, but reads the pages before the cut. A row
+    whose cell is damaged reads as id 0 and NULLs: the rows of all topics are scanned, so that
+    one stops the salvage too (the data of other topics is not fetched)."""
+    data = db.read_bytes()
+    out = Salvage()
+    con = sqlite3.connect(":memory:")
+    last_id = 0
+    try:
+        con.deserialize(data + bytes(_sqlite_size(data) - len(data)))
+        topics = con.execute("SELECT id, type FROM topics WHERE name = ?", (topic,)).fetchall()
+        out.msgtype = topics[0][1] if topics else ""
+        wanted = {tid for tid, _ in topics}
+        rows = con.execute(
+            "SELECT id, topic_id, timestamp, CASE WHEN topic_id IN "
+            "(SELECT id FROM topics WHERE name = ?) THEN data END FROM messages ORDER BY id",
+            (topic,),
+        )
+        for row_id, topic_id, stamp, raw in rows:
+            if row_id <= last_id or stamp is None or (topic_id in wanted and raw is None):
+                out.damage = f"{db}: the row after id {last_id} is unreadable"
+                break
+            last_id = row_id
+            if topic_id in wanted:
+                out.messages.append((int(stamp), bytes(raw)))
+    except sqlite3.DatabaseError as err:
+        out.damage = f"{db}: {err}"
+    finally:
+        con.close()
+    return out
+
+
+def _sqlite_size(data: bytes) -> int:
+    """The size of an sqlite file as its header gives it (page size × page count), at least
+    `data`'s rounded up to whole pages; len(data) if the header is not sqlite's."""
+    if len(data) < 100:
+        return len(data)
+    (page,) = struct.unpack_from(">H", data, 16)
+    page = 65536 if page == 1 else page
+    if page < 512 or page & (page - 1):
+        return len(data)
+    (pages,) = struct.unpack_from(">I", data, 28)
+    return max(page * pages, -(-len(data) // page) * page)
+
+
+def _as_ros2(value: Any) -> Any:
+    """A deserialized ROS 1 message (or field value) as the ROS 2 (Jazzy) message of the same
+    name: the fields ROS 2 has are copied, those it lacks (header.seq) dropped."""
+    name = getattr(value, "__msgtype__", None)
+    if name is None:
+        return [_as_ros2(v) for v in value] if isinstance(value, list) else value
+    cls: Any = TYPESTORE.types[name]
+    return cls(**{f.name: _as_ros2(getattr(value, f.name)) for f in dataclasses.fields(cls)})
 
 
 PARTIAL_KEY = "mount_twin.partial"
@@ -241,13 +371,21 @@ class OutputBag:
         self.last_stamp_ns: int | None = None
         self.partial: str | None = None
         """Why the bag is partial (then recorded in its metadata), or None: complete."""
+        self._failed: OSError | None = None
 
     def write(self, topic: str, stamp_ns: int, raw: bytes | memoryview) -> None:
-        """Write one serialized message; a failed write names the bag."""
+        """Write one serialized message; a failed write (a full disk) names the bag, which
+        is then closed without its index (`close`)."""
+        check_stamp(self.path, topic, stamp_ns)
         try:
             self._writer.write(self._conns[topic], stamp_ns, raw)
         except OSError as err:
-            msg = f"{self.path}: cannot write: {err.strerror or err}"
+            self._failed = err
+            msg = (
+                f"{self.path}: cannot write: {err.strerror or err}, after {self.written} "
+                f"messages{_up_to(self.last_stamp_ns)}; the bag is left unfinished (no index, "
+                "no metadata.yaml)"
+            )
             raise BagError(msg) from err
         self.written += 1
         self.last_stamp_ns = stamp_ns
@@ -264,8 +402,21 @@ class OutputBag:
         self._writer.set_custom_data(PARTIAL_KEY, self.partial)
 
     def close(self) -> None:
-        """Finish the bag (writes its metadata)."""
-        self._writer.close()
+        """Finish the bag (writes its index and metadata); after a failed write, only close
+        its file (the failure was said then)."""
+        if self._failed is not None:
+            self._abort()
+            return
+        try:
+            self._writer.close()
+        except OSError as err:
+            self._abort()
+            msg = f"{self.path}: cannot finish the bag: {err.strerror or err}"
+            raise BagError(msg) from err
+
+    def _abort(self) -> None:
+        with suppress(OSError):  # flushing what is still buffered fails like the write did
+            self._writer.abort()
 
     def __enter__(self) -> OutputBag:
         return self
@@ -285,6 +436,14 @@ def check_new_bag(path: str | Path) -> None:
         raise BagError(msg)
 
 
+def check_stamp(path: str | Path, topic: str, stamp_ns: int) -> None:
+    """Raise BagError if a bag cannot hold a message stamped `stamp_ns` (ns): one before 1970
+    (a negative header.stamp.sec) would crash its writer and leave the file unreadable."""
+    if stamp_ns < 0:
+        msg = f"{path}: {topic}: stamp {stamp_ns} ns is before 1970: a bag cannot hold it"
+        raise BagError(msg)
+
+
 def write_bag(
     path: str | Path,
     topic: str,
@@ -292,12 +451,18 @@ def write_bag(
     messages: Iterator[tuple[int, bytes]],
     storage: str = "mcap",
 ) -> int:
-    """Write one topic's (stamp ns, CDR bytes) messages into a new bag; return the count."""
+    """Write one topic's (stamp ns, CDR bytes) messages into a new bag; return the count. A
+    failed write (a full disk) names the bag."""
     plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
     n = 0
-    with Writer(Path(path), version=Writer.VERSION_LATEST, storage_plugin=plugin) as writer:
-        conn = writer.add_connection(topic, msgtype, typestore=TYPESTORE)
-        for stamp, raw in messages:
-            writer.write(conn, stamp, raw)
-            n += 1
+    try:
+        with Writer(Path(path), version=Writer.VERSION_LATEST, storage_plugin=plugin) as writer:
+            conn = writer.add_connection(topic, msgtype, typestore=TYPESTORE)
+            for stamp, raw in messages:
+                check_stamp(path, topic, stamp)
+                writer.write(conn, stamp, raw)
+                n += 1
+    except OSError as err:
+        msg = f"{path}: cannot write: {err.strerror or err}, after {n} messages"
+        raise BagError(msg) from err
     return n

@@ -1,0 +1,341 @@
+"""Replay of hostile input: stamps before 1970, bags damaged in many ways (each a real bag whose
+bytes are edited), bags that are no bags, a full disk, and a signal before the output exists.
+
+Signals mid-replay and an mcap cut short are in test_replay_stops.py; ROS 1 bags replayed and
+the --topic/--frame-id overrides in test_replay_inputs.py.
+"""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+from io_helpers import SCENE_FILE, default_scene, read_bag, read_raw, run_python, stamp_ns
+from rosbags.rosbag1 import Writer as Ros1Writer
+from rosbags.rosbag2 import StoragePlugin, Writer
+from rosbags.typesys import Stores, get_typestore
+
+from mount_twin.cli import main
+from mount_twin.errors import BagError
+from mount_twin.io.bag import PARTIAL_KEY, InputBag, OutputBag, write_bag
+from mount_twin.io.messages import IMU, POSE, TYPESTORE
+from mount_twin.replay import replay
+
+N = 5000  # messages of a 5 s ship-motion bag at 1 kHz
+POSES = "/mount_twin/pose"
+
+
+@pytest.fixture(scope="module")
+def ship(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """5 s of ship motion on /deck/imu, in mcap and in sqlite3."""
+    d = tmp_path_factory.mktemp("ship")
+    for storage in ("mcap", "sqlite3"):
+        gen = ["generate", "ship-motion", "-o", str(d / storage), "--storage", storage]
+        assert main(gen) == 0
+    return {"mcap": d / "mcap", "sqlite3": d / "sqlite3"}
+
+
+def _replay(bag: Path, out: Path) -> int:
+    return main(["replay", str(bag), "--scene", str(SCENE_FILE), "-o", str(out), "--no-progress"])
+
+
+def _one_message_bag(path: Path) -> Path:
+    assert main(["generate", "ship-motion", "-o", str(path), "--duration", "0.001"]) == 0
+    return path
+
+
+def _edited_copy(bag: Path, dst: Path, edit: Callable[[bytes], bytes]) -> Path:
+    """A copy of `bag` whose storage file's bytes are replaced by edit(bytes)."""
+    shutil.copytree(bag, dst)
+    (storage,) = [f for f in dst.iterdir() if f.suffix in (".mcap", ".db3")]
+    storage.write_bytes(edit(storage.read_bytes()))
+    return dst
+
+
+def _partial(out: Path) -> str:
+    """The partial marker in a finished output bag's metadata.yaml ('' if none)."""
+    meta = yaml.safe_load((out / "metadata.yaml").read_text(encoding="utf-8"))
+    return (meta["rosbag2_bagfile_information"].get("custom_data") or {}).get(PARTIAL_KEY, "")
+
+
+def _damaged_count(err: str) -> int:
+    """N of '... the N messages of /deck/imu before the damage ...'."""
+    return int(err.split("; the ")[1].split(" messages", maxsplit=1)[0])
+
+
+# --------------------------------------------------------------------------- stamps before 1970
+
+
+def test_a_negative_stamp_is_rejected_and_counted_and_never_reaches_the_output(
+    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """sec = -5 on the first message (the one /tf_static used to be stamped with) and on
+    another: each is counted, the replay goes on, and every output stamp is one taken."""
+    msgs = read_raw(ship["mcap"], ["/deck/imu"])["/deck/imu"][:500]
+    for k in (0, 100):
+        m: Any = TYPESTORE.deserialize_cdr(msgs[k][1], IMU)
+        m.header.stamp.sec = -5
+        msgs[k] = (msgs[k][0], bytes(TYPESTORE.serialize_cdr(m, IMU)))
+    bag = tmp_path / "negative"
+    write_bag(bag, "/deck/imu", IMU, iter(msgs))
+    out = tmp_path / "out"
+    assert _replay(bag, out) == 0
+    assert "'rejected_negative_stamp': 2" in capsys.readouterr().out
+    _, got = read_bag(out)
+    ((static_time, static),) = got["/tf_static"]
+    first = stamp_ns(TYPESTORE.deserialize_cdr(msgs[1][1], IMU))
+    assert static_time == stamp_ns(static.transforms[0]) == first
+    assert len(got[POSES]) == 498 and min(t for t, _ in got[POSES]) == first
+    assert _partial(out) == ""
+
+
+def test_an_output_bag_refuses_a_stamp_before_1970_naming_it_and_stays_readable(
+    tmp_path: Path,
+) -> None:
+    ((stamp, raw),) = read_raw(_one_message_bag(tmp_path / "one"))["/deck/imu"]
+    out = tmp_path / "out"
+    with OutputBag(out, {"/deck/imu": IMU}) as bag:
+        bag.write("/deck/imu", stamp, raw)
+        with pytest.raises(BagError, match=rf"{out}: /deck/imu: stamp -1 ns is before 1970"):
+            bag.write("/deck/imu", -1, raw)
+    assert read_raw(out) == {"/deck/imu": [(stamp, raw)]}
+
+
+def test_generate_with_a_start_before_1970_exits_2_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag = tmp_path / "early"
+    gen = ["generate", "ship-motion", "-o", str(bag), "--duration", "0.1", "--start", "-5"]
+    assert main(gen) == 2
+    assert f"{bag}: /deck/imu: stamp -5 ns is before 1970" in capsys.readouterr().err
+    assert not bag.exists()
+
+
+# --------------------------------------------------------------------------- damaged mcap
+
+
+def _record_of(data: bytes, raw: bytes) -> int:
+    """Offset of the mcap Message record holding `raw` (opcode, length u64, channel u16,
+    sequence u32, log and publish times u64, then the data)."""
+    at = data.find(raw)
+    assert at > 0 and data.find(raw, at + 1) < 0
+    return at - 31
+
+
+def test_a_corrupted_mcap_record_stops_at_it_with_exit_5_after_the_messages_before_it(
+    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A record length overwritten inside the second chunk: rosbags fails on the whole chunk;
+    read record by record, the 4000 messages before the damaged one are replayed."""
+    raw = read_raw(ship["mcap"], ["/deck/imu"])["/deck/imu"][4000][1]
+
+    def corrupt(data: bytes) -> bytes:
+        at = _record_of(data, raw) + 1
+        return data[:at] + (2**40).to_bytes(8, "little") + data[at + 8 :]
+
+    bag = _edited_copy(ship["mcap"], tmp_path / "bad", corrupt)
+    out = tmp_path / "out"
+    assert _replay(bag, out) == 5
+    err = capsys.readouterr().err
+    assert f"{bag}: damaged (chunk at byte " in err and "(opcode 0x05) cut short" in err
+    assert _damaged_count(err) == 4000 and "Traceback" not in err
+    _, got = read_bag(out)
+    assert len(got[POSES]) == 4000
+    assert _partial(out).startswith("stopped by DamagedBagError")
+
+
+def test_bytes_zeroed_inside_an_mcap_chunk_are_no_silent_loss(
+    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """rosbags skips zeroed records without an error (its chunks carry no checksum when
+    rosbags wrote them): the count against the bag's index catches it."""
+    raw = read_raw(ship["mcap"], ["/deck/imu"])["/deck/imu"][1000][1]
+
+    def zero(data: bytes) -> bytes:
+        at = _record_of(data, raw)
+        return data[:at] + bytes(4096) + data[at + 4096 :]
+
+    bag = _edited_copy(ship["mcap"], tmp_path / "zeroed", zero)
+    out = tmp_path / "out"
+    assert _replay(bag, out) == 5
+    err = capsys.readouterr().err
+    assert f"{bag}: damaged: its index lists {N} messages of /deck/imu, only " in err
+    assert "could be read: those lost inside the file were skipped" in err
+    assert _partial(out).startswith("stopped by DamagedBagError")
+
+
+def test_a_killed_recorder_split_bag_is_read_in_file_order_up_to_the_cut(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """No metadata.yaml, NAME_9.mcap whole and NAME_10.mcap cut short (numbered, not
+    alphabetical, order): all of the first file, then the second up to its cut."""
+    rec = tmp_path / "rec"
+    rec.mkdir()
+    start = 1_700_000_000_000_000_000
+    for i, (begin, keep) in enumerate([(start, 1.0), (start + 500_000_000, 0.5)]):
+        part = tmp_path / f"part{i}"
+        gen = ["generate", "ship-motion", "-o", str(part), "--duration", "0.5"]
+        assert main([*gen, "--start", str(begin)]) == 0
+        data = next(part.glob("*.mcap")).read_bytes()
+        (rec / f"rec_{9 + i}.mcap").write_bytes(data[: int(len(data) * keep)])
+    out = tmp_path / "out"
+    assert _replay(rec, out) == 5
+    err = capsys.readouterr().err
+    assert f"{rec / 'rec_10.mcap'}: a record (opcode 0x06) cut short" in err
+    n = _damaged_count(err)
+    assert 500 < n < 1000
+    _, got = read_bag(out)
+    stamps = np.array([t for t, _ in got[POSES]])
+    np.testing.assert_array_equal(stamps, start + np.arange(n) * 1_000_000)
+
+
+def test_an_intact_mcap_without_metadata_yaml_replays_whole(
+    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag = tmp_path / "no_meta"
+    shutil.copytree(ship["mcap"], bag)
+    (bag / "metadata.yaml").unlink()
+    assert _replay(bag, tmp_path / "out") == 0
+    assert f"{N} received, {N} accepted" in capsys.readouterr().out
+
+
+# --------------------------------------------------------------------------- damaged sqlite3
+
+
+def test_an_sqlite3_bag_cut_short_replays_its_readable_rows_then_exits_5(
+    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """rosbags cannot open it at all (it counts every row first); read row by row, the rows
+    before the cut are replayed, and none of a page the cut left half."""
+    bag = _edited_copy(ship["sqlite3"], tmp_path / "cut", lambda d: d[: int(len(d) * 0.6)])
+    out = tmp_path / "out"
+    assert _replay(bag, out) == 5
+    err = capsys.readouterr().err
+    assert f"{bag}: damaged (" in err and "messages of /deck/imu before the damage" in err
+    n = _damaged_count(err)
+    assert 0.5 * N < n < 0.6 * N
+    _, got = read_bag(out)
+    want = [t for t, _ in read_raw(ship["sqlite3"], ["/deck/imu"])["/deck/imu"][:n]]
+    assert [t for t, _ in got[POSES]] == want
+
+
+@pytest.mark.parametrize(
+    ("make", "said"),
+    [
+        (lambda p: None, "no such file or directory"),
+        (lambda p: p.mkdir(), "an empty directory"),
+        (lambda p: (p.mkdir(), (p / "notes.txt").write_text("x")), "no metadata.yaml and no"),
+        (
+            lambda p: (p.mkdir(), (p / "x.db3").write_bytes(b"not sqlite" * 100)),
+            "no message of /deck/imu comes before its damage (",
+        ),
+    ],
+    ids=["missing", "empty", "no-bag-files", "not-sqlite"],
+)
+def test_what_is_no_bag_is_an_error_saying_why(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    make: Callable[[Path], object],
+    said: str,
+) -> None:
+    bag = tmp_path / "bag"
+    make(bag)
+    assert _replay(bag, tmp_path / "out") == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"mount-twin: error: {bag}: cannot open bag") and said in err
+    assert not (tmp_path / "out").exists()
+
+
+# --------------------------------------------------------------------------- topics, ROS 1
+
+
+def test_a_topic_without_messages_is_an_error_listing_the_bag_topics(tmp_path: Path) -> None:
+    bag = tmp_path / "bag"
+    ((stamp, raw),) = read_raw(_one_message_bag(tmp_path / "one"))["/deck/imu"]
+    with Writer(bag, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP) as w:
+        w.add_connection("/deck/imu", IMU, typestore=TYPESTORE)
+        other = w.add_connection("/imu/data", IMU, typestore=TYPESTORE)
+        for k in range(3):
+            w.write(other, stamp + k, raw)
+    with pytest.raises(
+        BagError,
+        match=rf"{bag}: no message on topic '/deck/imu' \(input\.topic; `replay --topic` "
+        r"overrides it\); the bag has: /deck/imu \(sensor_msgs/msg/Imu, 0 messages\), "
+        r"/imu/data \(sensor_msgs/msg/Imu, 3 messages\)",
+    ):
+        InputBag(bag, "/deck/imu", IMU)
+
+
+def _garbage_ros1_bag(path: Path) -> Path:
+    ros1 = get_typestore(Stores.ROS1_NOETIC)
+    with Ros1Writer(path) as writer:
+        conn = writer.add_connection("/deck/imu", IMU, typestore=ros1)
+        for k in range(3):
+            writer.write(conn, 1_700_000_000_000_000_000 + k, b"\x01\x02\x03")
+    return path
+
+
+def test_an_unreadable_ros1_message_is_counted_never_raised(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert _replay(_garbage_ros1_bag(tmp_path / "in.bag"), tmp_path / "out") == 3
+    assert "3 received, rejected: {'rejected_undecodable': 3}" in capsys.readouterr().err
+
+
+def test_a_ros1_bag_cut_short_is_an_error_naming_it_and_the_repair(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag = _garbage_ros1_bag(tmp_path / "in.bag")
+    bag.write_bytes(bag.read_bytes()[:-100])
+    assert _replay(bag, tmp_path / "out") == 2
+    err = capsys.readouterr().err
+    assert f"{bag}: cannot open bag: " in err and "`rosbag reindex`" in err
+
+
+# --------------------------------------------------------------------------- output, stopping
+
+
+def test_a_full_disk_names_the_output_bag_and_leaves_its_messages_readable(
+    ship: dict[str, Path], tmp_path: Path
+) -> None:
+    """A file size limit (EFBIG, as a full disk's ENOSPC) in a real process: the error names
+    the bag, no traceback, and the unfinished bag's messages can still be read."""
+    out = tmp_path / "out"
+    code = (
+        "import resource, sys\n"
+        "resource.setrlimit(resource.RLIMIT_FSIZE, (2_000_000, 2_000_000))\n"
+        "from mount_twin.cli import main\n"
+        f"sys.exit(main(['replay', {str(ship['mcap'])!r}, '--scene', {str(SCENE_FILE)!r}, "
+        f"'-o', {str(out)!r}, '--no-progress']))\n"
+    )
+    done = run_python("-c", code)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith(f"mount-twin: error: {out}: cannot write: File too large")
+    assert "the bag is left unfinished" in done.stderr and "Traceback" not in done.stderr
+    with InputBag(out, POSES, POSE) as unfinished:
+        assert 0 < unfinished.count < N
+
+
+def test_a_signal_while_the_kernels_load_stops_before_any_output_exists(
+    ship: dict[str, Path], tmp_path: Path
+) -> None:
+    def signalled() -> None:
+        raise KeyboardInterrupt
+
+    out = tmp_path / "out"
+    with pytest.raises(KeyboardInterrupt):
+        replay(default_scene(), ship["mcap"], out, progress=False, checkpoint=signalled)
+    assert not out.exists()
+
+
+def test_replay_help_lists_the_exit_statuses(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit):
+        main(["replay", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    for status in ("3 no input sample accepted", "5 input bag damaged part-way", "130 SIGINT"):
+        assert status in text
