@@ -24,6 +24,23 @@ def _scene_file(tmp_path: Path, **input_changes: object) -> Path:
     return path
 
 
+def test_a_scene_with_stiffness_in_n_per_mm_is_run_with_its_warning_on_stderr(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every command that loads a scene says what the loader found implausible (here `info`)."""
+    data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
+    for m in data["mounts"]:
+        m["stiffness"] = [v / 1000.0 for v in m["stiffness"][:3]] + m["stiffness"][3:]
+    path = tmp_path / "soft.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    assert main(["info", str(path)]) == 0
+    err = capsys.readouterr().err
+    assert f"mount-twin: warning: {path}: mounts: under its weight" in err
+    assert "stiffness in N/mm, or mass in g?" in err
+    assert main(["info", str(SCENE_FILE)]) == 0
+    assert "warning" not in capsys.readouterr().err  # the bundled scene is plausible
+
+
 def test_demo_replays_the_bundled_bag_and_prints_a_summary(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

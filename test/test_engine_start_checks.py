@@ -112,23 +112,3 @@ def test_a_gap_reset_while_gathering_starts_the_gathering_again() -> None:
     stamps = np.concatenate([1.0 + np.arange(3) * 1e-3, 3.0 + np.arange(6) * 1e-3])
     out = engine.push(batch(stamps))
     assert out.stamps[0] == pytest.approx(3.0 + 4e-3)  # 5th sample after the gap
-
-
-def test_a_sag_of_metres_warns_of_units() -> None:
-    """Stiffness written in N/mm (a thousandth of N/m): the pump sags ~2.5 m at rest."""
-    import dataclasses
-
-    from io_helpers import default_scene
-
-    scene = default_scene()
-    soft = tuple(
-        dataclasses.replace(m, stiffness=tuple(k / 1000.0 for k in m.stiffness))  # type: ignore[union-attr]
-        for m in scene.mounts
-    )
-    engine = engine_for(dataclasses.replace(scene, mounts=soft))
-    engine.push(batch(1.0 + np.arange(10) * 1e-3))
-    report = engine.flush()
-    assert report is not None
-    (status,) = [s for s in report.statuses if s.name == "mount_twin: input"]
-    assert status.level == WARN
-    assert "m from its reference pose" in status.message and "N/mm" in status.message

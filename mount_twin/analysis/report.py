@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from mount_twin.errors import ModelError
 from mount_twin.io.output_tables import Table, read_output_bag
 from mount_twin.scene.description import Scene
 
@@ -103,15 +104,17 @@ def _table(head: list[str], rows: list[list[str]]) -> str:
 
 
 def _srs_section(stamps_ns: np.ndarray, f: np.ndarray) -> list[str]:
-    """The input's shock response spectra (5 % damping, first sample removed), per axis of F."""
-    from mount_twin.analysis.srs import octave_frequencies, srs
+    """The input's shock response spectra (5 % damping; gravity and bias taken out as
+    `mount-twin srs` does by default, the mean of a quiet head), per axis of F."""
+    from mount_twin.analysis.srs import gravity_offset, octave_frequencies, srs
 
     t = (stamps_ns - stamps_ns[0]) * 1e-9
     rate = (len(t) - 1) / float(t[-1]) if len(t) > 1 and t[-1] > 0 else 0.0
     if rate <= 0.0:
         return []
     freqs = octave_frequencies(5.0, min(2000.0, rate / 10.0), 6)
-    spectra = {axis: srs(f[:, k] - f[0, k], rate, freqs, 0.05) for k, axis in enumerate("xyz")}
+    offset, removed = gravity_offset(t, f)
+    spectra = {axis: srs(f[:, k] - offset[k], rate, freqs, 0.05) for k, axis in enumerate("xyz")}
 
     def draw(fig: Any) -> None:
         ax = fig.subplots()
@@ -134,7 +137,7 @@ def _srs_section(stamps_ns: np.ndarray, f: np.ndarray) -> list[str]:
         if k % 3 == 0
     ]
     return [
-        "<h2>Shock response spectra of the input (ζ = 5 %, first sample removed)</h2>",
+        f"<h2>Shock response spectra of the input (ζ = 5 %, {html.escape(removed)} removed)</h2>",
         _png(draw, (9, 4.5)),
         _table(["f Hz", "x g", "y g", "z g", "PV z m/s"], rows),
     ]
@@ -146,7 +149,7 @@ def _modes_section(scene: Scene) -> list[str]:
 
     try:
         result = modes(scene)
-    except Exception as err:  # a scene the modal analysis cannot linearise: said, not fatal
+    except (ModelError, np.linalg.LinAlgError) as err:  # no equilibrium or linearisation: said
         return ["<h2>Modes</h2>", f"<p>not computed: {html.escape(str(err))}</p>"]
     rows = []
     for i, m in enumerate(result.modes, 1):

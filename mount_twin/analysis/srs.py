@@ -147,3 +147,30 @@ def srs(
         pseudo_velocity=maximax / (2.0 * np.pi * f),
         accurate=f <= ACCURATE_SHARE * rate_hz,
     )
+
+
+GRAVITY_MODES = ("mean-head", "first", "none")
+"""How `gravity_offset` finds the constant to take out of a record."""
+HEAD_S = 0.01
+"""Default quiet head of a record for `mean-head`, s."""
+
+
+def gravity_offset(
+    t: np.ndarray, accel: np.ndarray, mode: str = "mean-head", head_s: float = HEAD_S
+) -> tuple[np.ndarray, str]:
+    """The per-axis constant (m/s²) to take out of a record (t s, accel (n, 3) m/s²) before its
+    spectra, and how it was found: `mean-head`, the mean over the first head_s s (which must be
+    quiet: gravity and bias, the noise averaged down); `first`, the first sample; `none`, zero
+    (a constant is then a step)."""
+    if mode == "none":
+        return np.zeros(3), "nothing"
+    if mode == "first":
+        return accel[0], "the first sample"
+    if mode != "mean-head":
+        msg = f"gravity mode {mode!r}: choose from {', '.join(GRAVITY_MODES)}"
+        raise ValueError(msg)
+    if not head_s > 0.0:
+        msg = f"--head {head_s} s: the quiet head must be longer than 0"
+        raise ValueError(msg)
+    count = int(np.count_nonzero(t - t[0] < head_s))
+    return accel[:count].mean(axis=0), f"the mean of the first {count} samples"

@@ -48,14 +48,14 @@ def run(args: argparse.Namespace) -> int:
         reference_run,
         run_at,
     )
+    from mount_twin.commands.common import load_scene
     from mount_twin.io.input_samples import read_samples
-    from mount_twin.scene.loader import load_scene_file
 
     if args.plot:
         from mount_twin.commands.extras import require
 
         require("matplotlib", "--plot")
-    loaded = load_scene_file(args.scene)
+    loaded = load_scene(args.scene)
     scene, samples = conditioned(loaded, read_samples(args.bag, loaded.input))
     duration = float(samples.stamps[-1] - samples.stamps[0])
     print(

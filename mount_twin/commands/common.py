@@ -1,7 +1,10 @@
-"""Pieces shared by several commands: where the bundled files are, writing a signal as a bag."""
+"""Pieces shared by several commands: where the bundled files are, loading a scene and saying
+what is implausible in it, writing a signal as a bag."""
 
 from __future__ import annotations
 
+import sys
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -9,6 +12,7 @@ from mount_twin.errors import MountTwinError
 
 if TYPE_CHECKING:
     from mount_twin.io.signals import Signal
+    from mount_twin.scene.description import Scene
 
 DEFAULT_SCENE = "pump_8_mounts.scene.yaml"
 DEFAULT_BAG = "ship_motion_1khz"
@@ -24,6 +28,23 @@ def share_dir() -> Path:
             return candidate
     msg = "cannot find mount_twin's config/ and bags/ (source tree or share/mount_twin)"
     raise MountTwinError(msg)
+
+
+def load_scene(path: str | Path, input_overrides: Mapping[str, str] | None = None) -> Scene:
+    """The scene file at `path`, with `input` fields replaced by `input_overrides` (checked like
+    the file's own); each of its warnings (units? a message type's convention?) is printed on
+    stderr, so that no command runs a scene it found implausible without saying so."""
+    from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
+
+    data = read_scene_yaml(path)
+    source = str(path)
+    if input_overrides:
+        data.setdefault("input", {}).update(input_overrides)
+        source += f" (with input {', '.join(sorted(input_overrides))} from the command line)"
+    scene = scene_from_dict(data, source, refuse_unheld=True)
+    for warning in scene.warnings:
+        print(f"mount-twin: warning: {warning}", file=sys.stderr)
+    return scene
 
 
 def write_signal(

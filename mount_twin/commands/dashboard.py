@@ -18,12 +18,12 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from mount_twin.analysis.dashboards import foxglove_layout, plotjuggler_layout
-    from mount_twin.scene.loader import load_scene_file
+    from mount_twin.commands.common import load_scene
 
     if not (args.plotjuggler or args.foxglove):
         msg = "give --plotjuggler XML and/or --foxglove JSON"
         raise ValueError(msg)
-    scene = load_scene_file(args.scene)
+    scene = load_scene(args.scene)
     for path, text in ((args.plotjuggler, plotjuggler_layout), (args.foxglove, foxglove_layout)):
         if path:
             Path(path).write_text(text(scene), encoding="utf-8")

@@ -20,9 +20,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     path = Path(args.path)
     if path.suffix in (".yaml", ".yml"):
-        from mount_twin.scene.loader import load_scene_file
+        from mount_twin.commands.common import load_scene
 
-        print(scene_text(load_scene_file(path)))
+        print(scene_text(load_scene(path)))
     else:
         from mount_twin.io.bag_info import bag_info
 

@@ -39,9 +39,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from mount_twin.analysis.modes import modes
-    from mount_twin.scene.loader import load_scene_file
+    from mount_twin.commands.common import load_scene
 
-    scene = load_scene_file(args.scene)
+    scene = load_scene(args.scene)
     result = modes(scene, geometric=not args.no_geometric)
     print(json.dumps(document(scene, result), indent=2) if args.json else table(scene, result))
     return 0

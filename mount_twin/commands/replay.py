@@ -87,15 +87,10 @@ def replay_and_report(
     """Replay, print the summary (and plot), and return the exit status (see `verdict`).
     `input_overrides`: scene `input` fields replaced (topic, frame_id), checked like the
     scene's own."""
+    from mount_twin.commands.common import load_scene
     from mount_twin.replay import replay
-    from mount_twin.scene.loader import load_scene_file, read_scene_yaml, scene_from_dict
 
-    if input_overrides:
-        data = read_scene_yaml(scene_path)
-        data.setdefault("input", {}).update(input_overrides)
-        scene = scene_from_dict(data, f"{scene_path} (with --topic/--frame-id)")
-    else:
-        scene = load_scene_file(scene_path)
+    scene = load_scene(scene_path, input_overrides)
     from mount_twin.commands.stopping import checkpoint
 
     summary = replay(scene, bag, output, chunk=chunk, progress=progress, checkpoint=checkpoint)

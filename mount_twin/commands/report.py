@@ -24,9 +24,9 @@ def run(args: argparse.Namespace) -> int:
 
     require("matplotlib", "mount-twin report")
     from mount_twin.analysis.report import write_report
-    from mount_twin.scene.loader import load_scene_file
+    from mount_twin.commands.common import load_scene
 
-    scene = load_scene_file(args.scene) if args.scene else None
+    scene = load_scene(args.scene) if args.scene else None
     samples = None
     if args.input:
         if scene is None:

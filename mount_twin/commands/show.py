@@ -20,7 +20,7 @@ def run(args: argparse.Namespace) -> int:
 
     require("matplotlib", "mount-twin show")
     from mount_twin.analysis.layout_view import draw_layout
-    from mount_twin.scene.loader import load_scene_file
+    from mount_twin.commands.common import load_scene
 
-    print(f"layout: {draw_layout(load_scene_file(args.scene), args.output)}")
+    print(f"layout: {draw_layout(load_scene(args.scene), args.output)}")
     return 0

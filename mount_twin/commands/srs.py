@@ -94,7 +94,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from mount_twin.analysis.srs import ACCURATE_SHARE, damping_ratio, octave_frequencies, srs
+    from mount_twin.analysis.srs import (
+        ACCURATE_SHARE,
+        damping_ratio,
+        gravity_offset,
+        octave_frequencies,
+        srs,
+    )
     from mount_twin.io.csv_import import G
 
     if args.plot:
@@ -105,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
     design = _design(args.design) if args.design else None
     t, accel, name = _record(args)
     rate = _rate(t, args.input)
-    offset, removed = _gravity(t, accel, args.gravity, args.head)
+    offset, removed = gravity_offset(t, accel, args.gravity, args.head)
     freqs = (
         np.array(args.freqs)
         if args.freqs
@@ -215,21 +221,6 @@ def _rate(t: np.ndarray, source: str) -> float:
         )
         raise ValueError(msg)
     return 1.0 / mean
-
-
-def _gravity(t: np.ndarray, accel: np.ndarray, mode: str, head_s: float) -> tuple[np.ndarray, str]:
-    """The per-axis constant (m/s²) to take out of the record, and how it was found."""
-    import numpy as np
-
-    if mode == "none":
-        return np.zeros(3), "nothing"
-    if mode == "first":
-        return accel[0], "the first sample"
-    if not head_s > 0.0:
-        msg = f"--head {head_s} s: the quiet head must be longer than 0"
-        raise ValueError(msg)
-    count = int(np.count_nonzero(t - t[0] < head_s))
-    return accel[:count].mean(axis=0), f"the mean of the first {count} samples"
 
 
 def _design(path: str) -> tuple[list[float], list[float]]:

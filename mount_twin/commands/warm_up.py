@@ -24,16 +24,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from mount_twin.commands.common import share_dir
+    from mount_twin.commands.common import load_scene, share_dir
     from mount_twin.replay import kernels_loading
-    from mount_twin.scene.loader import load_scene_file
     from mount_twin.stream import TwinStream
 
     scenes = args.scenes or sorted(str(p) for p in (share_dir() / "config").glob("*.scene.yaml"))
     start = time.perf_counter()
     for path in scenes:
         with kernels_loading():
-            TwinStream(load_scene_file(path))  # builds the engine, which loads its kernels
+            TwinStream(load_scene(path))  # builds the engine, which loads its kernels
         print(f"kernels ready for {path}")
     print(f"warm-up done in {time.perf_counter() - start:.1f} s")
     return 0

@@ -71,8 +71,6 @@ READING_LIMIT = 1e150
 """Largest |component| of an accepted reading, m/s² or rad/s: a larger one (a garbled message) is
 rejected as non_finite, and the rotation into F cannot overflow."""
 
-SAG_WARN_M = 0.1
-"""A start state this far (m) from the reference pose is reported: mounts sag millimetres."""
 
 MAX_EVENTS = 100_000
 """Mount events kept in TwinEngine.events (later ones are counted only)."""
@@ -691,8 +689,8 @@ class TwinEngine:
 
     def _check_start(self, stamp: float, f0: np.ndarray, gathered: np.ndarray) -> None:
         """Start checks on the start specific force f0 (m/s², F) and the samples it is the mean
-        of: its magnitude against g, its angle from +z of F, their spread (at rest?), and the
-        start state's sag from the reference pose (SAG_WARN_M: units?)."""
+        of: its magnitude against g, its angle from +z of F, and their spread (at rest?). An
+        implausible sag (units?) is the scene's load-time warning (scene.checks), not repeated."""
         spec, init = self.scene.input, self.scene.initial
         g, magnitude = spec.g, float(np.linalg.norm(f0))
         tilt = math.atan2(math.hypot(f0[0], f0[1]), f0[2])
@@ -719,22 +717,6 @@ class TwinEngine:
                     ERROR if tilt > 3.0 * init.tilt_tolerance_rad else WARN,
                     f"start specific force is {math.degrees(tilt):.1f}° from +z of F "
                     "(is input.sensor_rpy right?)",
-                )
-            )
-        sag = max(
-            (
-                abs(float(self._y[k]))
-                for k, d in enumerate(self.scene.dofs)
-                if d in ("x", "y", "z")
-            ),
-            default=0.0,
-        )
-        if sag > SAG_WARN_M:
-            notes.append(
-                (
-                    WARN,
-                    f"the body starts {sag:.3g} m from its reference pose: a static sag that "
-                    "large is implausible on mounts (stiffness in N/mm? mass in g?)",
                 )
             )
         if spread > init.gravity_tolerance * g:

@@ -105,6 +105,8 @@ class MountTwinNode(Node):
             + "outputs "
             + ", ".join(p.topic_name for p in self._pubs.values())
         )
+        for warning in self.scene.warnings:  # implausible values: units? a type's convention?
+            self.get_logger().warning(str(warning))
 
     def _create_outputs(self) -> dict[str, Publisher]:
         """A reliable publisher per output (unresolved topic → publisher); the mount frames on

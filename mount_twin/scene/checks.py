@@ -43,7 +43,7 @@ STIFFNESS_LIMIT = 1.0e13
 20 mm thick (bolted steel joints are ~1e9 N/m); more is a unit error."""
 SAG_WARN_M = 0.1
 """Static sag under the weight, m, past which a scene is implausible: mounts sag millimetres
-(a 1.6 Hz bounce sags 0.1 m); the engine's start check uses the same figure."""
+(a 1.6 Hz bounce sags 0.1 m)."""
 FAR_FACTOR = 10.0
 """A mount farther from the CG than this many radii of gyration lies outside the body."""
 GYRATION_WARN_M = 30.0

@@ -94,7 +94,9 @@ def run_case(base: dict[str, Any], source: str, case: Case) -> dict[str, Any]:
         row[key if op == "set" else f"{key} (scale)"] = json.dumps(value)
     t0 = time.perf_counter()
     try:
-        scene = scene_from_dict(apply(base, case.settings), f"{source} case {case.case_id}")
+        scene = scene_from_dict(
+            apply(base, case.settings), f"{source} case {case.case_id}", refuse_unheld=True
+        )
         samples = _input_samples(case.input, scene.input)
         row.update(_figures(scene, samples))
     except (MountTwinError, ValueError, KeyError, OSError) as err:

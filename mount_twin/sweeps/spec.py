@@ -71,7 +71,7 @@ def load_sweep(path: str | Path) -> SweepSpec:
     top = Reader(data, str(path))
     base_path = (path.parent / top.string("base")).resolve()
     base = read_scene_yaml(base_path)
-    scene_from_dict(base, str(base_path))  # the base itself must be a valid scene
+    scene_from_dict(base, str(base_path), refuse_unheld=True)  # the base must be a valid scene
     raw_vary = top.raw("vary", [])
     if not isinstance(raw_vary, list):
         raise top.error("vary", f"expected a list of variations, got {raw_vary!r}")
