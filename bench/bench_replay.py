@@ -2,7 +2,8 @@
 
     python3 bench/bench_replay.py [--seconds 10]
 
-1. engine alone: decode raw Imu bytes, integrate, compute outputs (no encoding, no bag I/O);
+1. engine alone: decode raw Imu bytes, integrate, compute outputs (no encoding, no bag I/O),
+   with the live error estimate (the default) and without it;
 2. end-to-end replay writing every output at the input rate;
 3. end-to-end replay at a 100 Hz output rate (decimation 10, peaks held).
 """
@@ -70,6 +71,8 @@ def main_bench() -> None:
             ]
         )
         rtf_engine = engine_alone(scene, bag)
+        off = dataclasses.replace(scene.integration, error_estimate=False)
+        rtf_no_estimate = engine_alone(dataclasses.replace(scene, integration=off), bag)
         every = replay(scene, bag, Path(tmp) / "out1", progress=False)
         slow = dataclasses.replace(
             scene, outputs=dataclasses.replace(scene.outputs, decimation=10)
@@ -80,6 +83,7 @@ def main_bench() -> None:
         f"{args.seconds:g} s"
     )
     print(f"  engine alone (decode, integrate, outputs): {rtf_engine:7.1f} x real")
+    print(f"  engine alone, error_estimate: false:       {rtf_no_estimate:7.1f} x real")
     print(
         f"  replay, every output at 1 kHz:             {every.real_time_factor:7.1f} x real"
         f"  ({every.written} messages)"

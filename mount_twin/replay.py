@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import threading
 import time
@@ -14,6 +15,7 @@ import numpy as np
 from tqdm import tqdm
 
 from mount_twin.engine.batch import LEVEL_NAMES, OK, HealthReport, HealthStatus, MountEvent
+from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.health import tilt_from_quaternions
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import TF, TF_STATIC_TOPIC, output_types, resolve, static_transforms
@@ -55,6 +57,18 @@ def kernels_loading(notice: bool = True) -> Iterator[None]:
         timer.cancel()
 
 
+def _estimate_text(est: ErrorEstimate | None) -> str:
+    if est is None:
+        return "estimated integration error: not estimated (integration.error_estimate: false)"
+    text = (
+        f"estimated integration error: mount forces {est.force_error_rel:.2g} of the largest "
+        f"({est.force_error_n:.3g} N), attitude {est.attitude_error_rad:.2g} rad"
+    )
+    if est.resyncs:
+        text += f" (the estimate lost its history {est.resyncs} times: a lower bound)"
+    return text
+
+
 @dataclass
 class ReplaySummary:
     """What a replay did: counts, figures and per-mount peaks (N, N·m in mount axes)."""
@@ -74,6 +88,7 @@ class ReplaySummary:
     origin_s: int = 0  # whole seconds to add to event stamps to get header stamps
     wrong_frame_id: str | None = None  # the last header.frame_id rejected as wrong, if any
     start_s: float = 0.0  # engine seconds of the first output (event times count from it)
+    error_estimate: ErrorEstimate | None = None  # the live estimate over the run (None: off)
 
     @property
     def worst_level(self) -> int:
@@ -99,6 +114,7 @@ class ReplaySummary:
             f"{self.wall_s:.2f} s wall: real-time factor {self.real_time_factor:.1f}",
             f"  max CG displacement {self.displacement_max_m * 1e3:.3f} mm, "
             f"max tilt {np.degrees(self.tilt_max_rad):.4f} deg",
+            f"  {_estimate_text(self.error_estimate)}",
             "  peak mount loads (largest magnitude, mount axes): Fx Fy Fz [N]  Mx My Mz [N·m]",
         ]
         for name, peak in self.peak_wrench.items():
@@ -136,6 +152,9 @@ class ReplaySummary:
             "real_time_factor": self.real_time_factor,
             "max_cg_displacement_m": self.displacement_max_m,
             "max_tilt_rad": self.tilt_max_rad,
+            "error_estimate": dataclasses.asdict(self.error_estimate)
+            if self.error_estimate
+            else None,
             "mounts": {
                 name: {
                     "peak_force_N": [float(v) for v in peak[:3]],
@@ -269,4 +288,5 @@ def replay(
         stream.engine.health.origin_s,
         stream.engine.health.last_wrong_frame_id,
         float(first_stamp) if first_stamp is not None else 0.0,
+        stream.engine.error_estimate,
     )

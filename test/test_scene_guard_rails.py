@@ -54,14 +54,14 @@ def _warnings(scene: Scene) -> dict[str, str]:
 
 # ------------------------------------------------------------------ 1. duplicate keys
 def test_a_key_given_twice_is_an_error_naming_the_lines(tmp_path: Path) -> None:
-    text = (
-        _pump_text()
-        + "mounts:\n  - {name: x, position: [0, 0, 0], stiffness: [1, 1, 1, 0, 0, 0]}\n"
-    )
+    pump = _pump_text()
+    text = pump + "mounts:\n  - {name: x, position: [0, 0, 0], stiffness: [1, 1, 1, 0, 0, 0]}\n"
+    second = pump.count("\n") + 1  # the appended line
+    first = pump.splitlines().index("mounts:") + 1
     with pytest.raises(
         SceneError,
-        match=r"s\.scene\.yaml: <file>: line 105: key 'mounts' given twice in one "
-        r"mapping \(first on line 14\)",
+        match=rf"s\.scene\.yaml: <file>: line {second}: key 'mounts' given twice in one "
+        rf"mapping \(first on line {first}\)",
     ):
         load_scene_file(_file(tmp_path, text))
 

@@ -25,6 +25,7 @@ import numpy as np
 
 from mount_twin.engine.batch import OutputBatch, SampleBatch
 from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.gyro_filter import GyroConditioner
 from mount_twin.errors import MountTwinError
 from mount_twin.model.assemble import assemble
@@ -36,6 +37,7 @@ REFINE = 8
 REFERENCE_RTOLS = (1e-12, 1e-11, 1e-10)
 ATOL_PER_RTOL = 1e-3
 """atol = rtol · this (m, rad, m/s, rad/s: the state's units)."""
+NAN = float("nan")
 
 
 @dataclass(frozen=True)
@@ -48,6 +50,7 @@ class Run:
         wall_s: engine wall time, s.
         failures: stepper failures (each restarted the twin).
         substeps_per_sample: accepted + rejected steps per input interval.
+        estimate: the engine's own live error estimate (None: off).
     """
 
     rtol: float
@@ -56,6 +59,7 @@ class Run:
     wall_s: float
     failures: int
     substeps_per_sample: float
+    estimate: ErrorEstimate | None
 
 
 @dataclass(frozen=True)
@@ -65,11 +69,17 @@ class Accuracy:
     Attributes:
         rtol: the run's relative tolerance.
         force_error: max |F − F_ref| over samples, mounts, axes / max |F_ref|, −.
-        peak_force_error: max over mounts of |peak|F| − peak|F_ref|| / peak|F_ref|, −.
+        peak_force_error: max over mounts of |peak|F| − peak|F_ref|| / peak|F_ref|, −
+            (mounts that carry no force in the reference, such as a key that never closes its
+            clearance, have no peak to compare).
         attitude_error_rad: max |Δα|, |Δγ|, |Δδ|, rad.
         position_error_m: max |ΔCG| component, m.
         wall_s_per_sim_s: engine wall time per second of record, s/s.
         substeps_per_sample, failures: from the run.
+        est_force_error, est_attitude_error_rad: the run's live error estimate of force_error
+            and attitude_error_rad (NaN: not estimated).
+        estimate_cost: wall time with the live estimate over wall time without (NaN: not
+            estimated); wall_s_per_sim_s is without it.
     """
 
     rtol: float
@@ -80,6 +90,9 @@ class Accuracy:
     wall_s_per_sim_s: float
     substeps_per_sample: float
     failures: int
+    est_force_error: float
+    est_attitude_error_rad: float
+    estimate_cost: float
 
 
 def conditioned(scene: Scene, samples: SampleBatch) -> tuple[Scene, SampleBatch]:
@@ -112,11 +125,20 @@ def refined(scene: Scene, samples: SampleBatch, factor: int = REFINE) -> SampleB
     return SampleBatch(fine, hold(samples.accel), hold(samples.gyro), frames)
 
 
-def run_at(scene: Scene, samples: SampleBatch, rtol: float, max_substeps: int) -> Run:
+def run_at(
+    scene: Scene, samples: SampleBatch, rtol: float, max_substeps: int, estimate: bool = True
+) -> Run:
     """The twin over `samples` at `rtol` (atol = rtol·ATOL_PER_RTOL), every sample published
-    (the scene and samples as `conditioned` gives them)."""
+    (the scene and samples as `conditioned` gives them), with its live error estimate if
+    `estimate` (the wall time then includes the estimate's companion solution)."""
     atol = rtol * ATOL_PER_RTOL
-    integ = dataclasses.replace(scene.integration, rtol=rtol, atol=atol, max_substeps=max_substeps)
+    integ = dataclasses.replace(
+        scene.integration,
+        rtol=rtol,
+        atol=atol,
+        max_substeps=max_substeps,
+        error_estimate=estimate,
+    )
     outputs = dataclasses.replace(scene.outputs, decimation=1)
     engine = TwinEngine(assemble(dataclasses.replace(scene, integration=integ, outputs=outputs)))
     t0 = time.perf_counter()
@@ -125,7 +147,13 @@ def run_at(scene: Scene, samples: SampleBatch, rtol: float, max_substeps: int) -
     counts = engine.counts
     intervals = max(counts["accepted"] - counts["starts"], 1)
     return Run(
-        rtol, atol, out, wall, counts["integration_failures"], counts["substeps"] / intervals
+        rtol,
+        atol,
+        out,
+        wall,
+        counts["integration_failures"],
+        counts["substeps"] / intervals,
+        engine.error_estimate,
     )
 
 
@@ -134,7 +162,7 @@ def reference_run(scene: Scene, samples: SampleBatch, max_substeps: int) -> Run:
     stepper failure; its outputs at the record's own stamps."""
     fine = refined(scene, samples)
     for rtol in REFERENCE_RTOLS:
-        ref = run_at(scene, fine, rtol, max_substeps)
+        ref = run_at(scene, fine, rtol, max_substeps, estimate=False)
         if ref.failures == 0:
             at_samples = np.isin(ref.out.stamps, samples.stamps)
             return dataclasses.replace(ref, out=ref.out.select(at_samples))
@@ -147,8 +175,23 @@ def reference_run(scene: Scene, samples: SampleBatch, max_substeps: int) -> Run:
     raise MountTwinError(msg)
 
 
-def compare(run: Run, ref: Run, duration_s: float) -> Accuracy:
-    """The errors of `run` against `ref`, both over the same samples."""
+def measure(
+    scene: Scene, samples: SampleBatch, rtol: float, max_substeps: int, ref: Run
+) -> Accuracy:
+    """The twin at `rtol` against `ref`: timed without its live error estimate, then run again
+    with it (the outputs are the same: the estimate never touches the twin's state)."""
+    timed = run_at(scene, samples, rtol, max_substeps, estimate=False)
+    estimated = run_at(scene, samples, rtol, max_substeps, estimate=True)
+    duration = float(samples.stamps[-1] - samples.stamps[0])
+    return compare(timed, ref, duration, estimated)
+
+
+def compare(run: Run, ref: Run, duration_s: float, estimated: Run | None = None) -> Accuracy:
+    """The errors of `run` against `ref`, both over the same samples; the live estimate of
+    `estimated` (a run of the same twin with it on; default `run`) and its cost."""
+    estimated = estimated or run
+    est = estimated.estimate
+    cost = estimated.wall_s / run.wall_s if est is not None and estimated is not run else NAN
     out, want = run.out, ref.out
     if not np.array_equal(out.stamps, want.stamps):  # a failure skips no sample: same rows
         msg = "runs answer different samples"
@@ -157,13 +200,19 @@ def compare(run: Run, ref: Run, duration_s: float) -> Accuracy:
     peak = np.linalg.norm(force, axis=2).max(axis=0)
     peak_ref = np.linalg.norm(force_ref, axis=2).max(axis=0)
     scale = np.abs(force_ref).max()
+    loaded = peak_ref > 0.0
     return Accuracy(
         rtol=run.rtol,
-        force_error=float(np.abs(force - force_ref).max() / scale),
-        peak_force_error=float((np.abs(peak - peak_ref) / peak_ref).max()),
+        force_error=float(np.abs(force - force_ref).max() / scale) if scale > 0.0 else 0.0,
+        peak_force_error=float(
+            (np.abs(peak - peak_ref)[loaded] / peak_ref[loaded]).max(initial=0.0)
+        ),
         attitude_error_rad=float(np.abs(out.angles - want.angles).max()),
         position_error_m=float(np.abs(out.position - want.position).max()),
         wall_s_per_sim_s=run.wall_s / duration_s,
         substeps_per_sample=run.substeps_per_sample,
         failures=run.failures,
+        est_force_error=est.force_error_rel if est else NAN,
+        est_attitude_error_rad=est.attitude_error_rad if est else NAN,
+        estimate_cost=cost,
     )

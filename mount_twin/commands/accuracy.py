@@ -11,16 +11,6 @@ if TYPE_CHECKING:
 
 NAME = "accuracy"
 HELP = "error against run time of the twin on a scene and bag, per tolerance (work-precision)"
-COLUMNS = (
-    "rtol",
-    "force_error",
-    "peak_force_error",
-    "attitude_error_rad",
-    "position_error_m",
-    "wall_s_per_sim_s",
-    "substeps_per_sample",
-    "failures",
-)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -43,10 +33,9 @@ def run(args: argparse.Namespace) -> int:
     from mount_twin.analysis.accuracy import (
         DEFAULT_RTOLS,
         REFINE,
-        compare,
         conditioned,
+        measure,
         reference_run,
-        run_at,
     )
     from mount_twin.commands.common import load_scene
     from mount_twin.io.input_samples import read_samples
@@ -66,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
     rows = []
     for rtol in args.rtol or DEFAULT_RTOLS:
         print(f"  rtol {rtol:g} ...", file=sys.stderr, flush=True)
-        rows.append(compare(run_at(scene, samples, rtol, args.max_substeps), ref, duration))
+        rows.append(measure(scene, samples, rtol, args.max_substeps, ref))
     print(
         f"reference: the same twin at rtol {ref.rtol:g}, atol {ref.atol:g}, on the input "
         f"refined {REFINE}×"
@@ -83,15 +72,18 @@ def run(args: argparse.Namespace) -> int:
 
 def _table(rows: list[Accuracy]) -> str:
     head = (
-        f"{'rtol':>8} {'force err':>10} {'peak err':>10} {'attitude rad':>13} "
-        f"{'CG m':>10} {'wall s/s':>9} {'substeps':>9} {'failures':>8}"
+        f"{'rtol':>8} {'force err':>10} {'estimated':>10} {'peak err':>10} "
+        f"{'attitude rad':>13} {'estimated':>10} {'CG m':>10} {'wall s/s':>9} "
+        f"{'substeps':>9} {'failures':>8} {'est cost':>8}"
     )
     lines = [head]
     for r in rows:
         lines.append(
-            f"{r.rtol:>8.0e} {r.force_error:>10.2e} {r.peak_force_error:>10.2e} "
-            f"{r.attitude_error_rad:>13.2e} {r.position_error_m:>10.2e} "
-            f"{r.wall_s_per_sim_s:>9.4f} {r.substeps_per_sample:>9.2f} {r.failures:>8d}"
+            f"{r.rtol:>8.0e} {r.force_error:>10.2e} {r.est_force_error:>10.2e} "
+            f"{r.peak_force_error:>10.2e} {r.attitude_error_rad:>13.2e} "
+            f"{r.est_attitude_error_rad:>10.2e} {r.position_error_m:>10.2e} "
+            f"{r.wall_s_per_sim_s:>9.4f} {r.substeps_per_sample:>9.2f} {r.failures:>8d} "
+            f"{r.estimate_cost:>7.2f}×"
         )
     return "\n".join(lines)
 
@@ -100,12 +92,15 @@ def _write_csv(rows: list[Accuracy], path: str) -> None:
     import csv
     import dataclasses
 
+    from mount_twin.analysis.accuracy import Accuracy
+
     with open(path, "w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
-        writer.writerow(COLUMNS)
+        columns = [f.name for f in dataclasses.fields(Accuracy)]
+        writer.writerow(columns)
         for r in rows:
             values = dataclasses.asdict(r)
-            writer.writerow([f"{values[c]:.6g}" for c in COLUMNS])
+            writer.writerow([f"{values[c]:.6g}" for c in columns])
 
 
 def _plot(rows: list[Accuracy], ref: Run, png: str, title: str) -> None:
@@ -115,9 +110,12 @@ def _plot(rows: list[Accuracy], ref: Run, png: str, title: str) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 5))
+    wall = [r.wall_s_per_sim_s for r in rows]
     for name, label in (("force_error", "max mount force"), ("peak_force_error", "peak force")):
         err = [max(getattr(r, name), 1e-17) for r in rows]
-        ax.loglog([r.wall_s_per_sim_s for r in rows], err, "o-", label=f"{label} error")
+        ax.loglog(wall, err, "o-", label=f"{label} error")
+    est = [max(r.est_force_error, 1e-17) for r in rows]
+    ax.loglog(wall, est, "x:", color="k", label="max mount force error, the twin's live estimate")
     for i, r in enumerate(rows):
         ax.annotate(
             f"rtol {r.rtol:.0e}" + (f", {r.failures} failures" if r.failures else ""),
@@ -126,6 +124,8 @@ def _plot(rows: list[Accuracy], ref: Run, png: str, title: str) -> None:
             textcoords="offset points",
             xytext=(4, 4 + 9 * (i % 3)),  # staggered: close points stay readable
         )
+    shown = [max(getattr(r, n), 1e-17) for r in rows for n in ("force_error", "peak_force_error")]
+    ax.set_ylim(min(shown) / 3.0, max(shown) * 4.0)  # room for the labels inside the axes
     ax.set_xlabel("engine wall time per simulated second [s/s]")
     ax.set_ylabel(f"relative error against rtol {ref.rtol:.0e} [-]")
     ax.set_title(f"work-precision: {title}", fontsize=9)

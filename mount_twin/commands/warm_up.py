@@ -8,6 +8,7 @@ package starts warm; after `pip install` run it once by hand, or let the first r
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import time
 
 NAME = "warm-up"
@@ -19,7 +20,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "scenes",
         nargs="*",
         help="scene YAML files to warm for (default: the bundled scenes, which cover the "
-        "kernels' variants: linear mounts only, and with non-linear kinds)",
+        "kernels' variants: linear mounts only, and with non-linear kinds; each with and "
+        "without the error estimate)",
     )
 
 
@@ -31,8 +33,11 @@ def run(args: argparse.Namespace) -> int:
     scenes = args.scenes or sorted(str(p) for p in (share_dir() / "config").glob("*.scene.yaml"))
     start = time.perf_counter()
     for path in scenes:
-        with kernels_loading():
-            TwinStream(load_scene(path))  # builds the engine, which loads its kernels
-        print(f"kernels ready for {path}")
+        scene = load_scene(path)
+        for estimate in (True, False):  # integration.error_estimate compiles its own variant
+            integ = dataclasses.replace(scene.integration, error_estimate=estimate)
+            with kernels_loading():  # building the engine loads (or compiles) its kernels
+                TwinStream(dataclasses.replace(scene, integration=integ))
+        print(f"kernels ready for {path} (with and without the error estimate)")
     print(f"warm-up done in {time.perf_counter() - start:.1f} s")
     return 0

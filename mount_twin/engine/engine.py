@@ -23,6 +23,8 @@ from mount_twin.engine.batch import (
     OutputBatch,
     SampleBatch,
 )
+from mount_twin.engine.companion import Companion, new_companion, restart
+from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.gyro_filter import GyroConditioner
 from mount_twin.engine.health import PLATEAU_G, SATURATION_SHARE, HealthWindow
 from mount_twin.engine.kernel import (
@@ -171,6 +173,7 @@ class TwinEngine:
         )
         st = self.stepper
         self._integ = Integrator(st.method, st.settings, st.work2d, st.work1d, st.result)
+        self._companion = self._new_companion()
         # Fails now, at load, if the mounts cannot hold the body; and is the restart fallback.
         self._y_nominal = initial_state(model, self._gravity_up)
         self._warm_up()
@@ -189,11 +192,29 @@ class TwinEngine:
         watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
         samples = Samples(t, f, np.zeros((2, 3)))
         u, scratch = np.zeros(INPUT_SIZE), model.new_scratch()
-        run_samples(integ, model.arrays, scratch, u, y, samples, self._options, out, watch)
+        companion = self._new_companion()
+        run_samples(
+            integ, model.arrays, scratch, u, y, samples, self._options, out, watch, companion
+        )
         gyro = GyroConditioner(self.scene.input.gyro_filter, self.scene.input.gyro_cutoff_hz)
         gyro.rows(t[1:], np.zeros((1, 3)), 0.0)
         watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
         self._start_outputs(self._y_nominal.copy(), model.new_scratch(), watch)
+
+    def _new_companion(self) -> Companion | None:
+        """The error estimate's companion solution, or None if the scene turns it off."""
+        integ = self.scene.integration
+        if not integ.error_estimate:
+            return None
+        return new_companion(
+            self.stepper,
+            integ.rtol,
+            integ.atol,
+            integ.max_substeps,
+            self.model.new_scratch(),
+            self.model.n_mounts,
+            self._watch.g.shape,
+        )
 
     def _buffers(self, n: int, counter: np.ndarray, peak: np.ndarray) -> Published:
         """Output buffers for a run of n rows, with the decimation state to carry."""
@@ -211,6 +232,11 @@ class TwinEngine:
     def state(self) -> np.ndarray:
         """Current state vector (copy); names in `model.state_names`."""
         return self._y.copy()
+
+    @property
+    def error_estimate(self) -> ErrorEstimate | None:
+        """The estimated error of everything published so far (None: `error_estimate` off)."""
+        return None if self._companion is None else ErrorEstimate.of(self.health.estimate_run)
 
     @property
     def running(self) -> bool:
@@ -523,10 +549,14 @@ class TwinEngine:
                 self._options,
                 out_buf,
                 self._watch,
+                self._companion,
             )
             pose, wrenches, publish, step_log = out_buf[2:]
             self._drain_events()
             self.health.add_steps(step_log[1 : done + 1])
+            if self._companion is not None:
+                self.health.add_estimate(self._companion.figures)
+                self._companion.figures[:] = 0.0
             self.counts["substeps"] += int(step_log[1 : done + 1, 1:3].sum())
             if done > 0:
                 self._last = (float(t[done]), ff[done], ww[done])
@@ -685,6 +715,8 @@ class TwinEngine:
         self._counter[0] = 0
         self._last = (stamp, f[i].copy(), w0)
         pose, wrenches = self._start_outputs(self._y, self._scratch, self._watch)
+        if self._companion is not None:
+            restart(self._companion, self._y)
         return _Rows(np.array([i]), pose, wrenches)
 
     def _check_start(self, stamp: float, f0: np.ndarray, gathered: np.ndarray) -> None:

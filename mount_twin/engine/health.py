@@ -8,6 +8,13 @@ from collections import Counter
 import numpy as np
 
 from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus, MountEvent
+from mount_twin.engine.estimate import (
+    FORCE_SCALE,
+    N_FIGURES,
+    WARN_FORCE_ERROR_REL,
+    ErrorEstimate,
+    accumulate,
+)
 from mount_twin.physics import pose_row
 from mount_twin.scene.description import Scene
 
@@ -44,6 +51,8 @@ class HealthWindow:
         self._next_due: float | None = None
         self._reset()
         self._last_counts: Counter[str] = Counter()
+        self.estimate_run = np.zeros(N_FIGURES)
+        """The error estimate's figures over the whole run (`engine.companion`)."""
         self.stopped_at: float | None = None
         """Stamp (s) where a scene with a given initial motion failed: the twin follows no more
         (until the record restarts), and each report says so at ERROR."""
@@ -55,6 +64,7 @@ class HealthWindow:
         self.t_last = math.nan
         self.wall = 0.0
         self.err_max = 0.0
+        self.estimate = np.zeros(N_FIGURES)
         self.substeps = 0
         self.samples = 0
         self.tilt_max = 0.0
@@ -86,6 +96,11 @@ class HealthWindow:
             self.err_max = max(self.err_max, float(step_log[:, 0].max()))
             self.substeps += int(step_log[:, 1].sum() + step_log[:, 2].sum())
             self.samples += step_log.shape[0]
+
+    def add_estimate(self, figures: np.ndarray) -> None:
+        """The error estimate's companion figures since the last call (`engine.companion`)."""
+        accumulate(self.estimate, figures)
+        accumulate(self.estimate_run, figures)
 
     def add_outputs(self, stamps: np.ndarray, pose: np.ndarray, wrenches: np.ndarray) -> None:
         """Published rows: their stamps (s), poses and mount wrenches (N, N·m, mount axes)."""
@@ -240,14 +255,24 @@ class HealthWindow:
             step_text = f"stepper failed and the twin restarted: {fail_text}"
         else:
             step_text = "ok"
+        level = ERROR if self.failures or self.stopped_at is not None else OK
+        estimate = self._estimate_values()
+        rel = float(estimate["est_force_error_rel"]) if estimate else 0.0
+        if rel > WARN_FORCE_ERROR_REL:
+            level = max(level, WARN)
+            step_text = (
+                f"estimated mount-force error {rel:.2g} of the largest force: tighten "
+                "integration.rtol" + ("" if step_text == "ok" else f"; {step_text}")
+            )
         step = HealthStatus(
             f"{PREFIX}: integration",
-            ERROR if self.failures or self.stopped_at is not None else OK,
+            level,
             step_text,
             {
                 "method": self.method,
                 "rtol": f"{integ.rtol:g}",
                 "atol": f"{integ.atol:g}",
+                **estimate,
                 "error_norm_max": f"{self.err_max:.3g}",
                 "substeps_per_sample": f"{self.substeps / self.samples:.2f}"
                 if self.samples
@@ -269,6 +294,23 @@ class HealthWindow:
         mounts = self._mount_statuses(utilisation, active)
         self._reset()
         return HealthReport(stamp, sample, [inp, step, att, *mounts])
+
+    def _estimate_values(self) -> dict[str, str]:
+        """The period's estimated errors as diagnostic values (none: the estimate is off).
+
+        The relative force error is the period's largest |ΔF| over the largest |F| component
+        of the run so far."""
+        if not self.scene.integration.error_estimate:
+            return {}
+        period = self.estimate.copy()
+        period[FORCE_SCALE] = self.estimate_run[FORCE_SCALE]
+        est = ErrorEstimate.of(period)
+        return {
+            "est_force_error_rel": f"{est.force_error_rel:.2g}",
+            "est_force_error_n": f"{est.force_error_n:.3g}",
+            "est_attitude_error_rad": f"{est.attitude_error_rad:.2g}",
+            "est_resyncs": str(est.resyncs),
+        }
 
     def _mount_statuses(
         self, utilisation: np.ndarray, active: dict[str, list[tuple[str, bool]]]

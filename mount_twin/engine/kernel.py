@@ -11,6 +11,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from mount_twin.engine.companion import follow
 from mount_twin.integrate.settings import CHAINED
 from mount_twin.integrate.stepper import advance
 from mount_twin.physics.compiled import kernel
@@ -131,7 +132,7 @@ class Published(NamedTuple):
 
 
 @kernel
-def run_samples(integ, m, s, u, y, samples, opts, out, watch) -> tuple[int, int]:
+def run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> tuple[int, int]:
     """Advance y through samples 1..n−1 of `samples`; sample 0 is the last one already done.
 
     Args:
@@ -140,6 +141,8 @@ def run_samples(integ, m, s, u, y, samples, opts, out, watch) -> tuple[int, int]
         samples: `Samples`; opts: `RunOptions`; out: `Published` (buffers of n rows).
         watch: the non-linear mounts' event functions, utilisation peaks and event log
             (`Watch`); events are located by linear interpolation inside the sample interval.
+        companion: the error estimate's companion solution (`engine.companion.Companion`), or
+            None (compiled away).
 
     Returns:
         (index of the last sample done, stepper status: 0, or the failure at the next sample).
@@ -175,6 +178,7 @@ def run_samples(integ, m, s, u, y, samples, opts, out, watch) -> tuple[int, int]
         step_log[j, 0], step_log[j, 1], step_log[j, 2] = result[0], result[1], result[2]
         outputs(y, m, s, pose[j], wrenches[j])  # the stepper's last right-hand side was at y
         watch_mounts(y, m.nl, s, watch, t[j - 1], t[j], wrenches[j])
+        follow(m, companion, u, t[j - 1], t[j], opts.chain, d_wdot, pose[j], wrenches[j], y)
         counter[0] += 1
         for a in range(nm):
             for b in range(6):

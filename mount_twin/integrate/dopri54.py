@@ -20,7 +20,7 @@ from mount_twin.integrate.methods import (
     SUCCESS,
     TOO_MANY_STEPS,
 )
-from mount_twin.integrate.settings import ATOL, CHAINED, MAX_SUBSTEPS, RTOL, STEP
+from mount_twin.integrate.settings import ATOL, CHAINED, MAX_SUBSTEPS, MIN_STEPS, RTOL, STEP
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import rhs
 
@@ -58,10 +58,11 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
 
     Args:
         settings: [first trial step s (0: the whole interval; updated to the next proposal),
-            rtol, atol, most substeps, chain flag]. On success the last right-hand side
-            evaluated is the one at (t1, y), in k[0] (FSAL), and the flag is set to 1: callers
-            may take outputs from the scratch, and, having moved k[0] to the next interval's
-            input, leave the flag at 1 so that the next call starts from it; else they set 0.
+            rtol, atol, most substeps, chain flag, fewest steps] (`integrate.settings`). On
+            success the last right-hand side evaluated is the one at (t1, y), in k[0] (FSAL),
+            and the flag is set to 1: callers may take outputs from the scratch, and, having
+            moved k[0] to the next interval's input, leave the flag at 1 so that the next call
+            starts from it; else they set 0.
         k: (7, n) stage work array; y_new: (n,) work array.
         result: out (3,): largest accepted error norm, accepted and rejected step counts.
 
@@ -76,6 +77,7 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
     n = y.shape[0]
     span = t1 - t0
     h = span if h <= 0.0 else h
+    h_max = span / settings[MIN_STEPS]  # caps the steps taken, not the proposal carried on
     t = t0
     err_max, n_acc, n_rej = 0.0, 0, 0
     rhs_failed = False
@@ -92,8 +94,9 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
             if not_finite:
                 return NOT_FINITE
             return LEFT_CHART if rhs_failed else STEP_TOO_SMALL
-        last = t + h >= t1 - 1e-12 * span
-        step = t1 - t if last else h
+        step = min(h, h_max)
+        last = t + step >= t1 - 1e-12 * span
+        step = t1 - t if last else step
         ok = True
         for stage in range(1, 7):
             for i in range(n):

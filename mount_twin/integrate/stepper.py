@@ -23,7 +23,15 @@ from mount_twin.integrate.methods import (
     STATUS_TEXT,
     UNKNOWN_METHOD,
 )
-from mount_twin.integrate.settings import ATOL, CHAINED, MAX_SUBSTEPS, N_SETTINGS, RTOL, STEP
+from mount_twin.integrate.settings import (
+    ATOL,
+    CHAINED,
+    MAX_SUBSTEPS,
+    MIN_STEPS,
+    N_SETTINGS,
+    RTOL,
+    STEP,
+)
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import ModelArrays, Scratch
 
@@ -46,7 +54,7 @@ class Stepper:
         name: scene name of the method.
         method: its id for `advance`.
         settings: (N_SETTINGS,) by the slots of `integrate.settings` (STEP, RTOL, ATOL,
-            MAX_SUBSTEPS, CHAINED).
+            MAX_SUBSTEPS, CHAINED, MIN_STEPS).
         work2d, work1d: the method's work arrays.
         result: last advance's [largest accepted error norm, accepted, rejected substeps].
     """
@@ -64,18 +72,24 @@ class Stepper:
         self.settings[CHAINED] = 0.0
 
 
-def new_stepper(method: str, n: int, rtol: float, atol: float, max_substeps: int) -> Stepper:
+def new_stepper(
+    method: str, n: int, rtol: float, atol: float, max_substeps: int, min_steps: int = 1
+) -> Stepper:
     """A stepper of `method` (a name in METHODS) for n states; atol in the state's units (m,
-    rad, m/s, rad/s)."""
+    rad, m/s, rad/s); at least `min_steps` steps per input interval."""
     if method not in METHODS:
         msg = f"unknown integration method {method!r}; choose from {', '.join(METHODS)}"
         raise ValueError(msg)
-    if n <= 0 or not rtol > 0.0 or not atol > 0.0 or max_substeps < 1:
-        msg = f"bad stepper settings: n={n}, rtol={rtol}, atol={atol}, max={max_substeps}"
+    if n <= 0 or not rtol > 0.0 or not atol > 0.0 or not 1 <= min_steps <= max_substeps:
+        msg = (
+            f"bad stepper settings: n={n}, rtol={rtol}, atol={atol}, max={max_substeps}, "
+            f"min={min_steps}"
+        )
         raise ValueError(msg)
     spec = METHODS[method]
     settings = np.zeros(N_SETTINGS)
     settings[RTOL], settings[ATOL], settings[MAX_SUBSTEPS] = rtol, atol, float(max_substeps)
+    settings[MIN_STEPS] = float(min_steps)
     return Stepper(spec.name, spec.id, settings, np.zeros((spec.stages, n)), np.zeros(n))
 
 

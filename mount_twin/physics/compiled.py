@@ -50,6 +50,8 @@ COMPILED_SOURCES = (
     "integrate",
     "model",
     "engine/kernel.py",
+    "engine/companion.py",
+    "engine/estimate.py",
     "engine/gyro_filter.py",
 )
 """Package-relative directories (their *.py files) and files that define compiled functions or

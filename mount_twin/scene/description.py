@@ -141,12 +141,15 @@ class InitialState:
 
 @dataclass(frozen=True)
 class Integration:
-    """Stepper settings: method name, relative and absolute tolerance, substep limit per sample."""
+    """Stepper settings: method name, relative and absolute tolerance (atol in the state's
+    units: m, rad, m/s, rad/s), substep limit per sample, and whether a companion solution at
+    half the step estimates the error live (`engine.companion`)."""
 
     method: str = "dopri54"
     rtol: float = 1.0e-6
     atol: float = 1.0e-9
     max_substeps: int = 10000
+    error_estimate: bool = True
 
 
 @dataclass(frozen=True)

@@ -321,6 +321,7 @@ def _integration(r: Reader) -> Integration:
         rtol=r.number("rtol", d.rtol, lo=1.0e-13, hi=0.1),
         atol=r.positive("atol", d.atol),
         max_substeps=r.integer("max_substeps", d.max_substeps, lo=1),
+        error_estimate=r.boolean("error_estimate", d.error_estimate),
     )
     r.finish()
     return spec

@@ -1,0 +1,175 @@
+"""The live error estimate: a companion solution of the twin at half the step.
+
+Richardson's global error estimate (Hairer, Nørsett & Wanner, *Solving Ordinary Differential
+Equations I*, §II.4 and §II.12): integrate the same problem twice, the published solution y and
+a companion ŷ of smaller error e/r; then y − ŷ = (1 − 1/r)·e: the difference is the published
+solution's error, not a bound on a local error norm (which is what the stepper's `error_norm`
+is: it tracks rtol, not the error). The companion runs the twin's own method with rtol and atol
+divided by TOLERANCE_DIVISOR = 8 (an adaptive step's error, hence the global error, 8× smaller:
+r ≈ 8, the estimate 0.88·e) and at least two steps per input interval (the one step an interval
+bounds is halved: r = 2⁵ for Dormand–Prince 5, the estimate 0.97·e). Measured against a
+reference on smooth, stiff and non-smooth scenes, the estimate is 0.77–1.03 of the true error
+(test/test_error_estimate.py, README "Error estimate"). A divisor of 32 gave 0.93–1.3 but cost
+10× the integration on the bolted genset, where tight tolerances hunt across switches; 4 cost
+3× there and gave 0.54. The companion reads the same held input, takes the same discrete
+mount switches between samples, and restarts with the twin.
+
+Cost: about 2× the engine's integration time on smooth scenes, 4× on the bolted genset at
+rtol 1e-6; `integration.error_estimate: false` turns it off. It never touches the twin's state:
+the published numbers are identical with it on or off (test/test_error_estimate.py).
+
+Its figures, kept as `engine.estimate` lays them out, are running maxima since the engine last
+read them: the largest |ΔF| over mounts and force components (N, mount axes), the largest
+|Δα|, |Δγ|, |Δδ| (rad), the largest |F| component of the twin (N: the scale of a relative
+error), and the intervals where the companion's own stepper failed (it is then
+re-synchronised to the twin: the error carried until then is lost, and the estimate counts
+it).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from mount_twin.engine.estimate import (
+    ATTITUDE_ERROR,
+    FAILURES,
+    FORCE_ERROR,
+    FORCE_SCALE,
+    N_FIGURES,
+)
+from mount_twin.integrate.settings import CHAINED, STEP
+from mount_twin.integrate.stepper import Stepper, advance, new_stepper
+from mount_twin.physics import pose_row
+from mount_twin.physics.compiled import kernel
+from mount_twin.physics.dynamics import (
+    Scratch,
+    mount_monitors,
+    outputs,
+    rhs_after_rate_step,
+)
+from mount_twin.physics.gate import skip_if_none
+
+TOLERANCE_DIVISOR = 8.0
+"""The companion's rtol and atol are the twin's over this (see the module docstring)."""
+MIN_STEPS = 2
+"""The companion's fewest steps per input interval."""
+
+
+class Companion(NamedTuple):
+    """The companion solution's stepper, state and work arrays (compiled code reads these).
+
+    method, settings, work2d, work1d, result: its stepper (`integrate.stepper.Stepper`).
+    y: (n_state,) its state; s: its scratch; y_prev, g, util: its mount monitors' arrays.
+    pose: (pose_row.WIDTH,), wrenches: (n_mounts, 6): its outputs at the last sample.
+    figures: (N_FIGURES,) running maxima (see the module docstring), reset by the reader.
+    """
+
+    method: int
+    settings: np.ndarray
+    work2d: np.ndarray
+    work1d: np.ndarray
+    result: np.ndarray
+    y: np.ndarray
+    s: Scratch
+    y_prev: np.ndarray
+    g: np.ndarray
+    util: np.ndarray
+    pose: np.ndarray
+    wrenches: np.ndarray
+    figures: np.ndarray
+
+
+def new_companion(
+    stepper: Stepper,
+    rtol: float,
+    atol: float,
+    max_substeps: int,
+    scratch: Scratch,
+    n_mounts: int,
+    g_shape: tuple[int, int],
+) -> Companion:
+    """A companion of the twin whose stepper is `stepper` (same method and state length) at the
+    twin's tolerances rtol, atol; `scratch`: fresh work arrays of the model; g_shape: the shape
+    of the twin's mount event functions (non-linear mounts × events)."""
+    n = stepper.work1d.shape[0]
+    own = new_stepper(
+        stepper.name,
+        n,
+        rtol / TOLERANCE_DIVISOR,
+        atol / TOLERANCE_DIVISOR,
+        MIN_STEPS * max_substeps,
+        MIN_STEPS,
+    )
+    return Companion(
+        own.method,
+        own.settings,
+        own.work2d,
+        own.work1d,
+        own.result,
+        np.zeros(n),
+        scratch,
+        np.zeros(n),
+        np.full(g_shape, -1.0),
+        np.zeros(g_shape[0]),
+        np.zeros(pose_row.WIDTH),
+        np.zeros((n_mounts, 6)),
+        np.zeros(N_FIGURES),
+    )
+
+
+def restart(c: Companion, y: np.ndarray) -> None:
+    """Start the companion again from the twin's state y (a twin start or restart)."""
+    c.y[:] = y
+    c.y_prev[:] = y
+    c.settings[STEP] = 0.0
+    c.settings[CHAINED] = 0.0
+
+
+@kernel
+def _monitor(y, nl, y_prev, s, g, util) -> None:
+    """The companion's discrete mount switches at a sample (as the twin's watch takes them)."""
+    mount_monitors(y, y_prev, nl, s, g, util)
+    for i in range(y.shape[0]):
+        y_prev[i] = y[i]
+
+
+monitor = skip_if_none(_monitor)
+
+
+@kernel
+def _follow(m, c, u, t0, t1, chain, d_wdot, pose, wrenches, y) -> None:
+    """Advance the companion over [t0, t1] under the input u the twin just took, and fold the
+    differences of its outputs from the twin's (pose, wrenches: the twin's rows at t1; y its
+    state) into the figures."""
+    settings, figures = c.settings, c.figures
+    if chain and settings[CHAINED] == 1.0:
+        rhs_after_rate_step(m, c.s, d_wdot, c.work2d[0])
+    else:
+        settings[CHAINED] = 0.0
+    status = advance(c.method, c.y, t0, t1, settings, m, c.s, u, c.work2d, c.work1d, c.result)
+    if status != 0:  # re-synchronised to the twin: what it had carried is lost, and counted
+        for i in range(y.shape[0]):
+            c.y[i] = y[i]
+            c.y_prev[i] = y[i]
+        settings[STEP] = 0.0
+        settings[CHAINED] = 0.0
+        figures[FAILURES] += 1.0
+        return
+    outputs(c.y, m, c.s, c.pose, c.wrenches)
+    monitor(c.y, m.nl, c.y_prev, c.s, c.g, c.util)
+    force, scale = figures[FORCE_ERROR], figures[FORCE_SCALE]
+    for a in range(wrenches.shape[0]):
+        for b in range(3):
+            force = max(force, abs(wrenches[a, b] - c.wrenches[a, b]))
+            scale = max(scale, abs(wrenches[a, b]))
+    attitude = figures[ATTITUDE_ERROR]
+    for i in range(3):
+        k = pose_row.ANGLES + i
+        attitude = max(attitude, abs(pose[k] - c.pose[k]))
+    figures[FORCE_ERROR], figures[FORCE_SCALE], figures[ATTITUDE_ERROR] = force, scale, attitude
+
+
+follow = skip_if_none(_follow)
+"""`_follow`, or nothing when the companion (the second argument) is None: off."""

@@ -1,0 +1,157 @@
+"""The live error estimate is an error: within a small factor of the true error of the published
+mount forces and attitude (against a reference run at rtol 1e-12 on the input refined 8×,
+itself tied to scipy in test_accuracy.py), on smooth, stiff and non-smooth scenes; it never
+touches the published numbers; it is on /diagnostics and WARNs when the forces are off by more
+than a percent."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from io_helpers import CONFIG, ROOT, default_scene
+from kinds_helpers import kind_mount
+from physics_helpers import base_scene, mount
+
+from mount_twin.analysis.accuracy import conditioned, measure, reference_run, run_at
+from mount_twin.engine.batch import WARN, SampleBatch
+from mount_twin.engine.engine import TwinEngine
+from mount_twin.io.input_samples import read_samples
+from mount_twin.model.assemble import assemble
+from mount_twin.scene.description import Scene
+from mount_twin.scene.loader import load_scene_file, scene_from_dict
+
+G = 9.80665
+CORNERS = [(0.4, 0.3), (-0.4, 0.3), (-0.4, -0.3), (0.4, -0.3)]
+FACTOR = 2.0
+"""The estimate is asserted within this factor of the true error (the issue asks for 10)."""
+
+
+def _first(samples: SampleBatch, n: int) -> SampleBatch:
+    return SampleBatch(
+        samples.stamps[:n], samples.accel[:n], samples.gyro[:n], samples.frame_ids[:n]
+    )
+
+
+def _ship_motion(scene: Scene, seconds: float) -> tuple[Scene, SampleBatch]:
+    samples = read_samples(ROOT / "bags" / "ship_motion_1khz", scene.input)
+    return conditioned(scene, _first(samples, int(seconds * 1000) + 1))
+
+
+def _with_pump_input(data: dict) -> Scene:
+    pump = default_scene().input
+    data["input"] = {"topic": pump.topic, "frame_id": pump.frame_id, "msg_type": pump.msg_type}
+    return scene_from_dict(data, "<error estimate test>")
+
+
+def _stiff_light() -> tuple[Scene, SampleBatch]:
+    """10 kg on 4 × 1e9 N/m (modes of 2–6 kHz) under 1 kHz ship motion: the stepper runs at
+    its stability limit, where a loose tolerance gives percent errors."""
+    mounts = [
+        mount(f"m{i}", (x, y, 0.0), (1e9,) * 3 + (0,) * 3, (2e3,) * 3 + (0,) * 3)
+        for i, (x, y) in enumerate(CORNERS)
+    ]
+    scene = _with_pump_input(base_scene(10.0, [0.0, 0.0, 0.1], [1.0] * 3 + [0.0] * 3, mounts))
+    return _ship_motion(scene, 1.0)
+
+
+def _rubber_on_snubbers() -> tuple[Scene, SampleBatch]:
+    """200 kg on four hysteretic elastomers that hit their snubbers (3 mm gap, Hertzian
+    contact) under a 30 g, 5 ms half-sine at 10 kHz: non-smooth in the state (|ẋ| of
+    Bouc–Wen, contact onset)."""
+    mounts = [
+        kind_mount(
+            "elastomer",
+            f"r{i}",
+            (x, y, 0.0),
+            stiffness_linear=[1e5, 1e5, 2e5],
+            damping=[300.0, 300.0, 500.0],
+            hysteresis={"ratio": 0.6, "beta": 120.0, "gamma": 80.0},
+            snubber={"gap": 3e-3, "stiffness": 1e9, "exponent": 1.5, "axes": ["z"]},
+        )
+        for i, (x, y) in enumerate(CORNERS)
+    ]
+    scene = _with_pump_input(
+        base_scene(200.0, [0.0, 0.0, 0.3], [20.0, 30.0, 40.0, 0, 0, 0], mounts)
+    )
+    t = 1.0 + np.arange(2001) / 10_000.0
+    pulse = np.where((t > 1.02) & (t < 1.025), 30 * G * np.sin(math.pi * (t - 1.02) / 0.005), 0.0)
+    accel = np.column_stack([0.3 * pulse, np.zeros_like(t), G + pulse])
+    frames = [scene.input.frame_id] * t.shape[0]
+    return conditioned(scene, SampleBatch(t, accel, np.zeros_like(accel), frames))
+
+
+def _pump() -> tuple[Scene, SampleBatch]:
+    return _ship_motion(default_scene(), 2.0)
+
+
+CASES = {
+    "stiff_light": (_stiff_light, [1e-3, 1e-6]),
+    "rubber_on_snubbers": (_rubber_on_snubbers, [1e-3, 1e-6]),
+    "pump_ship_motion": (_pump, [1e-4]),
+}
+
+
+@pytest.mark.parametrize(
+    ("case", "rtol"), [(c, r) for c, (_, rtols) in CASES.items() for r in rtols]
+)
+def test_the_estimate_is_within_a_factor_two_of_the_true_error(case: str, rtol: float) -> None:
+    build, _ = CASES[case]
+    scene, samples = build()
+    ref = reference_run(scene, samples, 1_000_000)
+    acc = measure(scene, samples, rtol, 100_000, ref)
+    assert acc.failures == 0
+    assert acc.force_error > 1e-12, "an error worth estimating, above rounding"
+    assert 1 / FACTOR < acc.est_force_error / acc.force_error < FACTOR, acc
+    if acc.attitude_error_rad > 1e-13:
+        assert 1 / FACTOR < acc.est_attitude_error_rad / acc.attitude_error_rad < FACTOR, acc
+
+
+@pytest.mark.parametrize("case", ["rubber_on_snubbers", "pump_ship_motion"])
+def test_the_estimate_never_changes_what_is_published(case: str) -> None:
+    """Bit for bit: the companion has its own state, scratch and mount switches."""
+    scene, samples = CASES[case][0]()
+    on, off = (run_at(scene, samples, 1e-5, 100_000, estimate=e) for e in (True, False))
+    assert on.estimate is not None and off.estimate is None
+    for field in ("wrenches", "position", "angles", "quaternion"):
+        np.testing.assert_array_equal(getattr(on.out, field), getattr(off.out, field))
+
+
+def _integration_status(scene: Scene, samples: SampleBatch):
+    """The engine after the run, and its worst integration status of the run."""
+    engine = TwinEngine(assemble(scene))
+    reports = list(engine.push(samples).health)
+    final = engine.flush()
+    reports += [final] if final is not None else []
+    statuses = [s for r in reports for s in r.statuses if s.name == "mount_twin: integration"]
+    return engine, max(statuses, key=lambda s: s.level)
+
+
+def test_a_loose_tolerance_on_a_stiff_scene_warns_with_the_estimate() -> None:
+    scene, samples = _stiff_light()
+    loose = dataclasses.replace(scene.integration, rtol=1e-3, atol=1e-6)
+    engine, status = _integration_status(dataclasses.replace(scene, integration=loose), samples)
+    estimate = engine.error_estimate
+    assert estimate is not None and estimate.force_error_rel > 0.01
+    assert status.level == WARN
+    assert "estimated mount-force error" in status.message and "rtol" in status.message
+    assert float(status.values["est_force_error_rel"]) > 0.01
+    assert float(status.values["est_force_error_n"]) > 0.0
+
+
+def test_the_bundled_scene_reports_a_tiny_estimate_and_it_can_be_turned_off() -> None:
+    scene, samples = _pump()
+    engine, status = _integration_status(scene, samples)
+    assert status.level == 0
+    assert 0.0 < float(status.values["est_force_error_rel"]) < 1e-6
+    assert status.values["est_resyncs"] == "0"
+    off = dataclasses.replace(scene.integration, error_estimate=False)
+    engine, status = _integration_status(dataclasses.replace(scene, integration=off), samples)
+    assert engine.error_estimate is None
+    assert not any(k.startswith("est_") for k in status.values)
+
+
+def test_the_genset_scene_file_loads_with_the_estimate_on_by_default() -> None:
+    assert load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml").integration.error_estimate
