@@ -103,6 +103,22 @@ def base_scene(
     return data
 
 
+def free_body(
+    inertia: list[float], omega0: np.ndarray, v0: tuple[float, ...] = (0.0, 0.0, 0.0)
+) -> dict[str, Any]:
+    """A 10 kg body held by nothing (one mount of zero stiffness), CG 0.3 m above F's origin,
+    started at the identity pose with CG velocity v0 (m/s, F) and body rate omega0 (rad/s,
+    B): a torque-free flight under zero specific force."""
+    rates = np.linalg.solve(kinematic_matrix_ref(0.0, 0.0), omega0)
+    return base_scene(
+        10.0,
+        [0.0, 0.0, 0.3],
+        inertia,
+        [mount("nothing", [0.0, 0.0, 0.0], [0.0] * 6)],
+        initial={"mode": "given", "pose": [0.0] * 6, "velocity": [*v0, *rates]},
+    )
+
+
 def build(data: dict[str, Any]) -> Model:
     """Validated, assembled model of a scene mapping."""
     return assemble(scene_from_dict(data, "<physics test>"))

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 from io_helpers import batch
-from physics_helpers import base_scene, kinematic_matrix_ref, mount
+from physics_helpers import free_body
 
 from mount_twin.engine.batch import ERROR
 from mount_twin.engine.engine import TwinEngine
@@ -17,14 +17,7 @@ OMEGA0 = np.array([4.0, 0.3, 0.5])  # rad/s in B, about the axis of least inerti
 
 
 def _tumbling_engine() -> TwinEngine:
-    rates = np.linalg.solve(kinematic_matrix_ref(0.0, 0.0), OMEGA0)
-    data = base_scene(
-        10.0,
-        [0.0, 0.0, 0.3],
-        [2.0, 3.0, 4.0, 0.0, 0.0, 0.0],
-        [mount("nothing", [0.0, 0.0, 0.0], [0.0] * 6)],
-        initial={"mode": "given", "pose": [0.0] * 6, "velocity": [0.0, 0.0, 0.0, *rates]},
-    )
+    data = free_body([2.0, 3.0, 4.0, 0.0, 0.0, 0.0], OMEGA0)
     data["outputs"] = {"diagnostics_period_s": 0.5}
     return TwinEngine(assemble(scene_from_dict(data, "<tumble>")))
 

@@ -12,13 +12,12 @@ import math
 import numpy as np
 import pytest
 from physics_helpers import (
-    base_scene,
     build,
     chart_to_matrix_ref,
+    free_body,
     inertia_tensor,
     integrate_twin,
     kinematic_matrix_ref,
-    mount,
     rotation_angle_between,
     torque_free_reference,
 )
@@ -36,14 +35,7 @@ def tumble():
     """Twin run and quaternion reference on the same time grid."""
     inertia = inertia_tensor(*INERTIA6)
     chart_rates0 = np.linalg.solve(kinematic_matrix_ref(0.0, 0.0), OMEGA0)
-    data = base_scene(
-        10.0,
-        [0.0, 0.0, 0.3],
-        INERTIA6,
-        [mount("nothing", [0.0, 0.0, 0.0], [0.0] * 6)],
-        initial={"mode": "given", "pose": [0.0] * 6, "velocity": [*V0, *chart_rates0]},
-    )
-    model = build(data)
+    model = build(free_body(INERTIA6, OMEGA0, tuple(V0)))
     y0 = np.concatenate([np.zeros(6), V0, chart_rates0])
     ys = integrate_twin(model, y0, TIMES, np.zeros(13), rtol=1e-10, atol=1e-12)
     ref = torque_free_reference(inertia, OMEGA0, TIMES)
