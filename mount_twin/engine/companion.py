@@ -40,7 +40,7 @@ from mount_twin.engine.estimate import (
     N_FIGURES,
 )
 from mount_twin.integrate.settings import CHAINED, STEP
-from mount_twin.integrate.stepper import Stepper, advance, new_stepper
+from mount_twin.integrate.stepper import advance, new_stepper
 from mount_twin.physics import pose_row
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import (
@@ -82,7 +82,8 @@ class Companion(NamedTuple):
 
 
 def new_companion(
-    stepper: Stepper,
+    method: str,
+    n: int,
     rtol: float,
     atol: float,
     max_substeps: int,
@@ -90,12 +91,12 @@ def new_companion(
     n_mounts: int,
     g_shape: tuple[int, int],
 ) -> Companion:
-    """A companion of the twin whose stepper is `stepper` (same method and state length) at the
-    twin's tolerances rtol, atol; `scratch`: fresh work arrays of the model; g_shape: the shape
-    of the twin's mount event functions (non-linear mounts × events)."""
-    n = stepper.work1d.shape[0]
+    """A companion of a twin of n states integrated by `method` (a name, or AUTO: then
+    `switch` it with the twin) at the twin's tolerances rtol, atol; `scratch`: fresh work
+    arrays of the model; g_shape: the shape of the twin's mount event functions (non-linear
+    mounts × events)."""
     own = new_stepper(
-        stepper.name,
+        method,
         n,
         rtol / TOLERANCE_DIVISOR,
         atol / TOLERANCE_DIVISOR,
@@ -117,6 +118,13 @@ def new_companion(
         np.zeros((n_mounts, 6)),
         np.zeros(N_FIGURES),
     )
+
+
+def switch(c: Companion, method: int) -> Companion:
+    """The companion running `method` (an id; its work arrays were made for AUTO) afresh."""
+    c.settings[STEP] = 0.0
+    c.settings[CHAINED] = 0.0
+    return c._replace(method=method)
 
 
 def restart(c: Companion, y: np.ndarray) -> None:

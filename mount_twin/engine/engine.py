@@ -24,6 +24,7 @@ from mount_twin.engine.batch import (
     SampleBatch,
 )
 from mount_twin.engine.companion import Companion, new_companion, restart
+from mount_twin.engine.companion import switch as switch_companion
 from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.gyro_filter import GyroConditioner
 from mount_twin.engine.health import PLATEAU_G, SATURATION_SHARE, HealthWindow
@@ -38,9 +39,11 @@ from mount_twin.engine.kernel import (
 )
 from mount_twin.engine.linear_rating import LinearRatings
 from mount_twin.errors import ModelError
-from mount_twin.integrate.stepper import STATUS_TEXT, STEPPERS
+from mount_twin.integrate.methods import AUTO, choose
+from mount_twin.integrate.stepper import STATUS_TEXT, new_stepper, switch
 from mount_twin.kinds import KINDS, N_EVENTS
 from mount_twin.model.assemble import Model, initial_state
+from mount_twin.model.stiffness import spectral_radius
 from mount_twin.physics import pose_row
 from mount_twin.physics.dynamics import INPUT_SIZE, Scratch, evaluate, mount_monitors
 
@@ -123,8 +126,8 @@ class TwinEngine:
         self.scene = scene
         self._clock = clock
         integ = scene.integration
-        self.stepper = STEPPERS[integ.method](
-            model.n_state, integ.rtol, integ.atol, integ.max_substeps
+        self.stepper = new_stepper(
+            integ.method, model.n_state, integ.rtol, integ.atol, integ.max_substeps
         )
         self._scratch = model.new_scratch()
         self._u = np.zeros(INPUT_SIZE)
@@ -176,6 +179,10 @@ class TwinEngine:
         self._companion = self._new_companion()
         # Fails now, at load, if the mounts cannot hold the body; and is the restart fallback.
         self._y_nominal = initial_state(model, self._gravity_up)
+        self._rho: float | None = None
+        """Spectral radius at the nominal start, rad/s, while `auto` has not chosen yet."""
+        if integ.method == AUTO:
+            self._rho = spectral_radius(model, self._y_nominal, self._gravity_up)
         self._warm_up()
 
     def _warm_up(self) -> None:
@@ -201,13 +208,26 @@ class TwinEngine:
         watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
         self._start_outputs(self._y_nominal.copy(), model.new_scratch(), watch)
 
+    def _choose_method(self, interval_s: float) -> None:
+        """`auto`: the method for this scene at this sample interval (`methods.choose`)."""
+        rho_dt = (self._rho or 0.0) * interval_s
+        name = choose(rho_dt)
+        switch(self.stepper, name)
+        st = self.stepper
+        self._integ = Integrator(st.method, st.settings, st.work2d, st.work1d, st.result)
+        if self._companion is not None:
+            self._companion = switch_companion(self._companion, st.method)
+        self.health.method = f"{name} (auto: ρ·Δt = {rho_dt:.3g})"
+        self._rho = None
+
     def _new_companion(self) -> Companion | None:
         """The error estimate's companion solution, or None if the scene turns it off."""
         integ = self.scene.integration
         if not integ.error_estimate:
             return None
         return new_companion(
-            self.stepper,
+            integ.method,
+            self.model.n_state,
             integ.rtol,
             integ.atol,
             integ.max_substeps,
@@ -531,6 +551,8 @@ class TwinEngine:
                 return out
             out.append(self._start(index[0], stamps, f, w, gathered))
             index = index[1:]
+        if index and self._rho is not None:
+            self._choose_method(float(stamps[index[0]]) - self._last[0])  # type: ignore[index]
         while index:
             t0, f0, w0 = self._last  # type: ignore[misc]
             n = len(index) + 1

@@ -13,12 +13,16 @@ import math
 
 import numpy as np
 
+from mount_twin.integrate.control import (
+    MIN_STEP_FRACTION,
+    OFF_CHART_SHRINK,
+    give_up,
+    next_proposal,
+    step_factor,
+    trial_step,
+)
 from mount_twin.integrate.methods import (
-    LEFT_CHART,
-    NOT_FINITE,
-    STEP_TOO_SMALL,
     SUCCESS,
-    TOO_MANY_STEPS,
 )
 from mount_twin.integrate.settings import ATOL, CHAINED, MAX_SUBSTEPS, MIN_STEPS, RTOL, STEP
 from mount_twin.physics.compiled import kernel
@@ -43,10 +47,7 @@ FSAL = True
 """The last stage is evaluated at (t + h, y_new): it is the next step's first."""
 ORDER = 4
 """Order of the error estimate (the step-size controller's exponent is −1/(ORDER + 1))."""
-SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
-OFF_CHART_SHRINK = 0.25
-MIN_STEP_FRACTION = 1e-12
-"""A step shorter than this fraction of the interval is a failure."""
+MAX_FACTOR = 10.0
 
 
 @kernel
@@ -86,17 +87,13 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
         rhs_failed = rhs(t, y, m, s, u, k[0]) != 0
     settings[CHAINED] = 0.0  # set again below on success: k[0] is then dy/dt at (t1, y)
     while t < t1:
-        if n_acc + n_rej >= max_steps:
+        # a step too small, or the start state itself off the chart (no step can help)
+        too_small = h < MIN_STEP_FRACTION * span or (rhs_failed and n_acc == 0 and t == t0)
+        status = give_up(n_acc + n_rej, max_steps, too_small, not_finite, rhs_failed)
+        if status != SUCCESS:
             settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
-            return NOT_FINITE if not_finite else TOO_MANY_STEPS
-        if h < MIN_STEP_FRACTION * span or (rhs_failed and n_acc == 0 and t == t0):
-            settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
-            if not_finite:
-                return NOT_FINITE
-            return LEFT_CHART if rhs_failed else STEP_TOO_SMALL
-        step = min(h, h_max)
-        last = t + step >= t1 - 1e-12 * span
-        step = t1 - t if last else step
+            return status
+        step, last = trial_step(t, t1, h, h_max, span)
         ok = True
         for stage in range(1, 7):
             for i in range(n):
@@ -128,12 +125,7 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
         err = math.sqrt(err / n)
         # NaN or inf: rejected below and shrunk by the most; if it persists, NOT_FINITE
         not_finite = not math.isfinite(err)
-        if not_finite:
-            factor = MIN_FACTOR
-        elif err == 0.0:
-            factor = MAX_FACTOR
-        else:
-            factor = min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err ** (-1.0 / (ORDER + 1))))
+        factor = step_factor(err, not_finite, ORDER, MAX_FACTOR)
         if err <= 1.0:
             t = t1 if last else t + step
             for i in range(n):
@@ -141,8 +133,7 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
                 k[0, i] = k[6, i]
             err_max = max(err_max, err)
             n_acc += 1
-            # keep the proposal from a full step, not from a last step clipped to the interval
-            h = step * factor if (not last or step >= h) else h
+            h = next_proposal(step, h, factor, last)
         else:
             h = step * min(1.0, factor)
             n_rej += 1

@@ -5,9 +5,9 @@ factories and its compiled switch from it; every method's compiled `advance` ret
 statuses below and the engine reports `STATUS_TEXT` of a failure. Pure Python (no numba): the
 scene loader imports it.
 
-Adding a method: a module with its coefficient table and compiled `advance` (see `dopri54`), an
-entry here, and a branch in `stepper.advance` (test/test_integrate_methods.py checks the tables
-and that every method here is dispatched).
+Adding a method: a module with its coefficient table and compiled `advance` (see `dopri54`,
+`ros34pw2`), an entry here, and a branch in `stepper.advance` (test/test_integrate_methods.py
+checks the tables and that every method here is dispatched).
 """
 
 from __future__ import annotations
@@ -34,15 +34,18 @@ STATUS_TEXT: dict[int, str] = {
 
 @dataclass(frozen=True)
 class Method:
-    """An explicit embedded Runge–Kutta method.
+    """An embedded method: explicit Runge–Kutta, or linearly implicit (Rosenbrock).
 
     Attributes:
         name: scene name (`integration.method`).
         id: its branch in the compiled `stepper.advance`.
-        module: the module holding its tables (C, A, B, E as numpy arrays; ORDER, the order of
-            the error estimate; FSAL) and its compiled `advance`.
+        module: the module holding its tables (explicit: C, A, B, E as numpy arrays and FSAL;
+            Rosenbrock: ALPHA, GAMMAS, GAMMA, B, B_HAT; both ORDER, the order of the error
+            estimate) and its compiled `advance`.
         order: order of the solution it propagates.
-        stages: rows of its stage work array (stages, the FSAL one included).
+        stages: fixed rows of its work array (explicit: the stages, the FSAL one included).
+        square_blocks: further rows per state (n×n blocks: the Rosenbrock's J and LU).
+        implicit: linearly implicit (stable for stiff scenes, a Jacobian per interval).
         summary: one line for parameter descriptions.
     """
 
@@ -52,6 +55,12 @@ class Method:
     order: int
     stages: int
     summary: str
+    square_blocks: int = 0
+    implicit: bool = False
+
+    def work_rows(self, n: int) -> int:
+        """Rows of n of the work array for n states."""
+        return self.stages + self.square_blocks * n
 
 
 METHODS: dict[str, Method] = {
@@ -65,8 +74,33 @@ METHODS: dict[str, Method] = {
             7,
             "adaptive Dormand–Prince 5(4) inside each sample interval",
         ),
+        Method(
+            "ros34pw2",
+            1,
+            "mount_twin.integrate.ros34pw2",
+            3,
+            10,
+            "L-stable Rosenbrock-W 3(2) for stiff scenes (a Jacobian per sample interval)",
+            square_blocks=2,
+            implicit=True,
+        ),
     )
 }
 """Methods by scene name; ids are distinct (test/test_integrate_methods.py)."""
 
 DOPRI54 = METHODS["dopri54"].id
+ROS34PW2 = METHODS["ros34pw2"].id
+
+AUTO = "auto"
+"""`integration.method: auto` (the default): `choose` decides at the first input interval."""
+STIFF_RHO_DT = 10.0
+"""ρ·Δt (spectral radius of the Jacobian at the start state, rad/s, times the sample interval,
+s) past which `auto` takes the L-stable Rosenbrock: Dormand–Prince's stability reaches
+|hλ| ≈ 3.3 along the imaginary axis, so it would need at least three steps per sample for
+stability alone. The bundled pump is at 0.12 (1 kHz), the genset at 0.36 (10 kHz) and 3.6
+(1 kHz), 10 kg on 4 × 1e9 N/m at 31.6 (1 kHz)."""
+
+
+def choose(rho_dt: float) -> str:
+    """The method `auto` takes for a scene whose ρ·Δt (see STIFF_RHO_DT) is `rho_dt`."""
+    return "ros34pw2" if rho_dt > STIFF_RHO_DT else "dopri54"

@@ -16,10 +16,12 @@ from functools import partial
 
 import numpy as np
 
-from mount_twin.integrate import dopri54
+from mount_twin.integrate import dopri54, ros34pw2
 from mount_twin.integrate.methods import (
+    AUTO,
     DOPRI54,
     METHODS,
+    ROS34PW2,
     STATUS_TEXT,
     UNKNOWN_METHOD,
 )
@@ -43,6 +45,7 @@ __all__ = [
     "advance",
     "dormand_prince",
     "new_stepper",
+    "switch",
 ]
 
 
@@ -75,9 +78,10 @@ class Stepper:
 def new_stepper(
     method: str, n: int, rtol: float, atol: float, max_substeps: int, min_steps: int = 1
 ) -> Stepper:
-    """A stepper of `method` (a name in METHODS) for n states; atol in the state's units (m,
-    rad, m/s, rad/s); at least `min_steps` steps per input interval."""
-    if method not in METHODS:
+    """A stepper of `method` (a name in METHODS, or AUTO: work arrays for any method, running
+    dopri54 until `switch`) for n states; atol in the state's units (m, rad, m/s, rad/s); at
+    least `min_steps` steps per input interval."""
+    if method not in METHODS and method != AUTO:
         msg = f"unknown integration method {method!r}; choose from {', '.join(METHODS)}"
         raise ValueError(msg)
     if n <= 0 or not rtol > 0.0 or not atol > 0.0 or not 1 <= min_steps <= max_substeps:
@@ -86,11 +90,24 @@ def new_stepper(
             f"min={min_steps}"
         )
         raise ValueError(msg)
-    spec = METHODS[method]
+    spec = METHODS["dopri54" if method == AUTO else method]
+    rows = max(m.work_rows(n) for m in METHODS.values()) if method == AUTO else spec.work_rows(n)
     settings = np.zeros(N_SETTINGS)
     settings[RTOL], settings[ATOL], settings[MAX_SUBSTEPS] = rtol, atol, float(max_substeps)
     settings[MIN_STEPS] = float(min_steps)
-    return Stepper(spec.name, spec.id, settings, np.zeros((spec.stages, n)), np.zeros(n))
+    return Stepper(spec.name, spec.id, settings, np.zeros((rows, n)), np.zeros(n))
+
+
+def switch(st: Stepper, method: str) -> None:
+    """Run `method` (a name in METHODS) with st from now on, its step history forgotten; st's
+    work arrays must hold it (a stepper made for AUTO holds any)."""
+    spec = METHODS[method]
+    n = st.work1d.shape[0]
+    if st.work2d.shape[0] < spec.work_rows(n):
+        msg = f"stepper work arrays hold {st.work2d.shape[0]} rows, {method} needs more"
+        raise ValueError(msg)
+    st.name, st.method = spec.name, spec.id
+    st.reset()
 
 
 def dormand_prince(n: int, rtol: float, atol: float, max_substeps: int) -> Stepper:
@@ -115,6 +132,8 @@ def advance(
     """Advance y from t0 to t1 (s) with the stepper `method`; returns its status (0 = success)."""
     if method == DOPRI54:
         return dopri54.advance(y, t0, t1, settings, m, s, u, work2d, work1d, result)
+    if method == ROS34PW2:
+        return ros34pw2.advance(y, t0, t1, settings, m, s, u, work2d, work1d, result)
     return UNKNOWN_METHOD
 
 

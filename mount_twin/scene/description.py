@@ -141,11 +141,11 @@ class InitialState:
 
 @dataclass(frozen=True)
 class Integration:
-    """Stepper settings: method name, relative and absolute tolerance (atol in the state's
-    units: m, rad, m/s, rad/s), substep limit per sample, and whether a companion solution at
-    half the step estimates the error live (`engine.companion`)."""
+    """Stepper settings: method name (or "auto", see `integrate.methods.choose`), relative and
+    absolute tolerance (atol in the state's units: m, rad, m/s, rad/s), substep limit per
+    sample, and whether a companion solution estimates the error live (`engine.companion`)."""
 
-    method: str = "dopri54"
+    method: str = "auto"
     rtol: float = 1.0e-6
     atol: float = 1.0e-9
     max_substeps: int = 10000

@@ -11,7 +11,7 @@ from typing import Any
 import yaml
 
 from mount_twin.errors import SceneError
-from mount_twin.integrate.methods import METHODS
+from mount_twin.integrate.methods import AUTO, METHODS
 from mount_twin.kinds import KINDS
 from mount_twin.scene.checks import check_scene
 from mount_twin.scene.description import (
@@ -49,7 +49,7 @@ NAME_TOKEN = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,99}")
 node's namespace and name, must stay within TOPIC_MAX_CHARS)."""
 TOPIC_MAX_CHARS = 247
 """Longest ROS 2 topic name (rmw: 255 less 8 reserved for the DDS prefix)."""
-STEPPERS = tuple(METHODS)
+STEPPERS = (AUTO, *METHODS)
 
 
 def load_scene_file(path: str | Path) -> Scene:

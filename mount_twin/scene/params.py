@@ -56,7 +56,7 @@ PARAMETERS: dict[str, tuple[str, str]] = {
     "initial_state.gravity_samples": ("integer", "Start gravity: mean of this many samples"),
     "initial_state.gravity_tolerance": ("double", "Start check: WARN past | |f0| − g | / g"),
     "initial_state.tilt_tolerance_rad": ("double", "Start check: WARN past this tilt of f0, rad"),
-    "integration.method": ("string", "Stepper: " + ", ".join(METHODS)),
+    "integration.method": ("string", "Stepper: auto (by stiffness), " + ", ".join(METHODS)),
     "integration.rtol": ("double", "Relative tolerance of the stepper"),
     "integration.atol": ("double", "Absolute tolerance of the stepper (m, rad, m/s, rad/s)"),
     "integration.max_substeps": ("integer", "Most substeps between two input samples"),
