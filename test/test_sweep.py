@@ -94,6 +94,8 @@ def test_a_bad_case_is_a_failed_row_and_the_rest_still_run(swept) -> None:
     assert all("body.mass" in r["error"] for r in failed)
     good = [r for r in rows if r["verdict"] != FAILED]
     assert len(good) == 4 and all(float(r["peak_force_N.fl"]) > 1000.0 for r in good)
+    # each case's own error estimate: the pump at one step per sample is ~1e-9 off
+    assert all(0.0 < float(r["est_force_error_rel"]) < 1e-6 for r in good)
 
 
 def test_a_rerun_skips_finished_cases_and_reruns_failed_ones(swept) -> None:

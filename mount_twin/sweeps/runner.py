@@ -58,6 +58,7 @@ def columns(spec: SweepSpec) -> list[str]:
         "first_event_s",
         "max_displacement_m",
         "max_tilt_rad",
+        "est_force_error_rel",
         "wall_s",
     ]
 
@@ -133,6 +134,10 @@ def _figures(scene: Scene, samples: SampleBatch) -> dict[str, Any]:
         else math.nan,
         "max_tilt_rad": float(tilt_from_quaternions(out.quaternion).max())
         if len(out)
+        else math.nan,
+        # the twin's own estimate of its mount-force error (NaN: integration.error_estimate off)
+        "est_force_error_rel": engine.error_estimate.force_error_rel
+        if engine.error_estimate
         else math.nan,
     }
     for i, m in enumerate(scene.mounts):
