@@ -168,6 +168,14 @@ def test_live_node_over_dds_equals_the_replay_of_the_same_messages(
             continue
         assert len(got) == len(want[topic]) == n, topic
         assert got == want[topic], f"{topic}: live bytes differ from the replay's"
+    # the live error estimate travels on /diagnostics (equal to the replay's, compared above)
+    integration = [
+        values
+        for _, statuses in diagnostics(peer.got["/diagnostics"])
+        for name, _, _, values in statuses
+        if name == "mount_twin: integration"
+    ]
+    assert integration and all(0.0 <= float(v["est_force_error_rel"]) < 0.01 for v in integration)
 
 
 def _stamp(raw: bytes) -> int:

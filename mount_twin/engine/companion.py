@@ -39,7 +39,8 @@ from mount_twin.engine.estimate import (
     FORCE_SCALE,
     N_FIGURES,
 )
-from mount_twin.integrate.settings import CHAINED, STEP
+from mount_twin.integrate.control import forget
+from mount_twin.integrate.settings import CHAINED
 from mount_twin.integrate.stepper import advance, new_stepper
 from mount_twin.physics import pose_row
 from mount_twin.physics.compiled import kernel
@@ -122,8 +123,7 @@ def new_companion(
 
 def switch(c: Companion, method: int) -> Companion:
     """The companion running `method` (an id; its work arrays were made for AUTO) afresh."""
-    c.settings[STEP] = 0.0
-    c.settings[CHAINED] = 0.0
+    forget(c.settings)
     return c._replace(method=method)
 
 
@@ -131,8 +131,7 @@ def restart(c: Companion, y: np.ndarray) -> None:
     """Start the companion again from the twin's state y (a twin start or restart)."""
     c.y[:] = y
     c.y_prev[:] = y
-    c.settings[STEP] = 0.0
-    c.settings[CHAINED] = 0.0
+    forget(c.settings)
 
 
 @kernel
@@ -161,8 +160,7 @@ def _follow(m, c, u, t0, t1, chain, d_wdot, pose, wrenches, y) -> None:
         for i in range(y.shape[0]):
             c.y[i] = y[i]
             c.y_prev[i] = y[i]
-        settings[STEP] = 0.0
-        settings[CHAINED] = 0.0
+        forget(settings)
         figures[FAILURES] += 1.0
         return
     outputs(c.y, m, c.s, c.pose, c.wrenches)

@@ -18,6 +18,7 @@ from mount_twin.integrate.methods import (
     SUCCESS,
     TOO_MANY_STEPS,
 )
+from mount_twin.integrate.settings import CHAINED, JACOBIAN_AGE, STEP
 
 SAFETY, MIN_FACTOR = 0.9, 0.2
 OFF_CHART_SHRINK = 0.25
@@ -65,3 +66,12 @@ def next_proposal(step: float, h: float, factor: float, last: bool) -> float:
     """The proposal after an accepted step: from a full step, not from a last step clipped
     to the interval (that one keeps the proposal it had)."""
     return step * factor if (not last or step >= h) else h
+
+
+@njit(cache=True, inline="always")
+def forget(settings):
+    """Forget a stepper's history (after its state jumped: a start, a restart, a resync): the
+    step proposal, the chained last stage, the Jacobian held."""
+    settings[STEP] = 0.0
+    settings[CHAINED] = 0.0
+    settings[JACOBIAN_AGE] = 0.0

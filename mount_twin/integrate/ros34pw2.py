@@ -7,11 +7,14 @@ approximation of the Jacobian. A stiff mode (keys and bolts at 1e9–1e10 N/m un
 is then damped, not resolved: the explicit Dormand–Prince must take steps shorter than about
 3.3/ω_max whatever the tolerance, this method takes the steps the accuracy asks for.
 
-Per input interval the Jacobian J = ∂f/∂y at (t0, y0) and ∂f/∂t are taken by finite
-differences of the compiled right-hand side (n + 2 evaluations; exact for linear mounts up to
-rounding); each step solves (I − hγJ)·k_i = h·f(t + α_i h, y + Σ α_ij k_j) + h·J·Σ γ_ij k_j
-+ h²·γ_i·∂f/∂t for its four stages through one LU factorisation (partial pivoting, in place),
-y ← y + Σ b_i k_i, and Σ (b_i − b̂_i)·k_i estimates the local error (RMS norm as Dormand–Prince).
+The Jacobian J = ∂f/∂y is taken by finite differences of the compiled right-hand side (n + 1
+evaluations; exact for linear mounts up to rounding) at the start of an interval once the one
+held has served JACOBIAN_MAX_AGE intervals (or none is held: `control.forget`), and again at
+the first rejected step of an interval it did not start; ∂f/∂t (the input's slopes) every
+interval (1 evaluation). Each step solves, for its four stages,
+(I − hγJ)·k_i = h·f(t + α_i h, y + Σ α_ij k_j) + h·J·Σ γ_ij k_j + h²·γ_i·∂f/∂t
+through one LU factorisation (partial pivoting, in place); y ← y + Σ b_i k_i, and
+Σ (b_i − b̂_i)·k_i estimates the local error (RMS norm as Dormand–Prince).
 After each accepted step the right-hand side is evaluated at the new state, so on success the
 scratch holds the body motion at (t1, y) as `outputs` requires. Not first-same-as-last: the
 chain flag is always left at 0.
@@ -37,7 +40,15 @@ from mount_twin.integrate.methods import (
     LEFT_CHART,
     SUCCESS,
 )
-from mount_twin.integrate.settings import ATOL, CHAINED, MAX_SUBSTEPS, MIN_STEPS, RTOL, STEP
+from mount_twin.integrate.settings import (
+    ATOL,
+    CHAINED,
+    JACOBIAN_AGE,
+    MAX_SUBSTEPS,
+    MIN_STEPS,
+    RTOL,
+    STEP,
+)
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import rhs
 
@@ -70,6 +81,8 @@ ORDER = 2
 """Order of the error estimate (the step-size controller's exponent is −1/(ORDER + 1))."""
 STAGES = 4
 MAX_FACTOR = 6.0
+JACOBIAN_MAX_AGE = 20.0
+"""Input intervals a Jacobian serves at most (a W-method keeps its order with a stale one)."""
 JAC_STEP = 1.4901161193847656e-08
 """√ε: the relative finite-difference step of the Jacobian columns (relative to |y_c|, or to
 atol/rtol, bounded to [1e-6, 1], where y_c is smaller)."""
@@ -135,8 +148,8 @@ def _lu_solve(a, first, n, piv_row, b) -> None:
 
 @kernel
 def _jacobian(y, t, m, s, u, k, rtol, atol) -> bool:
-    """J (rows J0..) = ∂f/∂y and row FT = ∂f/∂t at (t, y) by finite differences; row F holds
-    f(t, y) on entry. False if an evaluation failed (off the chart)."""
+    """J (rows J0..) = ∂f/∂y at (t, y) by finite differences, then `_time_derivative`; row F
+    holds f(t, y) on entry. False if an evaluation failed (off the chart)."""
     n = y.shape[0]
     typical = min(max(atol / rtol, 1e-6), 1.0)  # where relative and absolute tolerance meet
     for c in range(n):
@@ -150,6 +163,14 @@ def _jacobian(y, t, m, s, u, k, rtol, atol) -> bool:
             return False
         for r in range(n):
             k[J0 + r, c] = (k[FTMP, r] - k[F, r]) / d
+    return _time_derivative(y, t, m, s, u, k)
+
+
+@kernel
+def _time_derivative(y, t, m, s, u, k) -> bool:
+    """Row FT = ∂f/∂t at (t, y) (the input's slopes: new each interval) by a finite
+    difference; row F holds f(t, y) on entry. False if the evaluation failed."""
+    n = y.shape[0]
     dt = JAC_STEP * max(abs(t), 1.0)
     if rhs(t + dt, y, m, s, u, k[FTMP]) != 0:
         return False
@@ -172,9 +193,16 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
     t = t0
     err_max, n_acc, n_rej = 0.0, 0, 0
     lu0 = J0 + n
-    if rhs(t, y, m, s, u, k[F]) != 0 or not _jacobian(y, t, m, s, u, k, rtol, atol):
+    # W-method: a Jacobian serves up to JACOBIAN_MAX_AGE intervals, and is taken afresh at the
+    # first rejected step of an interval it did not start
+    age = settings[JACOBIAN_AGE]
+    fresh = age == 0.0 or age >= JACOBIAN_MAX_AGE
+    if rhs(t, y, m, s, u, k[F]) != 0 or not (
+        _jacobian(y, t, m, s, u, k, rtol, atol) if fresh else _time_derivative(y, t, m, s, u, k)
+    ):
         settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
         return LEFT_CHART
+    settings[JACOBIAN_AGE] = 1.0 if fresh else age + 1.0
     not_finite = off_chart = False  # what the last rejection was for
     while t < t1:
         too_small = h < MIN_STEP_FRACTION * span
@@ -223,6 +251,10 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
             err = math.sqrt(err / n)
         not_finite = ok and not math.isfinite(err)
         off_chart = not ok
+        stale = settings[JACOBIAN_AGE] > 1.0
+        # F holds f(t, y): y is unchanged by a rejected step
+        if (not ok or not err <= 1.0) and stale and _jacobian(y, t, m, s, u, k, rtol, atol):
+            settings[JACOBIAN_AGE] = 1.0
         if not ok:
             h = step * OFF_CHART_SHRINK
             n_rej += 1

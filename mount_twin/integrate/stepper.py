@@ -17,6 +17,7 @@ from functools import partial
 import numpy as np
 
 from mount_twin.integrate import dopri54, ros34pw2
+from mount_twin.integrate.control import forget
 from mount_twin.integrate.methods import (
     AUTO,
     DOPRI54,
@@ -27,12 +28,10 @@ from mount_twin.integrate.methods import (
 )
 from mount_twin.integrate.settings import (
     ATOL,
-    CHAINED,
     MAX_SUBSTEPS,
     MIN_STEPS,
     N_SETTINGS,
     RTOL,
-    STEP,
 )
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.dynamics import ModelArrays, Scratch
@@ -70,9 +69,8 @@ class Stepper:
     result: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     def reset(self) -> None:
-        """Forget the step-size history (after a restart of the state)."""
-        self.settings[STEP] = 0.0
-        self.settings[CHAINED] = 0.0
+        """Forget the step-size history and any Jacobian (after a restart of the state)."""
+        forget(self.settings)
 
 
 def new_stepper(
