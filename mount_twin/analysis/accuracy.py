@@ -1,10 +1,10 @@
 """Error against run time: the twin at several tolerances against a tight reference run.
 
 For one scene and one input record, each tolerance's run is compared with a reference run of
-the same twin at a much tighter tolerance (rtol 1e-12 by default) on the same input refined
-REFINE times: the record's held input (linear between samples, or held) sampled REFINE times
-as densely, so the reference takes at least REFINE steps per interval where a run may take
-one, and its error is not the run's own (the physics tests tie the formulation itself to
+the same twin (by dopri54) at a much tighter tolerance (rtol 1e-12 by default) on the same
+input refined REFINE times: the record's held input (linear between samples, or held) sampled
+REFINE times as densely, so the reference takes at least REFINE steps per interval where a run
+may take one, and its error is not the run's own (the physics tests tie the formulation itself to
 closed forms and to an independent quaternion formulation integrated by scipy). The gyro is
 conditioned once, by the scene's `input.gyro_filter`, before both: that filter is part of the
 input, not of the integration.
@@ -35,6 +35,9 @@ DEFAULT_RTOLS = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
 REFINE = 8
 """Reference input samples per record interval."""
 REFERENCE_RTOLS = (1e-12, 1e-11, 1e-10)
+REFERENCE_METHOD = "dopri54"
+"""The reference's method: 5th order, resolving every mode at tight tolerances (an L-stable
+method of lower order would damp what the reference must resolve, and take far more steps)."""
 ATOL_PER_RTOL = 1e-3
 """atol = rtol · this (m, rad, m/s, rad/s: the state's units)."""
 NAN = float("nan")
@@ -159,8 +162,11 @@ def run_at(
 
 def reference_run(scene: Scene, samples: SampleBatch, max_substeps: int) -> Run:
     """The tightest run of REFERENCE_RTOLS on the `refined` input that completes without a
-    stepper failure; its outputs at the record's own stamps."""
+    stepper failure, by REFERENCE_METHOD whatever the scene's; its outputs at the record's own
+    stamps."""
     fine = refined(scene, samples)
+    integ = dataclasses.replace(scene.integration, method=REFERENCE_METHOD)
+    scene = dataclasses.replace(scene, integration=integ)
     for rtol in REFERENCE_RTOLS:
         ref = run_at(scene, fine, rtol, max_substeps, estimate=False)
         if ref.failures == 0:
