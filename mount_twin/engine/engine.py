@@ -155,7 +155,7 @@ class TwinEngine:
         self._gathered: list[np.ndarray] = []
         """Specific forces (m/s², F) of the samples taken so far toward the next start."""
         self.counts: Counter[str] = Counter()
-        self.health = HealthWindow(scene, self.stepper.name)
+        self.health = HealthWindow(scene, integ.method)  # `auto` until it has chosen
         self._watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
         self._event_meta = {
             slot: (model.scene.mounts[slot].name, KINDS[model.scene.mounts[slot].kind])
