@@ -31,11 +31,12 @@ def run(args: argparse.Namespace) -> int:
 
 
 def scene_text(scene: Scene) -> str:
-    """A scene in a few lines: body, DOFs, each mount, input, outputs and their topics."""
+    """A scene in a few lines: body, DOFs, each mount, input, integration, outputs and their
+    topics."""
     from mount_twin.io.messages import output_streams, resolve
     from mount_twin.replay import NODE_NAME
 
-    b, i = scene.body, scene.input
+    b, i, g = scene.body, scene.input, scene.integration
     lines = [
         f"scene:   {scene.name} ({scene.source})",
         f"body:    {b.mass:g} kg, CG {list(b.cg)} m in F, inertia {list(b.inertia)} kg·m²",
@@ -52,6 +53,10 @@ def scene_text(scene: Scene) -> str:
         f"input:   {i.topic} ({i.msg_type}), frame_id {i.frame_id or '(any)'}, "
         f"gyro {i.gyro_filter}"
         + (f" {i.gyro_cutoff_hz:g} Hz" if i.gyro_filter == "lowpass" else ""),
+        f"integration: {g.method}"
+        + (" (by stiffness at the first sample interval)" if g.method == "auto" else "")
+        + f", rtol {g.rtol:g}, atol {g.atol:g}, error estimate "
+        + ("on" if g.error_estimate else "off"),
         f"outputs (node named {NODE_NAME}):",
         *(f"  {resolve(s.topic, NODE_NAME):<40} {s.msgtype}" for s in output_streams(scene)),
     ]
