@@ -4,15 +4,15 @@ Everything comes from the twin itself, so every mount kind enters as it is simul
 
 - Equilibrium: the model's own solver (`static_equilibrium`) under the scene's nominal gravity
   (specific force g along +z of F, foundation at rest), the mounts' internal states at zero.
-- Linearisation: central differences (step `STEP`) of the twin's right-hand side about it give
-  ∂q″/∂q, ∂q″/∂q′, ∂q″/∂s and ∂s′/∂q′ (q: the free coordinates, m and rad; s: the mounts'
-  internal states). The kinds expose no closed tangent, so this is how elastomers, bolted joints
-  (closed joint k_S + k_P, stuck face k_τ) and shear keys (nothing inside their clearance) enter:
-  by their tangent at equilibrium; a law with a kink exactly there (a key with zero clearance
-  and no load) enters with the mean of its two slopes. Internal states are rate-independent
-  (Bouc–Wen z, slip, plastic elongation): at rest s′ = S·q′, so for small motions
-  s − s_eq = S·(q − q_eq), and their forces add to the stiffness (a Bouc–Wen axis at z = 0 adds
-  (1 − a)·k₀·A to its tangent a·F_el′).
+- Linearisation: central differences (`model.stiffness.jacobian`) of the twin's right-hand side
+  about it give ∂q″/∂q, ∂q″/∂q′, ∂q″/∂s and ∂s′/∂q′ (q: the free coordinates, m and rad; s: the
+  mounts' internal states). The kinds expose no closed tangent, so this is how elastomers,
+  bolted joints (closed joint k_S + k_P, stuck face k_τ) and shear keys (nothing inside their
+  clearance) enter: by their tangent at equilibrium; a law with a kink exactly there (a key
+  with zero clearance and no load) enters with the mean of its two slopes. Internal states are
+  rate-independent (Bouc–Wen z, slip, plastic elongation): at rest s′ = S·q′, so for small
+  motions s − s_eq = S·(q − q_eq), and their forces add to the stiffness (a Bouc–Wen axis at z
+  = 0 adds (1 − a)·k₀·A to its tangent a·F_el′).
 - Matrices, in the generalized coordinates q (the twin's: X, Y, Z of the CG and the chart angles
   α, γ, δ; units kg, kg·m², N/m, N/rad, N·m/rad, N·s/m, N·m·s/rad): with P (6×n) the map from
   q′ to the CG velocity and the angular velocity in F at equilibrium (P = blockdiag(1, R·B), R
@@ -61,18 +61,16 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import eig, eigh, solve
 
-from mount_twin.errors import ModelError
 from mount_twin.model.assemble import Model, assemble, gravity_input, static_equilibrium
+from mount_twin.model.stiffness import jacobian
 from mount_twin.physics.chart import kinematic_matrix, rotation_matrix
-from mount_twin.physics.dynamics import OK, evaluate, rhs
+from mount_twin.physics.dynamics import evaluate
 from mount_twin.physics.pose_row import WIDTH
 from mount_twin.physics.rotations import rpy_matrix
 from mount_twin.scene.description import DOF_NAMES, Scene
 
 F_AXES = ("x", "y", "z", "rot_x", "rot_y", "rot_z")
 """Components of a motion in F: CG translation along x, y, z (m), rotation about them (rad)."""
-STEP = 1.0e-7
-"""Central-difference step, relative to max(1, |value|) (m, rad, m/s, rad/s, internal units)."""
 RESOLVED = 1.0e-9
 """|ω²| below this fraction of the largest is zero: the central differences' rounding."""
 
@@ -195,7 +193,7 @@ def modes(scene: Scene, *, geometric: bool = True) -> Modes:
     nf = len(scene.dofs)
     g_up = np.array([0.0, 0.0, scene.input.g])
     y_eq = static_equilibrium(model, np.zeros(model.n_state), g_up)
-    jac = _jacobian(model, y_eq, gravity_input(0.0, g_up))
+    jac = jacobian(model, y_eq, gravity_input(0.0, g_up))
     q, v, s = slice(0, nf), slice(nf, 2 * nf), slice(2 * nf, model.n_state)
     q6 = model.arrays.q_fixed.copy()
     q6[[DOF_NAMES.index(d) for d in scene.dofs]] = y_eq[:nf]
@@ -223,25 +221,6 @@ def modes(scene: Scene, *, geometric: bool = True) -> Modes:
         cg_m=_vec3(scene.body.cg),
         centre=_centre(scene, k_full - k_geo, mass, to_f),
     )
-
-
-def _jacobian(model: Model, y0: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """∂(dy/dt)/∂y of the whole state at y0, by central differences."""
-    n = model.n_state
-    scratch = model.new_scratch()
-    jac = np.empty((n, n))
-    plus, minus = np.empty(n), np.empty(n)
-    for k in range(n):
-        h = STEP * max(1.0, abs(y0[k]))
-        y_plus, y_minus = y0.copy(), y0.copy()
-        y_plus[k] += h
-        y_minus[k] -= h
-        for y, out in ((y_plus, plus), (y_minus, minus)):
-            if rhs(0.0, y, model.arrays, scratch, u, out) != OK:
-                msg = f"{model.scene.source}: the static equilibrium is at the chart's edge"
-                raise ModelError(msg)
-        jac[:, k] = (plus - minus) / (y_plus[k] - y_minus[k])
-    return jac
 
 
 def _chart_map(scene: Scene, q6: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -1,9 +1,9 @@
 """The integration methods and the statuses of a step: the one list of both.
 
-The scene loader offers `METHODS` as `integration.method`; `integrate.stepper` builds its
-factories and its compiled switch from it; every method's compiled `advance` returns one of the
-statuses below and the engine reports `STATUS_TEXT` of a failure. Pure Python (no numba): the
-scene loader imports it.
+The scene loader offers `METHODS` (and AUTO) as `integration.method`; `integrate.stepper`
+sizes its work arrays and builds its compiled switch from it; every method's compiled `advance`
+returns one of the statuses below and the engine reports `STATUS_TEXT` of a failure. Pure
+Python (no numba): the scene loader imports it.
 
 Adding a method: a module with its coefficient table and compiled `advance` (see `dopri54`,
 `ros34pw2`), an entry here, and a branch in `stepper.advance` (test/test_integrate_methods.py

@@ -10,9 +10,7 @@ on the method id: compiled functions passed as arguments would make every caller
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import partial
 
 import numpy as np
 
@@ -39,7 +37,6 @@ from mount_twin.physics.dynamics import ModelArrays, Scratch
 __all__ = [
     "METHODS",
     "STATUS_TEXT",
-    "STEPPERS",
     "Stepper",
     "advance",
     "dormand_prince",
@@ -133,9 +130,3 @@ def advance(
     if method == ROS34PW2:
         return ros34pw2.advance(y, t0, t1, settings, m, s, u, work2d, work1d, result)
     return UNKNOWN_METHOD
-
-
-STEPPERS: dict[str, Callable[[int, float, float, int], Stepper]] = {
-    name: partial(new_stepper, name) for name in METHODS
-}
-"""Stepper factories (n, rtol, atol, max_substeps) by scene name (integration.method)."""

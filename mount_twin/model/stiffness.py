@@ -1,41 +1,45 @@
-"""How stiff a model is where it starts: the spectral radius of its Jacobian.
+"""The linearised model where it stands: its Jacobian and how stiff it is.
 
-The Jacobian ∂f/∂y of the compiled right-hand side at a state and input, by forward
-differences (√ε relative steps), and the largest |λ| of its eigenvalues (rad/s): the fastest
-mode's rate. `integrate.methods.choose` compares ρ·Δt with an explicit method's stability.
+The Jacobian ∂f/∂y of the compiled right-hand side at a state and input, by central
+differences, and the largest |λ| of its eigenvalues (rad/s): the fastest mode's rate.
+`analysis.modes` builds its stiffness and damping from the Jacobian;
+`integrate.methods.choose` compares ρ·Δt with an explicit method's stability.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from mount_twin.model.assemble import Model
-from mount_twin.physics.dynamics import INPUT_SIZE, rhs
+from mount_twin.errors import ModelError
+from mount_twin.model.assemble import Model, gravity_input
+from mount_twin.physics.dynamics import OK, rhs
 
-STEP = 1.4901161193847656e-08
-"""√ε: the relative finite-difference step (of |y_i|, or of 1e-3 where y_i is smaller)."""
+STEP = 1.0e-7
+"""Central-difference step, relative to max(1, |y_i|)."""
 
 
-def jacobian(model: Model, y: np.ndarray, specific_force: np.ndarray) -> np.ndarray:
-    """∂f/∂y (n × n) at state y under a constant specific force (m/s², F), foundation at rest
-    otherwise. Raises ValueError off the α/γ/δ chart."""
-    u = np.zeros(INPUT_SIZE)
-    u[1:4] = specific_force
-    n, scratch = y.shape[0], model.new_scratch()
-    f0, f = np.zeros(n), np.zeros(n)
-    if rhs(0.0, y, model.arrays, scratch, u, f0) != 0:
-        msg = "the state is off the α/γ/δ chart: no Jacobian"
-        raise ValueError(msg)
+def jacobian(model: Model, y: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """∂(dy/dt)/∂y (n × n) of the whole state at y under the input vector u. Raises ModelError
+    where y is at the α/γ/δ chart's edge."""
+    n = model.n_state
+    scratch = model.new_scratch()
     jac = np.empty((n, n))
-    for c in range(n):
-        probe = y.copy()
-        probe[c] += STEP * max(abs(y[c]), 1e-3)
-        step = probe[c] - y[c]
-        rhs(0.0, probe, model.arrays, scratch, u, f)
-        jac[:, c] = (f - f0) / step
+    plus, minus = np.empty(n), np.empty(n)
+    for k in range(n):
+        h = STEP * max(1.0, abs(y[k]))
+        y_plus, y_minus = y.copy(), y.copy()
+        y_plus[k] += h
+        y_minus[k] -= h
+        for probe, out in ((y_plus, plus), (y_minus, minus)):
+            if rhs(0.0, probe, model.arrays, scratch, u, out) != OK:
+                msg = f"{model.scene.source}: the state is at the α/γ/δ chart's edge"
+                raise ModelError(msg)
+        jac[:, k] = (plus - minus) / (y_plus[k] - y_minus[k])
     return jac
 
 
 def spectral_radius(model: Model, y: np.ndarray, specific_force: np.ndarray) -> float:
-    """Largest |λ| of `jacobian` (rad/s): the rate of the model's fastest mode at y."""
-    return float(np.abs(np.linalg.eigvals(jacobian(model, y, specific_force))).max())
+    """Largest |λ| of the Jacobian at y under a constant specific force (m/s², F), foundation
+    at rest otherwise (rad/s): the rate of the model's fastest mode there."""
+    jac = jacobian(model, y, gravity_input(0.0, specific_force))
+    return float(np.abs(np.linalg.eigvals(jac)).max())
