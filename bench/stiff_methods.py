@@ -6,6 +6,7 @@ test/test_error_estimate.py): per method and rtol, the mount-force error against
 real-time factor without the error estimate, and the substeps per sample.
 
     python3 bench/stiff_methods.py [--seconds 2] [--rtol 1e-3 1e-4 1e-5 1e-6 1e-7]
+        [--methods dopri54 ros34pw2 exprb32]
 """
 
 from __future__ import annotations
@@ -19,16 +20,18 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test"))
 from test_error_estimate import _ship_motion, _stiff_light
 
 from mount_twin.analysis.accuracy import measure, reference_run
+from mount_twin.integrate.methods import METHODS
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=2.0)
     parser.add_argument("--rtol", type=float, nargs="+", default=[1e-3, 1e-4, 1e-5, 1e-6, 1e-7])
+    parser.add_argument("--methods", nargs="+", default=list(METHODS), choices=list(METHODS))
     args = parser.parse_args()
     head = ("method", "rtol", "force err", "peak err", "x real", "substeps")
     print("{:<9} {:>6} {:>10} {:>9} {:>7} {:>8}".format(*head))
-    for method in ("dopri54", "ros34pw2"):
+    for method in args.methods:
         scene, _ = _stiff_light(method)
         scene, samples = _ship_motion(scene, args.seconds)
         ref = reference_run(scene, samples, 1_000_000)

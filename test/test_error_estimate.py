@@ -93,6 +93,7 @@ def _pump() -> tuple[Scene, SampleBatch]:
 CASES = {
     "stiff_light": (_stiff_light, [1e-3, 1e-6]),
     "stiff_light_rosenbrock": (partial(_stiff_light, "ros34pw2"), [1e-6]),
+    "stiff_light_exponential": (partial(_stiff_light, "exprb32"), [1e-3]),
     "rubber_on_snubbers": (_rubber_on_snubbers, [1e-3, 1e-6]),
     "pump_ship_motion": (_pump, [1e-4]),
 }
@@ -161,34 +162,67 @@ def test_the_genset_scene_file_loads_with_the_estimate_on_by_default() -> None:
     assert load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml").integration.error_estimate
 
 
-def test_on_a_stiff_scene_the_rosenbrock_method_is_stable_where_the_explicit_one_hunts() -> None:
+def test_on_a_stiff_scene_the_linearising_methods_are_stable_where_explicit_ones_hunt() -> None:
     """10 kg on 4 × 1e9 N/m at rtol 1e-3: Dormand–Prince is held to ~14 steps per 1 ms sample
     by stability and is 9 % off; the L-stable ros34pw2 takes one step per sample and is within
-    1e-3. Both estimates stay within 10× of their true errors (the Rosenbrock's 0.3: the
-    companion damps the same kink-excited kHz ringing the twin damps, see the README)."""
+    1e-3 (it damps the kHz ringing each input kink excites, see the README); the exponential
+    exprb32, exact on linear mounts, takes one step per sample and is within 1e-7. Every
+    estimate stays within 10× of its true error (the Rosenbrock's 0.3: the companion damps the
+    ringing the twin damps)."""
     scene, samples = _stiff_light("auto")
     ref = reference_run(scene, samples, 1_000_000)
     got = {}
-    for method in ("dopri54", "ros34pw2"):
+    for method in ("dopri54", "ros34pw2", "exprb32"):
         integ = dataclasses.replace(scene.integration, method=method)
         got[method] = measure(
             dataclasses.replace(scene, integration=integ), samples, 1e-3, 100_000, ref
         )
-    explicit, rosenbrock = got["dopri54"], got["ros34pw2"]
+    explicit, rosenbrock, exponential = got["dopri54"], got["ros34pw2"], got["exprb32"]
     assert explicit.substeps_per_sample > 10 and explicit.force_error > 1e-2
     assert rosenbrock.substeps_per_sample < 1.5 and rosenbrock.force_error < 1e-3
+    assert exponential.substeps_per_sample == 1.0 and exponential.force_error < 1e-7
     for acc in got.values():
         assert 0.1 < acc.est_force_error / acc.force_error < 10.0, acc
 
 
-def test_auto_takes_the_rosenbrock_where_the_explicit_method_would_be_stability_bound() -> None:
+def _stiff_with_a_snubbed_mount() -> tuple[Scene, SampleBatch]:
+    """The stiff scene with a fifth, soft elastomer mount on a snubber: as stiff, not smooth."""
+    data = base_scene(
+        10.0,
+        [0.0, 0.0, 0.1],
+        [1.0] * 3 + [0.0] * 3,
+        [
+            *(
+                mount(f"m{i}", (x, y, 0.0), (1e9,) * 3 + (0,) * 3, (2e3,) * 3 + (0,) * 3)
+                for i, (x, y) in enumerate(CORNERS)
+            ),
+            kind_mount(
+                "elastomer",
+                "soft",
+                (0.0, 0.0, 0.0),
+                stiffness_linear=[1e4, 1e4, 1e4],
+                damping=[10.0, 10.0, 10.0],
+                snubber={"gap": 3e-3, "stiffness": 1e8, "exponent": 1.5, "axes": ["z"]},
+            ),
+        ],
+    )
+    data["integration"]["method"] = "auto"
+    return _ship_motion(_with_pump_input(data), 0.1)
+
+
+def test_auto_takes_a_linearising_method_where_the_explicit_one_would_be_stability_bound() -> None:
     """ρ of 10 kg on 4 × 1e9 N/m at (±0.4, ±0.3) m is its yaw mode, √(4k(a² + b²)/I_zz) =
     31 623 rad/s (the mounts' plane holds no coupling to it): ρ·Δt = 31.6 at 1 kHz, past
-    STIFF_RHO_DT; the bundled pump (modes below 20 Hz) stays explicit."""
+    STIFF_RHO_DT. Its mounts are linear: the exponential method; with a snubbed elastomer
+    beside them (a switch in the right-hand side), the L-stable Rosenbrock. The bundled pump
+    (modes below 20 Hz) stays explicit."""
     scene, samples = _stiff_light("auto")
     _, status = _integration_status(scene, samples)
     yaw = math.sqrt(4 * 1e9 * (0.4**2 + 0.3**2) / 1.0) * 1e-3
-    assert status.values["method"] == f"ros34pw2 (auto: ρ·Δt = {yaw:.3g})"
+    assert status.values["method"] == f"exprb32 (auto: ρ·Δt = {yaw:.3g})"
+    scene, samples = _stiff_with_a_snubbed_mount()
+    _, status = _integration_status(scene, samples)
+    assert status.values["method"].startswith("ros34pw2 (auto: ρ·Δt = 31.")
     scene, samples = _pump()
     _, status = _integration_status(scene, samples)
     assert status.values["method"].startswith("dopri54 (auto: ρ·Δt = 0.1")

@@ -211,7 +211,7 @@ class TwinEngine:
     def _choose_method(self, interval_s: float) -> None:
         """`auto`: the method for this scene at this sample interval (`methods.choose`)."""
         rho_dt = (self._rho or 0.0) * interval_s
-        name = choose(rho_dt)
+        name = choose(rho_dt, smooth=self.model.arrays.nl is None)
         switch(self.stepper, name)
         st = self.stepper
         self._integ = Integrator(st.method, st.settings, st.work2d, st.work1d, st.result)

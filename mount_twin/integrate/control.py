@@ -18,7 +18,7 @@ from mount_twin.integrate.methods import (
     SUCCESS,
     TOO_MANY_STEPS,
 )
-from mount_twin.integrate.settings import CHAINED, JACOBIAN_AGE, STEP
+from mount_twin.integrate.settings import CHAINED, JACOBIAN_AGE, PHI_STEP, STEP
 
 SAFETY, MIN_FACTOR = 0.9, 0.2
 OFF_CHART_SHRINK = 0.25
@@ -71,7 +71,8 @@ def next_proposal(step: float, h: float, factor: float, last: bool) -> float:
 @njit(cache=True, inline="always")
 def forget(settings):
     """Forget a stepper's history (after its state jumped: a start, a restart, a resync): the
-    step proposal, the chained last stage, the Jacobian held."""
+    step proposal, the chained last stage, the Jacobian held and its matrix functions."""
     settings[STEP] = 0.0
     settings[CHAINED] = 0.0
     settings[JACOBIAN_AGE] = 0.0
+    settings[PHI_STEP] = 0.0

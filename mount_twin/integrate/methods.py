@@ -6,8 +6,8 @@ returns one of the statuses below and the engine reports `STATUS_TEXT` of a fail
 Python (no numba): the scene loader imports it.
 
 Adding a method: a module with its coefficient table and compiled `advance` (see `dopri54`,
-`ros34pw2`), an entry here, and a branch in `stepper.advance` (test/test_integrate_methods.py
-checks the tables and that every method here is dispatched).
+`ros34pw2`, `exprb32`), an entry here, and a branch in `stepper.advance`
+(test/test_integrate_methods.py checks the tables and that every method here is dispatched).
 """
 
 from __future__ import annotations
@@ -32,20 +32,26 @@ STATUS_TEXT: dict[int, str] = {
 """Status of a stepper's `advance` → the text the engine reports on a failure."""
 
 
+EXPLICIT, ROSENBROCK, EXPONENTIAL = "explicit", "rosenbrock", "exponential"
+"""Families of methods: what a method's module holds (its tables) and which tests apply."""
+
+
 @dataclass(frozen=True)
 class Method:
-    """An embedded method: explicit Runge–Kutta, or linearly implicit (Rosenbrock).
+    """An embedded method: explicit Runge–Kutta, linearly implicit (Rosenbrock) or exponential.
 
     Attributes:
         name: scene name (`integration.method`).
         id: its branch in the compiled `stepper.advance`.
         module: the module holding its tables (explicit: C, A, B, E as numpy arrays and FSAL;
-            Rosenbrock: ALPHA, GAMMAS, GAMMA, B, B_HAT; both ORDER, the order of the error
-            estimate) and its compiled `advance`.
+            Rosenbrock: ALPHA, GAMMAS, GAMMA, B, B_HAT; all ORDER, the order of the error
+            estimate; those that hold a Jacobian JACOBIAN_MAX_AGE) and its compiled `advance`.
         order: order of the solution it propagates.
         stages: fixed rows of its work array (explicit: the stages, the FSAL one included).
-        square_blocks: further rows per state (n×n blocks: the Rosenbrock's J and LU).
-        implicit: linearly implicit (stable for stiff scenes, a Jacobian per interval).
+        square_blocks: further rows per state (n×n blocks: the Rosenbrock's J and LU, the
+            exponential method's J, φ functions and their work).
+        family: EXPLICIT, ROSENBROCK or EXPONENTIAL (the last two hold a Jacobian, taken by
+            finite differences, for stiff scenes).
         summary: one line for parameter descriptions.
     """
 
@@ -56,7 +62,12 @@ class Method:
     stages: int
     summary: str
     square_blocks: int = 0
-    implicit: bool = False
+    family: str = EXPLICIT
+
+    @property
+    def holds_jacobian(self) -> bool:
+        """Linearises the model (a Jacobian held across intervals)."""
+        return self.family != EXPLICIT
 
     def work_rows(self, n: int) -> int:
         """Rows of n of the work array for n states."""
@@ -82,7 +93,17 @@ METHODS: dict[str, Method] = {
             10,
             "L-stable Rosenbrock-W 3(2) for stiff scenes (a Jacobian per sample interval)",
             square_blocks=2,
-            implicit=True,
+            family=ROSENBROCK,
+        ),
+        Method(
+            "exprb32",
+            2,
+            "mount_twin.integrate.exprb32",
+            3,
+            6,
+            "exponential Rosenbrock 3(2), exact on linear mounts (stiff, smooth scenes)",
+            square_blocks=8,
+            family=EXPONENTIAL,
         ),
     )
 }
@@ -90,17 +111,23 @@ METHODS: dict[str, Method] = {
 
 DOPRI54 = METHODS["dopri54"].id
 ROS34PW2 = METHODS["ros34pw2"].id
+EXPRB32 = METHODS["exprb32"].id
 
 AUTO = "auto"
 """`integration.method: auto` (the default): `choose` decides at the first input interval."""
 STIFF_RHO_DT = 10.0
 """ρ·Δt (spectral radius of the Jacobian at the start state, rad/s, times the sample interval,
-s) past which `auto` takes the L-stable Rosenbrock: Dormand–Prince's stability reaches
-|hλ| ≈ 3.3 along the imaginary axis, so it would need at least three steps per sample for
-stability alone. The bundled pump is at 0.12 (1 kHz), the genset at 0.36 (10 kHz) and 3.6
-(1 kHz), 10 kg on 4 × 1e9 N/m at 31.6 (1 kHz)."""
+s) past which `auto` takes a method that does not step at the stiff modes' rate:
+Dormand–Prince's stability reaches |hλ| ≈ 3.3 along the imaginary axis, so it would need at
+least three steps per sample for stability alone. The bundled pump is at 0.12 (1 kHz), the
+genset at 0.36 (10 kHz) and 3.6 (1 kHz), 10 kg on 4 × 1e9 N/m at 31.6 (1 kHz)."""
 
 
-def choose(rho_dt: float) -> str:
-    """The method `auto` takes for a scene whose ρ·Δt (see STIFF_RHO_DT) is `rho_dt`."""
-    return "ros34pw2" if rho_dt > STIFF_RHO_DT else "dopri54"
+def choose(rho_dt: float, smooth: bool) -> str:
+    """The method `auto` takes for a scene whose ρ·Δt (see STIFF_RHO_DT) is `rho_dt`: past it,
+    on a smooth scene (linear mounts only) the exponential method, exact on the linear part
+    (its modes resolved in one step per sample); with switches in the mounts (joints opening,
+    slip, contact) the L-stable Rosenbrock, which damps what a switch rings."""
+    if rho_dt <= STIFF_RHO_DT:
+        return "dopri54"
+    return "exprb32" if smooth else "ros34pw2"

@@ -7,8 +7,8 @@ approximation of the Jacobian. A stiff mode (keys and bolts at 1e9–1e10 N/m un
 is then damped, not resolved: the explicit Dormand–Prince must take steps shorter than about
 3.3/ω_max whatever the tolerance, this method takes the steps the accuracy asks for.
 
-The Jacobian J = ∂f/∂y is taken by finite differences of the compiled right-hand side (n + 1
-evaluations; exact for linear mounts up to rounding) at the start of an interval once the one
+The Jacobian J = ∂f/∂y is taken by finite differences of the compiled right-hand side
+(`fd_jacobian`) at the start of an interval once the one
 held has served JACOBIAN_MAX_AGE intervals (or none is held: `control.forget`), and again at
 the first rejected step of an interval it did not start; ∂f/∂t (the input's slopes) every
 interval (1 evaluation). Each step solves, for its four stages,
@@ -36,6 +36,7 @@ from mount_twin.integrate.control import (
     step_factor,
     trial_step,
 )
+from mount_twin.integrate.fd_jacobian import jacobian, time_derivative
 from mount_twin.integrate.methods import (
     LEFT_CHART,
     SUCCESS,
@@ -83,9 +84,6 @@ STAGES = 4
 MAX_FACTOR = 6.0
 JACOBIAN_MAX_AGE = 20.0
 """Input intervals a Jacobian serves at most (a W-method keeps its order with a stale one)."""
-JAC_STEP = 1.4901161193847656e-08
-"""√ε: the relative finite-difference step of the Jacobian columns (relative to |y_c|, or to
-atol/rtol, bounded to [1e-6, 1], where y_c is smaller)."""
 F, YS, ACC, FT, PIV, FTMP = range(STAGES, STAGES + 6)
 """Rows of the work array after the stages: f at the step's start, the stage state, Σ γ_ij k_j,
 ∂f/∂t, the pivots (as floats), a right-hand side's scratch row; then J and LU (n rows each)."""
@@ -147,39 +145,6 @@ def _lu_solve(a, first, n, piv_row, b) -> None:
 
 
 @kernel
-def _jacobian(y, t, m, s, u, k, rtol, atol) -> bool:
-    """J (rows J0..) = ∂f/∂y at (t, y) by finite differences, then `_time_derivative`; row F
-    holds f(t, y) on entry. False if an evaluation failed (off the chart)."""
-    n = y.shape[0]
-    typical = min(max(atol / rtol, 1e-6), 1.0)  # where relative and absolute tolerance meet
-    for c in range(n):
-        keep = y[c]
-        d = JAC_STEP * max(abs(keep), typical)
-        y[c] = keep + d
-        d = y[c] - keep  # the step actually taken
-        bad = rhs(t, y, m, s, u, k[FTMP]) != 0
-        y[c] = keep
-        if bad:
-            return False
-        for r in range(n):
-            k[J0 + r, c] = (k[FTMP, r] - k[F, r]) / d
-    return _time_derivative(y, t, m, s, u, k)
-
-
-@kernel
-def _time_derivative(y, t, m, s, u, k) -> bool:
-    """Row FT = ∂f/∂t at (t, y) (the input's slopes: new each interval) by a finite
-    difference; row F holds f(t, y) on entry. False if the evaluation failed."""
-    n = y.shape[0]
-    dt = JAC_STEP * max(abs(t), 1.0)
-    if rhs(t + dt, y, m, s, u, k[FTMP]) != 0:
-        return False
-    for r in range(n):
-        k[FT, r] = (k[FTMP, r] - k[F, r]) / dt
-    return True
-
-
-@kernel
 def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
     """Advance y (in place) from t0 to t1 s with input u held over the interval: the signature
     and statuses of `dopri54.advance` (k: `work_rows(n)` × n)."""
@@ -193,12 +158,15 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
     t = t0
     err_max, n_acc, n_rej = 0.0, 0, 0
     lu0 = J0 + n
+    typical = min(max(atol / rtol, 1e-6), 1.0)  # where relative and absolute tolerance meet
     # W-method: a Jacobian serves up to JACOBIAN_MAX_AGE intervals, and is taken afresh at the
     # first rejected step of an interval it did not start
     age = settings[JACOBIAN_AGE]
     fresh = age == 0.0 or age >= JACOBIAN_MAX_AGE
     if rhs(t, y, m, s, u, k[F]) != 0 or not (
-        _jacobian(y, t, m, s, u, k, rtol, atol) if fresh else _time_derivative(y, t, m, s, u, k)
+        jacobian(y, t, m, s, u, k, typical, F, FTMP, FT, J0)
+        if fresh
+        else time_derivative(y, t, m, s, u, k, F, FTMP, FT)
     ):
         settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
         return LEFT_CHART
@@ -253,7 +221,11 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
         off_chart = not ok
         stale = settings[JACOBIAN_AGE] > 1.0
         # F holds f(t, y): y is unchanged by a rejected step
-        if (not ok or not err <= 1.0) and stale and _jacobian(y, t, m, s, u, k, rtol, atol):
+        if (
+            (not ok or not err <= 1.0)
+            and stale
+            and jacobian(y, t, m, s, u, k, typical, F, FTMP, FT, J0)
+        ):
             settings[JACOBIAN_AGE] = 1.0
         if not ok:
             h = step * OFF_CHART_SHRINK

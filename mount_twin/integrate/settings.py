@@ -3,11 +3,12 @@ stepper holder and the engine's loop (plain integers: numba folds them into the 
 
 from __future__ import annotations
 
-STEP, RTOL, ATOL, MAX_SUBSTEPS, CHAINED, MIN_STEPS, JACOBIAN_AGE, N_SETTINGS = range(8)
+STEP, RTOL, ATOL, MAX_SUBSTEPS, CHAINED, MIN_STEPS, JACOBIAN_AGE, PHI_STEP, N_SETTINGS = range(9)
 """Slots of a stepper's `settings` vector: STEP the step size to try next (s; 0: none yet),
 RTOL, ATOL (the state's units), MAX_SUBSTEPS per input interval, CHAINED: 1.0 after a
 success, when work2d[0] holds dy/dt at the end state (FSAL); a caller that changes the input
 between calls moves that stage to the new input and leaves the flag, or sets it to 0.0; and
 MIN_STEPS, the fewest steps per input interval (no step longer than the interval / MIN_STEPS:
 1 for the twin, 2 for its error-estimating companion); JACOBIAN_AGE, for methods that keep a
-Jacobian: the input intervals it has served (0: none held)."""
+Jacobian: the input intervals it has served (0: none held); PHI_STEP, for the exponential
+method: the step (s) its matrix functions of the Jacobian held were computed for (0: none)."""

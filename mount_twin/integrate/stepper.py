@@ -14,11 +14,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from mount_twin.integrate import dopri54, ros34pw2
+from mount_twin.integrate import dopri54, exprb32, ros34pw2
 from mount_twin.integrate.control import forget
 from mount_twin.integrate.methods import (
     AUTO,
     DOPRI54,
+    EXPRB32,
     METHODS,
     ROS34PW2,
     STATUS_TEXT,
@@ -129,4 +130,6 @@ def advance(
         return dopri54.advance(y, t0, t1, settings, m, s, u, work2d, work1d, result)
     if method == ROS34PW2:
         return ros34pw2.advance(y, t0, t1, settings, m, s, u, work2d, work1d, result)
+    if method == EXPRB32:
+        return exprb32.advance(y, t0, t1, settings, m, s, u, work2d, work1d, result)
     return UNKNOWN_METHOD
