@@ -12,7 +12,7 @@ from functools import partial
 
 import numpy as np
 import pytest
-from io_helpers import CONFIG, ROOT, default_scene
+from io_helpers import CONFIG, ROOT, default_scene, split
 from kinds_helpers import kind_mount
 from physics_helpers import base_scene, mount
 
@@ -226,3 +226,53 @@ def test_auto_takes_a_linearising_method_where_the_explicit_one_would_be_stabili
     scene, samples = _pump()
     _, status = _integration_status(scene, samples)
     assert status.values["method"].startswith("dopri54 (auto: ρ·Δt = 0.1")
+
+
+def _soft_beside_a_stiff_key() -> tuple[Scene, SampleBatch]:
+    """5 kg on four soft mounts (1e4 N/m: ρ·Δt ≈ 0.3 at 1 kHz) beside a key along x (1e9 N/m
+    past a 0.5 mm clearance, 0.1 m below the CG: in contact ρ = √(k(1/m + h²/I_yy)), ρ·Δt =
+    17.3), pushed into the key by a 3 g, 50 ms
+    lateral half-sine: stiff only once the key bears."""
+    soft = [
+        mount(f"m{i}", (x, y, 0.0), (1e4,) * 3 + (0,) * 3, (20.0,) * 3 + (0,) * 3)
+        for i, (x, y) in enumerate(CORNERS)
+    ]
+    key = kind_mount(
+        "shear_key",
+        "key",
+        (0.0, 0.0, 0.0),
+        stiffness=[1e9, 0.0, 0.0],
+        damping=[1e3, 0, 0],
+        clearance=5e-4,
+    )
+    data = base_scene(5.0, [0.0, 0.0, 0.1], [0.1, 0.1, 0.1, 0.0, 0.0, 0.0], [*soft, key])
+    data["integration"]["method"] = "auto"
+    t = np.arange(301) * 1e-3
+    push = np.where((t > 0.02) & (t < 0.07), 3.0 * G * np.sin(math.pi * (t - 0.02) / 0.05), 0.0)
+    accel = np.column_stack([push, np.zeros_like(t), np.full_like(t, G)])
+    scene = _with_pump_input(data)
+    frames = [scene.input.frame_id] * t.shape[0]
+    return conditioned(scene, SampleBatch(1.0 + t, accel, np.zeros_like(accel), frames))
+
+
+def test_auto_looks_again_after_a_mount_event_the_same_live_and_replayed() -> None:
+    """The soft scene starts explicit; when the key closes (its `key_contact` event) `auto`
+    takes ρ at that sample, which is now the key's, and switches to the Rosenbrock (the key
+    switches: not smooth). One push of the record and one push per sample make the same
+    choice at the same sample and publish the same numbers, bit for bit."""
+    scene, samples = _soft_beside_a_stiff_key()
+    engine, status = _integration_status(scene, samples)
+    contact = next(e for e in engine.events if e.event == "key_contact")
+    # the key 0.1 m below the CG couples x and pitch: the one stiff mode, closed form
+    key_rate = math.sqrt(1e9 * (1 / 5.0 + 0.1**2 / 0.1)) * 1e-3
+    assert status.values["method"].startswith("ros34pw2 (auto: ρ·Δt = ")
+    assert status.values["method"].endswith("after key_contact of key)")
+    rho_dt = float(status.values["method"].split("= ")[1].split(" ")[0])
+    assert rho_dt == pytest.approx(key_rate, rel=0.01)
+    assert engine.counts["method_switches"] == 1 and engine.counts["integration_failures"] == 0
+    assert 1.02 < contact.stamp < 1.07
+    whole = TwinEngine(assemble(scene)).push(samples)
+    live = TwinEngine(assemble(scene))
+    parts = [live.push(one) for one in split(samples, [1] * len(samples))]
+    np.testing.assert_array_equal(whole.wrenches, np.concatenate([p.wrenches for p in parts]))
+    assert live.counts["method_switches"] == 1

@@ -15,6 +15,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from mount_twin.engine.auto_method import REEXAMINE_S, Choice, after_event, at_start
 from mount_twin.engine.batch import (
     ERROR,
     WARN,
@@ -29,6 +30,7 @@ from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.gyro_filter import GyroConditioner
 from mount_twin.engine.health import PLATEAU_G, SATURATION_SHARE, HealthWindow
 from mount_twin.engine.kernel import (
+    AT_EVENT,
     Integrator,
     Published,
     RunOptions,
@@ -39,7 +41,7 @@ from mount_twin.engine.kernel import (
 )
 from mount_twin.engine.linear_rating import LinearRatings
 from mount_twin.errors import ModelError
-from mount_twin.integrate.methods import AUTO, choose
+from mount_twin.integrate.methods import AUTO
 from mount_twin.integrate.stepper import STATUS_TEXT, new_stepper, switch
 from mount_twin.kinds import KINDS, N_EVENTS
 from mount_twin.model.assemble import Model, initial_state
@@ -183,6 +185,7 @@ class TwinEngine:
         """Spectral radius at the nominal start, rad/s, while `auto` has not chosen yet."""
         if integ.method == AUTO:
             self._rho = spectral_radius(model, self._y_nominal, self._gravity_up)
+            self._watch.stop_after[0] = -math.inf  # `auto` looks again after mount events
         self._warm_up()
 
     def _warm_up(self) -> None:
@@ -208,17 +211,27 @@ class TwinEngine:
         watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
         self._start_outputs(self._y_nominal.copy(), model.new_scratch(), watch)
 
-    def _choose_method(self, interval_s: float) -> None:
-        """`auto`: the method for this scene at this sample interval (`methods.choose`)."""
-        rho_dt = (self._rho or 0.0) * interval_s
-        name = choose(rho_dt, smooth=self.model.arrays.nl is None)
-        switch(self.stepper, name)
+    def _use(self, choice: Choice) -> None:
+        """Run `auto`'s choice from now on: the first, or a change after a mount event (its
+        step history forgotten; counted)."""
+        self.health.method = choice.status
+        if self._rho is None:
+            if choice.method == self.stepper.name:
+                return
+            self.counts["method_switches"] += 1
+        self._rho = None
+        switch(self.stepper, choice.method)
         st = self.stepper
         self._integ = Integrator(st.method, st.settings, st.work2d, st.work1d, st.result)
         if self._companion is not None:
             self._companion = switch_companion(self._companion, st.method)
-        self.health.method = f"{name} (auto: ρ·Δt = {rho_dt:.3g})"
-        self._rho = None
+
+    def _look_again(self, t: np.ndarray, f: np.ndarray, j: int, event: MountEvent) -> None:
+        """`auto` at sample j of the run just ended, which logged `event` (`auto_method`)."""
+        self._watch.stop_after[0] = t[j] + REEXAMINE_S
+        choice = after_event(self.model, self._y, f[j], float(t[j] - t[j - 1]), event)
+        if choice is not None:
+            self._use(choice)
 
     def _new_companion(self) -> Companion | None:
         """The error estimate's companion solution, or None if the scene turns it off."""
@@ -552,7 +565,8 @@ class TwinEngine:
             out.append(self._start(index[0], stamps, f, w, gathered))
             index = index[1:]
         if index and self._rho is not None:
-            self._choose_method(float(stamps[index[0]]) - self._last[0])  # type: ignore[index]
+            interval = float(stamps[index[0]]) - self._last[0]  # type: ignore[index]
+            self._use(at_start(self.model, self._rho, interval))
         while index:
             t0, f0, w0 = self._last  # type: ignore[misc]
             n = len(index) + 1
@@ -574,7 +588,7 @@ class TwinEngine:
                 self._companion,
             )
             pose, wrenches, publish, step_log = out_buf[2:]
-            self._drain_events()
+            events = self._drain_events()
             self.health.add_steps(step_log[1 : done + 1])
             if self._companion is not None:
                 self.health.add_estimate(self._companion.figures)
@@ -586,6 +600,10 @@ class TwinEngine:
             out.append(_Rows(np.asarray(index)[keep - 1], pose[keep], wrenches[keep]))
             if status == 0:
                 break
+            if status == AT_EVENT:
+                self._look_again(t, ff, done, events[-1])
+                index = index[done:]
+                continue
             self.counts["integration_failures"] += 1
             self.health.failure(float(t[done + 1]), STATUS_TEXT.get(status, f"status {status}"))
             self._last = None
@@ -666,12 +684,13 @@ class TwinEngine:
             ]
         return out
 
-    def _drain_events(self) -> None:
-        """Move the kernel's event log into MountEvents (health window and `events`)."""
+    def _drain_events(self) -> list[MountEvent]:
+        """Move the kernel's event log into MountEvents (health window and `events`); returns
+        the new ones (those the log could hold)."""
         watch = self._watch
         n = int(watch.n_events[0])
         if n == 0:
-            return
+            return []
         cap = watch.events.shape[0]
         if n > cap:
             self.counts["mount_events_dropped"] += n - cap
@@ -684,6 +703,7 @@ class TwinEngine:
         room = MAX_EVENTS - len(self.events)
         self.events.extend(new[: max(room, 0)])
         self.health.add_events(new)
+        return new
 
     def _gather(self, run: _Run, f: np.ndarray) -> tuple[list[int], np.ndarray]:
         """Take a run's samples toward a start (`initial.gravity_samples` of them).

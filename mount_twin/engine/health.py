@@ -279,6 +279,7 @@ class HealthWindow:
                 else "n/a",
                 "real_time_factor": f"{rtf:.1f}",
                 "failures_total": str(counts["integration_failures"]),
+                "method_switches_total": str(counts["method_switches"]),
             },
         )
         warn = self.scene.outputs.tilt_warn_rad

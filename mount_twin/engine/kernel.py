@@ -27,6 +27,8 @@ class Watch(NamedTuple):
     events: (cap, 4) log rows [crossing time s, mount index in the scene, event index, |force| N]
     n_events: (1,) rows written (may exceed cap: the excess is counted, not stored).
     y_prev: (n_state,) the state at the previous sample (trial states of the event functions).
+    stop_after: (1,) stamp, s: a sample after it that logs an event ends the run (status
+        AT_EVENT) so that the engine can look at the scene again (`auto`); inf: never.
     """
 
     g_prev: np.ndarray
@@ -36,6 +38,12 @@ class Watch(NamedTuple):
     events: np.ndarray
     n_events: np.ndarray
     y_prev: np.ndarray
+    stop_after: np.ndarray
+
+
+AT_EVENT = -100
+"""`run_samples`' status when it ended the run at a sample that logged an event (not a
+failure; no stepper status has this value)."""
 
 
 def new_watch(k: int, n_events: int, n_state: int, capacity: int = 4096) -> Watch:
@@ -48,6 +56,7 @@ def new_watch(k: int, n_events: int, n_state: int, capacity: int = 4096) -> Watc
         np.zeros((capacity, 4)),
         np.zeros(1, dtype=np.int64),
         np.zeros(n_state),
+        np.full(1, np.inf),
     )
 
 
@@ -145,7 +154,9 @@ def run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> tupl
             None (compiled away).
 
     Returns:
-        (index of the last sample done, stepper status: 0, or the failure at the next sample).
+        (index of the last sample done, status: 0 when all are done; AT_EVENT when the run ended
+        at that sample because it logged an event past watch.stop_after; else the stepper's
+        failure at the next sample).
     """
     t, f, w = samples.t, samples.f, samples.w
     method, settings, work2d, work1d = integ.method, integ.settings, integ.work2d, integ.work1d
@@ -175,6 +186,7 @@ def run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> tupl
         status = advance(method, y, t[j - 1], t[j], settings, m, s, u, work2d, work1d, result)
         if status != 0:
             return j - 1, status
+        logged = watch.n_events[0]
         step_log[j, 0], step_log[j, 1], step_log[j, 2] = result[0], result[1], result[2]
         outputs(y, m, s, pose[j], wrenches[j])  # the stepper's last right-hand side was at y
         watch_mounts(y, m.nl, s, watch, t[j - 1], t[j], wrenches[j])
@@ -191,4 +203,6 @@ def run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> tupl
                     wrenches[j, a, b] = peak[a, b]
                     peak[a, b] = 0.0
             counter[0] = 0
+        if watch.n_events[0] > logged and t[j] > watch.stop_after[0]:
+            return j, AT_EVENT
     return n - 1, 0
