@@ -85,6 +85,9 @@ setup(
         ],
         "plot": ["matplotlib>=3.6"],
         "sweep": ["dask[distributed]>=2024.1"],
+        # bench/peers.py's MuJoCo peer (tested with mujoco 4.0.0); not in `test`: the CI
+        # installs .[test,ros] and test_mujoco_peer skips without it.
+        "bench": ["mujoco>=3.0"],
         # Jazzy's rclpy and message packages from the package registry, for a machine without a
         # ROS install (a sourced Jazzy has them: do not install a second rclpy there). The
         # node reaches into rclpy 7.x in one module (ros/rclpy_private.py): pinned.
