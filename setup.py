@@ -82,12 +82,12 @@ setup(
             "matplotlib>=3.6",
             "dask[distributed]>=2024.1",
             "pyyeti>=1.4.7",  # test_srs holds the SRS to pyyeti.srs.srs
+            "mujoco>=4.0,<5",  # test_mujoco_peer: the peer poses the twin's problem
         ],
         "plot": ["matplotlib>=3.6"],
         "sweep": ["dask[distributed]>=2024.1"],
-        # bench/peers.py's MuJoCo peer (tested with mujoco 4.0.0); not in `test`: the CI
-        # installs .[test,ros] and test_mujoco_peer skips without it.
-        "bench": ["mujoco>=3.0"],
+        # bench/peers.py's MuJoCo peer (measured with mujoco 4.0.0)
+        "bench": ["mujoco>=4.0,<5"],
         # Jazzy's rclpy and message packages from the package registry, for a machine without a
         # ROS install (a sourced Jazzy has them: do not install a second rclpy there). The
         # node reaches into rclpy 7.x in one module (ros/rclpy_private.py): pinned.
