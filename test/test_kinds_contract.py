@@ -240,6 +240,7 @@ def fake_kind(name: str = "end_stop") -> ModuleType:
     module.KIND = name
     module.EVENTS = ("stop_contact",)
     module.EVENT_ERROR = (False,)
+    module.EVENT_STIFFENS = (True,)
     module.PARAMETERS = {}
     module.N_PAR = 2
     module.read = lambda r, name, position, rpy: None
@@ -283,3 +284,24 @@ def test_a_module_lacking_part_of_the_contract_is_refused() -> None:
         check_modules({"end_stop": module})
     with pytest.raises(KindContractError, match="whose KIND is"):
         check_modules({"other_name": fake_kind()})
+
+
+@pytest.mark.parametrize("table", ["EVENT_ERROR", "EVENT_STIFFENS"])
+def test_an_event_table_of_another_length_than_the_events_is_refused(table: str) -> None:
+    """Each event has its level and whether it may stiffen the scene (`auto` looks again)."""
+    module = fake_kind()
+    setattr(module, table, (False, True))
+    with pytest.raises(KindContractError, match=f"{table} and EVENTS differ in length"):
+        check_modules({"end_stop": module})
+
+
+def test_only_contact_events_may_stiffen_a_scene() -> None:
+    """A key closing or a snubber touching adds stiffness; a joint yielding, opening, slipping
+    or breaking, an overload or an over-travel (already in contact) adds none."""
+    stiffening = {
+        (name, event)
+        for name, module in KINDS.items()
+        for event, flag in zip(module.EVENTS, module.EVENT_STIFFENS, strict=True)
+        if flag
+    }
+    assert stiffening == {("shear_key", "key_contact"), ("elastomer", "snubber_contact")}

@@ -158,11 +158,14 @@ class TwinEngine:
         """Specific forces (m/s², F) of the samples taken so far toward the next start."""
         self.counts: Counter[str] = Counter()
         self.health = HealthWindow(scene, integ.method)  # `auto` until it has chosen
-        self._watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
         self._event_meta = {
             slot: (model.scene.mounts[slot].name, KINDS[model.scene.mounts[slot].kind])
             for slot in model.nonlinear_slots
         }
+        stiffens = np.zeros((len(model.nonlinear_slots), N_EVENTS))
+        for i, (_, kind) in enumerate(self._event_meta.values()):
+            stiffens[i, : len(kind.EVENTS)] = kind.EVENT_STIFFENS
+        self._watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state, stiffens)
         self.events: list[MountEvent] = []
         """Every mount event so far, in time order (the first MAX_EVENTS; the rest counted)."""
         self._ratings = LinearRatings(scene)
@@ -226,9 +229,11 @@ class TwinEngine:
         if self._companion is not None:
             self._companion = switch_companion(self._companion, st.method)
 
-    def _look_again(self, t: np.ndarray, f: np.ndarray, j: int, event: MountEvent) -> None:
-        """`auto` at sample j of the run just ended, which logged `event` (`auto_method`)."""
+    def _look_again(self, t: np.ndarray, f: np.ndarray, j: int, events: list[MountEvent]) -> None:
+        """`auto` at sample j of the run just ended, which logged `events`, one of which may
+        stiffen the scene (`auto_method`)."""
         self._watch.stop_after[0] = t[j] + REEXAMINE_S
+        event = next((e for e in reversed(events) if self._stiffens(e)), events[-1])
         choice = after_event(self.model, self._y, f[j], float(t[j] - t[j - 1]), event)
         if choice is not None:
             self._use(choice)
@@ -601,7 +606,7 @@ class TwinEngine:
             if status == 0:
                 break
             if status == AT_EVENT:
-                self._look_again(t, ff, done, events[-1])
+                self._look_again(t, ff, done, events)
                 index = index[done:]
                 continue
             self.counts["integration_failures"] += 1
@@ -683,6 +688,11 @@ class TwinEngine:
                 if value >= 0.0
             ]
         return out
+
+    def _stiffens(self, event: MountEvent) -> bool:
+        """Whether a mount event may stiffen the scene (its kind's EVENT_STIFFENS)."""
+        kind = next(k for name, k in self._event_meta.values() if name == event.mount)
+        return bool(kind.EVENT_STIFFENS[kind.EVENTS.index(event.event)])
 
     def _drain_events(self) -> list[MountEvent]:
         """Move the kernel's event log into MountEvents (health window and `events`); returns

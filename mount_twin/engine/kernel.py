@@ -27,8 +27,11 @@ class Watch(NamedTuple):
     events: (cap, 4) log rows [crossing time s, mount index in the scene, event index, |force| N]
     n_events: (1,) rows written (may exceed cap: the excess is counted, not stored).
     y_prev: (n_state,) the state at the previous sample (trial states of the event functions).
-    stop_after: (1,) stamp, s: a sample after it that logs an event ends the run (status
-        AT_EVENT) so that the engine can look at the scene again (`auto`); inf: never.
+    stop_after: (1,) stamp, s: a sample after it that logs an event that may stiffen the scene
+        ends the run (status AT_EVENT) so that the engine can look at it again (`auto`);
+        inf: never.
+    stiffens: (k, NE) 1.0 where an event may stiffen the scene (the kinds' EVENT_STIFFENS).
+    n_stiffening: (1,) such events logged so far (counted beyond the log's capacity too).
     """
 
     g_prev: np.ndarray
@@ -39,6 +42,8 @@ class Watch(NamedTuple):
     n_events: np.ndarray
     y_prev: np.ndarray
     stop_after: np.ndarray
+    stiffens: np.ndarray
+    n_stiffening: np.ndarray
 
 
 AT_EVENT = -100
@@ -46,8 +51,11 @@ AT_EVENT = -100
 failure; no stepper status has this value)."""
 
 
-def new_watch(k: int, n_events: int, n_state: int, capacity: int = 4096) -> Watch:
-    """Empty watch for k mounts in a model of n_state states."""
+def new_watch(
+    k: int, n_events: int, n_state: int, stiffens: np.ndarray | None = None, capacity: int = 4096
+) -> Watch:
+    """Empty watch for k mounts in a model of n_state states; `stiffens` (k, n_events): the
+    events that may stiffen the scene (default none)."""
     return Watch(
         np.full((k, n_events), -1.0),
         np.full((k, n_events), -1.0),  # a kind with fewer events never writes the rest
@@ -57,6 +65,8 @@ def new_watch(k: int, n_events: int, n_state: int, capacity: int = 4096) -> Watc
         np.zeros(1, dtype=np.int64),
         np.zeros(n_state),
         np.full(1, np.inf),
+        np.zeros((k, n_events)) if stiffens is None else stiffens.astype(float),
+        np.zeros(1, dtype=np.int64),
     )
 
 
@@ -75,6 +85,8 @@ def _watch(y, nl, s, watch, t0, t1, wrenches) -> None:
             g0, g1 = g_prev[i, e], g[i, e]
             g_prev[i, e] = g1
             if g0 < 0.0 <= g1:
+                if watch.stiffens[i, e] > 0.0:
+                    watch.n_stiffening[0] += 1
                 k = count[0]
                 count[0] += 1
                 if k < events.shape[0]:
@@ -155,8 +167,8 @@ def run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> tupl
 
     Returns:
         (index of the last sample done, status: 0 when all are done; AT_EVENT when the run ended
-        at that sample because it logged an event past watch.stop_after; else the stepper's
-        failure at the next sample).
+        at that sample because it logged an event that may stiffen the scene, past
+        watch.stop_after; else the stepper's failure at the next sample).
     """
     t, f, w = samples.t, samples.f, samples.w
     method, settings, work2d, work1d = integ.method, integ.settings, integ.work2d, integ.work1d
@@ -186,7 +198,7 @@ def run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> tupl
         status = advance(method, y, t[j - 1], t[j], settings, m, s, u, work2d, work1d, result)
         if status != 0:
             return j - 1, status
-        logged = watch.n_events[0]
+        stiffening = watch.n_stiffening[0]
         step_log[j, 0], step_log[j, 1], step_log[j, 2] = result[0], result[1], result[2]
         outputs(y, m, s, pose[j], wrenches[j])  # the stepper's last right-hand side was at y
         watch_mounts(y, m.nl, s, watch, t[j - 1], t[j], wrenches[j])
@@ -203,6 +215,6 @@ def run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> tupl
                     wrenches[j, a, b] = peak[a, b]
                     peak[a, b] = 0.0
             counter[0] = 0
-        if watch.n_events[0] > logged and t[j] > watch.stop_after[0]:
+        if watch.n_stiffening[0] > stiffening and t[j] > watch.stop_after[0]:
             return j, AT_EVENT
     return n - 1, 0

@@ -48,6 +48,7 @@ MODULE_NAMES = (
     "KIND",
     "EVENTS",
     "EVENT_ERROR",
+    "EVENT_STIFFENS",
     "PARAMETERS",
     "N_PAR",
     "read",
@@ -119,9 +120,10 @@ def check_modules(kinds: Mapping[str, ModuleType]) -> None:
         if name != module.KIND:
             msg = f"KINDS maps {name!r} to {module.__name__}, whose KIND is {module.KIND!r}"
             raise KindContractError(msg)
-        if len(module.EVENT_ERROR) != len(module.EVENTS):
-            msg = f"kind {name!r}: EVENT_ERROR and EVENTS differ in length"
-            raise KindContractError(msg)
+        for table in ("EVENT_ERROR", "EVENT_STIFFENS"):
+            if len(getattr(module, table)) != len(module.EVENTS):
+                msg = f"kind {name!r}: {table} and EVENTS differ in length"
+                raise KindContractError(msg)
 
 
 check_modules(KINDS)

@@ -26,6 +26,8 @@ if TYPE_CHECKING:  # only annotations: importing mount_twin.scene here is a cycl
 KIND = "elastomer"
 EVENTS = ("snubber_contact", "over_travel")
 EVENT_ERROR = (False, True)
+EVENT_STIFFENS = (True, False)
+"""A snubber that touches stiffens the mount (`auto` looks again); over-travel is in contact."""
 AXES = ("x", "y", "z")
 TABLE_MAX = 16
 """Most points in a force–deflection table."""

@@ -20,6 +20,9 @@ if TYPE_CHECKING:  # only annotations: importing mount_twin.scene here is a cycl
 KIND = "shear_key"
 EVENTS = ("key_contact", "key_overload")
 EVENT_ERROR = (False, True)
+EVENT_STIFFENS = (True, False)
+"""A key that closes its clearance stiffens the scene (`auto` looks again); overload is in
+contact."""
 STATES: tuple[str, ...] = ()
 
 PARAMETERS = {
