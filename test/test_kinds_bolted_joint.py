@@ -212,6 +212,44 @@ def test_the_joint_face_sticks_then_slides_at_mu_times_the_clamp_force(axis, u_a
     assert np.max(np.abs(g[~stuck])) <= 1e-9 * MU * F_V
 
 
+def play_operator(x: np.ndarray, half_width: np.ndarray) -> np.ndarray:
+    """Slip of a Jenkins element whose half-width changes along the path (the clamp force
+    moves the friction bound): s_k = clip(s_{k−1}, x_k − h_k, x_k + h_k)."""
+    s = np.zeros_like(x)
+    for k in range(1, x.shape[0]):
+        s[k] = min(max(s[k - 1], x[k] - half_width[k]), x[k] + half_width[k])
+    return s
+
+
+def test_sliding_follows_the_friction_bound_as_the_clamp_force_moves():
+    """Slide out while the clamp force falls to 30 %, reverse, slide again while it rises
+    back: the slip is the play operator of half-width μF_K(u)/k_τ, the face force −k_τ(x − s)
+    never exceeds μF_K. The bound's rate is in the law: with |e| frozen while sliding (its
+    old form) the spring stayed loaded at the first bound, the reversal slid on for 0.7 of a
+    stick deflection instead of sticking at once, and a rising bound chattered."""
+    law = joint()
+    n = 400
+    x = nodes(
+        leg(0.0, 3 * D_STICK, n),
+        leg(3 * D_STICK, 6 * D_STICK, n),
+        leg(6 * D_STICK, 4 * D_STICK, n),
+        leg(4 * D_STICK, 8 * D_STICK, n),
+    )
+    falls = np.linspace(0.0, 0.7 * U_OPEN, n + 1)[1:]
+    u = np.concatenate([np.zeros(n + 1), falls, np.full(n, 0.7 * U_OPEN), falls[::-1]])
+    path = along(0, x)
+    path[:, 2] = u
+    forces, states = quasi_static(law, path)
+    half = MU * clamp_force(u) / K_T
+    slip = play_operator(x, half)
+    step = 3 * D_STICK / n  # a switch inside a segment costs at most its length
+    np.testing.assert_allclose(states[:, SLIP_X], slip, rtol=0, atol=2 * step)
+    np.testing.assert_allclose(forces[:, 0], -K_T * (x - slip), rtol=0, atol=2 * K_T * step)
+    assert np.all(np.abs(forces[:, 0]) <= MU * clamp_force(u) * (1 + 1e-12))
+    reversal = 3 * n + 1  # the first node of the way back: stuck, the force off the bound
+    assert abs(forces[reversal, 0]) < MU * clamp_force(u[reversal]) - 0.5 * K_T * step
+
+
 @pytest.mark.parametrize("angle", [0.0, math.pi / 4, 2.0 * math.pi / 3])
 def test_past_the_hole_clearance_the_shank_bears_radially(angle):
     law = joint()

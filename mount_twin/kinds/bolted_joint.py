@@ -13,8 +13,15 @@ unloading and lowers the preload. At F_u, or at the ultimate plastic elongation,
 good (a discrete state, switched between input samples).
 
 Shear: stick spring k_τ in series with a slip s_p; the friction force never exceeds μ·F_K and
-slides (ṡ_p along the stick deflection) at that bound; past the hole clearance the shank bears
-with k_b (until the bolt breaks).
+slides (ṡ_p along the stick deflection e = d − s_p) at that bound; past the hole clearance the
+shank bears with k_b (until the bolt breaks). Sliding obeys the consistency condition of
+rate-independent friction under a moving bound: ṡ_p = λ̇·e/|e| with λ̇ = max(0, e·ḋ/|e| −
+μ·Ḟ_K/k_τ), so k_τ·|e| stays on μ·F_K while the clamp force changes (Ḟ_K = −k_P·u̇ while the
+joint is closed); with the joint open (or μ = 0) nothing holds the face and the stick point moves
+with the foot (ṡ_p = ḋ). The bound's rate matters: without it (|e| frozen while sliding) a rising
+clamp force makes the face stick, catch up and slide again at every step, a sliding mode that
+chattered thousands of times per 0.1 ms on the genset's shock and made an adaptive step's cost
+grow as 1/tolerance; a falling one left the spring loaded above the bound.
 """
 
 from __future__ import annotations
@@ -34,6 +41,9 @@ EVENTS = ("bolt_yielded", "joint_opened", "joint_slipped", "bolt_fractured")
 """Monitored events, in the order `monitor` fills them (signed: ≥ 0 means it happened)."""
 EVENT_ERROR = (True, True, False, True)
 """Whether each event is an ERROR (a limit passed) rather than a WARN."""
+EVENT_STIFFENS = (False, False, False, False)
+"""Whether each event can make the scene stiffer (`auto` then looks at it again): a joint that
+yields, opens, slips or breaks only loses stiffness."""
 STATES = ("plastic_elongation", "slip_x", "slip_y", "fractured")
 
 PARAMETERS = {
@@ -189,20 +199,27 @@ def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
     joined = 1.0 if broken < 0.5 or f_k > 0.0 else 0.0
     f[2] = f_k - f_s - joined * p[CAX] * ud
     # shear: stick spring in series with slip, bounded by μ·F_K
-    tx, ty = p[KT] * (d[0] - sx), p[KT] * (d[1] - sy)
+    ex, ey = d[0] - sx, d[1] - sy
+    tx, ty = p[KT] * ex, p[KT] * ey
     tau = math.sqrt(tx * tx + ty * ty)
     limit = p[MU] * f_k
     dydt[o + 1] = 0.0
     dydt[o + 2] = 0.0
     scale = 1.0
-    if tau >= limit:
-        scale = limit / tau if tau > 0.0 else 0.0
-        ex, ey = d[0] - sx, d[1] - sy
-        norm2 = ex * ex + ey * ey
-        outward = ex * v[0] + ey * v[1]
-        if norm2 > 0.0 and outward > 0.0:
-            dydt[o + 1] = outward / norm2 * ex
-            dydt[o + 2] = outward / norm2 * ey
+    if limit <= 0.0:
+        # nothing holds the face (joint open, or no friction): the stick point moves with the
+        # foot, e kept as it was (the bound fell to zero as the joint opened)
+        scale = 0.0
+        dydt[o + 1] = v[0]
+        dydt[o + 2] = v[1]
+    elif tau >= limit:
+        scale = limit / tau
+        # consistency: sliding keeps k_τ·|e| on the bound μ·F_K as the clamp force moves
+        norm = tau / p[KT]
+        rate = (ex * v[0] + ey * v[1]) / norm + p[MU] * p[KP] * ud / p[KT]
+        if rate > 0.0:
+            dydt[o + 1] = rate * ex / norm
+            dydt[o + 2] = rate * ey / norm
     f[0] = -scale * tx - joined * p[CSH] * v[0]
     f[1] = -scale * ty - joined * p[CSH] * v[1]
     if broken < 0.5:
