@@ -42,9 +42,9 @@ Limits: linear mounts only. No bolted joint (opening, slip, yield, fracture), no
 clearance, no elastomer law: `closed_joints` poses a bolted scene as its linearised closed joint
 (bolt and clamp in parallel axially, the stuck face in shear) without its keys, which is a
 different model, valid only while no joint opens or slips and no key closes its clearance. On
-the genset's shock record they do (its twin reference: feet pulled to −138 kN past the
+the genset's shock record they do (its twin reference: feet pulled to −135 kN past the
 120 kN opening load, key_y bearing 206 kN): there the closed-joint reference differs from the
-full one by 0.91 of the peak force, so only its cost is comparable, not its answer.
+full one by 0.85 of the peak force, so only its cost is comparable, not its answer.
 MuJoCo also has no input between steps (gravity and xfrc_applied are held over a step: Python
 sets them, per stage here, at a cost the figures include) and no moving base (the fictitious
 terms are ours).

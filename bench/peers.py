@@ -29,7 +29,7 @@ per stage or step. A bolted scene is posed only with `--closed-joints`: each bol
 closed, stuck, elastic joint (axial k_S + k_P, shear k_τ, its dampers), keys left out, for every
 peer, the twin included: a different, linear model, valid while no joint opens or slips and no
 key closes its clearance; `--full-reference` also runs the full scene's reference and prints
-how far the closed-joint model is from it (on the genset's shock record 0.91 of the peak
+how far the closed-joint model is from it (on the genset's shock record 0.85 of the peak
 force: feet open and a key bears; only the cost of the closed-joint model compares there).
 
     python3 bench/peers.py [--scene config/pump_8_mounts.scene.yaml --bag bags/ship_motion_1khz]
