@@ -19,6 +19,7 @@ from mount_twin.integrate.methods import (
     TOO_MANY_STEPS,
 )
 from mount_twin.integrate.settings import CHAINED, JACOBIAN_AGE, PHI_STEP, STEP
+from mount_twin.physics.dynamics import rhs
 
 SAFETY, MIN_FACTOR = 0.9, 0.2
 OFF_CHART_SHRINK = 0.25
@@ -76,3 +77,19 @@ def forget(settings):
     settings[CHAINED] = 0.0
     settings[JACOBIAN_AGE] = 0.0
     settings[PHI_STEP] = 0.0
+
+
+@njit(cache=True, inline="always")
+def conclude(y, y_new, t, t1, step, h, last, err, not_finite, order, max_factor, m, s, u, k, rows):
+    """End a step of a method that restarts from f(t, y) (no FSAL: the linearising ones): accept
+    it if err ≤ 1 and the right-hand side at (t + step, y_new) is defined (y ← y_new, and
+    k[rows[0]] ← f there, for the next step and for the outputs; k[rows[1]] is scratch), else
+    reject it. Returns (t, the next step to try, accepted)."""
+    factor = step_factor(err, not_finite, order, max_factor)
+    t_new = t1 if last else t + step
+    if err <= 1.0 and rhs(t_new, y_new, m, s, u, k[rows[1]]) == 0:
+        for r in range(y.shape[0]):
+            y[r] = y_new[r]
+            k[rows[0], r] = k[rows[1], r]
+        return t_new, next_proposal(step, h, factor, last), True
+    return t, step * min(1.0, factor), False

@@ -31,9 +31,8 @@ import numpy as np
 from mount_twin.integrate.control import (
     MIN_STEP_FRACTION,
     OFF_CHART_SHRINK,
+    conclude,
     give_up,
-    next_proposal,
-    step_factor,
     trial_step,
 )
 from mount_twin.integrate.fd_jacobian import jacobian, time_derivative
@@ -231,17 +230,28 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
             h = step * OFF_CHART_SHRINK
             n_rej += 1
             continue
-        factor = step_factor(err, not_finite, ORDER, MAX_FACTOR)
-        if err <= 1.0 and rhs(t1 if last else t + step, y_new, m, s, u, k[FTMP]) == 0:
-            t = t1 if last else t + step
-            for r in range(n):
-                y[r] = y_new[r]
-                k[F, r] = k[FTMP, r]  # f at the new step's start
+        t, h, accepted = conclude(
+            y,
+            y_new,
+            t,
+            t1,
+            step,
+            h,
+            last,
+            err,
+            not_finite,
+            ORDER,
+            MAX_FACTOR,
+            m,
+            s,
+            u,
+            k,
+            (F, FTMP),
+        )
+        if accepted:
             err_max = max(err_max, err)
             n_acc += 1
-            h = next_proposal(step, h, factor, last)
         else:
-            h = step * min(1.0, factor)
             n_rej += 1
     settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
     return SUCCESS
