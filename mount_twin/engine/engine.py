@@ -15,7 +15,13 @@ from typing import NamedTuple
 
 import numpy as np
 
-from mount_twin.engine.auto_method import REEXAMINE_S, Choice, after_event, at_start
+from mount_twin.engine.auto_method import (
+    REEXAMINE_S,
+    Choice,
+    after_event,
+    at_start,
+    tangent_rate,
+)
 from mount_twin.engine.batch import (
     ERROR,
     WARN,
@@ -184,10 +190,14 @@ class TwinEngine:
         self._companion = self._new_companion()
         # Fails now, at load, if the mounts cannot hold the body; and is the restart fallback.
         self._y_nominal = initial_state(model, self._gravity_up)
-        self._rho: float | None = None
-        """Spectral radius at the nominal start, rad/s, while `auto` has not chosen yet."""
+        self._rho: tuple[float, float] | None = None
+        """Spectral radius at the nominal start and rate of the nominal tangents, rad/s, while
+        `auto` has not chosen yet."""
         if integ.method == AUTO:
-            self._rho = spectral_radius(model, self._y_nominal, self._gravity_up)
+            self._rho = (
+                spectral_radius(model, self._y_nominal, self._gravity_up),
+                tangent_rate(model),
+            )
             self._watch.stop_after[0] = -math.inf  # `auto` looks again after mount events
         self._warm_up()
 
@@ -571,7 +581,7 @@ class TwinEngine:
             index = index[1:]
         if index and self._rho is not None:
             interval = float(stamps[index[0]]) - self._last[0]  # type: ignore[index]
-            self._use(at_start(self.model, self._rho, interval))
+            self._use(at_start(self.model, *self._rho, interval))
         while index:
             t0, f0, w0 = self._last  # type: ignore[misc]
             n = len(index) + 1
