@@ -54,7 +54,11 @@ def scene_text(scene: Scene) -> str:
         f"gyro {i.gyro_filter}"
         + (f" {i.gyro_cutoff_hz:g} Hz" if i.gyro_filter == "lowpass" else ""),
         f"integration: {g.method}"
-        + (" (by stiffness at the first sample interval)" if g.method == "auto" else "")
+        + (
+            " (by stiffness: at the first sample interval, again after a contact)"
+            if g.method == "auto"
+            else ""
+        )
         + f", rtol {g.rtol:g}, atol {g.atol:g}, error estimate "
         + ("on" if g.error_estimate else "off"),
         f"outputs (node named {NODE_NAME}):",
