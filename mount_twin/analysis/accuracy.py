@@ -174,9 +174,10 @@ def reference_run(scene: Scene, samples: SampleBatch, max_substeps: int) -> Run:
             return dataclasses.replace(ref, out=ref.out.select(at_samples))
     msg = (
         f"no reference: the stepper failed at every reference tolerance {REFERENCE_RTOLS} "
-        f"with at most {max_substeps} substeps per input interval (--max-substeps). On scenes "
-        "with switches (joints opening, slip, contact, fracture) the explicit stepper steps "
-        "across them and tight tolerances make it hunt: no converged reference exists yet."
+        f"with at most {max_substeps} substeps per input interval (--max-substeps). The explicit "
+        "stepper steps across the mounts' switches (joints opening, slip, contact): a scene "
+        "that switches at every step (a chattering law) makes tight tolerances hunt; raise "
+        "--max-substeps, or look for the mount whose law chatters."
     )
     raise MountTwinError(msg)
 
