@@ -1,4 +1,4 @@
-"""Both methods on a stiff scene, side by side in one run: error against run time.
+"""The integration methods on a stiff scene, side by side in one run: error against run time.
 
 10 kg on 4 × 1e9 N/m (modes of 2–6 kHz) under 1 kHz ship motion (the `stiff_light` case of
 test/test_error_estimate.py): per method and rtol, the mount-force error against a reference

@@ -2,7 +2,8 @@
 
 Hochbruck, Ostermann & Schweitzer, "Exponential Rosenbrock-type methods", SIAM J. Numer. Anal.
 47 (2009) 786–803, the method `exprb32`: order 3, with the exponential Rosenbrock–Euler method
-(order 2) embedded. With J = ∂f/∂y and v = ∂f/∂t at the step's start (t, y), f0 = f(t, y):
+(order 2) embedded. With J = ∂f/∂y, v = ∂f/∂t (taken at the interval's start; what they miss at
+a later step's start goes into the remainder D) and f0 = f(t, y) at the step's start:
 
     U = y + h·φ1(hJ)·f0 + h²·φ2(hJ)·v                    (exponential Rosenbrock–Euler)
     D = f(t + h, U) − f0 − J·(U − y) − h·v               (the non-linear remainder's change)
@@ -38,13 +39,12 @@ from mount_twin.integrate.control import (
     conclude,
     give_up,
 )
-from mount_twin.integrate.fd_jacobian import jacobian, time_derivative
+from mount_twin.integrate.fd_jacobian import linearise, renew_if_stale
 from mount_twin.integrate.methods import LEFT_CHART, SUCCESS
 from mount_twin.integrate.phi import Blocks, phi_functions
 from mount_twin.integrate.settings import (
     ATOL,
     CHAINED,
-    JACOBIAN_AGE,
     MAX_SUBSTEPS,
     MIN_STEPS,
     PHI_STEP,
@@ -98,18 +98,10 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
     settings[CHAINED] = 0.0
     t = t0
     err_max, n_acc, n_rej = 0.0, 0, 0
-    age = settings[JACOBIAN_AGE]
-    fresh = age == 0.0 or age >= JACOBIAN_MAX_AGE
-    if rhs(t, y, m, s, u, k[F]) != 0 or not (
-        jacobian(y, t, m, s, u, k, TYPICAL, F, FTMP, FT, J0)
-        if fresh
-        else time_derivative(y, t, m, s, u, k, F, FTMP, FT)
-    ):
+    rows = (F, FTMP, FT, J0)
+    if not linearise(y, t, m, s, u, k, TYPICAL, rows, settings, JACOBIAN_MAX_AGE):
         settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
         return LEFT_CHART
-    if fresh:
-        settings[PHI_STEP] = 0.0
-    settings[JACOBIAN_AGE] = 1.0 if fresh else age + 1.0
     not_finite = off_chart = False  # what the last rejection was for
     while t < t1:
         too_small = h < MIN_STEP_FRACTION * span
@@ -153,11 +145,8 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
                 err += (e / scale) ** 2
             err = math.sqrt(err / n)
             not_finite = not math.isfinite(err)
-        stale = settings[JACOBIAN_AGE] > 1.0
-        # F holds f(t, y): y is unchanged by a rejected step
-        if not err <= 1.0 and stale and jacobian(y, t, m, s, u, k, TYPICAL, F, FTMP, FT, J0):
-            settings[JACOBIAN_AGE] = 1.0
-            settings[PHI_STEP] = 0.0
+        if not err <= 1.0:
+            renew_if_stale(y, t, m, s, u, k, TYPICAL, rows, settings)
         if not ok:
             h = step * OFF_CHART_SHRINK
             n_rej += 1

@@ -114,10 +114,11 @@ ROS34PW2 = METHODS["ros34pw2"].id
 EXPRB32 = METHODS["exprb32"].id
 
 AUTO = "auto"
-"""`integration.method: auto` (the default): `choose` decides at the first input interval."""
+"""`integration.method: auto` (the default): `choose` decides at the first input interval and
+again after an event that may stiffen the scene (`engine.auto_method` takes ρ)."""
 STIFF_RHO_DT = 10.0
-"""ρ·Δt (spectral radius of the Jacobian at the start state, rad/s, times the sample interval,
-s) past which `auto` takes a method that does not step at the stiff modes' rate:
+"""ρ·Δt (the body's fastest rate, rad/s, as `engine.auto_method` takes it, times the sample
+interval, s) past which `auto` takes a method that does not step at the stiff modes' rate:
 Dormand–Prince's stability reaches |hλ| ≈ 3.3 along the imaginary axis, so it would need at
 least three steps per sample for stability alone. The bundled pump is at 0.12 (1 kHz), the
 genset at 0.36 (10 kHz) and 3.6 (1 kHz), 10 kg on 4 × 1e9 N/m at 31.6 (1 kHz)."""

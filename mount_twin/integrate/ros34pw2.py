@@ -8,9 +8,9 @@ is then damped, not resolved: the explicit Dormand–Prince must take steps shor
 3.3/ω_max whatever the tolerance, this method takes the steps the accuracy asks for.
 
 The Jacobian J = ∂f/∂y is taken by finite differences of the compiled right-hand side
-(`fd_jacobian`) at the start of an interval once the one
-held has served JACOBIAN_MAX_AGE intervals (or none is held: `control.forget`), and again at
-the first rejected step of an interval it did not start; ∂f/∂t (the input's slopes) every
+(`fd_jacobian`) at the start of an interval once the one held has served JACOBIAN_MAX_AGE
+intervals (or none is held: `control.forget`), and again at the first rejected step of an
+interval it did not start; ∂f/∂t (the input's slopes) every
 interval (1 evaluation). Each step solves, for its four stages,
 (I − hγJ)·k_i = h·f(t + α_i h, y + Σ α_ij k_j) + h·J·Σ γ_ij k_j + h²·γ_i·∂f/∂t
 through one LU factorisation (partial pivoting, in place); y ← y + Σ b_i k_i, and
@@ -35,7 +35,7 @@ from mount_twin.integrate.control import (
     give_up,
     trial_step,
 )
-from mount_twin.integrate.fd_jacobian import jacobian, time_derivative
+from mount_twin.integrate.fd_jacobian import linearise, renew_if_stale
 from mount_twin.integrate.methods import (
     LEFT_CHART,
     SUCCESS,
@@ -43,7 +43,6 @@ from mount_twin.integrate.methods import (
 from mount_twin.integrate.settings import (
     ATOL,
     CHAINED,
-    JACOBIAN_AGE,
     MAX_SUBSTEPS,
     MIN_STEPS,
     RTOL,
@@ -160,16 +159,10 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
     typical = min(max(atol / rtol, 1e-6), 1.0)  # where relative and absolute tolerance meet
     # W-method: a Jacobian serves up to JACOBIAN_MAX_AGE intervals, and is taken afresh at the
     # first rejected step of an interval it did not start
-    age = settings[JACOBIAN_AGE]
-    fresh = age == 0.0 or age >= JACOBIAN_MAX_AGE
-    if rhs(t, y, m, s, u, k[F]) != 0 or not (
-        jacobian(y, t, m, s, u, k, typical, F, FTMP, FT, J0)
-        if fresh
-        else time_derivative(y, t, m, s, u, k, F, FTMP, FT)
-    ):
+    rows = (F, FTMP, FT, J0)
+    if not linearise(y, t, m, s, u, k, typical, rows, settings, JACOBIAN_MAX_AGE):
         settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
         return LEFT_CHART
-    settings[JACOBIAN_AGE] = 1.0 if fresh else age + 1.0
     not_finite = off_chart = False  # what the last rejection was for
     while t < t1:
         too_small = h < MIN_STEP_FRACTION * span
@@ -218,14 +211,8 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
             err = math.sqrt(err / n)
         not_finite = ok and not math.isfinite(err)
         off_chart = not ok
-        stale = settings[JACOBIAN_AGE] > 1.0
-        # F holds f(t, y): y is unchanged by a rejected step
-        if (
-            (not ok or not err <= 1.0)
-            and stale
-            and jacobian(y, t, m, s, u, k, typical, F, FTMP, FT, J0)
-        ):
-            settings[JACOBIAN_AGE] = 1.0
+        if not err <= 1.0:  # err is inf where a stage failed
+            renew_if_stale(y, t, m, s, u, k, typical, rows, settings)
         if not ok:
             h = step * OFF_CHART_SHRINK
             n_rej += 1
