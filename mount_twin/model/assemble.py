@@ -9,6 +9,7 @@ from scipy.optimize import least_squares
 
 from mount_twin.errors import ModelError
 from mount_twin.kinds import CODES, KINDS, N_PAR, check_dispatch
+from mount_twin.model import newton
 from mount_twin.physics.dynamics import (
     INPUT_SIZE,
     OK,
@@ -173,9 +174,10 @@ def static_equilibrium(
     specific_force: np.ndarray,
     rate_rad_s: np.ndarray | None = None,
 ) -> np.ndarray:
-    """State at rest relative to F where the free generalized accelerations vanish (least
-    squares on the coordinates, from those of `y_guess`), the foundation turning at
-    `rate_rad_s` (rad/s, F; None: not turning); internal mount states as in `y_guess`."""
+    """State at rest relative to F where the free generalized accelerations vanish (Newton on
+    the coordinates from those of `y_guess`; least squares where Newton does not get there),
+    the foundation turning at `rate_rad_s` (rad/s, F; None: not turning); internal mount
+    states as in `y_guess`."""
     nf = len(model.scene.dofs)
     q_guess = y_guess[:nf]
     m, s = model.arrays, model.new_scratch()
@@ -188,9 +190,8 @@ def static_equilibrium(
         y[:nf] = q
         if rhs(0.0, y, m, s, u, dydt) != OK:
             return np.full(nf, 1e6)
-        return dydt[nf:].copy()
+        return dydt[nf : 2 * nf].copy()
 
-    sol = least_squares(accelerations, q_guess, xtol=1e-15, ftol=1e-15, gtol=1e-15)
     g = float(np.linalg.norm(specific_force))
     # Relative to what floating point can resolve: a mount force is k·(R·p − p) with lever arms
     # p of up to `reach` metres, so each acceleration carries a rounding floor of about
@@ -198,18 +199,27 @@ def static_equilibrium(
     # stiff, light scenes whose equilibrium was as exact as their arithmetic.
     positions = [abs(v) for mt in model.scene.mounts for v in mt.position]
     reach = max(1.0, float(np.abs(m.cg_ref).max()), *positions)
-    floor = 64.0 * np.finfo(float).eps * reach * np.abs(sol.jac).max(axis=1)
-    allowed = 1e-9 * max(g, 1.0) + floor
-    if not (np.abs(sol.fun) <= allowed).all():  # NaN (a non-finite load) fails too
-        worst = int(np.nanargmax(np.abs(sol.fun) / allowed)) if np.isfinite(sol.fun).all() else 0
+
+    def allowed_at(jac: np.ndarray) -> np.ndarray:
+        floor = 64.0 * np.finfo(float).eps * reach * np.abs(jac).max(axis=1)
+        return 1e-9 * max(g, 1.0) + floor
+
+    found = newton.solve(accelerations, q_guess, allowed_at)
+    if found is None:  # Newton did not get there: the robust solver says why
+        sol = least_squares(accelerations, q_guess, xtol=1e-15, ftol=1e-15, gtol=1e-15)
+        found = sol.x, sol.fun, sol.jac
+    q, residual, jac = found
+    allowed = allowed_at(jac)
+    if not (np.abs(residual) <= allowed).all():  # NaN (a non-finite load) fails too
+        worst = int(np.nanargmax(np.abs(residual) / allowed)) if np.isfinite(residual).all() else 0
         msg = (
             f"{model.scene.source}: no static equilibrium found (residual "
-            f"{abs(sol.fun[worst]):.3g} m/s² or rad/s² on {model.scene.dofs[worst]}, where "
+            f"{abs(residual[worst]):.3g} m/s² or rad/s² on {model.scene.dofs[worst]}, where "
             f"rounding allows {allowed[worst]:.3g}): check that the mounts hold every free DOF"
         )
         raise ModelError(msg)
-    _check_restrained(model, sol.jac)
-    y[:nf] = sol.x
+    _check_restrained(model, jac)
+    y[:nf] = q
     return y.copy()
 
 
