@@ -18,14 +18,15 @@ STEP = 1.0e-7
 """Central-difference step, relative to max(1, |y_i|)."""
 
 
-def jacobian(model: Model, y: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """∂(dy/dt)/∂y (n × n) of the whole state at y under the input vector u. Raises ModelError
-    where y is at the α/γ/δ chart's edge."""
+def jacobian(model: Model, y: np.ndarray, u: np.ndarray, columns: int | None = None) -> np.ndarray:
+    """∂(dy/dt)/∂y (n × n) of the whole state at y under the input vector u; with `columns`,
+    only the derivatives by the first that many states (n × columns). Raises ModelError where
+    y is at the α/γ/δ chart's edge."""
     n = model.n_state
     scratch = model.new_scratch()
-    jac = np.empty((n, n))
+    jac = np.empty((n, n if columns is None else columns))
     plus, minus = np.empty(n), np.empty(n)
-    for k in range(n):
+    for k in range(jac.shape[1]):
         h = STEP * max(1.0, abs(y[k]))
         y_plus, y_minus = y.copy(), y.copy()
         y_plus[k] += h
@@ -47,7 +48,7 @@ def spectral_radius(model: Model, y: np.ndarray, specific_force: np.ndarray) -> 
     between sticking and sliding, a bolt between elastic and flowing), and a difference taken
     across such a switch reads as a rate of 1e5–1e6 rad/s that no mode has; the mount forces,
     hence the body's block, are continuous there."""
-    jac = jacobian(model, y, gravity_input(0.0, specific_force))
     arrays = model.arrays
     body = 2 * (arrays.free_trans.shape[0] + arrays.free_rot.shape[0])
+    jac = jacobian(model, y, gravity_input(0.0, specific_force), columns=body)
     return float(np.abs(np.linalg.eigvals(jac[:body, :body])).max())
