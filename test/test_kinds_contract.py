@@ -230,8 +230,8 @@ def _stop_monitor(p, y, y0, o, d, v, g) -> float:
 
 
 @njit
-def _stop_update(p, y, o, d) -> None:
-    pass
+def _stop_update(p, y, o, d) -> bool:
+    return False
 
 
 def fake_kind(name: str = "end_stop") -> ModuleType:

@@ -135,9 +135,11 @@ def restart(c: Companion, y: np.ndarray) -> None:
 
 
 @kernel
-def _monitor(y, nl, y_prev, s, g, util) -> None:
-    """The companion's discrete mount switches at a sample (as the twin's watch takes them)."""
-    mount_monitors(y, y_prev, nl, s, g, util)
+def _monitor(y, nl, y_prev, s, g, util, settings) -> None:
+    """The companion's discrete mount switches at a sample (as the twin's watch takes them);
+    one that switched clears its stepper's chain flag."""
+    if mount_monitors(y, y_prev, nl, s, g, util):
+        settings[CHAINED] = 0.0
     for i in range(y.shape[0]):
         y_prev[i] = y[i]
 
@@ -164,7 +166,7 @@ def _follow(m, c, u, t0, t1, chain, d_wdot, pose, wrenches, y) -> None:
         figures[FAILURES] += 1.0
         return
     outputs(c.y, m, c.s, c.pose, c.wrenches)
-    monitor(c.y, m.nl, c.y_prev, c.s, c.g, c.util)
+    monitor(c.y, m.nl, c.y_prev, c.s, c.g, c.util, settings)
     force, scale = figures[FORCE_ERROR], figures[FORCE_SCALE]
     for a in range(wrenches.shape[0]):
         for b in range(3):

@@ -180,10 +180,12 @@ class TwinEngine:
         self._linear_util = np.zeros(len(self._ratings.slots))
         self._util_max = np.zeros(self._rated.shape[0])
         # Chaining the stepper's last stage into the next interval needs a continuous input
-        # (first-order hold) and no discrete switch of the state between samples (fracture).
-        chain = scene.input.hold == "first_order" and model.arrays.nl is None
+        # (first-order hold); a discrete switch of the state between samples (a bolt breaking)
+        # clears the flag in the compiled loop.
         self._options = RunOptions(
-            scene.input.hold == "zero_order", scene.outputs.decimation, bool(chain)
+            scene.input.hold == "zero_order",
+            scene.outputs.decimation,
+            scene.input.hold == "first_order",
         )
         st = self.stepper
         self._integ = Integrator(st.method, st.settings, st.work2d, st.work1d, st.result)

@@ -71,12 +71,14 @@ def new_watch(
 
 
 @kernel
-def _watch(y, nl, s, watch, t0, t1, wrenches) -> None:
-    """Evaluate the event functions at t1; log each upward zero crossing since t0."""
+def _watch(y, nl, s, watch, t0, t1, wrenches, settings) -> None:
+    """Evaluate the event functions at t1; log each upward zero crossing since t0. A discrete
+    switch (the state jumped) clears the stepper's chain flag (settings[CHAINED])."""
     g_prev, g, util, peak = watch.g_prev, watch.g, watch.util, watch.util_peak
     events, count = watch.events, watch.n_events
     y_prev = watch.y_prev
-    mount_monitors(y, y_prev, nl, s, g, util)
+    if mount_monitors(y, y_prev, nl, s, g, util):
+        settings[CHAINED] = 0.0
     for i in range(y.shape[0]):  # a loop: slice assignment may need a temporary (NRT)
         y_prev[i] = y[i]
     for i in range(g.shape[0]):
@@ -125,9 +127,9 @@ class Samples(NamedTuple):
 class RunOptions(NamedTuple):
     """zero_order: hold each sample until the next instead of interpolating linearly.
     decimation: publish every Nth sample. chain: start each interval from the previous one's
-    last stage when the stepper says it is there (settings[CHAINED]; first-order hold, no discrete
-    switches between samples, and nothing else used the scratch since: `Stepper.reset`
-    clears it)."""
+    last stage when the stepper says it is there (settings[CHAINED]: first-order hold, and
+    nothing else used the scratch since; `Stepper.reset` and a mount's discrete switch between
+    samples clear it)."""
 
     zero_order: bool
     decimation: int
@@ -201,7 +203,7 @@ def run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> tupl
         stiffening = watch.n_stiffening[0]
         step_log[j, 0], step_log[j, 1], step_log[j, 2] = result[0], result[1], result[2]
         outputs(y, m, s, pose[j], wrenches[j])  # the stepper's last right-hand side was at y
-        watch_mounts(y, m.nl, s, watch, t[j - 1], t[j], wrenches[j])
+        watch_mounts(y, m.nl, s, watch, t[j - 1], t[j], wrenches[j], settings)
         follow(m, companion, u, t[j - 1], t[j], opts.chain, d_wdot, pose[j], wrenches[j], y)
         counter[0] += 1
         for a in range(nm):

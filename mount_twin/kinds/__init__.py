@@ -1,6 +1,7 @@
 """Mount kinds besides the linear one: each module is one place for a kind's scene keys and
 checks (`read`), its parameter row (`pack`), internal states, force law (`load`), event
-functions (`monitor`) and discrete switches between samples (`update`).
+functions (`monitor`) and discrete switches between samples (`update`, which says whether it
+switched: the state then jumped, and a stepper must not start from a stage it took before).
 
 The compiled dispatchers below select a kind by its code; adding a kind is a new module, a line
 in KINDS and a branch in each dispatcher. The integrator and the engine never change.
@@ -97,17 +98,18 @@ def kind_monitor(code, p, y, y0, o, d, v, g) -> float:
 
 
 @njit(cache=True, inline="always")
-def kind_update(code, p, y, o, d) -> None:
-    """The kind's `update`: discrete switches between samples. An unknown code writes NaN into
-    the state (its own, or y[0] for a kind without states): the next step fails."""
+def kind_update(code, p, y, o, d) -> bool:
+    """The kind's `update`: discrete switches between samples; returns whether one changed the
+    state. An unknown code writes NaN into the state (its own, or y[0] for a kind without
+    states; the next step fails) and returns True."""
     if code == ELASTOMER:
-        elastomer.update(p, y, o, d)
-    elif code == BOLTED_JOINT:
-        bolted_joint.update(p, y, o, d)
-    elif code == SHEAR_KEY:
-        shear_key.update(p, y, o, d)
-    else:
-        y[max(o, 0)] = math.nan
+        return elastomer.update(p, y, o, d)
+    if code == BOLTED_JOINT:
+        return bolted_joint.update(p, y, o, d)
+    if code == SHEAR_KEY:
+        return shear_key.update(p, y, o, d)
+    y[max(o, 0)] = math.nan
+    return True
 
 
 def check_modules(kinds: Mapping[str, ModuleType]) -> None:
@@ -202,7 +204,7 @@ def check_dispatch(kinds: Mapping[str, ModuleType] | None = None, samples: int =
                 if not np.all(np.isfinite(own)):
                     msg = f"kind {name!r}: the probe input makes its own law non-finite: {own}"
                     raise KindContractError(msg)
-                if not np.allclose(got, own, rtol=1e-12, atol=0.0):
+                if got.shape != own.shape or not np.allclose(got, own, rtol=1e-12, atol=0.0):
                     msg = (
                         f"{dispatcher} with the code of kind {name!r} ({code}) does not run "
                         f"{module.__name__}: {got} instead of {own}; add or fix its branch in "

@@ -256,9 +256,12 @@ def monitor(p, y, y0, o, d, v, g) -> float:
 
 
 @njit(cache=True, inline="always")
-def update(p, y, o, d) -> None:
-    """Between samples: a bolt at its ultimate load or elongation breaks, irreversibly."""
+def update(p, y, o, d) -> bool:
+    """Between samples: a bolt at its ultimate load or elongation breaks, irreversibly.
+    Returns whether it broke now."""
     if y[o + 3] < 0.5:
         f_s = bolt_force(p, d[2], y[o], 0.0)
         if f_s >= p[FU] or y[o] >= p[EPU]:
             y[o + 3] = 1.0
+            return True
+    return False

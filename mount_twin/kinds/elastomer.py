@@ -330,5 +330,6 @@ def monitor(p, y, y0, o, d, v, g) -> float:
 
 
 @njit(cache=True, inline="always")
-def update(p, y, o, d) -> None:
-    """No discrete state."""
+def update(p, y, o, d) -> bool:
+    """No discrete state: never switches."""
+    return False

@@ -126,5 +126,6 @@ def _engaged(p, d) -> bool:
 
 
 @njit(cache=True, inline="always")
-def update(p, y, o, d) -> None:
-    """No discrete state."""
+def update(p, y, o, d) -> bool:
+    """No discrete state: never switches."""
+    return False

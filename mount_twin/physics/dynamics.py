@@ -325,16 +325,20 @@ def mount_monitors(
     s: Scratch,
     g: np.ndarray,
     util: np.ndarray,
-) -> None:
+) -> bool:
     """Event functions g[i] and utilisation util[i] of each non-linear mount at state y (whose
     body motion `evaluate` or `rhs` has just computed; y0: the state at the previous sample,
-    for trial functions); then their discrete switches."""
+    for trial functions); then their discrete switches. Returns whether one switched (y
+    jumped)."""
     loc = s.loc
+    switched = False
     for i in range(nl.kind.shape[0]):
         _local_motion(i, nl, s)
         code, p, o = nl.kind[i], nl.par[i], nl.state[i]
         util[i] = kind_monitor(code, p, y, y0, o, loc[0], loc[1], g[i])
-        kind_update(code, p, y, o, loc[0])
+        if kind_update(code, p, y, o, loc[0]):
+            switched = True
+    return switched
 
 
 nl_loads = skip_if_none(_nl_loads)
