@@ -1,10 +1,10 @@
 """Dormand–Prince 5(4) with error control, advancing across one input-sample interval.
 
 The method is its coefficient table and one free compiled function (scipy `integrate/_ivp`
-shape). It calls the model's right-hand side `dynamics.rhs` directly: a compiled function passed
-as an argument would make it and every caller uncacheable. The state advances with the
-5th-order solution; the
-embedded 4th-order one estimates the local error. Error norm: RMS of err / (atol + rtol·|y|).
+shape). It calls the model's right-hand side directly (a compiled function passed as an
+argument would make it and every caller uncacheable), inlined in the stage loop
+(`dynamics.rhs_inlined`). The state advances with the 5th-order solution; the embedded
+4th-order one estimates the local error. Error norm: RMS of err / (atol + rtol·|y|).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from mount_twin.integrate.methods import (
 )
 from mount_twin.integrate.settings import ATOL, CHAINED, MAX_SUBSTEPS, MIN_STEPS, RTOL, STEP
 from mount_twin.physics.compiled import kernel
-from mount_twin.physics.dynamics import rhs
+from mount_twin.physics.dynamics import rhs, rhs_inlined
 
 C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0, 1.0])
 A = np.array(
@@ -97,11 +97,13 @@ def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
         ok = True
         for stage in range(1, 7):
             for i in range(n):
-                acc = y[i]
-                for j in range(stage):
-                    acc += step * A[stage, j] * k[j, i]
-                y_new[i] = acc
-            if rhs(t + C[stage] * step, y_new, m, s, u, k[stage]) != 0:
+                y_new[i] = y[i]
+            for j in range(stage):  # row by row: the inner loop runs along k[j], vectorised
+                a = step * A[stage, j]
+                if a != 0.0:
+                    for i in range(n):
+                        y_new[i] += a * k[j, i]
+            if rhs_inlined(t + C[stage] * step, y_new, m, s, u, k[stage]) != 0:
                 ok = False
                 break
         rhs_failed = not ok

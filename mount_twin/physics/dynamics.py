@@ -345,8 +345,7 @@ nl_loads = skip_if_none(_nl_loads)
 nl_wrenches = skip_if_none(_nl_wrenches)
 
 
-@kernel
-def rhs(
+def _rhs(
     t: float, y: np.ndarray, m: ModelArrays, s: Scratch, u: np.ndarray, dydt: np.ndarray
 ) -> int:
     """dy/dt at time t (s); returns OK or OFF_CHART."""
@@ -369,6 +368,14 @@ def rhs(
     if nr > 0 and not _rotational(m, s, ct, dydt, nf + nt):
         return OFF_CHART
     return OK
+
+
+rhs = kernel(_rhs)
+"""dy/dt at time t (s); returns OK or OFF_CHART. A function of its own: a call passes the
+model's and the scratch's arrays (some 400 machine words), about 90 ns on the genset."""
+rhs_inlined = njit(cache=True, inline="always")(_rhs)
+"""`rhs` inlined into its caller, without the call: for the one call site that runs at every
+stage of every step (Dormand–Prince's stage loop: the genset's right-hand side 0.50 → 0.40 µs)."""
 
 
 @njit(cache=True, inline="always")
@@ -424,18 +431,19 @@ def _rotational(m: ModelArrays, s: Scratch, ct: float, dydt: np.ndarray, first: 
     for i in range(3):
         i_acc = inertia[i, 0] * acc[0] + inertia[i, 1] * acc[1] + inertia[i, 2] * acc[2]
         h[i] = moment_b[i] - _cross(w_abs, i_w, i) - i_acc
-    # Reduced mass matrix Jᵀ I J and right side Jᵀ h, J = the free columns of B.
+    # Reduced mass matrix Jᵀ I J and right side Jᵀ h, J = the free columns of B; its lower
+    # triangle only (what the Cholesky factorisation reads), row a as (I·J_a)ᵀ J_b.
     nr = free_rot.shape[0]
     for a in range(nr):
         ca = free_rot[a]
-        rhs_rot[a] = kin[0, ca] * h[0] + kin[1, ca] * h[1] + kin[2, ca] * h[2]
-        for b in range(nr):
+        k0, k1, k2 = kin[0, ca], kin[1, ca], kin[2, ca]
+        rhs_rot[a] = k0 * h[0] + k1 * h[1] + k2 * h[2]
+        i0 = inertia[0, 0] * k0 + inertia[0, 1] * k1 + inertia[0, 2] * k2
+        i1 = inertia[1, 0] * k0 + inertia[1, 1] * k1 + inertia[1, 2] * k2
+        i2 = inertia[2, 0] * k0 + inertia[2, 1] * k1 + inertia[2, 2] * k2
+        for b in range(a + 1):
             cb = free_rot[b]
-            total = 0.0
-            for i in range(3):
-                for j in range(3):
-                    total += kin[i, ca] * inertia[i, j] * kin[j, cb]
-            mass_rot[a, b] = total
+            mass_rot[a, b] = i0 * kin[0, cb] + i1 * kin[1, cb] + i2 * kin[2, cb]
     if not _solve_spd(mass_rot, rhs_rot, nr):
         return False
     for a in range(nr):
