@@ -116,7 +116,7 @@ class _Intervals(NamedTuple):
 class _Run:
     """Accepted samples to integrate in one go; `restart`: the first one starts a new state."""
 
-    index: list[int]
+    index: np.ndarray  # int64: positions in the pushed batch
     restart: bool
 
 
@@ -461,28 +461,40 @@ class TwinEngine:
         spec = self.scene.input
         last_t = self._last_stamp
         n = len(batch)
+        first = int(last_t is None)  # 1: the batch's first sample starts the twin
         if (
-            last_t is not None
+            n > first
             and finite.all()
             and (not spec.frame_id or batch.frame_ids.count(spec.frame_id) == n)
         ):
             before = np.empty(n)
-            before[0], before[1:] = last_t, batch.stamps[:-1]
+            before[0] = batch.stamps[0] if first else last_t
+            before[1:] = batch.stamps[:-1]
             steps = batch.stamps - before
             prev = np.empty(n)
             prev[0] = math.inf if self._last_step is None else self._last_step
             prev[1:] = steps[:-1]
+            if first:
+                prev[1] = math.inf  # the start has no interval before it
+            checked = steps[first:]
             if (
-                (steps > 0.0).all()
-                and (steps <= spec.max_gap_s).all()
-                and (steps <= JUMP_FACTOR * prev).all()
+                (checked > 0.0).all()
+                and (checked <= spec.max_gap_s).all()
+                and (checked <= JUMP_FACTOR * prev[first:]).all()
             ):
                 # The usual batch, every sample in order: no per-sample Python loop.
                 self._last_stamp = float(batch.stamps[-1])
                 self._last_step = float(steps[-1])
-                intervals = _Intervals(steps, {0: self._skipped} if self._skipped else {}, True)
+                # A START has no interval, and what was skipped before it is not counted.
+                before_first = {0: self._skipped} if self._skipped and not first else {}
+                if first:
+                    steps[0] = math.nan
                 self._skipped = 0
-                return [ACCEPT] * n, self.health.ticks(batch.stamps), intervals
+                return (
+                    [START if first else ACCEPT] + [ACCEPT] * (n - 1),
+                    self.health.ticks(batch.stamps),
+                    _Intervals(steps, before_first, not first),
+                )
         verdicts: list[str] = []
         due: list[int] = []
         into = np.full(n, np.nan)
@@ -551,18 +563,23 @@ class TwinEngine:
     def _runs(verdicts: list[str], start: int, stop: int) -> list[_Run]:
         """Group the taken samples in [start, stop) into runs split at restarts."""
         segment = verdicts[start:stop]
-        if segment.count(ACCEPT) == len(segment):  # the usual case, without a Python loop
-            return [_Run(list(range(start, stop)), False)] if segment else []
-        runs: list[_Run] = []
+        if not segment:
+            return []
+        head = segment[0]
+        restart = head in _RESTARTS
+        if (head == ACCEPT or restart) and segment.count(ACCEPT) == len(segment) - restart:
+            # the usual cases, without a Python loop: all accepted, or a start and the rest
+            return [_Run(np.arange(start, stop), restart)]
+        runs: list[tuple[list[int], bool]] = []
         for i in range(start, stop):
             verdict = verdicts[i]
             if verdict not in _COUNTS:
                 continue
             if verdict in _RESTARTS or not runs:
-                runs.append(_Run([i], verdict in _RESTARTS))
+                runs.append(([i], verdict in _RESTARTS))
             else:
-                runs[-1].index.append(i)
-        return runs
+                runs[-1][0].append(i)
+        return [_Run(np.array(index, dtype=np.int64), restart) for index, restart in runs]
 
     def _integrate(
         self, run: _Run, stamps: np.ndarray, f: np.ndarray, w: np.ndarray
@@ -577,14 +594,14 @@ class TwinEngine:
             self.health.stopped_at = None
         if run.restart or self._last is None:
             index, gathered = self._gather(run, f)
-            if not index:
+            if not len(index):
                 return out
             out.append(self._start(index[0], stamps, f, w, gathered))
             index = index[1:]
-        if index and self._rho is not None:
+        if len(index) and self._rho is not None:
             interval = float(stamps[index[0]]) - self._last[0]  # type: ignore[index]
             self._use(at_start(self.model, *self._rho, interval))
-        while index:
+        while len(index):
             t0, f0, w0 = self._last  # type: ignore[misc]
             n = len(index) + 1
             t, ff, ww = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
@@ -614,7 +631,10 @@ class TwinEngine:
             if done > 0:
                 self._last = (float(t[done]), ff[done], ww[done])
             keep = np.flatnonzero(publish[: done + 1])  # never row 0: the previous sample
-            out.append(_Rows(np.asarray(index)[keep - 1], pose[keep], wrenches[keep]))
+            if keep.shape[0] == done:  # every sample published: views of this run's buffers
+                out.append(_Rows(index[:done], pose[1 : done + 1], wrenches[1 : done + 1]))
+            else:
+                out.append(_Rows(index[keep - 1], pose[keep], wrenches[keep]))
             if status == 0:
                 break
             if status == AT_EVENT:
@@ -631,7 +651,7 @@ class TwinEngine:
                 self.health.stopped_at = float(t[done + 1])
                 self.counts["samples_not_followed"] += len(rest)
                 break
-            if not rest:
+            if not len(rest):
                 break
             out.append(self._start(rest[0], stamps, f, w, f[rest[:1]]))
             index = rest[1:]
@@ -727,7 +747,7 @@ class TwinEngine:
         self.health.add_events(new)
         return new
 
-    def _gather(self, run: _Run, f: np.ndarray) -> tuple[list[int], np.ndarray]:
+    def _gather(self, run: _Run, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Take a run's samples toward a start (`initial.gravity_samples` of them).
 
         Returns the run's samples from the start sample on (none while still gathering) and
@@ -739,7 +759,7 @@ class TwinEngine:
         taken = run.index[:need]
         self._gathered.extend(f[taken])
         if len(self._gathered) < self._start_samples:
-            return [], np.empty((0, 3))
+            return run.index[:0], np.empty((0, 3))
         gathered, self._gathered = np.array(self._gathered), []
         return run.index[len(taken) - 1 :], gathered
 
