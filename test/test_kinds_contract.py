@@ -29,6 +29,7 @@ from mount_twin.kinds import (
     check_dispatch,
     check_modules,
     dispatch_results,
+    elastomer,
     kind_load,
     kind_monitor,
     kind_update,
@@ -241,6 +242,7 @@ def fake_kind(name: str = "end_stop") -> ModuleType:
     module.EVENTS = ("stop_contact",)
     module.EVENT_ERROR = (False,)
     module.EVENT_STIFFENS = (True,)
+    module.ROTATIONAL = False
     module.PARAMETERS = {}
     module.N_PAR = 2
     module.read = lambda r, name, position, rpy: None
@@ -305,3 +307,14 @@ def test_only_contact_events_may_stiffen_a_scene() -> None:
         if flag
     }
     assert stiffening == {("shear_key", "key_contact"), ("elastomer", "snubber_contact")}
+
+
+def test_a_kind_that_reads_the_rotation_must_declare_it(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A kind declared without a rotational law gets NaN for its local rotation and rate and
+    no couple is taken from it: the elastomer (rotational stiffness) declared so is refused at
+    load, not run without its couple; the bolted joint and the key pass with NaN there."""
+    monkeypatch.setattr(elastomer, "ROTATIONAL", False)
+    with pytest.raises(KindContractError, match="'elastomer' declares ROTATIONAL = False"):
+        check_dispatch(dict(KINDS))
+    monkeypatch.setattr(elastomer, "ROTATIONAL", True)
+    check_dispatch(dict(KINDS))

@@ -14,6 +14,9 @@ The contract is checked, so a forgotten step cannot run another kind's law:
 - `check_dispatch` (run by `model.assemble` before the first model with such mounts) drives
   every code through every dispatcher on a sample input and compares with the kind's own
   `load`, `monitor` and `update`; a missing or crossed branch is a `KindContractError` at load.
+  It also holds a kind that declares `ROTATIONAL = False` to it: the right-hand side then
+  leaves its local rotation and rate uncomputed (NaN) and takes no couple from it, so its
+  `load` must give finite forces, rates and a zero couple with NaN there.
 """
 
 from __future__ import annotations
@@ -50,6 +53,7 @@ MODULE_NAMES = (
     "EVENTS",
     "EVENT_ERROR",
     "EVENT_STIFFENS",
+    "ROTATIONAL",
     "PARAMETERS",
     "N_PAR",
     "read",
@@ -211,5 +215,27 @@ def check_dispatch(kinds: Mapping[str, ModuleType] | None = None, samples: int =
                         "mount_twin/kinds/__init__.py"
                     )
                     raise KindContractError(msg)
+            if not module.ROTATIONAL:
+                _check_not_rotational(name, module, x)
     if kinds is KINDS:
         _checked.add(key)
+
+
+def _check_not_rotational(name: str, module: ModuleType, x: dict[str, np.ndarray]) -> None:
+    """Raise KindContractError unless the kind's load, given NaN for the local rotation and its
+    rate, gives finite forces and state rates and a zero couple."""
+    arrays = {k: v.copy() for k, v in x.items()}
+    arrays["phi"][:] = math.nan
+    arrays["w"][:] = math.nan
+    module.load(*(_PROBE_STATE_OFFSET if a == "o" else arrays[a] for a in _LOAD_ARGS))
+    if not (
+        np.isfinite(arrays["f"]).all()
+        and np.isfinite(arrays["dydt"]).all()
+        and (arrays["c"] == 0.0).all()
+    ):
+        msg = (
+            f"kind {name!r} declares ROTATIONAL = False, but its load reads the local rotation "
+            f"or its rate, or gives a couple (force {arrays['f']}, couple {arrays['c']}): "
+            "declare ROTATIONAL = True"
+        )
+        raise KindContractError(msg)

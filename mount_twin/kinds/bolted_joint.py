@@ -45,6 +45,8 @@ EVENT_STIFFENS = (False, False, False, False)
 """Whether each event can make the scene stiffer (`auto` then looks at it again): a joint that
 yields, opens, slips or breaks only loses stiffness."""
 STATES = ("plastic_elongation", "slip_x", "slip_y", "fractured")
+ROTATIONAL = False
+"""A single bolt carries no moment: `load` reads no local rotation or rate and gives no couple."""
 
 PARAMETERS = {
     "bolt_stiffness": ("double", "Bolt stiffness k_S, N/m"),

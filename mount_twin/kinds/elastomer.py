@@ -28,6 +28,8 @@ EVENTS = ("snubber_contact", "over_travel")
 EVENT_ERROR = (False, True)
 EVENT_STIFFENS = (True, False)
 """A snubber that touches stiffens the mount (`auto` looks again); over-travel is in contact."""
+ROTATIONAL = True
+"""`load` reads the local rotation and its rate and gives a couple (the rotational stiffness)."""
 AXES = ("x", "y", "z")
 TABLE_MAX = 16
 """Most points in a force–deflection table."""

@@ -24,6 +24,8 @@ EVENT_STIFFENS = (True, False)
 """A key that closes its clearance stiffens the scene (`auto` looks again); overload is in
 contact."""
 STATES: tuple[str, ...] = ()
+ROTATIONAL = False
+"""A key carries no moment: `load` reads no local rotation or rate and gives no couple."""
 
 PARAMETERS = {
     "stiffness": ("double_array", "[kx, ky, kz] N/m along the key axes; 0 leaves an axis free"),

@@ -124,6 +124,7 @@ def _nonlinear(
         slot=np.array(index, dtype=np.int64),
         state=np.array(offsets, dtype=np.int64),
         par=par,
+        rotational=np.array([KINDS[mounts[i].kind].ROTATIONAL for i in index], dtype=np.bool_),
     )
 
 

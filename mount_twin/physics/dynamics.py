@@ -78,6 +78,7 @@ class NonLinearMounts(NamedTuple):
     slot: np.ndarray  # int64 (k,): index in the scene
     state: np.ndarray  # int64 (k,): offset of the mount's internal states in y (−1: none)
     par: np.ndarray  # (k, N_PAR) parameter rows, columns per kind
+    rotational: np.ndarray  # bool (k,): the kind has a rotational law (its ROTATIONAL)
 
 
 class Scratch(NamedTuple):
@@ -213,8 +214,9 @@ def body_motion(y: np.ndarray, m: ModelArrays, s: Scratch) -> float:
 
 @njit(cache=True, inline="always")
 def _local_motion(i: int, nl: NonLinearMounts, s: Scratch) -> None:
-    """Deflection, rate, rotation and rate of non-linear mount i in its axes into s.loc[:4];
-    its lever arm R·p into s.arm."""
+    """Deflection, rate, rotation and rate of non-linear mount i in its axes into s.loc[:4]
+    (the rotation and its rate NaN where its kind has no rotational law: it must not read
+    them); its lever arm R·p into s.arm."""
     rot, q, qd, omega_f, phi, arm, loc = s.rot, s.q, s.qd, s.omega_f, s.phi, s.arm, s.loc
     axes = nl.axes
     d0, d1, d2, e0, e1, e2 = point_motion(i, nl.point, rot, q, qd, omega_f, arm)
@@ -222,8 +224,15 @@ def _local_motion(i: int, nl: NonLinearMounts, s: Scratch) -> None:
         a0, a1, a2 = axes[i, 0, j], axes[i, 1, j], axes[i, 2, j]
         loc[0, j] = a0 * d0 + a1 * d1 + a2 * d2
         loc[1, j] = a0 * e0 + a1 * e1 + a2 * e2
-        loc[2, j] = a0 * phi[0] + a1 * phi[1] + a2 * phi[2]
-        loc[3, j] = a0 * omega_f[0] + a1 * omega_f[1] + a2 * omega_f[2]
+    if nl.rotational[i]:
+        for j in range(3):
+            a0, a1, a2 = axes[i, 0, j], axes[i, 1, j], axes[i, 2, j]
+            loc[2, j] = a0 * phi[0] + a1 * phi[1] + a2 * phi[2]
+            loc[3, j] = a0 * omega_f[0] + a1 * omega_f[1] + a2 * omega_f[2]
+    else:
+        for j in range(3):
+            loc[2, j] = math.nan
+            loc[3, j] = math.nan
 
 
 @njit(cache=True, inline="always")
@@ -274,7 +283,12 @@ def _nl_loads(y: np.ndarray, nl: NonLinearMounts, s: Scratch, dydt: np.ndarray) 
         for j in range(3):  # back from mount axes to F
             a0, a1, a2 = axes[i, j, 0], axes[i, j, 1], axes[i, j, 2]
             f[j] = a0 * loc[4, 0] + a1 * loc[4, 1] + a2 * loc[4, 2]
-            c[j] = a0 * loc[5, 0] + a1 * loc[5, 1] + a2 * loc[5, 2]
+        if nl.rotational[i]:
+            for j in range(3):
+                a0, a1, a2 = axes[i, j, 0], axes[i, j, 1], axes[i, j, 2]
+                c[j] = a0 * loc[5, 0] + a1 * loc[5, 1] + a2 * loc[5, 2]
+        else:
+            c[0], c[1], c[2] = 0.0, 0.0, 0.0
         _add_load(arm, f, c, total_f, total_m)
 
 
