@@ -259,7 +259,9 @@ def test_error_estimate_bounds_the_true_error_on_the_linear_test_equation(
 @pytest.mark.parametrize("name", list(METHODS))
 def test_compiled_error_norm_bounds_the_true_error_of_an_oscillator_step(name: str) -> None:
     """The compiled stepper on the twin's own 1-DOF oscillator (ω = 2π·50 rad/s), one step per
-    call: its error norm exceeds the true error norm of the step, in the same scaling."""
+    call: its error norm exceeds the true error norm of the step, in the same scaling, down to
+    what the arithmetic resolves (exprb32 is exact on a linear mount: its true error and its
+    estimate are both rounding, a few ε of the state)."""
     omega = 2.0 * math.pi * 50.0
     model, y_eq, u = oscillator(omega)
     dz = 1e-3
@@ -270,7 +272,8 @@ def test_compiled_error_norm_bounds_the_true_error_of_an_oscillator_step(name: s
         assert status == methods.SUCCESS and result[1] == 1  # a single step
         exact = np.array([y_eq[0] + dz * math.cos(omega * h), -dz * omega * math.sin(omega * h)])
         true_norm = math.sqrt(np.mean((y1 - exact) ** 2))  # scale = atol = 1 (rtol 1e-13)
-        assert true_norm <= result[0], (h, true_norm, result[0])
+        floor = 16.0 * np.finfo(float).eps * np.abs(exact).max()
+        assert true_norm <= max(result[0], floor), (h, true_norm, result[0])
 
 
 # ------------------------------------------------------------------- the Rosenbrock method(s)

@@ -19,6 +19,7 @@ from mount_twin.physics.dynamics import (
     new_scratch,
     rhs,
 )
+from mount_twin.physics.jacobian import central_columns
 from mount_twin.physics.rotations import rpy_matrix
 from mount_twin.scene.description import DOF_NAMES, LinearMount, Scene
 
@@ -186,12 +187,20 @@ def static_equilibrium(
     y = np.zeros(model.n_state)
     y[2 * nf :] = y_guess[2 * nf :]
     dydt = np.zeros(model.n_state)
+    by_q, work = np.empty((model.n_state, nf)), np.empty((2, model.n_state))
 
     def accelerations(q: np.ndarray) -> np.ndarray:
         y[:nf] = q
         if rhs(0.0, y, m, s, u, dydt) != OK:
             return np.full(nf, 1e6)
         return dydt[nf : 2 * nf].copy()
+
+    def stiffness(q: np.ndarray) -> np.ndarray:
+        """∂(accelerations)/∂q; NaN off the chart (Newton then gives up)."""
+        y[:nf] = q
+        if not central_columns(y, 0.0, m, s, u, work[0], work[1], by_q):
+            return np.full((nf, nf), np.nan)
+        return by_q[nf : 2 * nf].copy()
 
     g = float(np.linalg.norm(specific_force))
     # Relative to what floating point can resolve: a mount force is k·(R·p − p) with lever arms
@@ -205,7 +214,7 @@ def static_equilibrium(
         floor = 64.0 * np.finfo(float).eps * reach * np.abs(jac).max(axis=1)
         return 1e-9 * max(g, 1.0) + floor
 
-    found = newton.solve(accelerations, q_guess, allowed_at)
+    found = newton.solve(accelerations, stiffness, q_guess, allowed_at)
     if found is None:  # Newton did not get there: the robust solver says why
         sol = least_squares(accelerations, q_guess, xtol=1e-15, ftol=1e-15, gtol=1e-15)
         found = sol.x, sol.fun, sol.jac

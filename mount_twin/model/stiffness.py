@@ -12,30 +12,20 @@ import numpy as np
 
 from mount_twin.errors import ModelError
 from mount_twin.model.assemble import Model, gravity_input
-from mount_twin.physics.dynamics import OK, rhs
-
-STEP = 1.0e-7
-"""Central-difference step, relative to max(1, |y_i|)."""
+from mount_twin.physics.jacobian import central_columns
 
 
 def jacobian(model: Model, y: np.ndarray, u: np.ndarray, columns: int | None = None) -> np.ndarray:
     """∂(dy/dt)/∂y (n × n) of the whole state at y under the input vector u; with `columns`,
-    only the derivatives by the first that many states (n × columns). Raises ModelError where
-    y is at the α/γ/δ chart's edge."""
+    only the derivatives by the first that many states (n × columns); central differences
+    (`physics.jacobian`). Raises ModelError where y is at the α/γ/δ chart's edge."""
     n = model.n_state
-    scratch = model.new_scratch()
     jac = np.empty((n, n if columns is None else columns))
     plus, minus = np.empty(n), np.empty(n)
-    for k in range(jac.shape[1]):
-        h = STEP * max(1.0, abs(y[k]))
-        y_plus, y_minus = y.copy(), y.copy()
-        y_plus[k] += h
-        y_minus[k] -= h
-        for probe, out in ((y_plus, plus), (y_minus, minus)):
-            if rhs(0.0, probe, model.arrays, scratch, u, out) != OK:
-                msg = f"{model.scene.source}: the state is at the α/γ/δ chart's edge"
-                raise ModelError(msg)
-        jac[:, k] = (plus - minus) / (y_plus[k] - y_minus[k])
+    probe = np.array(y, dtype=float)
+    if not central_columns(probe, 0.0, model.arrays, model.new_scratch(), u, plus, minus, jac):
+        msg = f"{model.scene.source}: the state is at the α/γ/δ chart's edge"
+        raise ModelError(msg)
     return jac
 
 
