@@ -83,6 +83,7 @@ def assemble(scene: Scene) -> Model:
         offsets.append(len(names) if own else -1)
         names.extend(own)
     points = np.array([mt.position for mt in mounts]).reshape(-1, 3) - cg
+    nl = _nonlinear(mounts, other, points, axes, offsets) if other else None
     arrays = ModelArrays(
         mass=float(body.mass),
         inertia=inertia,
@@ -98,7 +99,8 @@ def assemble(scene: Scene) -> Model:
         lin_k_r=in_f(lin_axes, stiffness[:, 3:]),
         lin_c_r=in_f(lin_axes, damping[:, 3:]),
         lin_slot=np.array(lin, dtype=np.int64),
-        nl=_nonlinear(mounts, other, points, axes, offsets) if other else None,
+        nl=nl,
+        rotation_read=bool(lin) or (nl is not None and bool(nl.rotational.any())),
     )
     return Model(scene, arrays, tuple(names), rpy_matrix(*scene.input.sensor_rpy))
 

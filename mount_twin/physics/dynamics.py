@@ -30,7 +30,7 @@ from mount_twin.physics.chart import kinematic_matrix, kinematic_matrix_rate, ro
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.gate import skip_if_none
 from mount_twin.physics.linear_mount import linear_mount_load, point_motion
-from mount_twin.physics.rotations import rotation_vector
+from mount_twin.physics.rotations import quaternion_from_matrix, rotation_vector
 
 OK = 0
 OFF_CHART = 1
@@ -67,6 +67,7 @@ class ModelArrays(NamedTuple):
     lin_c_r: np.ndarray  # (n, 3, 3) N·m·s/rad in F
     lin_slot: np.ndarray  # int64 (n,): each linear mount's index in the scene (wrench row)
     nl: NonLinearMounts | None  # the other kinds; None compiles their code away
+    rotation_read: bool  # a mount reads the body's rotation vector (linear ones, rotational kinds)
 
 
 class NonLinearMounts(NamedTuple):
@@ -87,8 +88,10 @@ class Scratch(NamedTuple):
     Which call fills which fields, and who may read them after it (a field holds what its
     last writer left; nothing else is promised):
 
-    - `body_motion(y)` fills q, qd, trig, rot, kin, omega, omega_f, phi: read by the mount
-      laws and the rest of `rhs` at that y.
+    - `body_motion(y)` fills q, qd, trig, rot, kin, omega, omega_f, and phi with its
+      quaternion quat where a mount reads them (`ModelArrays.rotation_read`; else phi is NaN
+      and quat is left, for `outputs` to take): read by the mount laws and the rest of `rhs`
+      at that y.
     - `mount_loads` (inside `rhs`) fills arm, force, couple, loc, total_force, total_moment,
       sink: read by `rhs` itself.
     - `rhs(t, y, u)` fills all of the above, then f_s, big_w, big_w_dot, rel, w_x_rel,
@@ -177,7 +180,9 @@ def new_scratch(n_state: int) -> Scratch:
 
 @njit(cache=True, inline="always")
 def body_motion(y: np.ndarray, m: ModelArrays, s: Scratch) -> float:
-    """Fill s.q, s.qd, s.trig, s.rot, s.kin, s.omega, s.omega_f, s.phi from y.
+    """Fill s.q, s.qd, s.trig, s.rot, s.kin, s.omega, s.omega_f, s.phi from y; s.phi and its
+    quaternion s.quat only where a mount reads the rotation vector (m.rotation_read; NaN else,
+    and `outputs` takes the quaternion itself).
 
     Returns cos θ (NaN off the chart, i.e. at or below COS_TILT_MIN). Kernels bind scratch
     arrays to locals once: every attribute access on a tuple of arrays costs a reference-count
@@ -208,7 +213,11 @@ def body_motion(y: np.ndarray, m: ModelArrays, s: Scratch) -> float:
         omega[i] = kin[i, 0] * qd[3] + kin[i, 1] * qd[4] + kin[i, 2] * qd[5]
     for i in range(3):
         omega_f[i] = rot[i, 0] * omega[0] + rot[i, 1] * omega[1] + rot[i, 2] * omega[2]
-    rotation_vector(rot, s.quat, s.phi)
+    if m.rotation_read:
+        rotation_vector(rot, s.quat, s.phi)
+    else:
+        for i in range(3):
+            s.phi[i] = math.nan
     return ct
 
 
@@ -525,6 +534,8 @@ def outputs(
     """`evaluate` when s already holds the body motion at y (the last `rhs` was at y)."""
     mount_wrenches(y, m, s, wrenches)
     q, quat, cg_ref = s.q, s.quat, m.cg_ref
+    if not m.rotation_read:  # body_motion left it
+        quaternion_from_matrix(s.rot, quat)
     for i in range(3):
         pose[pose_row.POSITION + i] = cg_ref[i] + q[i]
         pose[pose_row.ANGLES + i] = q[3 + i]
