@@ -127,7 +127,7 @@ def advance(
 ) -> int:
     """Advance y from t0 to t1 (s) with the stepper `method`; returns its status (0 = success)."""
     if method == DOPRI54:
-        return dopri54.advance(y, t0, t1, settings, m, s, u, work2d, work1d, result)
+        return dopri54.advance_inlined(y, t0, t1, settings, m, s, u, work2d, work1d, result)
     if method == ROS34PW2:
         return ros34pw2.advance(y, t0, t1, settings, m, s, u, work2d, work1d, result)
     if method == EXPRB32:
