@@ -90,11 +90,14 @@ MAX_EVENTS = 100_000
 
 
 class _Rows(NamedTuple):
-    """Published rows: positions of their samples in the pushed batch, poses, wrenches."""
+    """Published rows: positions of their samples in the pushed batch, poses, wrenches; and
+    where the compiled loop gave them, their largest |wrench component| per mount and smallest
+    cos θ (`kernel.Published`)."""
 
     sample: np.ndarray
     pose: np.ndarray
     wrenches: np.ndarray
+    peaks: tuple[np.ndarray, float] | None = None
 
 
 class _Intervals(NamedTuple):
@@ -276,6 +279,8 @@ class TwinEngine:
             np.empty((n, nm, 6)),
             np.zeros(n, dtype=np.bool_),
             np.zeros((n, 3)),
+            np.zeros((nm, 6)),
+            np.ones(1),
         )
 
     @property
@@ -369,7 +374,16 @@ class TwinEngine:
             for run in self._runs(verdicts, start, stop):
                 parts.extend(self._integrate(run, batch.stamps, f, w))
             for rows in parts[first:]:
-                self.health.add_outputs(batch.stamps[rows.sample], rows.pose, rows.wrenches)
+                if rows.peaks is None:
+                    self.health.add_outputs(batch.stamps[rows.sample], rows.pose, rows.wrenches)
+                elif rows.sample.shape[0]:
+                    abs_max, cos_tilt = rows.peaks
+                    self.health.add_output_peaks(
+                        batch.stamps[rows.sample[0]],
+                        batch.stamps[rows.sample[-1]],
+                        abs_max,
+                        math.acos(min(max(cos_tilt, -1.0), 1.0)),
+                    )
                 np.maximum(
                     self._linear_util,
                     self._ratings.utilisation(rows.pose, rows.wrenches),
@@ -621,7 +635,8 @@ class TwinEngine:
                 self._watch,
                 self._companion,
             )
-            pose, wrenches, publish, step_log = out_buf[2:]
+            pose, wrenches, publish, step_log, abs_max, cos_tilt = out_buf[2:]
+            peaks = abs_max, float(cos_tilt[0])
             events = self._drain_events()
             self.health.add_steps(step_log[1 : done + 1])
             if self._companion is not None:
@@ -632,9 +647,10 @@ class TwinEngine:
                 self._last = (float(t[done]), ff[done], ww[done])
             keep = np.flatnonzero(publish[: done + 1])  # never row 0: the previous sample
             if keep.shape[0] == done:  # every sample published: views of this run's buffers
-                out.append(_Rows(index[:done], pose[1 : done + 1], wrenches[1 : done + 1]))
+                rows = _Rows(index[:done], pose[1 : done + 1], wrenches[1 : done + 1], peaks)
             else:
-                out.append(_Rows(index[keep - 1], pose[keep], wrenches[keep]))
+                rows = _Rows(index[keep - 1], pose[keep], wrenches[keep], peaks)
+            out.append(rows)
             if status == 0:
                 break
             if status == AT_EVENT:

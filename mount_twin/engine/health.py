@@ -106,13 +106,20 @@ class HealthWindow:
         """Published rows: their stamps (s), poses and mount wrenches (N, N·m, mount axes)."""
         if stamps.shape[0] == 0:
             return
-        np.maximum(self.wrench_peak, np.abs(wrenches).max(axis=0), out=self.wrench_peak)
+        tilt = float(tilt_from_quaternions(pose[:, pose_row.QUATERNION_COLS]).max())
+        self.add_output_peaks(stamps[0], stamps[-1], np.abs(wrenches).max(axis=0), tilt)
+
+    def add_output_peaks(
+        self, t_first: float, t_last: float, wrench_abs_max: np.ndarray, tilt_max_rad: float
+    ) -> None:
+        """`add_outputs` from the figures of published rows (the compiled loop folds them in):
+        their first and last stamps (s), the largest |wrench component| per mount (n, 6; N,
+        N·m) and the largest tilt (rad)."""
+        np.maximum(self.wrench_peak, wrench_abs_max, out=self.wrench_peak)
         if math.isnan(self.t_first):
-            self.t_first = float(stamps[0])
-        self.t_last = float(stamps[-1])
-        self.tilt_max = max(
-            self.tilt_max, float(tilt_from_quaternions(pose[:, pose_row.QUATERNION_COLS]).max())
-        )
+            self.t_first = float(t_first)
+        self.t_last = float(t_last)
+        self.tilt_max = max(self.tilt_max, tilt_max_rad)
 
     def add_intervals(self, steps: np.ndarray, skipped: dict[int, int]) -> None:
         """Stamp intervals (s) into samples with a plain ACCEPT verdict, each from the previous

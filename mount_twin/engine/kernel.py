@@ -144,6 +144,10 @@ class Published(NamedTuple):
     pose: out (n, pose_row.WIDTH) pose rows; wrenches: out (n, nm, 6) published wrenches.
     publish: out (n,) True where the sample is published.
     step_log: out (n, 3) per sample: error norm, accepted and rejected substeps.
+    wrench_abs_max: out (nm, 6), zeros on entry: the largest |component| of the published
+        wrenches (N, N·m), folded in while they are in cache (the health window's peaks).
+    cos_tilt_min: out (1,), 1 on entry: the smallest cos θ (R₃₃, body z against F's z) of the
+        published poses.
     """
 
     counter: np.ndarray
@@ -152,6 +156,8 @@ class Published(NamedTuple):
     wrenches: np.ndarray
     publish: np.ndarray
     step_log: np.ndarray
+    wrench_abs_max: np.ndarray
+    cos_tilt_min: np.ndarray
 
 
 @kernel
@@ -177,6 +183,7 @@ def run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> tupl
     result = integ.result
     counter, peak, pose, wrenches = out.counter, out.peak, out.pose, out.wrenches
     publish, step_log, decimation = out.publish, out.step_log, opts.decimation
+    abs_max, cos_tilt = out.wrench_abs_max, out.cos_tilt_min
     n, nm = t.shape[0], peak.shape[0]
     hold = 0.0 if opts.zero_order else 1.0
     d_wdot = s.rate_step
@@ -215,8 +222,10 @@ def run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> tupl
             for a in range(nm):
                 for b in range(6):
                     wrenches[j, a, b] = peak[a, b]
+                    abs_max[a, b] = max(abs_max[a, b], abs(peak[a, b]))
                     peak[a, b] = 0.0
             counter[0] = 0
+            cos_tilt[0] = min(cos_tilt[0], s.rot[2, 2])  # outputs() took pose[j] from s.rot
         if watch.n_stiffening[0] > stiffening and t[j] > watch.stop_after[0]:
             return j, AT_EVENT
     return n - 1, 0

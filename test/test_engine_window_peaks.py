@@ -1,0 +1,45 @@
+"""The health window's peaks, which the compiled loop folds in from each published row while it
+is in cache (its wrench components' largest magnitude per mount, and its largest tilt from the
+rotation matrix), against the same figures computed from the rows the engine published (the
+tilt from their quaternions)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from io_helpers import scene_with
+
+from mount_twin.analysis.accuracy import conditioned
+from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.health import tilt_from_quaternions
+from mount_twin.io.input_samples import read_samples
+from mount_twin.model.assemble import assemble
+from mount_twin.scene.loader import load_scene_file
+
+ROOT = Path(__file__).resolve().parent.parent
+CASES = {
+    "genset_shock": ("genset_bolted_keyed.scene.yaml", "genset_shock_10khz"),
+    "pump_ship_motion": ("pump_8_mounts.scene.yaml", "ship_motion_1khz"),
+}
+
+
+@pytest.mark.parametrize("decimation", [1, 7])
+@pytest.mark.parametrize("case", list(CASES))
+def test_the_window_peaks_are_those_of_the_published_rows(case: str, decimation: int) -> None:
+    scene_file, bag = CASES[case]
+    scene = load_scene_file(ROOT / "config" / scene_file)
+    samples = read_samples(ROOT / "bags" / bag, scene.input)
+    scene, samples = conditioned(scene, samples)  # every sample taken, no estimate
+    # one window over the whole record: no report is due before the end
+    scene = scene_with(scene, outputs={"decimation": decimation, "diagnostics_period_s": 1e3})
+    engine = TwinEngine(assemble(scene))
+    out = engine.push(samples)
+    assert not out.health and len(out) == len(samples) // decimation + (decimation > 1)
+    window = engine.health
+    np.testing.assert_array_equal(window.wrench_peak, np.abs(out.wrenches).max(axis=0))
+    tilt = float(tilt_from_quaternions(out.quaternion).max())
+    assert tilt > 1e-5  # the body tilts: a wrong element of R would not pass
+    assert window.tilt_max == pytest.approx(tilt, rel=1e-9)
+    assert (window.t_first, window.t_last) == (out.stamps[0], out.stamps[-1])
