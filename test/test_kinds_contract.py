@@ -8,6 +8,7 @@ shear key's law, silently.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 from types import ModuleType
@@ -37,7 +38,7 @@ from mount_twin.kinds import (
     shear_key,
 )
 from mount_twin.model.assemble import assemble, gravity_input, initial_state
-from mount_twin.physics.dynamics import body_motion, mount_monitors
+from mount_twin.physics.dynamics import OK, body_motion, mount_monitors, rhs
 from mount_twin.scene.loader import load_scene_file
 
 GENSET = Path(__file__).resolve().parent.parent / "config" / "genset_bolted_keyed.scene.yaml"
@@ -318,3 +319,31 @@ def test_a_kind_that_reads_the_rotation_must_declare_it(monkeypatch: pytest.Monk
         check_dispatch(dict(KINDS))
     monkeypatch.setattr(elastomer, "ROTATIONAL", True)
     check_dispatch(dict(KINDS))
+
+
+def test_mounts_in_the_axes_of_f_skip_the_rotation_and_give_the_same_loads() -> None:
+    """A non-linear mount whose axes are F's (the genset's feet and keys) is moved into and out
+    of them by copying: the right-hand side is the general rotation's to the last bit, and a
+    mount turned by its orientation_rpy still takes the rotation."""
+    model = assemble(load_scene_file(GENSET))
+    nl = model.arrays.nl
+    assert nl.aligned.all()
+    rotating = model.arrays._replace(nl=nl._replace(aligned=np.zeros_like(nl.aligned)))
+    g = np.array([0.0, 0.0, model.scene.input.g])
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        y = initial_state(model, g)
+        y[:12] += rng.normal(0.0, [2e-4] * 6 + [0.05] * 6)
+        u = gravity_input(0.0, g + rng.normal(0.0, 5.0, 3))
+        fast, general = np.zeros(model.n_state), np.zeros(model.n_state)
+        assert rhs(0.0, y, model.arrays, model.new_scratch(), u, fast) == OK
+        assert rhs(0.0, y, rotating, model.new_scratch(), u, general) == OK
+        np.testing.assert_array_equal(fast, general)
+    turned = dataclasses.replace(
+        model.scene,
+        mounts=(
+            dataclasses.replace(model.scene.mounts[0], orientation_rpy=(0.0, 0.0, 0.3)),
+            *model.scene.mounts[1:],
+        ),
+    )
+    assert list(assemble(turned).arrays.nl.aligned) == [False] + [True] * 7

@@ -128,6 +128,7 @@ def _nonlinear(
         state=np.array(offsets, dtype=np.int64),
         par=par,
         rotational=np.array([KINDS[mounts[i].kind].ROTATIONAL for i in index], dtype=np.bool_),
+        aligned=np.array([np.array_equal(axes[i], np.eye(3)) for i in index], dtype=np.bool_),
     )
 
 

@@ -80,6 +80,7 @@ class NonLinearMounts(NamedTuple):
     state: np.ndarray  # int64 (k,): offset of the mount's internal states in y (−1: none)
     par: np.ndarray  # (k, N_PAR) parameter rows, columns per kind
     rotational: np.ndarray  # bool (k,): the kind has a rotational law (its ROTATIONAL)
+    aligned: np.ndarray  # bool (k,): the mount's axes are F's (axes[i] = I: nothing to rotate)
 
 
 class Scratch(NamedTuple):
@@ -222,22 +223,39 @@ def body_motion(y: np.ndarray, m: ModelArrays, s: Scratch) -> float:
 
 
 @njit(cache=True, inline="always")
+def _into_axes(nl: NonLinearMounts, i: int, x0: float, x1: float, x2: float, out) -> None:
+    """out = Qᵢᵀ·x: a vector of F in mount i's axes (copied where they are F's)."""
+    if nl.aligned[i]:
+        out[0], out[1], out[2] = x0, x1, x2
+        return
+    axes = nl.axes
+    for j in range(3):
+        out[j] = axes[i, 0, j] * x0 + axes[i, 1, j] * x1 + axes[i, 2, j] * x2
+
+
+@njit(cache=True, inline="always")
+def _out_of_axes(nl: NonLinearMounts, i: int, local, out) -> None:
+    """out = Qᵢ·local: a vector of mount i's axes in F (copied where they are F's)."""
+    if nl.aligned[i]:
+        out[0], out[1], out[2] = local[0], local[1], local[2]
+        return
+    axes = nl.axes
+    for j in range(3):
+        out[j] = axes[i, j, 0] * local[0] + axes[i, j, 1] * local[1] + axes[i, j, 2] * local[2]
+
+
+@njit(cache=True, inline="always")
 def _local_motion(i: int, nl: NonLinearMounts, s: Scratch) -> None:
     """Deflection, rate, rotation and rate of non-linear mount i in its axes into s.loc[:4]
     (the rotation and its rate NaN where its kind has no rotational law: it must not read
     them); its lever arm R·p into s.arm."""
     rot, q, qd, omega_f, phi, arm, loc = s.rot, s.q, s.qd, s.omega_f, s.phi, s.arm, s.loc
-    axes = nl.axes
     d0, d1, d2, e0, e1, e2 = point_motion(i, nl.point, rot, q, qd, omega_f, arm)
-    for j in range(3):
-        a0, a1, a2 = axes[i, 0, j], axes[i, 1, j], axes[i, 2, j]
-        loc[0, j] = a0 * d0 + a1 * d1 + a2 * d2
-        loc[1, j] = a0 * e0 + a1 * e1 + a2 * e2
+    _into_axes(nl, i, d0, d1, d2, loc[0])
+    _into_axes(nl, i, e0, e1, e2, loc[1])
     if nl.rotational[i]:
-        for j in range(3):
-            a0, a1, a2 = axes[i, 0, j], axes[i, 1, j], axes[i, 2, j]
-            loc[2, j] = a0 * phi[0] + a1 * phi[1] + a2 * phi[2]
-            loc[3, j] = a0 * omega_f[0] + a1 * omega_f[1] + a2 * omega_f[2]
+        _into_axes(nl, i, phi[0], phi[1], phi[2], loc[2])
+        _into_axes(nl, i, omega_f[0], omega_f[1], omega_f[2], loc[3])
     else:
         for j in range(3):
             loc[2, j] = math.nan
@@ -285,17 +303,12 @@ def mount_loads(y: np.ndarray, m: ModelArrays, s: Scratch, dydt: np.ndarray) -> 
 def _nl_loads(y: np.ndarray, nl: NonLinearMounts, s: Scratch, dydt: np.ndarray) -> None:
     """Add the non-linear mounts' loads to the totals; their state rates into dydt."""
     total_f, total_m = s.total_force, s.total_moment
-    arm, f, c = s.arm, s.force, s.couple
-    axes, loc = nl.axes, s.loc
+    arm, f, c, loc = s.arm, s.force, s.couple, s.loc
     for i in range(nl.kind.shape[0]):
         _nl_load(i, y, nl, s, dydt)
-        for j in range(3):  # back from mount axes to F
-            a0, a1, a2 = axes[i, j, 0], axes[i, j, 1], axes[i, j, 2]
-            f[j] = a0 * loc[4, 0] + a1 * loc[4, 1] + a2 * loc[4, 2]
+        _out_of_axes(nl, i, loc[4], f)  # back from mount axes to F
         if nl.rotational[i]:
-            for j in range(3):
-                a0, a1, a2 = axes[i, j, 0], axes[i, j, 1], axes[i, j, 2]
-                c[j] = a0 * loc[5, 0] + a1 * loc[5, 1] + a2 * loc[5, 2]
+            _out_of_axes(nl, i, loc[5], c)
         else:
             c[0], c[1], c[2] = 0.0, 0.0, 0.0
         _add_load(arm, f, c, total_f, total_m)
