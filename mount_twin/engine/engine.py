@@ -100,6 +100,42 @@ class _Rows(NamedTuple):
     peaks: tuple[np.ndarray, float] | None = None
 
 
+class _BatchRows:
+    """Output rows for a pushed batch, one per sample (row r + 1 holds sample r's; row 0 is
+    before the batch): a start and a run over consecutive samples write theirs in place, so a
+    push whose published rows are consecutive returns views of these rather than a
+    concatenation of each run's (0.5 ms of the genset's 2,500-sample shock record)."""
+
+    def __init__(self, n: int, n_mounts: int) -> None:
+        self.pose = np.empty((n + 1, pose_row.WIDTH))
+        self.wrenches = np.empty((n + 1, n_mounts, 6))
+
+    def of_run(self, index: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """A run's buffers (row 0: the sample before index[0]) where its samples are
+        consecutive; None else."""
+        first, n = int(index[0]), index.shape[0] + 1
+        if int(index[-1]) - first != n - 2:
+            return None
+        return self.pose[first : first + n], self.wrenches[first : first + n]
+
+    def gather(self, parts: list[_Rows]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The parts' samples, poses and wrenches, in order."""
+        sample = np.concatenate([r.sample for r in parts])
+        n = sample.shape[0]
+        if (
+            n
+            and int(sample[-1]) - int(sample[0]) == n - 1
+            and all(np.may_share_memory(r.pose, self.pose) for r in parts)
+        ):  # consecutive rows of these buffers, in place
+            rows = slice(int(sample[0]) + 1, int(sample[-1]) + 2)
+            return sample, self.pose[rows], self.wrenches[rows]
+        return (
+            sample,
+            np.concatenate([r.pose for r in parts]),
+            np.concatenate([r.wrenches for r in parts]),
+        )
+
+
 class _Intervals(NamedTuple):
     """Stamp intervals of a pushed batch, for the lost-sample estimate.
 
@@ -269,14 +305,22 @@ class TwinEngine:
             self._watch.g.shape,
         )
 
-    def _buffers(self, n: int, counter: np.ndarray, peak: np.ndarray) -> Published:
-        """Output buffers for a run of n rows, with the decimation state to carry."""
+    def _buffers(
+        self,
+        n: int,
+        counter: np.ndarray,
+        peak: np.ndarray,
+        rows: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> Published:
+        """Output buffers for a run of n rows, with the decimation state to carry; `rows`: the
+        pose and wrench rows to write into (`_BatchRows.of_run`), else new ones."""
         nm = self.model.n_mounts
+        pose, wrenches = rows or (np.empty((n, pose_row.WIDTH)), np.empty((n, nm, 6)))
         return Published(
             counter,
             peak,
-            np.empty((n, pose_row.WIDTH)),
-            np.empty((n, nm, 6)),
+            pose,
+            wrenches,
             np.zeros(n, dtype=np.bool_),
             np.zeros((n, 3)),
             np.zeros((nm, 6)),
@@ -353,6 +397,7 @@ class TwinEngine:
         f, w, finite = self._screen(batch)
         verdicts, due, intervals = self._classify(batch, finite)
         suspect = self._suspect_readings(batch)
+        rows_out = _BatchRows(len(batch), nm)
         parts: list[_Rows] = []
         reports = []
         start = 0
@@ -372,7 +417,7 @@ class TwinEngine:
             self._add_intervals(intervals, start, stop)
             first = len(parts)
             for run in self._runs(verdicts, start, stop):
-                parts.extend(self._integrate(run, batch.stamps, f, w))
+                parts.extend(self._integrate(run, batch.stamps, f, w, rows_out))
             for rows in parts[first:]:
                 if rows.peaks is None:
                     self.health.add_outputs(batch.stamps[rows.sample], rows.pose, rows.wrenches)
@@ -398,14 +443,8 @@ class TwinEngine:
             empty = OutputBatch.empty(nm)
             empty.health = reports
             return empty
-        sample = np.concatenate([r.sample for r in parts])
-        return OutputBatch(
-            batch.stamps[sample],
-            sample,
-            np.concatenate([r.pose for r in parts]),
-            np.concatenate([r.wrenches for r in parts]),
-            reports,
-        )
+        sample, pose, wrenches = rows_out.gather(parts)
+        return OutputBatch(batch.stamps[sample], sample, pose, wrenches, reports)
 
     def _add_intervals(self, intervals: _Intervals, start: int, stop: int) -> None:
         """Hand the stamp intervals of samples [start, stop) to the health window."""
@@ -596,9 +635,10 @@ class TwinEngine:
         return [_Run(np.array(index, dtype=np.int64), restart) for index, restart in runs]
 
     def _integrate(
-        self, run: _Run, stamps: np.ndarray, f: np.ndarray, w: np.ndarray
+        self, run: _Run, stamps: np.ndarray, f: np.ndarray, w: np.ndarray, rows: _BatchRows
     ) -> list[_Rows]:
-        """Integrate one run; on a stepper failure restart at the next sample."""
+        """Integrate one run, its outputs into `rows` where it can; on a stepper failure
+        restart at the next sample."""
         out: list[_Rows] = []
         index = run.index
         if self.health.stopped_at is not None:
@@ -610,7 +650,7 @@ class TwinEngine:
             index, gathered = self._gather(run, f)
             if not len(index):
                 return out
-            out.append(self._start(index[0], stamps, f, w, gathered))
+            out.append(self._start(index[0], stamps, f, w, gathered, rows))
             index = index[1:]
         if len(index) and self._rho is not None:
             interval = float(stamps[index[0]]) - self._last[0]  # type: ignore[index]
@@ -622,7 +662,7 @@ class TwinEngine:
             t[0], ff[0], ww[0] = t0, f0, w0  # row 0: the last sample done
             t[1:], ff[1:], ww[1:] = stamps[index], f[index], w[index]
             self._gyro.rows(t[1:], ww[1:], t0)
-            out_buf = self._buffers(n, self._counter, self._peak)
+            out_buf = self._buffers(n, self._counter, self._peak, rows.of_run(index))
             done, status = run_samples(
                 self._integ,
                 self.model.arrays,
@@ -647,10 +687,10 @@ class TwinEngine:
                 self._last = (float(t[done]), ff[done], ww[done])
             keep = np.flatnonzero(publish[: done + 1])  # never row 0: the previous sample
             if keep.shape[0] == done:  # every sample published: views of this run's buffers
-                rows = _Rows(index[:done], pose[1 : done + 1], wrenches[1 : done + 1], peaks)
+                published = _Rows(index[:done], pose[1 : done + 1], wrenches[1 : done + 1], peaks)
             else:
-                rows = _Rows(index[keep - 1], pose[keep], wrenches[keep], peaks)
-            out.append(rows)
+                published = _Rows(index[keep - 1], pose[keep], wrenches[keep], peaks)
+            out.append(published)
             if status == 0:
                 break
             if status == AT_EVENT:
@@ -669,7 +709,7 @@ class TwinEngine:
                 break
             if not len(rest):
                 break
-            out.append(self._start(rest[0], stamps, f, w, f[rest[:1]]))
+            out.append(self._start(rest[0], stamps, f, w, f[rest[:1]], rows))
             index = rest[1:]
         return out
 
@@ -780,13 +820,19 @@ class TwinEngine:
         return run.index[len(taken) - 1 :], gathered
 
     def _start(
-        self, i: int, stamps: np.ndarray, f: np.ndarray, w: np.ndarray, gathered: np.ndarray
+        self,
+        i: int,
+        stamps: np.ndarray,
+        f: np.ndarray,
+        w: np.ndarray,
+        gathered: np.ndarray,
+        rows: _BatchRows,
     ) -> _Rows:
         """(Re)start the twin at sample i, under the mean specific force of `gathered` (m/s²,
         F; sample i's last) as gravity and sample i's rotation rate (as the gyro policy takes
-        it) where the scene starts at equilibrium under the input; its outputs are published.
-        A restart keeps the mounts' internal states (fracture, plastic elongation, slip,
-        hysteresis): only the motion starts afresh."""
+        it) where the scene starts at equilibrium under the input; its outputs are published
+        (into `rows`). A restart keeps the mounts' internal states (fracture, plastic
+        elongation, slip, hysteresis): only the motion starts afresh."""
         internal = self._y[2 * len(self.scene.dofs) :].copy()
         damage = internal if self.counts["starts"] and np.isfinite(internal).all() else None
         if self._last is not None or self.counts["starts"]:
@@ -817,7 +863,8 @@ class TwinEngine:
         pose, wrenches = self._start_outputs(self._y, self._scratch, self._watch)
         if self._companion is not None:
             restart(self._companion, self._y)
-        return _Rows(np.array([i]), pose, wrenches)
+        rows.pose[i + 1], rows.wrenches[i + 1] = pose[0], wrenches[0]
+        return _Rows(np.array([i]), rows.pose[i + 1 : i + 2], rows.wrenches[i + 1 : i + 2])
 
     def _check_start(self, stamp: float, f0: np.ndarray, gathered: np.ndarray) -> None:
         """Start checks on the start specific force f0 (m/s², F) and the samples it is the mean
