@@ -422,12 +422,8 @@ class TwinEngine:
                 if rows.peaks is None:
                     self.health.add_outputs(batch.stamps[rows.sample], rows.pose, rows.wrenches)
                 elif rows.sample.shape[0]:
-                    abs_max, cos_tilt = rows.peaks
                     self.health.add_output_peaks(
-                        batch.stamps[rows.sample[0]],
-                        batch.stamps[rows.sample[-1]],
-                        abs_max,
-                        math.acos(min(max(cos_tilt, -1.0), 1.0)),
+                        batch.stamps[rows.sample[0]], batch.stamps[rows.sample[-1]], *rows.peaks
                     )
                 np.maximum(
                     self._linear_util,

@@ -35,8 +35,12 @@ NAMED_FRAMES = 3
 
 def tilt_from_quaternions(quat: np.ndarray) -> np.ndarray:
     """Tilt θ of body z from the vertical of F, rad, for (k, 4) quaternions (x, y, z, w)."""
-    r33 = 1.0 - 2.0 * (quat[:, 0] ** 2 + quat[:, 1] ** 2)
-    return np.arccos(np.clip(r33, -1.0, 1.0))
+    return tilt_from_cos(1.0 - 2.0 * (quat[:, 0] ** 2 + quat[:, 1] ** 2))  # R₃₃ = cos θ
+
+
+def tilt_from_cos(cos_tilt: np.ndarray | float) -> np.ndarray:
+    """Tilt θ, rad, from cos θ = R₃₃ (clipped to [−1, 1]: rounding may step past it)."""
+    return np.arccos(np.clip(cos_tilt, -1.0, 1.0))
 
 
 class HealthWindow:
@@ -107,14 +111,19 @@ class HealthWindow:
         if stamps.shape[0] == 0:
             return
         tilt = float(tilt_from_quaternions(pose[:, pose_row.QUATERNION_COLS]).max())
-        self.add_output_peaks(stamps[0], stamps[-1], np.abs(wrenches).max(axis=0), tilt)
+        self._add_peaks(stamps[0], stamps[-1], np.abs(wrenches).max(axis=0), tilt)
 
     def add_output_peaks(
+        self, t_first: float, t_last: float, wrench_abs_max: np.ndarray, cos_tilt_min: float
+    ) -> None:
+        """`add_outputs` from the figures of published rows that the compiled loop folds in
+        (`kernel.Published`): their first and last stamps (s), the largest |wrench component|
+        per mount (n, 6; N, N·m) and the smallest cos θ (R₃₃)."""
+        self._add_peaks(t_first, t_last, wrench_abs_max, float(tilt_from_cos(cos_tilt_min)))
+
+    def _add_peaks(
         self, t_first: float, t_last: float, wrench_abs_max: np.ndarray, tilt_max_rad: float
     ) -> None:
-        """`add_outputs` from the figures of published rows (the compiled loop folds them in):
-        their first and last stamps (s), the largest |wrench component| per mount (n, 6; N,
-        N·m) and the largest tilt (rad)."""
         np.maximum(self.wrench_peak, wrench_abs_max, out=self.wrench_peak)
         if math.isnan(self.t_first):
             self.t_first = float(t_first)

@@ -2,6 +2,11 @@
 compiled call: the model's stiffness (`model.stiffness`, `auto`'s spectral radius) and the start
 equilibrium's Newton steps. From Python, each right-hand side was a call that unboxed the
 model's and the scratch's arrays (~10 µs); the genset's 24 columns for `auto` took 0.3 ms.
+
+The steppers' Jacobian (`integrate.fd_jacobian`) is another one on purpose: forward
+differences, n + 1 evaluations with ∂f/∂t, into rows of a stepper's work array and taken at
+every renewal; these are occasional, central (second-order accurate, for eigenvalues and the
+equilibrium's Newton steps) and return a plain matrix.
 """
 
 from __future__ import annotations
