@@ -119,8 +119,9 @@ class Peer:
         executor.remove_node(self.node)
         return future.result()
 
-    def publisher(self, msgtype: str, topic: str, depth: int = 1000) -> Any:
-        """A publisher of `msgtype` (reliable; the node's best-effort input matches it)."""
+    def publisher(self, msgtype: str, topic: str, depth: int = 100_000) -> Any:
+        """A publisher of `msgtype` (reliable, keeping `depth` messages: a node whose input is
+        overridden to reliable gets every one; a best-effort input matches it too)."""
         return self.node.create_publisher(message_class(msgtype), topic, depth)
 
     def record(self, topics: dict[str, str], depth: int = 10_000) -> None:
@@ -159,6 +160,33 @@ class Peer:
     def connected(self, topic: str) -> bool:
         """True once the recorder's subscription to `topic` has a publisher."""
         return self._subs[topic].get_publisher_count() > 0
+
+
+LOSSLESS = [
+    "-p",
+    "qos_overrides./deck/imu.subscription.reliability:=reliable",
+    "-p",
+    "input_queue_depth:=100000",
+    "-p",
+    "output_queue_depth:=100000",
+]
+"""Node arguments for tests that compare every message: a reliable input (ROS 2's QoS
+override) and histories no test run fills, so a loaded machine delays messages but never drops
+them (a best-effort input under load lost 36 % of a 10 kHz stream)."""
+
+
+def stop_and_take(
+    node: NodeProcess, peer: Peer, done: Callable[[], bool], sig: int = signal.SIGINT
+) -> int:
+    """Signal the node, take its outputs while it shuts down (it waits for its reliable
+    subscribers' acknowledgements before it exits), then until `done()` (e.g. the final
+    diagnostics period has arrived) or 30 s; the node's exit code."""
+    if node.alive:
+        node.proc.send_signal(sig)
+    peer.take_until(lambda: not node.alive, 60.0)
+    code = node.wait()
+    peer.take_until(done, 30.0)
+    return code
 
 
 def wait_for(predicate: Callable[[], bool], timeout: float, step: float = 0.02) -> bool:

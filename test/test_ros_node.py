@@ -21,7 +21,16 @@ else:
     pytest.importorskip("rclpy")
 
 from io_helpers import PARAMS_FILE, ROOT, read_raw
-from ros_harness import NodeProcess, Peer, fresh_domain, publish_paced, wait_for, wait_for_node
+from ros_harness import (
+    LOSSLESS,
+    NodeProcess,
+    Peer,
+    fresh_domain,
+    publish_paced,
+    stop_and_take,
+    wait_for,
+    wait_for_node,
+)
 
 from mount_twin.engine.batch import ERROR, OK
 from mount_twin.io.bag import InputBag, OutputBag
@@ -108,22 +117,26 @@ def run_live(
     *,
     expect_outputs: int,
 ) -> tuple[Peer, NodeProcess, int]:
-    """Start the node, publish `raws` at `rate_hz`, wait for `expect_outputs` pose messages,
-    SIGINT it; return the peer (with everything recorded), the process and its exit code."""
+    """Start the node (input reliable: `LOSSLESS`), publish `raws` at `rate_hz`, wait for
+    `expect_outputs` pose messages, SIGINT it and take until the last, partial diagnostics
+    period (stamped with the last input's stamp) has come; return the peer (with everything
+    recorded), the process and its exit code."""
     domain = fresh_domain()
     peer = Peer(domain)
     topics = live_topics(scene)
     peer.record(topics)
-    node = NodeProcess(domain, ros_args)
+    node = NodeProcess(domain, [*ros_args, *LOSSLESS])
     pub = peer.publisher(IMU, "/deck/imu")
     pose = resolve("~/pose", NODE_NAME)
+    last = _stamp(raws[-1])
     try:
         assert wait_for_node(pub, node), node.stop()
         assert wait_for(lambda: all(peer.connected(t) for t in topics), 10.0)
         publish_paced(pub, raws, rate_hz, peer)
-        peer.take_until(lambda: len(peer.got[pose]) >= expect_outputs, 30.0)
-        code = node.stop(signal.SIGINT)
-        peer.take_until(lambda: False, 0.5)  # the last diagnostics, published at shutdown
+        peer.take_until(lambda: len(peer.got[pose]) >= expect_outputs, 120.0)
+        code = stop_and_take(
+            node, peer, lambda: last in [d[0] for d in diagnostics(peer.got["/diagnostics"])]
+        )
     except BaseException:
         node.stop(signal.SIGKILL)
         peer.close()
@@ -212,7 +225,7 @@ def test_bad_input_is_counted_and_the_node_keeps_running(tmp_path: Path) -> None
     domain = fresh_domain()
     peer = Peer(domain)
     peer.record({"/diagnostics": DIAGNOSTICS, "/mount_twin/pose": "geometry_msgs/msg/PoseStamped"})
-    node = NodeProcess(domain, ["--params-file", str(PARAMS_FILE)])
+    node = NodeProcess(domain, ["--params-file", str(PARAMS_FILE), *LOSSLESS])
     pub = peer.publisher(IMU, "/deck/imu")
     other = Peer(domain, "wrong_type_peer")  # one participant cannot mix types on a topic
     other.publisher(ACCEL, "/deck/imu")
@@ -233,10 +246,15 @@ def test_bad_input_is_counted_and_the_node_keeps_running(tmp_path: Path) -> None
             *good[55:400],
         ]
         publish_paced(pub, sequence, 1000.0, peer)
-        peer.take_until(lambda: len(peer.got["/mount_twin/pose"]) >= 395, 20.0)
+        peer.take_until(lambda: len(peer.got["/mount_twin/pose"]) >= 395, 120.0)
         assert node.alive, node.stop()
-        code = node.stop(signal.SIGTERM)
-        peer.take_until(lambda: False, 0.5)
+        final = _stamp(good[-1])
+        code = stop_and_take(
+            node,
+            peer,
+            lambda: final in [d[0] for d in diagnostics(peer.got["/diagnostics"])],
+            signal.SIGTERM,
+        )
     finally:
         node.stop(signal.SIGKILL)
         peer.close()
@@ -341,6 +359,14 @@ def test_parameters_are_all_set_described_and_read_only() -> None:
             ["-p", f"scene_file:={GENSET}", "-p", "body.mass:=heavy"],
             "body.mass: expected a number, got 'heavy'",
         ),
+        (
+            ["-p", "qos_overrides./deck/imu.subscription.reliability:=sometimes"],
+            "qos_overrides./deck/imu.subscription.reliability: expected 'best_effort' or",
+        ),
+        (
+            ["-p", "qos_overrides./deck/imu.subscription.depth:=5"],
+            "qos_overrides./deck/imu.subscription.depth: no such QoS override",
+        ),
     ],
     ids=[
         "unknown_key",
@@ -349,6 +375,8 @@ def test_parameters_are_all_set_described_and_read_only() -> None:
         "bad_topic",
         "out_of_range",
         "bad_type",
+        "bad_qos_override",
+        "unknown_qos_override",
     ],
 )
 def test_configuration_errors_end_the_node_with_one_line_naming_the_parameter(

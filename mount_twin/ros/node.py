@@ -28,16 +28,18 @@ import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
 from rclpy.event_handler import QoSMessageLostInfo, SubscriptionEventCallbacks
-from rclpy.exceptions import InvalidTopicNameException
+from rclpy.exceptions import InvalidParameterTypeException, InvalidTopicNameException
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.publisher import Publisher
 from rclpy.qos import (
     DurabilityPolicy,
     HistoryPolicy,
+    QoSPolicyKind,
     QoSProfile,
     ReliabilityPolicy,
 )
+from rclpy.qos_overriding_options import QoSOverridingOptions
 from rclpy.signals import SignalHandlerOptions
 from rclpy.subscription import Subscription
 
@@ -51,7 +53,7 @@ from mount_twin.io.messages import (
     output_types,
     static_transforms,
 )
-from mount_twin.ros.parameters import configure
+from mount_twin.ros.parameters import check_qos_overrides, configure
 from mount_twin.ros.rclpy_private import take_waiting
 from mount_twin.stream import TwinStream
 
@@ -59,6 +61,10 @@ T = TypeVar("T")
 NODE_NAME = "mount_twin"
 TAKE_LIMIT = 100_000
 """Most input messages taken in one wake-up."""
+SHUTDOWN_ACK_S = 10.0
+"""At shutdown, how long (s, steady clock) the node waits for every reliable subscriber to
+acknowledge what it published last (the final, partial diagnostics period among it) before it
+destroys its publishers; what is still unacknowledged then is named in a warning."""
 WATCH_PERIOD_S = 1.0
 """Steady-clock period of the checks only a live node can make (publisher types, /clock)."""
 
@@ -84,6 +90,7 @@ class MountTwinNode(Node):
         self._batched = self.options.batch_period_s > 0.0
         self._pending: list[bytes] = []
         self._sub = self._create_input()
+        check_qos_overrides(self)
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         if self._batched:
             self.create_timer(self.options.batch_period_s, self._drain, clock=steady)
@@ -99,7 +106,8 @@ class MountTwinNode(Node):
         self.get_logger().info(
             f"scene {self.scene.name!r} from {self.scene.source}: "
             f"{len(self.scene.mounts)} mounts, DOFs {list(self.scene.dofs)}; input "
-            f"{self._sub.topic_name} ({self.scene.input.msg_type}, best effort, depth "
+            f"{self._sub.topic_name} ({self.scene.input.msg_type}, "
+            f"{self._sub.qos_profile.reliability.name.lower()}, depth "
             f"{self.options.input_queue_depth}); "
             + (f"batches every {self.options.batch_period_s} s; " if self._batched else "")
             + "outputs "
@@ -145,7 +153,9 @@ class MountTwinNode(Node):
         return pubs
 
     def _create_input(self) -> Subscription:
-        """The raw, best-effort input subscription with its message-lost and type events."""
+        """The raw input subscription with its message-lost and type events: best effort (a
+        sensor stream), unless `qos_overrides.<topic>.subscription.reliability` (ROS 2's QoS
+        override parameter) says reliable, for a publisher whose every message must count."""
         spec = self.scene.input
         qos = QoSProfile(
             depth=self.options.input_queue_depth,
@@ -155,17 +165,23 @@ class MountTwinNode(Node):
         events = SubscriptionEventCallbacks(
             message_lost=self._on_lost, incompatible_type=self._on_incompatible_type
         )
-        return self._named(
-            "input.topic",
-            lambda: self.create_subscription(
-                message_class(spec.msg_type),
-                spec.topic,
-                self._on_input,
-                qos,
-                raw=True,
-                event_callbacks=events,
-            ),
-        )
+        override = f"qos_overrides.{self.resolve_topic_name(spec.topic)}.subscription.reliability"
+        try:
+            return self._named(
+                "input.topic",
+                lambda: self.create_subscription(
+                    message_class(spec.msg_type),
+                    spec.topic,
+                    self._on_input,
+                    qos,
+                    raw=True,
+                    event_callbacks=events,
+                    qos_overriding_options=QoSOverridingOptions([QoSPolicyKind.RELIABILITY]),
+                ),
+            )
+        except (RuntimeError, InvalidParameterTypeException) as err:  # rclpy's override check
+            msg = f"{self.get_fully_qualified_name()}: {override}: expected 'best_effort' or "
+            raise MountTwinError(f"{msg}'reliable' ({err})".replace("\n", " ")) from err
 
     def _named(self, parameter: str, create: Callable[[], T]) -> T:
         """Create a publisher or subscription; a name rclpy refuses names the parameter."""
@@ -251,12 +267,24 @@ class MountTwinNode(Node):
 
     def finish(self) -> None:
         """Take what is still waiting, process the queue, publish the last, partial
-        diagnostics period, and give reliable subscribers a moment to receive it."""
+        diagnostics period, and wait (up to SHUTDOWN_ACK_S) until every reliable subscriber
+        has acknowledged it all; a topic still unacknowledged then is named in a warning."""
         self._pending.extend(take_waiting(self._sub, TAKE_LIMIT))
         self._drain()
         self._publish(self.stream.finish())
-        for pub in self._pubs.values():
-            pub.wait_for_all_acked(Duration(seconds=1.0))
+        deadline = time.monotonic() + SHUTDOWN_ACK_S
+        unacked = [
+            pub.topic_name
+            for pub in self._pubs.values()
+            if not pub.wait_for_all_acked(
+                Duration(seconds=max(0.0, deadline - time.monotonic()))
+            )
+        ]
+        if unacked:
+            self.get_logger().warning(
+                f"shutdown: not acknowledged by every subscriber within {SHUTDOWN_ACK_S} s, "
+                f"the last messages may be lost on {', '.join(unacked)}"
+            )
 
 
 def main(args: list[str] | None = None) -> int:

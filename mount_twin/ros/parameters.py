@@ -68,6 +68,9 @@ _OPTIONS: dict[str, ParameterDescriptor] = {
 }
 BUILT_IN = frozenset({"use_sim_time", "start_type_description_service"})
 """Parameters rclpy declares itself."""
+QOS_OVERRIDES = "qos_overrides."
+"""Prefix of ROS 2's QoS override parameters, which rclpy declares and checks itself (the node
+lets the input subscription's reliability be overridden)."""
 
 
 def configure(node: Node) -> tuple[NodeOptions, Scene]:
@@ -77,7 +80,11 @@ def configure(node: Node) -> tuple[NodeOptions, Scene]:
         SceneError: naming the parameter (or scene file key path) at fault.
     """
     source = f"parameters of {node.get_fully_qualified_name()}"
-    given = {k: v for k, v in given_parameters(node).items() if k not in BUILT_IN}
+    given = {
+        k: v
+        for k, v in given_parameters(node).items()
+        if k not in BUILT_IN and not k.startswith(QOS_OVERRIDES)
+    }
     options = {k: given.pop(k) for k in list(given) if k in _OPTIONS}
     scene, effective = effective_parameters(given, source)
     values = _declare_options(node, options, source)
@@ -118,3 +125,19 @@ def _description(name: str, effective: dict[str, Any]) -> str:
         return PARAMETERS[name][1]
     _, mount, key = name.split(".", 2)
     return mount_parameters(str(effective.get(f"mounts.{mount}.kind", "linear")))[key][1]
+
+
+def check_qos_overrides(node: Node) -> None:
+    """Refuse a given `qos_overrides.*` parameter that no entity of the node declared (a typo
+    in the topic or policy, or a policy the node does not let be overridden), which rclpy
+    would otherwise ignore without a word. Call after every publisher and subscription exists.
+
+    Raises:
+        SceneError: naming the parameter and the overrides the node takes.
+    """
+    for name in given_parameters(node):
+        if name.startswith(QOS_OVERRIDES) and not node.has_parameter(name):
+            declared = node.list_parameters([QOS_OVERRIDES.rstrip(".")], 0).names
+            source = f"parameters of {node.get_fully_qualified_name()}"
+            raise SceneError(source, name, f"no such QoS override; the node takes {declared}")
+
