@@ -165,7 +165,9 @@ def test_live_node_over_dds_equals_the_replay_of_the_same_messages(
     else:
         scene = scene_from_params(dict(flatten(_params())), str(params))
         args = ["--params-file", str(params)]
-    args += ["-p", f"batch_period_s:={batch_period_s}", *extra]
+    # A publisher starved for one diagnostics period of the node's clock (a loaded machine)
+    # makes the node report the stall, a live-only report with its own test: held off here.
+    args += ["-p", f"batch_period_s:={batch_period_s}", "-p", "stall_period_s:=3600.0", *extra]
     raws = bag_inputs(BAGS / bag, n)
     want = replayed(scene, raws, tmp_path)
     peer, node, code = run_live(scene, args, raws, 1000.0, expect_outputs=n)
@@ -177,7 +179,7 @@ def test_live_node_over_dds_equals_the_replay_of_the_same_messages(
         if topic == "/diagnostics":  # less the reports of the node's clock before input came
             span = (_stamp(raws[0]), _stamp(raws[-1]))
             live = [d for d in diagnostics(got) if span[0] <= d[0] <= span[1]]
-            assert live == diagnostics(want[topic])
+            assert live == diagnostics(want[topic]), node.stderr
             continue
         assert len(got) == len(want[topic]) == n, topic
         assert got == want[topic], f"{topic}: live bytes differ from the replay's"

@@ -94,10 +94,9 @@ class MountTwinNode(Node):
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         if self._batched:
             self.create_timer(self.options.batch_period_s, self._drain, clock=steady)
-        period = self.scene.outputs.diagnostics_period_s
         self._reports = 0
         self._accepted_at_tick = 0
-        self.create_timer(period, self._on_diagnostics_period)
+        self.create_timer(self.options.stall_period(self.scene), self._on_stall_period)
         self._problems: dict[str, str] = {}
         """Problems seen by events (kept); `_watch` adds the ones it finds each time."""
         self._reported: dict[str, str] = {}
@@ -215,13 +214,13 @@ class MountTwinNode(Node):
             if pub is not None:
                 pub.publish(bytes(data))
 
-    def _on_diagnostics_period(self) -> None:
-        """A period of the node's clock: if it brought no input report (stamp-driven) and no
-        accepted sample, report now, saying why."""
+    def _on_stall_period(self) -> None:
+        """A stall period of the node's clock (`stall_period_s`): if it brought no input
+        report (stamp-driven) and no accepted sample, report now, saying why."""
         accepted = self.stream.engine.counts["accepted"]
         if self._reports == 0 and accepted == self._accepted_at_tick:
             now = self.get_clock().now().nanoseconds
-            period = self.scene.outputs.diagnostics_period_s
+            period = self.options.stall_period(self.scene)
             self._publish(self.stream.stalled(period, now))
         self._reports = 0
         self._accepted_at_tick = accepted

@@ -32,11 +32,18 @@ class NodeOptions:
             every batch_period_s (s, steady clock) in one engine call.
         input_queue_depth: messages the input subscription keeps (best effort, keep last).
         output_queue_depth: messages each output publisher keeps (reliable, keep last).
+        stall_period_s: period of the node's clock (s) after which, without any report or
+            accepted sample, the node reports why; 0: the scene's diagnostics period.
     """
 
     batch_period_s: float = 0.0
     input_queue_depth: int = 1000
     output_queue_depth: int = 100
+    stall_period_s: float = 0.0
+
+    def stall_period(self, scene: Scene) -> float:
+        """The stall check's period, s (`stall_period_s`, or the scene's diagnostics period)."""
+        return self.stall_period_s or scene.outputs.diagnostics_period_s
 
 
 def _option(description: str, lo: float, hi: float) -> ParameterDescriptor:
@@ -64,6 +71,13 @@ _OPTIONS: dict[str, ParameterDescriptor] = {
     ),
     "output_queue_depth": _option(
         "History depth of each output publisher (reliable, keep last), messages", 1, 1_000_000
+    ),
+    "stall_period_s": _option(
+        "Period of the node's clock (s, wall or sim time) after which, if it brought no report "
+        "and no accepted sample, the node publishes a report saying why (no input, all "
+        "rejected, stalled); 0.0: outputs.diagnostics_period_s",
+        0.0,
+        3600.0,
     ),
 }
 BUILT_IN = frozenset({"use_sim_time", "start_type_description_service"})
