@@ -651,21 +651,28 @@ class TwinEngine:
         if len(index) and self._rho is not None:
             interval = float(stamps[index[0]]) - self._last[0]  # type: ignore[index]
             self._use(at_start(self.model, *self._rho, interval))
+        # The run's samples from the last one done on, gyro rows conditioned once: after a stop
+        # at an event the run goes on with the rows it has (conditioning them again advanced
+        # the filter twice: output depended on where the batches ended).
+        segment: Samples | None = None
         while len(index):
-            t0, f0, w0 = self._last  # type: ignore[misc]
-            n = len(index) + 1
-            t, ff, ww = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
-            t[0], ff[0], ww[0] = t0, f0, w0  # row 0: the last sample done
-            t[1:], ff[1:], ww[1:] = stamps[index], f[index], w[index]
-            self._gyro.rows(t[1:], ww[1:], t0)
-            out_buf = self._buffers(n, self._counter, self._peak, rows.of_run(index))
+            if segment is None:
+                t0, f0, w0 = self._last  # type: ignore[misc]
+                n = len(index) + 1
+                t, ff, ww = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
+                t[0], ff[0], ww[0] = t0, f0, w0  # row 0: the last sample done
+                t[1:], ff[1:], ww[1:] = stamps[index], f[index], w[index]
+                self._gyro.rows(t[1:], ww[1:], t0)
+                segment = Samples(t, ff, ww)
+            t, ff, ww = segment
+            out_buf = self._buffers(len(t), self._counter, self._peak, rows.of_run(index))
             done, status = run_samples(
                 self._integ,
                 self.model.arrays,
                 self._scratch,
                 self._u,
                 self._y,
-                Samples(t, ff, ww),
+                segment,
                 self._options,
                 out_buf,
                 self._watch,
@@ -692,7 +699,9 @@ class TwinEngine:
             if status == AT_EVENT:
                 self._look_again(t, ff, done, events)
                 index = index[done:]
+                segment = Samples(t[done:], ff[done:], ww[done:])
                 continue
+            segment = None  # a restart conditions the gyro rows after it afresh
             self.counts["integration_failures"] += 1
             self.health.failure(float(t[done + 1]), STATUS_TEXT.get(status, f"status {status}"))
             self._last = None
