@@ -25,6 +25,7 @@ from physics_helpers import (
     mount_wrench_ref,
     natural_frequencies_from_jacobian,
     skew,
+    spring_tangent_ref,
     twin_jacobian,
 )
 from scipy.linalg import eig, eigh
@@ -65,25 +66,14 @@ def corners(a: float, b: float) -> list[tuple[float, float, float]]:
     return [(a, b, 0.0), (a, -b, 0.0), (-a, b, 0.0), (-a, -b, 0.0)]
 
 
-def inverse_left_jacobian(phi: np.ndarray) -> np.ndarray:
-    """J_l⁻¹(φ) of SO(3): log(exp([θ]×)·exp([φ]×)) = φ + J_l⁻¹(φ)·θ + O(θ²), the inverse left
-    Jacobian (Solà, Deray and Atchuthan, "A micro Lie theory for state estimation in robotics",
-    2018, appendix on SO(3))."""
-    angle = float(np.linalg.norm(phi))
-    w = skew(phi)
-    if angle < 1e-8:
-        return np.eye(3) - 0.5 * w
-    coef = 1.0 / angle**2 - (1.0 + math.cos(angle)) / (2.0 * angle * math.sin(angle))
-    return np.eye(3) - 0.5 * w + coef * w @ w
-
-
 def independent_eigenproblem(data: dict[str, Any], geometric: bool) -> tuple[np.ndarray, ...]:
     """M and K about the CG in F (translation, rotation vector), from the scene's numbers only.
 
     Equilibrium: force and moment balance of the mounts (physics notes §7, `mount_wrench_ref`)
     against the weight, solved here for (r, φ). About it, with arms aᵢ = R₀·pᵢ:
-    K = Σ Tᵢᵀ·K_t,i·Tᵢ (Tᵢ = [1, −[aᵢ]×]) + Σ K_r,i·J_l⁻¹(φ₀) (the couple −K_r·φ with φ the
-    rotation vector of R) + [if geometric] Σ (F₀ᵢ·aᵢ)·1 − aᵢ·F₀ᵢᵀ; M = diag(m·1, R₀·I·R₀ᵀ).
+    K = Σ Tᵢᵀ·K_t,i·Tᵢ (Tᵢ = [1, −[aᵢ]×]) + the tangents of the rotational springs' couples
+    −J_l⁻ᵀ(φ)·K_r,i·φ (φ the rotation vector of R, `spring_tangent_ref`) + [if geometric]
+    Σ (F₀ᵢ·aᵢ)·1 − aᵢ·F₀ᵢᵀ; M = diag(m·1, R₀·I·R₀ᵀ).
     """
     frames = mount_frames(data)
     mass = data["body"]["mass"]
@@ -101,7 +91,7 @@ def independent_eigenproblem(data: dict[str, Any], geometric: bool) -> tuple[np.
         arm = rot @ fr["p"]
         t = np.hstack([np.eye(3), -skew(arm)])
         k += t.T @ fr["kt"] @ t
-        k[3:, 3:] += fr["kr"] @ inverse_left_jacobian(x0[3:])
+        k[3:, 3:] += spring_tangent_ref(fr["kr"], rot)
         if geometric:
             k[3:, 3:] += (f0 @ arm) * np.eye(3) - np.outer(arm, f0)
     m = np.zeros((6, 6))
