@@ -119,6 +119,28 @@ def test_frequencies_and_shapes_equal_an_independent_6x6_eigenproblem(geometric:
     assert np.abs(frequencies(other) / frequencies(result) - 1.0).min() > 1e-4
 
 
+def test_without_gravity_the_modes_are_the_eigenproblem_of_k_and_m_alone() -> None:
+    """input.g: 0: the body rests at its reference pose under no preload, so with or without
+    the geometric stiffness the frequencies are those of K = Σ Tᵢᵀ·K_t,i·Tᵢ + Σ K_r,i (arms pᵢ
+    at the reference pose) and M = diag(m·1, I). At g > 0, --no-geometric still linearises
+    about the sagged pose: its frequencies differ from these by far more than the tolerance."""
+    data = base_scene(MASS, CG, INERTIA, LAYOUT)
+    data["input"]["g"] = 0.0
+    k, m = np.zeros((6, 6)), np.zeros((6, 6))
+    for fr in mount_frames(data):
+        t = np.hstack([np.eye(3), -skew(fr["p"])])
+        k += t.T @ fr["kt"] @ t
+        k[3:, 3:] += fr["kr"]
+    m[:3, :3] = MASS * np.eye(3)
+    m[3:, 3:] = inertia_tensor(*INERTIA)
+    textbook = np.sqrt(eigh(k, m, eigvals_only=True)) / TWO_PI
+    for geometric in (True, False):
+        np.testing.assert_allclose(frequencies(analyse(data, geometric)), textbook, rtol=1e-7)
+    data["input"]["g"] = G
+    sagged = frequencies(analyse(data, geometric=False))
+    assert np.abs(sagged / textbook - 1.0).max() > 1e-5
+
+
 # ------------------------------------------------------------------ (b) closed forms
 def test_symmetric_four_mounts_give_the_closed_form_bounce_pitch_and_damping() -> None:
     """Four equal mounts at (±a, ±b) in the plane of the CG: bounce √(4k/m)/2π, pitch
