@@ -17,11 +17,14 @@ The model (MJCF generated from the twin's Scene, not a hand-written file):
   digits: its length rounds to ε·L, ε·L·k ≈ 3e-7 N at 1 km (1.5e-10 of the pump's peak force,
   the floor of MuJoCo's converged solution) but 1.5e-9 at 10 km, the twin's own error; hence
   1 km. The mount's force component j is read as the tendon's pull k·(ℓ − L) + c·ℓ̇;
-- the mounts' rotational stiffness and damping: the twin's couple −Q K_r Qᵀ φ − Q C_r Qᵀ ω (φ the
-  rotation vector of R) is, summed over mounts whose K_r and C_r are isotropic, exactly a ball
-  joint's spring and damper (MuJoCo's ball spring is the rotation vector of the joint's
-  quaternion). Anisotropic sums (no such joint in MuJoCo) are refused. Modelled, not dropped:
-  the pump's 8 × 500 N·m/rad left out would change its mount forces by 4.3e-4 of the peak;
+- the mounts' rotational stiffness and damping: the twin's couple −J⁻ᵀ·(Q K_r Qᵀ φ + Q C_r Qᵀ φ′)
+  (φ the rotation vector of R, φ′ = J⁻¹ω, J its left Jacobian: `physics/linear_mount.py`) is,
+  summed over mounts whose K_r and C_r are isotropic, exactly a ball joint's spring (J⁻ᵀφ = φ;
+  MuJoCo's ball spring is the rotation vector of the joint's quaternion) and its damper to
+  second order in the angle (J⁻ᵀJ⁻¹ = 1 − [φ]×²/12 + …: 1e-7 of the damping couple at the
+  pump's milliradians). Anisotropic sums (no such joint in MuJoCo) are refused. Modelled, not
+  dropped: the pump's 8 × 500 N·m/rad left out would change its mount forces by 4.3e-4 of the
+  peak;
 - the foundation: the model stays in the moving deck frame F, as the twin does. The specific
   force f(t) and rate Ω(t) are held linear between samples as the twin holds them; the body
   gets −m·f(t) at its CG (the same as gravity −f(t): a uniform field on one body) and the

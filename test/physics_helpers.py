@@ -219,12 +219,45 @@ def mount_frames(scene_data: dict[str, Any]) -> list[dict[str, np.ndarray]]:
     return out
 
 
+def inverse_left_jacobian(phi: np.ndarray) -> np.ndarray:
+    """J_l⁻¹(φ) of SO(3): log(exp([θ]×)·exp([φ]×)) = φ + J_l⁻¹(φ)·θ + O(θ²), the inverse left
+    Jacobian (Solà, Deray and Atchuthan, "A micro Lie theory for state estimation in robotics",
+    2018, appendix on SO(3))."""
+    angle = float(np.linalg.norm(phi))
+    w = skew(phi)
+    if angle < 1e-8:
+        return np.eye(3) - 0.5 * w
+    coef = 1.0 / angle**2 - (1.0 + math.cos(angle)) / (2.0 * angle * math.sin(angle))
+    return np.eye(3) - 0.5 * w + coef * w @ w
+
+
+def spring_couple_ref(kr: np.ndarray, rot: np.ndarray) -> np.ndarray:
+    """Couple (N·m, F) of a rotational spring of stiffness kr (F) on a body at attitude R: minus
+    the gradient of ½ φᵀ·kr·φ (φ the rotation vector of R) over a small turn θ of the body in
+    F, −J_l⁻ᵀ(φ)·kr·φ (notes §7)."""
+    phi = Rotation.from_matrix(rot).as_rotvec()
+    return -inverse_left_jacobian(phi).T @ kr @ phi
+
+
+def spring_tangent_ref(kr: np.ndarray, rot: np.ndarray, h: float = 1e-7) -> np.ndarray:
+    """−∂(couple)/∂θ of `spring_couple_ref` at R (N·m/rad, F), θ a small turn in F: central
+    differences over exp([θ]×)·R."""
+    out = np.zeros((3, 3))
+    for k in range(3):
+        e = np.zeros(3)
+        e[k] = h
+        plus, minus = (
+            spring_couple_ref(kr, Rotation.from_rotvec(s * e).as_matrix() @ rot) for s in (1, -1)
+        )
+        out[:, k] = (minus - plus) / (2 * h)
+    return out
+
+
 def mount_wrench_ref(
     frames, r: np.ndarray, rot: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, list]:
     """Static mount load on the body (force, moment about the CG, both in F) for CG displacement r
     and attitude R (notes §7), plus each mount's force."""
-    phi = Rotation.from_matrix(rot).as_rotvec()
     f_tot, m_tot, forces = np.zeros(3), np.zeros(3), []
     for fr in frames:
         arm = rot @ fr["p"]
@@ -232,7 +265,7 @@ def mount_wrench_ref(
         f = -fr["kt"] @ d
         forces.append(f)
         f_tot += f
-        m_tot += np.cross(arm, f) - fr["kr"] @ phi
+        m_tot += np.cross(arm, f) + spring_couple_ref(fr["kr"], rot)
     return f_tot, m_tot, forces
 
 

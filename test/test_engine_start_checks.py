@@ -80,6 +80,21 @@ def test_gravity_added_twice_is_named() -> None:
     assert "input.includes_gravity is false, so g was added" in status.message
 
 
+def test_a_scene_without_gravity_checks_the_start_in_standard_gravity() -> None:
+    """input.g: 0 (a test rig): no specific force at the start passes with no tilt to check;
+    an input reading 1 g up (a sensor at rest on Earth) is an ERROR naming input.g, and a
+    start 0.2 g off zero a WARN."""
+    status = _input_status(_steady(np.zeros(3)), input={"g": 0.0})
+    assert (status.level, status.message) == (OK, "ok")
+    assert float(status.values["start_tilt_rad"]) == 0.0
+    status = _input_status(_steady(REST), input={"g": 0.0})
+    assert status.level == ERROR
+    assert "is 1 g (standard) (the scene has no gravity (input.g: 0)" in status.message
+    status = _input_status(_steady(np.array([0.2 * G, 0.0, 0.0])), input={"g": 0.0})
+    assert status.level == WARN
+    assert "is 0.2 g (standard) (a start on a shock or spike" in status.message
+
+
 def test_the_start_gravity_is_the_mean_of_the_first_n_samples() -> None:
     """With gravity_samples N, nothing is published before the N-th sample, the twin starts
     there at the static equilibrium under the mean of the N readings."""

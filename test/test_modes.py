@@ -25,6 +25,7 @@ from physics_helpers import (
     mount_wrench_ref,
     natural_frequencies_from_jacobian,
     skew,
+    spring_tangent_ref,
     twin_jacobian,
 )
 from scipy.linalg import eig, eigh
@@ -65,25 +66,14 @@ def corners(a: float, b: float) -> list[tuple[float, float, float]]:
     return [(a, b, 0.0), (a, -b, 0.0), (-a, b, 0.0), (-a, -b, 0.0)]
 
 
-def inverse_left_jacobian(phi: np.ndarray) -> np.ndarray:
-    """J_l⁻¹(φ) of SO(3): log(exp([θ]×)·exp([φ]×)) = φ + J_l⁻¹(φ)·θ + O(θ²), the inverse left
-    Jacobian (Solà, Deray and Atchuthan, "A micro Lie theory for state estimation in robotics",
-    2018, appendix on SO(3))."""
-    angle = float(np.linalg.norm(phi))
-    w = skew(phi)
-    if angle < 1e-8:
-        return np.eye(3) - 0.5 * w
-    coef = 1.0 / angle**2 - (1.0 + math.cos(angle)) / (2.0 * angle * math.sin(angle))
-    return np.eye(3) - 0.5 * w + coef * w @ w
-
-
 def independent_eigenproblem(data: dict[str, Any], geometric: bool) -> tuple[np.ndarray, ...]:
     """M and K about the CG in F (translation, rotation vector), from the scene's numbers only.
 
     Equilibrium: force and moment balance of the mounts (physics notes §7, `mount_wrench_ref`)
     against the weight, solved here for (r, φ). About it, with arms aᵢ = R₀·pᵢ:
-    K = Σ Tᵢᵀ·K_t,i·Tᵢ (Tᵢ = [1, −[aᵢ]×]) + Σ K_r,i·J_l⁻¹(φ₀) (the couple −K_r·φ with φ the
-    rotation vector of R) + [if geometric] Σ (F₀ᵢ·aᵢ)·1 − aᵢ·F₀ᵢᵀ; M = diag(m·1, R₀·I·R₀ᵀ).
+    K = Σ Tᵢᵀ·K_t,i·Tᵢ (Tᵢ = [1, −[aᵢ]×]) + the tangents of the rotational springs' couples
+    −J_l⁻ᵀ(φ)·K_r,i·φ (φ the rotation vector of R, `spring_tangent_ref`) + [if geometric]
+    Σ (F₀ᵢ·aᵢ)·1 − aᵢ·F₀ᵢᵀ; M = diag(m·1, R₀·I·R₀ᵀ).
     """
     frames = mount_frames(data)
     mass = data["body"]["mass"]
@@ -101,7 +91,7 @@ def independent_eigenproblem(data: dict[str, Any], geometric: bool) -> tuple[np.
         arm = rot @ fr["p"]
         t = np.hstack([np.eye(3), -skew(arm)])
         k += t.T @ fr["kt"] @ t
-        k[3:, 3:] += fr["kr"] @ inverse_left_jacobian(x0[3:])
+        k[3:, 3:] += spring_tangent_ref(fr["kr"], rot)
         if geometric:
             k[3:, 3:] += (f0 @ arm) * np.eye(3) - np.outer(arm, f0)
     m = np.zeros((6, 6))
@@ -127,6 +117,28 @@ def test_frequencies_and_shapes_equal_an_independent_6x6_eigenproblem(geometric:
     # over a hundred times the tolerance
     other = analyse(data, not geometric)
     assert np.abs(frequencies(other) / frequencies(result) - 1.0).min() > 1e-4
+
+
+def test_without_gravity_the_modes_are_the_eigenproblem_of_k_and_m_alone() -> None:
+    """input.g: 0: the body rests at its reference pose under no preload, so with or without
+    the geometric stiffness the frequencies are those of K = Σ Tᵢᵀ·K_t,i·Tᵢ + Σ K_r,i (arms pᵢ
+    at the reference pose) and M = diag(m·1, I). At g > 0, --no-geometric still linearises
+    about the sagged pose: its frequencies differ from these by far more than the tolerance."""
+    data = base_scene(MASS, CG, INERTIA, LAYOUT)
+    data["input"]["g"] = 0.0
+    k, m = np.zeros((6, 6)), np.zeros((6, 6))
+    for fr in mount_frames(data):
+        t = np.hstack([np.eye(3), -skew(fr["p"])])
+        k += t.T @ fr["kt"] @ t
+        k[3:, 3:] += fr["kr"]
+    m[:3, :3] = MASS * np.eye(3)
+    m[3:, 3:] = inertia_tensor(*INERTIA)
+    textbook = np.sqrt(eigh(k, m, eigvals_only=True)) / TWO_PI
+    for geometric in (True, False):
+        np.testing.assert_allclose(frequencies(analyse(data, geometric)), textbook, rtol=1e-7)
+    data["input"]["g"] = G
+    sagged = frequencies(analyse(data, geometric=False))
+    assert np.abs(sagged / textbook - 1.0).max() > 1e-5
 
 
 # ------------------------------------------------------------------ (b) closed forms

@@ -27,8 +27,8 @@ Everything comes from the twin itself, so every mount kind enters as it is simul
   mounts' tangent k-matrices moved to the CG (Tᵢ = [1, −[aᵢ]×]) plus their rotational springs.
 - Modes: K·φ = ω²·M·φ on the symmetric part of K (scipy.linalg.eigh), φᵀ·M·φ = 1; a negative
   ω² (an equilibrium the weight's geometric stiffness makes unstable) is reported as a negative
-  frequency −√|ω²|/2π. `stiffness_asymmetry` says how far K is from symmetric (anisotropic
-  rotational springs at a tilted equilibrium are not conservative; notes §7).
+  frequency −√|ω²|/2π. `stiffness_asymmetry` says how far K is from symmetric (a law that is
+  not the gradient of an energy; rotational springs are, at any rotation: `linear_mount`).
 - Damping: ζᵢ = φᵢᵀ·C·φᵢ/(2ωᵢ), the proportional-damping approximation (exact when the
   modes' damping does not couple them); `complex_modes` are the exact eigenvalues λ of the
   linearised first-order system with the full K and C: frequency |λ|/2π and ζ = −Re λ/|λ| of

@@ -33,7 +33,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--no-geometric",
         action="store_true",
         help="leave out the geometric stiffness of the weight's preload (elastic stiffness "
-        "of the mounts only, still at the static equilibrium)",
+        "of the mounts only, still about the sagged static equilibrium: the textbook answer "
+        "without gravity, about the reference pose, needs input.g: 0 in the scene)",
     )
 
 

@@ -54,6 +54,7 @@ from mount_twin.model.assemble import Model, initial_state
 from mount_twin.model.stiffness import spectral_radius
 from mount_twin.physics import pose_row
 from mount_twin.physics.dynamics import INPUT_SIZE, Scratch, evaluate, mount_monitors
+from mount_twin.scene.description import STANDARD_GRAVITY, InputSpec
 
 ACCEPT, START, JUMPED_BACK, GAP_RESET, GAP_BRIDGED = (
     "accept",
@@ -157,6 +158,19 @@ class _Run:
 
     index: np.ndarray  # int64: positions in the pushed batch
     restart: bool
+
+
+def _start_hint(spec: InputSpec, magnitude: float) -> str:
+    """Why a start specific force of `magnitude` (m/s²) may be off g: the likeliest cause."""
+    g = spec.g
+    if g == 0.0 and abs(magnitude - STANDARD_GRAVITY) < 0.25 * STANDARD_GRAVITY:
+        return "the scene has no gravity (input.g: 0): is the input a sensor at rest on Earth?"
+    if not spec.includes_gravity and abs(magnitude - 2.0 * g) < 0.25 * g:
+        return "input.includes_gravity is false, so g was added: does the input include it?"
+    return (
+        "a start on a shock or spike, free fall, or a sensor bias? "
+        "initial.gravity_samples averages the start"
+    )
 
 
 class TwinEngine:
@@ -469,7 +483,7 @@ class TwinEngine:
         before = np.concatenate([self._last_reading[None, :], accel[:-1]])
         with np.errstate(invalid="ignore", over="ignore"):
             plateau = (accel == before).all(axis=1) & (
-                np.linalg.norm(accel, axis=1) > PLATEAU_G * spec.g
+                np.linalg.norm(accel, axis=1) > PLATEAU_G * spec.g_scale
             )
         taken = np.ones(n, dtype=bool)
         if self._held is not None:  # HOLD is only ever the last sample
@@ -873,26 +887,22 @@ class TwinEngine:
 
     def _check_start(self, stamp: float, f0: np.ndarray, gathered: np.ndarray) -> None:
         """Start checks on the start specific force f0 (m/s², F) and the samples it is the mean
-        of: its magnitude against g, its angle from +z of F, and their spread (at rest?). An
+        of: its magnitude against g, its angle from +z of F (where g > 0), and their spread (at
+        rest?), in units of g (of standard gravity at g = 0: `InputSpec.g_scale`). An
         implausible sag (units?) is the scene's load-time warning (scene.checks), not repeated."""
         spec, init = self.scene.input, self.scene.initial
-        g, magnitude = spec.g, float(np.linalg.norm(f0))
-        tilt = math.atan2(math.hypot(f0[0], f0[1]), f0[2])
-        off = abs(magnitude - g) / g
+        g, unit, magnitude = spec.g, spec.g_scale, float(np.linalg.norm(f0))
+        tilt = math.atan2(math.hypot(f0[0], f0[1]), f0[2]) if g > 0.0 else 0.0
+        off = abs(magnitude - g) / unit
         spread = float(np.linalg.norm(gathered - f0, axis=1).max())
         notes: list[tuple[int, str]] = []
         if off > init.gravity_tolerance:
-            hint = (
-                "input.includes_gravity is false, so g was added: does the input include it?"
-                if not spec.includes_gravity and abs(magnitude - 2.0 * g) < 0.25 * g
-                else "a start on a shock or spike, free fall, or a sensor bias? "
-                "initial.gravity_samples averages the start"
-            )
             notes.append(
                 (
                     ERROR if off > 3.0 * init.gravity_tolerance else WARN,
-                    f"start specific force |f0| = {magnitude:.4g} m/s² is {magnitude / g:.3g} g "
-                    f"({hint})",
+                    f"start specific force |f0| = {magnitude:.4g} m/s² is "
+                    f"{magnitude / unit:.3g} g{'' if g > 0.0 else ' (standard)'} "
+                    f"({_start_hint(spec, magnitude)})",
                 )
             )
         if tilt > init.tilt_tolerance_rad:
@@ -903,7 +913,7 @@ class TwinEngine:
                     "(is input.sensor_rpy right?)",
                 )
             )
-        if spread > init.gravity_tolerance * g:
+        if spread > init.gravity_tolerance * unit:
             notes.append(
                 (
                     WARN,

@@ -27,7 +27,7 @@ LOST_ERROR = 0.01
 SATURATION_SHARE = 0.999
 """A reading at this share of `input.accel_range_m_s2` (or `gyro_range_rad_s`) is saturated."""
 PLATEAU_G = 2.0
-"""A reading repeated exactly, sample after sample, beyond this many g (m/s² / input.g) is a
+"""A reading repeated exactly, sample after sample, beyond this many g (`InputSpec.g_scale`) is a
 plateau: a clipped or stuck sensor (real vibration never repeats to the last bit)."""
 NAMED_FRAMES = 3
 """Wrong frame_ids named in a message (the rest are elided)."""

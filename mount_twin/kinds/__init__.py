@@ -73,7 +73,9 @@ class KindContractError(ModelError):
 @njit(cache=True, inline="always")
 def kind_load(code, p, y, o, d, v, phi, w, dydt, f, c) -> None:
     """The kind's `load`: local force f and couple c on the body; internal rates into dydt.
-    An unknown code writes NaN into f and c."""
+    phi and w are the body's rotation vector and its rate in the mount's axes, and c is taken
+    as the generalized force conjugate to phi (the right-hand side turns it into the couple
+    on the body: `physics.linear_mount`). An unknown code writes NaN into f and c."""
     if code == ELASTOMER:
         elastomer.load(p, y, o, d, v, phi, w, dydt, f, c)
     elif code == BOLTED_JOINT:

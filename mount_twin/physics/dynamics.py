@@ -30,7 +30,7 @@ from mount_twin.physics.chart import kinematic_matrix, kinematic_matrix_rate, ro
 from mount_twin.physics.compiled import kernel
 from mount_twin.physics.gate import skip_if_none
 from mount_twin.physics.linear_mount import linear_mount_load, point_motion
-from mount_twin.physics.rotations import quaternion_from_matrix, rotation_vector
+from mount_twin.physics.rotations import couple_map, quaternion_from_matrix, rotation_vector
 
 OK = 0
 OFF_CHART = 1
@@ -90,9 +90,9 @@ class Scratch(NamedTuple):
     last writer left; nothing else is promised):
 
     - `body_motion(y)` fills q, qd, trig, rot, kin, omega, omega_f, and phi with its
-      quaternion quat where a mount reads them (`ModelArrays.rotation_read`; else phi is NaN
-      and quat is left, for `outputs` to take): read by the mount laws and the rest of `rhs`
-      at that y.
+      quaternion quat, its rate phi_rate and the couple map where a mount reads them
+      (`ModelArrays.rotation_read`; else phi, phi_rate and the map are NaN and quat is left,
+      for `outputs` to take): read by the mount laws and the rest of `rhs` at that y.
     - `mount_loads` (inside `rhs`) fills arm, force, couple, loc, total_force, total_moment,
       sink: read by `rhs` itself.
     - `rhs(t, y, u)` fills all of the above, then f_s, big_w, big_w_dot, rel, w_x_rel,
@@ -115,7 +115,9 @@ class Scratch(NamedTuple):
     kin_rate: np.ndarray  # (3, 3) dB/dt
     omega: np.ndarray  # (3,) ω in B
     omega_f: np.ndarray  # (3,) R·ω in F
-    phi: np.ndarray  # (3,)
+    phi: np.ndarray  # (3,) rotation vector of R, rad, F
+    phi_rate: np.ndarray  # (3,) its rate J(φ)⁻¹·R·ω, rad/s
+    couple_map: np.ndarray  # (3, 3) J(φ)⁻ᵀ: a force conjugate to φ → its couple in F
     quat: np.ndarray  # (4,)
     arm: np.ndarray  # (3,)
     force: np.ndarray  # (3,)
@@ -153,6 +155,8 @@ def new_scratch(n_state: int) -> Scratch:
         omega=np.zeros(3),
         omega_f=np.zeros(3),
         phi=np.zeros(3),
+        phi_rate=np.zeros(3),
+        couple_map=np.eye(3),
         quat=np.zeros(4),
         arm=np.zeros(3),
         force=np.zeros(3),
@@ -181,9 +185,10 @@ def new_scratch(n_state: int) -> Scratch:
 
 @njit(cache=True, inline="always")
 def body_motion(y: np.ndarray, m: ModelArrays, s: Scratch) -> float:
-    """Fill s.q, s.qd, s.trig, s.rot, s.kin, s.omega, s.omega_f, s.phi from y; s.phi and its
-    quaternion s.quat only where a mount reads the rotation vector (m.rotation_read; NaN else,
-    and `outputs` takes the quaternion itself).
+    """Fill s.q, s.qd, s.trig, s.rot, s.kin, s.omega, s.omega_f, s.phi from y; s.phi, its
+    quaternion s.quat, its rate s.phi_rate and s.couple_map (`rotations.couple_map`) only where
+    a mount reads the rotation vector (m.rotation_read; NaN else, and `outputs` takes the
+    quaternion itself).
 
     Returns cos θ (NaN off the chart, i.e. at or below COS_TILT_MIN). Kernels bind scratch
     arrays to locals once: every attribute access on a tuple of arrays costs a reference-count
@@ -214,11 +219,20 @@ def body_motion(y: np.ndarray, m: ModelArrays, s: Scratch) -> float:
         omega[i] = kin[i, 0] * qd[3] + kin[i, 1] * qd[4] + kin[i, 2] * qd[5]
     for i in range(3):
         omega_f[i] = rot[i, 0] * omega[0] + rot[i, 1] * omega[1] + rot[i, 2] * omega[2]
+    phi, phi_rate, cmap = s.phi, s.phi_rate, s.couple_map
     if m.rotation_read:
-        rotation_vector(rot, s.quat, s.phi)
+        rotation_vector(rot, s.quat, phi)
+        couple_map(phi, s.quat, cmap)
+        for i in range(3):  # φ′ = J⁻¹·R·ω, J⁻¹ the transpose of the map
+            phi_rate[i] = (
+                cmap[0, i] * omega_f[0] + cmap[1, i] * omega_f[1] + cmap[2, i] * omega_f[2]
+            )
     else:
         for i in range(3):
-            s.phi[i] = math.nan
+            phi[i] = math.nan
+            phi_rate[i] = math.nan
+            for j in range(3):
+                cmap[i, j] = math.nan
     return ct
 
 
@@ -246,16 +260,17 @@ def _out_of_axes(nl: NonLinearMounts, i: int, local, out) -> None:
 
 @njit(cache=True, inline="always")
 def _local_motion(i: int, nl: NonLinearMounts, s: Scratch) -> None:
-    """Deflection, rate, rotation and rate of non-linear mount i in its axes into s.loc[:4]
-    (the rotation and its rate NaN where its kind has no rotational law: it must not read
+    """Deflection, rate, rotation vector φ and its rate φ′ of non-linear mount i in its axes
+    into s.loc[:4] (φ and φ′ NaN where its kind has no rotational law: it must not read
     them); its lever arm R·p into s.arm."""
     rot, q, qd, omega_f, phi, arm, loc = s.rot, s.q, s.qd, s.omega_f, s.phi, s.arm, s.loc
+    phi_rate = s.phi_rate
     d0, d1, d2, e0, e1, e2 = point_motion(i, nl.point, rot, q, qd, omega_f, arm)
     _into_axes(nl, i, d0, d1, d2, loc[0])
     _into_axes(nl, i, e0, e1, e2, loc[1])
     if nl.rotational[i]:
         _into_axes(nl, i, phi[0], phi[1], phi[2], loc[2])
-        _into_axes(nl, i, omega_f[0], omega_f[1], omega_f[2], loc[3])
+        _into_axes(nl, i, phi_rate[0], phi_rate[1], phi_rate[2], loc[3])
     else:
         for j in range(3):
             loc[2, j] = math.nan
@@ -264,7 +279,9 @@ def _local_motion(i: int, nl: NonLinearMounts, s: Scratch) -> None:
 
 @njit(cache=True, inline="always")
 def _nl_load(i: int, y: np.ndarray, nl: NonLinearMounts, s: Scratch, dydt: np.ndarray) -> None:
-    """Load of non-linear mount i in its axes into s.loc[4:6]; its state rates into dydt."""
+    """Load of non-linear mount i in its axes into s.loc[4:6] (the couple as the kind gives
+    it, a generalized force conjugate to φ: `_nl_couple` turns it into the couple on the body);
+    its state rates into dydt."""
     _local_motion(i, nl, s)
     loc = s.loc
     kind_load(
@@ -288,13 +305,16 @@ def mount_loads(y: np.ndarray, m: ModelArrays, s: Scratch, dydt: np.ndarray) -> 
     internal-state rates of the mounts that have them into dydt."""
     total_f, total_m = s.total_force, s.total_moment
     arm, f, c = s.arm, s.force, s.couple
-    rot, q, qd, omega_f, phi = s.rot, s.q, s.qd, s.omega_f, s.phi
+    rot, q, qd, omega_f = s.rot, s.q, s.qd, s.omega_f
+    phi, phi_rate, cmap = s.phi, s.phi_rate, s.couple_map
     point, k_t, c_t, k_r, c_r = m.lin_point, m.lin_k_t, m.lin_c_t, m.lin_k_r, m.lin_c_r
     for j in range(3):
         total_f[j] = 0.0
         total_m[j] = 0.0
     for i in range(point.shape[0]):
-        linear_mount_load(i, point, k_t, c_t, k_r, c_r, rot, q, qd, omega_f, phi, arm, f, c)
+        linear_mount_load(
+            i, point, k_t, c_t, k_r, c_r, rot, q, qd, omega_f, phi, phi_rate, cmap, arm, f, c
+        )
         _add_load(arm, f, c, total_f, total_m)
     nl_loads(y, m.nl, s, dydt)
 
@@ -308,10 +328,21 @@ def _nl_loads(y: np.ndarray, nl: NonLinearMounts, s: Scratch, dydt: np.ndarray) 
         _nl_load(i, y, nl, s, dydt)
         _out_of_axes(nl, i, loc[4], f)  # back from mount axes to F
         if nl.rotational[i]:
-            _out_of_axes(nl, i, loc[5], c)
+            _nl_couple(i, nl, s, c)
         else:
             c[0], c[1], c[2] = 0.0, 0.0, 0.0
         _add_load(arm, f, c, total_f, total_m)
+
+
+@njit(cache=True, inline="always")
+def _nl_couple(i: int, nl: NonLinearMounts, s: Scratch, c: np.ndarray) -> None:
+    """c = J(φ)⁻ᵀ·Qᵢ·s.loc[5]: the couple on the body (F) of the generalized force non-linear
+    mount i gave in its axes (`linear_mount`'s module docstring says why)."""
+    cmap = s.couple_map
+    _out_of_axes(nl, i, s.loc[5], c)
+    c0, c1, c2 = c[0], c[1], c[2]
+    for j in range(3):
+        c[j] = cmap[j, 0] * c0 + cmap[j, 1] * c1 + cmap[j, 2] * c2
 
 
 @njit(cache=True, inline="always")
@@ -328,11 +359,14 @@ def _add_load(arm, f, c, total_f, total_m) -> None:
 def mount_wrenches(y: np.ndarray, m: ModelArrays, s: Scratch, wrenches: np.ndarray) -> None:
     """Each mount's force (N) and own couple (N·m) on the body, in its axes: wrenches[i]."""
     arm, f, c = s.arm, s.force, s.couple
-    rot, q, qd, omega_f, phi = s.rot, s.q, s.qd, s.omega_f, s.phi
+    rot, q, qd, omega_f = s.rot, s.q, s.qd, s.omega_f
+    phi, phi_rate, cmap = s.phi, s.phi_rate, s.couple_map
     point, k_t, c_t, k_r, c_r = m.lin_point, m.lin_k_t, m.lin_c_t, m.lin_k_r, m.lin_c_r
     axes, slot = m.lin_axes, m.lin_slot
     for i in range(point.shape[0]):
-        linear_mount_load(i, point, k_t, c_t, k_r, c_r, rot, q, qd, omega_f, phi, arm, f, c)
+        linear_mount_load(
+            i, point, k_t, c_t, k_r, c_r, rot, q, qd, omega_f, phi, phi_rate, cmap, arm, f, c
+        )
         row = slot[i]
         for j in range(3):
             wrenches[row, j] = axes[i, 0, j] * f[0] + axes[i, 1, j] * f[1] + axes[i, 2, j] * f[2]
@@ -344,9 +378,12 @@ def mount_wrenches(y: np.ndarray, m: ModelArrays, s: Scratch, wrenches: np.ndarr
 
 @kernel
 def _nl_wrenches(y: np.ndarray, nl: NonLinearMounts, s: Scratch, wrenches: np.ndarray) -> None:
-    loc = s.loc
+    loc, c = s.loc, s.couple
     for i in range(nl.kind.shape[0]):
         _nl_load(i, y, nl, s, s.sink)
+        if nl.rotational[i]:  # the couple on the body, in the mount's axes
+            _nl_couple(i, nl, s, c)
+            _into_axes(nl, i, c[0], c[1], c[2], loc[5])
         row = nl.slot[i]
         for j in range(3):
             wrenches[row, j] = loc[4, j]

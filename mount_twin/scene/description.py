@@ -14,6 +14,8 @@ from mount_twin.kinds.elastomer import Elastomer
 from mount_twin.kinds.shear_key import ShearKey
 
 DOF_NAMES: tuple[str, ...] = ("x", "y", "z", "alpha", "gamma", "delta")
+STANDARD_GRAVITY = 9.80665
+"""m/s²: the unit of the checks scaled by g in a scene without gravity (`InputSpec.g_scale`)."""
 GYRO_FILTERS = ("lowpass", "none", "ignore")
 """`input.gyro_filter` choices (mount_twin.engine.gyro_filter applies them)."""
 """Generalized coordinates: CG displacement X, Y, Z (m, F) and the chart angles α, γ, δ (rad)."""
@@ -81,7 +83,8 @@ class InputSpec:
         sensor_rpy: rotation of the sensor frame into F as fixed-axis roll, pitch, yaw, rad.
         sensor_position: accelerometer position, m, in F.
         includes_gravity: True if the acceleration is specific force (Imu: +g up at rest).
-        g: gravity magnitude, m/s², added along +z of F when includes_gravity is False.
+        g: gravity magnitude, m/s², added along +z of F when includes_gravity is False; 0 is
+            a scene without gravity (a test rig, a textbook case).
         hold: input between samples, 'first_order' (linear) or 'zero_order'.
         max_gap_s: a larger stamp gap is a gap, handled per gap_policy.
         gap_policy: 'reset' (restart at equilibrium) or 'bridge' (integrate across the gap).
@@ -110,6 +113,13 @@ class InputSpec:
     accel_range_m_s2: float = 0.0
     gyro_range_rad_s: float = 0.0
 
+    @property
+    def g_scale(self) -> float:
+        """The acceleration (m/s²) the checks scaled by g take as their unit: g, or standard
+        gravity in a scene without gravity (a start check then asks for |f₀| within the
+        tolerance of 0 in units of STANDARD_GRAVITY)."""
+        return self.g if self.g > 0.0 else STANDARD_GRAVITY
+
 
 @dataclass(frozen=True)
 class InitialState:
@@ -125,9 +135,11 @@ class InitialState:
             this many accepted samples from each (re)start; the twin starts at the last of them
             (those before it are taken but not integrated).
         gravity_tolerance: start check: | |f₀| − g | / g past this is a WARN, past three times
-            this an ERROR (a start on a shock, free fall, a bias, g added twice), −.
+            this an ERROR (a start on a shock, free fall, a bias, g added twice), −; at g = 0
+            the unit is standard gravity (`InputSpec.g_scale`).
         tilt_tolerance_rad: start check: the angle of f₀ from +z of F past this is a WARN,
-            past three times this an ERROR (a sensor frame turned wrong), rad.
+            past three times this an ERROR (a sensor frame turned wrong), rad; not checked at
+            g = 0 (no direction to expect).
     """
 
     mode: str = "equilibrium"
