@@ -58,8 +58,10 @@ class HealthWindow:
         self.estimate_run = np.zeros(N_FIGURES)
         """The error estimate's figures over the whole run (`engine.companion`)."""
         self.stopped_at: float | None = None
-        """Stamp (s) where a scene with a given initial motion failed: the twin follows no more
-        (until the record restarts), and each report says so at ERROR."""
+        """Stamp (s) from which the twin follows no more (a given initial motion whose stepper
+        failed, a start without equilibrium) until a restart; each report says so at ERROR."""
+        self.stopped_why = ""
+        """Why it stopped (`stop`)."""
         self.last_wrong_frame_id: str | None = None
         """header.frame_id of the last sample rejected as wrong_frame (any period)."""
 
@@ -193,6 +195,10 @@ class HealthWindow:
         (rad) from +z of F, with the start checks' findings (level, text)."""
         self.starts.append((stamp, magnitude, tilt, notes))
 
+    def stop(self, stamp: float, why: str) -> None:
+        """The twin follows no more from `stamp` (s), because `why`."""
+        self.stopped_at, self.stopped_why = stamp, why
+
     def failure(self, stamp: float, text: str) -> None:
         """A stepper failure (or a forced start) at `stamp` (s)."""
         self.failures.append((stamp, text))
@@ -262,9 +268,9 @@ class HealthWindow:
         fail_text = "; ".join(f"{self.origin_s + t:.6f} s: {m}" for t, m in self.failures)
         if self.stopped_at is not None:
             step_text = (
-                f"not following since {self.origin_s + self.stopped_at:.6f} s: the stepper "
-                "failed, and restarting a given initial motion would replay a motion the body "
-                "is not making; no pose, angles or wrenches until the record restarts"
+                f"not following since {self.origin_s + self.stopped_at:.6f} s: "
+                f"{self.stopped_why}; no pose, angles or wrenches until a restart (a gap or "
+                "the stamps jumping back) finds a state to start from"
                 + (f" ({fail_text})" if self.failures else "")
             )
         elif self.failures:
