@@ -6,14 +6,21 @@ publishes nothing and says why."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 from io_helpers import CONFIG, REST, G, batch
 from physics_helpers import free_body
 
+from mount_twin.commands.common import write_signal
 from mount_twin.engine.batch import ERROR
 from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.health import INTEGRATION
+from mount_twin.io.signals import Signal
 from mount_twin.model.assemble import assemble
+from mount_twin.replay import replay
 from mount_twin.scene import load_scene_file
+from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
 
 OMEGA0 = np.array([4.0, 0.3, 0.5])  # rad/s in B, about the axis of least inertia: tips over
@@ -104,21 +111,23 @@ def test_a_machine_whose_bolts_broke_restarts_resting_on_its_feet() -> None:
     np.testing.assert_allclose(pose - pose[0], 0.0, atol=1e-9)
 
 
-def _hanging_genset() -> TwinEngine:
+def _hanging_genset() -> tuple[Scene, np.ndarray, np.ndarray]:
     """The genset hung from a ceiling by its six bolted feet (their z, where the joint opens,
-    points down; no keys): once the bolts break nothing holds it."""
+    points down; no keys): once the bolts break nothing holds it. With `_breaking_stream`'s
+    kick, now pulling the frame off the ceiling."""
     data = read_scene_yaml(GENSET)
     data["mounts"] = [m for m in data["mounts"] if m["kind"] == "bolted_joint"]
     for mount in data["mounts"]:
         mount["orientation_rpy"] = [np.pi, 0.0, 0.0]
     data["body"]["cg"] = [0.1, 0.0, -0.8]
-    return TwinEngine(assemble(scene_from_dict(data, "<hanging genset>")))
+    t, f = _breaking_stream()
+    f[:, 2] = 2.0 * G - f[:, 2]
+    return scene_from_dict(data, "<hanging genset>"), t, f
 
 
 def test_a_machine_nothing_holds_any_more_publishes_nothing_and_says_why() -> None:
-    engine = _hanging_genset()
-    t, f = _breaking_stream()
-    f[:, 2] = 2.0 * G - f[:, 2]  # the same kick, now pulling the frame off the ceiling
+    scene, t, f = _hanging_genset()
+    engine = TwinEngine(assemble(scene))
     out = engine.push(batch(t, f))
     assert len(_broken(engine)) == 6
     restart = t[0] + 0.3 + 0.5 * GAP_S
@@ -132,3 +141,22 @@ def test_a_machine_nothing_holds_any_more_publishes_nothing_and_says_why() -> No
         assert status.level == ERROR
         assert "not following since" in status.message
         assert "no static equilibrium" in status.message and "bolt_fractured" in status.message
+
+
+def test_the_replay_summary_says_what_was_not_followed_and_why(tmp_path: Path) -> None:
+    scene, t, f = _hanging_genset()
+    bag = tmp_path / "hanging"
+    write_signal(
+        Signal(t, f, np.zeros_like(f)),
+        str(bag),
+        scene.input.topic,
+        scene.input.frame_id,
+        1_700_000_000_000_000_000,
+        "mcap",
+    )
+    summary = replay(scene, bag, tmp_path / "out", progress=False)
+    assert summary.counts["samples_not_followed"] == 2000
+    assert "not followed: 2000 samples, nothing published for them" in summary.text()
+    status = summary.worst[INTEGRATION]
+    assert status.level == ERROR and "no static equilibrium" in status.message
+    assert summary.to_dict()["diagnostics_worst"][INTEGRATION]["message"] == status.message
