@@ -16,7 +16,7 @@ from tqdm import tqdm
 
 from mount_twin.engine.batch import LEVEL_NAMES, OK, HealthReport, HealthStatus, MountEvent
 from mount_twin.engine.estimate import ErrorEstimate
-from mount_twin.engine.health import tilt_from_quaternions
+from mount_twin.engine.health import INTEGRATION, tilt_from_quaternions
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import TF, TF_STATIC_TOPIC, output_types, resolve, static_transforms
 from mount_twin.physics.compiled import kernel_cache_is_cold
@@ -62,7 +62,7 @@ def _estimate_text(est: ErrorEstimate | None) -> str:
         return "estimated integration error: not estimated (integration.error_estimate: false)"
     text = (
         f"estimated integration error: mount forces {est.force_error_rel:.2g} of the largest "
-        f"({est.force_error_n:.3g} N), attitude {est.attitude_error_rad:.2g} rad"
+        f"({est.force_error_n:.3g} N), attitude {est.attitude_error_rad:.2g} rad, over the run"
     )
     if est.resyncs:
         text += f" (the estimate lost its history {est.resyncs} times: a lower bound)"
@@ -110,6 +110,15 @@ class ReplaySummary:
             f"rejected: {rejected or 'none'}, gaps: {c.get('gaps', 0)}, "
             f"restarts: {c.get('restarts', 0)}, integration failures: "
             f"{c.get('integration_failures', 0)}",
+            *(
+                [
+                    f"  not followed: {not_followed} samples, nothing published for them "
+                    f"({c.get('starts_without_equilibrium', 0)} starts found no equilibrium; "
+                    "the integration status says why)"
+                ]
+                if (not_followed := c.get("samples_not_followed", 0))
+                else []
+            ),
             f"  {self.written} messages written over {self.stamp_span_s:.3f} s of stamps in "
             f"{self.wall_s:.2f} s wall: real-time factor {self.real_time_factor:.1f}",
             f"  max CG displacement {self.displacement_max_m * 1e3:.3f} mm, "
@@ -178,14 +187,24 @@ class ReplaySummary:
                 name: {"level": LEVEL_NAMES[st.level], "message": st.message}
                 for name, st in self.worst.items()
             },
-            "accuracy": "not estimated live; `mount-twin accuracy SCENE BAG` measures it",
+            "accuracy": "estimated live: error_estimate, over the run"
+            if self.error_estimate
+            else "not estimated live (integration.error_estimate: false); "
+            "`mount-twin accuracy SCENE BAG` measures it",
         }
 
 
 def _keep_worst(worst: dict[str, HealthStatus], report: HealthReport) -> None:
-    """Keep, per status name, the first status of the highest level seen."""
+    """Keep, per status name, the first status of the highest level seen; of the integration
+    status the latest: its estimated error is that of the run so far (`health.estimate_warning`),
+    so the worst over the run is the summary's `error_estimate`."""
     for status in report.statuses:
-        if status.name not in worst or status.level > worst[status.name].level:
+        kept = worst.get(status.name)
+        if (
+            kept is None
+            or status.level > kept.level
+            or (status.level == kept.level and status.name == INTEGRATION)
+        ):
             worst[status.name] = status
 
 

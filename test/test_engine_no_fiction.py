@@ -1,17 +1,27 @@
 """Past the chart's limit the twin never replays an old motion: a scene with a given initial
 motion whose stepper fails stops following (no pose, angles or wrenches) and says so at ERROR in
-every report, until the record restarts; a scene started at equilibrium restarts there."""
+every report, until the record restarts; a scene started at equilibrium restarts there. A
+machine a shock damaged restarts at its own equilibrium, as damaged; where it has none, the twin
+publishes nothing and says why."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
-from io_helpers import batch
+from io_helpers import CONFIG, REST, G, batch
 from physics_helpers import free_body
 
+from mount_twin.commands.common import write_signal
 from mount_twin.engine.batch import ERROR
 from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.health import INTEGRATION
+from mount_twin.io.signals import Signal
 from mount_twin.model.assemble import assemble
-from mount_twin.scene.loader import scene_from_dict
+from mount_twin.replay import replay
+from mount_twin.scene import load_scene_file
+from mount_twin.scene.description import Scene
+from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
 
 OMEGA0 = np.array([4.0, 0.3, 0.5])  # rad/s in B, about the axis of least inertia: tips over
 
@@ -53,3 +63,100 @@ def test_a_restart_of_the_record_follows_again() -> None:
     engine.push(batch(1.0 + np.arange(2000) * 1e-3, np.zeros((2000, 3)), frame_ids=""))
     again = engine.push(batch(1.0 + np.arange(50) * 1e-3, np.zeros((50, 3)), frame_ids=""))
     assert len(again) == 50 and engine.counts["reset_stamp_jumped_back"] == 1
+
+
+# A damaged machine restarts at its own equilibrium, or publishes nothing.
+
+GENSET = CONFIG / "genset_bolted_keyed.scene.yaml"
+RATE = 10_000.0  # Hz
+GAP_S = 1.0  # > the genset's input.max_gap_s: the twin restarts after it
+
+
+def _breaking_stream() -> tuple[np.ndarray, np.ndarray]:
+    """Stamps (s) and specific forces (m/s², F): rest, a downward deck half-sine of 80 g for
+    10 ms (the frame pulls its bolts apart), rest; a gap; rest again."""
+    t1 = np.arange(0.0, 0.3, 1.0 / RATE)
+    pulse = (t1 > 0.05) & (t1 < 0.06)
+    f1 = np.tile(REST, (t1.shape[0], 1))
+    f1[pulse, 2] += -800.0 * np.sin(np.pi * (t1[pulse] - 0.05) / 0.01)
+    t2 = t1[-1] + GAP_S + np.arange(0.0, 0.2, 1.0 / RATE)
+    return np.concatenate([t1, t2]), np.vstack([f1, np.tile(REST, (t2.shape[0], 1))])
+
+
+def _broken(engine: TwinEngine) -> set[str]:
+    return {e.mount for e in engine.events if e.event == "bolt_fractured"}
+
+
+def test_a_machine_whose_bolts_broke_restarts_resting_on_its_feet() -> None:
+    scene = load_scene_file(GENSET)
+    engine = TwinEngine(assemble(scene))
+    t, f = _breaking_stream()
+    out = engine.push(batch(t, f))
+    feet = [i for i, m in enumerate(scene.mounts) if m.kind == "bolted_joint"]
+    assert _broken(engine) == {scene.mounts[i].name for i in feet} and len(feet) == 6
+    assert engine.counts["restarts"] == 1 and engine.counts["starts_without_equilibrium"] == 0
+    after = out.stamps > t[0] + 0.3 + 0.5 * GAP_S
+    assert after.sum() == 2000  # every sample after the gap is published
+    # Static balance of the frame on its feet (closed form): the clamp forces carry the
+    # weight and its moment about the CG, nothing pulls (no bolt), nothing acts sideways.
+    weight = scene.body.mass * G
+    fz = out.wrenches[after][:, feet, 2]  # feet axes are F's
+    x = np.array([scene.mounts[i].position for i in feet])[:, :2] - np.array(scene.body.cg[:2])
+    np.testing.assert_allclose(fz.sum(axis=1), weight, rtol=1e-6)
+    np.testing.assert_allclose(fz @ x, 0.0, atol=1e-6 * weight)
+    np.testing.assert_allclose(out.wrenches[after][:, :, :2].sum(axis=1), 0.0, atol=1e-6 * weight)
+    assert (fz >= 0.0).all() and fz.max() < weight, "no spike: no foot carries more than all"
+    # at rest: the pose does not move
+    pose = out.pose[after]
+    np.testing.assert_allclose(pose - pose[0], 0.0, atol=1e-9)
+
+
+def _hanging_genset() -> tuple[Scene, np.ndarray, np.ndarray]:
+    """The genset hung from a ceiling by its six bolted feet (their z, where the joint opens,
+    points down; no keys): once the bolts break nothing holds it. With `_breaking_stream`'s
+    kick, now pulling the frame off the ceiling."""
+    data = read_scene_yaml(GENSET)
+    data["mounts"] = [m for m in data["mounts"] if m["kind"] == "bolted_joint"]
+    for mount in data["mounts"]:
+        mount["orientation_rpy"] = [np.pi, 0.0, 0.0]
+    data["body"]["cg"] = [0.1, 0.0, -0.8]
+    t, f = _breaking_stream()
+    f[:, 2] = 2.0 * G - f[:, 2]
+    return scene_from_dict(data, "<hanging genset>"), t, f
+
+
+def test_a_machine_nothing_holds_any_more_publishes_nothing_and_says_why() -> None:
+    scene, t, f = _hanging_genset()
+    engine = TwinEngine(assemble(scene))
+    out = engine.push(batch(t, f))
+    assert len(_broken(engine)) == 6
+    restart = t[0] + 0.3 + 0.5 * GAP_S
+    assert not (out.stamps > restart).any(), "nothing published for a machine in no state"
+    assert engine.counts["starts_without_equilibrium"] == 1
+    assert engine.counts["samples_not_followed"] == 2000 and not engine.running
+    reports = [r for r in out.health if r.stamp > restart]
+    assert reports
+    for report in reports:
+        status = _integration_status(report)
+        assert status.level == ERROR
+        assert "not following since" in status.message
+        assert "no static equilibrium" in status.message and "bolt_fractured" in status.message
+
+
+def test_the_replay_summary_says_what_was_not_followed_and_why(tmp_path: Path) -> None:
+    scene, t, f = _hanging_genset()
+    bag = tmp_path / "hanging"
+    write_signal(
+        Signal(t, f, np.zeros_like(f)),
+        str(bag),
+        scene.input.topic,
+        scene.input.frame_id,
+        1_700_000_000_000_000_000,
+        "mcap",
+    )
+    summary = replay(scene, bag, tmp_path / "out", progress=False)
+    assert summary.counts["samples_not_followed"] == 2000
+    assert "not followed: 2000 samples, nothing published for them" in summary.text()
+    status = summary.worst[INTEGRATION]
+    assert status.level == ERROR and "no static equilibrium" in status.message
+    assert summary.to_dict()["diagnostics_worst"][INTEGRATION]["message"] == status.message

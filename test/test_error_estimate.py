@@ -7,8 +7,10 @@ than a percent."""
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 from functools import partial
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,8 +21,10 @@ from physics_helpers import base_scene, mount
 from mount_twin.analysis.accuracy import conditioned, measure, reference_run, run_at
 from mount_twin.engine.batch import WARN, SampleBatch
 from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.health import INTEGRATION
 from mount_twin.io.input_samples import read_samples
 from mount_twin.model.assemble import assemble
+from mount_twin.replay import replay
 from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import load_scene_file, scene_from_dict
 
@@ -325,3 +329,32 @@ def test_auto_looks_again_after_a_mount_event_the_same_live_and_replayed() -> No
     parts = [live.push(one) for one in split(samples, [1] * len(samples))]
     np.testing.assert_array_equal(whole.wrenches, np.concatenate([p.wrenches for p in parts]))
     assert live.counts["method_switches"] == 1
+
+
+def test_the_worst_estimate_over_a_replay_is_one_figure_in_summary_json_and_diagnostics(
+    tmp_path: Path,
+) -> None:
+    """The run's largest |ΔF| over its largest |F| (the definition `mount-twin accuracy` uses)
+    in the summary text, its JSON and the worst-over-the-run integration status alike; no
+    period's figure exceeds it."""
+    scene, _ = _stiff_light()
+    loose = dataclasses.replace(scene.integration, rtol=1e-3, atol=1e-6)
+    summary = replay(
+        dataclasses.replace(scene, integration=loose),
+        ROOT / "bags" / "ship_motion_1khz",
+        tmp_path / "out",
+        progress=False,
+    )
+    est = summary.error_estimate
+    assert est is not None and est.force_error_rel > 0.01
+    figure = f"{est.force_error_rel:.2g}"
+    worst = summary.worst[INTEGRATION]
+    assert worst.level == WARN
+    assert f"estimated mount-force error {figure} of the largest force" in worst.message
+    assert worst.values["est_force_error_rel_run"] == figure
+    assert float(worst.values["est_force_error_rel"]) <= est.force_error_rel
+    assert f"mount forces {figure} of the largest" in summary.text()
+    data = json.loads(json.dumps(summary.to_dict()))
+    assert data["error_estimate"]["force_error_rel"] == est.force_error_rel
+    assert data["diagnostics_worst"][INTEGRATION]["message"] == worst.message
+    assert "not estimated" not in data["accuracy"]

@@ -244,6 +244,7 @@ def fake_kind(name: str = "end_stop") -> ModuleType:
     module.EVENT_ERROR = (False,)
     module.EVENT_STIFFENS = (True,)
     module.ROTATIONAL = False
+    module.RESTUCK = ()
     module.PARAMETERS = {}
     module.N_PAR = 2
     module.read = lambda r, name, position, rpy: None

@@ -46,7 +46,7 @@ from mount_twin.engine.kernel import (
     run_samples,
 )
 from mount_twin.engine.linear_rating import LinearRatings
-from mount_twin.errors import ModelError
+from mount_twin.engine.restart import start_state
 from mount_twin.integrate.methods import AUTO
 from mount_twin.integrate.stepper import STATUS_TEXT, new_stepper, switch
 from mount_twin.kinds import KINDS, N_EVENTS
@@ -85,6 +85,12 @@ READING_LIMIT = 1e150
 """Largest |component| of an accepted reading, m/s² or rad/s: a larger one (a garbled message) is
 rejected as non_finite, and the rotation into F cannot overflow."""
 
+
+GIVEN_MOTION_STOP = (
+    "the stepper failed, and restarting a given initial motion would replay a motion the body "
+    "is not making"
+)
+"""Why a scene with a given initial motion stops following at a stepper failure."""
 
 MAX_EVENTS = 100_000
 """Mount events kept in TwinEngine.events (later ones are counted only)."""
@@ -660,7 +666,8 @@ class TwinEngine:
             index, gathered = self._gather(run, f)
             if not len(index):
                 return out
-            out.append(self._start(index[0], stamps, f, w, gathered, rows))
+            if not self._started(out, index, stamps, f, w, gathered, rows):
+                return out
             index = index[1:]
         if len(index) and self._rho is not None:
             interval = float(stamps[index[0]]) - self._last[0]  # type: ignore[index]
@@ -723,14 +730,32 @@ class TwinEngine:
             if self.scene.initial.mode == "given":
                 # A restart would launch the given initial motion again: a motion the body is
                 # not making. The twin stops following until the record restarts.
-                self.health.stopped_at = float(t[done + 1])
+                self._stop_following(float(t[done + 1]), GIVEN_MOTION_STOP)
                 self.counts["samples_not_followed"] += len(rest)
                 break
-            if not len(rest):
+            if not len(rest) or not self._started(out, rest, stamps, f, w, f[rest[:1]], rows):
                 break
-            out.append(self._start(rest[0], stamps, f, w, f[rest[:1]], rows))
             index = rest[1:]
         return out
+
+    def _started(
+        self,
+        out: list[_Rows],
+        index: np.ndarray,
+        stamps: np.ndarray,
+        f: np.ndarray,
+        w: np.ndarray,
+        gathered: np.ndarray,
+        rows: _BatchRows,
+    ) -> bool:
+        """Start at sample index[0] (`_start`), its outputs onto `out`; False where no
+        equilibrium holds: `index` is then counted as not followed."""
+        start = self._start(int(index[0]), stamps, f, w, gathered, rows)
+        if start is None:
+            self.counts["samples_not_followed"] += len(index)
+            return False
+        out.append(start)
+        return True
 
     def flush(self) -> HealthReport | None:
         """The report of what happened since the last one, due or not (end of a bag, shutdown);
@@ -846,12 +871,14 @@ class TwinEngine:
         w: np.ndarray,
         gathered: np.ndarray,
         rows: _BatchRows,
-    ) -> _Rows:
+    ) -> _Rows | None:
         """(Re)start the twin at sample i, under the mean specific force of `gathered` (m/s²,
         F; sample i's last) as gravity and sample i's rotation rate (as the gyro policy takes
         it) where the scene starts at equilibrium under the input; its outputs are published
-        (into `rows`). A restart keeps the mounts' internal states (fracture, plastic
-        elongation, slip, hysteresis): only the motion starts afresh."""
+        (into `rows`). A restart keeps the mounts' damage (fracture, plastic elongation,
+        hysteresis) and starts the machine as it is at rest in its own equilibrium
+        (`restart.start_state`). None: it has none; the twin follows no more (nothing
+        published) until a later restart finds one."""
         internal = self._y[2 * len(self.scene.dofs) :].copy()
         damage = internal if self.counts["starts"] and np.isfinite(internal).all() else None
         if self._last is not None or self.counts["starts"]:
@@ -859,22 +886,17 @@ class TwinEngine:
         self.counts["starts"] += 1
         stamp = float(stamps[i])
         f0 = gathered.mean(axis=0)
-        self._y = self._y_nominal.copy()
-        if damage is not None:  # a machine is not re-bolted by a restart
-            self._y[2 * len(self.scene.dofs) :] = damage
         w0 = self._gyro.start(w[i])
-        if self.scene.initial.gravity == "first_sample":
-            try:
-                self._y = initial_state(self.model, f0, w0, damage)
-            except ModelError:
-                # Restarting inside a shock: no equilibrium holds under that load.
-                self.counts["starts_at_nominal_gravity"] += 1
-                self.health.failure(
-                    stamp,
-                    f"no static equilibrium under the start specific force "
-                    f"{np.linalg.norm(f0):.4g} m/s²: started from rest under nominal gravity",
-                )
+        start = start_state(self.model, self._y_nominal, self._gravity_up, f0, w0, damage)
         self._check_start(stamp, f0, gathered)
+        if start.state is None:
+            self._stop_following(stamp, f"{start.note}{self._damage_text()}")
+            self.counts["starts_without_equilibrium"] += 1
+            return None
+        if start.note is not None:
+            self.counts["starts_at_nominal_gravity"] += 1
+            self.health.failure(stamp, start.note)
+        self._y = start.state
         self.stepper.reset()
         self._peak[:] = 0.0
         self._counter[0] = 0
@@ -884,6 +906,18 @@ class TwinEngine:
             restart(self._companion, self._y)
         rows.pose[i + 1], rows.wrenches[i + 1] = pose[0], wrenches[0]
         return _Rows(np.array([i]), rows.pose[i + 1 : i + 2], rows.wrenches[i + 1 : i + 2])
+
+    def _damage_text(self) -> str:
+        """'; at the last sample: <mount> <condition>, ...' of the error conditions holding
+        at the last sample (a broken bolt), or ''."""
+        held = [f"{m} {e}" for m, now in self._active().items() for e, error in now if error]
+        return f"; at the last sample: {', '.join(held)}" if held else ""
+
+    def _stop_following(self, stamp: float, why: str) -> None:
+        """Follow no more from `stamp` (s): nothing is published until a restart, and every
+        report says why at ERROR."""
+        self.health.stop(stamp, why)
+        self._last = None
 
     def _check_start(self, stamp: float, f0: np.ndarray, gathered: np.ndarray) -> None:
         """Start checks on the start specific force f0 (m/s², F) and the samples it is the mean

@@ -19,6 +19,8 @@ from mount_twin.physics import pose_row
 from mount_twin.scene.description import Scene
 
 PREFIX = "mount_twin"
+INTEGRATION = f"{PREFIX}: integration"
+"""Name of the integration status."""
 
 HOLE = 1.5
 """A stamp interval longer than HOLE nominal intervals is a hole: samples were lost."""
@@ -58,8 +60,10 @@ class HealthWindow:
         self.estimate_run = np.zeros(N_FIGURES)
         """The error estimate's figures over the whole run (`engine.companion`)."""
         self.stopped_at: float | None = None
-        """Stamp (s) where a scene with a given initial motion failed: the twin follows no more
-        (until the record restarts), and each report says so at ERROR."""
+        """Stamp (s) from which the twin follows no more (a given initial motion whose stepper
+        failed, a start without equilibrium) until a restart; each report says so at ERROR."""
+        self.stopped_why = ""
+        """Why it stopped (`stop`)."""
         self.last_wrong_frame_id: str | None = None
         """header.frame_id of the last sample rejected as wrong_frame (any period)."""
 
@@ -193,6 +197,10 @@ class HealthWindow:
         (rad) from +z of F, with the start checks' findings (level, text)."""
         self.starts.append((stamp, magnitude, tilt, notes))
 
+    def stop(self, stamp: float, why: str) -> None:
+        """The twin follows no more from `stamp` (s), because `why`."""
+        self.stopped_at, self.stopped_why = stamp, why
+
     def failure(self, stamp: float, text: str) -> None:
         """A stepper failure (or a forced start) at `stamp` (s)."""
         self.failures.append((stamp, text))
@@ -262,9 +270,9 @@ class HealthWindow:
         fail_text = "; ".join(f"{self.origin_s + t:.6f} s: {m}" for t, m in self.failures)
         if self.stopped_at is not None:
             step_text = (
-                f"not following since {self.origin_s + self.stopped_at:.6f} s: the stepper "
-                "failed, and restarting a given initial motion would replay a motion the body "
-                "is not making; no pose, angles or wrenches until the record restarts"
+                f"not following since {self.origin_s + self.stopped_at:.6f} s: "
+                f"{self.stopped_why}; no pose, angles or wrenches until a restart (a gap or "
+                "the stamps jumping back) finds a state to start from"
                 + (f" ({fail_text})" if self.failures else "")
             )
         elif self.failures:
@@ -273,15 +281,12 @@ class HealthWindow:
             step_text = "ok"
         level = ERROR if self.failures or self.stopped_at is not None else OK
         estimate = self._estimate_values()
-        rel = float(estimate["est_force_error_rel"]) if estimate else 0.0
-        if rel > WARN_FORCE_ERROR_REL:
+        warning = estimate_warning(ErrorEstimate.of(self.estimate_run)) if estimate else None
+        if warning is not None:
             level = max(level, WARN)
-            step_text = (
-                f"estimated mount-force error {rel:.2g} of the largest force: tighten "
-                "integration.rtol" + ("" if step_text == "ok" else f"; {step_text}")
-            )
+            step_text = warning + ("" if step_text == "ok" else f"; {step_text}")
         step = HealthStatus(
-            f"{PREFIX}: integration",
+            INTEGRATION,
             level,
             step_text,
             {
@@ -313,20 +318,26 @@ class HealthWindow:
         return HealthReport(stamp, sample, [inp, step, att, *mounts])
 
     def _estimate_values(self) -> dict[str, str]:
-        """The period's estimated errors as diagnostic values (none: the estimate is off).
+        """The estimated errors of the period and, `_run`, of the run so far as diagnostic
+        values (none: the estimate is off).
 
-        The relative force error is the period's largest |ΔF| over the largest |F| component
-        of the run so far."""
+        The relative force error is the largest |ΔF| (of the period, of the run so far) over
+        the largest |F| component of the run so far: the run's figure is the one the replay
+        summary gives at the end (`TwinEngine.error_estimate`), and the period's never exceeds
+        it."""
         if not self.scene.integration.error_estimate:
             return {}
         period = self.estimate.copy()
         period[FORCE_SCALE] = self.estimate_run[FORCE_SCALE]
-        est = ErrorEstimate.of(period)
+        est, run = ErrorEstimate.of(period), ErrorEstimate.of(self.estimate_run)
         return {
             "est_force_error_rel": f"{est.force_error_rel:.2g}",
             "est_force_error_n": f"{est.force_error_n:.3g}",
             "est_attitude_error_rad": f"{est.attitude_error_rad:.2g}",
             "est_resyncs": str(est.resyncs),
+            "est_force_error_rel_run": f"{run.force_error_rel:.2g}",
+            "est_force_error_n_run": f"{run.force_error_n:.3g}",
+            "est_attitude_error_rad_run": f"{run.attitude_error_rad:.2g}",
         }
 
     def _mount_statuses(
@@ -483,6 +494,18 @@ class HealthWindow:
         if len(seen) > NAMED_FRAMES:
             got += f" and {len(seen) - NAMED_FRAMES} more"
         return f"{reason} {n}: expected frame_id {self.scene.input.frame_id!r}, got {got}"
+
+
+def estimate_warning(run: ErrorEstimate) -> str | None:
+    """The integration status' warning on the estimated error of everything published so far
+    (`run`), None while it is within WARN_FORCE_ERROR_REL of the largest force: the figure of
+    the diagnostics and of the replay summary, one definition."""
+    if run.force_error_rel <= WARN_FORCE_ERROR_REL:
+        return None
+    return (
+        f"estimated mount-force error {run.force_error_rel:.2g} of the largest force over the "
+        "run so far: tighten integration.rtol"
+    )
 
 
 def _seconds(t: float) -> str:

@@ -1,7 +1,8 @@
 """Mount kinds besides the linear one: each module is one place for a kind's scene keys and
-checks (`read`), its parameter row (`pack`), internal states, force law (`load`), event
-functions (`monitor`) and discrete switches between samples (`update`, which says whether it
-switched: the state then jumped, and a stepper must not start from a stage it took before).
+checks (`read`), its parameter row (`pack`), internal states (and which of them a restart
+resets: `RESTUCK`), force law (`load`), event functions (`monitor`) and discrete switches
+between samples (`update`, which says whether it switched: the state then jumped, and a stepper
+must not start from a stage it took before).
 
 The compiled dispatchers below select a kind by its code; adding a kind is a new module, a line
 in KINDS and a branch in each dispatcher. The integrator and the engine never change.
@@ -54,6 +55,7 @@ MODULE_NAMES = (
     "EVENT_ERROR",
     "EVENT_STIFFENS",
     "ROTATIONAL",
+    "RESTUCK",
     "PARAMETERS",
     "N_PAR",
     "read",

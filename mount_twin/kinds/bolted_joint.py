@@ -45,6 +45,12 @@ EVENT_STIFFENS = (False, False, False, False)
 """Whether each event can make the scene stiffer (`auto` then looks at it again): a joint that
 yields, opens, slips or breaks only loses stiffness."""
 STATES = ("plastic_elongation", "slip_x", "slip_y", "fractured")
+RESTUCK = ("slip_x", "slip_y")
+"""States a restart sets to zero: the joint face's stick point, where it stuck relative to a
+pose the restart discards. Kept, it would start the face loaded to its friction bound (the
+frame of a machine that slid before a gap pulled sideways while "at rest", and with broken
+bolts no equilibrium: friction at its bound holds no yaw). Plastic elongation and fracture are
+damage, and stay."""
 ROTATIONAL = False
 """A single bolt carries no moment: `load` reads no local rotation or rate and gives no couple."""
 

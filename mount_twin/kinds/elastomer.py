@@ -28,6 +28,8 @@ EVENTS = ("snubber_contact", "over_travel")
 EVENT_ERROR = (False, True)
 EVENT_STIFFENS = (True, False)
 """A snubber that touches stiffens the mount (`auto` looks again); over-travel is in contact."""
+RESTUCK: tuple[str, ...] = ()
+"""States a restart sets to zero (none: all of this kind's states are kept)."""
 ROTATIONAL = True
 """`load` reads the local rotation and its rate and gives a couple (the rotational stiffness)."""
 AXES = ("x", "y", "z")

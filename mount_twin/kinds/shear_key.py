@@ -24,6 +24,8 @@ EVENT_STIFFENS = (True, False)
 """A key that closes its clearance stiffens the scene (`auto` looks again); overload is in
 contact."""
 STATES: tuple[str, ...] = ()
+RESTUCK: tuple[str, ...] = ()
+"""States a restart sets to zero (none: all of this kind's states are kept)."""
 ROTATIONAL = False
 """A key carries no moment: `load` reads no local rotation or rate and gives no couple."""
 
