@@ -361,6 +361,7 @@ def test_parameters_are_all_set_described_and_read_only() -> None:
             ["-p", f"scene_file:={GENSET}", "-p", "body.mass:=heavy"],
             "body.mass: expected a number, got 'heavy'",
         ),
+        (["-p", "body.mass:=heavy"], "body.mass: expected a number, got 'heavy'"),
         (
             ["-p", "qos_overrides./deck/imu.subscription.reliability:=sometimes"],
             "qos_overrides./deck/imu.subscription.reliability: expected 'best_effort' or",
@@ -377,6 +378,7 @@ def test_parameters_are_all_set_described_and_read_only() -> None:
         "bad_topic",
         "out_of_range",
         "bad_type",
+        "bad_type_over_params_file",
         "bad_qos_override",
         "unknown_qos_override",
     ],
@@ -391,6 +393,32 @@ def test_configuration_errors_end_the_node_with_one_line_naming_the_parameter(
     assert code == 2, node.stderr
     assert len(lines) == 1 and names in lines[0], node.stderr
     assert "Traceback" not in node.stderr
+
+
+def test_the_command_line_outranks_a_params_file_section_for_the_node(tmp_path: Path) -> None:
+    """rcl reads params files after every -p: the node takes back the -p values that a file's
+    section for it (its name, its full name, or /**) also sets, and only those."""
+    from mount_twin.ros.parameters import shadowed_command_line
+
+    params = tmp_path / "p.yaml"
+    params.write_text(
+        "/**:\n  ros__parameters:\n    body: {mass: 1200.0}\n    name: a\n"
+        "/ship/twin:\n  ros__parameters:\n    outputs: {decimation: 4}\n"
+        "other_node:\n  ros__parameters:\n    input: {g: 9.0}\n"
+    )
+    args = [
+        "mount_twin_node",
+        "--ros-args",
+        "-p", "body.mass:=heavy",
+        "--params-file", str(params),
+        "-p", "twin:outputs.decimation:=2",
+        "-p", "input.g:=9.5",  # only another node's section sets it: rcl keeps this -p
+        "-p", "other_node:name:=b",  # for another node
+        "--",
+        "-p", "name:=c",  # not a ROS argument
+    ]  # fmt: skip
+    got = shadowed_command_line(args, {"twin", "ship/twin"})
+    assert got == {"body.mass": "heavy", "outputs.decimation": 2}
 
 
 def test_a_renamed_namespaced_node_takes_the_bundled_params_file() -> None:

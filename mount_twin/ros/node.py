@@ -20,7 +20,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from functools import partial
 from typing import Any, TypeVar
 
@@ -82,9 +82,10 @@ class MountTwinNode(Node):
         MountTwinError: a parameter, scene file or topic name is wrong (the message names it).
     """
 
-    def __init__(self, **kwargs: Any) -> None:
+    def __init__(self, args: Sequence[str] = (), **kwargs: Any) -> None:
+        """`args`: the process's command line (its `-p` outrank a params file's section)."""
         super().__init__(NODE_NAME, **kwargs)
-        self.options, self.scene = configure(self)
+        self.options, self.scene = configure(self, args)
         self.stream = TwinStream(self.scene)
         self._pubs = self._create_outputs()
         self._batched = self.options.batch_period_s > 0.0
@@ -299,7 +300,7 @@ def main(args: list[str] | None = None) -> int:
         signal.signal(sig, lambda *_: stop.set())
     node = None
     try:
-        node = MountTwinNode()
+        node = MountTwinNode(sys.argv if args is None else args)
         executor = SingleThreadedExecutor()
         executor.add_node(node)
         while not stop.is_set() and rclpy.ok():

@@ -10,9 +10,12 @@ double, and a `scene_file` is loaded with the other scene parameters overriding 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from itertools import pairwise
 from typing import Any
 
+import yaml
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.exceptions import InvalidParameterValueException
 from rclpy.node import Node
@@ -20,7 +23,7 @@ from rclpy.node import Node
 from mount_twin.errors import SceneError
 from mount_twin.ros.rclpy_private import given_parameters
 from mount_twin.scene.description import Scene
-from mount_twin.scene.params import PARAMETERS, effective_parameters, mount_parameters
+from mount_twin.scene.params import PARAMETERS, effective_parameters, flatten, mount_parameters
 
 
 @dataclass(frozen=True)
@@ -87,16 +90,57 @@ QOS_OVERRIDES = "qos_overrides."
 lets the input subscription's reliability be overridden)."""
 
 
-def configure(node: Node) -> tuple[NodeOptions, Scene]:
-    """Check the node's given parameters, load the scene, declare every parameter.
+def _ros_arguments(args: Sequence[str]) -> list[str]:
+    """The tokens of `args` inside `--ros-args` … (up to `--` or the end)."""
+    out, inside = [], False
+    for arg in args:
+        if arg in ("--ros-args", "--"):
+            inside = arg == "--ros-args"
+        elif inside:
+            out.append(arg)
+    return out
+
+
+def shadowed_command_line(args: Sequence[str], names: set[str]) -> dict[str, Any]:
+    """The `-p NAME:=VALUE` (or `-p NODE:NAME:=VALUE` for a node in `names`) of the command
+    line `args` that a `--params-file` section for the node (its name, or `/**`) also sets,
+    values read as YAML.
+
+    rcl reads the params files after every `-p`, so a file outranks the command line whatever
+    their order: `--params-file params.yaml -p body.mass:=heavy` ran on the file's 1200 kg
+    without a word. The node takes the command line's values back, as a user means them.
+    """
+    tokens = _ros_arguments(args)
+    given: dict[str, Any] = {}
+    in_files: set[str] = set()
+    for flag, value in pairwise(tokens):
+        if flag in ("-p", "--param") and ":=" in value:
+            name, _, text = value.partition(":=")
+            target, _, name = name.rpartition(":")
+            if not target or target.lstrip("/") in names:
+                given[name] = yaml.safe_load(text)
+        elif flag == "--params-file":
+            with open(value, encoding="utf-8") as f:  # rcl has read it: it exists and parses
+                sections = yaml.safe_load(f) or {}
+            for section, body in sections.items():
+                if str(section).lstrip("/") in {*names, "**"} and isinstance(body, dict):
+                    in_files |= {n for n, _ in flatten(body.get("ros__parameters") or {})}
+    return {name: value for name, value in given.items() if name in in_files}
+
+
+def configure(node: Node, args: Sequence[str] = ()) -> tuple[NodeOptions, Scene]:
+    """Check the node's given parameters (with the command line `args`' `-p` over a params
+    file's section for the node: `shadowed_command_line`), load the scene, declare every
+    parameter.
 
     Raises:
         SceneError: naming the parameter (or scene file key path) at fault.
     """
     source = f"parameters of {node.get_fully_qualified_name()}"
+    names = {node.get_name(), node.get_fully_qualified_name().lstrip("/")}
     given = {
         k: v
-        for k, v in given_parameters(node).items()
+        for k, v in {**given_parameters(node), **shadowed_command_line(args, names)}.items()
         if k not in BUILT_IN and not k.startswith(QOS_OVERRIDES)
     }
     options = {k: given.pop(k) for k in list(given) if k in _OPTIONS}
