@@ -34,21 +34,27 @@ scene needing kernels not compiled yet, or sources edited since. Loading takes <
 
 
 @contextmanager
-def kernels_loading(notice: bool = True) -> Iterator[None]:
-    """Around building a TwinEngine: with `notice`, say COMPILE_NOTICE on stderr at once if the
-    kernel cache is cold, else if loading the kernels takes COMPILE_NOTICE_AFTER_S."""
+def kernels_loading(
+    notice: bool = True, say: Callable[[str], object] | None = None
+) -> Iterator[None]:
+    """Around building a TwinEngine: with `notice`, say COMPILE_NOTICE (on stderr, or through
+    `say`, e.g. a node's logger) at once if the kernel cache is cold, else if loading the
+    kernels takes COMPILE_NOTICE_AFTER_S."""
     if not notice:
         yield
         return
 
-    def say() -> None:
-        print(COMPILE_NOTICE, file=sys.stderr, flush=True)
+    def tell() -> None:
+        if say is None:
+            print(COMPILE_NOTICE, file=sys.stderr, flush=True)
+        else:
+            say(COMPILE_NOTICE)
 
     if kernel_cache_is_cold():
-        say()
+        tell()
         yield
         return
-    timer = threading.Timer(COMPILE_NOTICE_AFTER_S, say)
+    timer = threading.Timer(COMPILE_NOTICE_AFTER_S, tell)
     timer.daemon = True
     timer.start()
     try:

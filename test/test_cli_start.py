@@ -100,6 +100,10 @@ def test_a_cold_cache_is_announced_at_once(
     with replay_module.kernels_loading(notice=False):
         pass
     assert capsys.readouterr().err == ""
+    told: list[str] = []  # the node passes its logger: the notice goes there, not to stderr
+    with replay_module.kernels_loading(say=told.append):
+        assert told == [replay_module.COMPILE_NOTICE]
+    assert capsys.readouterr().err == ""
 
 
 def test_a_slow_load_from_a_warm_cache_is_announced_and_a_fast_one_is_not(
