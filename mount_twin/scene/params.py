@@ -18,7 +18,10 @@ from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import load_scene_file, read_scene_yaml, scene_from_dict
 
 PARAMETERS: dict[str, tuple[str, str]] = {
-    "scene_file": ("string", "Scene YAML file; when set, every other scene parameter is ignored"),
+    "scene_file": (
+        "string",
+        "Scene YAML file; when set, the other scene parameters given override its values",
+    ),
     "name": ("string", "Scene name"),
     "frames.foundation": ("string", "frame_id of the foundation frame F"),
     "frames.body": ("string", "frame_id of the body frame B (origin at the CG)"),
