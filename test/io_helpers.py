@@ -15,7 +15,7 @@ import numpy as np
 import yaml
 from rosbags.highlevel import AnyReader
 
-from mount_twin.engine.batch import SampleBatch
+from mount_twin.engine.batch import HealthReport, OutputBatch, SampleBatch
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.io.messages import TYPESTORE
 from mount_twin.model.assemble import Model, assemble
@@ -152,3 +152,18 @@ def mount_forces_in_f(scene: Scene, wrenches: np.ndarray) -> np.ndarray:
 
     axes = np.array([rpy_matrix(*m.orientation_rpy) for m in scene.mounts])  # columns: axes in F
     return np.einsum("nij,knj->kni", axes, wrenches[..., :3])
+
+
+def push_all(
+    engine: TwinEngine, parts: list[SampleBatch]
+) -> tuple[OutputBatch, list[list[HealthReport]]]:
+    """Push each part; return the concatenated outputs and the reports of each push (the joined
+    `sample` column is per push, so meaningless here: tests read stamps, poses and wrenches)."""
+    outs = [engine.push(p) for p in parts]
+    joined = OutputBatch(
+        np.concatenate([o.stamps for o in outs]),
+        np.concatenate([o.sample for o in outs]),
+        np.concatenate([o.pose for o in outs]),
+        np.concatenate([o.wrenches for o in outs]),
+    )
+    return joined, [o.health for o in outs]

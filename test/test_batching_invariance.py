@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_helpers import ROOT, read_raw, split
+from io_helpers import ROOT, push_all, read_raw, split
 
 from mount_twin.engine.batch import OutputBatch, SampleBatch
 from mount_twin.engine.engine import TwinEngine
@@ -42,14 +42,7 @@ def _run(pieces: list[int] | None) -> tuple[OutputBatch, TwinEngine]:
     assert scene.integration.method == "auto" and scene.input.gyro_filter != "none"
     engine = TwinEngine(assemble(scene))
     full = _rolling_shock()
-    parts = [full] if pieces is None else split(full, pieces)
-    outs = [engine.push(p) for p in parts]
-    joined = OutputBatch(
-        np.concatenate([o.stamps for o in outs]),
-        np.concatenate([o.sample for o in outs]),
-        np.concatenate([o.pose for o in outs]),
-        np.concatenate([o.wrenches for o in outs]),
-    )
+    joined, _ = push_all(engine, [full] if pieces is None else split(full, pieces))
     return joined, engine
 
 

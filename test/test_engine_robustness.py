@@ -13,7 +13,16 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from io_helpers import REST, batch, default_model, default_scene, engine_for, scene_with, split
+from io_helpers import (
+    REST,
+    batch,
+    default_model,
+    default_scene,
+    engine_for,
+    push_all,
+    scene_with,
+    split,
+)
 
 from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, OutputBatch, SampleBatch
 from mount_twin.engine.engine import TwinEngine
@@ -27,21 +36,6 @@ POSE_TOL = 1e-12  # m, rad: same arithmetic, so only round-off may differ
 
 def stamps(n: int, t0: float = 0.0, rate: float = RATE) -> np.ndarray:
     return t0 + np.arange(n) / rate
-
-
-def push_all(
-    engine: TwinEngine, parts: list[SampleBatch]
-) -> tuple[OutputBatch, list[list[HealthReport]]]:
-    """Push each part; return the concatenated outputs and the reports of each push (the joined
-    `sample` column is per push, so meaningless here: tests read stamps, poses and wrenches)."""
-    outs = [engine.push(p) for p in parts]
-    joined = OutputBatch(
-        np.concatenate([o.stamps for o in outs]),
-        np.concatenate([o.sample for o in outs]),
-        np.concatenate([o.pose for o in outs]),
-        np.concatenate([o.wrenches for o in outs]),
-    )
-    return joined, [o.health for o in outs]
 
 
 def assert_finite(out: OutputBatch) -> None:
