@@ -78,6 +78,10 @@ class NodeProcess:
         """True while the process runs."""
         return self.proc.poll() is None
 
+    def failed(self) -> str:
+        """Stop the node (SIGINT) and say how it ended: for an assertion's message."""
+        return f"node exit {self.stop()}: {self.stderr}"
+
     def stop(self, sig: int = signal.SIGINT, timeout: float = 30.0) -> int:
         """Send `sig`, wait for the exit, keep its output; return the exit code."""
         if self.alive:
@@ -199,12 +203,13 @@ def wait_for(predicate: Callable[[], bool], timeout: float, step: float = 0.02) 
     return True
 
 
-def wait_for_node(pub: Any, node: NodeProcess, timeout: float = 60.0) -> bool:
+def wait_for_node(pub: Any, node: NodeProcess, timeout: float = 300.0) -> bool:
     """Wait until the node's input subscription has matched `pub` (or the node died).
 
     The publisher sees the match when the node's reader is discovered; the reader matches the
     writer on its own discovery a moment later, and best-effort samples sent in between are
-    dropped: hence the settling time.
+    dropped: hence the settling time. The timeout is generous: a node starting on a loaded
+    machine (imports, kernels, DDS discovery) took over 60 s beside a parallel test run.
     """
     if not wait_for(lambda: pub.get_subscription_count() > 0 or not node.alive, timeout):
         return False

@@ -130,7 +130,7 @@ def run_live(
     pose = resolve("~/pose", NODE_NAME)
     last = _stamp(raws[-1])
     try:
-        assert wait_for_node(pub, node), node.stop()
+        assert wait_for_node(pub, node), node.failed()
         assert wait_for(lambda: all(peer.connected(t) for t in topics), 10.0)
         publish_paced(pub, raws, rate_hz, peer)
         peer.take_until(lambda: len(peer.got[pose]) >= expect_outputs, 120.0)
@@ -232,7 +232,7 @@ def test_bad_input_is_counted_and_the_node_keeps_running(tmp_path: Path) -> None
     other = Peer(domain, "wrong_type_peer")  # one participant cannot mix types on a topic
     other.publisher(ACCEL, "/deck/imu")
     try:
-        assert wait_for_node(pub, node), node.stop()
+        assert wait_for_node(pub, node), node.failed()
         stamps, accel = _at_rest(400)
         good = _imu(stamps, accel)
         nan = accel.copy()
@@ -431,7 +431,7 @@ def test_a_renamed_namespaced_node_takes_the_bundled_params_file() -> None:
     )
     try:
         pub = peer.publisher(IMU, "/deck/imu")
-        assert wait_for_node(pub, node), node.stop()
+        assert wait_for_node(pub, node), node.failed()
         assert wait_for(lambda: peer.connected(topic), 10.0)
         publish_paced(pub, _imu(*_at_rest(100)), 1000.0, peer)
         assert peer.take_until(lambda: len(peer.got[topic]) >= 100, 10.0)
@@ -465,7 +465,7 @@ def test_sim_time_without_clock_is_reported_and_with_clock_is_followed() -> None
     )
     try:
         pub = peer.publisher(IMU, "/deck/imu")
-        assert wait_for_node(pub, node), node.stop()
+        assert wait_for_node(pub, node), node.failed()
         publish_paced(pub, _imu(*_at_rest(200)), 1000.0, peer)
         assert peer.take_until(lambda: len(peer.got["/mount_twin/pose"]) >= 200, 10.0)
         assert peer.take_until(
