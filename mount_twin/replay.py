@@ -135,9 +135,8 @@ class ReplaySummary:
             lines += [f"    {n:>12}: {u:.3f}" for n, u in self.utilisation_max.items()]
         lines.append(f"  mount events: {len(self.events) or 'none'}")
         for (mount, event), same in _grouped(self.events).items():
-            level = "ERROR" if same[0].error else "WARN"
             lines.append(
-                f"    {level:5} {mount:>12} {event:<16} ×{len(same):<5} "
+                f"    {same[0].level:5} {mount:>12} {event:<16} ×{len(same):<5} "
                 f"first {self.origin_s + same[0].stamp:.6f} s  "
                 f"|F| max {max(e.force for e in same):.4g} N"
             )
@@ -176,7 +175,7 @@ class ReplaySummary:
                 {
                     "mount": e.mount,
                     "event": e.event,
-                    "level": "ERROR" if e.error else "WARN",
+                    "level": e.level,
                     "t_s": e.stamp - self.start_s,
                     "stamp_s": self.origin_s + e.stamp,
                     "force_N": e.force,

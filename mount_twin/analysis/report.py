@@ -20,8 +20,10 @@ from typing import Any
 
 import numpy as np
 
+from mount_twin.engine.batch import event_level
 from mount_twin.errors import ModelError
 from mount_twin.io.output_tables import Table, read_output_bag
+from mount_twin.kinds.events import EVENT_IS_ERROR
 from mount_twin.scene.description import Scene
 
 EVENT = re.compile(r"(\w+) ×(\d+) \(first (\d+\.\d+) s, \|F\| max ([\d.e+-]+) N\)")
@@ -43,10 +45,11 @@ class Event:
 
 
 def events_of(diagnostics: Table, origin_ns: int) -> list[Event]:
-    """Mount event groups named in the diagnostics messages, in time order."""
+    """Mount event groups named in the diagnostics messages, in time order; each at its own
+    kind's level (the mount status' level is that of its worst event in the period)."""
     out = []
     c = diagnostics.columns
-    for status, level, message in zip(c["status"], c["level"], c["message"], strict=True):
+    for status, message in zip(c["status"], c["message"], strict=True):
         if not status.startswith("mount_twin: mount "):
             continue
         for name, count, first, force in EVENT.findall(message):
@@ -58,7 +61,7 @@ def events_of(diagnostics: Table, origin_ns: int) -> list[Event]:
                     int(count),
                     t,
                     float(force),
-                    level,
+                    event_level(EVENT_IS_ERROR[name]),
                 )
             )
     return sorted(out, key=lambda e: e.t_s)

@@ -65,6 +65,16 @@ class MountEvent:
     force: float
     error: bool
 
+    @property
+    def level(self) -> str:
+        """The level name: ERROR or WARN."""
+        return event_level(self.error)
+
+
+def event_level(error: bool) -> str:
+    """The level name of a mount event that is an ERROR (`error`) or a WARN."""
+    return LEVEL_NAMES[ERROR if error else WARN]
+
 
 @dataclass
 class HealthReport:
