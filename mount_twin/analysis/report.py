@@ -20,9 +20,17 @@ from typing import Any
 
 import numpy as np
 
+from mount_twin.analysis.figures import (
+    DISPLACEMENT,
+    PEAK_COUPLE,
+    PEAK_FORCE,
+    displacement_from_start,
+    peak_magnitudes,
+)
 from mount_twin.engine.batch import event_level
 from mount_twin.errors import ModelError
-from mount_twin.io.output_tables import Table, read_output_bag
+from mount_twin.io.messages import WRENCH
+from mount_twin.io.output_tables import COLUMNS, Table, read_output_bag
 from mount_twin.kinds.events import EVENT_IS_ERROR
 from mount_twin.scene.description import Scene
 
@@ -289,20 +297,24 @@ def write_report(
     rows = []
     for name, table in mounts.items():
         c = table.columns
-        peaks = [float(np.abs(c[k]).max()) for k in ("fx_N", "fy_N", "fz_N")]
-        u = utilisation.get(name)
+        wrenches = np.stack([c[k] for k in COLUMNS[WRENCH]], axis=1)[:, None, :]
+        (force, couple), u = peak_magnitudes(wrenches)[0], utilisation.get(name)
         rows.append(
             [
                 name,
                 kinds.get(name, ""),
-                *(f"{p:.4g}" for p in peaks),
-                f"{float(np.sqrt(c['fx_N'] ** 2 + c['fy_N'] ** 2 + c['fz_N'] ** 2).max()):.4g}",
+                f"{force:.4g}",
+                f"{couple:.4g}",
                 "n/a" if u is None else f"{float(u[1].max()):.3g}",
             ]
         )
+    if "pose" in tables:
+        position = np.stack([tables["pose"].columns[f"{a}_m"] for a in "xyz"], axis=1)
+        moved = displacement_from_start(position, position[0])
+        sections.append(f"<p>{DISPLACEMENT} (CG): {moved:.6g}</p>")
     sections += [
-        "<h2>Peaks</h2>",
-        _table(["mount", "kind", "|Fx| N", "|Fy| N", "|Fz| N", "|F| N", "utilisation max"], rows),
+        "<h2>Peaks (largest magnitude at one instant)</h2>",
+        _table(["mount", "kind", PEAK_FORCE, PEAK_COUPLE, "utilisation max"], rows),
         "<h2>Events</h2>",
         _table(
             ["time s", "mount", "event", "count in period", "|F| max N", "level"],
