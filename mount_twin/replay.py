@@ -14,7 +14,21 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from mount_twin.engine.batch import LEVEL_NAMES, OK, HealthReport, HealthStatus, MountEvent
+from mount_twin.analysis.figures import (
+    DISPLACEMENT,
+    PEAK_COUPLE,
+    PEAK_FORCE,
+    displacement_from_start,
+    peak_magnitudes,
+)
+from mount_twin.engine.batch import (
+    FAILED,
+    LEVEL_NAMES,
+    OK,
+    HealthReport,
+    HealthStatus,
+    MountEvent,
+)
 from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.health import INTEGRATION, tilt_from_quaternions
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
@@ -77,7 +91,7 @@ def _estimate_text(est: ErrorEstimate | None) -> str:
 
 @dataclass
 class ReplaySummary:
-    """What a replay did: counts, figures and per-mount peaks (N, N·m in mount axes)."""
+    """What a replay did: counts, figures and per-mount peaks (`analysis.figures`)."""
 
     input_bag: str
     output_bag: str
@@ -85,9 +99,9 @@ class ReplaySummary:
     written: int
     stamp_span_s: float
     wall_s: float
-    peak_wrench: dict[str, np.ndarray] = field(default_factory=dict)
+    peaks: dict[str, np.ndarray] = field(default_factory=dict)  # peak |F| N, |M| N·m
     tilt_max_rad: float = 0.0
-    displacement_max_m: float = 0.0
+    displacement_max_m: float = 0.0  # from the first published position
     worst: dict[str, HealthStatus] = field(default_factory=dict)
     events: list[MountEvent] = field(default_factory=list)
     utilisation_max: dict[str, float] = field(default_factory=dict)
@@ -95,11 +109,32 @@ class ReplaySummary:
     wrong_frame_id: str | None = None  # the last header.frame_id rejected as wrong, if any
     start_s: float = 0.0  # engine seconds of the first output (event times count from it)
     error_estimate: ErrorEstimate | None = None  # the live estimate over the run (None: off)
+    failure: str = ""  # how often the integration failed and why ('' if never)
 
     @property
     def worst_level(self) -> int:
         """The worst diagnostics level of the whole run (OK, WARN, ERROR: 0, 1, 2)."""
         return max((s.level for s in self.worst.values()), default=OK)
+
+    @property
+    def verdict(self) -> str:
+        """FAILED if the integration failed (any failure: the twin then restarted at an
+        equilibrium or stopped following, so from there on its figures are not the motion the
+        record drove), else the worst diagnostics level's name."""
+        return FAILED if self.failure else LEVEL_NAMES[self.worst_level]
+
+    def nothing_accepted(self) -> str:
+        """Why no input sample was accepted ('' if some were): the rejection counts, and the
+        bag's header.frame_id when it is the wrong one."""
+        if self.counts.get("accepted", 0):
+            return ""
+        why = f"{self.counts.get('received', 0)} received, rejected: {self._rejected()}"
+        if self.wrong_frame_id is not None:
+            why += f"; the bag's header.frame_id is {self.wrong_frame_id!r}: see input.frame_id"
+        return f"no input sample was accepted ({why})"
+
+    def _rejected(self) -> dict[str, int]:
+        return {k: v for k, v in self.counts.items() if k.startswith("rejected_") and v}
 
     @property
     def real_time_factor(self) -> float:
@@ -109,11 +144,12 @@ class ReplaySummary:
     def text(self) -> str:
         """Human-readable summary."""
         c = self.counts
-        rejected = {k: v for k, v in c.items() if k.startswith("rejected_") and v}
         lines = [
             f"replayed {self.input_bag} -> {self.output_bag}",
+            *([f"  {nothing}"] if (nothing := self.nothing_accepted()) else []),
+            *([f"  {FAILED}: {self.failure}"] if self.failure else []),
             f"  input samples: {c.get('received', 0)} received, {c.get('accepted', 0)} accepted, "
-            f"rejected: {rejected or 'none'}, gaps: {c.get('gaps', 0)}, "
+            f"rejected: {self._rejected() or 'none'}, gaps: {c.get('gaps', 0)}, "
             f"restarts: {c.get('restarts', 0)}, integration failures: "
             f"{c.get('integration_failures', 0)}",
             *(
@@ -127,12 +163,13 @@ class ReplaySummary:
             ),
             f"  {self.written} messages written over {self.stamp_span_s:.3f} s of stamps in "
             f"{self.wall_s:.2f} s wall: real-time factor {self.real_time_factor:.1f}",
-            f"  max CG displacement {self.displacement_max_m * 1e3:.3f} mm, "
-            f"max tilt {np.degrees(self.tilt_max_rad):.4f} deg",
+            f"  max CG displacement from the first published position "
+            f"{self.displacement_max_m * 1e3:.3f} mm, max tilt "
+            f"{np.degrees(self.tilt_max_rad):.4f} deg",
             f"  {_estimate_text(self.error_estimate)}",
-            "  peak mount loads (largest magnitude, mount axes): Fx Fy Fz [N]  Mx My Mz [N·m]",
+            "  peak mount loads (largest magnitude at one instant): |F| [N]  |M| [N·m]",
         ]
-        for name, peak in self.peak_wrench.items():
+        for name, peak in self.peaks.items():
             lines.append(f"    {name:>12}: " + " ".join(f"{v:10.1f}" for v in peak))
         if self.utilisation_max:
             lines.append(
@@ -141,9 +178,8 @@ class ReplaySummary:
             lines += [f"    {n:>12}: {u:.3f}" for n, u in self.utilisation_max.items()]
         lines.append(f"  mount events: {len(self.events) or 'none'}")
         for (mount, event), same in _grouped(self.events).items():
-            level = "ERROR" if same[0].error else "WARN"
             lines.append(
-                f"    {level:5} {mount:>12} {event:<16} ×{len(same):<5} "
+                f"    {same[0].level:5} {mount:>12} {event:<16} ×{len(same):<5} "
                 f"first {self.origin_s + same[0].stamp:.6f} s  "
                 f"|F| max {max(e.force for e in same):.4g} N"
             )
@@ -151,6 +187,7 @@ class ReplaySummary:
         lines += [
             f"    {LEVEL_NAMES[s.level]:5} {s.name}: {s.message}" for s in self.worst.values()
         ]
+        lines.append(f"  verdict: {self.verdict}")
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, object]:
@@ -160,29 +197,32 @@ class ReplaySummary:
         return {
             "input_bag": self.input_bag,
             "output_bag": self.output_bag,
-            "verdict": LEVEL_NAMES[self.worst_level],
+            "verdict": self.verdict,
+            "failure": self.failure or None,
+            "nothing_accepted": self.nothing_accepted() or None,
+            "diagnostics_worst_level": LEVEL_NAMES[self.worst_level],
             "counts": dict(self.counts),
             "stamp_span_s": self.stamp_span_s,
             "wall_s": self.wall_s,
             "real_time_factor": self.real_time_factor,
-            "max_cg_displacement_m": self.displacement_max_m,
+            DISPLACEMENT: self.displacement_max_m,
             "max_tilt_rad": self.tilt_max_rad,
             "error_estimate": dataclasses.asdict(self.error_estimate)
             if self.error_estimate
             else None,
             "mounts": {
                 name: {
-                    "peak_force_N": [float(v) for v in peak[:3]],
-                    "peak_couple_Nm": [float(v) for v in peak[3:]],
+                    PEAK_FORCE: float(peak[0]),
+                    PEAK_COUPLE: float(peak[1]),
                     "utilisation_max": util.get(name),
                 }
-                for name, peak in self.peak_wrench.items()
+                for name, peak in self.peaks.items()
             },
             "events": [
                 {
                     "mount": e.mount,
                     "event": e.event,
-                    "level": "ERROR" if e.error else "WARN",
+                    "level": e.level,
                     "t_s": e.stamp - self.start_s,
                     "stamp_s": self.origin_s + e.stamp,
                     "force_N": e.force,
@@ -257,10 +297,9 @@ def replay(
     topics[TF_STATIC_TOPIC] = TF
     static_due = True
     nm = len(scene.mounts)
-    peak = np.zeros((nm, 6))
+    peak = np.zeros((nm, 2))
     tilt, disp = 0.0, 0.0
-    first_stamp = last_stamp = None
-    cg = np.array(scene.body.cg)
+    first_stamp = last_stamp = start = None
     wall0 = time.perf_counter()
     worst: dict[str, HealthStatus] = {}
     with (
@@ -280,12 +319,10 @@ def replay(
             batch = stream.last_outputs
             if batch is not None and len(batch):
                 first_stamp = batch.stamps[0] if first_stamp is None else first_stamp
+                start = batch.position[0].copy() if start is None else start
                 last_stamp = batch.stamps[-1]
-                bigger = np.abs(batch.wrenches).max(axis=0) > np.abs(peak)
-                idx = np.abs(batch.wrenches).argmax(axis=0)
-                at_max = np.take_along_axis(batch.wrenches, idx[None], axis=0)[0]
-                peak = np.where(bigger, at_max, peak)
-                disp = max(disp, float(np.linalg.norm(batch.position - cg, axis=1).max()))
+                np.maximum(peak, peak_magnitudes(batch.wrenches), out=peak)
+                disp = max(disp, displacement_from_start(batch.position, start))
                 tilt = max(tilt, float(tilt_from_quaternions(batch.quaternion).max()))
             for report in batch.health if batch is not None else []:
                 _keep_worst(worst, report)
@@ -314,4 +351,5 @@ def replay(
         stream.engine.health.last_wrong_frame_id,
         float(first_stamp) if first_stamp is not None else 0.0,
         stream.engine.error_estimate,
+        stream.engine.failure_text,
     )

@@ -32,6 +32,8 @@ class TwinStream:
         self.base: TimeBase | None = None
         self.last_outputs: OutputBatch | None = None
         self._last_ns = 0
+        self._received_ns = 0
+        """Stamp (ns) of the last sample received with a stamp (> 0), accepted or not."""
         self._held_ns = 0
         """Stamp (ns) of the sample the engine holds back (see TwinEngine.holding)."""
         self.final_report: HealthReport | None = None
@@ -52,6 +54,8 @@ class TwinStream:
                 self.engine.count("received", int(bad.sum()))
                 self.engine.count(f"rejected_{reason}", int(bad.sum()))
                 decoded = decoded.select(~bad)
+        if decoded.stamps_ns.shape[0]:
+            self._received_ns = int(decoded.stamps_ns[-1])
         if self.base is None:
             if not decoded.stamps_ns.shape[0]:
                 return []
@@ -76,8 +80,9 @@ class TwinStream:
 
     def finish(self) -> list[tuple[str, int, bytes]]:
         """The last, partial diagnostics period (end of a bag, node shutdown), stamped with the
-        last input stamp answered; nothing if that period is empty."""
+        last input stamp answered (none answered: the last received; none with a stamp: 0);
+        nothing if that period is empty."""
         report = self.final_report = self.engine.flush()
         if report is None:
             return []
-        return [encode_report(self.scene, report, self._last_ns)]
+        return [encode_report(self.scene, report, self._last_ns or self._received_ns)]

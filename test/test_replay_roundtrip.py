@@ -252,7 +252,7 @@ def test_replay_summary_reports_counts_and_real_time_factor(
     assert summary.stamp_span_s == pytest.approx(0.499, abs=1e-9)
     text = summary.text()
     assert "real-time factor" in text and "500 received, 500 accepted" in text
-    assert set(summary.peak_wrench) == {m.name for m in _scene().mounts}
+    assert set(summary.peaks) == {m.name for m in _scene().mounts}
     assert 0.0 < summary.displacement_max_m < 0.01
 
 

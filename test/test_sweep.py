@@ -93,7 +93,7 @@ def test_a_bad_case_is_a_failed_row_and_the_rest_still_run(swept) -> None:
     assert len(failed) == 4 and all(r["body.mass"] == "-5.0" for r in failed)
     assert all("body.mass" in r["error"] for r in failed)
     good = [r for r in rows if r["verdict"] != FAILED]
-    assert len(good) == 4 and all(float(r["peak_force_N.fl"]) > 1000.0 for r in good)
+    assert len(good) == 4 and all(float(r["peak_force_magnitude_N.fl"]) > 1000.0 for r in good)
     # each case's own error estimate: the pump at one step per sample is ~1e-9 off
     assert all(0.0 < float(r["est_force_error_rel"]) < 1e-6 for r in good)
 

@@ -20,8 +20,18 @@ from typing import Any
 
 import numpy as np
 
+from mount_twin.analysis.figures import (
+    DISPLACEMENT,
+    PEAK_COUPLE,
+    PEAK_FORCE,
+    displacement_from_start,
+    peak_magnitudes,
+)
+from mount_twin.engine.batch import event_level
 from mount_twin.errors import ModelError
-from mount_twin.io.output_tables import Table, read_output_bag
+from mount_twin.io.messages import WRENCH
+from mount_twin.io.output_tables import COLUMNS, Table, read_output_bag
+from mount_twin.kinds.events import EVENT_IS_ERROR
 from mount_twin.scene.description import Scene
 
 EVENT = re.compile(r"(\w+) ×(\d+) \(first (\d+\.\d+) s, \|F\| max ([\d.e+-]+) N\)")
@@ -43,10 +53,11 @@ class Event:
 
 
 def events_of(diagnostics: Table, origin_ns: int) -> list[Event]:
-    """Mount event groups named in the diagnostics messages, in time order."""
+    """Mount event groups named in the diagnostics messages, in time order; each at its own
+    kind's level (the mount status' level is that of its worst event in the period)."""
     out = []
     c = diagnostics.columns
-    for status, level, message in zip(c["status"], c["level"], c["message"], strict=True):
+    for status, message in zip(c["status"], c["message"], strict=True):
         if not status.startswith("mount_twin: mount "):
             continue
         for name, count, first, force in EVENT.findall(message):
@@ -58,7 +69,7 @@ def events_of(diagnostics: Table, origin_ns: int) -> list[Event]:
                     int(count),
                     t,
                     float(force),
-                    level,
+                    event_level(EVENT_IS_ERROR[name]),
                 )
             )
     return sorted(out, key=lambda e: e.t_s)
@@ -286,20 +297,24 @@ def write_report(
     rows = []
     for name, table in mounts.items():
         c = table.columns
-        peaks = [float(np.abs(c[k]).max()) for k in ("fx_N", "fy_N", "fz_N")]
-        u = utilisation.get(name)
+        wrenches = np.stack([c[k] for k in COLUMNS[WRENCH]], axis=1)[:, None, :]
+        (force, couple), u = peak_magnitudes(wrenches)[0], utilisation.get(name)
         rows.append(
             [
                 name,
                 kinds.get(name, ""),
-                *(f"{p:.4g}" for p in peaks),
-                f"{float(np.sqrt(c['fx_N'] ** 2 + c['fy_N'] ** 2 + c['fz_N'] ** 2).max()):.4g}",
+                f"{force:.4g}",
+                f"{couple:.4g}",
                 "n/a" if u is None else f"{float(u[1].max()):.3g}",
             ]
         )
+    if "pose" in tables:
+        position = np.stack([tables["pose"].columns[f"{a}_m"] for a in "xyz"], axis=1)
+        moved = displacement_from_start(position, position[0])
+        sections.append(f"<p>{DISPLACEMENT} (CG): {moved:.6g}</p>")
     sections += [
-        "<h2>Peaks</h2>",
-        _table(["mount", "kind", "|Fx| N", "|Fy| N", "|Fz| N", "|F| N", "utilisation max"], rows),
+        "<h2>Peaks (largest magnitude at one instant)</h2>",
+        _table(["mount", "kind", PEAK_FORCE, PEAK_COUPLE, "utilisation max"], rows),
         "<h2>Events</h2>",
         _table(
             ["time s", "mount", "event", "count in period", "|F| max N", "level"],

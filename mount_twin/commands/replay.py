@@ -18,7 +18,10 @@ FAIL_ON = ("never", "warn", "error")
 """`--fail-on` choices; the index of warn and error is their diagnostics level."""
 EXIT_STATUS = (
     "exit status: 0 done; 2 bad input or configuration, or a failed write (the message names "
-    "the file); 3 no input sample accepted; 4 diagnostics reached --fail-on; 5 input bag "
+    "the file); 3 no input sample accepted; 4 diagnostics reached --fail-on; 6 FAILED: the "
+    "integration failed at least once (the summary says how often and why), whatever "
+    "--fail-on says: after a failure the twin restarts at an equilibrium or stops following, "
+    "so its figures are no longer the motion the record drove; 5 input bag "
     "damaged part-way (the messages before the damage are replayed); 130 SIGINT (Ctrl-C), 143 "
     "SIGTERM. On 5, 130 and 143 the output bag is finished and marked partial in its metadata "
     "(custom_data mount_twin.partial: why, and up to which stamp)."
@@ -48,7 +51,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--fail-on",
         choices=FAIL_ON,
         default="never",
-        help="exit 4 if the worst diagnostics level of the run reaches this (default: never)",
+        help="exit 4 if the worst diagnostics level of the run reaches this (default: never); "
+        "a FAILED run (the integration failed) exits 6 whatever this says",
     )
 
 
@@ -110,21 +114,23 @@ def replay_and_report(
     return verdict(summary, fail_on)
 
 
+EXIT_NOTHING_ACCEPTED, EXIT_FAIL_ON, EXIT_FAILED = 3, 4, 6
+
+
 def verdict(summary: ReplaySummary, fail_on: str) -> int:
     """The exit status of a replay: 3 if no input sample was accepted (saying why: the bag
-    holds some, `InputBag` saw to it), 4 if the run's worst diagnostics level reached
-    `fail_on`, else 0."""
-    if not summary.counts.get("accepted", 0):
-        rejected = {k: v for k, v in summary.counts.items() if k.startswith("rejected_") and v}
-        why = f"{summary.counts.get('received', 0)} received, rejected: {rejected}"
-        if summary.wrong_frame_id is not None:
-            why += f"; the bag's header.frame_id is {summary.wrong_frame_id!r}: see input.frame_id"
-        print(f"mount-twin: error: no input sample was accepted ({why})", file=sys.stderr)
-        return 3
+    holds some, `InputBag` saw to it), 6 if the integration failed (FAILED), 4 if the run's
+    worst diagnostics level reached `fail_on`, else 0."""
+    if nothing := summary.nothing_accepted():
+        print(f"mount-twin: error: {nothing}", file=sys.stderr)
+        return EXIT_NOTHING_ACCEPTED
+    if summary.failure:
+        print(f"mount-twin: error: {summary.failure}", file=sys.stderr)
+        return EXIT_FAILED
     if fail_on != "never" and summary.worst_level >= FAIL_ON.index(fail_on):
         from mount_twin.engine.batch import LEVEL_NAMES
 
         level = LEVEL_NAMES[summary.worst_level]
         print(f"mount-twin: diagnostics reached {level} (--fail-on {fail_on})", file=sys.stderr)
-        return 4
+        return EXIT_FAIL_ON
     return 0

@@ -12,6 +12,10 @@ OK, WARN, ERROR = 0, 1, 2
 """Health levels, as diagnostic_msgs/DiagnosticStatus uses them."""
 LEVEL_NAMES = ("OK", "WARN", "ERROR")
 """Each health level's name, by its value."""
+FAILED = "FAILED"
+"""The verdict of a run worse than any health level: the integration failed (the twin then
+restarted or stopped following, so its figures are not the machine's), or a sweep case that
+raised."""
 
 
 @dataclass
@@ -64,6 +68,16 @@ class MountEvent:
     event: str
     force: float
     error: bool
+
+    @property
+    def level(self) -> str:
+        """The level name: ERROR or WARN."""
+        return event_level(self.error)
+
+
+def event_level(error: bool) -> str:
+    """The level name of a mount event that is an ERROR (`error`) or a WARN."""
+    return LEVEL_NAMES[ERROR if error else WARN]
 
 
 @dataclass

@@ -34,7 +34,7 @@ from mount_twin.engine.companion import Companion, new_companion, restart
 from mount_twin.engine.companion import switch as switch_companion
 from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.gyro_filter import GyroConditioner
-from mount_twin.engine.health import PLATEAU_G, SATURATION_SHARE, HealthWindow
+from mount_twin.engine.health import ENDED, PLATEAU_G, SATURATION_SHARE, HealthWindow
 from mount_twin.engine.kernel import (
     AT_EVENT,
     Integrator,
@@ -222,6 +222,8 @@ class TwinEngine:
         self._gathered: list[np.ndarray] = []
         """Specific forces (m/s², F) of the samples taken so far toward the next start."""
         self.counts: Counter[str] = Counter()
+        self.failure_causes: Counter[str] = Counter()
+        """Integration failures by cause (`STATUS_TEXT`), counts["integration_failures"] in all."""
         self.health = HealthWindow(scene, integ.method)  # `auto` until it has chosen
         self._event_meta = {
             slot: (model.scene.mounts[slot].name, KINDS[model.scene.mounts[slot].kind])
@@ -356,6 +358,19 @@ class TwinEngine:
     def error_estimate(self) -> ErrorEstimate | None:
         """The estimated error of everything published so far (None: `error_estimate` off)."""
         return None if self._companion is None else ErrorEstimate.of(self.health.estimate_run)
+
+    @property
+    def failure_text(self) -> str:
+        """How often the integration failed and why ('' if never): a run with any failure is
+        FAILED (`replay`, the sweep), whatever its diagnostics level."""
+        n = self.counts["integration_failures"]
+        if not n:
+            return ""
+        causes = ", ".join(f"{cause} ×{k}" for cause, k in self.failure_causes.most_common())
+        return (
+            f"integration failed {n} times ({causes}); {self.counts['restarts']} restarts, "
+            f"{self.counts['samples_not_followed']} samples not followed"
+        )
 
     @property
     def running(self) -> bool:
@@ -724,7 +739,9 @@ class TwinEngine:
                 continue
             segment = None  # a restart conditions the gyro rows after it afresh
             self.counts["integration_failures"] += 1
-            self.health.failure(float(t[done + 1]), STATUS_TEXT.get(status, f"status {status}"))
+            cause = STATUS_TEXT.get(status, f"status {status}")
+            self.failure_causes[cause] += 1
+            self.health.failure(float(t[done + 1]), cause)
             self._last = None
             rest = index[done + 1 :]
             if self.scene.initial.mode == "given":
@@ -762,13 +779,19 @@ class TwinEngine:
         None if nothing was processed since. Its `sample` is −1: the last accepted sample.
 
         A sample still held back (a stamp jump that no later sample confirmed) is counted as
-        rejected_unconfirmed_jump: the record ends before it can be told from a glitch.
+        rejected_unconfirmed_jump: the record ends before it can be told from a glitch. Where
+        samples were received but none ever accepted, the report (`stamp` NaN) says so at
+        ERROR, and why (`health.ENDED`).
         """
         if self._held is not None:
             self._held = None
             self.count("received")
             self.count("rejected_unconfirmed_jump")
-        if self._last_stamp is None or not self.health.pending:
+        if self._last_stamp is None:
+            if not self.counts["received"] or self.counts["accepted"]:
+                return None
+            return self._report(math.nan, -1, stalled_s=ENDED)
+        if not self.health.pending:
             return None
         return self._report(self._last_stamp, -1)
 

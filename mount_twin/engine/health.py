@@ -31,6 +31,9 @@ SATURATION_SHARE = 0.999
 PLATEAU_G = 2.0
 """A reading repeated exactly, sample after sample, beyond this many g (`InputSpec.g_scale`) is a
 plateau: a clipped or stuck sensor (real vibration never repeats to the last bit)."""
+ENDED = math.inf
+"""`HealthWindow.report`'s `stalled_s` when the input ended with no sample accepted since the
+last report (`TwinEngine.flush`)."""
 NAMED_FRAMES = 3
 """Wrong frame_ids named in a message (the rest are elided)."""
 
@@ -257,7 +260,8 @@ class HealthWindow:
         which keep the mount's level after the events themselves have been reported.
         `lost_from_stamps`, `nominal_interval_s` (s): `lost_estimate` of this window (already
         added to counts["lost_estimated"]). `stalled_s`: set by a live adapter's stall timer,
-        the clock time (s) since the last report; the input status is then an ERROR.
+        the clock time (s) since the last report, or `ENDED` when the input ended (a bag) with
+        no sample accepted since; the input status is then an ERROR.
         """
         new = counts - self._last_counts
         self._last_counts = counts.copy()
@@ -403,17 +407,20 @@ class HealthWindow:
         all_rejected = False
         if stalled_s is not None:
             level = ERROR
-            waited = _seconds(stalled_s)
+            waited = (
+                "by the end of the input" if stalled_s == ENDED else f"for {_seconds(stalled_s)}"
+            )
             if not new["received"]:
-                parts.append(f"no input received for {waited}")
+                parts.append(f"no input received {waited}")
             elif not new["accepted"]:
                 all_rejected = n_rejected > 0
                 why = ", ".join(self._reason(r, n) for r, n in new_rejected.items())
                 parts.append(
-                    f"no sample accepted for {waited}: {new['received']} received, "
+                    f"no sample accepted {waited}: {new['received']} received, "
                     + (f"all rejected ({why})" if all_rejected else "none accepted")
                 )
             else:
+                waited = _seconds(stalled_s)
                 parts.append(f"input stalled: only {new['accepted']} samples accepted in {waited}")
         for stamp, _, _, notes in self.starts:
             for note_level, text in notes:
@@ -477,7 +484,7 @@ class HealthWindow:
         }
         if counts["rejected_wrong_frame"] and self.last_wrong_frame_id is not None:
             values["last_wrong_frame_id"] = self.last_wrong_frame_id
-        if stalled_s is not None:
+        if stalled_s is not None and stalled_s != ENDED:
             values["since_last_report_s"] = f"{stalled_s:.6g}"
         if self.starts:
             _, magnitude, tilt, _ = self.starts[-1]

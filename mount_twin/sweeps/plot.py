@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from mount_twin.sweeps.runner import FAILED, columns
+from mount_twin.sweeps.runner import FAILED, columns, largest_peak_force
 from mount_twin.sweeps.spec import SweepSpec
 
 
@@ -24,7 +24,7 @@ def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> 
         if r["verdict"] == FAILED or not varied:
             continue
         label = " ".join([r["input"], *(f"{k}={r[k]}" for k in varied[1:])])
-        peak = max(float(r[f"peak_force_N.{n}"]) for n in names)
+        peak = largest_peak_force(r, names)
         lines.setdefault(label, []).append((float(r[varied[0]]), peak, r["verdict"]))
     fig, ax = plt.subplots(figsize=(8, 5))
     marks = {"OK": "o", "WARN": "s", "ERROR": "v"}

@@ -21,9 +21,13 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from mount_twin.engine.batch import LEVEL_NAMES, SampleBatch
+from mount_twin.analysis.figures import (
+    DISPLACEMENT,
+    PEAK_FORCE,
+    displacement_from_start,
+    peak_magnitudes,
+)
+from mount_twin.engine.batch import FAILED, LEVEL_NAMES, SampleBatch
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.health import tilt_from_quaternions
 from mount_twin.errors import MountTwinError
@@ -34,7 +38,6 @@ from mount_twin.scene.loader import scene_from_dict
 from mount_twin.sweeps.cases import Case, apply, expand
 from mount_twin.sweeps.spec import InputCase, SweepSpec
 
-FAILED = "FAILED"
 BATCHES_PER_WORKER = 4
 """Tasks per worker a sweep is cut into: few enough to share the scheduling cost, enough to
 balance the load and to report progress."""
@@ -51,12 +54,12 @@ def columns(spec: SweepSpec) -> list[str]:
         *(v.key if v.op == "set" else f"{v.key} (scale)" for v in spec.variations),
         "verdict",
         "error",
-        *(f"peak_force_N.{n}" for n in names),
+        *(f"{PEAK_FORCE}.{n}" for n in names),
         *(f"utilisation.{n}" for n in names),
         "events",
         "first_event",
         "first_event_s",
-        "max_displacement_m",
+        DISPLACEMENT,
         "max_tilt_rad",
         "est_force_error_rel",
         "wall_s",
@@ -119,19 +122,19 @@ def _figures(scene: Scene, samples: SampleBatch) -> dict[str, Any]:
     if final is not None:
         reports.append(final)
     worst = max((s.level for r in reports for s in r.statuses), default=0)
-    force = np.linalg.norm(out.wrenches[:, :, :3], axis=2).max(axis=0) if len(out) else None
+    force = peak_magnitudes(out.wrenches)[:, 0] if len(out) else None
     util = engine.utilisation_max
     first = engine.events[0] if engine.events else None
     position = out.pose[:, pose_row.POSITION_COLS]
     row: dict[str, Any] = {
-        "verdict": LEVEL_NAMES[worst],
-        "error": "",
+        # FAILED: its figures are not the machine's (`engine.failure_text`), and stay out of
+        # the summary's lowest and highest
+        "verdict": FAILED if engine.failure_text else LEVEL_NAMES[worst],
+        "error": engine.failure_text,
         "events": engine.counts["mount_events"],
         "first_event": f"{first.mount}:{first.event}" if first else "",
         "first_event_s": first.stamp - float(samples.stamps[0]) if first else math.nan,
-        "max_displacement_m": float(np.abs(position - position[0]).max())
-        if len(out)
-        else math.nan,
+        DISPLACEMENT: displacement_from_start(position, position[0]) if len(out) else math.nan,
         "max_tilt_rad": float(tilt_from_quaternions(out.quaternion).max())
         if len(out)
         else math.nan,
@@ -141,7 +144,7 @@ def _figures(scene: Scene, samples: SampleBatch) -> dict[str, Any]:
         else math.nan,
     }
     for i, m in enumerate(scene.mounts):
-        row[f"peak_force_N.{m.name}"] = float(force[i]) if force is not None else math.nan
+        row[f"{PEAK_FORCE}.{m.name}"] = float(force[i]) if force is not None else math.nan
         row[f"utilisation.{m.name}"] = util.get(m.name, math.nan)
     return row
 
@@ -212,6 +215,16 @@ def run_sweep(
 def _appender(path: Path, head: list[str]) -> Iterator[Callable[[dict[str, Any]], None]]:
     """Append rows to a CSV (header written if the file is new), flushed row by row."""
     new = not path.exists() or path.stat().st_size == 0
+    if not new:
+        with path.open(encoding="utf-8", newline="") as fh:
+            had = next(csv.reader(fh), [])
+        if had != head:
+            msg = (
+                f"{path}: its columns are not this sweep's (another sweep, or an older "
+                f"mount_twin's column names); missing {sorted(set(head) - set(had))}, not "
+                f"ours {sorted(set(had) - set(head))}: write to a new file"
+            )
+            raise MountTwinError(msg)
     with path.open("a", encoding="utf-8", newline="") as fh:
         writer = csv.DictWriter(fh, head, extrasaction="raise")
         if new:
@@ -234,6 +247,11 @@ def read_results(results: str | Path) -> list[dict[str, str]]:
         return list(csv.DictReader(fh))
 
 
+def largest_peak_force(row: dict[str, Any], mounts: list[str]) -> float:
+    """The largest of a row's peak mount forces |F| (N)."""
+    return max(float(row[f"{PEAK_FORCE}.{n}"]) for n in mounts)
+
+
 def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
     """The verdict counts, and the cases of the lowest and highest peak mount force."""
     rows = list(rows)
@@ -247,7 +265,7 @@ def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
     if done:
 
         def peak(r: dict[str, Any]) -> float:
-            return max(float(r[f"peak_force_N.{n}"]) for n in names)
+            return largest_peak_force(r, names)
 
         for label, r in (("lowest", min(done, key=peak)), ("highest", max(done, key=peak))):
             setting = ", ".join(f"{k} = {r[k]}" for k in varied)

@@ -1,0 +1,178 @@
+"""A failed run looks failed: integration failure is its own verdict (FAILED, exit 6, a FAILED
+sweep row out of the sweep's lowest/highest); a replay that accepted nothing says so, at ERROR,
+in its summary and its output bag; and the peak figures have one definition each, the same in
+the summary's JSON, the report and the sweep, checked against the output bag's own messages."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from io_helpers import CONFIG, ROOT, read_bag
+
+from mount_twin.cli import main
+from mount_twin.scene.loader import read_scene_yaml
+from mount_twin.sweeps.cases import check
+from mount_twin.sweeps.runner import FAILED, run_case, summary
+from mount_twin.sweeps.spec import load_sweep
+
+PUMP = CONFIG / "pump_8_mounts.scene.yaml"
+GENSET = CONFIG / "genset_bolted_keyed.scene.yaml"
+SHOCK = ROOT / "bags" / "half_sine_shock_10khz"
+GENSET_BAG = ROOT / "bags" / "genset_shock_10khz"
+FAILING = {"method": "dopri54", "rtol": 1.0e-13, "atol": 1.0e-15, "max_substeps": 1}
+"""An integration that cannot meet its tolerance in one substep through the shock."""
+
+
+def _failing_scene(tmp_path: Path) -> Path:
+    data = read_scene_yaml(PUMP)
+    data["integration"] = {**data["integration"], **FAILING}
+    path = tmp_path / "failing.scene.yaml"
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    return path
+
+
+def _replay(tmp_path: Path, scene: Path, bag: Path, *extra: str) -> tuple[int, dict, Path]:
+    out, doc = tmp_path / "out", tmp_path / "summary.json"
+    args = ["replay", str(bag), "--scene", str(scene), "-o", str(out), "--no-progress"]
+    code = main([*args, "--json", str(doc), *extra])
+    return code, json.loads(doc.read_text(encoding="utf-8")), out
+
+
+def test_a_replay_whose_integration_fails_is_failed_with_its_count_and_cause(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, doc, out = _replay(tmp_path, _failing_scene(tmp_path), SHOCK, "--fail-on", "never")
+    assert code == 6, "a failed integration must not exit 0, whatever --fail-on says"
+    n = doc["counts"]["integration_failures"]
+    # each failing sample has no output (the twin restarts at the next one)
+    published = len(read_bag(out)[1]["/mount_twin/pose"])
+    assert n == len(read_bag(SHOCK)[1]["/deck/imu"]) - published > 0
+    assert doc["verdict"] == FAILED
+    assert f"integration failed {n} times" in doc["failure"]
+    assert "too many substeps in one input interval" in doc["failure"]
+    out, err = capsys.readouterr()
+    assert f"FAILED: integration failed {n} times" in out and "verdict: FAILED" in out
+    assert "too many substeps" in err
+    help_text = _help(capsys)
+    assert "6 FAILED" in help_text
+
+
+def _help(capsys: pytest.CaptureFixture[str]) -> str:
+    with pytest.raises(SystemExit):
+        main(["replay", "--help"])
+    return " ".join(capsys.readouterr().out.split())
+
+
+def test_a_sweep_case_whose_integration_fails_is_a_failed_row_out_of_the_extremes(
+    tmp_path: Path,
+) -> None:
+    sweep = tmp_path / "sweep.yaml"
+    sweep.write_text(
+        f"base: {PUMP}\ncombine: zip\nvary:\n"
+        "  - key: integration.max_substeps\n    values: [1, 10000]\n"
+        "  - key: integration.rtol\n    values: [1.0e-13, 1.0e-6]\n"
+        "  - key: integration.method\n    values: [dopri54, auto]\n"
+        "  - key: integration.atol\n    values: [1.0e-15, 1.0e-9]\n"
+        f"inputs:\n  - bag: {SHOCK}\n",
+        encoding="utf-8",
+    )
+    spec = load_sweep(sweep)
+    rows = [run_case(spec.base, spec.source, case) for case in check(spec)]
+    failed = [r for r in rows if r["integration.max_substeps"] == "1"]
+    (bad,) = failed
+    assert bad["verdict"] == FAILED
+    assert "integration failed" in bad["error"] and "too many substeps" in bad["error"]
+    (good,) = [r for r in rows if r is not bad]
+    assert good["verdict"] != FAILED and good["error"] == ""
+    text = summary(rows, spec)
+    assert f"{FAILED} 1" in text
+    assert text.count(good["case"]) == 2 and bad["case"] not in text
+
+
+def test_a_replay_that_accepted_nothing_says_so_at_error_in_its_summary_and_bag(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, doc, out = _replay(tmp_path, PUMP, SHOCK, "--frame-id", "not_the_imu")
+    assert code == 3
+    n_in = len(read_bag(SHOCK)[1]["/deck/imu"])
+    assert doc["counts"]["received"] == doc["counts"]["rejected_wrong_frame"] == n_in
+    assert doc["verdict"] == "ERROR" and "no input sample was accepted" in doc["nothing_accepted"]
+    text = capsys.readouterr().out
+    assert f"no input sample was accepted ({n_in} received" in text
+    assert "worst over the run: OK" not in text and "worst over the run: ERROR" in text
+    _, msgs = read_bag(out)
+    (report,) = [m for _, m in msgs["/diagnostics"]]
+    (status,) = [s for s in report.status if s.name == "mount_twin: input"]
+    assert status.level == 2, status
+    assert f"no sample accepted by the end of the input: {n_in} received, all rejected" in (
+        status.message
+    )
+
+
+@pytest.mark.parametrize(
+    ("scene_file", "bag", "differs"),
+    [(GENSET, GENSET_BAG, "extremes"), (PUMP, SHOCK, "sag")],
+    ids=["genset", "pump"],
+)
+def test_peak_force_and_displacement_are_one_definition_in_json_report_and_sweep(
+    tmp_path: Path, scene_file: Path, bag: Path, differs: str
+) -> None:
+    """Peak |F|: the largest magnitude of a mount's force at one instant (the genset's
+    per-component extremes make a larger vector: no force that acted); displacement: of the
+    CG from its first published position (the start's static equilibrium), not from the
+    scene's undeformed cg (which would count the pump's static sag)."""
+    code, doc, out = _replay(tmp_path, scene_file, bag)
+    assert code == 0
+    _, msgs = read_bag(out)
+    scene = read_scene_yaml(scene_file)
+    peak, of_extremes = {}, {}
+    for mount in (m["name"] for m in scene["mounts"]):
+        f = np.array(
+            [
+                [m.wrench.force.x, m.wrench.force.y, m.wrench.force.z]
+                for _, m in msgs[f"/mount_twin/mounts/{mount}/wrench"]
+            ]
+        )
+        peak[mount] = float(np.sqrt((f**2).sum(axis=1)).max())
+        assert doc["mounts"][mount]["peak_force_magnitude_N"] == pytest.approx(
+            peak[mount], rel=1e-12
+        )
+        of_extremes[mount] = float(np.linalg.norm(np.abs(f).max(axis=0)))
+    # the per-component extremes come at different times: a vector of them is no force
+    if differs == "extremes":
+        assert any(of_extremes[m] > peak[m] * 1.01 for m in peak), (of_extremes, peak)
+    p = np.array(
+        [
+            [m.pose.position.x, m.pose.position.y, m.pose.position.z]
+            for _, m in msgs["/mount_twin/pose"]
+        ]
+    )
+    moved = float(np.sqrt(((p - p[0]) ** 2).sum(axis=1)).max())
+    assert doc["max_cg_displacement_from_start_m"] == pytest.approx(moved, rel=1e-12)
+    if differs == "sag":
+        sag = float(np.linalg.norm(p[0] - np.array(scene["body"]["cg"])))
+        assert sag > 1e-3, "the pump sags on its rubber mounts"
+
+    page = tmp_path / "r.html"
+    assert main(["report", str(out), "-o", str(page)]) == 0
+    html = page.read_text(encoding="utf-8")
+    assert f"max_cg_displacement_from_start_m (CG): {moved:.6g}" in html
+    for mount, value in peak.items():
+        assert f"<td>{mount}</td><td></td><td>{value:.4g}</td>" in html
+
+    sweep = tmp_path / "sweep.yaml"
+    sweep.write_text(
+        f"base: {scene_file}\nvary:\n  - key: body.mass\n    values: [{scene['body']['mass']}]\n"
+        f"inputs:\n  - bag: {bag}\n",
+        encoding="utf-8",
+    )
+    spec = load_sweep(sweep)
+    (case,) = check(spec)
+    row = run_case(spec.base, spec.source, case)
+    assert row["max_cg_displacement_from_start_m"] == pytest.approx(moved, rel=1e-9)
+    for mount, value in peak.items():
+        assert row[f"peak_force_magnitude_N.{mount}"] == pytest.approx(value, rel=1e-9)
