@@ -71,26 +71,29 @@ def _damaged_count(err: str) -> int:
 # --------------------------------------------------------------------------- stamps before 1970
 
 
-def test_a_negative_stamp_is_rejected_and_counted_and_never_reaches_the_output(
+def test_negative_and_zero_stamps_are_rejected_and_counted_and_never_reach_the_output(
     ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """sec = -5 on the first message (the one /tf_static used to be stamped with) and on
-    another: each is counted, the replay goes on, and every output stamp is one taken."""
+    another, and an unset stamp (0) on a third, in one chunk: each is counted, the replay goes
+    on, and every output stamp is one taken (a zero with a negative stamp failed the replay)."""
     msgs = read_raw(ship["mcap"], ["/deck/imu"])["/deck/imu"][:500]
-    for k in (0, 100):
+    for k, sec in ((0, -5), (100, -5), (200, 0)):
         m: Any = TYPESTORE.deserialize_cdr(msgs[k][1], IMU)
-        m.header.stamp.sec = -5
+        m.header.stamp.sec = sec
+        m.header.stamp.nanosec = 0
         msgs[k] = (msgs[k][0], bytes(TYPESTORE.serialize_cdr(m, IMU)))
     bag = tmp_path / "negative"
     write_bag(bag, "/deck/imu", IMU, iter(msgs))
     out = tmp_path / "out"
     assert _replay(bag, out) == 0
-    assert "'rejected_negative_stamp': 2" in capsys.readouterr().out
+    summary = capsys.readouterr().out
+    assert "'rejected_zero_stamp': 1" in summary and "'rejected_negative_stamp': 2" in summary
     _, got = read_bag(out)
     ((static_time, static),) = got["/tf_static"]
     first = stamp_ns(TYPESTORE.deserialize_cdr(msgs[1][1], IMU))
     assert static_time == stamp_ns(static.transforms[0]) == first
-    assert len(got[POSES]) == 498 and min(t for t, _ in got[POSES]) == first
+    assert len(got[POSES]) == 497 and min(t for t, _ in got[POSES]) == first
     assert _partial(out) == ""
 
 
