@@ -56,7 +56,7 @@ def streams(draw: st.DrawFn) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[s
         elif what == "duplicate" and at > 0:
             stamps[at] = stamps[at - 1]
         elif what == "glitch":
-            stamps[at] += draw(st.sampled_from([0.05, 0.3, 0.99, 2.5]))
+            stamps[at] += draw(st.sampled_from([0.003, 0.018, 0.05, 0.3, 0.99, 2.5]))
         elif what == "jump_huge":
             stamps[at:] += 1e6
         elif what == "burst":
