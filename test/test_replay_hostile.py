@@ -8,6 +8,7 @@ the --topic/--frame-id overrides in test_replay_inputs.py.
 from __future__ import annotations
 
 import shutil
+import struct
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -227,6 +228,36 @@ def test_an_sqlite3_bag_cut_short_replays_its_readable_rows_then_exits_5(
     assert [t for t, _ in got[POSES]] == want
 
 
+def _sqlite_header(page_size: int, pages: int) -> Callable[[bytes], bytes]:
+    """An edit setting an sqlite file's header page size (1: 65536) and page count."""
+
+    def edit(data: bytes) -> bytes:
+        out = bytearray(data)
+        struct.pack_into(">H", out, 16, page_size)
+        struct.pack_into(">I", out, 28, pages)
+        return bytes(out)
+
+    return edit
+
+
+def test_an_sqlite3_header_giving_a_huge_size_costs_no_memory(
+    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Without metadata.yaml (so salvaged row by row), a header saying 64 GiB replays whole,
+    one saying 256 TiB (no file system holds it) is an error naming the file: the salvage
+    asked for that memory (a MemoryError traceback)."""
+    bag = _edited_copy(ship["sqlite3"], tmp_path / "big", _sqlite_header(4096, 1 << 24))
+    (bag / "metadata.yaml").unlink()
+    assert _replay(bag, tmp_path / "out") == 0
+    assert len(read_bag(tmp_path / "out")[1][POSES]) == N
+    bag = _edited_copy(ship["sqlite3"], tmp_path / "huge", _sqlite_header(1, (1 << 32) - 1))
+    (bag / "metadata.yaml").unlink()
+    assert _replay(bag, tmp_path / "out2") == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"mount-twin: error: {bag}: cannot open bag") and ".db3: " in err
+    assert not (tmp_path / "out2").exists()
+
+
 @pytest.mark.parametrize(
     ("make", "said"),
     [
@@ -237,8 +268,12 @@ def test_an_sqlite3_bag_cut_short_replays_its_readable_rows_then_exits_5(
             lambda p: (p.mkdir(), (p / "x.db3").write_bytes(b"not sqlite" * 100)),
             "no message of /deck/imu comes before its damage (",
         ),
+        (  # a recorder killed before its first write: a MemoryError traceback before
+            lambda p: (p.mkdir(), (p / "x.db3").write_bytes(b"")),
+            "x.db3: empty file (0 bytes)",
+        ),
     ],
-    ids=["missing", "empty", "no-bag-files", "not-sqlite"],
+    ids=["missing", "empty", "no-bag-files", "not-sqlite", "empty-db3"],
 )
 def test_what_is_no_bag_is_an_error_saying_why(
     tmp_path: Path,
