@@ -24,7 +24,7 @@ from rosbags.typesys import Stores, get_typestore
 from mount_twin.cli import main
 from mount_twin.errors import BagError
 from mount_twin.io.bag import PARTIAL_KEY, InputBag, OutputBag, write_bag
-from mount_twin.io.messages import IMU, POSE, TYPESTORE
+from mount_twin.io.messages import IMU, POSE, TYPESTORE, imu_messages
 from mount_twin.replay import replay
 
 N = 5000  # messages of a 5 s ship-motion bag at 1 kHz
@@ -287,6 +287,37 @@ def test_what_is_no_bag_is_an_error_saying_why(
     err = capsys.readouterr().err
     assert err.startswith(f"mount-twin: error: {bag}: cannot open bag") and said in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_scene_beyond_the_size_limit_is_an_error_naming_it(
+    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--scene /dev/zero was read whole (a MemoryError traceback)."""
+    out = tmp_path / "out"
+    run = ["replay", str(ship["mcap"]), "--scene", "/dev/zero", "-o", str(out), "--no-progress"]
+    assert main(run) == 2
+    err = capsys.readouterr().err
+    assert "/dev/zero: <file>: cannot read: larger than 16 MiB" in err
+    assert "SCENE_MAX_BYTES" in err and not out.exists()
+
+
+def test_messages_of_1_mb_frame_ids_are_read_in_bounded_chunks(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """2000 of them made one 2 GB chunk (a MemoryError traceback): chunks stop at
+    CHUNK_MAX_BYTES, and the frame id the error names is cut short."""
+    n, frame = 40, "f" * (1 << 20)
+    stamps = 1_700_000_000_000_000_000 + np.arange(n, dtype=np.int64) * 1_000_000
+    msgs = imu_messages(stamps, np.tile([0.0, 0.0, 9.81], (n, 1)), np.zeros((n, 3)), frame)
+    bag = tmp_path / "frames"
+    write_bag(bag, "/deck/imu", IMU, iter(msgs))
+    with InputBag(bag, "/deck/imu", IMU) as reading:
+        sizes = [len(c) for c in reading.chunks(2000)]
+    assert sizes == [32, 8]  # 32 MiB of 1 MiB messages, then the rest
+    assert _replay(bag, tmp_path / "out") == 3
+    err = capsys.readouterr().err
+    assert "rejected: {'rejected_wrong_frame': 40}; the bag's header.frame_id is 'fff" in err
+    assert len(err) < 1000
 
 
 # --------------------------------------------------------------------------- topics, ROS 1

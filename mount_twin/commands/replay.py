@@ -118,7 +118,10 @@ def verdict(summary: ReplaySummary, fail_on: str) -> int:
         rejected = {k: v for k, v in summary.counts.items() if k.startswith("rejected_") and v}
         why = f"{summary.counts.get('received', 0)} received, rejected: {rejected}"
         if summary.wrong_frame_id is not None:
-            why += f"; the bag's header.frame_id is {summary.wrong_frame_id!r}: see input.frame_id"
+            from mount_twin.scene.reader import shown
+
+            frame = shown(summary.wrong_frame_id)
+            why += f"; the bag's header.frame_id is {frame}: see input.frame_id"
         print(f"mount-twin: error: no input sample was accepted ({why})", file=sys.stderr)
         return 3
     if fail_on != "never" and summary.worst_level >= FAIL_ON.index(fail_on):

@@ -123,14 +123,15 @@ class InputBag:
         self.ros1 = False
 
     def chunks(self, size: int) -> Iterator[list[bytes]]:
-        """Raw messages of the topic in log-time order, `size` at a time. From a damaged bag,
+        """Raw messages of the topic in log-time order, `size` at a time, fewer where they
+        reach CHUNK_MAX_BYTES (1 MB frame ids: 2 GB a chunk). From a damaged bag,
         those before the damage, then DamagedBagError saying how many and up to which log
         time."""
         if self._salvage is not None:
             yield from self._salvaged_chunks(self._salvage, 0, size)
             return
         chunk: list[bytes] = []
-        read, last = 0, None
+        read, last, held = 0, None, 0
         messages = self._reader.messages(connections=self._conns)
         while True:
             try:
@@ -149,10 +150,10 @@ class InputBag:
                 )
                 raise DamagedBagError(msg) from err
             chunk.append(self._ros1_to_cdr(raw) if self.ros1 else raw)
-            read, last = read + 1, log_time
-            if len(chunk) == size:
+            read, last, held = read + 1, log_time, held + len(raw)
+            if len(chunk) == size or held >= CHUNK_MAX_BYTES:
                 yield chunk
-                chunk = []
+                chunk, held = [], 0
         if chunk:
             yield chunk
         if read < self.count:  # records lost without an error: zeroed or overwritten bytes
@@ -228,6 +229,8 @@ def _up_to(log_time_ns: int | None) -> str:
     return "" if log_time_ns is None else f" (up to log time {log_time_ns} ns)"
 
 
+CHUNK_MAX_BYTES = 32 << 20
+"""Most bytes of raw messages in one chunk (2000 Imu messages with short frame ids: 0.7 MB)."""
 STORAGE_SUFFIXES = (".mcap", ".db3")
 """rosbag2 storage files that can be read without the bag's metadata.yaml."""
 

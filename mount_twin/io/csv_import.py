@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from mount_twin.io.signals import Signal
+from mount_twin.textfiles import MIB, FileTooLargeError, read_limited
 
 G = 9.80665
 ROLES = ("t", "ax", "ay", "az", "wx", "wy", "wz")
@@ -59,6 +60,11 @@ class CsvFormat:
     units: dict[str, str] = field(default_factory=dict)
 
 
+CSV_MAX_BYTES = 256 * MIB
+"""Largest CSV imported: ~2.5 million rows of seven columns (45 min at 1 kHz); reading one
+takes some 10 times its size in memory."""
+
+
 @dataclass(frozen=True)
 class Imported:
     """The signal read, and what was assumed or found, to tell the user (`notes`)."""
@@ -75,7 +81,10 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     """Read a recorder's CSV (see the module docstring); every error names file, row, column."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8-sig")  # utf-8-sig drops a byte-order mark
+        # utf-8-sig drops a byte-order mark
+        text = read_limited(path, CSV_MAX_BYTES, "CSV_MAX_BYTES", "utf-8-sig")
+    except FileTooLargeError as err:
+        raise _fail(path, "<file>", f"cannot read: {err}") from err
     except OSError as err:
         raise _fail(path, "<file>", f"cannot read: {err.strerror}") from err
     except UnicodeDecodeError as err:

@@ -31,6 +31,7 @@ from mount_twin.scene.description import (
 )
 from mount_twin.scene.reader import Reader, shown
 from mount_twin.scene.yaml_reading import SceneYamlError, load_yaml
+from mount_twin.textfiles import MIB, FileTooLargeError, read_limited
 
 INPUT_TYPES = ("sensor_msgs/msg/Imu", "geometry_msgs/msg/AccelStamped")
 START_TILT_MAX_RAD = 1.55
@@ -50,6 +51,8 @@ node's namespace and name, must stay within TOPIC_MAX_CHARS)."""
 TOPIC_MAX_CHARS = 247
 """Longest ROS 2 topic name (rmw: 255 less 8 reserved for the DDS prefix)."""
 STEPPERS = (AUTO, *METHODS)
+SCENE_MAX_BYTES = 16 * MIB
+"""Largest scene, parameter or sweep YAML file read (the bundled scenes are < 10 kB)."""
 
 
 def load_scene_file(path: str | Path) -> Scene:
@@ -62,7 +65,9 @@ def read_scene_yaml(path: str | Path) -> Any:
     """The YAML document of a scene file, unvalidated; errors name the file."""
     path = Path(path)
     try:
-        return load_yaml(path.read_text(encoding="utf-8"))
+        return load_yaml(read_limited(path, SCENE_MAX_BYTES, "SCENE_MAX_BYTES"))
+    except FileTooLargeError as err:
+        raise SceneError(str(path), "<file>", f"cannot read: {err}") from err
     except OSError as err:
         raise SceneError(str(path), "<file>", f"cannot read: {err.strerror}") from err
     except UnicodeDecodeError as err:
