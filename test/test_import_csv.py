@@ -60,6 +60,10 @@ def test_a_column_mapping_and_unit_overrides(tmp_path: Path) -> None:
     [
         ("t,ax,ay,az\n0,1,2,3\n0.1,1,,3\n", "row 3, column ay: '' is not a number"),
         ("t,ax,ay,az\n0,1,2,3\n0.1,1,nan,3\n", "row 3, column ay: 'nan' is not finite"),
+        (
+            "t,ax [g],ay,az\n0,1,2,3\n0.1,1e308,0,3\n",
+            "row 3, column ax: '1e308' is beyond a float in SI units (×9.80665)",
+        ),
         ("# c\nt,ax,ay,az\n0,1,2,3\n0,1,2,3\n", "row 4, column t: time does not increase"),
         ("t,ax,ay,az\n0,1,2,3\n0.1,1,2\n", "row 3: 3 cells where the header has 4"),
         ("time,a,b,c\n0,1,2,3\n", "row 1: no column for ax, ay, az: the header has time, a, b, c"),

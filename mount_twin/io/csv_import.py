@@ -136,6 +136,9 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
             if not math.isfinite(v):
                 raise _fail(path, f"row {row}, column {names[col]}", f"{cell!r} is not finite")
             values[i, j] = v * scale[role]
+            if not math.isfinite(values[i, j]):  # 1e308 g: finite, but not in m/s²
+                what = f"{cell!r} is beyond a float in SI units (×{scale[role]:g})"
+                raise _fail(path, f"row {row}, column {names[col]}", what)
     t = values[:, 0]
     back = np.flatnonzero(np.diff(t) <= 0.0)
     if back.size:
