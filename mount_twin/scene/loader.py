@@ -255,7 +255,8 @@ def topic_name_problem(name: str) -> str:
 
 
 def _frame_id(r: Reader, key: str, default: str, *, empty_ok: bool = False) -> str:
-    """A tf2 frame id: no whitespace, no leading '/' (empty only where it means 'any')."""
+    """A tf2 frame id the twin publishes: no whitespace, no leading '/' (empty only where
+    `empty_ok`: a mount frame prefix)."""
     frame = r.string(key, default)
     if (not frame and not empty_ok) or any(c.isspace() for c in frame) or frame.startswith("/"):
         raise r.error(
@@ -265,12 +266,21 @@ def _frame_id(r: Reader, key: str, default: str, *, empty_ok: bool = False) -> s
     return frame
 
 
+def _header_frame_id(r: Reader, key: str, default: str) -> str:
+    """A frame id the input's header.frame_id is compared with, as its sensor writes it: no
+    whitespace; empty for any; a leading '/' is ROS 1's (a bag from there says '/imu')."""
+    frame = r.string(key, default)
+    if any(c.isspace() for c in frame):
+        raise r.error(key, f"{shown(frame)} is not a frame id (it has whitespace)")
+    return frame
+
+
 def _input(r: Reader) -> InputSpec:
     d = InputSpec()
     spec = InputSpec(
         msg_type=r.choice("msg_type", INPUT_TYPES, d.msg_type),
         topic=_topic(r, "topic", d.topic),
-        frame_id=_frame_id(r, "frame_id", d.frame_id, empty_ok=True),
+        frame_id=_header_frame_id(r, "frame_id", d.frame_id),
         sensor_rpy=_angles(r, "sensor_rpy", d.sensor_rpy),
         sensor_position=_position(r, "sensor_position", d.sensor_position),
         includes_gravity=r.boolean("includes_gravity", d.includes_gravity),
