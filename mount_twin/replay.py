@@ -130,7 +130,10 @@ class ReplaySummary:
             return ""
         why = f"{self.counts.get('received', 0)} received, rejected: {self._rejected()}"
         if self.wrong_frame_id is not None:
-            why += f"; the bag's header.frame_id is {self.wrong_frame_id!r}: see input.frame_id"
+            from mount_twin.scene.reader import shown  # a 1 MB frame id, shortened
+
+            frame = shown(self.wrong_frame_id)
+            why += f"; the bag's header.frame_id is {frame}: see input.frame_id"
         return f"no input sample was accepted ({why})"
 
     def _rejected(self) -> dict[str, int]:

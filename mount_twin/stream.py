@@ -46,6 +46,7 @@ class TwinStream:
             self.engine.count("rejected_undecodable", decoded.undecodable)
         # An unset header.stamp has no time to place the sample at; one before 1970 (sec < 0,
         # which builtin_interfaces/Time allows) cannot be written to a bag or answered.
+        # Both masks are taken before either selects: each is of the messages as decoded.
         for reason, bad in (
             ("zero_stamp", decoded.stamps_ns == 0),
             ("negative_stamp", decoded.stamps_ns < 0),
@@ -53,7 +54,8 @@ class TwinStream:
             if bad.any():
                 self.engine.count("received", int(bad.sum()))
                 self.engine.count(f"rejected_{reason}", int(bad.sum()))
-                decoded = decoded.select(~bad)
+        if (decoded.stamps_ns <= 0).any():
+            decoded = decoded.select(decoded.stamps_ns > 0)
         if decoded.stamps_ns.shape[0]:
             self._received_ns = int(decoded.stamps_ns[-1])
         if self.base is None:

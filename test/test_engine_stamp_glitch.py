@@ -34,12 +34,13 @@ def _rows(outs: list[OutputBatch]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     )
 
 
-@pytest.mark.parametrize("jump_s", [0.3, 0.99, 2.5])
+@pytest.mark.parametrize("jump_s", [0.003, 0.018, 0.3, 0.99, 2.5])
 def test_a_glitched_stamp_costs_one_sample_and_the_rest_is_as_if_it_were_absent(
     jump_s: float,
 ) -> None:
-    """0.3 s (within max_gap_s), 0.99 s (a gap) and 2.5 s (a gap, and further than
-    back_jump_reset_s): before, 299 and 989 valid samples were dropped or restarted."""
+    """3 and 18 intervals, 0.3 s (within max_gap_s), 0.99 s (a gap) and 2.5 s (a gap, and
+    further than back_jump_reset_s): before, 2, 17, 299 and 989 valid samples were dropped or
+    restarted."""
     glitched = STAMPS.copy()
     glitched[K] += jump_s
     engine, outs = _push_all(glitched)

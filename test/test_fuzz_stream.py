@@ -56,7 +56,7 @@ def streams(draw: st.DrawFn) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[s
         elif what == "duplicate" and at > 0:
             stamps[at] = stamps[at - 1]
         elif what == "glitch":
-            stamps[at] += draw(st.sampled_from([0.05, 0.3, 0.99, 2.5]))
+            stamps[at] += draw(st.sampled_from([0.003, 0.018, 0.05, 0.3, 0.99, 2.5]))
         elif what == "jump_huge":
             stamps[at:] += 1e6
         elif what == "burst":
@@ -110,11 +110,15 @@ def test_any_stream_is_accounted_finite_and_batching_invariant(case) -> None:
         max_size=25,
     ),
     st.lists(st.integers(1, 50), min_size=1, max_size=6),
+    st.lists(st.tuples(st.integers(0, 399), st.sampled_from([0, -5_000_000_000])), max_size=4),
 )
-def test_damaged_cdr_bytes_are_counted_never_raised(damage, sizes) -> None:
+def test_damaged_cdr_bytes_are_counted_never_raised(damage, sizes, unset_stamps) -> None:
+    """Bytes damaged, and stamps unset (0) or before 1970, in any mix within one message batch."""
     scene = default_scene()
     n = 400
     stamps_ns = 1_700_000_000_000_000_000 + np.arange(n, dtype=np.int64) * 1_000_000
+    for at, stamp in unset_stamps:
+        stamps_ns[at] = stamp
     raws = [
         bytearray(raw)
         for _, raw in imu_messages(

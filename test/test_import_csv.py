@@ -60,6 +60,10 @@ def test_a_column_mapping_and_unit_overrides(tmp_path: Path) -> None:
     [
         ("t,ax,ay,az\n0,1,2,3\n0.1,1,,3\n", "row 3, column ay: '' is not a number"),
         ("t,ax,ay,az\n0,1,2,3\n0.1,1,nan,3\n", "row 3, column ay: 'nan' is not finite"),
+        (
+            "t,ax [g],ay,az\n0,1,2,3\n0.1,1e308,0,3\n",
+            "row 3, column ax: '1e308' is beyond a float in SI units (×9.80665)",
+        ),
         ("# c\nt,ax,ay,az\n0,1,2,3\n0,1,2,3\n", "row 4, column t: time does not increase"),
         ("t,ax,ay,az\n0,1,2,3\n0.1,1,2\n", "row 3: 3 cells where the header has 4"),
         ("time,a,b,c\n0,1,2,3\n", "row 1: no column for ax, ay, az: the header has time, a, b, c"),
@@ -95,3 +99,19 @@ def test_the_bundled_sample_imports_and_replays_through_the_default_scene(
     scene = str(CONFIG / "pump_8_mounts.scene.yaml")
     assert main(["replay", str(bag), "--scene", scene, "-o", str(out), "--no-progress"]) == 0
     assert "1000 received, 1000 accepted" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("sparse", [False, True], ids=["dev-zero", "sparse-2GB"])
+def test_a_file_beyond_the_size_limit_is_an_error_naming_it_read_no_further(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], sparse: bool
+) -> None:
+    """/dev/zero and a 2 GB sparse file were read whole (a MemoryError traceback)."""
+    path = Path("/dev/zero")
+    if sparse:
+        path = tmp_path / "sparse.csv"
+        with path.open("wb") as fh:
+            fh.truncate(2 << 30)
+    assert main(["import-csv", str(path), "-o", str(tmp_path / "bag")]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}: <file>: cannot read: larger than 256 MiB" in err and "CSV_MAX_BYTES" in err
+    assert not (tmp_path / "bag").exists()

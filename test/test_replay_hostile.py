@@ -8,6 +8,7 @@ the --topic/--frame-id overrides in test_replay_inputs.py.
 from __future__ import annotations
 
 import shutil
+import struct
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -23,7 +24,7 @@ from rosbags.typesys import Stores, get_typestore
 from mount_twin.cli import main
 from mount_twin.errors import BagError
 from mount_twin.io.bag import PARTIAL_KEY, InputBag, OutputBag, write_bag
-from mount_twin.io.messages import IMU, POSE, TYPESTORE
+from mount_twin.io.messages import IMU, POSE, TYPESTORE, imu_messages
 from mount_twin.replay import replay
 
 N = 5000  # messages of a 5 s ship-motion bag at 1 kHz
@@ -71,26 +72,29 @@ def _damaged_count(err: str) -> int:
 # --------------------------------------------------------------------------- stamps before 1970
 
 
-def test_a_negative_stamp_is_rejected_and_counted_and_never_reaches_the_output(
+def test_negative_and_zero_stamps_are_rejected_and_counted_and_never_reach_the_output(
     ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """sec = -5 on the first message (the one /tf_static used to be stamped with) and on
-    another: each is counted, the replay goes on, and every output stamp is one taken."""
+    another, and an unset stamp (0) on a third, in one chunk: each is counted, the replay goes
+    on, and every output stamp is one taken (a zero with a negative stamp failed the replay)."""
     msgs = read_raw(ship["mcap"], ["/deck/imu"])["/deck/imu"][:500]
-    for k in (0, 100):
+    for k, sec in ((0, -5), (100, -5), (200, 0)):
         m: Any = TYPESTORE.deserialize_cdr(msgs[k][1], IMU)
-        m.header.stamp.sec = -5
+        m.header.stamp.sec = sec
+        m.header.stamp.nanosec = 0
         msgs[k] = (msgs[k][0], bytes(TYPESTORE.serialize_cdr(m, IMU)))
     bag = tmp_path / "negative"
     write_bag(bag, "/deck/imu", IMU, iter(msgs))
     out = tmp_path / "out"
     assert _replay(bag, out) == 0
-    assert "'rejected_negative_stamp': 2" in capsys.readouterr().out
+    summary = capsys.readouterr().out
+    assert "'rejected_zero_stamp': 1" in summary and "'rejected_negative_stamp': 2" in summary
     _, got = read_bag(out)
     ((static_time, static),) = got["/tf_static"]
     first = stamp_ns(TYPESTORE.deserialize_cdr(msgs[1][1], IMU))
     assert static_time == stamp_ns(static.transforms[0]) == first
-    assert len(got[POSES]) == 498 and min(t for t, _ in got[POSES]) == first
+    assert len(got[POSES]) == 497 and min(t for t, _ in got[POSES]) == first
     assert _partial(out) == ""
 
 
@@ -224,6 +228,36 @@ def test_an_sqlite3_bag_cut_short_replays_its_readable_rows_then_exits_5(
     assert [t for t, _ in got[POSES]] == want
 
 
+def _sqlite_header(page_size: int, pages: int) -> Callable[[bytes], bytes]:
+    """An edit setting an sqlite file's header page size (1: 65536) and page count."""
+
+    def edit(data: bytes) -> bytes:
+        out = bytearray(data)
+        struct.pack_into(">H", out, 16, page_size)
+        struct.pack_into(">I", out, 28, pages)
+        return bytes(out)
+
+    return edit
+
+
+def test_an_sqlite3_header_giving_a_huge_size_costs_no_memory(
+    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Without metadata.yaml (so salvaged row by row), a header saying 64 GiB replays whole,
+    one saying 256 TiB (no file system holds it) is an error naming the file: the salvage
+    asked for that memory (a MemoryError traceback)."""
+    bag = _edited_copy(ship["sqlite3"], tmp_path / "big", _sqlite_header(4096, 1 << 24))
+    (bag / "metadata.yaml").unlink()
+    assert _replay(bag, tmp_path / "out") == 0
+    assert len(read_bag(tmp_path / "out")[1][POSES]) == N
+    bag = _edited_copy(ship["sqlite3"], tmp_path / "huge", _sqlite_header(1, (1 << 32) - 1))
+    (bag / "metadata.yaml").unlink()
+    assert _replay(bag, tmp_path / "out2") == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"mount-twin: error: {bag}: cannot open bag") and ".db3: " in err
+    assert not (tmp_path / "out2").exists()
+
+
 @pytest.mark.parametrize(
     ("make", "said"),
     [
@@ -234,8 +268,12 @@ def test_an_sqlite3_bag_cut_short_replays_its_readable_rows_then_exits_5(
             lambda p: (p.mkdir(), (p / "x.db3").write_bytes(b"not sqlite" * 100)),
             "no message of /deck/imu comes before its damage (",
         ),
+        (  # a recorder killed before its first write: a MemoryError traceback before
+            lambda p: (p.mkdir(), (p / "x.db3").write_bytes(b"")),
+            "x.db3: empty file (0 bytes)",
+        ),
     ],
-    ids=["missing", "empty", "no-bag-files", "not-sqlite"],
+    ids=["missing", "empty", "no-bag-files", "not-sqlite", "empty-db3"],
 )
 def test_what_is_no_bag_is_an_error_saying_why(
     tmp_path: Path,
@@ -249,6 +287,37 @@ def test_what_is_no_bag_is_an_error_saying_why(
     err = capsys.readouterr().err
     assert err.startswith(f"mount-twin: error: {bag}: cannot open bag") and said in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_scene_beyond_the_size_limit_is_an_error_naming_it(
+    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--scene /dev/zero was read whole (a MemoryError traceback)."""
+    out = tmp_path / "out"
+    run = ["replay", str(ship["mcap"]), "--scene", "/dev/zero", "-o", str(out), "--no-progress"]
+    assert main(run) == 2
+    err = capsys.readouterr().err
+    assert "/dev/zero: <file>: cannot read: larger than 16 MiB" in err
+    assert "SCENE_MAX_BYTES" in err and not out.exists()
+
+
+def test_messages_of_1_mb_frame_ids_are_read_in_bounded_chunks(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """2000 of them made one 2 GB chunk (a MemoryError traceback): chunks stop at
+    CHUNK_MAX_BYTES, and the frame id the error names is cut short."""
+    n, frame = 40, "f" * (1 << 20)
+    stamps = 1_700_000_000_000_000_000 + np.arange(n, dtype=np.int64) * 1_000_000
+    msgs = imu_messages(stamps, np.tile([0.0, 0.0, 9.81], (n, 1)), np.zeros((n, 3)), frame)
+    bag = tmp_path / "frames"
+    write_bag(bag, "/deck/imu", IMU, iter(msgs))
+    with InputBag(bag, "/deck/imu", IMU) as reading:
+        sizes = [len(c) for c in reading.chunks(2000)]
+    assert sizes == [32, 8]  # 32 MiB of 1 MiB messages, then the rest
+    assert _replay(bag, tmp_path / "out") == 3
+    err = capsys.readouterr().err
+    assert "rejected: {'rejected_wrong_frame': 40}; the bag's header.frame_id is 'fff" in err
+    assert len(err) < 1000
 
 
 # --------------------------------------------------------------------------- topics, ROS 1

@@ -19,8 +19,9 @@ PUMP = CONFIG / "pump_8_mounts.scene.yaml"
 N = 300
 
 
-def _ros1_copy(path: Path) -> None:
-    """The first N messages of the ship bag, as a ROS 1 bag (header.seq numbered)."""
+def _ros1_copy(path: Path, frame_id: str | None = None) -> None:
+    """The first N messages of the ship bag, as a ROS 1 bag (header.seq numbered), their
+    header.frame_id replaced by `frame_id` if given."""
     ros1 = get_typestore(Stores.ROS1_NOETIC)
     t = ros1.types
     with Ros1Writer(path) as writer:
@@ -33,7 +34,7 @@ def _ros1_copy(path: Path) -> None:
                     stamp=t["builtin_interfaces/msg/Time"](
                         sec=m.header.stamp.sec, nanosec=m.header.stamp.nanosec
                     ),
-                    frame_id=m.header.frame_id,
+                    frame_id=m.header.frame_id if frame_id is None else frame_id,
                 ),
                 orientation=t["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
                 orientation_covariance=m.orientation_covariance,
@@ -83,6 +84,16 @@ def test_a_ros1_bag_replays_like_the_same_messages_in_a_ros2_bag(tmp_path: Path)
     want = [[m.pose.position.z, m.pose.orientation.x] for _, m in b["/mount_twin/pose"]]
     assert len(pose) == N
     np.testing.assert_array_equal(pose, want)
+
+
+def test_a_ros1_frame_id_with_a_leading_slash_can_be_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """ROS 1 frame ids start with '/': --frame-id /imu was refused as no tf2 frame id."""
+    ros1 = tmp_path / "slash.bag"
+    _ros1_copy(ros1, "/imu")
+    assert _replay(ros1, tmp_path / "out", "--frame-id", "/imu") == 0
+    assert f"{N} received, {N} accepted" in capsys.readouterr().out
 
 
 def test_topic_and_frame_overrides(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -221,14 +221,26 @@ def test_a_mount_name_that_is_no_ros_name_token_is_refused(name: str) -> None:
 
 
 @pytest.mark.parametrize(
-    ("section", "key", "frame"),
-    [("frames", "body", ""), ("frames", "body", "pump frame"), ("input", "frame_id", "/deck")],
+    ("section", "key", "frame", "says"),
+    [
+        ("frames", "body", "", "is not a tf2 frame id"),
+        ("frames", "body", "pump frame", "is not a tf2 frame id"),
+        ("frames", "body", "/pump", "is not a tf2 frame id"),
+        ("input", "frame_id", "deck imu", "is not a frame id \\(it has whitespace\\)"),
+    ],
 )
-def test_a_bad_frame_id_is_refused(section: str, key: str, frame: str) -> None:
+def test_a_bad_frame_id_is_refused(section: str, key: str, frame: str, says: str) -> None:
     data = _pump()
     data[section][key] = frame
-    with pytest.raises(SceneError, match=rf"pump: {section}\.{key}: .* is not a tf2 frame id"):
+    with pytest.raises(SceneError, match=rf"pump: {section}\.{key}: .* {says}"):
         scene_from_dict(data, "pump")
+
+
+def test_the_input_frame_id_may_be_a_ros1_one_with_a_leading_slash() -> None:
+    """A ROS 1 bag's header says '/imu': the scene can name it (it was refused as no tf2 id)."""
+    data = _pump()
+    data["input"]["frame_id"] = "/imu"
+    assert scene_from_dict(data, "pump").input.frame_id == "/imu"
 
 
 # ------------------------------------------------------------------ 5. absurd numbers, sizes

@@ -60,6 +60,61 @@ def test_a_key_path_the_scene_lacks_fails_at_load_naming_it(tmp_path: Path) -> N
         load_sweep(_sweep_file(tmp_path, SWEEP.split("inputs:", maxsplit=1)[0]))
 
 
+@pytest.mark.parametrize(
+    ("edit", "says"),
+    [
+        ((f"base: {PUMP}", "base: /dev/zero"), "/dev/zero: <file>: cannot read: larger than"),
+        (
+            ("values: [1100.0, -5.0]", "range: {start: 1.0, stop: 2.0, num: 1000000000}"),
+            "vary[1].range.num: must be in [1, 100000], got 1000000000",
+        ),
+        (
+            ("values: [1100.0, -5.0]", "range: {start: 1.0, stop: 2.0, num: 100000}"),
+            "vary: 400000 cases, more than MAX_CASES (100000) allows",
+        ),
+    ],
+    ids=["base-dev-zero", "range-num", "cases"],
+)
+def test_a_sweep_beyond_a_limit_fails_at_load_naming_it(
+    tmp_path: Path, edit: tuple[str, str], says: str
+) -> None:
+    """Each was a MemoryError traceback (a base read for ever, 10⁹ values, 4·10⁵ cases)."""
+    with pytest.raises((SceneError, ValueError)) as err:
+        load_sweep(_sweep_file(tmp_path, SWEEP.replace(*edit)))
+    assert says in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("options", "says"),
+    [
+        ("rate: 0.0, duration: 0.15", "rate must be > 0 Hz and finite, got 0.0"),
+        (
+            "rate: 1.0e6, duration: 1.0e6",
+            "must give 1 to 10000000 samples (MAX_SAMPLES), got 1000000.0 s × 1000000.0 Hz",
+        ),
+    ],
+    ids=["rate-0", "1e12-samples"],
+)
+def test_a_generated_input_of_no_or_too_many_samples_is_a_failed_case(
+    tmp_path: Path, options: str, says: str
+) -> None:
+    """At rate 0 a case ran on nothing and was reported OK; 10¹² samples were a MemoryError."""
+    text = SWEEP.replace("rate: 4000.0,\n               duration: 0.15", options)
+    spec = load_sweep(_sweep_file(tmp_path, text))
+    case = next(c for c in check(spec) if c.input.generate)
+    row = run_case(spec.base, spec.source, case)
+    assert row["verdict"] == FAILED and says in row["error"]
+
+
+def test_results_that_are_no_regular_file_are_an_error_before_any_case_runs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """-o /dev/full was read back as results for ever (a MemoryError traceback)."""
+    sweep = str(_sweep_file(tmp_path))
+    assert main(["sweep", sweep, "-o", "/dev/full", "--workers", "1", "--no-progress"]) == 2
+    assert "/dev/full: the results CSV is no regular file" in capsys.readouterr().err
+
+
 @pytest.fixture(scope="module")
 def swept(tmp_path_factory: pytest.TempPathFactory):
     tmp = tmp_path_factory.mktemp("sweep")

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import dataclasses
 import re
+import shutil
 import sqlite3
 import struct
+import tempfile
 from collections import Counter
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import suppress
@@ -121,14 +123,15 @@ class InputBag:
         self.ros1 = False
 
     def chunks(self, size: int) -> Iterator[list[bytes]]:
-        """Raw messages of the topic in log-time order, `size` at a time. From a damaged bag,
+        """Raw messages of the topic in log-time order, `size` at a time, fewer where they
+        reach CHUNK_MAX_BYTES (1 MB frame ids: 2 GB a chunk). From a damaged bag,
         those before the damage, then DamagedBagError saying how many and up to which log
         time."""
         if self._salvage is not None:
             yield from self._salvaged_chunks(self._salvage, 0, size)
             return
         chunk: list[bytes] = []
-        read, last = 0, None
+        read, last, held = 0, None, 0
         messages = self._reader.messages(connections=self._conns)
         while True:
             try:
@@ -147,10 +150,10 @@ class InputBag:
                 )
                 raise DamagedBagError(msg) from err
             chunk.append(self._ros1_to_cdr(raw) if self.ros1 else raw)
-            read, last = read + 1, log_time
-            if len(chunk) == size:
+            read, last, held = read + 1, log_time, held + len(raw)
+            if len(chunk) == size or held >= CHUNK_MAX_BYTES:
                 yield chunk
-                chunk = []
+                chunk, held = [], 0
         if chunk:
             yield chunk
         if read < self.count:  # records lost without an error: zeroed or overwritten bytes
@@ -226,6 +229,8 @@ def _up_to(log_time_ns: int | None) -> str:
     return "" if log_time_ns is None else f" (up to log time {log_time_ns} ns)"
 
 
+CHUNK_MAX_BYTES = 32 << 20
+"""Most bytes of raw messages in one chunk (2000 Imu messages with short frame ids: 0.7 MB)."""
 STORAGE_SUFFIXES = (".mcap", ".db3")
 """rosbag2 storage files that can be read without the bag's metadata.yaml."""
 
@@ -278,49 +283,68 @@ def _salvage(files: list[Path], topic: str) -> Salvage:
 
 def _salvage_sqlite(db: Path, topic: str) -> Salvage:
     """`topic`'s messages from a rosbag2 sqlite3 file in the order they were written (row id),
-    up to the first unreadable row. The file is read into memory and zero-filled to the size its
-    header gives: sqlite refuses a file cut short, but reads the pages before the cut. A row
-    whose cell is damaged reads as id 0 and NULLs: the rows of all topics are scanned, so that
-    one stops the salvage too (the data of other topics is not fetched)."""
-    data = db.read_bytes()
+    up to the first unreadable row. The file is read from a temporary copy extended with zeros
+    (sparse: no memory, whatever the header says) to the size its header gives: sqlite refuses
+    a file cut short, but reads the pages before the cut. A row whose cell is damaged reads as
+    id 0 and NULLs: the rows of all topics are scanned, so that one stops the salvage too (the
+    data of other topics is not fetched). An empty file (a recorder killed before its first
+    write) is damage from its first byte."""
     out = Salvage()
-    con = sqlite3.connect(":memory:")
-    last_id = 0
     try:
-        con.deserialize(data + bytes(_sqlite_size(data) - len(data)))
-        topics = con.execute("SELECT id, type FROM topics WHERE name = ?", (topic,)).fetchall()
-        out.msgtype = topics[0][1] if topics else ""
-        wanted = {tid for tid, _ in topics}
-        rows = con.execute(
-            "SELECT id, topic_id, timestamp, CASE WHEN topic_id IN "
-            "(SELECT id FROM topics WHERE name = ?) THEN data END FROM messages ORDER BY id",
-            (topic,),
-        )
-        for row_id, topic_id, stamp, raw in rows:
-            if row_id <= last_id or stamp is None or (topic_id in wanted and raw is None):
-                out.damage = f"{db}: the row after id {last_id} is unreadable"
-                break
-            last_id = row_id
-            if topic_id in wanted:
-                out.messages.append((int(stamp), bytes(raw)))
+        if not db.stat().st_size:
+            out.damage = f"{db}: empty file (0 bytes)"
+            return out
+        with tempfile.TemporaryDirectory(prefix="mount-twin-salvage-") as tmp:
+            copy = Path(tmp) / db.name
+            shutil.copyfile(db, copy)
+            # A header giving a size no file system holds lies: the copy is read as it is.
+            with copy.open("r+b") as file, suppress(OSError):
+                file.truncate(_sqlite_size(file.read(100), copy.stat().st_size))
+            con = sqlite3.connect(f"file:{copy}?mode=ro&immutable=1", uri=True)
+            try:
+                _read_sqlite_rows(con, db, topic, out)
+            finally:
+                con.close()
     except sqlite3.DatabaseError as err:
         out.damage = f"{db}: {err}"
-    finally:
-        con.close()
+    except OSError as err:
+        out.damage = f"{db}: cannot salvage: {err.strerror or err}"
     return out
 
 
-def _sqlite_size(data: bytes) -> int:
-    """The size of an sqlite file as its header gives it (page size × page count), at least
-    `data`'s rounded up to whole pages; len(data) if the header is not sqlite's."""
-    if len(data) < 100:
-        return len(data)
-    (page,) = struct.unpack_from(">H", data, 16)
+def _read_sqlite_rows(con: sqlite3.Connection, db: Path, topic: str, out: Salvage) -> None:
+    """Into `out`: `topic`'s type and messages from the rosbag2 database `con` (of file `db`),
+    up to the first unreadable row."""
+    topics = con.execute("SELECT id, type FROM topics WHERE name = ?", (topic,)).fetchall()
+    out.msgtype = topics[0][1] if topics else ""
+    wanted = {tid for tid, _ in topics}
+    rows = con.execute(
+        "SELECT id, topic_id, timestamp, CASE WHEN topic_id IN "
+        "(SELECT id FROM topics WHERE name = ?) THEN data END FROM messages ORDER BY id",
+        (topic,),
+    )
+    last_id = 0
+    for row_id, topic_id, stamp, raw in rows:
+        if row_id <= last_id or stamp is None or (topic_id in wanted and raw is None):
+            out.damage = f"{db}: the row after id {last_id} is unreadable"
+            return
+        last_id = row_id
+        if topic_id in wanted:
+            out.messages.append((int(stamp), bytes(raw)))
+
+
+def _sqlite_size(header: bytes, size: int) -> int:
+    """The size of an sqlite file of `size` bytes as its `header` (first 100 bytes) gives it
+    (page size × page count), at least `size` rounded up to whole pages; `size` if the header
+    is not sqlite's."""
+    if len(header) < 100:
+        return size
+    (page,) = struct.unpack_from(">H", header, 16)
     page = 65536 if page == 1 else page
     if page < 512 or page & (page - 1):
-        return len(data)
-    (pages,) = struct.unpack_from(">I", data, 28)
-    return max(page * pages, -(-len(data) // page) * page)
+        return size
+    (pages,) = struct.unpack_from(">I", header, 28)
+    return max(page * pages, -(-size // page) * page)
 
 
 def _as_ros2(value: Any) -> Any:

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from mount_twin.io.signals import Signal
+from mount_twin.textfiles import MIB, FileTooLargeError, read_limited
 
 G = 9.80665
 ROLES = ("t", "ax", "ay", "az", "wx", "wy", "wz")
@@ -59,6 +60,11 @@ class CsvFormat:
     units: dict[str, str] = field(default_factory=dict)
 
 
+CSV_MAX_BYTES = 256 * MIB
+"""Largest CSV imported: ~2.5 million rows of seven columns (45 min at 1 kHz); reading one
+takes some 10 times its size in memory."""
+
+
 @dataclass(frozen=True)
 class Imported:
     """The signal read, and what was assumed or found, to tell the user (`notes`)."""
@@ -75,7 +81,10 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     """Read a recorder's CSV (see the module docstring); every error names file, row, column."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8-sig")  # utf-8-sig drops a byte-order mark
+        # utf-8-sig drops a byte-order mark
+        text = read_limited(path, CSV_MAX_BYTES, "CSV_MAX_BYTES", "utf-8-sig")
+    except FileTooLargeError as err:
+        raise _fail(path, "<file>", f"cannot read: {err}") from err
     except OSError as err:
         raise _fail(path, "<file>", f"cannot read: {err.strerror}") from err
     except UnicodeDecodeError as err:
@@ -127,6 +136,9 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
             if not math.isfinite(v):
                 raise _fail(path, f"row {row}, column {names[col]}", f"{cell!r} is not finite")
             values[i, j] = v * scale[role]
+            if not math.isfinite(values[i, j]):  # 1e308 g: finite, but not in m/s²
+                what = f"{cell!r} is beyond a float in SI units (×{scale[role]:g})"
+                raise _fail(path, f"row {row}, column {names[col]}", what)
     t = values[:, 0]
     back = np.flatnonzero(np.diff(t) <= 0.0)
     if back.size:

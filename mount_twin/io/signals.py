@@ -8,6 +8,25 @@ from dataclasses import dataclass
 
 import numpy as np
 
+MAX_SAMPLES = 10_000_000
+"""Most samples a generated signal may have (rate × duration): 1000 s at 10 kHz, ~0.6 GB."""
+
+
+def _sample_times(rate_hz: float, total: float) -> np.ndarray:
+    """Sample times (s) of `total` s at `rate_hz`; ValueError unless that is 1 to MAX_SAMPLES
+    samples at a positive rate."""
+    if not 0.0 < rate_hz < math.inf:
+        msg = f"rate must be > 0 Hz and finite, got {rate_hz!r}"
+        raise ValueError(msg)
+    n = total * rate_hz
+    if not 1.0 <= round(n) <= MAX_SAMPLES:
+        msg = (
+            f"duration × rate must give 1 to {MAX_SAMPLES} samples (MAX_SAMPLES), got "
+            f"{total!r} s × {rate_hz!r} Hz = {n:.4g}"
+        )
+        raise ValueError(msg)
+    return np.arange(round(n)) / rate_hz
+
 
 @dataclass(frozen=True)
 class Signal:
@@ -47,7 +66,7 @@ def half_sine_shock(
     if rebound < 0.0:
         msg = f"rebound must be ≥ 0 (the peak of a downward pulse), got {rebound!r} m/s²"
         raise ValueError(msg)
-    t = np.arange(round(total * rate_hz)) / rate_hz
+    t = _sample_times(rate_hz, total)
     tau = t - pre
     a = np.where((tau >= 0.0) & (tau <= duration), peak * np.sin(math.pi * tau / duration), 0.0)
     if rebound > 0.0:
@@ -78,7 +97,7 @@ def ship_motion(
     heave z = heave_amp·sin(2πt/heave_period)
     m in the earth frame; vertical vibration vib_amp·sin(2π·vib_hz·t) m/s² along z of F.
     """
-    t = np.arange(round(total * rate_hz)) / rate_hz
+    t = _sample_times(rate_hz, total)
     wr, wh, wv = 2 * math.pi / roll_period, 2 * math.pi / heave_period, 2 * math.pi * vib_hz
     phi = roll_amp * np.sin(wr * t)
     phi_dot = roll_amp * wr * np.cos(wr * t)

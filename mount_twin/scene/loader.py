@@ -31,6 +31,7 @@ from mount_twin.scene.description import (
 )
 from mount_twin.scene.reader import Reader, shown
 from mount_twin.scene.yaml_reading import SceneYamlError, load_yaml
+from mount_twin.textfiles import MIB, FileTooLargeError, read_limited
 
 INPUT_TYPES = ("sensor_msgs/msg/Imu", "geometry_msgs/msg/AccelStamped")
 START_TILT_MAX_RAD = 1.55
@@ -50,6 +51,8 @@ node's namespace and name, must stay within TOPIC_MAX_CHARS)."""
 TOPIC_MAX_CHARS = 247
 """Longest ROS 2 topic name (rmw: 255 less 8 reserved for the DDS prefix)."""
 STEPPERS = (AUTO, *METHODS)
+SCENE_MAX_BYTES = 16 * MIB
+"""Largest scene, parameter or sweep YAML file read (the bundled scenes are < 10 kB)."""
 
 
 def load_scene_file(path: str | Path) -> Scene:
@@ -62,7 +65,9 @@ def read_scene_yaml(path: str | Path) -> Any:
     """The YAML document of a scene file, unvalidated; errors name the file."""
     path = Path(path)
     try:
-        return load_yaml(path.read_text(encoding="utf-8"))
+        return load_yaml(read_limited(path, SCENE_MAX_BYTES, "SCENE_MAX_BYTES"))
+    except FileTooLargeError as err:
+        raise SceneError(str(path), "<file>", f"cannot read: {err}") from err
     except OSError as err:
         raise SceneError(str(path), "<file>", f"cannot read: {err.strerror}") from err
     except UnicodeDecodeError as err:
@@ -250,7 +255,8 @@ def topic_name_problem(name: str) -> str:
 
 
 def _frame_id(r: Reader, key: str, default: str, *, empty_ok: bool = False) -> str:
-    """A tf2 frame id: no whitespace, no leading '/' (empty only where it means 'any')."""
+    """A tf2 frame id the twin publishes: no whitespace, no leading '/' (empty only where
+    `empty_ok`: a mount frame prefix)."""
     frame = r.string(key, default)
     if (not frame and not empty_ok) or any(c.isspace() for c in frame) or frame.startswith("/"):
         raise r.error(
@@ -260,12 +266,21 @@ def _frame_id(r: Reader, key: str, default: str, *, empty_ok: bool = False) -> s
     return frame
 
 
+def _header_frame_id(r: Reader, key: str, default: str) -> str:
+    """A frame id the input's header.frame_id is compared with, as its sensor writes it: no
+    whitespace; empty for any; a leading '/' is ROS 1's (a bag from there says '/imu')."""
+    frame = r.string(key, default)
+    if any(c.isspace() for c in frame):
+        raise r.error(key, f"{shown(frame)} is not a frame id (it has whitespace)")
+    return frame
+
+
 def _input(r: Reader) -> InputSpec:
     d = InputSpec()
     spec = InputSpec(
         msg_type=r.choice("msg_type", INPUT_TYPES, d.msg_type),
         topic=_topic(r, "topic", d.topic),
-        frame_id=_frame_id(r, "frame_id", d.frame_id, empty_ok=True),
+        frame_id=_header_frame_id(r, "frame_id", d.frame_id),
         sensor_rpy=_angles(r, "sensor_rpy", d.sensor_rpy),
         sensor_position=_position(r, "sensor_position", d.sensor_position),
         includes_gravity=r.boolean("includes_gravity", d.includes_gravity),

@@ -153,6 +153,9 @@ def finished_cases(results: Path) -> set[str]:
     """Ids of the cases already in a results CSV (FAILED ones are run again)."""
     if not results.exists():
         return set()
+    if not results.is_file():  # /dev/full, /dev/zero: read back for ever
+        msg = f"{results}: the results CSV is no regular file (it is read back and appended to)"
+        raise ValueError(msg)
     with results.open(encoding="utf-8", newline="") as fh:
         return {r["case"] for r in csv.DictReader(fh) if r.get("verdict") != FAILED}
 

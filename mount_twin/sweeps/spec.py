@@ -20,6 +20,7 @@ inputs:                               # each case runs against every input
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -63,6 +64,10 @@ class SweepSpec:
     inputs: tuple[InputCase, ...]
 
 
+MAX_CASES = 100_000
+"""Most cases a sweep may have (variations × inputs), and values a `range` may give."""
+
+
 def load_sweep(path: str | Path) -> SweepSpec:
     """Read and validate a sweep file; errors name the file and key path (and a variation that
     makes no valid scene, with the scene's own error)."""
@@ -89,6 +94,10 @@ def load_sweep(path: str | Path) -> SweepSpec:
     )
     if len({i.name for i in inputs}) != len(inputs):
         raise top.error("inputs", "input names must differ (give each a `name`)")
+    sizes = [len(v.values) for v in variations]
+    cases = (math.prod(sizes) if combine == "product" else min(sizes, default=1)) * len(inputs)
+    if cases > MAX_CASES:
+        raise top.error("vary", f"{cases} cases, more than MAX_CASES ({MAX_CASES}) allows")
     top.finish()
     return SweepSpec(str(path), str(base_path), base, variations, combine, inputs)
 
@@ -101,7 +110,7 @@ def _variation(r: Reader) -> Variation:
     if ops[0] == "range":
         spec = r.sub("range")
         start, stop = spec.number("start"), spec.number("stop")
-        num = spec.integer("num", lo=1)
+        num = spec.integer("num", lo=1, hi=MAX_CASES)
         spec.finish()
         values: tuple[Any, ...] = tuple(float(v) for v in np.linspace(start, stop, num))
         op = "set"
