@@ -34,6 +34,7 @@ def run(args: argparse.Namespace) -> int:
     done = build(args.prefix, jobs=args.jobs, force=args.force)
     state = "built" if done.built else "up to date"
     print(f"tf2_msgs {state} in {done.prefix} ({time.perf_counter() - start:.1f} s)")
+    print(f"a new interpreter imports it with its type support from {done.module}")
     if done.exports:
         print("the node finds it once a shell has run:")
         for line in done.exports:

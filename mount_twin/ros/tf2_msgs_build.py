@@ -128,6 +128,8 @@ class Install:
     exports: tuple[str, ...]
     """Lines a shell must run to use it (empty: the environment finds it by itself; Python
     always does, through the .pth file)."""
+    module: str
+    """Where a fresh interpreter imported tf2_msgs from (with its type support)."""
 
 
 def _site_packages() -> Path:
@@ -262,8 +264,8 @@ def build(
     exports: tuple[str, ...] = ()
     if not _activate(python_dir, lib_dir):
         exports = (f'export LD_LIBRARY_PATH="{lib_dir}${{LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}}"',)
-    check(None if not exports else lib_dir)
-    return Install(prefix, python_dir, lib_dir, fresh, exports)
+    module = check(lib_dir if exports else None)
+    return Install(prefix, python_dir, lib_dir, fresh, exports, module)
 
 
 def _pip_log(prefix: Path) -> Path:
