@@ -23,7 +23,7 @@ from typing import Any
 import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
-from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from mount_twin.ros.node import message_class
 from mount_twin.ros.rclpy_private import take_waiting
@@ -128,10 +128,14 @@ class Peer:
         overridden to reliable gets every one; a best-effort input matches it too)."""
         return self.node.create_publisher(message_class(msgtype), topic, depth)
 
-    def record(self, topics: dict[str, str], depth: int = 10_000) -> None:
-        """Subscribe to `topics` (name → type), reliable, and keep what arrives."""
+    def record(self, topics: dict[str, str], depth: int = 10_000, latched: bool = False) -> None:
+        """Subscribe to `topics` (name → type), reliable, and keep what arrives; `latched`:
+        transient local, as tf2_ros' static listener (gets what was published before)."""
         qos = QoSProfile(
-            depth=depth, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST
+            depth=depth,
+            reliability=ReliabilityPolicy.RELIABLE,
+            history=HistoryPolicy.KEEP_LAST,
+            durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE,
         )
         for topic, msgtype in topics.items():
             self._subs[topic] = self.node.create_subscription(

@@ -1,7 +1,9 @@
 """The node, run for real: Jazzy rclpy, Fast DDS, the node in its own process.
 
 In CI (CI set) rclpy must be importable: `.ci/run` installs it, and a missing one fails the
-collection instead of skipping. Elsewhere the module skips without rclpy.
+collection instead of skipping. Elsewhere the module skips without rclpy. Likewise tf2_msgs
+(`.ci/run` builds it with `mount-twin build-tf2-msgs`): in CI a missing one fails the tests of
+/tf and /tf_static; elsewhere they skip, and the comparison with the replay leaves /tf out.
 """
 
 from __future__ import annotations
@@ -9,6 +11,8 @@ from __future__ import annotations
 import math
 import os
 import signal
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -38,10 +42,15 @@ from mount_twin.io.messages import (
     ACCEL,
     DIAGNOSTICS,
     IMU,
+    POSE,
+    TF,
+    TF_STATIC_TOPIC,
+    TF_TOPIC,
     TYPESTORE,
     imu_messages,
     output_types,
     resolve,
+    static_transforms,
 )
 from mount_twin.replay import NODE_NAME, replay
 from mount_twin.scene import load_scene_file, scene_from_params
@@ -55,10 +64,14 @@ WALL_FIGURES = {"real_time_factor"}
 
 
 def tf_available() -> bool:
-    """Whether tf2_msgs is importable for rclpy here (it is not on the package registry)."""
+    """Whether tf2_msgs is importable here (it is not on the package registry: `mount-twin
+    build-tf2-msgs` builds it). In CI, where `.ci/run` has built it, its absence fails the
+    test that asks."""
     try:
         import tf2_msgs.msg  # noqa: F401
-    except ImportError:
+    except ImportError as err:
+        if os.environ.get("CI"):
+            pytest.fail(f"tf2_msgs is not importable in CI ({err}): .ci/run builds it")
         return False
     return True
 
@@ -492,3 +505,76 @@ def test_sim_time_without_clock_is_reported_and_with_clock_is_followed() -> None
     ]
     assert stamps and all(sim0 <= s <= sim0 + 2_000_000_000 for s in stamps), stamps
     assert ros[-1][0] == OK, ros  # the clock came: the problem clears
+
+
+def test_tf_static_is_latched_for_a_late_subscriber_and_tf_carries_the_pose() -> None:
+    """/tf_static reaches a subscriber that joins seconds after the node published it (reliable,
+    transient local: tf2_ros' static listener), once, with one transform per mount: byte-equal
+    to `static_transforms` at the node's stamp (frames.foundation → each mount frame at its
+    position and axes); a volatile subscriber joining then gets nothing. /tf: one transform per
+    pose, frames.foundation → frames.body, with the pose's stamp, position and orientation."""
+    if not tf_available():
+        pytest.skip("tf2_msgs is not importable: `mount-twin build-tf2-msgs` builds it")
+    scene = scene_from_params(dict(flatten(_params())), str(PARAMS_FILE))
+    pose = resolve("~/pose", NODE_NAME)
+    domain = fresh_domain()
+    peer, late, volatile = (Peer(domain, f"{n}_peer") for n in ("tf", "late", "volatile"))
+    peer.record({TF_TOPIC: TF, pose: POSE})
+    node = NodeProcess(domain, ["--params-file", str(PARAMS_FILE), *LOSSLESS])
+    pub = peer.publisher(IMU, "/deck/imu")
+    try:
+        assert wait_for_node(pub, node), node.stop()
+        assert wait_for(lambda: peer.connected(TF_TOPIC) and peer.connected(pose), 10.0)
+        stamps, accel = _at_rest(300)
+        publish_paced(pub, _imu(stamps, accel), 1000.0, peer)
+        assert peer.take_until(lambda: min(map(len, peer.got.values())) >= 300, 60.0)
+        late.record({TF_STATIC_TOPIC: TF}, latched=True)  # the node published it at its start
+        volatile.record({TF_STATIC_TOPIC: TF})
+        assert late.take_until(lambda: len(late.got[TF_STATIC_TOPIC]) >= 1, 10.0)
+        assert volatile.connected(TF_STATIC_TOPIC)
+        late.take_until(lambda: False, 0.5)
+        volatile.take()
+    finally:
+        code = node.stop()
+        for p in (peer, late, volatile):
+            p.close()
+    assert code == 0, node.stderr
+    assert "tf2_msgs" not in node.stderr, node.stderr  # no "not importable": it published TF
+    assert len(late.got[TF_STATIC_TOPIC]) == 1 and volatile.got[TF_STATIC_TOPIC] == []
+    raw = late.got[TF_STATIC_TOPIC][0]
+    static = TYPESTORE.deserialize_cdr(raw, TF).transforms
+    assert [(t.header.frame_id, t.child_frame_id) for t in static] == [
+        (scene.frames.foundation, scene.frames.mount_frame(m.name)) for m in scene.mounts
+    ]
+    stamp = static[0].header.stamp
+    assert raw == static_transforms(scene, stamp.sec * 10**9 + stamp.nanosec)[2]
+    tfs = [TYPESTORE.deserialize_cdr(r, TF).transforms for r in peer.got[TF_TOPIC]]
+    poses = [TYPESTORE.deserialize_cdr(r, POSE) for r in peer.got[pose]]
+    assert len(tfs) == len(poses) == 300
+    frames = (scene.frames.foundation, scene.frames.body)
+    for (tf,), p in zip(tfs, poses, strict=True):
+        assert (tf.header.frame_id, tf.child_frame_id) == frames == (p.header.frame_id, frames[1])
+        assert tf.header.stamp == p.header.stamp
+        t, q = tf.transform.translation, tf.transform.rotation
+        x, o = p.pose.position, p.pose.orientation
+        assert (t.x, t.y, t.z, q.x, q.y, q.z, q.w) == (x.x, x.y, x.z, o.x, o.y, o.z, o.w)
+
+
+def test_building_tf2_msgs_again_finds_the_build() -> None:
+    """`mount-twin build-tf2-msgs` run again (.ci/run ran it before the tests) rebuilds
+    nothing, needs no export, and the interpreter it checks with imports this tf2_msgs."""
+    if not tf_available():
+        pytest.skip("tf2_msgs is not importable: `mount-twin build-tf2-msgs` builds it")
+    import tf2_msgs
+
+    done = subprocess.run(
+        [sys.executable, "-m", "mount_twin.cli", "build-tf2-msgs"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "tf2_msgs up to date in" in done.stdout and "export" not in done.stdout, done.stdout
+    assert f"type support from {tf2_msgs.__file__}" in done.stdout, done.stdout

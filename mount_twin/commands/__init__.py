@@ -29,5 +29,6 @@ COMMANDS = (
     "show",
     "dashboard",
     "warm_up",
+    "build_tf2_msgs",
 )
 """Module names under mount_twin.commands, in the order `--help` lists them."""
