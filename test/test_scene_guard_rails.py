@@ -390,6 +390,21 @@ def test_inertia_in_kg_mm2_is_warned_of() -> None:
     assert "radius of gyration √(I/m) is 645 m" in warned["body.inertia"]
 
 
+@pytest.mark.parametrize("dofs", [None, ["x", "y", "z"]])
+def test_a_body_too_compact_to_turn_is_refused_for_it_not_as_unheld(dofs: list | None) -> None:
+    """Inertia 1e-9 kg·m² on 1200 kg: √(I/m) ≈ 9.1e-7 m. It was refused as 'no mount holds
+    z, x, y'; with no rotation free it does not matter and loads."""
+    data = _pump()
+    data["body"]["inertia"] = [1e-9, 1e-9, 1e-9, 0.0, 0.0, 0.0]
+    if dofs is not None:
+        data["dofs"] = dofs
+        scene_from_dict(data, "pump", refuse_unheld=True)
+        return
+    says = r"pump: body\.inertia: the body's smallest radius of gyration √\(I/m\) is 9\.13e-07 m"
+    with pytest.raises(SceneError, match=says):
+        scene_from_dict(data, "pump", refuse_unheld=True)
+
+
 def test_an_imu_input_without_gravity_is_warned_of() -> None:
     data = _pump()
     data["input"]["includes_gravity"] = False

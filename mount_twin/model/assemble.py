@@ -64,8 +64,7 @@ class Model:
 def assemble(scene: Scene) -> Model:
     """Build the kernel arrays of `scene` (done once, at load)."""
     body = scene.body
-    ixx, iyy, izz, ixy, ixz, iyz = body.inertia
-    inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+    inertia = np.array(body.inertia_tensor())
     cg = np.array(body.cg)
     mounts = scene.mounts
     axes = np.array([rpy_matrix(*mt.orientation_rpy) for mt in mounts]).reshape(-1, 3, 3)

@@ -4,6 +4,10 @@
 Errors (SceneError naming the key path):
 - a mount's nominal stiffness beyond STIFFNESS_LIMIT;
 - mounts too soft to carry the weight at all (the static sag overflows);
+- a body so compact (a principal radius of gyration √(I/m) below GYRATION_MIN_M, with a
+  rotation free) that its rotational modes lie beyond what the restraint check and the
+  integrators resolve beside its translational ones (it was refused as "no mount holds x, y,
+  z": a tolerance relative to 1e15 rad²/s² hid the translations' 1e3);
 - a free DOF that nothing holds (zero stiffness, the weight's geometric stiffness included),
   when the twin starts at equilibrium (`initial_state.mode: equilibrium`) and the caller asks
   (`refuse_unheld`: scene files and parameter sets do): the body would drift along it under
@@ -48,6 +52,9 @@ FAR_FACTOR = 10.0
 """A mount farther from the CG than this many radii of gyration lies outside the body."""
 GYRATION_WARN_M = 30.0
 """Largest plausible radius of gyration √(I/m) of a machine on mounts, m."""
+GYRATION_MIN_M = 1.0e-4
+"""Smallest principal radius of gyration √(I/m), m, of a body whose rotation is free: a
+machine, or a lab specimen of a few grams, is far larger; less is a unit error."""
 INPUT_IMU = "sensor_msgs/msg/Imu"
 
 
@@ -62,6 +69,7 @@ def check_scene(
         refuse_unheld: a free DOF nothing holds is an error if the start is at equilibrium
             (else it is a warning).
     """
+    _check_compactness(scene)
     st = statics(scene)
     _check_stiffness_limits(scene, st, mount_paths)
     if not st.finite:
@@ -78,6 +86,22 @@ def check_scene(
         *_geometry(scene, mount_paths),
         *_gravity_convention(scene),
     )
+
+
+def _check_compactness(scene: Scene) -> None:
+    if not {"alpha", "gamma", "delta"} & set(scene.dofs):
+        return
+    body = scene.body
+    smallest = float(np.linalg.eigvalsh(np.array(body.inertia_tensor()))[0])
+    gyration = math.sqrt(max(smallest, 0.0) / body.mass)
+    if gyration < GYRATION_MIN_M:
+        raise SceneError(
+            scene.source,
+            "body.inertia",
+            f"the body's smallest radius of gyration √(I/m) is {gyration:.3g} m, below "
+            f"{GYRATION_MIN_M:g} m: no body on mounts is that compact (its rotation would be "
+            "orders of magnitude faster than its translation); inertia in t·m², or mass in g?",
+        )
 
 
 def _check_stiffness_limits(scene: Scene, st: Statics, mount_paths: Sequence[str]) -> None:

@@ -39,6 +39,11 @@ class Body:
     cg: Vec3
     inertia: Vec6
 
+    def inertia_tensor(self) -> tuple[Vec3, Vec3, Vec3]:
+        """The 3×3 inertia tensor about the CG in B, kg·m², rows."""
+        ixx, iyy, izz, ixy, ixz, iyz = self.inertia
+        return ((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz))
+
 
 @dataclass(frozen=True)
 class LinearMount:

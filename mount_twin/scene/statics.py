@@ -130,10 +130,9 @@ def _skew(v: np.ndarray) -> np.ndarray:
 def statics(scene: Scene) -> Statics:
     """The small-motion statics of `scene` under its nominal weight m·input.g along −z of F."""
     body, mounts = scene.body, scene.mounts
-    ixx, iyy, izz, ixy, ixz, iyz = body.inertia
     mass = np.zeros((6, 6))
     mass[:3, :3] = body.mass * np.eye(3)
-    mass[3:, 3:] = [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]
+    mass[3:, 3:] = body.inertia_tensor()
     axes = np.array([rpy_matrix(*m.orientation_rpy) for m in mounts])
     tangents = tuple(nominal_tangent(m) for m in mounts)
     k = np.array([t.stiffness for t in tangents])
