@@ -113,11 +113,8 @@ def run_cases(base: dict[str, Any], source: str, cases: list[Case]) -> list[dict
 
 def _figures(scene: Scene, samples: SampleBatch) -> dict[str, Any]:
     engine = TwinEngine(assemble(scene))
-    out = engine.push(samples)
-    reports = [*out.health]
-    final = engine.flush()
-    if final is not None:
-        reports.append(final)
+    out = engine.run(samples)
+    reports = out.health
     worst = max((s.level for r in reports for s in r.statuses), default=0)
     force = np.linalg.norm(out.wrenches[:, :, :3], axis=2).max(axis=0) if len(out) else None
     util = engine.utilisation_max
