@@ -268,12 +268,11 @@ def test_past_90_degrees_the_twin_stops_following_and_says_so() -> None:
     """A given motion past the chart's limit: no fiction (test_engine_no_fiction.py has more)."""
     scene, samples = _tumbler()
     engine = TwinEngine(assemble(scene))
-    out = engine.push(samples)
+    out = engine.run(samples)
     _assert_finite(out)
     assert _tilt(out).max() > 85.0
     assert engine.counts["samples_not_followed"] > 0 and not engine.running
-    reports = [*out.health, engine.flush()]
-    last = [r for r in reports if r is not None][-1]
+    last = out.health[-1]
     (status,) = [s for s in last.statuses if s.name == "mount_twin: integration"]
     assert status.level == ERROR and "not following since" in status.message
 
@@ -304,7 +303,7 @@ def test_a_one_second_gap_is_bridged_or_reset(policy: str) -> None:
     stamps = np.concatenate([1.0 + np.arange(500) * 1e-3, 2.5 + np.arange(500) * 1e-3])
     samples = batch(stamps, frame_ids=scene.input.frame_id)
     engine = TwinEngine(assemble(scene))
-    out = engine.push(samples)
+    out = engine.run(samples)
     _assert_finite(out)
     assert len(out) == len(samples)
     assert engine.counts["gaps"] == 1
