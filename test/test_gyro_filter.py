@@ -37,13 +37,13 @@ def _gain(rate_hz: float, frequency_hz: float) -> float:
     n = half.shape[0] - 1
     k = np.arange(2 * n + 4000)
     x = np.sin(2.0 * math.pi * frequency_hz * k / rate_hz)
-    raw = np.repeat(x[:, None], 3, axis=1)
-    out = np.empty((k.shape[0] - 2 * n, 3))
+    raw = np.repeat(x[None, :], 3, axis=0)
+    out = np.empty((3, k.shape[0] - 2 * n))
     fir_rows(raw, half, out)
-    centre = k[n : n + out.shape[0]]  # output k answers raw sample k + N: no phase left
+    centre = k[n : n + out.shape[1]]  # output k answers raw sample k + N: no phase left
     phase = 2.0 * math.pi * frequency_hz * centre / rate_hz
     basis = np.column_stack([np.sin(phase), np.cos(phase)])
-    (a, b), *_ = np.linalg.lstsq(basis, out[:, 0], rcond=None)
+    (a, b), *_ = np.linalg.lstsq(basis, out[0], rcond=None)
     assert abs(b) <= 1e-9, "a symmetric FIR delays by exactly N samples"
     return float(a)
 

@@ -156,10 +156,10 @@ class GyroDelay:
         parts = [np.repeat(raw[:1], delay - before, axis=0), raw]
         if end:
             parts.append(np.repeat(raw[-1:], delay, axis=0))
-        out = np.empty((n, 3))
-        fir_rows(np.concatenate(parts), half, out)
+        out = np.empty((3, n))
+        fir_rows(np.ascontiguousarray(np.concatenate(parts).T), half, out)
         rows = pending[:n]
-        frame.w[rows] = out
+        frame.w[rows] = out.T
         self._pending = pending[n:]
         self._raw = raw[max(0, before + n - delay) :]
         released = Run(rows, self._restart)

@@ -280,7 +280,7 @@ class TwinEngine:
         run_samples(
             integ, model.arrays, scratch, u, y, samples, self._options, out, watch, companion
         )
-        fir_rows(np.zeros((3, 3)), np.full(2, 0.5), np.empty((1, 3)))
+        fir_rows(np.zeros((3, 3)), np.full(2, 0.5), np.empty((3, 1)))
         watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
         self._start_outputs(self._y_nominal.copy(), model.new_scratch(), watch)
 

@@ -90,16 +90,18 @@ def response(half: np.ndarray, frequency_hz: np.ndarray, rate_hz: float) -> np.n
 
 @kernel
 def fir_rows(raw, half, out) -> None:
-    """out[k] = h[N]·raw[k + N] + Σ_j h[N + j]·(raw[k + N − j] + raw[k + N + j]), j = 1..N,
-    for k < out.shape[0]: the filtered rate of the sample at raw[k + N] (rad/s, rows (·, 3)).
+    """out[i, k] = h[N]·raw[i, k + N] + Σ_j h[N + j]·(raw[i, k + N − j] + raw[i, k + N + j]),
+    j = 1..N in that order, for k < out.shape[1]: the filtered rate of the sample at
+    raw[:, k + N] (rad/s; per axis i, rows (3, ·) so the loop over k runs on contiguous memory).
 
-    Each output sums the same terms in the same order whatever rows surround it, so any
+    Each output sums the same terms in the same order whatever samples surround it, so any
     batching gives the same bits."""
     n = half.shape[0] - 1
-    for k in range(out.shape[0]):
-        c = k + n
-        for i in range(3):
-            acc = half[0] * raw[c, i]
-            for j in range(1, n + 1):
-                acc += half[j] * (raw[c - j, i] + raw[c + j, i])
-            out[k, i] = acc
+    m = out.shape[1]
+    for i in range(3):
+        for k in range(m):
+            out[i, k] = half[0] * raw[i, k + n]
+        for j in range(1, n + 1):
+            h = half[j]
+            for k in range(m):
+                out[i, k] += h * (raw[i, k + n - j] + raw[i, k + n + j])
