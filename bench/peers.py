@@ -48,7 +48,7 @@ from importlib.util import find_spec
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from mount_twin.analysis.accuracy import Run, conditioned, measure, reference_run
+from mount_twin.analysis.accuracy import Run, measure, raw_gyro, reference_run
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.io.input_samples import read_samples
 from mount_twin.kinds import N_EVENTS
@@ -275,7 +275,7 @@ def main() -> None:
     cut = SampleBatch(
         full.stamps[keep], full.accel[keep], full.gyro[keep], list(np.array(full.frame_ids)[keep])
     )
-    scene, samples = conditioned(loaded, cut)
+    scene, samples = raw_gyro(loaded), cut
     if args.closed_joints:
         from mujoco_peer import closed_joints
 

@@ -12,7 +12,7 @@ bags; `sweep` runs a design sweep file (scene variants × inputs) on a Dask clus
     engine = TwinEngine(assemble(load_scene_file("config/pump_8_mounts.scene.yaml")))
     t = np.arange(100) * 1e-3  # 0.1 s at 1 kHz, at rest: +g up along z
     accel = np.tile([0.0, 0.0, 9.80665], (t.size, 1))
-    out = engine.push(SampleBatch(t, accel, np.zeros((t.size, 3)), ["deck_imu"] * t.size))
+    out = engine.run(SampleBatch(t, accel, np.zeros((t.size, 3)), ["deck_imu"] * t.size))
     print(out.wrenches[-1])  # (n_mounts, 6): force (N) and couple (N·m) in mount axes
 
 Importing the package is cheap: each name below is imported on first use (PEP 562), so only

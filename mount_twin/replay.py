@@ -9,6 +9,7 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from itertools import chain
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +32,7 @@ from mount_twin.engine.batch import (
 )
 from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.health import INTEGRATION, tilt_from_quaternions
+from mount_twin.errors import DamagedBagError
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import TF, TF_STATIC_TOPIC, output_types, resolve, static_transforms
 from mount_twin.physics.compiled import kernel_cache_is_cold
@@ -110,6 +112,7 @@ class ReplaySummary:
     start_s: float = 0.0  # engine seconds of the first output (event times count from it)
     error_estimate: ErrorEstimate | None = None  # the live estimate over the run (None: off)
     failure: str = ""  # how often the integration failed and why ('' if never)
+    latency: tuple[int, float] = (0, 0.0)  # samples, s: outputs after their input (gyro delay)
 
     @property
     def worst_level(self) -> int:
@@ -170,6 +173,8 @@ class ReplaySummary:
             f"{self.displacement_max_m * 1e3:.3f} mm, max tilt "
             f"{np.degrees(self.tilt_max_rad):.4f} deg",
             f"  {_estimate_text(self.error_estimate)}",
+            f"  latency: outputs {self.latency[0]} samples ({self.latency[1] * 1e3:.1f} ms) "
+            "after their input, at its stamps (input.gyro_filter; none: no latency)",
             "  peak mount loads (largest magnitude at one instant): |F| [N]  |M| [N·m]",
         ]
         for name, peak in self.peaks.items():
@@ -210,6 +215,8 @@ class ReplaySummary:
             "real_time_factor": self.real_time_factor,
             DISPLACEMENT: self.displacement_max_m,
             "max_tilt_rad": self.tilt_max_rad,
+            "latency_samples": self.latency[0],
+            "latency_s": self.latency[1],
             "error_estimate": dataclasses.asdict(self.error_estimate)
             if self.error_estimate
             else None,
@@ -265,6 +272,16 @@ def _grouped(events: list[MountEvent]) -> dict[tuple[str, str], list[MountEvent]
     return out
 
 
+def _until_damage(
+    chunks: Iterator[list[bytes]], damage: list[DamagedBagError]
+) -> Iterator[list[bytes]]:
+    """The chunks up to a damaged bag's damage, which is put in `damage` rather than raised."""
+    try:
+        yield from chunks
+    except DamagedBagError as err:
+        damage.append(err)
+
+
 def replay(
     scene: Scene,
     input_path: str | Path,
@@ -310,10 +327,13 @@ def replay(
         OutputBag(output_path, topics, {TF_STATIC_TOPIC: [LATCHED_QOS]}) as out,
         tqdm(total=bag.count, unit="msg", disable=not progress, desc="replay", leave=False) as bar,
     ):
-        for raws in bag.chunks(chunk):
+        # the chunks, then the end (also where a damaged bag ends): the outputs the gyro delay
+        # holds and the last, partial diagnostics period
+        damage: list[DamagedBagError] = []
+        for raws in chain(_until_damage(bag.chunks(chunk), damage), [None]):
             if checkpoint is not None:
                 checkpoint()
-            outputs = stream.process(raws)
+            outputs = stream.finish() if raws is None else stream.process(raws)
             if static_due and outputs:
                 out.write(*static_transforms(scene, outputs[0][1]))
                 static_due = False
@@ -329,11 +349,11 @@ def replay(
                 tilt = max(tilt, float(tilt_from_quaternions(batch.quaternion).max()))
             for report in batch.health if batch is not None else []:
                 _keep_worst(worst, report)
-            bar.update(len(raws))
-        for topic, stamp, raw in stream.finish():  # the last, partial diagnostics period
-            out.write(resolved[topic], stamp, raw)
+            bar.update(len(raws or ()))
         if stream.final_report is not None:
             _keep_worst(worst, stream.final_report)
+        if damage:
+            raise damage[0]
         written = out.written
     wall = time.perf_counter() - wall0
     span = float(last_stamp - first_stamp) if first_stamp is not None else 0.0
@@ -355,4 +375,5 @@ def replay(
         float(first_stamp) if first_stamp is not None else 0.0,
         stream.engine.error_estimate,
         stream.engine.failure_text,
+        stream.engine.health.latency,
     )

@@ -34,8 +34,9 @@ class TwinStream:
         self._last_ns = 0
         self._received_ns = 0
         """Stamp (ns) of the last sample received with a stamp (> 0), accepted or not."""
-        self._held_ns = 0
-        """Stamp (ns) of the sample the engine holds back (see TwinEngine.holding)."""
+        self._tail_ns = np.zeros(0, np.int64)
+        """Stamps (ns) of the last samples pushed that later outputs may answer
+        (`TwinEngine.lookback`: the gyro delay, a sample held back), oldest first."""
         self.final_report: HealthReport | None = None
 
     def process(self, raws: list[bytes]) -> list[tuple[str, int, bytes]]:
@@ -63,14 +64,17 @@ class TwinStream:
                 return []
             self.base = TimeBase.at(int(decoded.stamps_ns[0]))
             self.engine.health.origin_s = self.base.origin_ns // 1_000_000_000
-        held = self.engine.holding
         out = self.engine.push(decoded.batch(self.base))
         self.last_outputs = out
-        # Rows and reports of the sample held back from the last push come as sample −1: the
-        # stamps get its stamp appended, where index −1 finds it.
-        stamps_ns = np.append(decoded.stamps_ns, self._held_ns) if held else decoded.stamps_ns
-        if self.engine.holding and len(decoded.stamps_ns):
-            self._held_ns = int(decoded.stamps_ns[-1])
+        # Rows of samples of earlier pushes (the gyro delay, a sample held back) come as
+        # negative samples: the earlier stamps appended find them (−1: the last one).
+        stamps_ns = np.concatenate([decoded.stamps_ns, self._tail_ns])
+        tail = np.concatenate([self._tail_ns, decoded.stamps_ns])
+        self._tail_ns = tail[tail.shape[0] - self.engine.lookback :]
+        return self._encode(out, stamps_ns)
+
+    def _encode(self, out: OutputBatch, stamps_ns: np.ndarray) -> list[tuple[str, int, bytes]]:
+        """encode_outputs, keeping the last stamp answered."""
         if len(out):
             self._last_ns = int(stamps_ns[out.sample[-1]])
         return encode_outputs(self.scene, out, stamps_ns)
@@ -81,10 +85,15 @@ class TwinStream:
         return [encode_report(self.scene, self.engine.report_stalled(waited_s), stamp_ns)]
 
     def finish(self) -> list[tuple[str, int, bytes]]:
-        """The last, partial diagnostics period (end of a bag, node shutdown), stamped with the
-        last input stamp answered (none answered: the last received; none with a stamp: 0);
-        nothing if that period is empty."""
-        report = self.final_report = self.engine.flush()
-        if report is None:
-            return []
-        return [encode_report(self.scene, report, self._last_ns or self._received_ns)]
+        """The end of the stream (end of a bag, node shutdown): the outputs the gyro delay
+        still holds, then the last, partial diagnostics period, stamped with the last input
+        stamp answered (none answered: the last received; none with a stamp: 0); no report if
+        that period is empty."""
+        out = self.engine.flush()
+        reports, out.health = out.health, []
+        msgs = self._encode(out, self._tail_ns)
+        self._tail_ns = self._tail_ns[:0]
+        self.last_outputs = out
+        self.final_report = reports[0] if reports else None
+        stamp_ns = self._last_ns or self._received_ns
+        return msgs + [encode_report(self.scene, r, stamp_ns) for r in reports]

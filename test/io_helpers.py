@@ -157,9 +157,10 @@ def mount_forces_in_f(scene: Scene, wrenches: np.ndarray) -> np.ndarray:
 def push_all(
     engine: TwinEngine, parts: list[SampleBatch]
 ) -> tuple[OutputBatch, list[list[HealthReport]]]:
-    """Push each part; return the concatenated outputs and the reports of each push (the joined
-    `sample` column is per push, so meaningless here: tests read stamps, poses and wrenches)."""
-    outs = [engine.push(p) for p in parts]
+    """Push each part, then flush (the end of the stream: the rows the gyro delay holds); return
+    the concatenated outputs and the reports of each push and of the flush (the joined `sample`
+    column is per push, so meaningless here: tests read stamps, poses and wrenches)."""
+    outs = [*(engine.push(p) for p in parts), engine.flush()]
     joined = OutputBatch(
         np.concatenate([o.stamps for o in outs]),
         np.concatenate([o.sample for o in outs]),

@@ -26,8 +26,7 @@ def _run(accel: np.ndarray, sizes: list[int] | None = None, **inp: float):
     engine = engine_for(scene_with(input=inp) if inp else None)
     for part in split(batch(T, accel), sizes or [N]):
         engine.push(part)
-    report = engine.flush()
-    assert report is not None
+    (report,) = engine.flush().health
     (status,) = [s for s in report.statuses if s.name == "mount_twin: input"]
     return engine.counts, status
 

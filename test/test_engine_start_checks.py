@@ -19,9 +19,7 @@ def _input_status(accel: np.ndarray, **sections: dict) -> HealthStatus:
     """The input status of the one report of a short run from rest readings `accel` (n, 3)."""
     n = accel.shape[0]
     engine = engine_for(scene_with(**sections) if sections else None)
-    engine.push(batch(1.0 + np.arange(n) * 1e-3, accel))
-    report = engine.flush()
-    assert report is not None
+    (report,) = engine.run(batch(1.0 + np.arange(n) * 1e-3, accel)).health
     (status,) = [s for s in report.statuses if s.name == "mount_twin: input"]
     return status
 
@@ -103,12 +101,12 @@ def test_the_start_gravity_is_the_mean_of_the_first_n_samples() -> None:
     accel = REST + rng.normal(0.0, 0.05, (200, 3))
     scene = scene_with(initial={"gravity_samples": n_start})
     engine = engine_for(scene)
-    out = engine.push(batch(1.0 + np.arange(200) * 1e-3, accel))
+    out = engine.run(batch(1.0 + np.arange(200) * 1e-3, accel))
     assert out.sample[0] == n_start - 1
     assert out.stamps[0] == pytest.approx(1.0 + (n_start - 1) * 1e-3)
     expected = initial_state(assemble(scene), accel[:n_start].mean(axis=0))
     reference = engine_for(scene_with(initial={"gravity_samples": 1}))
-    reference.push(batch([1.0], accel[:n_start].mean(axis=0)[None, :]))
+    reference.run(batch([1.0], accel[:n_start].mean(axis=0)[None, :]))
     np.testing.assert_allclose(reference.state, expected, rtol=0, atol=1e-15)
     assert engine.counts["accepted"] == 200
 
@@ -125,5 +123,5 @@ def test_a_gap_reset_while_gathering_starts_the_gathering_again() -> None:
     scene = scene_with(initial={"gravity_samples": 5})
     engine = engine_for(scene)
     stamps = np.concatenate([1.0 + np.arange(3) * 1e-3, 3.0 + np.arange(6) * 1e-3])
-    out = engine.push(batch(stamps))
+    out = engine.run(batch(stamps))
     assert out.stamps[0] == pytest.approx(3.0 + 4e-3)  # 5th sample after the gap

@@ -18,7 +18,7 @@ from io_helpers import CONFIG, ROOT, default_scene, split
 from kinds_helpers import kind_mount
 from physics_helpers import base_scene, mount
 
-from mount_twin.analysis.accuracy import conditioned, measure, reference_run, run_at
+from mount_twin.analysis.accuracy import measure, raw_gyro, reference_run, run_at
 from mount_twin.engine.batch import WARN, SampleBatch
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.health import INTEGRATION
@@ -42,7 +42,7 @@ def _first(samples: SampleBatch, n: int) -> SampleBatch:
 
 def _ship_motion(scene: Scene, seconds: float) -> tuple[Scene, SampleBatch]:
     samples = read_samples(ROOT / "bags" / "ship_motion_1khz", scene.input)
-    return conditioned(scene, _first(samples, int(seconds * 1000) + 1))
+    return raw_gyro(scene), _first(samples, int(seconds * 1000) + 1)
 
 
 def _with_pump_input(data: dict) -> Scene:
@@ -87,7 +87,7 @@ def _rubber_on_snubbers() -> tuple[Scene, SampleBatch]:
     pulse = np.where((t > 1.02) & (t < 1.025), 30 * G * np.sin(math.pi * (t - 1.02) / 0.005), 0.0)
     accel = np.column_stack([0.3 * pulse, np.zeros_like(t), G + pulse])
     frames = [scene.input.frame_id] * t.shape[0]
-    return conditioned(scene, SampleBatch(t, accel, np.zeros_like(accel), frames))
+    return raw_gyro(scene), SampleBatch(t, accel, np.zeros_like(accel), frames)
 
 
 def _pump() -> tuple[Scene, SampleBatch]:
@@ -131,9 +131,7 @@ def test_the_estimate_never_changes_what_is_published(case: str) -> None:
 def _integration_status(scene: Scene, samples: SampleBatch):
     """The engine after the run, and its worst integration status of the run."""
     engine = TwinEngine(assemble(scene))
-    reports = list(engine.push(samples).health)
-    final = engine.flush()
-    reports += [final] if final is not None else []
+    reports = engine.run(samples).health
     statuses = [s for r in reports for s in r.statuses if s.name == "mount_twin: integration"]
     return engine, max(statuses, key=lambda s: s.level)
 
@@ -247,7 +245,7 @@ def _soft_beside(stop: dict) -> tuple[Scene, SampleBatch]:
     accel = np.column_stack([push, np.zeros_like(t), np.full_like(t, G)])
     scene = _with_pump_input(data)
     frames = [scene.input.frame_id] * t.shape[0]
-    return conditioned(scene, SampleBatch(1.0 + t, accel, np.zeros_like(accel), frames))
+    return raw_gyro(scene), SampleBatch(1.0 + t, accel, np.zeros_like(accel), frames)
 
 
 BEARING_RHO_DT = math.sqrt(1e9 * (1 / 5.0 + 0.1**2 / 0.1)) * 1e-3

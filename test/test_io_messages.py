@@ -148,10 +148,15 @@ def test_accel_stamped_without_gravity_gets_g_added_on_z_of_f() -> None:
     acc_out = TwinStream(accel_scene)
     imu_msgs = imu_out.process(imu_raws)
     acc_msgs = acc_out.process(acc_raws)
-    assert len(imu_msgs) == len(acc_msgs) == n * (3 + 8)  # pose, angles, /tf, 8 wrenches
+    poses = [(imu_out.last_outputs.pose, acc_out.last_outputs.pose)]
+    imu_msgs += imu_out.finish()  # the end: the rows the gyro delay holds
+    acc_msgs += acc_out.finish()
+    poses.append((imu_out.last_outputs.pose, acc_out.last_outputs.pose))
+    # pose, angles, /tf, 8 wrenches per sample, then the final report
+    assert len(imu_msgs) == len(acc_msgs) == n * (3 + 8) + 1
     np.testing.assert_allclose(
-        acc_out.last_outputs.pose,
-        imu_out.last_outputs.pose,
+        np.concatenate([acc for _, acc in poses]),
+        np.concatenate([imu for imu, _ in poses]),
         rtol=0,
         atol=1e-12,
         err_msg="AccelStamped + g on z must move the twin exactly as Imu with gravity included",
@@ -193,15 +198,17 @@ def test_stream_output_stamps_stay_exact_for_a_node_running_a_year() -> None:
     stamps, accel, gyro = rng_signal(300, seed=2)
     stamps = stamps + year_ns + np.arange(300) * 3  # odd ns everywhere
     msgs = stream.process([raw for _, raw in imu_messages(stamps, accel, gyro, "deck_imu")])
+    msgs += stream.finish()  # the end: the rows the gyro delay holds
     assert stream.engine.counts["gaps"] == 1  # the year between them: a restart, not a failure
     pose_stamps = [s for topic, s, _ in msgs if topic == "~/pose"]
-    assert pose_stamps == stamps.tolist()
+    assert pose_stamps == [*first.tolist(), *stamps.tolist()]  # the first: at the restart
 
 
 def test_stream_output_stamps_equal_input_stamps_exactly() -> None:
     stamps, accel, gyro = rng_signal(200)
     stream = TwinStream(scene_with(outputs={"diagnostics_period_s": 100.0}))
     msgs = stream.process([raw for _, raw in imu_messages(stamps, accel, gyro, "deck_imu")])
+    msgs += stream.finish()  # the end: the rows the gyro delay holds
     pose_stamps = [s for topic, s, _ in msgs if topic == "~/pose"]
     assert pose_stamps == stamps.tolist()
 
@@ -297,6 +304,7 @@ def test_diagnostics_are_encoded_with_levels_names_and_values() -> None:
             HealthStatus("mount_twin: integration", ERROR, "failed", {}),
             HealthStatus("mount_twin: attitude", OK, "ok", {"tilt_max_rad": "0.01"}),
         ],
+        rows=1,  # due after the batch's one row
     )
     msgs = encode_outputs(scene, _one_row_batch(scene, 0.25, [report]), np.array([START_NS]))
     diag = [(s, raw) for t, s, raw in msgs if t == "/diagnostics"]

@@ -284,7 +284,7 @@ def test_single_dof_hysteresis_loop_through_the_engine_matches_an_independent_in
     accel = np.zeros((t.size, 3))
     accel[:, 2] = G + a
     engine = TwinEngine(model)
-    out = engine.push(SampleBatch(t, accel, np.zeros((t.size, 3)), ["imu"] * t.size))
+    out = engine.run(SampleBatch(t, accel, np.zeros((t.size, 3)), ["imu"] * t.size))
     assert len(out) == t.size
 
     z0 = brentq(lambda z: RATIO * (K1Z * z + K3Z * z**3) + MASS * G, -0.1, 0.0, xtol=1e-16)

@@ -144,7 +144,7 @@ def test_a_body_in_the_clearance_flies_freely_and_bounces_elastically_off_the_ke
     )
     t = np.arange(1501) / 10_000.0  # 150 ms: more than two bounces
     engine = TwinEngine(build(scene))
-    out = engine.push(SampleBatch(t, np.zeros((t.size, 3)), np.zeros((t.size, 3)), [""] * t.size))
+    out = engine.run(SampleBatch(t, np.zeros((t.size, 3)), np.zeros((t.size, 3)), [""] * t.size))
     x_ref, v_ref, force_ref = bounce(t)
     assert np.sum(np.diff(np.sign(x_ref)) != 0) >= 3, "the body should cross the clearance"
     scale = SPEED / OMEGA  # penetration amplitude

@@ -42,9 +42,8 @@ def _engine(
 
 
 def _run(engine: TwinEngine, accel: np.ndarray | None = None, n: int = 200):
-    out = engine.push(batch(1.0 + np.arange(n) * 1e-3, accel))
-    report = engine.flush()
-    assert report is not None
+    out = engine.run(batch(1.0 + np.arange(n) * 1e-3, accel))
+    report = out.health[-1]
     (status,) = [s for s in report.statuses if s.name == "mount_twin: mount m0"]
     return out, status
 

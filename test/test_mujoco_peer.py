@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from io_helpers import CONFIG, ROOT
 
-from mount_twin.analysis.accuracy import conditioned, run_at
+from mount_twin.analysis.accuracy import raw_gyro, run_at
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.io.input_samples import read_samples
 from mount_twin.model.assemble import assemble
@@ -35,7 +35,7 @@ def _pump(seconds: float) -> tuple:
     cut = SampleBatch(
         full.stamps[keep], full.accel[keep], full.gyro[keep], list(np.array(full.frame_ids)[keep])
     )
-    return conditioned(scene, cut)
+    return raw_gyro(scene), cut
 
 
 def test_mujoco_matches_the_twin_on_the_pump() -> None:

@@ -35,8 +35,10 @@ def _push_all(scene, accel: np.ndarray, chunk: int):
         poses.append(out.pose)
         wrenches.append(out.wrenches)
         reports.extend(out.health)
-    final = engine.flush()
-    reports.extend([final] if final is not None else [])
+    final = engine.flush()  # the end: the rows the gyro delay holds, the last report
+    poses.append(final.pose)
+    wrenches.append(final.wrenches)
+    reports.extend(final.health)
     return np.concatenate(poses), np.concatenate(wrenches), reports
 
 

@@ -77,7 +77,7 @@ def deck_motion(rate: float = 1000.0, duration: float = 1.5) -> SampleBatch:
 
 
 def run(data: dict, batch: SampleBatch) -> np.ndarray:
-    out = TwinEngine(build(data)).push(batch)
+    out = TwinEngine(build(data)).run(batch)
     assert len(out) == len(batch)
     return out.pose
 

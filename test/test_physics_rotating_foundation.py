@@ -105,7 +105,7 @@ def spin(model, omega_z: float, gravity: float, duration: float, rate: float = 1
     t = np.arange(round(duration * rate) + 1) / rate
     accel = np.tile([0.0, 0.0, gravity], (t.size, 1))
     gyro = np.tile([0.0, 0.0, omega_z], (t.size, 1))
-    out = TwinEngine(model).push(SampleBatch(t, accel, gyro, ["deck_imu"] * t.size))
+    out = TwinEngine(model).run(SampleBatch(t, accel, gyro, ["deck_imu"] * t.size))
     assert len(out) == t.size
     return out.pose
 

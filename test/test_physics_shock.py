@@ -123,7 +123,7 @@ def run_twin(signal, hold: str) -> tuple[np.ndarray, np.ndarray]:
     data["input"]["hold"] = hold
     engine = TwinEngine(build(data))
     n = signal.t.size
-    out = engine.push(SampleBatch(signal.t, signal.accel, signal.gyro, ["imu"] * n))
+    out = engine.run(SampleBatch(signal.t, signal.accel, signal.gyro, ["imu"] * n))
     assert len(out) == n, f"{len(out)} outputs for {n} samples"
     np.testing.assert_array_equal(out.stamps, signal.t)
     return out.stamps, out.pose[:, 2] - CG_Z

@@ -52,7 +52,11 @@ def scene_text(scene: Scene) -> str:
     lines += [
         f"input:   {i.topic} ({i.msg_type}), frame_id {i.frame_id or '(any)'}, "
         f"gyro {i.gyro_filter}"
-        + (f" {i.gyro_cutoff_hz:g} Hz" if i.gyro_filter == "lowpass" else ""),
+        + (
+            f" {i.gyro_passband_hz:g}/{i.gyro_stopband_hz:g} Hz"
+            if i.gyro_filter == "linear_phase"
+            else ""
+        ),
         f"integration: {g.method}"
         + (
             " (by stiffness: at the first sample interval, again after a contact)"

@@ -82,11 +82,14 @@ def event_level(error: bool) -> str:
 
 @dataclass
 class HealthReport:
-    """Diagnostics at one stamp (s), due once sample `sample` of the pushed batch is processed."""
+    """Diagnostics at one stamp (s), due once sample `sample` of the pushed batch is processed,
+    published after the first `rows` output rows of its batch (with the gyro delay, rows of
+    earlier samples may follow it)."""
 
     stamp: float
     sample: int
     statuses: list[HealthStatus]
+    rows: int = 0
 
 
 @dataclass
@@ -121,6 +124,20 @@ class OutputBatch:
             np.zeros(0, np.intp),
             np.zeros((0, pose_row.WIDTH)),
             np.zeros((0, n_mounts, 6)),
+        )
+
+    def then(self, later: OutputBatch, n: int) -> OutputBatch:
+        """These rows and reports, then `later`'s, which count their samples (and rows) from
+        the end of a batch of n samples (`TwinEngine.flush` after a push of n)."""
+        for report in later.health:
+            report.sample += n
+            report.rows += len(self)
+        return OutputBatch(
+            np.concatenate([self.stamps, later.stamps]),
+            np.concatenate([self.sample, later.sample + n]),
+            np.concatenate([self.pose, later.pose]),
+            np.concatenate([self.wrenches, later.wrenches]),
+            [*self.health, *later.health],
         )
 
     def select(self, keep: np.ndarray) -> OutputBatch:

@@ -10,7 +10,6 @@ import math
 import time
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -32,8 +31,9 @@ from mount_twin.engine.batch import (
 )
 from mount_twin.engine.companion import Companion, new_companion, restart
 from mount_twin.engine.companion import switch as switch_companion
+from mount_twin.engine.delay_line import Frame, GyroDelay, Run
 from mount_twin.engine.estimate import ErrorEstimate
-from mount_twin.engine.gyro_filter import GyroConditioner
+from mount_twin.engine.gyro_filter import Design, fir_rows
 from mount_twin.engine.health import ENDED, PLATEAU_G, SATURATION_SHARE, HealthWindow
 from mount_twin.engine.kernel import (
     AT_EVENT,
@@ -161,14 +161,6 @@ class _Intervals(NamedTuple):
     plain: bool
 
 
-@dataclass
-class _Run:
-    """Accepted samples to integrate in one go; `restart`: the first one starts a new state."""
-
-    index: np.ndarray  # int64: positions in the pushed batch
-    restart: bool
-
-
 def _start_hint(spec: InputSpec, magnitude: float) -> str:
     """Why a start specific force of `magnitude` (m/s²) may be off g: the likeliest cause."""
     g = spec.g
@@ -215,7 +207,15 @@ class TwinEngine:
         self._skipped = 0
         """Samples rejected since the last taken one: they fill a stamp hole, are not lost."""
         self._gravity_up = np.array([0.0, 0.0, scene.input.g])
-        self._gyro = GyroConditioner(scene.input.gyro_filter, scene.input.gyro_cutoff_hz)
+        spec = scene.input
+        self._gyro = GyroDelay(
+            (spec.gyro_passband_hz, spec.gyro_stopband_hz)
+            if spec.gyro_filter == "linear_phase"
+            else None,
+            self._designed,
+        )
+        self._pushed = 0
+        """Samples pushed so far (a held one once)."""
         init = scene.initial
         self._start_samples = (
             init.gravity_samples
@@ -285,8 +285,7 @@ class TwinEngine:
         run_samples(
             integ, model.arrays, scratch, u, y, samples, self._options, out, watch, companion
         )
-        gyro = GyroConditioner(self.scene.input.gyro_filter, self.scene.input.gyro_cutoff_hz)
-        gyro.rows(t[1:], np.zeros((1, 3)), 0.0)
+        fir_rows(np.zeros((3, 3)), np.full(2, 0.5), np.empty((3, 1)))
         watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
         self._start_outputs(self._y_nominal.copy(), model.new_scratch(), watch)
 
@@ -412,16 +411,23 @@ class TwinEngine:
         nm = self.model.n_mounts
         if len(batch) == 0:
             return OutputBatch.empty(nm)
+        first_id = self._pushed
+        self._pushed += len(batch)
         if self._held is None:
-            return self._push(batch)
+            return self._push(batch, first_id)
         # The held sample goes first, now with the next one to confirm or refute it: positions
         # in the result count from it, so it is −1 to the caller.
         batch, self._held = SampleBatch.concat([self._held, batch]), None
-        out = self._push(batch)
+        out = self._push(batch, first_id - 1)
         out.sample -= 1
         for report in out.health:
             report.sample -= 1
         return out
+
+    def run(self, samples: SampleBatch) -> OutputBatch:
+        """A whole record: `push` it, then `flush`; every row and report, positions in
+        `samples` (the final report last)."""
+        return self.push(samples).then(self.flush(), len(samples))
 
     @property
     def holding(self) -> bool:
@@ -429,13 +435,32 @@ class TwinEngine:
         gives its outputs, as sample −1."""
         return self._held is not None
 
-    def _push(self, batch: SampleBatch) -> OutputBatch:
-        """`push` of a batch that holds any held-back sample first."""
+    @property
+    def lookback(self) -> int:
+        """How many of the samples pushed so far, counted back from the last, later outputs
+        may still answer (as negative `OutputBatch.sample`): the gyro delay's pending samples
+        (`delay_line`) and a sample held back (a stamp jump to confirm)."""
+        oldest = self._gyro.oldest_id
+        return max(0 if oldest is None else self._pushed - oldest, int(self.holding))
+
+    @property
+    def latency(self) -> int:
+        """Samples by which outputs follow their input (the gyro delay; 0 until designed)."""
+        return self._gyro.delay
+
+    def _designed(self, stamp: float, design: Design) -> None:
+        """The gyro filter was designed, at the interval into `stamp` (s)."""
+        self.health.gyro_designed(stamp, design)
+
+    def _push(self, batch: SampleBatch, first_id: int) -> OutputBatch:
+        """`push` of a batch that holds any held-back sample first (stream position
+        `first_id`)."""
         nm = self.model.n_mounts
         f, w, finite = self._screen(batch)
         verdicts, due, intervals = self._classify(batch, finite)
         suspect = self._suspect_readings(batch)
-        rows_out = _BatchRows(len(batch), nm)
+        frame = self._gyro.frame(batch.stamps, f, w, first_id)
+        rows_out = _BatchRows(len(frame.stamps), nm)
         parts: list[_Rows] = []
         reports = []
         start = 0
@@ -453,32 +478,49 @@ class TwinEngine:
                     ]
                 )
             self._add_intervals(intervals, start, stop)
-            first = len(parts)
             for run in self._runs(verdicts, start, stop):
-                parts.extend(self._integrate(run, batch.stamps, f, w, rows_out))
-            for rows in parts[first:]:
-                if rows.peaks is None:
-                    self.health.add_outputs(batch.stamps[rows.sample], rows.pose, rows.wrenches)
-                elif rows.sample.shape[0]:
-                    self.health.add_output_peaks(
-                        batch.stamps[rows.sample[0]], batch.stamps[rows.sample[-1]], *rows.peaks
-                    )
-                np.maximum(
-                    self._linear_util,
-                    self._ratings.utilisation(rows.pose, rows.wrenches),
-                    out=self._linear_util,
-                )
+                self._follow(self._gyro.feed(run, frame), frame, rows_out, parts)
             self.health.add_wall(self._clock() - wall0)
             if report_due:
                 stamp = float(batch.stamps[stop - 1])
-                reports.append(self._report(stamp, stop - 1))
+                reports.append(self._report(stamp, stop - 1, parts))
             start = stop
+        self._gyro.close(frame)
+        return self._outputs(frame, rows_out, parts, reports)
+
+    def _follow(self, runs: list[Run], frame: Frame, rows: _BatchRows, parts: list[_Rows]) -> None:
+        """Integrate runs of frame rows (`_integrate`), their outputs onto `parts` and into the
+        health window."""
+        first = len(parts)
+        for run in runs:
+            parts.extend(self._integrate(run, frame.stamps, frame.f, frame.w, rows))
+        for published in parts[first:]:
+            if published.peaks is None:
+                self.health.add_outputs(
+                    frame.stamps[published.sample], published.pose, published.wrenches
+                )
+            elif published.sample.shape[0]:
+                self.health.add_output_peaks(
+                    frame.stamps[published.sample[0]],
+                    frame.stamps[published.sample[-1]],
+                    *published.peaks,
+                )
+            np.maximum(
+                self._linear_util,
+                self._ratings.utilisation(published.pose, published.wrenches),
+                out=self._linear_util,
+            )
+
+    def _outputs(
+        self, frame: Frame, rows: _BatchRows, parts: list[_Rows], reports: list[HealthReport]
+    ) -> OutputBatch:
+        """The OutputBatch of a push's (or a flush's) published parts and reports."""
         if not parts:
-            empty = OutputBatch.empty(nm)
+            empty = OutputBatch.empty(self.model.n_mounts)
             empty.health = reports
             return empty
-        sample, pose, wrenches = rows_out.gather(parts)
-        return OutputBatch(batch.stamps[sample], sample, pose, wrenches, reports)
+        sample, pose, wrenches = rows.gather(parts)
+        return OutputBatch(frame.stamps[sample], frame.relative(sample), pose, wrenches, reports)
 
     def _add_intervals(self, intervals: _Intervals, start: int, stop: int) -> None:
         """Hand the stamp intervals of samples [start, stop) to the health window."""
@@ -538,6 +580,8 @@ class TwinEngine:
         f = accel @ rot.T
         if not self.scene.input.includes_gravity:
             f = f + self._gravity_up
+        if self.scene.input.gyro_filter == "ignore":  # the foundation's rotation neglected
+            return f, np.zeros_like(f), finite
         return f, gyro @ rot.T, finite
 
     def _classify(
@@ -649,7 +693,7 @@ class TwinEngine:
         return tally
 
     @staticmethod
-    def _runs(verdicts: list[str], start: int, stop: int) -> list[_Run]:
+    def _runs(verdicts: list[str], start: int, stop: int) -> list[Run]:
         """Group the taken samples in [start, stop) into runs split at restarts."""
         segment = verdicts[start:stop]
         if not segment:
@@ -658,7 +702,7 @@ class TwinEngine:
         restart = head in _RESTARTS
         if (head == ACCEPT or restart) and segment.count(ACCEPT) == len(segment) - restart:
             # the usual cases, without a Python loop: all accepted, or a start and the rest
-            return [_Run(np.arange(start, stop), restart)]
+            return [Run(np.arange(start, stop), restart)]
         runs: list[tuple[list[int], bool]] = []
         for i in range(start, stop):
             verdict = verdicts[i]
@@ -668,10 +712,10 @@ class TwinEngine:
                 runs.append(([i], verdict in _RESTARTS))
             else:
                 runs[-1][0].append(i)
-        return [_Run(np.array(index, dtype=np.int64), restart) for index, restart in runs]
+        return [Run(np.array(index, dtype=np.int64), restart) for index, restart in runs]
 
     def _integrate(
-        self, run: _Run, stamps: np.ndarray, f: np.ndarray, w: np.ndarray, rows: _BatchRows
+        self, run: Run, stamps: np.ndarray, f: np.ndarray, w: np.ndarray, rows: _BatchRows
     ) -> list[_Rows]:
         """Integrate one run, its outputs into `rows` where it can; on a stepper failure
         restart at the next sample."""
@@ -692,9 +736,8 @@ class TwinEngine:
         if len(index) and self._rho is not None:
             interval = float(stamps[index[0]]) - self._last[0]  # type: ignore[index]
             self._use(at_start(self.model, *self._rho, interval))
-        # The run's samples from the last one done on, gyro rows conditioned once: after a stop
-        # at an event the run goes on with the rows it has (conditioning them again advanced
-        # the filter twice: output depended on where the batches ended).
+        # The run's samples from the last one done on: after a stop at an event the run goes on
+        # with the rows it has.
         segment: Samples | None = None
         while len(index):
             if segment is None:
@@ -703,7 +746,6 @@ class TwinEngine:
                 t, ff, ww = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
                 t[0], ff[0], ww[0] = t0, f0, w0  # row 0: the last sample done
                 t[1:], ff[1:], ww[1:] = stamps[index], f[index], w[index]
-                self._gyro.rows(t[1:], ww[1:], t0)
                 segment = Samples(t, ff, ww)
             t, ff, ww = segment
             out_buf = self._buffers(len(t), self._counter, self._peak, rows.of_run(index))
@@ -742,7 +784,7 @@ class TwinEngine:
                 index = index[done:]
                 segment = Samples(t[done:], ff[done:], ww[done:])
                 continue
-            segment = None  # a restart conditions the gyro rows after it afresh
+            segment = None  # a restart takes the rows after it afresh
             self.counts["integration_failures"] += 1
             cause = STATUS_TEXT.get(status, f"status {status}")
             self.failure_causes[cause] += 1
@@ -779,9 +821,11 @@ class TwinEngine:
         out.append(start)
         return True
 
-    def flush(self) -> HealthReport | None:
-        """The report of what happened since the last one, due or not (end of a bag, shutdown);
-        None if nothing was processed since. Its `sample` is −1: the last accepted sample.
+    def flush(self) -> OutputBatch:
+        """The end of the stream (end of a bag, shutdown): the outputs of the samples the gyro
+        delay still holds (the rate after the last held at its value; `sample` negative, −1
+        the last sample pushed), and in `health` the report of what happened since the last
+        one, due or not (none if nothing was processed since; its `sample` is −1).
 
         A sample still held back (a stamp jump that no later sample confirmed) is counted as
         rejected_unconfirmed_jump: the record ends before it can be told from a glitch. Where
@@ -792,13 +836,18 @@ class TwinEngine:
             self._held = None
             self.count("received")
             self.count("rejected_unconfirmed_jump")
-        if self._last_stamp is None:
-            if not self.counts["received"] or self.counts["accepted"]:
-                return None
-            return self._report(math.nan, -1, stalled_s=ENDED)
-        if not self.health.pending:
-            return None
-        return self._report(self._last_stamp, -1)
+        empty = np.zeros((0, 3))
+        frame = self._gyro.frame(np.zeros(0), empty, empty, self._pushed)
+        rows = _BatchRows(len(frame.stamps), self.model.n_mounts)
+        parts: list[_Rows] = []
+        self._follow(self._gyro.drain(frame), frame, rows, parts)
+        reports = []
+        if self._last_stamp is not None:
+            if self.health.pending:
+                reports.append(self._report(self._last_stamp, -1, parts))
+        elif self.counts["received"] and not self.counts["accepted"]:
+            reports.append(self._report(math.nan, -1, parts, stalled_s=ENDED))
+        return self._outputs(frame, rows, parts, reports)
 
     def report_stalled(self, waited_s: float) -> HealthReport:
         """The report a live adapter publishes when `waited_s` (s, its clock) passed without
@@ -814,7 +863,15 @@ class TwinEngine:
         self.health.restart_cadence()
         return report
 
-    def _report(self, stamp: float, sample: int, stalled_s: float | None = None) -> HealthReport:
+    def _report(
+        self,
+        stamp: float,
+        sample: int,
+        parts: list[_Rows] | None = None,
+        stalled_s: float | None = None,
+    ) -> HealthReport:
+        """The report due at `stamp` (s), after sample `sample` and the output rows of `parts`
+        (those published before it in its batch)."""
         util = self._window_utilisation()
         per_mount = np.full(self.model.n_mounts, math.nan)
         per_mount[self._rated] = util
@@ -831,6 +888,7 @@ class TwinEngine:
             nominal_interval_s=nominal,
             stalled_s=stalled_s,
         )
+        report.rows = sum(p.sample.shape[0] for p in parts or ())
         np.maximum(self._util_max, util, out=self._util_max)
         self._watch.util_peak[:] = 0.0
         self._linear_util[:] = 0.0
@@ -875,7 +933,7 @@ class TwinEngine:
         self.health.add_events(new)
         return new
 
-    def _gather(self, run: _Run, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _gather(self, run: Run, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Take a run's samples toward a start (`initial.gravity_samples` of them).
 
         Returns the run's samples from the start sample on (none while still gathering) and
@@ -914,7 +972,7 @@ class TwinEngine:
         self.counts["starts"] += 1
         stamp = float(stamps[i])
         f0 = gathered.mean(axis=0)
-        w0 = self._gyro.start(w[i])
+        w0 = w[i].copy()
         start = start_state(self.model, self._y_nominal, self._gravity_up, f0, w0, damage)
         self._check_start(stamp, f0, gathered)
         if start.state is None:

@@ -7,85 +7,101 @@ metres per second squared at its mounts, and joint-slip alarms on a record at re
 
 Policies (scene key `input.gyro_filter`):
 
-- ``lowpass`` (default): Ω passes a critically damped second-order low-pass (two equal
-  first-order sections, advanced by their exact solution for a held input over the actual stamp
-  interval, so it holds for irregular stamps and any batching) whose −3 dB frequency is
-  `input.gyro_cutoff_hz` (default 50 Hz). Ω′ is then the slope of the filtered Ω, whose noise
-  is bounded by the cutoff, not by the sampling rate. The price: Ω lags by
-  2τ = 2·√(√2 − 1)/(2π·fc) (4.1 ms at 50 Hz) and rotation above the cutoff is attenuated.
-  Ship roll, pitch and hull whipping (< 20 Hz) pass. On a real 47 g water entry with tumbling
-  the default changes the peak mount force of the bundled pump by −2 % (`bench/gyro_noise.py`).
-- ``none``: Ω as sampled (exact for clean, e.g. simulated, input).
+- ``linear_phase`` (default): Ω passes a symmetric (linear-phase) FIR low-pass, which delays
+  every frequency by the same N samples, and the specific force f is delayed by those N
+  samples too (`engine/delay_line.py`): Ω, Ω′ and f then describe one deck motion, the motion
+  N samples ago, and the twin publishes it at the stamps it happened at, N samples late
+  (N ≈ 3.0 / (stopband − passband) s: 38 ms by default, at any sample rate). The
+  filter is flat to 2·FLATNESS up to `input.gyro_passband_hz` (default 20 Hz: ship motion, hull
+  whipping) and attenuates by 2·FLATNESS from `input.gyro_stopband_hz` (default 100 Hz) on, so
+  Ω′'s noise is bounded by the stopband, not the sampling rate. A causal filter on Ω alone
+  cannot do this: at 20 Hz an error of 1e-3 needs less than 8 µs of lag, and any lag of Ω
+  against f is a deck whose rotation disagrees with its acceleration.
+- ``none``: Ω as sampled, no latency (exact for clean, e.g. simulated, input).
 - ``ignore``: Ω = Ω′ = 0, the foundation's rotation neglected (accelerometer-only records).
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 from mount_twin.physics.compiled import kernel
-from mount_twin.scene.description import GYRO_FILTERS
 
-SECTION_SHARE = math.sqrt(math.sqrt(2.0) - 1.0)
-"""Two equal first-order sections of corner fc/SECTION_SHARE are −3 dB at fc together."""
+FLATNESS = 2e-5
+"""Design ripple δ of the Kaiser window (Kaiser's formulas give about δ in both bands; measured
+at 0.4-20 kHz: |H − 1| ≤ 3.5e-5 up to the passband edge, |H| ≤ 2.5e-5 from the stopband edge,
+so Ω is flat to 1e-4 as the twin's 1e-3 force budget needs)."""
+MIN_RATE_SHARE = 4.0
+"""A sample rate below this many times the stopband edge is too low for the filter: raw Ω."""
 
 
-def section_time_constant(cutoff_hz: float) -> float:
-    """Time constant τ (s) of each of the two sections for an overall −3 dB at `cutoff_hz`."""
-    return SECTION_SHARE / (2.0 * math.pi * cutoff_hz)
+class Design(NamedTuple):
+    """The filter for a sample rate: `half` (N + 1,) taps h[N], h[N ± 1], ... h[N ± N] (the
+    centre first; the FIR is symmetric, so it delays by exactly N samples); `rate_hz` the
+    sample rate it was designed for; `note` why it is raw (half = [1.0], N = 0), else ''."""
+
+    half: np.ndarray
+    rate_hz: float
+    note: str
+
+    @property
+    def delay(self) -> int:
+        """N, the delay in samples."""
+        return self.half.shape[0] - 1
+
+    @property
+    def delay_s(self) -> float:
+        """The delay in seconds at the design rate."""
+        return self.delay / self.rate_hz
+
+
+def design(rate_hz: float, passband_hz: float, stopband_hz: float) -> Design:
+    """The Kaiser-window low-pass for `rate_hz` (Kaiser 1974: attenuation A = −20 log10 δ,
+    β = 0.1102 (A − 8.7), order M = (A − 7.95) / (2.285 Δω) over the transition Δω), ideal
+    cut-off mid-transition, taps scaled to a DC gain of exactly 1 (a constant rate, the deck at
+    rest, passes unchanged). Raw (N = 0, with a note) below MIN_RATE_SHARE × the stopband."""
+    if not rate_hz >= MIN_RATE_SHARE * stopband_hz:
+        note = (
+            f"sample rate {rate_hz:.4g} Hz is below {MIN_RATE_SHARE:g} × input.gyro_stopband_hz "
+            f"({stopband_hz:g} Hz): the gyro is taken raw (no filter, no delay)"
+        )
+        return Design(np.ones(1), rate_hz, note)
+    attenuation = -20.0 * math.log10(FLATNESS)
+    beta = 0.1102 * (attenuation - 8.7)
+    transition = 2.0 * math.pi * (stopband_hz - passband_hz) / rate_hz
+    n = math.ceil((attenuation - 7.95) / (2.285 * transition) / 2.0)
+    cutoff = (passband_hz + stopband_hz) / rate_hz  # 2 fc / fs
+    k = np.arange(-n, n + 1)
+    taps = cutoff * np.sinc(cutoff * k) * np.kaiser(2 * n + 1, beta)
+    taps /= taps.sum()
+    return Design(taps[n:].copy(), rate_hz, "")
+
+
+def response(half: np.ndarray, frequency_hz: np.ndarray, rate_hz: float) -> np.ndarray:
+    """The zero-phase gain H(f) = h[N] + 2 Σ h[N + j] cos(2π f j / fs) of the filter (real:
+    the phase is the pure delay of N samples)."""
+    j = np.arange(1, half.shape[0])
+    arg = 2.0 * math.pi * np.outer(frequency_hz, j) / rate_hz
+    return half[0] + 2.0 * np.cos(arg) @ half[1:]
 
 
 @kernel
-def lowpass_rows(t, w, state, t_prev, tau) -> None:
-    """Filter gyro rows w (k, 3) rad/s at stamps t (k,) s in place, after the sample at
-    `t_prev` s; `state` (2, 3) holds the two sections' outputs y1, y2 and is advanced.
+def fir_rows(raw, half, out) -> None:
+    """out[i, k] = h[N]·raw[i, k + N] + Σ_j h[N + j]·(raw[i, k + N − j] + raw[i, k + N + j]),
+    j = 1..N in that order, for k < out.shape[1]: the filtered rate of the sample at
+    raw[:, k + N] (rad/s; per axis i, rows (3, ·) so the loop over k runs on contiguous memory).
 
-    Over an interval Δt the input x is held at the new sample (as a sample-and-hold would), and
-    the sections are advanced by their exact solution: with e = exp(−Δt/τ),
-    y1 ← x + (y1 − x)·e and y2 ← x + ((y2 − x) + (y1 − x)·Δt/τ)·e (the old y1): a cascade that
-    is exact for any stamp spacing, so irregular stamps and any batching give the same numbers.
-    """
-    before = t_prev
-    for k in range(t.shape[0]):
-        r = (t[k] - before) / tau
-        e = math.exp(-r)
-        before = t[k]
-        for i in range(3):
-            x = w[k, i]
-            d1 = state[0, i] - x
-            state[1, i] = x + (state[1, i] - x + d1 * r) * e
-            state[0, i] = x + d1 * e
-            w[k, i] = state[1, i]
-
-
-class GyroConditioner:
-    """Applies an `input.gyro_filter` policy to the Ω rows of accepted samples, in order.
-
-    `start(w0)` at each (re)start: the filter is at rest at the start sample's rate, which is
-    taken as it is (the start is a static equilibrium, Ω′ = 0). `rows(t, w, t_prev)` then
-    conditions the next rows in place.
-    """
-
-    def __init__(self, policy: str, cutoff_hz: float) -> None:
-        if policy not in GYRO_FILTERS:
-            msg = f"gyro filter {policy!r} is not one of {GYRO_FILTERS}"
-            raise ValueError(msg)
-        self.policy = policy
-        self.tau = section_time_constant(cutoff_hz)
-        self._state = np.zeros((2, 3))
-
-    def start(self, w0: np.ndarray) -> np.ndarray:
-        """The start sample's Ω as used (rad/s, a copy), and the filter at rest there."""
-        w0 = np.zeros(3) if self.policy == "ignore" else w0.copy()
-        self._state[:] = w0
-        return w0
-
-    def rows(self, t: np.ndarray, w: np.ndarray, t_prev: float) -> None:
-        """Condition rows w (k, 3) rad/s at stamps t (k,) s in place; t_prev: the last stamp
-        conditioned."""
-        if self.policy == "lowpass":
-            lowpass_rows(t, w, self._state, t_prev, self.tau)
-        elif self.policy == "ignore":
-            w[:] = 0.0
+    Each output sums the same terms in the same order whatever samples surround it, so any
+    batching gives the same bits."""
+    n = half.shape[0] - 1
+    m = out.shape[1]
+    for i in range(3):
+        for k in range(m):
+            out[i, k] = half[0] * raw[i, k + n]
+        for j in range(1, n + 1):
+            h = half[j]
+            for k in range(m):
+                out[i, k] += h * (raw[i, k + n - j] + raw[i, k + n + j])

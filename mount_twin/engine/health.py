@@ -15,6 +15,7 @@ from mount_twin.engine.estimate import (
     ErrorEstimate,
     accumulate,
 )
+from mount_twin.engine.gyro_filter import Design
 from mount_twin.physics import pose_row
 from mount_twin.scene.description import Scene
 
@@ -69,6 +70,8 @@ class HealthWindow:
         """Why it stopped (`stop`)."""
         self.last_wrong_frame_id: str | None = None
         """header.frame_id of the last sample rejected as wrong_frame (any period)."""
+        self.latency = (0, 0.0)
+        """Samples and seconds by which outputs follow their input (the gyro delay)."""
 
     def _reset(self) -> None:
         self.t_first = math.nan
@@ -89,6 +92,8 @@ class HealthWindow:
         self.wrong_frames: dict[str, None] = {}
         self.starts: list[tuple[float, float, float, list[tuple[int, str]]]] = []
         """(stamp s, |f0| m/s², tilt of f0 rad, findings (level, text)) per start."""
+        self.notes: list[str] = []
+        """Warnings on how the input is taken (a gyro filter the sample rate cannot carry)."""
 
     @property
     def pending(self) -> bool:
@@ -100,6 +105,13 @@ class HealthWindow:
             or self.starts
             or not math.isnan(self.t_last)
         )
+
+    def gyro_designed(self, stamp: float, design: Design) -> None:
+        """The gyro filter designed at the interval into `stamp` (s): its latency from now on;
+        a fallback to the raw gyro is a warning of this period."""
+        self.latency = (design.delay, design.delay_s)
+        if design.note:
+            self.notes.append(f"{self.origin_s + stamp:.6f} s: {design.note}")
 
     def add_steps(self, step_log: np.ndarray) -> None:
         """Per-sample stepper figures: (error norm, accepted, rejected substeps)."""
@@ -286,9 +298,10 @@ class HealthWindow:
         level = ERROR if self.failures or self.stopped_at is not None else OK
         estimate = self._estimate_values()
         warning = estimate_warning(ErrorEstimate.of(self.estimate_run)) if estimate else None
-        if warning is not None:
-            level = max(level, WARN)
-            step_text = warning + ("" if step_text == "ok" else f"; {step_text}")
+        for note in (*self.notes, warning):
+            if note is not None:
+                level = max(level, WARN)
+                step_text = note + ("" if step_text == "ok" else f"; {step_text}")
         step = HealthStatus(
             INTEGRATION,
             level,
@@ -305,6 +318,8 @@ class HealthWindow:
                 "real_time_factor": f"{rtf:.1f}",
                 "failures_total": str(counts["integration_failures"]),
                 "method_switches_total": str(counts["method_switches"]),
+                "latency_samples": str(self.latency[0]),
+                "latency_s": f"{self.latency[1]:.6g}",
             },
         )
         warn = self.scene.outputs.tilt_warn_rad

@@ -350,7 +350,8 @@ def encode_outputs(
     scene: Scene, out: OutputBatch, stamps_ns: np.ndarray
 ) -> list[tuple[str, int, bytes]]:
     """CDR messages for an output batch as (unresolved topic, stamp ns, bytes), in the order the
-    samples were processed; each diagnostics report follows the sample it was due at.
+    samples were processed; each diagnostics report follows the rows published before it was
+    due (`HealthReport.rows`).
 
     Args:
         stamps_ns: (n,) header stamps of the pushed samples, integer ns; rows reuse them, so
@@ -369,8 +370,8 @@ def encode_outputs(
     msgs: list[tuple[str, int, bytes]] = []
     reports = iter(out.health)
     report = next(reports, None)
-    for k, (sample, stamp) in enumerate(zip(out.sample.tolist(), stamps.tolist(), strict=True)):
-        while report is not None and report.sample < sample:
+    for k, stamp in enumerate(stamps.tolist()):
+        while report is not None and report.rows <= k:
             msgs.append(encode_report(scene, report, int(stamps_ns[report.sample])))
             report = next(reports, None)
         msgs.extend((topic, stamp, raws[k]) for topic, raws in rows)

@@ -278,9 +278,7 @@ class MountTwinNode(Node):
         unacked = [
             pub.topic_name
             for pub in self._pubs.values()
-            if not pub.wait_for_all_acked(
-                Duration(seconds=max(0.0, deadline - time.monotonic()))
-            )
+            if not pub.wait_for_all_acked(Duration(seconds=max(0.0, deadline - time.monotonic())))
         ]
         if unacked:
             self.get_logger().warning(

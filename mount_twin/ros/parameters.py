@@ -198,4 +198,3 @@ def check_qos_overrides(node: Node) -> None:
             declared = node.list_parameters([QOS_OVERRIDES.rstrip(".")], 0).names
             source = f"parameters of {node.get_fully_qualified_name()}"
             raise SceneError(source, name, f"no such QoS override; the node takes {declared}")
-

@@ -16,7 +16,7 @@ from mount_twin.kinds.shear_key import ShearKey
 DOF_NAMES: tuple[str, ...] = ("x", "y", "z", "alpha", "gamma", "delta")
 STANDARD_GRAVITY = 9.80665
 """m/s²: the unit of the checks scaled by g in a scene without gravity (`InputSpec.g_scale`)."""
-GYRO_FILTERS = ("lowpass", "none", "ignore")
+GYRO_FILTERS = ("linear_phase", "none", "ignore")
 """`input.gyro_filter` choices (mount_twin.engine.gyro_filter applies them)."""
 """Generalized coordinates: CG displacement X, Y, Z (m, F) and the chart angles α, γ, δ (rad)."""
 
@@ -95,9 +95,12 @@ class InputSpec:
         gap_policy: 'reset' (restart at equilibrium) or 'bridge' (integrate across the gap).
         back_jump_reset_s: a stamp going back by more than this resets the twin (bag --loop);
             smaller steps back are skipped.
-        gyro_filter: how Ω and Ω′ are taken from the gyro: 'lowpass', 'none' or 'ignore'
-            (see mount_twin.engine.gyro_filter).
-        gyro_cutoff_hz: −3 dB frequency of the 'lowpass' gyro filter, Hz.
+        gyro_filter: how Ω and Ω′ are taken from the gyro: 'linear_phase' (Ω low-passed
+            and f delayed alike: outputs come N samples late), 'none' or 'ignore' (see
+            mount_twin.engine.gyro_filter).
+        gyro_passband_hz: the 'linear_phase' filter is flat (to 4e-5) up to this, Hz.
+        gyro_stopband_hz: ... and attenuates (to 4e-5) from this on, Hz; the transition sets
+            the delay: about 3.0 / (stopband − passband) s (38 ms by default).
         accel_range_m_s2, gyro_range_rad_s: the sensor's full scale (0: unknown); a reading at
             it is counted as saturated (clipped: the true peak was higher).
     """
@@ -113,8 +116,9 @@ class InputSpec:
     max_gap_s: float = 0.5
     gap_policy: str = "reset"
     back_jump_reset_s: float = 1.0
-    gyro_filter: str = "lowpass"
-    gyro_cutoff_hz: float = 50.0
+    gyro_filter: str = "linear_phase"
+    gyro_passband_hz: float = 20.0
+    gyro_stopband_hz: float = 100.0
     accel_range_m_s2: float = 0.0
     gyro_range_rad_s: float = 0.0
 

@@ -289,13 +289,36 @@ def _input(r: Reader) -> InputSpec:
         max_gap_s=r.positive("max_gap_s", d.max_gap_s),
         gap_policy=r.choice("gap_policy", ("reset", "bridge"), d.gap_policy),
         back_jump_reset_s=r.number("back_jump_reset_s", d.back_jump_reset_s, lo=0.0),
-        gyro_filter=r.choice("gyro_filter", GYRO_FILTERS, d.gyro_filter),
-        gyro_cutoff_hz=r.positive("gyro_cutoff_hz", d.gyro_cutoff_hz),
+        gyro_filter=_gyro_filter(r, d.gyro_filter),
+        gyro_passband_hz=r.positive("gyro_passband_hz", d.gyro_passband_hz),
+        gyro_stopband_hz=r.positive("gyro_stopband_hz", d.gyro_stopband_hz),
         accel_range_m_s2=r.number("accel_range_m_s2", d.accel_range_m_s2, lo=0.0),
         gyro_range_rad_s=r.number("gyro_range_rad_s", d.gyro_range_rad_s, lo=0.0),
     )
+    if spec.gyro_stopband_hz <= spec.gyro_passband_hz:
+        raise r.error(
+            "gyro_stopband_hz",
+            f"{spec.gyro_stopband_hz:g} Hz is not above gyro_passband_hz "
+            f"({spec.gyro_passband_hz:g} Hz)",
+        )
     r.finish()
     return spec
+
+
+REMOVED_LOWPASS = (
+    "was removed: it delayed Ω but not the specific force (5-40 % of the mount force on a "
+    "1-20 Hz rolling deck); the default 'linear_phase' filters Ω and delays f alike (set its "
+    "band with gyro_passband_hz, gyro_stopband_hz), 'none' takes the gyro raw, without latency"
+)
+
+
+def _gyro_filter(r: Reader, default: str) -> str:
+    """input.gyro_filter, with the removed 'lowpass' (and its gyro_cutoff_hz) named."""
+    if r.has("gyro_cutoff_hz"):
+        raise r.error("gyro_cutoff_hz", f"(of gyro_filter 'lowpass') {REMOVED_LOWPASS}")
+    if r.raw("gyro_filter", default) == "lowpass":
+        raise r.error("gyro_filter", f"'lowpass' {REMOVED_LOWPASS}")
+    return r.choice("gyro_filter", GYRO_FILTERS, default)
 
 
 def _pose(r: Reader, key: str, default: Vec6) -> Vec6:

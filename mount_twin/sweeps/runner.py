@@ -116,11 +116,8 @@ def run_cases(base: dict[str, Any], source: str, cases: list[Case]) -> list[dict
 
 def _figures(scene: Scene, samples: SampleBatch) -> dict[str, Any]:
     engine = TwinEngine(assemble(scene))
-    out = engine.push(samples)
-    reports = [*out.health]
-    final = engine.flush()
-    if final is not None:
-        reports.append(final)
+    out = engine.run(samples)
+    reports = out.health
     worst = max((s.level for r in reports for s in r.statuses), default=0)
     force = peak_magnitudes(out.wrenches)[:, 0] if len(out) else None
     util = engine.utilisation_max

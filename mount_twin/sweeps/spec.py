@@ -8,8 +8,8 @@ vary:                                 # each a key path into the scene and its v
     values: [1100.0, 1300.0]          # set
   - key: mounts[fl].position
     values: [[0.9, 0.4, 0.0], [1.0, 0.4, 0.0]]
-  - key: input.gyro_cutoff_hz
-    range: {start: 20.0, stop: 80.0, num: 3}   # evenly spaced, both ends included
+  - key: input.gyro_stopband_hz
+    range: {start: 60.0, stop: 100.0, num: 3}   # evenly spaced, both ends included
 combine: product                      # every combination (default), or zip (in step)
 inputs:                               # each case runs against every input
   - bag: ../bags/half_sine_shock_10khz

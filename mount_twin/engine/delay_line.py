@@ -1,0 +1,167 @@
+"""The delay line of `input.gyro_filter: linear_phase`: Ω filtered, f delayed alike.
+
+A sample's filtered rate needs the N samples after it (`gyro_filter.fir_rows`), so the twin
+integrates each accepted sample once N more of its run have come: the motion it integrates, Ω,
+Ω′ and f of sample k, is the deck's at stamp t_k (Ω delayed by the filter's N samples, f by the
+same N samples exactly), and its outputs carry sample k's stamp, N samples late.
+
+Run edges: before a run's first sample the rate is taken as that sample's, held (a start is at
+rest); at its end (a restart, a gap reset, the end of the stream) the pending samples are
+integrated with the rate after them held at the last one, so every accepted sample has its
+output. The filter is designed once, at the stream's first interval (`gyro_filter.design`).
+
+Everything depends on the accepted samples alone, in order: any batching gives the same bits.
+The engine works on a `Frame` per push: the samples still pending from earlier pushes, then the
+pushed ones.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from mount_twin.engine.gyro_filter import Design, design, fir_rows
+
+RAW = Design(np.ones(1), math.nan, "")
+"""No filter, no delay (`gyro_filter: none` and `ignore`)."""
+
+
+@dataclass
+class Run:
+    """Accepted samples to integrate in one go (rows of a Frame); `restart`: the first one
+    starts a new state."""
+
+    index: np.ndarray  # int64
+    restart: bool
+
+
+@dataclass
+class Frame:
+    """The samples of one push, after those still pending from earlier pushes (`offset` of
+    them): stamps (s), specific force f (m/s², F), Ω (rad/s, F: the filtered rate once a row
+    is integrated, raw before) per row; `stored_ids` the stream positions (among all pushed
+    samples) of the pending rows, `first_id` that of the push's first sample."""
+
+    stamps: np.ndarray
+    f: np.ndarray
+    w: np.ndarray
+    offset: int
+    stored_ids: np.ndarray
+    first_id: int
+
+    def relative(self, rows: np.ndarray) -> np.ndarray:
+        """The positions of rows' samples relative to the push's first sample (negative: a
+        sample of an earlier push)."""
+        rel = rows - self.offset
+        early = rows < self.offset
+        rel[early] = self.stored_ids[rows[early]] - self.first_id
+        return rel
+
+
+class GyroDelay:
+    """Filters Ω of accepted samples and releases them N samples late (see the module).
+
+    Args:
+        bands: (passband, stopband) edges, Hz, for `linear_phase`; None: raw (no delay).
+        designed: told the design (and the stamp, s, of the interval it came from) once made.
+    """
+
+    def __init__(
+        self,
+        bands: tuple[float, float] | None,
+        designed: Callable[[float, Design], None],
+    ) -> None:
+        self._bands = bands
+        self._designed = designed
+        self.design: Design | None = None if bands else RAW
+        self._pending = np.zeros(0, dtype=np.int64)
+        """Rows of the current frame accepted but not yet released, in order."""
+        self._raw = np.zeros((0, 3))
+        """Raw Ω of the pending samples and of up to N samples of their run before them."""
+        self._restart = False
+        """The pending samples' first starts a new state (its run's first release)."""
+        self._stored: Frame | None = None
+
+    @property
+    def delay(self) -> int:
+        """N, the delay in samples (0 until designed)."""
+        return 0 if self.design is None else self.design.delay
+
+    @property
+    def oldest_id(self) -> int | None:
+        """The stream position of the oldest pending sample (None: none pending)."""
+        return None if self._stored is None else int(self._stored.stored_ids[0])
+
+    def frame(self, stamps: np.ndarray, f: np.ndarray, w: np.ndarray, first_id: int) -> Frame:
+        """The frame of a push: pending samples, then these (w: raw Ω, rad/s, filtered in
+        place as samples are released)."""
+        old = self._stored
+        self._stored = None
+        if old is None:
+            return Frame(stamps, f, w, 0, self._pending, first_id)
+        self._pending = np.arange(old.offset)
+        return Frame(
+            np.concatenate([old.stamps, stamps]),
+            np.concatenate([old.f, f]),
+            np.concatenate([old.w, w]),
+            old.offset,
+            old.stored_ids,
+            first_id,
+        )
+
+    def close(self, frame: Frame) -> None:
+        """Keep the pending rows of `frame` for the next push."""
+        p = self._pending
+        if p.shape[0]:
+            ids = frame.first_id + p - frame.offset
+            early = p < frame.offset
+            ids[early] = frame.stored_ids[p[early]]
+            self._stored = Frame(frame.stamps[p], frame.f[p], frame.w[p], p.shape[0], ids, 0)
+
+    def feed(self, run: Run, frame: Frame) -> list[Run]:
+        """Take a run of accepted samples (batch positions); the runs now ready to integrate
+        (frame rows, their Ω filtered in frame.w)."""
+        rows = run.index + frame.offset
+        if self.delay == 0 and self.design is not None and not self._pending.shape[0]:
+            return [Run(rows, run.restart)] if rows.shape[0] else []
+        ready = self.drain(frame) if run.restart else []
+        if run.restart:
+            self._restart, self._raw = True, np.zeros((0, 3))
+        self._pending = np.concatenate([self._pending, rows])
+        self._raw = np.concatenate([self._raw, frame.w[rows]])
+        if self.design is None and self._pending.shape[0] >= 2:
+            t0, t1 = frame.stamps[self._pending[:2]]
+            self.design = design(1.0 / (t1 - t0), *self._bands)  # type: ignore[misc]
+            self._designed(float(t1), self.design)
+        if self.design is not None:
+            ready.extend(self._release(self._pending.shape[0] - self.delay, frame, end=False))
+        return ready
+
+    def drain(self, frame: Frame) -> list[Run]:
+        """Release every pending sample, the rate after the last held at its value (a run's
+        end)."""
+        return self._release(self._pending.shape[0], frame, end=True)
+
+    def _release(self, n: int, frame: Frame, *, end: bool) -> list[Run]:
+        """The first n pending samples, their Ω filtered into frame.w."""
+        if n <= 0:
+            return []
+        half = (self.design or RAW).half
+        delay = half.shape[0] - 1
+        raw, pending = self._raw, self._pending
+        before = raw.shape[0] - pending.shape[0]
+        parts = [np.repeat(raw[:1], delay - before, axis=0), raw]
+        if end:
+            parts.append(np.repeat(raw[-1:], delay, axis=0))
+        out = np.empty((3, n))
+        fir_rows(np.ascontiguousarray(np.concatenate(parts).T), half, out)
+        rows = pending[:n]
+        frame.w[rows] = out.T
+        self._pending = pending[n:]
+        self._raw = raw[max(0, before + n - delay) :]
+        released = Run(rows, self._restart)
+        self._restart = False
+        return [released]
