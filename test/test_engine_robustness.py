@@ -210,15 +210,24 @@ def _gap_run(policy: str) -> tuple[TwinEngine, SampleBatch, OutputBatch, list[li
     return engine, full, out, reports
 
 
-def test_gap_with_reset_policy_restarts_at_equilibrium_and_warns() -> None:
+def _gap_reported(report: HealthReport) -> None:
+    """The period of the gap: an ERROR naming the gap and the 700 samples a 1 kHz sensor sent
+    in its 0.701 s that never came (past 1 % of the period lost)."""
+    st = status(report, "input")
+    assert st.level == ERROR, st
+    assert st.message.startswith("0 samples rejected, 1 gaps in this period; ~700 samples lost")
+    assert st.values["lost_in_period"] == "700"
+
+
+def test_gap_with_reset_policy_restarts_at_equilibrium_and_reports_the_input_lost() -> None:
     engine, full, out, reports = _gap_run("reset")
     assert engine.counts["gaps"] == 1 and engine.counts["restarts"] == 1
     np.testing.assert_array_equal(out.stamps, full.stamps)
     assert_finite(out)
     np.testing.assert_allclose(out.pose[200], equilibrium_pose(), rtol=0, atol=POSE_TOL)
     levels = [status(r[0], "input").level for r in reports]  # per push, then the flush
-    assert levels == [OK, OK, WARN, OK, OK], f"input levels per period: {levels}"
-    assert status(reports[2][0], "input").message == "0 samples rejected, 1 gaps in this period"
+    assert levels == [OK, OK, ERROR, OK, OK], f"input levels per period: {levels}"
+    _gap_reported(reports[2][0])
 
 
 def test_gap_with_bridge_policy_integrates_across_it_without_restart() -> None:
@@ -230,7 +239,7 @@ def test_gap_with_bridge_policy_integrates_across_it_without_restart() -> None:
     assert moved > 1e-7, (
         f"bridged twin should still carry the shock's motion, differs by {moved} m"
     )
-    assert status(reports[2][0], "input").level == WARN
+    _gap_reported(reports[2][0])
 
 
 # --------------------------------------------------------------------------- streaming equivalence

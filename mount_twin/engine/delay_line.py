@@ -24,9 +24,24 @@ from dataclasses import dataclass
 import numpy as np
 
 from mount_twin.engine.gyro_filter import Design, design, fir_rows
+from mount_twin.scene.description import InputSpec
 
 RAW = Design(np.ones(1), math.nan, "")
 """No filter, no delay (`gyro_filter: none` and `ignore`)."""
+
+
+def filter_bands(spec: InputSpec) -> tuple[float, float] | None:
+    """(passband, stopband) edges, Hz, of the scene's `linear_phase` filter; None: no filter."""
+    if spec.gyro_filter != "linear_phase":
+        return None
+    return spec.gyro_passband_hz, spec.gyro_stopband_hz
+
+
+def delay_samples(spec: InputSpec, rate_hz: float) -> int:
+    """Samples by which the scene's gyro conditioning delays the outputs of a `rate_hz` stream
+    (what a live caller gets only at the end of the stream, `TwinEngine.flush`)."""
+    bands = filter_bands(spec)
+    return 0 if bands is None else design(rate_hz, *bands).delay
 
 
 @dataclass

@@ -31,7 +31,7 @@ from mount_twin.engine.batch import (
 )
 from mount_twin.engine.companion import Companion, new_companion, restart
 from mount_twin.engine.companion import switch as switch_companion
-from mount_twin.engine.delay_line import Frame, GyroDelay, Run
+from mount_twin.engine.delay_line import Frame, GyroDelay, Run, filter_bands
 from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.gyro_filter import Design, fir_rows
 from mount_twin.engine.health import ENDED, PLATEAU_G, SATURATION_SHARE, HealthWindow
@@ -75,6 +75,9 @@ stream was taken and the 17 valid samples after it rejected as going back); a ju
 later stamps, jitter included, only delays its sample by one when it ends a push."""
 
 _RESTARTS = frozenset((START, JUMPED_BACK, GAP_RESET))
+_INTERVALS = frozenset((ACCEPT, GAP_RESET, GAP_BRIDGED))
+"""Verdicts whose interval from the previous taken sample enters the lost-sample estimate: a
+gap is input lost (the samples a sensor would have sent in it), however the twin goes on."""
 _COUNTS = {
     ACCEPT: ("accepted",),
     START: ("accepted",),
@@ -149,9 +152,9 @@ class _BatchRows:
 class _Intervals(NamedTuple):
     """Stamp intervals of a pushed batch, for the lost-sample estimate.
 
-    steps: (n,) per sample with a plain ACCEPT verdict, the interval (s) from the previous taken
-        sample; NaN for the other samples.
-    skipped: sample → samples rejected since the previous taken one, where not 0 (plain ACCEPT
+    steps: (n,) per sample with a plain ACCEPT or a gap verdict (`_INTERVALS`), the interval (s)
+        from the previous taken sample; NaN for the other samples.
+    skipped: sample → samples rejected since the previous taken one, where not 0 (those
         samples only).
     plain: every sample has a plain ACCEPT verdict (no NaN in steps).
     """
@@ -201,19 +204,14 @@ class TwinEngine:
         self._last_step: float | None = None
         """Interval (s) into the last taken sample from the one before (None after a start)."""
         self._held: SampleBatch | None = None
+        """A sample held back at the end of the last push (a jump to confirm, see JUMP_FACTOR)."""
         self._last_reading = np.full(3, np.nan)
         """The last accelerometer reading pushed and not held back (sensor frame, m/s²)."""
-        """A sample held back at the end of the last push (a jump to confirm, see JUMP_FACTOR)."""
         self._skipped = 0
         """Samples rejected since the last taken one: they fill a stamp hole, are not lost."""
         self._gravity_up = np.array([0.0, 0.0, scene.input.g])
         spec = scene.input
-        self._gyro = GyroDelay(
-            (spec.gyro_passband_hz, spec.gyro_stopband_hz)
-            if spec.gyro_filter == "linear_phase"
-            else None,
-            self._designed,
-        )
+        self._gyro = GyroDelay(filter_bands(spec), self._designed)
         self._pushed = 0
         """Samples pushed so far (a held one once)."""
         init = scene.initial
@@ -588,7 +586,7 @@ class TwinEngine:
         self, batch: SampleBatch, finite: np.ndarray
     ) -> tuple[list[str], list[int], _Intervals]:
         """Verdict on each sample, the samples after which diagnostics are due, and the stamp
-        intervals into samples with a plain ACCEPT verdict."""
+        intervals into samples with a plain ACCEPT or a gap verdict."""
         spec = self.scene.input
         last_t = self._last_stamp
         n = len(batch)
@@ -667,8 +665,8 @@ class TwinEngine:
                 self._skipped += 1
                 continue
             last_step = None if verdict in _RESTARTS else t - last_t
-            if verdict == ACCEPT:
-                into[i] = t - last_t  # type: ignore[operator]  # ACCEPT: last_t is set
+            if verdict in _INTERVALS:
+                into[i] = t - last_t  # type: ignore[operator]  # not START: last_t is set
                 if self._skipped:
                     skipped[i] = self._skipped
             self._skipped = 0

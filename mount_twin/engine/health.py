@@ -150,9 +150,9 @@ class HealthWindow:
         self.tilt_max = max(self.tilt_max, tilt_max_rad)
 
     def add_intervals(self, steps: np.ndarray, skipped: dict[int, int]) -> None:
-        """Stamp intervals (s) into samples with a plain ACCEPT verdict, each from the previous
-        taken sample, in order; `skipped`: position in `steps` → samples received within that
-        interval but rejected (where not 0)."""
+        """Stamp intervals (s) into samples with a plain ACCEPT or a gap verdict (a gap is input
+        lost too), each from the previous taken sample, in order; `skipped`: position in
+        `steps` → samples received within that interval but rejected (where not 0)."""
         if steps.shape[0]:
             self.skipped.extend((self.n_steps + i, n) for i, n in skipped.items())
             self.steps.append(steps)
