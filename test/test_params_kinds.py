@@ -64,9 +64,9 @@ def test_params_of_every_kind_load_the_same_scene_as_the_yaml() -> None:
 
 def test_effective_parameters_of_every_kind_reload_to_the_same_scene() -> None:
     """What the node declares for each kind (defaults included) is a complete parameter set."""
-    scene, effective = effective_parameters(as_params(_tree()), "params")
+    scene, effective, _ = effective_parameters(as_params(_tree()), "params")
     assert effective["mounts.bolt.hardening"] == 0.02  # a kind's default, declared
-    assert effective_parameters(effective, "params")[0] == scene
+    assert effective_parameters(effective, "params").scene == scene
 
 
 @pytest.mark.parametrize("mount", MOUNTS, ids=[m["kind"] for m in MOUNTS])
@@ -79,7 +79,8 @@ def test_every_key_of_a_kind_is_a_declared_parameter_of_the_right_type(
         assert key in declared, f"{mount['kind']}: {key} not declared"
         ptype = declared[key][0]
         if isinstance(value, list):
-            want = "string_array" if isinstance(value[0], str) else "double_array"
+            # a list of names (axes) is declared as one space-separated string (Reader.names)
+            want = "string" if isinstance(value[0], str) else "double_array"
         else:
             want = {str: "string", float: "double", bool: "bool", int: "integer"}[type(value)]
         assert ptype == want, f"{mount['kind']}.{key}: declared {ptype}, value {value!r}"

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+import yaml
 
 if os.environ.get("CI"):
     import rclpy  # noqa: F401  (CI installs it: a node test that skips there is a failure)
@@ -37,7 +38,7 @@ from ros_harness import (
 )
 
 from mount_twin.engine.batch import ERROR, OK
-from mount_twin.engine.gyro_filter import design
+from mount_twin.engine.delay_line import delay_samples
 from mount_twin.io.bag import InputBag, OutputBag
 from mount_twin.io.messages import (
     ACCEL,
@@ -61,16 +62,7 @@ from mount_twin.scene.params import flatten
 BAGS = ROOT / "bags"
 GENSET = ROOT / "config" / "genset_bolted_keyed.scene.yaml"
 
-
-def gyro_delay(spec: InputSpec, rate_hz: float) -> int:
-    """Samples by which the scene's gyro filter delays the outputs of a `rate_hz` stream: the
-    node answers the last ones as it shuts down."""
-    if spec.gyro_filter != "linear_phase":
-        return 0
-    return design(rate_hz, spec.gyro_passband_hz, spec.gyro_stopband_hz).delay
-
-
-GYRO_DELAY = gyro_delay(InputSpec(), 1000.0)
+GYRO_DELAY = delay_samples(InputSpec(), 1000.0)
 """The shipped default's delay at 1 kHz (38 samples)."""
 STAMP0 = 1_700_000_000_000_000_000
 WALL_FIGURES = {"real_time_factor"}
@@ -161,7 +153,7 @@ def run_live(
         assert wait_for(lambda: all(peer.connected(t) for t in topics), 10.0)
         publish_paced(pub, raws, rate_hz, peer)
         rate = 1e9 / (_stamp(raws[1]) - _stamp(raws[0]))
-        before = expect_outputs - gyro_delay(scene.input, rate)  # the rest come at shutdown
+        before = expect_outputs - delay_samples(scene.input, rate)  # the rest come at shutdown
         peer.take_until(lambda: len(peer.got[pose]) >= before, 120.0)
         code = stop_and_take(
             node, peer, lambda: last in [d[0] for d in diagnostics(peer.got["/diagnostics"])]
@@ -343,26 +335,60 @@ def test_diagnostics_go_out_every_clock_period_without_input() -> None:
     assert ros and ros[-1][0] == ERROR and ACCEL in ros[-1][1], ros
 
 
-def test_parameters_are_all_set_described_and_read_only() -> None:
-    """What `ros2 param dump/describe/set` see, through the parameter services."""
+def _node_parameters(
+    args: list[str], set_mass: bool = False
+) -> tuple[list[str], list, list, list]:
+    """Start the node with `args`; through its parameter services (what `ros2 param` uses):
+    its parameter names, values, descriptors, and the results of setting body.mass (if
+    `set_mass`); the node stopped, exit 0."""
     from rclpy.parameter import Parameter
     from rclpy.parameter_client import AsyncParameterClient
 
     domain = fresh_domain()
     peer = Peer(domain)
-    node = NodeProcess(domain, ["--params-file", str(PARAMS_FILE), "-p", "body.mass:=1300"])
+    node = NodeProcess(domain, args)
+    refused: list[Any] = []
     try:
         client = AsyncParameterClient(peer.node, "/mount_twin")
         assert client.wait_for_services(60.0), node.stop()
-
         names = peer.call(client.list_parameters()).result.names
         values = peer.call(client.get_parameters(names)).values
         described = peer.call(client.describe_parameters(names)).descriptors
-        refused = peer.call(client.set_parameters([Parameter("body.mass", value=1.0)])).results
+        if set_mass:
+            mass = [Parameter("body.mass", value=1.0)]
+            refused = peer.call(client.set_parameters(mass)).results
     finally:
         code = node.stop()
         peer.close()
     assert code == 0, node.stderr
+    return names, values, described, refused
+
+
+def _dumped(names: list[str], values: list[Any]) -> str:
+    """The params file `ros2 param dump /mount_twin` writes (ros2param: names split at dots
+    into nested mappings, PyYAML's block style; a string list's `y` comes out bare)."""
+    from rclpy.parameter import parameter_value_to_python
+
+    tree: dict[str, Any] = {}
+    for name, value in zip(names, values, strict=True):
+        *parents, leaf = name.split(".")
+        node = tree
+        for part in parents:
+            node = node.setdefault(part, {})
+        node[leaf] = parameter_value_to_python(value)
+    return yaml.dump({"/mount_twin": {"ros__parameters": tree}}, default_flow_style=False)
+
+
+def test_parameters_are_all_set_described_and_read_only(tmp_path: Path) -> None:
+    """What `ros2 param dump/describe/set` see, through the parameter services; a dump
+    reloads as a params file into the same parameters."""
+    args = ["--params-file", str(PARAMS_FILE), "-p", "body.mass:=1300"]
+    names, values, described, refused = _node_parameters(args, set_mass=True)
+    dump = tmp_path / "dump.yaml"
+    dump.write_text(_dumped(names, values), encoding="utf-8")
+    assert "dofs: x y z alpha gamma delta" in dump.read_text()
+    again = _node_parameters(["--params-file", str(dump)])
+    assert dict(zip(again[0], again[1], strict=True)) == dict(zip(names, values, strict=True))
     unset = [n for n, v in zip(names, values, strict=True) if v.type == 0]
     assert not unset, f"parameters without a value: {unset}"
     by_name = dict(zip(names, values, strict=True))
@@ -376,6 +402,12 @@ def test_parameters_are_all_set_described_and_read_only() -> None:
         d.name for d in scene_params if not (d.description and d.read_only)
     ]
     assert not refused[0].successful and "read-only" in refused[0].reason
+    # every number declares the loader's range (ros2 param describe shows it)
+    numeric = {n for n, v in by_name.items() if v.type in (2, 3)}  # INTEGER, DOUBLE
+    ranges = {d.name: d.floating_point_range or d.integer_range for d in described}
+    assert len(numeric) >= 20 and [n for n in numeric if not ranges[n]] == []
+    (rtol,) = ranges["integration.rtol"]
+    assert (rtol.from_value, rtol.to_value) == (1e-13, 0.1)
 
 
 @pytest.mark.parametrize(

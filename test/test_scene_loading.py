@@ -113,7 +113,7 @@ def test_an_integer_given_for_a_double_parameter_is_taken_as_the_double(
     name: str, given: Any, want: Any
 ) -> None:
     """rcl would refuse `body.mass: 1300` for a double; the node takes what the user meant."""
-    _, effective = effective_parameters({**flat_params(), name: given}, "params")
+    effective = effective_parameters({**flat_params(), name: given}, "params").values
     got = effective[name]
     assert type(got) is (list if isinstance(given, list) else float)
     assert got == (want if want is not None else [float(v) for v in given])
@@ -125,10 +125,10 @@ def test_effective_parameters_hold_every_default_and_reload_to_the_same_scene() 
     gives the same scene, and it holds the loader's defaults for what params.yaml leaves out."""
     flat = flat_params()
     assert "outputs.alarm_margin" not in flat
-    scene, effective = effective_parameters(flat, "params")
+    scene, effective, _ = effective_parameters(flat, "params")
     assert effective["outputs.alarm_margin"] == scene.outputs.alarm_margin == 0.1
     assert effective["initial_state.pose"] == [0.0] * 6
-    again, effective_again = effective_parameters(effective, "params")
+    again, effective_again, _ = effective_parameters(effective, "params")
     assert again == scene
     assert effective_again == effective
     assert all(declared_type(n) for n in effective), [
@@ -456,3 +456,16 @@ def test_initial_pose_just_inside_the_chart_loads() -> None:
 
     scene = scene_from_dict(copy.deepcopy(data), "f.yaml")
     assert abs(scene.initial.pose[3]) + abs(scene.initial.pose[4]) < math.pi / 2
+
+
+def test_names_as_one_string_are_the_list_and_are_what_the_node_declares() -> None:
+    """`dofs` (and an elastomer's axes) as one space-separated string is the list; it is the
+    form declared, since `ros2 param dump` writes a list's y bare and rcl reads it as true."""
+    flat = flat_params()
+    as_list = {**flat, "dofs": ["x", "y", "z", "alpha", "gamma", "delta"]}
+    as_string = {**flat, "dofs": "x y  z alpha gamma delta"}
+    assert scene_from_params(as_list, "p") == scene_from_params(as_string, "p")
+    effective = effective_parameters(as_list, "p").values
+    assert effective["dofs"] == "x y z alpha gamma delta"
+    with pytest.raises(SceneError, match=re.escape("dofs[1]: unknown DOF 'yaw'")):
+        scene_from_params({**flat, "dofs": "z yaw"}, "p")

@@ -53,12 +53,12 @@ PARAMETERS = {
     "hysteresis.beta": ("double", "Bouc–Wen β, 1/mⁿ"),
     "hysteresis.gamma": ("double", "Bouc–Wen γ, 1/mⁿ"),
     "hysteresis.n": ("double", "Bouc–Wen exponent n ≥ 1 (1.0)"),
-    "hysteresis.axes": ("string_array", "Hysteretic local axes (all)"),
+    "hysteresis.axes": ("string", "Hysteretic local axes, space-separated (x y z)"),
     "snubber.gap": ("double", "Snubber gap, m"),
     "snubber.stiffness": ("double", "Snubber contact stiffness k_s, N/mᵖ"),
     "snubber.exponent": ("double", "Contact exponent p ≥ 1 (1.5)"),
     "snubber.damping": ("double", "Hunt–Crossley damping h, s/m (0.0)"),
-    "snubber.axes": ("string_array", "Snubbed local axes (all)"),
+    "snubber.axes": ("string", "Snubbed local axes, space-separated (x y z)"),
 }
 """ROS parameters of the kind, mounts.<name>.<key>: (type, description)."""
 
@@ -126,7 +126,7 @@ class Elastomer:
 
 
 def _axes(r: Reader, key: str) -> tuple[str, ...]:
-    axes = r.strings(key, AXES)
+    axes = r.names(key, AXES)
     for i, a in enumerate(axes):
         if a not in AXES or axes.index(a) != i:
             raise r.error(f"{key}[{i}]", f"expected distinct axes among x, y, z, got {a!r}")

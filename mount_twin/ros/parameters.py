@@ -10,6 +10,7 @@ double, and a `scene_file` is loaded with the other scene parameters overriding 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from itertools import pairwise
@@ -49,13 +50,24 @@ class NodeOptions:
         return self.stall_period_s or scene.outputs.diagnostics_period_s
 
 
+def _described(
+    description: str, bounds: tuple[float, float] | None = None, *, integer: bool = False
+) -> ParameterDescriptor:
+    """A read-only parameter's descriptor, with its range [lo, hi] where `bounds` say one
+    (an integer range if `integer`; none if both ends are infinite)."""
+    ranges: dict[str, Any] = {}
+    if bounds is not None and integer:
+        lo_int, hi_int = map(int, bounds)
+        ranges["integer_range"] = [IntegerRange(from_value=lo_int, to_value=hi_int)]
+    elif bounds is not None and not all(map(math.isinf, bounds)):
+        lo, hi = map(float, bounds)
+        ranges["floating_point_range"] = [FloatingPointRange(from_value=lo, to_value=hi)]
+    return ParameterDescriptor(description=description, read_only=True, **ranges)
+
+
 def _option(description: str, lo: float, hi: float) -> ParameterDescriptor:
     """A read-only node option in [lo, hi]: a double if lo is a float, else an integer."""
-    if isinstance(lo, float):
-        bounds = {"floating_point_range": [FloatingPointRange(from_value=lo, to_value=hi)]}
-    else:
-        bounds = {"integer_range": [IntegerRange(from_value=int(lo), to_value=int(hi))]}
-    return ParameterDescriptor(description=description, read_only=True, **bounds)
+    return _described(description, (lo, hi), integer=not isinstance(lo, float))
 
 
 _OPTIONS: dict[str, ParameterDescriptor] = {
@@ -144,15 +156,12 @@ def configure(node: Node, args: Sequence[str] = ()) -> tuple[NodeOptions, Scene]
         if k not in BUILT_IN and not k.startswith(QOS_OVERRIDES)
     }
     options = {k: given.pop(k) for k in list(given) if k in _OPTIONS}
-    scene, effective = effective_parameters(given, source)
+    scene, effective, bounds = effective_parameters(given, source)
     values = _declare_options(node, options, source)
     for name, value in effective.items():
-        node.declare_parameter(
-            name,
-            value,
-            ParameterDescriptor(description=_description(name, effective), read_only=True),
-            ignore_override=True,
-        )
+        integer = isinstance(value, int) and not isinstance(value, bool)
+        descriptor = _described(_description(name, effective), bounds.get(name), integer=integer)
+        node.declare_parameter(name, value, descriptor, ignore_override=True)
     return NodeOptions(**values), scene
 
 

@@ -29,7 +29,7 @@ from mount_twin.scene.description import (
     Vec3,
     Vec6,
 )
-from mount_twin.scene.reader import Reader, shown
+from mount_twin.scene.reader import Reader, Used, shown
 from mount_twin.scene.yaml_reading import SceneYamlError, load_yaml
 from mount_twin.textfiles import MIB, FileTooLargeError, read_limited
 
@@ -84,7 +84,7 @@ def scene_from_dict(
     source: str,
     *,
     mount_paths: list[str] | None = None,
-    record: dict[str, Any] | None = None,
+    record: Used | None = None,
     refuse_unheld: bool = False,
 ) -> Scene:
     """Validate a scene mapping (the layout of config/*.scene.yaml), then the scene as a whole
@@ -95,7 +95,8 @@ def scene_from_dict(
         data: the mapping.
         source: file or parameter set, named in errors.
         mount_paths: key path of each mount in errors (default mounts[i]).
-        record: if given, receives every value used (given or defaulted) by key path.
+        record: if given, receives every value used (given or defaulted) and the bounds each
+            number was checked against, by key path.
         refuse_unheld: a free DOF no mount holds is a SceneError (for a start at equilibrium)
             instead of a warning: what scene files and parameter sets get. Off for scenes built
             in code, such as tests of a single mount's law.
@@ -161,7 +162,7 @@ def _is_positive_definite(a: list[list[float]]) -> bool:
 
 
 def _dofs(top: Reader) -> tuple[str, ...]:
-    dofs = top.strings("dofs", DOF_NAMES)
+    dofs = top.names("dofs", DOF_NAMES)
     for i, d in enumerate(dofs):
         if d not in DOF_NAMES:
             raise top.error(

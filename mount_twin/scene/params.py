@@ -9,13 +9,14 @@ scene loader validates, so a params YAML and a scene YAML go through one loader.
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
-from typing import Any
+from typing import Any, NamedTuple
 
 from mount_twin.errors import SceneError
 from mount_twin.integrate.methods import METHODS
 from mount_twin.kinds import KINDS
 from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import load_scene_file, read_scene_yaml, scene_from_dict
+from mount_twin.scene.reader import Used
 
 PARAMETERS: dict[str, tuple[str, str]] = {
     "scene_file": (
@@ -35,7 +36,7 @@ PARAMETERS: dict[str, tuple[str, str]] = {
         "double_array",
         "Inertia about the CG in B [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], kg·m²",
     ),
-    "dofs": ("string_array", "Free DOFs, a subset of [x, y, z, alpha, gamma, delta]"),
+    "dofs": ("string", "Free DOFs, space-separated: a subset of x y z alpha gamma delta"),
     "mount_names": ("string_array", "Mount names; each has a namespace mounts.<name>"),
     "input.msg_type": ("string", "sensor_msgs/msg/Imu or geometry_msgs/msg/AccelStamped"),
     "input.topic": ("string", "Input topic"),
@@ -146,12 +147,21 @@ def scene_from_params(flat: Mapping[str, Any], source: str) -> Scene:
     If `scene_file` is set and non-empty, the scene is that file's, with the other parameters
     given overriding its values (`effective_parameters`).
     """
-    return effective_parameters(flat, source)[0]
+    return effective_parameters(flat, source).scene
 
 
-def effective_parameters(flat: Mapping[str, Any], source: str) -> tuple[Scene, dict[str, Any]]:
-    """The Scene of a flat parameter set and every parameter value it uses, defaults included
-    (what a node declares, so `ros2 param dump` shows the whole scene).
+class Effective(NamedTuple):
+    """A flat parameter set read: the Scene; every parameter value it uses, defaults included
+    (what a node declares, so `ros2 param dump` shows the whole scene); and the closed
+    interval [lo, hi] the loader checked each scalar number against (its declared range)."""
+
+    scene: Scene
+    values: dict[str, Any]
+    bounds: dict[str, tuple[float, float]]
+
+
+def effective_parameters(flat: Mapping[str, Any], source: str) -> Effective:
+    """The Scene of a flat parameter set, the values it uses and their bounds (`Effective`).
 
     With `scene_file` set, the file is validated on its own first (errors name the file's key
     paths), then the other parameters override its values (errors name the parameter).
@@ -182,7 +192,7 @@ def effective_parameters(flat: Mapping[str, Any], source: str) -> tuple[Scene, d
         node[leaf] = value
     tree = _mounts_as_list(tree, source)
     names = [m["name"] for m in tree["mounts"]]
-    used: dict[str, Any] = {}
+    used = Used()
     scene = scene_from_dict(
         tree,
         source,
@@ -190,12 +200,15 @@ def effective_parameters(flat: Mapping[str, Any], source: str) -> tuple[Scene, d
         record=used,
         refuse_unheld=True,
     )
-    types = parameter_types({**used, "mount_names": names})
+    types = parameter_types({**used.values, "mount_names": names})
     effective: dict[str, Any] = {"scene_file": str(scene_file), "mount_names": list(names)}
-    for name, value in used.items():
-        if name in types:
+    for name, value in used.values.items():
+        if types.get(name) == "string" and isinstance(value, (list, tuple)):
+            effective[name] = " ".join(value)  # names (`Reader.names`): as a dump reloads
+        elif name in types:
             effective[name] = list(value) if isinstance(value, tuple) else value
-    return scene, as_declared_types(effective)
+    bounds = {name: b for name, b in used.bounds.items() if name in types}
+    return Effective(scene, as_declared_types(effective), bounds)
 
 
 def as_params(tree: Mapping[str, Any]) -> dict[str, Any]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import reprlib
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any, Literal, overload
 
 from mount_twin.errors import SceneError
@@ -26,6 +27,16 @@ _SHOWN.maxlevel, _SHOWN.maxlist, _SHOWN.maxdict = 3, 8, 6
 _SHOWN.maxstring, _SHOWN.maxother, _SHOWN.maxlong = 60, 60, 40
 
 
+@dataclass
+class Used:
+    """What a scene read used, by key path: every value (given or defaulted, mappings
+    excepted), and the closed interval [lo, hi] each scalar number was checked against (an
+    open end, as `positive`'s 0, is recorded closed: the check itself is the stricter)."""
+
+    values: dict[str, Any] = field(default_factory=dict)
+    bounds: dict[str, tuple[float, float]] = field(default_factory=dict)
+
+
 def shown(value: object) -> str:
     """`repr(value)` bounded for a message: nesting, length and digits cut with '...' (a value
     read from a hostile file may be nested deep enough to exhaust repr's recursion, or be an
@@ -43,8 +54,8 @@ class Reader:
         data: the mapping.
         source: file or parameter set it came from, for messages.
         path: key path of `data` in the document ('' at the top).
-        record: if given, every value read (given or defaulted, mappings excepted) is stored
-            here under its key path: the effective parameters of a scene.
+        record: if given, what is read is stored here (`Used`): the effective parameters of a
+            scene and their bounds.
     """
 
     def __init__(
@@ -53,7 +64,7 @@ class Reader:
         source: str,
         path: str = "",
         *,
-        record: dict[str, Any] | None = None,
+        record: Used | None = None,
     ) -> None:
         if not isinstance(data, Mapping):
             raise SceneError(source, path or "<top>", f"expected a mapping, got {shown(data)}")
@@ -87,8 +98,12 @@ class Reader:
         else:
             value = default
         if self.record is not None and not isinstance(value, Mapping):
-            self.record[self.key_path(key)] = value
+            self.record.values[self.key_path(key)] = value
         return value
+
+    def _bound(self, key: str, lo: float, hi: float) -> None:
+        if self.record is not None:
+            self.record.bounds[self.key_path(key)] = (lo, hi)
 
     def sub(self, key: str, *, optional: bool = True) -> Reader:
         """The mapping at `key` (an empty one if absent and optional)."""
@@ -109,7 +124,8 @@ class Reader:
         hi: float = math.inf,
         lo_open: bool = False,
     ) -> float:
-        """A finite float in [lo, hi] (or (lo, hi] with lo_open)."""
+        """A finite float in [lo, hi] (or (lo, hi] with lo_open), and within ±NUMBER_LIMIT."""
+        self._bound(key, max(lo, -NUMBER_LIMIT), min(hi, NUMBER_LIMIT))
         return self._check_number(key, self.raw(key, default), lo, hi, lo_open)
 
     def positive(self, key: str, default: float | None = None) -> float:
@@ -120,6 +136,7 @@ class Reader:
         self, key: str, default: int | None = None, *, lo: int = 0, hi: int = INTEGER_LIMIT
     ) -> int:
         """An integer in [lo, hi]."""
+        self._bound(key, lo, hi)
         value = self.raw(key, default)
         if isinstance(value, bool) or not isinstance(value, int):
             raise self.error(key, f"expected an integer, got {shown(value)}")
@@ -182,10 +199,15 @@ class Reader:
             self._check_number(f"{key}[{i}]", v, lo, math.inf, False) for i, v in enumerate(value)
         )
 
-    def strings(self, key: str, default: Sequence[str] | None = None) -> tuple[str, ...]:
-        """A list of strings."""
+    def names(self, key: str, default: Sequence[str] | None = None) -> tuple[str, ...]:
+        """A list of names (DOFs, axes): a list of strings, or one string of names separated
+        by spaces, the form a node declares them in. (`ros2 param dump` writes a list's `y`
+        bare, and rcl reads a bare y back as a boolean: a string of names reloads as written.)
+        """
         value = self.raw(key, None if default is None else tuple(default))
-        if isinstance(value, str) or not isinstance(value, Sequence):
+        if isinstance(value, str):
+            value = tuple(value.split())
+        if not isinstance(value, Sequence):
             raise self.error(key, f"expected a list of strings, got {shown(value)}")
         for i, v in enumerate(value):
             if not isinstance(v, str):
