@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import os
 import subprocess
 import sys
 from collections import defaultdict
@@ -13,6 +14,7 @@ from typing import Any
 
 import numpy as np
 import yaml
+from hypothesis import HealthCheck, settings
 from rosbags.highlevel import AnyReader
 
 from mount_twin.engine.batch import HealthReport, OutputBatch, SampleBatch
@@ -168,3 +170,19 @@ def push_all(
         np.concatenate([o.wrenches for o in outs]),
     )
     return joined, [o.health for o in outs]
+
+
+def fuzz_settings(max_examples: int, **kwargs: Any) -> settings:
+    """Hypothesis settings of a fuzz suite: in the suite a fixed (derandomized) campaign of
+    `max_examples`; with MOUNT_TWIN_FUZZ_EXAMPLES=N a fresh campaign of N examples, seeded by
+    pytest's --hypothesis-seed (how the README's hostile-input figures are re-measured:
+    `MOUNT_TWIN_FUZZ_EXAMPLES=1000 python3 -m pytest test/test_fuzz_stream.py
+    --hypothesis-seed=7`)."""
+    campaign = os.environ.get("MOUNT_TWIN_FUZZ_EXAMPLES")
+    return settings(
+        max_examples=int(campaign) if campaign else max_examples,
+        derandomize=not campaign,
+        database=None,
+        suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+        **kwargs,
+    )

@@ -15,9 +15,9 @@ from typing import Any
 
 import pytest
 import yaml
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given
 from hypothesis import strategies as st
-from io_helpers import CONFIG
+from io_helpers import CONFIG, fuzz_settings
 
 from mount_twin.errors import SceneError
 from mount_twin.scene import Scene, load_scene_file, scene_from_dict
@@ -25,12 +25,7 @@ from mount_twin.scene import Scene, load_scene_file, scene_from_dict
 SCENES = sorted(p.name for p in CONFIG.glob("*.scene.yaml"))
 BUDGET_S = 2.0
 """Longest a single load may take (the bundled scenes load in ~20 ms)."""
-FUZZ = settings(
-    max_examples=800,
-    deadline=timedelta(seconds=BUDGET_S),
-    derandomize=True,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
-)
+FUZZ = fuzz_settings(800, deadline=timedelta(seconds=BUDGET_S))
 
 KeyPath = tuple[str | int, ...]
 

@@ -7,21 +7,16 @@ the samples are batched."""
 from __future__ import annotations
 
 import numpy as np
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given
 from hypothesis import strategies as st
-from io_helpers import batch, default_scene, engine_for, split
+from io_helpers import batch, default_scene, engine_for, fuzz_settings, split
 
 from mount_twin.engine.batch import OutputBatch
 from mount_twin.io.messages import imu_messages
 from mount_twin.stream import TwinStream
 
 G = 9.80665
-FUZZ = settings(
-    max_examples=200,
-    deadline=None,
-    derandomize=True,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
-)
+FUZZ = fuzz_settings(200, deadline=None)
 
 MUTATIONS = st.sampled_from(
     [

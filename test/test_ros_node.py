@@ -13,6 +13,7 @@ import os
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -630,3 +631,49 @@ def test_building_tf2_msgs_again_finds_the_build() -> None:
     assert done.returncode == 0, done.stderr
     assert "tf2_msgs up to date in" in done.stdout and "export" not in done.stdout, done.stdout
     assert f"type support from {tf2_msgs.__file__}" in done.stdout, done.stdout
+
+
+def test_a_slow_subscriber_loses_outputs_and_no_event_says_so() -> None:
+    """What the README's `output_queue_depth` says a user must size for: a reliable keep-last
+    subscriber that cannot take messages while a burst comes keeps its last `depth` of them,
+    and it gets no lost-message event (Fast DDS; the publisher has none to offer) — so the
+    node has nothing to count and the depths must be chosen."""
+    from rclpy.event_handler import SubscriptionEventCallbacks
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+    from std_msgs.msg import Int32
+
+    peer = Peer(fresh_domain())
+    lost: list[int] = []
+    got: list[int] = []
+    qos = QoSProfile(
+        depth=10, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST
+    )
+    executor = SingleThreadedExecutor(context=peer.context)
+    executor.add_node(peer.node)
+
+    def spin(seconds: float) -> None:
+        deadline = time.monotonic() + seconds
+        while time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.02)
+
+    try:
+        peer.node.create_subscription(
+            Int32,
+            "burst",
+            lambda m: got.append(m.data),
+            qos,
+            event_callbacks=SubscriptionEventCallbacks(
+                message_lost=lambda e: lost.append(e.total_count_change)
+            ),
+        )
+        pub = peer.node.create_publisher(Int32, "burst", qos)
+        assert wait_for(lambda: pub.get_subscription_count() == 1, 10.0)
+        spin(0.5)  # the reader matches the writer too
+        for i in range(1000):  # the subscriber's executor does not run meanwhile
+            pub.publish(Int32(data=i))
+        spin(1.0)
+    finally:
+        executor.remove_node(peer.node)
+        peer.close()
+    assert got == list(range(990, 1000)) and lost == []
