@@ -77,6 +77,7 @@ setup(
     extras_require={
         "test": [
             "pytest>=7",
+            "pytest-xdist>=3",  # the README's test command runs on two workers
             "ruff>=0.5",
             "hypothesis>=6.100",
             "matplotlib>=3.6",

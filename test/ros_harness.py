@@ -43,9 +43,14 @@ def _kill_leftovers() -> None:
 
 
 def fresh_domain() -> int:
-    """A DDS domain id for one run: differs between runs of this process and, very likely,
-    between processes (parallel CI jobs on one machine)."""
-    return 1 + (os.getpid() * 7 + next(_domains)) % 100
+    """A DDS domain id for one run: differs between runs of this process, between the
+    workers of one pytest-xdist run (each has its own share of the ids 1…100) and, very
+    likely, between processes (parallel CI jobs on one machine)."""
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "")  # gw0, gw1, ...
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    share = 100 // workers
+    first = 1 + share * int(worker[2:]) if worker.startswith("gw") else 1
+    return first + (os.getpid() * 7 + next(_domains)) % share
 
 
 def ros_env(domain: int) -> dict[str, str]:
