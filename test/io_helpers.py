@@ -19,7 +19,7 @@ from rosbags.highlevel import AnyReader
 
 from mount_twin.engine.batch import HealthReport, OutputBatch, SampleBatch
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.io.messages import TYPESTORE
+from mount_twin.io.messages import DIAGNOSTICS, TYPESTORE
 from mount_twin.model.assemble import Model, assemble
 from mount_twin.scene import Scene, load_scene_file
 
@@ -186,3 +186,30 @@ def fuzz_settings(max_examples: int, **kwargs: Any) -> settings:
         suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
         **kwargs,
     )
+
+
+def comparable_messages(path: Path) -> dict[str, list[tuple[int, object]]]:
+    """Topic → (stamp, message) of an output bag, to compare two runs: raw bytes, and for
+    /diagnostics the decoded statuses less the wall-time figures (the real-time factor differs
+    between any two runs)."""
+    out: dict[str, list[tuple[int, object]]] = {}
+    for topic, messages in read_raw(path).items():
+        if topic != "/diagnostics":
+            out[topic] = [(stamp, bytes(raw)) for stamp, raw in messages]
+            continue
+        out[topic] = [
+            (
+                stamp,
+                [
+                    (
+                        s.name,
+                        s.level,
+                        s.message,
+                        [(v.key, v.value) for v in s.values if v.key != "real_time_factor"],
+                    )
+                    for s in TYPESTORE.deserialize_cdr(raw, DIAGNOSTICS).status
+                ],
+            )
+            for stamp, raw in messages
+        ]
+    return out

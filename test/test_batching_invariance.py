@@ -14,12 +14,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_helpers import ROOT, push_all, read_raw, split
+from io_helpers import ROOT, comparable_messages, push_all, split
 
 from mount_twin.engine.batch import OutputBatch, SampleBatch
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.io.input_samples import read_samples
-from mount_twin.io.messages import DIAGNOSTICS, TYPESTORE
 from mount_twin.model.assemble import assemble
 from mount_twin.replay import replay
 from mount_twin.scene import load_scene_file
@@ -72,32 +71,6 @@ def test_a_switching_rotating_scene_gives_the_same_bits_in_any_batching(
     np.testing.assert_array_equal(engine.state, ref_engine.state)
 
 
-def _bag_messages(path: Path) -> dict[str, list[tuple[int, object]]]:
-    """Topic → (stamp, message) of an output bag: raw bytes, and for /diagnostics the decoded
-    statuses less the wall-time figures (the real-time factor differs between any two runs)."""
-    out: dict[str, list[tuple[int, object]]] = {}
-    for topic, messages in read_raw(path).items():
-        if topic != "/diagnostics":
-            out[topic] = [(stamp, bytes(raw)) for stamp, raw in messages]
-            continue
-        out[topic] = [
-            (
-                stamp,
-                [
-                    (
-                        s.name,
-                        s.level,
-                        s.message,
-                        [(v.key, v.value) for v in s.values if v.key != "real_time_factor"],
-                    )
-                    for s in TYPESTORE.deserialize_cdr(raw, DIAGNOSTICS).status
-                ],
-            )
-            for stamp, raw in messages
-        ]
-    return out
-
-
 @pytest.mark.parametrize(
     ("scene_file", "bag"),
     [
@@ -114,7 +87,7 @@ def test_replays_in_chunks_of_7_and_100000_write_the_same_bags(
     for chunk in (7, 100_000):
         out = tmp_path / f"out_{chunk}"
         replay(scene, ROOT / "bags" / bag, out, chunk=chunk, progress=False)
-        bags[chunk] = _bag_messages(out)
+        bags[chunk] = comparable_messages(out)
     assert bags[7].keys() == bags[100_000].keys()
     for topic, messages in bags[100_000].items():
         assert bags[7][topic] == messages, f"{topic} differs between chunks of 7 and 100000"
