@@ -207,6 +207,26 @@ def test_diagnostics_give_the_latency() -> None:
     assert float(values[-1]["latency_s"]) == pytest.approx(0.038)
 
 
+def test_one_odd_first_interval_does_not_set_the_design() -> None:
+    """A stamp one rounding step after the first (2e-16 s later, as sums of intervals give)
+    set a 4.5e15 Hz design that asked for petabytes (a fuzz campaign found it): the design
+    takes the median of the first intervals, 1 kHz here."""
+    stamps = 1.0 + np.arange(500) / 1000.0
+    stamps = np.concatenate([[1.006, np.nextafter(1.006, 2.0)], stamps[7:]])
+    assert 0.0 < stamps[1] - stamps[0] < 1e-15
+    engine = engine_for(_scene())
+    out = engine.run(batch(stamps, frame_ids=""))
+    assert engine.latency == 38
+    assert len(out) == engine.counts["accepted"] == len(stamps)
+
+
+def test_a_stream_faster_than_any_sensor_takes_the_gyro_raw_and_says_so() -> None:
+    out = engine_for(_scene()).run(batch(1.0 + np.arange(50) * 1e-9, frame_ids=""))
+    integration = [s for r in out.health for s in r.statuses if s.name.endswith("integration")]
+    assert "above 1e+06 Hz: the gyro is taken raw" in integration[0].message
+    assert integration[-1].values["latency_samples"] == "0"
+
+
 def test_ignore_equals_a_zero_gyro_and_none_differs() -> None:
     t = 1.0 + np.arange(300) / 1000.0
     gyro = 0.004 * np.random.default_rng(4).standard_normal((300, 3))

@@ -8,7 +8,8 @@ same N samples exactly), and its outputs carry sample k's stamp, N samples late.
 Run edges: before a run's first sample the rate is taken as that sample's, held (a start is at
 rest); at its end (a restart, a gap reset, the end of the stream) the pending samples are
 integrated with the rate after them held at the last one, so every accepted sample has its
-output. The filter is designed once, at the stream's first interval (`gyro_filter.design`).
+output. The filter is designed once, from the stream's first intervals (`DESIGN_SAMPLES`,
+`gyro_filter.design`).
 
 Everything depends on the accepted samples alone, in order: any batching gives the same bits.
 The engine works on a `Frame` per push: the samples still pending from earlier pushes, then the
@@ -28,6 +29,13 @@ from mount_twin.scene.description import InputSpec
 
 RAW = Design(np.ones(1), math.nan, "")
 """No filter, no delay (`gyro_filter: none` and `ignore`)."""
+DESIGN_SAMPLES = 8
+"""The filter is designed from the median interval of the stream's first this many accepted
+samples (fewer if its first run ends sooner): one odd interval, a stamp 1e-16 s after the one
+before, cannot set it (it did: a 4.5e15 Hz design asked for petabytes)."""
+MAX_RATE_HZ = 1.0e6
+"""Above this sample rate (no shock or motion sensor samples faster) the gyro is taken raw,
+with a note, rather than filtered by a design of that many taps."""
 
 
 def filter_bands(spec: InputSpec) -> tuple[float, float] | None:
@@ -147,10 +155,7 @@ class GyroDelay:
             self._restart, self._raw = True, np.zeros((0, 3))
         self._pending = np.concatenate([self._pending, rows])
         self._raw = np.concatenate([self._raw, frame.w[rows]])
-        if self.design is None and self._pending.shape[0] >= 2:
-            t0, t1 = frame.stamps[self._pending[:2]]
-            self.design = design(1.0 / (t1 - t0), *self._bands)  # type: ignore[misc]
-            self._designed(float(t1), self.design)
+        self._design(frame, DESIGN_SAMPLES)
         if self.design is not None:
             ready.extend(self._release(self._pending.shape[0] - self.delay, frame, end=False))
         return ready
@@ -158,7 +163,24 @@ class GyroDelay:
     def drain(self, frame: Frame) -> list[Run]:
         """Release every pending sample, the rate after the last held at its value (a run's
         end)."""
+        self._design(frame, 2)
         return self._release(self._pending.shape[0], frame, end=True)
+
+    def _design(self, frame: Frame, samples: int) -> None:
+        """Design the filter, once, from the median interval of the first DESIGN_SAMPLES
+        pending samples, once `samples` of them are there (2 at a run's end)."""
+        if self.design is not None or self._pending.shape[0] < samples:
+            return
+        stamps = frame.stamps[self._pending[:DESIGN_SAMPLES]]
+        rate_hz = 1.0 / float(np.median(np.diff(stamps)))
+        if rate_hz > MAX_RATE_HZ:
+            note = (
+                f"sample rate {rate_hz:.4g} Hz is above {MAX_RATE_HZ:g} Hz: the gyro is taken raw"
+            )
+            self.design = Design(np.ones(1), rate_hz, note)
+        else:
+            self.design = design(rate_hz, *self._bands)  # type: ignore[misc]
+        self._designed(float(stamps[-1]), self.design)
 
     def _release(self, n: int, frame: Frame, *, end: bool) -> list[Run]:
         """The first n pending samples, their Ω filtered into frame.w."""
