@@ -145,12 +145,29 @@ def test_a_bad_case_is_a_failed_row_and_the_rest_still_run(swept) -> None:
     _, results, _ = swept
     rows = read_results(results)
     failed = [r for r in rows if r["verdict"] == FAILED]
-    assert len(failed) == 4 and all(r["body.mass"] == "-5.0" for r in failed)
+    assert len(failed) == 4 and all(r["body.mass"] == -5.0 for r in failed)
     assert all("body.mass" in r["error"] for r in failed)
+    assert all(r["peak_force_magnitude_N.fl"] is None for r in failed)
     good = [r for r in rows if r["verdict"] != FAILED]
     assert len(good) == 4 and all(float(r["peak_force_magnitude_N.fl"]) > 1000.0 for r in good)
     # each case's own error estimate: the pump at one step per sample is ~1e-9 off
     assert all(0.0 < float(r["est_force_error_rel"]) < 1e-6 for r in good)
+
+
+def test_results_are_typed_numbers_as_numbers(swept) -> None:
+    """pandas.DataFrame(rows)[column].max() must compare numbers, not strings ('9809.98' >
+    '15564.19' as text)."""
+    pandas = pytest.importorskip("pandas")
+    _, results, _ = swept
+    rows = read_results(results)
+    good = [r for r in rows if r["verdict"] != FAILED]
+    assert all(isinstance(r["peak_force_magnitude_N.fl"], float) for r in good)
+    assert all(isinstance(r["events"], int) for r in good)
+    assert all(isinstance(r["case"], str) and isinstance(r["verdict"], str) for r in rows)
+    frame = pandas.DataFrame(rows)
+    column = frame["peak_force_magnitude_N.fl"]
+    assert column.dtype.kind == "f"
+    assert column.max() == max(r["peak_force_magnitude_N.fl"] for r in good)
 
 
 def test_a_rerun_skips_finished_cases_and_reruns_failed_ones(swept) -> None:

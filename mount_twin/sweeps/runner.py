@@ -241,10 +241,35 @@ def _cell(value: Any) -> Any:
     return repr(value) if isinstance(value, float) else value
 
 
-def read_results(results: str | Path) -> list[dict[str, str]]:
-    """The rows of a results CSV."""
+TEXT_COLUMNS = frozenset({"case", "input", "verdict", "error", "first_event"})
+"""Columns that hold text whatever they look like (a case id of digits stays an id)."""
+
+
+def read_results(results: str | Path) -> list[dict[str, Any]]:
+    """The rows of a results CSV, typed: each column but `TEXT_COLUMNS` whose every non-empty
+    cell is an integer holds ints, one whose every non-empty cell is a number floats (an
+    empty cell, a failed case's figure: None), any other text; so `DataFrame(rows)` has
+    numeric columns."""
     with Path(results).open(encoding="utf-8", newline="") as fh:
-        return list(csv.DictReader(fh))
+        rows: list[dict[str, Any]] = list(csv.DictReader(fh))
+    for name in rows[0] if rows else ():
+        if name not in TEXT_COLUMNS:
+            convert = _column_type([r[name] for r in rows if r[name] != ""])
+            for r in rows:
+                r[name] = None if r[name] == "" else convert(r[name])
+    return rows
+
+
+def _column_type(cells: list[str]) -> Callable[[str], Any]:
+    """int, float or str: the narrowest that reads every cell."""
+    for kind in (int, float):
+        try:
+            for cell in cells:
+                kind(cell)
+        except ValueError:
+            continue
+        return kind
+    return str
 
 
 def largest_peak_force(row: dict[str, Any], mounts: list[str]) -> float:
@@ -282,10 +307,10 @@ def sweep(
     *,
     scheduler: str | None = None,
     workers: int | None = None,
-) -> list[dict[str, str]]:
+) -> list[dict[str, Any]]:
     """Load, check and run a sweep file (cases already in `results` are skipped) and return
-    every row of `results`: one dict per case, columns as `columns` names them (the
-    `pandas.DataFrame(rows)` of it is the table)."""
+    every row of `results`, typed (`read_results`): one dict per case, columns as `columns`
+    names them (the `pandas.DataFrame(rows)` of it is the table)."""
     from mount_twin.sweeps.cases import check
     from mount_twin.sweeps.spec import load_sweep
 
