@@ -16,6 +16,7 @@ from pyyeti import srs as pyyeti_srs
 from rosbags.rosbag2 import Writer
 from scipy.integrate import solve_ivp
 
+from mount_twin.analysis.sampling import uniform
 from mount_twin.analysis.srs import damping_ratio, octave_frequencies, srs
 from mount_twin.cli import main
 from mount_twin.commands.common import write_signal
@@ -289,7 +290,7 @@ def test_a_bag_with_several_imu_topics_needs_topic(
     assert "no Imu/AccelStamped topic /nope" in capsys.readouterr().err
 
 
-def test_a_recorder_csv_in_g_is_read_and_uneven_sampling_refused(
+def test_a_recorder_csv_in_g_is_read_and_what_is_no_sampled_signal_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     t = np.arange(3000) / 10_000.0
@@ -301,10 +302,70 @@ def test_a_recorder_csv_in_g_is_read_and_uneven_sampling_refused(
     assert main(["srs", str(good), "--freqs", "81", "--damping", "0", "--csv", str(out)]) == 0
     # 10 g half-sine of 10 ms at f·T = 0.81: 1.7685 × 10 g, to the sampling's 1 − cos(πf/fs)
     assert float(_rows(out)[0]["maximax"]) == pytest.approx(17.685, rel=1e-3)
-    uneven = tmp_path / "uneven.csv"
-    uneven.write_text("t,ax,ay,az\n0,0,0,9.8\n0.001,0,0,9.8\n0.003,0,0,9.8\n", encoding="utf-8")
-    assert main(["srs", str(uneven)]) == 2
-    assert "not evenly spaced" in capsys.readouterr().err
+    for stamps, says in (
+        ("0 0.001 0.002 0.005 0.006", "a hole of 0.003 s after 0.002 s (3 times the 0.001 s"),
+        ("0 0.001 0.0005 0.002", "row 4, column t: time does not increase"),
+    ):
+        bad = tmp_path / "bad.csv"
+        rows = "".join(f"{x},0,0,9.8\n" for x in stamps.split())
+        bad.write_text("t,ax,ay,az\n" + rows, encoding="utf-8")
+        assert main(["srs", str(bad)]) == 2
+        assert says in capsys.readouterr().err
+
+
+def _jittered(rate_hz: float, n: int, seed: int) -> np.ndarray:
+    """Stamps (s) of a uniform clock with one sample in 100 stamped −20 … +11 µs off (the
+    bundled 20 kHz records' steps of 30 to 61 µs)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / rate_hz
+    moved = rng.choice(np.arange(1, n - 1), n // 100, replace=False)
+    t[moved] += rng.uniform(-20e-6, 11e-6, moved.shape[0])
+    return t
+
+
+def _shock(t: np.ndarray) -> np.ndarray:
+    """A shock of decaying sines from 40 Hz to 2 kHz (fs/10 at 20 kHz), m/s²."""
+    out = np.zeros_like(t)
+    for f, a, tau in (
+        (40.0, 30.0, 0.05),
+        (310.0, 80.0, 0.02),
+        (900.0, 60.0, 0.01),
+        (2000.0, 40.0, 0.004),
+    ):
+        on = t >= 0.01
+        out[on] += a * np.exp(-(t[on] - 0.01) / tau) * np.sin(2 * np.pi * f * (t[on] - 0.01))
+    return out
+
+
+def test_a_jittered_record_has_the_spectra_of_the_exact_uniform_one() -> None:
+    """The same shock sampled on a jittered clock (stamps where the samples were taken) and on
+    the exact uniform grid: the resampled record's spectra are the uniform one's to 1e-3 of the
+    peak, from 10 Hz to fs/10."""
+    rate = 20_000.0
+    t = _jittered(rate, 8000, seed=3)
+    record = uniform(t, _shock(t), "jittered")
+    assert record.note.startswith("resampled: 159 of 7999 steps")  # 79 samples moved, 2 steps each
+    assert record.rate_hz == pytest.approx(rate)
+    exact = np.arange(8000) / rate
+    np.testing.assert_allclose(record.t, exact, rtol=0, atol=1e-12)
+    freqs = octave_frequencies(10.0, 0.1 * rate, 12)
+    got = srs(record.values, record.rate_hz, freqs, 0.05)
+    want = srs(_shock(exact), rate, freqs, 0.05)
+    for kind in ("maximax", "primary", "residual"):
+        worst = np.abs(getattr(got, kind) - getattr(want, kind)).max()
+        assert worst <= 1e-3 * want.maximax.max(), (kind, worst / want.maximax.max())
+    taken = uniform(exact + 1e-9 * np.sin(np.arange(8000)), _shock(exact), "quantised stamps")
+    assert taken.note == "" and taken.rate_hz == pytest.approx(rate, rel=1e-8)
+
+
+def test_the_bundled_real_excerpt_is_taken_whole(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The real 20 kHz record (an excerpt in the repository) steps 50 µs but twice 30 µs:
+    refused before, resampled and reported now."""
+    excerpt = Path(__file__).resolve().parent / "data" / "water_entry_rest_20khz_excerpt.csv"
+    assert main(["srs", str(excerpt), "--axis", "all", "--freqs", "100", "1000"]) == 0
+    assert "resampled: 2 of 5599 steps" in capsys.readouterr().out
 
 
 def test_a_design_spectrum_needs_its_columns(

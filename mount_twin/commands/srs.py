@@ -6,8 +6,9 @@ one or every axis of the sensor frame. An Imu reports specific force, +g along t
 rest: gravity (and the sensor's bias) is taken out before the spectra, per axis, as the mean of
 the record's head (`--gravity mean-head`, the first `--head` seconds, which must be quiet: the
 default, averaging the noise down), its first sample (`first`), or not at all (`none`: a
-record's constant is then a step, whose spectrum is about twice the constant). The sampling must
-be uniform (the filter runs at one rate). Spectra: see `mount_twin.analysis.srs`.
+record's constant is then a step, whose spectrum is about twice the constant). The filter runs
+at one rate: recorder jitter is taken as such or resampled, and what is not one sampled signal
+refused (`mount_twin.analysis.sampling`). Spectra: see `mount_twin.analysis.srs`.
 """
 
 from __future__ import annotations
@@ -94,6 +95,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from mount_twin.analysis.sampling import uniform
     from mount_twin.analysis.srs import (
         ACCURATE_SHARE,
         damping_ratio,
@@ -110,7 +112,8 @@ def run(args: argparse.Namespace) -> int:
     zeta = damping_ratio(args.damping, args.q)
     design = _design(args.design) if args.design else None
     t, accel, name = _record(args)
-    rate = _rate(t, args.input)
+    record = uniform(t, accel, args.input)
+    t, accel, rate = record.t, record.values, record.rate_hz
     offset, removed = gravity_offset(t, accel, args.gravity, args.head)
     freqs = (
         np.array(args.freqs)
@@ -136,6 +139,8 @@ def run(args: argparse.Namespace) -> int:
     print(
         f"{name}: {len(t)} samples at {rate:.6g} Hz, axis {args.axis}, ζ = {zeta:g} (Q = {q_text})"
     )
+    if record.note:
+        print(record.note)
     print(f"gravity and bias taken out ({removed}): {', '.join(f'{v:.6g}' for v in offset)} m/s²")
     shown = [c for c in columns if c.kind in (TABLE if len(axes) == 1 else TABLE_ALL)]
     print(f"{'f Hz':>9}" + "".join(f" {c.label:>{c.width}}" for c in shown))
@@ -202,25 +207,6 @@ def _record(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, str]:
     decoded = read_input(path, InputSpec(msg_type=topic.msgtype, topic=topic.name))
     t = (decoded.stamps_ns - decoded.stamps_ns[0]) * 1e-9
     return t, decoded.accel, f"{path.name} {topic.name}"
-
-
-def _rate(t: np.ndarray, source: str) -> float:
-    """The sampling rate (Hz) of uniformly spaced stamps `t` (s); an error otherwise."""
-    import numpy as np
-
-    if len(t) < 2:
-        msg = f"{source}: {len(t)} sample(s): an SRS needs a record"
-        raise ValueError(msg)
-    steps = np.diff(t)
-    mean = float(t[-1] - t[0]) / (len(t) - 1)
-    worst = float(np.abs(steps - mean).max())
-    if worst > 0.01 * mean:
-        msg = (
-            f"{source}: the samples are not evenly spaced (steps {steps.min():.6g} to "
-            f"{steps.max():.6g} s): an SRS runs at one rate"
-        )
-        raise ValueError(msg)
-    return 1.0 / mean
 
 
 def _design(path: str) -> tuple[list[float], list[float]]:
