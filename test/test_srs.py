@@ -4,6 +4,7 @@ independent integration of the oscillator and pyyeti; the `srs` command on bags 
 from __future__ import annotations
 
 import csv
+import json
 import math
 import re
 import time
@@ -16,10 +17,13 @@ from pyyeti import srs as pyyeti_srs
 from rosbags.rosbag2 import Writer
 from scipy.integrate import solve_ivp
 
+from mount_twin.analysis.design_margin import TOLERANCE_DB as DEFAULT_BAND
+from mount_twin.analysis.design_margin import check_design
 from mount_twin.analysis.sampling import uniform
 from mount_twin.analysis.srs import damping_ratio, octave_frequencies, srs
 from mount_twin.cli import main
 from mount_twin.commands.common import write_signal
+from mount_twin.commands.srs import EXIT_OUT_OF_TOLERANCE, TOLERANCE_DB
 from mount_twin.io.messages import IMU, TYPESTORE, imu_messages
 from mount_twin.io.signals import Signal
 
@@ -390,3 +394,69 @@ def test_help_imports_no_numpy() -> None:
     done = run_python("-X", "importtime", "-m", "mount_twin.cli", "srs", "--help")
     assert done.returncode == 0 and "--gravity" in done.stdout
     assert not re.search(r"\|\s*numpy(\.|$)", done.stderr, re.MULTILINE)
+
+
+def test_a_design_table_is_interpolated_log_log_and_margins_are_in_db() -> None:
+    """A power law is a straight line on log-log axes: 1 g at 10 Hz to 100 g at 1 kHz is
+    f/10 g between; the margin of a spectrum k times the design is 20 log10 k dB."""
+    freqs = np.array([5.0, 10.0, 31.6, 100.0, 316.0, 1000.0, 2000.0])
+    design = freqs / 10.0
+    scale = np.array([1.0, 1.0, 0.8, 1.2, 1.5, 1.0, 1.0])
+    check = check_design(freqs, design * scale, [10.0, 1000.0], [1.0, 100.0])
+    assert check.skipped == 2  # 5 Hz and 2 kHz are outside the table
+    np.testing.assert_allclose(check.design, freqs[1:-1] / 10.0, rtol=1e-12)
+    np.testing.assert_allclose(check.margin_db, 20.0 * np.log10(scale[1:-1]), atol=1e-12)
+    assert check.within.tolist() == [True, False, True, False, True]  # −1.94 dB, +3.52 dB
+    assert check.bands() == [
+        (31.6, 31.6, "short", pytest.approx(20 * math.log10(0.8))),
+        (316.0, 316.0, "over", pytest.approx(20 * math.log10(1.5))),
+    ]
+    assert not check.passed and "FAIL: short by 1.94 dB at 31.6–31.6 Hz" in check.summary()
+    assert check_design(freqs, design * 1.1, [10.0, 1000.0], [1.0, 100.0]).passed
+
+
+def _design_file(path: Path, freqs: list[float], accel_g: list[float]) -> Path:
+    rows = "".join(f"{f!r},{a!r}\n" for f, a in zip(freqs, accel_g, strict=True))
+    path.write_text("frequency_hz,accel_g\n" + rows, encoding="utf-8")
+    return path
+
+
+def test_a_half_sine_record_meets_its_closed_form_spectrum_and_not_twice_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A 10 g, 10 ms half-sine record against the design table of its own closed-form undamped
+    maximax (10 g × max(primary, residual)): within −1.5/+3 dB (to the sampling's 1e-3, a few
+    thousandths of a dB), exit 0; against twice that table short by 6.02 dB, exit 4, the band
+    and verdict in the text, --csv and --json."""
+    t = np.arange(4001) / FS
+    pulse = np.where(t <= T, np.sin(np.pi * t / T), 0.0)
+    record = tmp_path / "half_sine.csv"
+    rows = "".join(f"{x!r},0,0,{10.0 * p!r}\n" for x, p in zip(t, pulse, strict=True))
+    record.write_text("t [s],ax [g],ay [g],az [g]\n" + rows, encoding="utf-8")
+    ratios = [0.2, 0.35, 1.0, 1.7, 3.2]
+    freqs = [r / T for r in ratios]
+    exact = [
+        10.0 * max(_primary_closed_form(r), abs(4 * r * math.cos(math.pi * r) / (1 - 4 * r * r)))
+        for r in ratios
+    ]
+    base = ["srs", str(record), "--gravity", "none", "--damping", "0", "--freqs", *map(str, freqs)]
+    out = tmp_path / "s.csv"
+    meets = _design_file(tmp_path / "design.csv", freqs, exact)
+    assert main([*base, "--design", str(meets), "--csv", str(out)]) == 0
+    assert "axis z maximax: 5 of 5 frequencies within -1.5/+3 dB: PASS" in capsys.readouterr().out
+    assert all(abs(float(r["margin_db"])) < 0.01 for r in _rows(out))
+    twice = _design_file(tmp_path / "twice.csv", freqs, [2.0 * a for a in exact])
+    doc = tmp_path / "s.json"
+    assert main([*base, "--design", str(twice), "--json", str(doc)]) == EXIT_OUT_OF_TOLERANCE
+    said = capsys.readouterr().out
+    assert "0 of 5 frequencies within -1.5/+3 dB: FAIL: short by 6.0" in said
+    result = json.loads(doc.read_text(encoding="utf-8"))
+    assert result["verdict"] == "FAIL" and result["tolerance_db"] == [-1.5, 3.0]
+    (band,) = result["axes"]["z"]["out_of_band"]
+    assert (band["from_hz"], band["to_hz"], band["kind"]) == (freqs[0], freqs[-1], "short")
+    assert band["worst_db"] == pytest.approx(-20 * math.log10(2.0), abs=0.01)
+    assert max(abs(m + 20 * math.log10(2.0)) for m in result["spectra"]["margin_db"]) < 0.01
+
+
+def test_the_tolerance_defaults_agree() -> None:
+    assert TOLERANCE_DB == DEFAULT_BAND

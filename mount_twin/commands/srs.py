@@ -14,11 +14,13 @@ refused (`mount_twin.analysis.sampling`). Spectra: see `mount_twin.analysis.srs`
 from __future__ import annotations
 
 import argparse
+from itertools import pairwise
 from typing import TYPE_CHECKING, NamedTuple
 
 if TYPE_CHECKING:
     import numpy as np
 
+    from mount_twin.analysis.design_margin import DesignCheck
     from mount_twin.analysis.srs import Spectrum
 
 NAME = "srs"
@@ -30,6 +32,14 @@ TABLE = ("maximax", "primary", "residual", "pseudo_velocity")
 """The printed table's spectra for one axis."""
 TABLE_ALL = ("maximax", "pseudo_velocity")
 """The printed table's spectra per axis with --axis all (the CSV has them all)."""
+TOLERANCE_DB = (-1.5, 3.0)
+"""--tolerance-db's default (`mount_twin.analysis.design_margin.TOLERANCE_DB`, which a test
+holds equal: this module does not import numpy before it runs)."""
+EXIT_OUT_OF_TOLERANCE = 4
+EXIT_STATUS = (
+    "exit status: 0 done (with --design: every axis within the tolerance); 2 bad input; "
+    f"{EXIT_OUT_OF_TOLERANCE} a spectrum out of the design's tolerance somewhere"
+)
 
 
 def _per_octave(text: str) -> float:
@@ -88,13 +98,27 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--plot", metavar="PNG", help="the spectra in g against Hz, log-log")
     parser.add_argument(
-        "--design", metavar="CSV", help="a design spectrum to plot against (frequency_hz,accel_g)"
+        "--design",
+        metavar="CSV",
+        help="a design spectrum (frequency_hz,accel_g): each axis's maximax is judged against "
+        "it, the margins in the table, --csv and --json, a PASS/FAIL line, exit 4 on FAIL",
     )
+    parser.add_argument(
+        "--tolerance-db",
+        type=float,
+        nargs=2,
+        metavar=("LOW", "HIGH"),
+        default=TOLERANCE_DB,
+        help="the band about the design spectrum, dB (default -1.5 3)",
+    )
+    parser.add_argument("--json", metavar="FILE", help="the spectra, margins and verdict as JSON")
+    parser.epilog = EXIT_STATUS
 
 
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from mount_twin.analysis.design_margin import check_design
     from mount_twin.analysis.sampling import uniform
     from mount_twin.analysis.srs import (
         ACCURATE_SHARE,
@@ -110,6 +134,10 @@ def run(args: argparse.Namespace) -> int:
 
         require("matplotlib", "--plot")
     zeta = damping_ratio(args.damping, args.q)
+    low, high = args.tolerance_db
+    if not low < 0.0 < high:
+        msg = f"--tolerance-db {low:g} {high:g}: needs LOW < 0 < HIGH (dB about the design)"
+        raise ValueError(msg)
     design = _design(args.design) if args.design else None
     t, accel, name = _record(args)
     record = uniform(t, accel, args.input)
@@ -135,6 +163,15 @@ def run(args: argparse.Namespace) -> int:
         for axis, s in spectra.items()
         for kind in SPECTRA
     ]
+    checks = (
+        {
+            axis: check_design(freqs, s.maximax / G, *design, (low, high))
+            for axis, s in spectra.items()
+        }
+        if design is not None
+        else {}
+    )
+    columns += _margin_columns(freqs, checks)
     q_text = f"{1 / (2 * zeta):g}" if zeta > 0.0 else "∞"
     print(
         f"{name}: {len(t)} samples at {rate:.6g} Hz, axis {args.axis}, ζ = {zeta:g} (Q = {q_text})"
@@ -151,14 +188,85 @@ def run(args: argparse.Namespace) -> int:
     if not accurate.all():
         limit = ACCURATE_SHARE * rate
         print(f"* above fs/10 = {limit:g} Hz the filter is less accurate (peaks picked low)")
+    for axis, check in checks.items():
+        print(f"design {args.design}, axis {axis} maximax: {check.summary()}")
     if args.csv:
         _write_csv(args.csv, freqs, columns)
         print(f"csv: {args.csv} (accelerations in g, pseudo-velocity in m/s)")
+    if args.json:
+        _write_json(args, freqs, columns, checks, rate, zeta)
+        print(f"json: {args.json}")
     if args.plot:
         title = f"SRS of {name}, ζ = {zeta:g}, {removed} taken out"
-        _plot(args.plot, spectra, design, title, ACCURATE_SHARE * rate)
+        band = (low, high) if design is not None else None
+        _plot(args.plot, spectra, design, band, title, ACCURATE_SHARE * rate)
         print(f"plot: {args.plot}")
-    return 0
+    return EXIT_OUT_OF_TOLERANCE if any(not c.passed for c in checks.values()) else 0
+
+
+def _margin_columns(freqs: np.ndarray, checks: dict[str, DesignCheck]) -> list[Column]:
+    """With a design: the design (g) and each axis's margin (dB) at every frequency, NaN
+    where the design does not reach."""
+    import numpy as np
+
+    out: list[Column] = []
+    for axis, check in checks.items():
+        judged = np.isin(freqs, check.frequency_hz)
+        if not out:
+            design = np.full(freqs.shape, np.nan)
+            design[judged] = check.design
+            out.append(Column("design", "design_g", "g", design))
+        margin = np.full(freqs.shape, np.nan)
+        margin[judged] = check.margin_db
+        name = "margin_db" if len(checks) == 1 else f"margin_db_{axis}"
+        out.append(Column("margin", name, "dB", margin))
+    return out
+
+
+def _write_json(
+    args: argparse.Namespace,
+    freqs: np.ndarray,
+    columns: list[Column],
+    checks: dict[str, DesignCheck],
+    rate_hz: float,
+    zeta: float,
+) -> None:
+    """The spectra (as --csv has them), and with a design the verdict and its bands."""
+    import json
+    import math
+
+    def number(v: float) -> float | None:
+        return None if math.isnan(v) else float(v)
+
+    doc = {
+        "input": args.input,
+        "axis": args.axis,
+        "rate_hz": rate_hz,
+        "damping": zeta,
+        "frequency_hz": [float(f) for f in freqs],
+        "spectra": {c.name: [number(v) for v in c.values] for c in columns},
+        "units": {c.name: c.unit for c in columns},
+        "design": args.design,
+        "tolerance_db": list(args.tolerance_db) if checks else None,
+        "verdict": ("PASS" if all(c.passed for c in checks.values()) else "FAIL")
+        if checks
+        else None,
+        "axes": {
+            axis: {
+                "passed": c.passed,
+                "summary": c.summary(),
+                "judged": int(c.frequency_hz.shape[0]),
+                "not_judged": c.skipped,
+                "out_of_band": [
+                    {"from_hz": f0, "to_hz": f1, "kind": kind, "worst_db": worst}
+                    for f0, f1, kind, worst in c.bands()
+                ],
+            }
+            for axis, c in checks.items()
+        },
+    }
+    with open(args.json, "w", encoding="utf-8") as fh:
+        json.dump(doc, fh, indent=1)
 
 
 class Column(NamedTuple):
@@ -221,10 +329,18 @@ def _design(path: str) -> tuple[list[float], list[float]]:
             raise ValueError(msg)
         rows = list(reader)
     try:
-        return [float(r["frequency_hz"]) for r in rows], [float(r["accel_g"]) for r in rows]
+        f = [float(r["frequency_hz"]) for r in rows]
+        a = [float(r["accel_g"]) for r in rows]
     except (TypeError, ValueError) as err:
         msg = f"{path}: a design spectrum's values must be numbers ({err})"
         raise ValueError(msg) from None
+    if len(f) < 2 or f[0] <= 0.0 or not all(f0 < f1 for f0, f1 in pairwise(f)):
+        msg = f"{path}: frequency_hz must be at least two increasing frequencies above 0 Hz"
+        raise ValueError(msg)
+    if not all(v > 0.0 and v < float("inf") for v in a):
+        msg = f"{path}: accel_g must be finite and above 0 g (the spectrum is log-log)"
+        raise ValueError(msg)
+    return f, a
 
 
 def _write_csv(path: str, freqs: np.ndarray, columns: list[Column]) -> None:
@@ -244,6 +360,7 @@ def _plot(
     png: str,
     spectra: dict[str, Spectrum],
     design: tuple[list[float], list[float]] | None,
+    band_db: tuple[float, float] | None,
     title: str,
     accurate_hz: float,
 ) -> None:
@@ -272,6 +389,12 @@ def _plot(
     if design is not None:
         ax.loglog(*design, "k--", label="design")
         top = max(top, *design[1])
+        if band_db is not None:
+            low, high = (10.0 ** (db / 20.0) for db in band_db)
+            band = f"tolerance {band_db[0]:+g}/{band_db[1]:+g} dB"
+            ax.loglog(design[0], [v * low for v in design[1]], "k:", lw=1.0, label=band)
+            ax.loglog(design[0], [v * high for v in design[1]], "k:", lw=1.0)
+            top = max(top, max(design[1]) * high)
     f_top = float(max(s.frequency_hz.max() for s in spectra.values()))
     if f_top > accurate_hz:
         ax.axvspan(accurate_hz, f_top, color="0.9", label="f > fs/10: less accurate")
