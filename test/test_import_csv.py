@@ -44,6 +44,35 @@ def test_plain_csv_in_si_with_common_names_and_tabs(tmp_path: Path) -> None:
     assert "no gyro columns: angular velocity taken as 0" in imported.notes
 
 
+def test_an_endaq_export_with_quoted_headers_and_range_units(tmp_path: Path) -> None:
+    """enDAQ writes `"Time (s)","X (100g)",...`: quoted cells, axes X, Y, Z, the channel named
+    by its range, values in g."""
+    path = _write(
+        tmp_path,
+        '"Time (s)","X (100g)","Y (100g)","Z (100g)"\n'
+        "1700000000.0,0.01,-0.02,1.0\n1700000000.0001,0.5,0.25,3.0\n",
+    )
+    imported = read_recorder_csv(path)
+    np.testing.assert_allclose(imported.signal.accel / G, [[0.01, -0.02, 1.0], [0.5, 0.25, 3.0]])
+    assert "accelerometer range '100g' in the header: values read in g" in imported.notes
+
+
+def test_a_single_axis_record_is_read_along_its_stated_axis(tmp_path: Path) -> None:
+    """One acceleration column (HR-SHM style) along a stated sensor axis, the others 0: the
+    only column besides time, or the one mapped to that axis."""
+    path = _write(tmp_path, "time [s],accel [g]\n0,1.0\n0.001,1.5\n")
+    got = read_recorder_csv(path, CsvFormat(axis="z"))
+    np.testing.assert_allclose(got.signal.accel, [[0, 0, G], [0, 0, 1.5 * G]], rtol=1e-15)
+    assert "single axis: accel along the sensor's z, the others 0" in got.notes
+    two = _write(tmp_path, "t,temperature,shock\n0,20,3.0\n0.001,20,4.0\n", "two.csv")
+    with pytest.raises(ValueError, match="needs one acceleration column besides time"):
+        read_recorder_csv(two, CsvFormat(axis="x"))
+    mapped = read_recorder_csv(two, CsvFormat(columns={"ax": "shock"}, axis="x"))
+    np.testing.assert_allclose(mapped.signal.accel, [[3.0, 0, 0], [4.0, 0, 0]])
+    out = tmp_path / "bag"
+    assert main(["import-csv", str(path), "-o", str(out), "--single-axis", "z"]) == 0
+
+
 def test_a_column_mapping_and_unit_overrides(tmp_path: Path) -> None:
     path = _write(tmp_path, "stamp,vert,lat,long\n1000,1,0,0\n2000,2,0,0\n")
     fmt = CsvFormat(

@@ -37,6 +37,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--gyro-unit", help="rad/s or deg/s (default: from the header, else rad/s)"
     )
     parser.add_argument(
+        "--single-axis",
+        choices=["x", "y", "z"],
+        help="a single-axis record: its one acceleration column is along this sensor axis "
+        "(the others 0); name the column with --columns az=NAME if time is not alone beside it",
+    )
+    parser.add_argument(
         "--storage", choices=["mcap", "sqlite3"], default="mcap", help="bag storage format"
     )
 
@@ -63,7 +69,8 @@ def run(args: argparse.Namespace) -> int:
         if u
     }
     delimiter = "\t" if args.delimiter in ("\\t", "tab") else args.delimiter
-    imported = read_recorder_csv(args.csv, CsvFormat(delimiter, args.decimal, columns, units))
+    fmt = CsvFormat(delimiter, args.decimal, columns, units, args.single_axis)
+    imported = read_recorder_csv(args.csv, fmt)
     n = write_signal(
         imported.signal, args.output, args.topic, args.frame_id, args.offset, args.storage
     )

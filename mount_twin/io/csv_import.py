@@ -3,8 +3,10 @@
 Accepted: `,` `;` tab or whitespace between cells (sniffed from the header line), a decimal
 comma (with `;`, tab or whitespace delimiters), a UTF-8 byte-order mark (Excel's "CSV UTF-8"),
 comment lines (`#`) and blank lines, units in the header (`t [s]`, `AccZ (g)`, `wx[deg/s]`),
-common column names (`time`, `AccX`, `gyro_x`, ...) or an explicit mapping, and files without
-gyro columns (Ω = 0). Units: time s, ms, us, ns; acceleration m/s², g (9.80665 m/s²), mm/s²;
+quoted header cells and channels named by their range (enDAQ's `"X (100g)"`: g), common column
+names (`time`, `AccX`, `gyro_x`, `X`, ...) or an explicit mapping, files without gyro columns
+(Ω = 0), and single-axis records (`CsvFormat.axis`: one acceleration column along a stated
+sensor axis, the others 0). Units: time s, ms, us, ns; acceleration m/s², g (9.80665 m/s²), mm/s²;
 angular rate rad/s, deg/s. Every error names the file, the row (its line number in the file)
 and the column. The values are specific force in the sensor frame, as an IMU reports them.
 """
@@ -25,14 +27,17 @@ G = 9.80665
 ROLES = ("t", "ax", "ay", "az", "wx", "wy", "wz")
 ALIASES: dict[str, tuple[str, ...]] = {
     "t": ("t", "time", "timestamp", "time_s", "sec", "seconds"),
-    "ax": ("ax", "accx", "acc_x", "accel_x", "acceleration_x", "a_x"),
-    "ay": ("ay", "accy", "acc_y", "accel_y", "acceleration_y", "a_y"),
-    "az": ("az", "accz", "acc_z", "accel_z", "acceleration_z", "a_z"),
+    "ax": ("ax", "accx", "acc_x", "accel_x", "acceleration_x", "a_x", "x"),
+    "ay": ("ay", "accy", "acc_y", "accel_y", "acceleration_y", "a_y", "y"),
+    "az": ("az", "accz", "acc_z", "accel_z", "acceleration_z", "a_z", "z"),
     "wx": ("wx", "gx", "gyrox", "gyro_x", "omega_x", "rate_x", "w_x"),
     "wy": ("wy", "gy", "gyroy", "gyro_y", "omega_y", "rate_y", "w_y"),
     "wz": ("wz", "gz", "gyroz", "gyro_z", "omega_z", "rate_z", "w_z"),
 }
-"""Header names (lower case, spaces as _) taken for each role without a mapping."""
+"""Header names (lower case, spaces as _) taken for each role without a mapping (enDAQ's
+exports name their axes X, Y, Z)."""
+RANGE_UNIT = re.compile(r"^(\d+)g$")
+"""An accelerometer channel named by its range, as enDAQ's exports do (`X (100g)`): in g."""
 UNITS: dict[str, dict[str, float]] = {
     "time": {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "ns": 1e-9},
     "accel": {"m/s^2": 1.0, "m/s2": 1.0, "m/s²": 1.0, "mps2": 1.0, "g": G, "mm/s^2": 1e-3},
@@ -52,12 +57,16 @@ class CsvFormat:
         decimal: '.' or ','; None: ',' if the delimiter is not ',' and the numbers have one.
         columns: role (t, ax, ay, az, wx, wy, wz) → header name, for names not recognised.
         units: quantity (time, accel, gyro) → unit, overriding the header's.
+        axis: 'x', 'y' or 'z' for a single-axis record: its one acceleration column (mapped
+            as that axis's role, e.g. az=Accel, else the only column besides time) is along
+            that sensor axis; the other axes read 0. None: three axes.
     """
 
     delimiter: str | None = None
     decimal: str | None = None
     columns: dict[str, str] = field(default_factory=dict)
     units: dict[str, str] = field(default_factory=dict)
+    axis: str | None = None
 
 
 CSV_MAX_BYTES = 256 * MIB
@@ -99,19 +108,26 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     header_row, header = lines[0]
     delimiter = fmt.delimiter or next((d for d in (";", "\t", ",") if d in header), None)
     names, header_units = _header(header, delimiter)
-    roles = _roles(path, header_row, names, fmt.columns)
+    if fmt.axis is None:
+        roles = _roles(path, header_row, names, fmt.columns)
+    else:
+        roles = _single_axis_roles(path, header_row, names, fmt)
     data = lines[1:]
     if not data:
         raise _fail(path, f"row {header_row}", "a header but no data rows")
     decimal = fmt.decimal or (
         "," if delimiter != "," and any("," in line for _, line in data[:50]) else "."
     )
-    notes = []
+    notes: list[str] = []
     scale = {}
     for role, col in roles.items():
         quantity = QUANTITY[role]
         unit = fmt.units.get(quantity) or header_units[col] or next(iter(UNITS[quantity]))
         factor = UNITS[quantity].get(unit.lower().replace(" ", ""))
+        if factor is None and quantity == "accel" and RANGE_UNIT.match(unit.lower()):
+            factor = G
+            if not any(n.startswith("accelerometer range") for n in notes):
+                notes.append(f"accelerometer range {unit!r} in the header: values read in g")
         if factor is None:
             known = ", ".join(UNITS[quantity])
             where = f"row {header_row}, column {names[col]}"
@@ -144,7 +160,13 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     if back.size:
         row = data[int(back[0]) + 1][0]
         raise _fail(path, f"row {row}, column {names[roles['t']]}", "time does not increase")
-    accel = values[:, 1:4]
+    if fmt.axis is not None:
+        accel = np.zeros((len(data), 3))
+        accel[:, "xyz".index(fmt.axis)] = values[:, 1]
+        column = names[roles[f"a{fmt.axis}"]]
+        notes.append(f"single axis: {column} along the sensor's {fmt.axis}, the others 0")
+    else:
+        accel = values[:, 1:4]
     if len(roles) == 7:
         gyro = values[:, 4:7]
     else:
@@ -152,7 +174,7 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
         notes.append("no gyro columns: angular velocity taken as 0")
     units = {
         q: fmt.units.get(q) or header_units[roles[r]] or next(iter(UNITS[q]))
-        for r, q in (("t", "time"), ("ax", "accel"), ("wx", "gyro"))
+        for r, q in (("t", "time"), (f"a{fmt.axis or 'x'}", "accel"), ("wx", "gyro"))
         if r in roles
     }
     notes.append("units: " + ", ".join(f"{q} {u}" for q, u in units.items()))
@@ -164,15 +186,43 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
 def _header(line: str, delimiter: str | None) -> tuple[list[str], list[str]]:
     """Column names (lower case, spaces as _) and units ('' where none) of the header line."""
     names, units = [], []
-    for cell in line.split(delimiter) if delimiter else line.split():
+    for raw in line.split(delimiter) if delimiter else line.split():
+        cell = raw.strip().strip('"')  # quoted cells: enDAQ's "X (100g)"
         match = HEADER_CELL.match(cell)
-        name, unit = (match.group(1), match.group(2) or "") if match else (cell.strip(), "")
+        name, unit = (match.group(1), match.group(2) or "") if match else (cell, "")
         names.append(name.strip().strip('"').lower().replace(" ", "_"))
         units.append(unit)
     return names, units
 
 
-def _roles(path: Path, row: int, names: list[str], mapping: dict[str, str]) -> dict[str, int]:
+def _single_axis_roles(path: Path, row: int, names: list[str], fmt: CsvFormat) -> dict[str, int]:
+    """t and the one acceleration column of a single-axis record (see CsvFormat.axis), in
+    that order."""
+    role = f"a{fmt.axis}"
+    found = _roles(path, row, names, fmt.columns, required=("t",))
+    t = found["t"]
+    if role in found:
+        col = found[role]
+    else:
+        rest = [i for i in range(len(names)) if i != t]
+        if len(rest) != 1:
+            raise _fail(
+                path,
+                f"row {row}",
+                f"a single-axis record needs one acceleration column besides time; the header "
+                f"has {', '.join(names)}: name it with --columns {role}=NAME",
+            )
+        (col,) = rest
+    return {"t": t, role: col}
+
+
+def _roles(
+    path: Path,
+    row: int,
+    names: list[str],
+    mapping: dict[str, str],
+    required: tuple[str, ...] = ROLES[:4],
+) -> dict[str, int]:
     """Role → column index: the mapping's names, else the first alias present."""
     roles: dict[str, int] = {}
     for role in ROLES:
@@ -186,7 +236,7 @@ def _roles(path: Path, row: int, names: list[str], mapping: dict[str, str]) -> d
                 f"row {row}",
                 f"no column {mapping[role]!r} (for {role}); the header has {', '.join(names)}",
             )
-    missing = [r for r in ROLES[:4] if r not in roles]
+    missing = [r for r in required if r not in roles]
     if missing:
         raise _fail(
             path,
