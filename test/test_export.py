@@ -12,6 +12,8 @@ import pytest
 from io_helpers import CONFIG, ROOT, read_bag
 
 from mount_twin.cli import main
+from mount_twin.replay import replay
+from mount_twin.scene import load_scene_file
 
 
 @pytest.fixture(scope="module")
@@ -82,3 +84,35 @@ def test_replay_json_summary_times_events_from_the_first_output(tmp_path: Path) 
     est = doc["error_estimate"]
     assert 3e-4 < est["force_error_rel"] < 1e-2 and est["resyncs"] == 0
     assert est["force_error_n"] > 0.0 and 0.0 < est["attitude_error_rad"] < 1e-5
+
+
+def test_the_events_table_holds_every_mount_event_of_the_run(tmp_path: Path) -> None:
+    """`events.csv`: per diagnostics period and mount event, its count, first stamp, level and
+    largest |F|; summed over the periods, the counts are the replay's own event list; the
+    rows in time order within the outputs' span (to the µs the message gives)."""
+    out = tmp_path / "out"
+    summary = replay(
+        load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml"),
+        ROOT / "bags" / "genset_shock_10khz",
+        out,
+        progress=False,
+    )
+    assert summary.events, "the case must have mount events"
+    assert main(["export", str(out), "--csv", str(tmp_path / "t")]) == 0
+    rows = _csv(tmp_path / "t" / "events.csv")
+    counts: dict[tuple[str, str], int] = {}
+    first: dict[tuple[str, str], int] = {}
+    for r in rows:
+        key = (r["mount"], r["event"])
+        counts[key] = counts.get(key, 0) + int(r["count"])
+        first.setdefault(key, int(r["stamp_ns"]))
+        assert r["level"] in ("WARN", "ERROR") and float(r["force_max_N"]) > 0.0
+    want: dict[tuple[str, str], int] = {}
+    for e in summary.events:
+        want[(e.mount, e.event)] = want.get((e.mount, e.event), 0) + 1
+    assert counts == want
+    pose = _csv(tmp_path / "t" / "pose.csv")
+    stamps = [int(r["stamp_ns"]) for r in rows]
+    assert stamps == sorted(stamps)
+    assert int(pose[0]["stamp_ns"]) - 1000 <= min(first.values())
+    assert max(stamps) <= int(pose[-1]["stamp_ns"]) + 1000

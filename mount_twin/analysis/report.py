@@ -12,9 +12,7 @@ import base64
 import html
 import io
 import json
-import re
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -27,52 +25,13 @@ from mount_twin.analysis.figures import (
     displacement_from_start,
     peak_magnitudes,
 )
-from mount_twin.engine.batch import event_level
 from mount_twin.errors import ModelError
 from mount_twin.io.messages import WRENCH
-from mount_twin.io.output_tables import COLUMNS, Table, read_output_bag
-from mount_twin.kinds.events import EVENT_IS_ERROR
+from mount_twin.io.output_tables import COLUMNS, Table, events_of, read_output_bag
 from mount_twin.scene.description import Scene
 
-EVENT = re.compile(r"(\w+) ×(\d+) \(first (\d+\.\d+) s, \|F\| max ([\d.e+-]+) N\)")
-"""An event group in a mount status message (engine.health._events_text)."""
 WINDOW_S = 0.05
 """Half-width of the zoom around the first event, s."""
-
-
-@dataclass(frozen=True)
-class Event:
-    """A mount event group of one diagnostics period: time from the first output (s)."""
-
-    mount: str
-    event: str
-    count: int
-    t_s: float
-    force_n: float
-    level: str
-
-
-def events_of(diagnostics: Table, origin_ns: int) -> list[Event]:
-    """Mount event groups named in the diagnostics messages, in time order; each at its own
-    kind's level (the mount status' level is that of its worst event in the period)."""
-    out = []
-    c = diagnostics.columns
-    for status, message in zip(c["status"], c["message"], strict=True):
-        if not status.startswith("mount_twin: mount "):
-            continue
-        for name, count, first, force in EVENT.findall(message):
-            t = float(first) - origin_ns * 1e-9
-            out.append(
-                Event(
-                    status.removeprefix("mount_twin: mount "),
-                    name,
-                    int(count),
-                    t,
-                    float(force),
-                    event_level(EVENT_IS_ERROR[name]),
-                )
-            )
-    return sorted(out, key=lambda e: e.t_s)
 
 
 def utilisation_of(diagnostics: Table) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -198,7 +157,7 @@ def write_report(
     the record, to plot beside the response."""
     tables = {t.name: t for t in read_output_bag(output_bag)}
     mounts = {k.removeprefix("mount_"): t for k, t in tables.items() if k.startswith("mount_")}
-    origin = min(int(t.columns["stamp_ns"][0]) for t in tables.values())
+    origin = min(int(t.columns["stamp_ns"][0]) for t in tables.values() if len(t))
     diagnostics = tables.get("diagnostics")
     events = events_of(diagnostics, origin) if diagnostics else []
     utilisation = utilisation_of(diagnostics) if diagnostics else {}

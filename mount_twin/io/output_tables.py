@@ -2,7 +2,9 @@
 
 One table per output: `pose` (CG position m, quaternion x, y, z, w of body → F), `angles`
 (α, γ, δ rad), one `mount_<name>` per mount (force N and couple N·m on the body, mount axes)
-and `diagnostics` (one row per status per report; `values` holds its key-values as JSON).
+`diagnostics` (one row per status per report; `values` holds its key-values as JSON) and
+`events` (one row per mount event group of a report: its first event's stamp, mount, event,
+level, count, largest |F|).
 Every table starts with the integer header stamp `stamp_ns` and `t_s`, seconds from the bag's
 first output stamp. Column names carry their unit.
 """
@@ -10,6 +12,7 @@ first output stamp. Column names carry their unit.
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -17,8 +20,10 @@ from typing import Any
 import numpy as np
 from rosbags.highlevel import AnyReader
 
+from mount_twin.engine.batch import event_level
 from mount_twin.errors import BagError
 from mount_twin.io.messages import DIAGNOSTICS, POSE, TYPESTORE, VECTOR3, WRENCH
+from mount_twin.kinds.events import EVENT_IS_ERROR
 
 COLUMNS = {
     POSE: ("x_m", "y_m", "z_m", "qx", "qy", "qz", "qw"),
@@ -27,6 +32,8 @@ COLUMNS = {
 }
 """Numeric columns per output message type, after stamp_ns and t_s."""
 LEVELS = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
+EVENT = re.compile(r"(\w+) ×(\d+) \(first (\d+\.\d+) s, \|F\| max ([\d.e+-]+) N\)")
+"""An event group in a mount status message (engine.health._events_text)."""
 
 
 @dataclass(frozen=True)
@@ -103,7 +110,63 @@ def read_output_bag(path: str | Path) -> list[Table]:
             values = np.array(rows[name], dtype=float)
             columns.update(zip(COLUMNS[kinds[name]], values.T, strict=True))
         tables.append(Table(name, columns))
+        if kinds[name] == DIAGNOSTICS:
+            tables.append(events_table(tables[-1], origin))
     return tables
+
+
+@dataclass(frozen=True)
+class Event:
+    """A mount event group of one diagnostics period: time from the first output (s)."""
+
+    mount: str
+    event: str
+    count: int
+    t_s: float
+    force_n: float
+    level: str
+
+
+def events_of(diagnostics: Table, origin_ns: int) -> list[Event]:
+    """Mount event groups named in the diagnostics messages, in time order; each at its own
+    kind's level (the mount status' level is that of its worst event in the period)."""
+    out = []
+    c = diagnostics.columns
+    for status, message in zip(c["status"], c["message"], strict=True):
+        if not status.startswith("mount_twin: mount "):
+            continue
+        for name, count, first, force in EVENT.findall(message):
+            t = float(first) - origin_ns * 1e-9
+            out.append(
+                Event(
+                    status.removeprefix("mount_twin: mount "),
+                    name,
+                    int(count),
+                    t,
+                    float(force),
+                    event_level(EVENT_IS_ERROR[name]),
+                )
+            )
+    return sorted(out, key=lambda e: e.t_s)
+
+
+def events_table(diagnostics: Table, origin_ns: int) -> Table:
+    """`events`: one row per mount event group of a diagnostics period (`events_of`): the
+    stamp of its first event, mount, event, level, count and the largest |F| (N)."""
+    events = events_of(diagnostics, origin_ns)
+    first_ns = np.array([origin_ns + round(e.t_s * 1e9) for e in events], dtype=np.int64)
+    return Table(
+        "events",
+        {
+            "stamp_ns": first_ns,
+            "t_s": np.array([e.t_s for e in events]),
+            "mount": np.array([e.mount for e in events], dtype=object),
+            "event": np.array([e.event for e in events], dtype=object),
+            "level": np.array([e.level for e in events], dtype=object),
+            "count": np.array([e.count for e in events], dtype=np.int64),
+            "force_max_N": np.array([e.force_n for e in events]),
+        },
+    )
 
 
 def write_tables(tables: list[Table], directory: str | Path, fmt: str = "csv") -> list[Path]:
