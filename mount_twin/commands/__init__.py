@@ -23,6 +23,7 @@ COMMANDS = (
     "export",
     "report",
     "srs",
+    "synthesize",
     "modes",
     "accuracy",
     "sweep",

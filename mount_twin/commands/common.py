@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Mapping
+from itertools import pairwise
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -62,3 +63,29 @@ def write_signal(
     return write_bag(
         out, topic, IMU, iter(imu_messages(stamps, sig.accel, sig.gyro, frame_id)), storage
     )
+
+
+def read_design_table(path: str) -> tuple[list[float], list[float]]:
+    """A design spectrum's (frequencies Hz, accelerations g) from its `frequency_hz,accel_g`
+    CSV."""
+    import csv
+
+    with open(path, encoding="utf-8-sig") as fh:
+        reader = csv.DictReader(fh)
+        if not {"frequency_hz", "accel_g"} <= set(reader.fieldnames or ()):
+            msg = f"{path}: a design spectrum needs the columns frequency_hz and accel_g"
+            raise ValueError(msg)
+        rows = list(reader)
+    try:
+        f = [float(r["frequency_hz"]) for r in rows]
+        a = [float(r["accel_g"]) for r in rows]
+    except (TypeError, ValueError) as err:
+        msg = f"{path}: a design spectrum's values must be numbers ({err})"
+        raise ValueError(msg) from None
+    if len(f) < 2 or f[0] <= 0.0 or not all(f0 < f1 for f0, f1 in pairwise(f)):
+        msg = f"{path}: frequency_hz must be at least two increasing frequencies above 0 Hz"
+        raise ValueError(msg)
+    if not all(v > 0.0 and v < float("inf") for v in a):
+        msg = f"{path}: accel_g must be finite and above 0 g (the spectrum is log-log)"
+        raise ValueError(msg)
+    return f, a

@@ -14,7 +14,6 @@ refused (`mount_twin.analysis.sampling`). Spectra: see `mount_twin.analysis.srs`
 from __future__ import annotations
 
 import argparse
-from itertools import pairwise
 from typing import TYPE_CHECKING, NamedTuple
 
 if TYPE_CHECKING:
@@ -127,6 +126,7 @@ def run(args: argparse.Namespace) -> int:
         octave_frequencies,
         srs,
     )
+    from mount_twin.commands.common import read_design_table
     from mount_twin.io.csv_import import G
 
     if args.plot:
@@ -138,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
     if not low < 0.0 < high:
         msg = f"--tolerance-db {low:g} {high:g}: needs LOW < 0 < HIGH (dB about the design)"
         raise ValueError(msg)
-    design = _design(args.design) if args.design else None
+    design = read_design_table(args.design) if args.design else None
     t, accel, name = _record(args)
     record = uniform(t, accel, args.input)
     t, accel, rate = record.t, record.values, record.rate_hz
@@ -315,32 +315,6 @@ def _record(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, str]:
     decoded = read_input(path, InputSpec(msg_type=topic.msgtype, topic=topic.name))
     t = (decoded.stamps_ns - decoded.stamps_ns[0]) * 1e-9
     return t, decoded.accel, f"{path.name} {topic.name}"
-
-
-def _design(path: str) -> tuple[list[float], list[float]]:
-    """A design spectrum's (frequencies Hz, accelerations g) from its `frequency_hz,accel_g`
-    CSV."""
-    import csv
-
-    with open(path, encoding="utf-8-sig") as fh:
-        reader = csv.DictReader(fh)
-        if not {"frequency_hz", "accel_g"} <= set(reader.fieldnames or ()):
-            msg = f"{path}: a design spectrum needs the columns frequency_hz and accel_g"
-            raise ValueError(msg)
-        rows = list(reader)
-    try:
-        f = [float(r["frequency_hz"]) for r in rows]
-        a = [float(r["accel_g"]) for r in rows]
-    except (TypeError, ValueError) as err:
-        msg = f"{path}: a design spectrum's values must be numbers ({err})"
-        raise ValueError(msg) from None
-    if len(f) < 2 or f[0] <= 0.0 or not all(f0 < f1 for f0, f1 in pairwise(f)):
-        msg = f"{path}: frequency_hz must be at least two increasing frequencies above 0 Hz"
-        raise ValueError(msg)
-    if not all(v > 0.0 and v < float("inf") for v in a):
-        msg = f"{path}: accel_g must be finite and above 0 g (the spectrum is log-log)"
-        raise ValueError(msg)
-    return f, a
 
 
 def _write_csv(path: str, freqs: np.ndarray, columns: list[Column]) -> None:
