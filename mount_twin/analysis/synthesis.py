@@ -24,6 +24,7 @@ import numpy as np
 
 from mount_twin.analysis.design_margin import TOLERANCE_DB, DesignCheck, check_design
 from mount_twin.analysis.srs import octave_frequencies, srs
+from mount_twin.io.signals import Signal
 
 G = 9.80665
 CLOSE_DB = 0.5
@@ -124,3 +125,14 @@ def synthesize(
         f"{max_iterations} iterations: {check.summary()}"
     )
     raise ValueError(msg)
+
+
+def imu_record(shock: Synthesis, rate_hz: float, axis: str, head_s: float) -> Signal:
+    """The shock as an Imu at rest reads it: +g on z throughout, `head_s` of rest first (the
+    start checks, the SRS's gravity head), then the shock along the sensor's `axis`."""
+    head = round(head_s * rate_hz)
+    n = head + shock.t.shape[0]
+    accel = np.zeros((n, 3))
+    accel[:, 2] = G
+    accel[head:, "xyz".index(axis)] += shock.accel
+    return Signal(np.arange(n) / rate_hz, accel, np.zeros((n, 3)))

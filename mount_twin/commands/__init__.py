@@ -24,6 +24,7 @@ COMMANDS = (
     "report",
     "srs",
     "synthesize",
+    "qualify",
     "modes",
     "accuracy",
     "sweep",

@@ -4,19 +4,39 @@ spectrum, as Imu bags (see `mount_twin.analysis.synthesis`)."""
 from __future__ import annotations
 
 import argparse
+from collections.abc import Iterator
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from mount_twin.analysis.synthesis import Synthesis
+    from mount_twin.io.signals import Signal
 
 NAME = "synthesize"
 HELP = "acceleration time histories whose SRS meets a design spectrum, written as input bags"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("-o", "--output", required=True, help="directory of the bags (new)")
+    add_synthesis_arguments(parser)
+    parser.add_argument("--topic", default="/deck/imu", help="(the bundled scenes' input)")
+    parser.add_argument("--frame-id", default="deck_imu", help="header.frame_id")
+    parser.add_argument(
+        "--start", type=int, default=1_700_000_000_000_000_000, help="first stamp, ns"
+    )
+    parser.add_argument(
+        "--storage", choices=["mcap", "sqlite3"], default="mcap", help="bag storage format"
+    )
+
+
+def add_synthesis_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options of a synthesis (also `qualify`'s): spectrum, seeds, rate, axis, damping,
+    tolerance, head."""
     parser.add_argument(
         "--spectrum",
         required=True,
         metavar="CSV",
         help="the design spectrum (frequency_hz,accel_g), maximax, interpolated log-log",
     )
-    parser.add_argument("-o", "--output", required=True, help="directory of the bags (new)")
     parser.add_argument("--seeds", type=int, default=3, help="time histories, one per seed")
     parser.add_argument("--first-seed", type=int, default=0, help="the first seed")
     parser.add_argument("--rate", type=float, default=20000.0, help="sampling rate, Hz")
@@ -37,37 +57,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--head", type=float, default=0.05, help="rest before the shock, s (the start checks)"
     )
-    parser.add_argument("--topic", default="/deck/imu", help="(the bundled scenes' input)")
-    parser.add_argument("--frame-id", default="deck_imu", help="header.frame_id")
-    parser.add_argument(
-        "--start", type=int, default=1_700_000_000_000_000_000, help="first stamp, ns"
-    )
-    parser.add_argument(
-        "--storage", choices=["mcap", "sqlite3"], default="mcap", help="bag storage format"
-    )
 
 
-def run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
-    import numpy as np
-
+def synthesized(args: argparse.Namespace) -> Iterator[tuple[int, Synthesis, Signal]]:
+    """Per seed of `args` (add_synthesis_arguments): the seed, the shock and its Imu record;
+    the design spectrum and the plan printed first."""
     from mount_twin.analysis.srs import damping_ratio
-    from mount_twin.analysis.synthesis import G, synthesize
-    from mount_twin.commands.common import read_design_table, write_signal
-    from mount_twin.io.signals import Signal
+    from mount_twin.analysis.synthesis import imu_record, synthesize
+    from mount_twin.commands.common import read_design_table
 
     if args.seeds < 1 or args.head < 0.0 or not args.rate > 0.0:
         msg = "--seeds must be ≥ 1, --head ≥ 0 s and --rate > 0 Hz"
         raise ValueError(msg)
     design = read_design_table(args.spectrum)
     zeta = damping_ratio(args.damping, args.q)
-    out = Path(args.output)
-    if out.exists():
-        msg = f"{out}: exists; synthesize writes a new directory"
-        raise ValueError(msg)
-    out.mkdir(parents=True)
-    axis = "xyz".index(args.axis)
     print(
         f"{args.spectrum}: {len(design[0])} points, {design[0][0]:g}–{design[0][-1]:g} Hz, "
         f"ζ = {zeta:g}, tolerance {args.tolerance_db[0]:+g}/{args.tolerance_db[1]:+g} dB"
@@ -76,20 +79,37 @@ def run(args: argparse.Namespace) -> int:
         shock = synthesize(
             *design, args.rate, damping=zeta, seed=seed, tolerance_db=tuple(args.tolerance_db)
         )
-        head = round(args.head * args.rate)
-        n = head + shock.t.shape[0]
-        accel = np.zeros((n, 3))
-        accel[:, 2] = G  # an Imu at rest reads +g up
-        accel[head:, axis] += shock.accel
-        sig = Signal(np.arange(n) / args.rate, accel, np.zeros((n, 3)))
+        yield seed, shock, imu_record(shock, args.rate, args.axis, args.head)
+
+
+def describe(shock: Synthesis, args: argparse.Namespace) -> str:
+    """One seed's shock in words: its length, peak, margin, iterations, end at rest."""
+    import numpy as np
+
+    from mount_twin.analysis.synthesis import G
+
+    v, d = shock.velocity, shock.displacement
+    return (
+        f"{shock.t[-1]:.3f} s of shock after {args.head:g} s of rest, peak "
+        f"{np.abs(shock.accel).max() / G:.4g} g along {args.axis}; {shock.check.summary()} "
+        f"after {shock.iterations} iterations; at its end velocity "
+        f"{abs(v[-1]) / np.abs(v).max():.1e} and displacement {abs(d[-1]) / np.abs(d).max():.1e}"
+        " of their peaks"
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from mount_twin.commands.common import write_signal
+
+    out = Path(args.output)
+    if out.exists():
+        msg = f"{out}: exists; synthesize writes a new directory"
+        raise ValueError(msg)
+    for seed, shock, sig in synthesized(args):
+        out.mkdir(parents=True, exist_ok=True)
         bag = out / f"seed_{seed}"
         written = write_signal(sig, str(bag), args.topic, args.frame_id, args.start, args.storage)
-        v, d = shock.velocity, shock.displacement
-        print(
-            f"{bag}: {written} messages, {shock.t[-1]:.3f} s of shock after {args.head:g} s "
-            f"of rest, peak {np.abs(shock.accel).max() / G:.4g} g along {args.axis}; "
-            f"{shock.check.summary()} after {shock.iterations} iterations; at its end "
-            f"velocity {abs(v[-1]) / np.abs(v).max():.1e} and displacement "
-            f"{abs(d[-1]) / np.abs(d).max():.1e} of their peaks"
-        )
+        print(f"{bag}: {written} messages, {describe(shock, args)}")
     return 0
