@@ -70,6 +70,15 @@ def test_the_page_is_self_contained_with_plots_tables_and_names(
     assert 'src="http' not in text and "<script" not in text  # one file, nothing fetched
     assert "Around the first event: foot_" in text and "joint_opened" in text
     assert "Shock response spectra of the input" in text and "Modes (about the static" in text
+    # It opens with the verdict (the replay's own), what produced it from what, the settings
+    # and the scene as loaded, every value with its meaning and unit.
+    _, summary = genset_run
+    head = text[: text.index("Input and response")]
+    assert f"<h2>Verdict: {summary.verdict}</h2>" in head
+    assert "produced by</td><td>mount_twin 0.1.0, " in head and "input bag</td><td>" in head
+    assert re.search(r"genset_shock_10khz \(sha256 [0-9a-f]{16}\)", head)
+    assert "gyro_filter linear_phase" in head and "rtol 1e-06" in head
+    assert "<td>body.mass</td><td>3000.0</td><td>Body mass, kg</td>" in head
     # The peak table holds each mount's largest |F| of the bag.
     _, msgs = read_bag(out)
     f = max(

@@ -9,10 +9,13 @@ anywhere. matplotlib is imported here only (the `plot` extra).
 from __future__ import annotations
 
 import base64
+import hashlib
 import html
 import io
 import json
 from collections.abc import Callable
+from datetime import datetime, timezone
+from importlib.metadata import version as package_version
 from pathlib import Path
 from typing import Any
 
@@ -25,10 +28,13 @@ from mount_twin.analysis.figures import (
     displacement_from_start,
     peak_magnitudes,
 )
+from mount_twin.engine.batch import FAILED
+from mount_twin.engine.health import INTEGRATION
 from mount_twin.errors import ModelError
 from mount_twin.io.messages import WRENCH
 from mount_twin.io.output_tables import COLUMNS, Table, events_of, read_output_bag
 from mount_twin.scene.description import Scene
+from mount_twin.scene.params import effective_parameters, parameter_description
 
 WINDOW_S = 0.05
 """Half-width of the zoom around the first event, s."""
@@ -71,6 +77,97 @@ def _table(head: list[str], rows: list[list[str]]) -> str:
         "<tr>" + "".join(f"<td>{html.escape(v)}</td>" for v in r) + "</tr>" for r in rows
     )
     return f"<table><tr>{cells}</tr>{body}</table>"
+
+
+def _verdict(diagnostics: Table | None) -> tuple[str, dict[str, str]]:
+    """The run's verdict from its diagnostics (FAILED if the integration ever failed, else the
+    worst level of any status but the live-only `mount_twin: ros`), and the last integration
+    status' values."""
+    if diagnostics is None or not len(diagnostics):
+        return "no diagnostics in the bag", {}
+    c = diagnostics.columns
+    worst, integration = "OK", {}
+    order = ["OK", "WARN", "ERROR"]
+    for status, level, values in zip(c["status"], c["level"], c["values"], strict=True):
+        if status == "mount_twin: ros":
+            continue
+        if level in order and order.index(level) > order.index(worst):
+            worst = level
+        if status == INTEGRATION:
+            integration = json.loads(values)
+    if int(integration.get("failures_total", "0")):
+        return f"{FAILED} ({integration['failures_total']} integration failures)", integration
+    return worst, integration
+
+
+def _digest(path: Path) -> str:
+    """sha256 over a bag's files' names and sha256s (one file, or a directory's in name order),
+    first 16 hex digits."""
+    h = hashlib.sha256()
+    for f in sorted(path.rglob("*")) if path.is_dir() else [path]:
+        if f.is_file():
+            h.update(f.name.encode())
+            with f.open("rb") as fh:  # in blocks: a bag may be larger than memory
+                h.update(hashlib.file_digest(fh, "sha256").digest())
+    return h.hexdigest()[:16]
+
+
+def _provenance_section(
+    diagnostics: Table | None,
+    output_bag: str | Path,
+    input_path: str | Path | None,
+    scene: Scene | None,
+) -> list[str]:
+    """The verdict, what produced the page from what, the solver's settings and estimated
+    error, and the scene as loaded."""
+    verdict, integration = _verdict(diagnostics)
+    now = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    rows = [
+        ["verdict (worst over the run)", verdict],
+        ["produced by", f"mount_twin {package_version('mount_twin')}, {now}"],
+        ["output bag", f"{output_bag} (sha256 {_digest(Path(output_bag))})"],
+    ]
+    if input_path is not None:
+        rows.append(["input bag", f"{input_path} (sha256 {_digest(Path(input_path))})"])
+    if scene is not None:
+        spec, integ = scene.input, scene.integration
+        rows += [
+            ["scene", f"{scene.name} from {scene.source}"],
+            ["input", f"{spec.topic} ({spec.msg_type}), frame {spec.frame_id or 'any'}"],
+            [
+                "input conditioning",
+                f"gyro_filter {spec.gyro_filter} (latency {integration.get('latency_s', '?')} s),"
+                f" hold {spec.hold}, gaps > {spec.max_gap_s:g} s: {spec.gap_policy}",
+            ],
+            [
+                "solver",
+                f"{integ.method} (ran: {integration.get('method', '?')}), rtol {integ.rtol:g}, "
+                f"atol {integ.atol:g}, error estimate {'on' if integ.error_estimate else 'off'}",
+            ],
+        ]
+    if integration.get("est_force_error_rel_run"):
+        rows.append(
+            [
+                "estimated integration error over the run",
+                f"mount forces {integration['est_force_error_rel_run']} of the largest, "
+                f"attitude {integration.get('est_attitude_error_rad_run', '?')} rad",
+            ]
+        )
+    out = [f"<h2>Verdict: {html.escape(verdict)}</h2>", _table(["", ""], rows)]
+    if scene is not None and Path(scene.source).is_file():
+        effective = effective_parameters({"scene_file": scene.source}, "report").values
+        out += [
+            "<h2>Scene as loaded</h2>",
+            _table(
+                ["parameter", "value", "meaning, unit"],
+                [
+                    [name, str(value), parameter_description(name, effective)]
+                    for name, value in effective.items()
+                    if name != "scene_file"
+                ],
+            ),
+        ]
+    return out
 
 
 def _srs_section(stamps_ns: np.ndarray, f: np.ndarray) -> list[str]:
@@ -152,9 +249,12 @@ def write_report(
     input_samples: tuple[np.ndarray, np.ndarray] | None = None,
     scene: Scene | None = None,
     input_name: str = "",
+    input_path: str | Path | None = None,
 ) -> Path:
     """Write the report page. `input_samples`: (stamps ns, specific force (n, 3) m/s² in F) of
-    the record, to plot beside the response."""
+    the record, to plot beside the response; `input_path`: the record's bag, hashed for its
+    provenance. The page opens with the verdict, what produced it and with what settings, and
+    the scene as loaded (every value with its meaning and unit)."""
     tables = {t.name: t for t in read_output_bag(output_bag)}
     mounts = {k.removeprefix("mount_"): t for k, t in tables.items() if k.startswith("mount_")}
     origin = min(int(t.columns["stamp_ns"][0]) for t in tables.values() if len(t))
@@ -166,6 +266,7 @@ def write_report(
     if input_name:
         title += f" (input {input_name})"
     sections = [f"<h1>{html.escape(title)}</h1>"]
+    sections += _provenance_section(diagnostics, output_bag, input_path, scene)
 
     def response(fig: Any) -> None:
         n = 3 if input_samples is not None else 2

@@ -41,6 +41,13 @@ def run(args: argparse.Namespace) -> int:
             f[:, 2] += scene.input.g
         samples = (decoded.stamps_ns, f)
     name = Path(args.input).name if args.input else ""
-    out = write_report(args.bag, args.output, input_samples=samples, scene=scene, input_name=name)
+    out = write_report(
+        args.bag,
+        args.output,
+        input_samples=samples,
+        scene=scene,
+        input_name=name,
+        input_path=args.input,
+    )
     print(f"report: {out}")
     return 0

@@ -24,7 +24,7 @@ from rclpy.node import Node
 from mount_twin.errors import SceneError
 from mount_twin.ros.rclpy_private import given_parameters
 from mount_twin.scene.description import Scene
-from mount_twin.scene.params import PARAMETERS, effective_parameters, flatten, mount_parameters
+from mount_twin.scene.params import effective_parameters, flatten, parameter_description
 
 
 @dataclass(frozen=True)
@@ -160,7 +160,8 @@ def configure(node: Node, args: Sequence[str] = ()) -> tuple[NodeOptions, Scene]
     values = _declare_options(node, options, source)
     for name, value in effective.items():
         integer = isinstance(value, int) and not isinstance(value, bool)
-        descriptor = _described(_description(name, effective), bounds.get(name), integer=integer)
+        meaning = parameter_description(name, effective)
+        descriptor = _described(meaning, bounds.get(name), integer=integer)
         node.declare_parameter(name, value, descriptor, ignore_override=True)
     return NodeOptions(**values), scene
 
@@ -184,14 +185,6 @@ def _declare_options(node: Node, given: dict[str, Any], source: str) -> dict[str
             msg = f"must be in [{bounds.from_value}, {bounds.to_value}], got {value!r}"
             raise SceneError(source, name, msg) from err
     return values
-
-
-def _description(name: str, effective: dict[str, Any]) -> str:
-    """The description of a scene parameter, from the tables the loader is tested against."""
-    if name in PARAMETERS:
-        return PARAMETERS[name][1]
-    _, mount, key = name.split(".", 2)
-    return mount_parameters(str(effective.get(f"mounts.{mount}.kind", "linear")))[key][1]
 
 
 def check_qos_overrides(node: Node) -> None:

@@ -101,6 +101,15 @@ MOUNT_PARAMETERS = mount_parameters("linear")
 """Parameters of a linear mount."""
 
 
+def parameter_description(name: str, effective: Mapping[str, Any]) -> str:
+    """The description (with its unit) of a flat scene parameter, from the tables the loader is
+    tested against; `effective` gives the mounts' kinds."""
+    if name in PARAMETERS:
+        return PARAMETERS[name][1]
+    _, mount, key = name.split(".", 2)
+    return mount_parameters(str(effective.get(f"mounts.{mount}.kind", "linear")))[key][1]
+
+
 def flatten(tree: Mapping[str, Any], prefix: str = "") -> Iterator[tuple[str, Any]]:
     """Dotted (name, value) pairs of a nested mapping, as rcl reads a params YAML."""
     for key, value in tree.items():
