@@ -28,7 +28,7 @@ from mount_twin.analysis.figures import (
     displacement_from_start,
     peak_magnitudes,
 )
-from mount_twin.engine.batch import FAILED
+from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
 from mount_twin.engine.health import INTEGRATION
 from mount_twin.errors import ModelError
 from mount_twin.io.messages import WRENCH
@@ -86,18 +86,17 @@ def _verdict(diagnostics: Table | None) -> tuple[str, dict[str, str]]:
     if diagnostics is None or not len(diagnostics):
         return "no diagnostics in the bag", {}
     c = diagnostics.columns
-    worst, integration = "OK", {}
-    order = ["OK", "WARN", "ERROR"]
+    worst, integration = OK, {}
     for status, level, values in zip(c["status"], c["level"], c["values"], strict=True):
         if status == "mount_twin: ros":
             continue
-        if level in order and order.index(level) > order.index(worst):
-            worst = level
+        if level in LEVEL_NAMES:
+            worst = max(worst, LEVEL_NAMES.index(level))
         if status == INTEGRATION:
             integration = json.loads(values)
     if int(integration.get("failures_total", "0")):
         return f"{FAILED} ({integration['failures_total']} integration failures)", integration
-    return worst, integration
+    return LEVEL_NAMES[worst], integration
 
 
 def _digest(path: Path) -> str:

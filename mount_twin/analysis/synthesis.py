@@ -25,8 +25,8 @@ import numpy as np
 from mount_twin.analysis.design_margin import TOLERANCE_DB, DesignCheck, check_design
 from mount_twin.analysis.srs import octave_frequencies, srs
 from mount_twin.io.signals import Signal
+from mount_twin.scene.description import STANDARD_GRAVITY as G
 
-G = 9.80665
 CLOSE_DB = 0.5
 """The iteration goes on past the tolerance until every margin is within ±this (dB), or it
 stops improving: a spectrum on the tolerance's edge meets it, but barely."""

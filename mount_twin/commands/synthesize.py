@@ -7,6 +7,8 @@ import argparse
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
+from mount_twin.commands.srs import TOLERANCE_DB
+
 if TYPE_CHECKING:
     from mount_twin.analysis.synthesis import Synthesis
     from mount_twin.io.signals import Signal
@@ -51,7 +53,7 @@ def add_synthesis_arguments(parser: argparse.ArgumentParser) -> None:
         type=float,
         nargs=2,
         metavar=("LOW", "HIGH"),
-        default=(-1.5, 3.0),
+        default=TOLERANCE_DB,
         help="the band about the design every frequency must meet, dB (default -1.5 3)",
     )
     parser.add_argument(
