@@ -1,11 +1,11 @@
-"""First start after `colcon build`, against a warm start: the build's kernel warm-up measured.
+"""`colcon build` (it compiles the C++ core) and the installed `mount-twin demo`'s first start
+against its warm starts.
 
     python3 bench/bench_colcon_start.py [--warm-runs 2]
 
-Builds the tracked files (`git ls-files`) in a fresh colcon workspace twice, without the
-warm-up (MOUNT_TWIN_NO_WARM_UP=1) and with it, timing each build; after each build it times
-the installed `mount-twin demo` first (cold or warmed by the build) and then warm (median).
-Needs colcon (`pip install colcon-common-extensions`).
+Builds the tracked files (`git ls-files`) in a fresh colcon workspace, timing the build, then
+times the installed `mount-twin demo` first and then warm (median). Needs colcon and pybind11
+(`pip install colcon-common-extensions pybind11`, or the rosdep key pybind11-dev).
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ def timed(cmd: list[str], cwd: Path, env: dict[str, str]) -> float:
     return time.perf_counter() - t0
 
 
-def build_and_start(ws: Path, warm_up: bool, warm_runs: int) -> tuple[float, float, float]:
+def build_and_start(ws: Path, warm_runs: int) -> tuple[float, float, float]:
     """(colcon build s, first demo s, warm demo s) for a fresh workspace at `ws`."""
     src = ws / "src" / "mount_twin"
     files = subprocess.run(
@@ -41,9 +41,7 @@ def build_and_start(ws: Path, warm_up: bool, warm_runs: int) -> tuple[float, flo
     for name in files:
         (src / name).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(ROOT / name, src / name)
-    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
-    if not warm_up:
-        env["MOUNT_TWIN_NO_WARM_UP"] = "1"
+    env = dict(os.environ)
     build = timed(["colcon", "build", "--event-handlers", "console_cohesion-"], ws, env)
     inst = ws / "install" / "mount_twin"
     lib = next((inst / "lib").glob("python3*/site-packages"))
@@ -63,11 +61,11 @@ def main() -> None:
         f"{'colcon build':<28} {'build s':>8} {'first demo s':>13} {'warm demo s':>12} "
         f"{'first/warm':>11}"
     )
-    for warm_up in (False, True):
-        with tempfile.TemporaryDirectory(prefix="bench_colcon_") as tmp:
-            build, first, warm = build_and_start(Path(tmp), warm_up, args.warm_runs)
-        label = "with kernel warm-up" if warm_up else "MOUNT_TWIN_NO_WARM_UP=1"
-        print(f"{label:<28} {build:>8.1f} {first:>13.1f} {warm:>12.1f} {first / warm:>11.2f}")
+    with tempfile.TemporaryDirectory(prefix="bench_colcon_") as tmp:
+        build, first, warm = build_and_start(Path(tmp), args.warm_runs)
+    print(
+        f"{'fresh workspace':<28} {build:>8.1f} {first:>13.2f} {warm:>12.2f} {first / warm:>11.2f}"
+    )
 
 
 if __name__ == "__main__":

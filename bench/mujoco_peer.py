@@ -62,7 +62,6 @@ from typing import Protocol
 
 import mujoco
 import numpy as np
-from numba import njit
 from scipy.optimize import least_squares
 
 from mount_twin.kinds.bolted_joint import BoltedJoint
@@ -71,6 +70,14 @@ from mount_twin.model.assemble import assemble, in_f, initial_state
 from mount_twin.physics.chart import rotation_matrix
 from mount_twin.physics.rotations import rpy_matrix
 from mount_twin.scene.description import DOF_NAMES, LinearMount, Scene
+
+try:  # the peer's frame-load callback runs at every MuJoCo step: compiled where numba is there
+    from numba import njit
+except ImportError:  # (the `bench` extra installs it); plain Python otherwise, the same numbers
+
+    def njit(**_options: object):  # type: ignore[no-redef]
+        return lambda fn: fn
+
 
 ANCHOR_LENGTH = 1000.0
 """Tendon length from a mount's attachment point to its anchor on the foundation, m."""

@@ -16,7 +16,7 @@ bags; `sweep` runs a design sweep file (scene variants × inputs) on a Dask clus
     print(out.wrenches[-1])  # (n_mounts, 6): force (N) and couple (N·m) in mount axes
 
 Importing the package is cheap: each name below is imported on first use (PEP 562), so only
-the names a program touches load numba and the compiled kernels.
+the names a program touches load numpy, scipy and the compiled core.
 """
 
 from __future__ import annotations

@@ -3,11 +3,8 @@
 from __future__ import annotations
 
 import dataclasses
-import sys
-import threading
 import time
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from itertools import chain
 from pathlib import Path
@@ -35,48 +32,11 @@ from mount_twin.engine.health import INTEGRATION, tilt_from_quaternions
 from mount_twin.errors import DamagedBagError
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import TF, TF_STATIC_TOPIC, output_types, resolve, static_transforms
-from mount_twin.physics.compiled import kernel_cache_is_cold
 from mount_twin.scene.description import Scene
 from mount_twin.stream import TwinStream
 
 NODE_NAME = "mount_twin"
 """The node name output topics resolve against, as with `ros2 run` and the default launch."""
-
-COMPILE_NOTICE = "mount-twin: compiling kernels (first run only, 20-60 s)..."
-"""Said on stderr while numba compiles the kernels instead of loading them from its cache."""
-COMPILE_NOTICE_AFTER_S = 3.0
-"""With kernels cached, the notice still comes once loading them has taken this long (s): a
-scene needing kernels not compiled yet, or sources edited since. Loading takes < 1 s."""
-
-
-@contextmanager
-def kernels_loading(
-    notice: bool = True, say: Callable[[str], object] | None = None
-) -> Iterator[None]:
-    """Around building a TwinEngine: with `notice`, say COMPILE_NOTICE (on stderr, or through
-    `say`, e.g. a node's logger) at once if the kernel cache is cold, else if loading the
-    kernels takes COMPILE_NOTICE_AFTER_S."""
-    if not notice:
-        yield
-        return
-
-    def tell() -> None:
-        if say is None:
-            print(COMPILE_NOTICE, file=sys.stderr, flush=True)
-        else:
-            say(COMPILE_NOTICE)
-
-    if kernel_cache_is_cold():
-        tell()
-        yield
-        return
-    timer = threading.Timer(COMPILE_NOTICE_AFTER_S, tell)
-    timer.daemon = True
-    timer.start()
-    try:
-        yield
-    finally:
-        timer.cancel()
 
 
 def _estimate_text(est: ErrorEstimate | None) -> str:
@@ -297,17 +257,15 @@ def replay(
     frames on /tf_static once, before anything else, stamped with the first output's stamp (that
     of the first input sample the stream took: never an unset or pre-1970 one) and offered
     latched (`LATCHED_QOS`) so `ros2 bag play` republishes it to late subscribers. Both bags are
-    checked before the kernels load (a first run compiles them: with `progress`,
-    `kernels_loading` says so on stderr). `checkpoint` is called once the kernels are loaded and
-    between chunks, where stopping is safe: it may raise to stop the replay (a signal noted by
+    checked before the twin is built. `checkpoint` is called once it is built and between
+    chunks, where stopping is safe: it may raise to stop the replay (a signal noted by
     the command line); once the output bag exists, it is then finished and marked partial.
     """
     bag = InputBag(input_path, scene.input.topic, scene.input.msg_type)
     try:
         check_new_bag(output_path)
-        with kernels_loading(progress):
-            stream = TwinStream(scene)
-        if checkpoint is not None:  # a signal while the kernels compiled: no output bag yet
+        stream = TwinStream(scene)
+        if checkpoint is not None:  # a signal while the twin was built: no output bag yet
             checkpoint()
     except BaseException:
         bag.close()

@@ -1,14 +1,10 @@
-"""Starting `mount-twin`: help and argument errors answer without importing numba; a cold kernel
-cache is detected cheaply and a compile is announced on stderr."""
+"""Starting `mount-twin`: help and argument errors answer without importing the compiled core or
+numpy; bag errors come before the twin is built."""
 
 from __future__ import annotations
 
-import hashlib
-import importlib
 import re
 import subprocess
-import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -17,10 +13,8 @@ from io_helpers import run_python
 from mount_twin.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
-HEAVY = re.compile(r"\|\s*(numba|numpy|scipy|rosbags|yaml)(\.|$)")
+HEAVY = re.compile(r"\|\s*(mount_twin\._core|numpy|scipy|rosbags|yaml)(\.|$)")
 """A line of `-X importtime` that imports one of the slow packages."""
-
-replay_module = importlib.import_module("mount_twin.replay")
 
 
 def _cli(*args: str) -> subprocess.CompletedProcess[str]:
@@ -33,7 +27,7 @@ def _heavy_imports(stderr: str) -> list[str]:
 
 
 @pytest.mark.parametrize("args", [("--help",), ("replay", "--help"), ("generate", "--help")])
-def test_help_answers_without_importing_numba(args: tuple[str, ...]) -> None:
+def test_help_answers_without_importing_numerics(args: tuple[str, ...]) -> None:
     done = _cli(*args)
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith("usage: mount-twin")
@@ -49,7 +43,7 @@ def test_help_answers_without_importing_numba(args: tuple[str, ...]) -> None:
         (("generate", "half-sine", "-o", "x", "--rate", "fast"), "invalid float value: 'fast'"),
     ],
 )
-def test_an_argument_error_exits_2_without_importing_numba(
+def test_an_argument_error_exits_2_without_importing_numerics(
     args: tuple[str, ...], says: str
 ) -> None:
     done = _cli(*args)
@@ -58,72 +52,9 @@ def test_an_argument_error_exits_2_without_importing_numba(
     assert _heavy_imports(done.stderr) == []
 
 
-# --------------------------------------------------------------------------- cold cache
-
-
-def _keyed(directory: Path) -> str:
-    """numba's cache sub-directory name for the sources in `directory`."""
-    return f"{directory.name}_{hashlib.sha1(str(directory).encode()).hexdigest()}"
-
-
-def test_a_kernel_cache_dir_without_index_files_is_cold(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+def test_bag_errors_come_before_the_twin_is_built(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
-    assert replay_module.kernel_cache_is_cold()
-    engine_dir = Path(str(replay_module.__file__)).resolve().parent / "engine"
-    keyed = tmp_path / _keyed(engine_dir)
-    keyed.mkdir()
-    tag = f"py{sys.version_info.major}{sys.version_info.minor}"
-    (keyed / "kernel.run_samples-81.py27.nbi").touch()  # another Python's index: still cold
-    assert replay_module.kernel_cache_is_cold()
-    (keyed / f"kernel.run_samples-81.{tag}.nbi").touch()
-    assert not replay_module.kernel_cache_is_cold()
-
-
-def test_the_cache_is_warm_once_an_engine_was_built() -> None:
-    """Guards the detection against a change of where numba keeps the kernels: once an engine
-    exists in this process, its kernels are in the cache `kernel_cache_is_cold` looks at."""
-    from mount_twin import TwinEngine, assemble, load_scene_file
-
-    TwinEngine(assemble(load_scene_file(ROOT / "config" / "pump_8_mounts.scene.yaml")))
-    assert not replay_module.kernel_cache_is_cold()
-
-
-def test_a_cold_cache_is_announced_at_once(
-    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
-) -> None:
-    monkeypatch.setattr(replay_module, "kernel_cache_is_cold", lambda: True)
-    with replay_module.kernels_loading():
-        assert capsys.readouterr().err == replay_module.COMPILE_NOTICE + "\n"
-    assert "first run only" in replay_module.COMPILE_NOTICE
-    with replay_module.kernels_loading(notice=False):
-        pass
-    assert capsys.readouterr().err == ""
-    told: list[str] = []  # the node passes its logger: the notice goes there, not to stderr
-    with replay_module.kernels_loading(say=told.append):
-        assert told == [replay_module.COMPILE_NOTICE]
-    assert capsys.readouterr().err == ""
-
-
-def test_a_slow_load_from_a_warm_cache_is_announced_and_a_fast_one_is_not(
-    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
-) -> None:
-    monkeypatch.setattr(replay_module, "kernel_cache_is_cold", lambda: False)
-    monkeypatch.setattr(replay_module, "COMPILE_NOTICE_AFTER_S", 0.05)
-    with replay_module.kernels_loading():
-        pass
-    time.sleep(0.2)
-    assert capsys.readouterr().err == "", "a fast load says nothing, and its timer is cancelled"
-    with replay_module.kernels_loading():
-        time.sleep(1.0)  # a kernel compiling for a scene the cache has not seen
-    assert capsys.readouterr().err == replay_module.COMPILE_NOTICE + "\n"
-
-
-def test_bag_errors_come_before_the_compile_notice(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
-) -> None:
-    monkeypatch.setattr(replay_module, "kernel_cache_is_cold", lambda: True)
     assert main(["demo", "-o", str(tmp_path)]) == 2  # the output exists
     err = capsys.readouterr().err
     assert err == (
@@ -134,11 +65,10 @@ def test_bag_errors_come_before_the_compile_notice(
     assert main(["replay", str(missing), "--scene", str(scene), "-o", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"mount-twin: error: {missing}: cannot open bag")
-    assert replay_module.COMPILE_NOTICE not in err
     assert not (tmp_path / "o").exists()
 
 
-def test_version_is_the_package_version_without_importing_numba() -> None:
+def test_version_is_the_package_version_without_importing_numerics() -> None:
     """`--version` answers from the installed metadata, which matches package.xml."""
     done = _cli("--version")
     assert done.returncode == 0, done.stderr

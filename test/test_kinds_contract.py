@@ -1,8 +1,9 @@
 """The mount-kind contract: every kind code runs that kind's own law in every compiled dispatcher,
 and a code without a branch can never run another kind's law (it fails loudly instead).
 
-The dispatchers (`kinds.kind_load`, `kind_monitor`, `kind_update`) are compiled `if code == ...`
-chains; before the contract was checked, a kind registered in KINDS without its branches ran the
+The dispatchers (`kinds.kind_load`, `kind_monitor`, `kind_update`, the core's, in
+src/core/kinds/dispatch.hpp) are `if code == ...` chains over the C++ ports of the kinds' Python
+laws; before the contract was checked, a kind registered in KINDS without its branches ran the
 shear key's law, silently.
 """
 
@@ -16,7 +17,6 @@ from types import ModuleType
 import numpy as np
 import pytest
 from kinds_helpers import kind_mount, law_of
-from numba import njit
 
 from mount_twin import kinds
 from mount_twin.integrate import stepper
@@ -218,20 +218,17 @@ def test_an_unknown_code_fails_the_step_with_a_status() -> None:
 # A kind registered without dispatcher branches ------------------------------------------------
 
 
-@njit
 def _stop_load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
     for j in range(3):
         f[j] = -p[0] * d[j] - 1.0
         c[j] = 0.0
 
 
-@njit
 def _stop_monitor(p, y, y0, o, d, v, g) -> float:
     g[0] = abs(d[0]) - p[1]
     return abs(d[0]) / p[1]
 
 
-@njit
 def _stop_update(p, y, o, d) -> bool:
     return False
 

@@ -514,7 +514,7 @@ def test_modes_help_imports_no_numerics() -> None:
         "    main(['modes', '--help'])\n"
         "except SystemExit:\n"
         "    pass\n"
-        "print(sorted(m for m in ('numba', 'numpy', 'scipy') if m in sys.modules))"
+        "print(sorted(m for m in ('mount_twin._core', 'numpy', 'scipy') if m in sys.modules))"
     )
     done = run_python("-c", code)
     assert done.returncode == 0, done.stderr

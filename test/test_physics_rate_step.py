@@ -11,8 +11,7 @@ import numpy as np
 import pytest
 from io_helpers import default_scene
 
-from mount_twin.engine.companion import _monitor
-from mount_twin.engine.kernel import _watch, new_watch
+from mount_twin.engine.kernel import monitor_switches, new_watch, watch_mounts
 from mount_twin.integrate.settings import CHAINED, N_SETTINGS
 from mount_twin.kinds import N_EVENTS, bolted_joint
 from mount_twin.model.assemble import assemble, initial_state
@@ -96,8 +95,8 @@ def test_a_bolt_breaking_between_samples_ends_the_chain() -> None:
             settings[CHAINED] = 1.0
             watch = new_watch(nl.kind.shape[0], N_EVENTS, model.n_state)
             if watch_or_monitor == "watch":
-                _watch(state, nl, s, watch, 0.0, 1e-3, wrenches, settings)
+                watch_mounts(state, nl, s, watch, 0.0, 1e-3, wrenches, settings)
             else:
-                _monitor(state, nl, state.copy(), s, watch.g, watch.util, settings)
+                monitor_switches(state, nl, state.copy(), s, watch.g, watch.util, settings)
             assert state[foot + 3] == (1.0 if broken else 0.0)
             assert settings[CHAINED] == (0.0 if broken else 1.0), watch_or_monitor

@@ -1,7 +1,7 @@
 """The `mount-twin` subcommands, one module each.
 
 A command module is imported to build the argument parser, so at module level it may import only
-the standard library and `mount_twin.errors`: numba, numpy and rosbags take seconds to import, and
+the standard library and `mount_twin.errors`: numpy, scipy and rosbags take a second to import, and
 `--help` or a mistyped argument must answer at once (tested). Each module defines
 
 - ``NAME``: the subcommand, as typed;
@@ -30,7 +30,6 @@ COMMANDS = (
     "sweep",
     "show",
     "dashboard",
-    "warm_up",
     "build_tf2_msgs",
 )
 """Module names under mount_twin.commands, in the order `--help` lists them."""

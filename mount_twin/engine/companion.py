@@ -33,24 +33,11 @@ from typing import NamedTuple
 import numpy as np
 
 from mount_twin.engine.estimate import (
-    ATTITUDE_ERROR,
-    FAILURES,
-    FORCE_ERROR,
-    FORCE_SCALE,
     N_FIGURES,
 )
-from mount_twin.integrate.control import forget
-from mount_twin.integrate.settings import CHAINED
-from mount_twin.integrate.stepper import advance, new_stepper
+from mount_twin.integrate.stepper import forget, new_stepper
 from mount_twin.physics import pose_row
-from mount_twin.physics.compiled import kernel
-from mount_twin.physics.dynamics import (
-    Scratch,
-    mount_monitors,
-    outputs,
-    rhs_after_rate_step,
-)
-from mount_twin.physics.gate import skip_if_none
+from mount_twin.physics.dynamics import Scratch
 
 TOLERANCE_DIVISOR = 8.0
 """The companion's rtol and atol are the twin's over this (see the module docstring)."""
@@ -59,7 +46,8 @@ MIN_STEPS = 2
 
 
 class Companion(NamedTuple):
-    """The companion solution's stepper, state and work arrays (compiled code reads these).
+    """The companion solution's stepper, state and work arrays (the core's loop advances it
+    after the twin at every sample: `follow` in src/core/engine/kernel.hpp).
 
     method, settings, work2d, work1d, result: its stepper (`integrate.stepper.Stepper`).
     y: (n_state,) its state; s: its scratch; y_prev, g, util: its mount monitors' arrays.
@@ -132,52 +120,3 @@ def restart(c: Companion, y: np.ndarray) -> None:
     c.y[:] = y
     c.y_prev[:] = y
     forget(c.settings)
-
-
-@kernel
-def _monitor(y, nl, y_prev, s, g, util, settings) -> None:
-    """The companion's discrete mount switches at a sample (as the twin's watch takes them);
-    one that switched clears its stepper's chain flag."""
-    if mount_monitors(y, y_prev, nl, s, g, util):
-        settings[CHAINED] = 0.0
-    for i in range(y.shape[0]):
-        y_prev[i] = y[i]
-
-
-monitor = skip_if_none(_monitor)
-
-
-@kernel
-def _follow(m, c, u, t0, t1, chain, d_wdot, pose, wrenches, y) -> None:
-    """Advance the companion over [t0, t1] under the input u the twin just took, and fold the
-    differences of its outputs from the twin's (pose, wrenches: the twin's rows at t1; y its
-    state) into the figures."""
-    settings, figures = c.settings, c.figures
-    if chain and settings[CHAINED] == 1.0:
-        rhs_after_rate_step(m, c.s, d_wdot, c.work2d[0])
-    else:
-        settings[CHAINED] = 0.0
-    status = advance(c.method, c.y, t0, t1, settings, m, c.s, u, c.work2d, c.work1d, c.result)
-    if status != 0:  # re-synchronised to the twin: what it had carried is lost, and counted
-        for i in range(y.shape[0]):
-            c.y[i] = y[i]
-            c.y_prev[i] = y[i]
-        forget(settings)
-        figures[FAILURES] += 1.0
-        return
-    outputs(c.y, m, c.s, c.pose, c.wrenches)
-    monitor(c.y, m.nl, c.y_prev, c.s, c.g, c.util, settings)
-    force, scale = figures[FORCE_ERROR], figures[FORCE_SCALE]
-    for a in range(wrenches.shape[0]):
-        for b in range(3):
-            force = max(force, abs(wrenches[a, b] - c.wrenches[a, b]))
-            scale = max(scale, abs(wrenches[a, b]))
-    attitude = figures[ATTITUDE_ERROR]
-    for i in range(3):
-        k = pose_row.ANGLES + i
-        attitude = max(attitude, abs(pose[k] - c.pose[k]))
-    figures[FORCE_ERROR], figures[FORCE_SCALE], figures[ATTITUDE_ERROR] = force, scale, attitude
-
-
-follow = skip_if_none(_follow)
-"""`_follow`, or nothing when the companion (the second argument) is None: off."""

@@ -33,7 +33,7 @@ from mount_twin.engine.companion import Companion, new_companion, restart
 from mount_twin.engine.companion import switch as switch_companion
 from mount_twin.engine.delay_line import Frame, GyroDelay, Run, filter_bands
 from mount_twin.engine.estimate import ErrorEstimate
-from mount_twin.engine.gyro_filter import Design, fir_rows
+from mount_twin.engine.gyro_filter import Design
 from mount_twin.engine.health import ENDED, PLATEAU_G, SATURATION_SHARE, HealthWindow
 from mount_twin.engine.kernel import (
     AT_EVENT,
@@ -263,29 +263,6 @@ class TwinEngine:
                 tangent_rate(model),
             )
             self._watch.stop_after[0] = -math.inf  # `auto` looks again after mount events
-        self._warm_up()
-
-    def _warm_up(self) -> None:
-        """Load (or compile) the kernels now, not at the first live sample."""
-        model, st = self.model, self.stepper
-        t = np.array([0.0, 1e-3])
-        f = np.tile(self._gravity_up, (2, 1))
-        n, nm = 2, model.n_mounts
-        y = np.zeros(model.n_state)
-        integ = Integrator(
-            st.method, st.settings.copy(), st.work2d.copy(), st.work1d.copy(), st.result.copy()
-        )
-        out = self._buffers(n, np.zeros(1, dtype=np.int64), np.zeros((nm, 6)))
-        watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
-        samples = Samples(t, f, np.zeros((2, 3)))
-        u, scratch = np.zeros(INPUT_SIZE), model.new_scratch()
-        companion = self._new_companion()
-        run_samples(
-            integ, model.arrays, scratch, u, y, samples, self._options, out, watch, companion
-        )
-        fir_rows(np.zeros((3, 3)), np.full(2, 0.5), np.empty((3, 1)))
-        watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
-        self._start_outputs(self._y_nominal.copy(), model.new_scratch(), watch)
 
     def _use(self, choice: Choice) -> None:
         """Run `auto`'s choice from now on: the first, or a change after a mount event (its

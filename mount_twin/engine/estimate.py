@@ -1,7 +1,8 @@
 """The live error estimate's figures: their layout, and what they say (pure Python).
 
-`engine.companion` (compiled) fills the figures; the health window and the engine read them.
-Compiled code reads the slot numbers: this file is one of `physics.compiled.COMPILED_SOURCES`.
+The core's loop fills the figures (`follow` in src/core/engine/kernel.hpp, which has the slots
+as `mt::Figure`: test/test_core_contract.py holds them equal); the health window and the engine
+read them.
 """
 
 from __future__ import annotations

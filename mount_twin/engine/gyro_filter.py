@@ -28,7 +28,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from mount_twin.physics.compiled import kernel
+from mount_twin import _core
 
 FLATNESS = 2e-5
 """Design ripple δ of the Kaiser window (Kaiser's formulas give about δ in both bands; measured
@@ -88,20 +88,11 @@ def response(half: np.ndarray, frequency_hz: np.ndarray, rate_hz: float) -> np.n
     return half[0] + 2.0 * np.cos(arg) @ half[1:]
 
 
-@kernel
-def fir_rows(raw, half, out) -> None:
-    """out[i, k] = h[N]·raw[i, k + N] + Σ_j h[N + j]·(raw[i, k + N − j] + raw[i, k + N + j]),
-    j = 1..N in that order, for k < out.shape[1]: the filtered rate of the sample at
-    raw[:, k + N] (rad/s; per axis i, rows (3, ·) so the loop over k runs on contiguous memory).
+fir_rows = _core.fir_rows
+"""fir_rows(raw, half, out): out[i, k] = h[N]·raw[i, k + N] + Σ_j h[N + j]·(raw[i, k + N − j]
++ raw[i, k + N + j]), j = 1..N in that order, for k < out.shape[1]: the filtered rate of the
+sample at raw[:, k + N] (rad/s; per axis i, rows (3, ·) so the loop over k runs on contiguous
+memory).
 
-    Each output sums the same terms in the same order whatever samples surround it, so any
-    batching gives the same bits."""
-    n = half.shape[0] - 1
-    m = out.shape[1]
-    for i in range(3):
-        for k in range(m):
-            out[i, k] = half[0] * raw[i, k + n]
-        for j in range(1, n + 1):
-            h = half[j]
-            for k in range(m):
-                out[i, k] += h * (raw[i, k + n - j] + raw[i, k + n + j])
+Each output sums the same terms in the same order whatever samples surround it, so any
+batching gives the same bits."""

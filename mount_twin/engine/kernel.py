@@ -1,4 +1,5 @@
-"""The compiled per-sample loop: integrate a run of accepted samples and evaluate outputs.
+"""The compiled per-sample loop: integrate a run of accepted samples and evaluate outputs (the
+loop is the core's, src/core/engine/kernel.hpp; these are the arrays it works on).
 
 One call handles a whole batch, so the Python-to-compiled call cost (µs) is paid once per batch,
 not per sample; a live node passes batches of one through the same function.
@@ -6,17 +7,11 @@ not per sample; a live node passes batches of one through the same function.
 
 from __future__ import annotations
 
-import math
 from typing import NamedTuple
 
 import numpy as np
 
-from mount_twin.engine.companion import follow
-from mount_twin.integrate.settings import CHAINED
-from mount_twin.integrate.stepper import advance
-from mount_twin.physics.compiled import kernel
-from mount_twin.physics.dynamics import mount_monitors, outputs, rhs_after_rate_step
-from mount_twin.physics.gate import skip_if_none
+from mount_twin import _core
 
 
 class Watch(NamedTuple):
@@ -46,8 +41,8 @@ class Watch(NamedTuple):
     n_stiffening: np.ndarray
 
 
-AT_EVENT = -100
-"""`run_samples`' status when it ended the run at a sample that logged an event (not a
+AT_EVENT = _core.AT_EVENT
+"""(−100) `run_samples`' status when it ended the run at a sample that logged an event (not a
 failure; no stepper status has this value)."""
 
 
@@ -68,39 +63,6 @@ def new_watch(
         np.zeros((k, n_events)) if stiffens is None else stiffens.astype(float),
         np.zeros(1, dtype=np.int64),
     )
-
-
-@kernel
-def _watch(y, nl, s, watch, t0, t1, wrenches, settings) -> None:
-    """Evaluate the event functions at t1; log each upward zero crossing since t0. A discrete
-    switch (the state jumped) clears the stepper's chain flag (settings[CHAINED])."""
-    g_prev, g, util, peak = watch.g_prev, watch.g, watch.util, watch.util_peak
-    events, count = watch.events, watch.n_events
-    y_prev = watch.y_prev
-    if mount_monitors(y, y_prev, nl, s, g, util):
-        settings[CHAINED] = 0.0
-    for i in range(y.shape[0]):  # a loop: slice assignment may need a temporary (NRT)
-        y_prev[i] = y[i]
-    for i in range(g.shape[0]):
-        peak[i] = max(peak[i], util[i])
-        for e in range(g.shape[1]):
-            g0, g1 = g_prev[i, e], g[i, e]
-            g_prev[i, e] = g1
-            if g0 < 0.0 <= g1:
-                if watch.stiffens[i, e] > 0.0:
-                    watch.n_stiffening[0] += 1
-                k = count[0]
-                count[0] += 1
-                if k < events.shape[0]:
-                    slot = nl.slot[i]
-                    w = wrenches[slot]
-                    events[k, 0] = t0 + (t1 - t0) * (-g0) / (g1 - g0)
-                    events[k, 1] = slot
-                    events[k, 2] = e
-                    events[k, 3] = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-
-
-watch_mounts = skip_if_none(_watch)
 
 
 class Integrator(NamedTuple):
@@ -160,72 +122,33 @@ class Published(NamedTuple):
     cos_tilt_min: np.ndarray
 
 
-@kernel
-def run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> tuple[int, int]:
-    """Advance y through samples 1..n−1 of `samples`; sample 0 is the last one already done.
+watch_mounts = _core.watch_mounts
+"""watch_mounts(y, nl, s, watch, t0, t1, wrenches, settings): `monitor_switches` at t1 (s),
+then each upward zero crossing of an event function since t0 logged into the watch (located by
+linear interpolation; |force| from the wrenches rows)."""
+monitor_switches = _core.monitor_switches
+"""monitor_switches(y, nl, y_prev, s, g, util, settings): the mounts' event functions g,
+utilisation util and discrete switches at a sample (y_prev: the state at the previous one, then
+y); a switch (y jumped) clears settings[CHAINED]. The twin's watch and the companion both take
+their switches through it."""
+run_samples = _core.run_samples
+"""run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> (done, status):
+advance y through samples 1..n−1 of `samples`; sample 0 is the last one already done
+(src/core/engine/kernel.hpp; the loop releases the GIL).
 
-    Args:
-        integ: the stepper (`Integrator`); m, s: the model's arrays and scratch; u: the input
-            vector the right-hand side reads (filled here per interval); y: the state.
-        samples: `Samples`; opts: `RunOptions`; out: `Published` (buffers of n rows).
-        watch: the non-linear mounts' event functions, utilisation peaks and event log
-            (`Watch`); events are located by linear interpolation inside the sample interval.
-        companion: the error estimate's companion solution (`engine.companion.Companion`), or
-            None (compiled away).
+Args:
+    integ: the stepper (`Integrator`); m, s: the model's arrays and scratch; u: the input
+        vector the right-hand side reads (filled here per interval); y: the state.
+    samples: `Samples`; opts: `RunOptions`; out: `Published` (buffers of n rows).
+    watch: the non-linear mounts' event functions, utilisation peaks and event log
+        (`Watch`, read only where the model has such mounts); events are located by linear
+        interpolation inside the sample interval.
+    companion: the error estimate's companion solution (`engine.companion.Companion`), or
+        None (off).
 
-    Returns:
-        (index of the last sample done, status: 0 when all are done; AT_EVENT when the run ended
-        at that sample because it logged an event that may stiffen the scene, past
-        watch.stop_after; else the stepper's failure at the next sample).
-    """
-    t, f, w = samples.t, samples.f, samples.w
-    method, settings, work2d, work1d = integ.method, integ.settings, integ.work2d, integ.work1d
-    result = integ.result
-    counter, peak, pose, wrenches = out.counter, out.peak, out.pose, out.wrenches
-    publish, step_log, decimation = out.publish, out.step_log, opts.decimation
-    abs_max, cos_tilt = out.wrench_abs_max, out.cos_tilt_min
-    n, nm = t.shape[0], peak.shape[0]
-    hold = 0.0 if opts.zero_order else 1.0
-    d_wdot = s.rate_step
-    for j in range(1, n):
-        dt = t[j] - t[j - 1]
-        u[0] = t[j - 1]
-        for i in range(3):
-            u[1 + i] = f[j - 1, i]
-            u[4 + i] = hold * (f[j, i] - f[j - 1, i]) / dt
-            u[7 + i] = w[j - 1, i]
-            w_dot = hold * (w[j, i] - w[j - 1, i]) / dt
-            d_wdot[i] = w_dot - u[10 + i]
-            u[10 + i] = w_dot
-        if opts.chain and settings[CHAINED] == 1.0:
-            # First-order hold: the input is continuous at t[j − 1] but for Ω', so the last
-            # stage of the previous interval, moved to the new Ω', starts this one. Live (one
-            # sample per call) and replay (many) thus compute exactly the same numbers.
-            rhs_after_rate_step(m, s, d_wdot, work2d[0])
-        else:
-            settings[CHAINED] = 0.0
-        status = advance(method, y, t[j - 1], t[j], settings, m, s, u, work2d, work1d, result)
-        if status != 0:
-            return j - 1, status
-        stiffening = watch.n_stiffening[0]
-        step_log[j, 0], step_log[j, 1], step_log[j, 2] = result[0], result[1], result[2]
-        outputs(y, m, s, pose[j], wrenches[j])  # the stepper's last right-hand side was at y
-        watch_mounts(y, m.nl, s, watch, t[j - 1], t[j], wrenches[j], settings)
-        follow(m, companion, u, t[j - 1], t[j], opts.chain, d_wdot, pose[j], wrenches[j], y)
-        counter[0] += 1
-        for a in range(nm):
-            for b in range(6):
-                if abs(wrenches[j, a, b]) > abs(peak[a, b]):
-                    peak[a, b] = wrenches[j, a, b]
-        publish[j] = counter[0] >= decimation
-        if publish[j]:
-            for a in range(nm):
-                for b in range(6):
-                    wrenches[j, a, b] = peak[a, b]
-                    abs_max[a, b] = max(abs_max[a, b], abs(peak[a, b]))
-                    peak[a, b] = 0.0
-            counter[0] = 0
-            cos_tilt[0] = min(cos_tilt[0], s.rot[2, 2])  # outputs() took pose[j] from s.rot
-        if watch.n_stiffening[0] > stiffening and t[j] > watch.stop_after[0]:
-            return j, AT_EVENT
-    return n - 1, 0
+Returns:
+    (index of the last sample done, status: 0 when all are done; AT_EVENT when the run ended
+    at that sample because it logged an event that may stiffen the scene, past
+    watch.stop_after; else the stepper's failure at the next sample). Every array is checked
+    (dtype, shape against the model) before the loop starts: a wrong one raises naming it.
+"""

@@ -31,28 +31,7 @@ then J, φ1, φ2, φ3 and the φ functions' four work blocks (`phi.Blocks`).
 
 from __future__ import annotations
 
-import math
-
-from mount_twin.integrate.control import (
-    MIN_STEP_FRACTION,
-    OFF_CHART_SHRINK,
-    conclude,
-    give_up,
-)
-from mount_twin.integrate.fd_jacobian import linearise, renew_if_stale
-from mount_twin.integrate.methods import LEFT_CHART, SUCCESS
-from mount_twin.integrate.phi import Blocks, phi_functions
-from mount_twin.integrate.settings import (
-    ATOL,
-    CHAINED,
-    MAX_SUBSTEPS,
-    MIN_STEPS,
-    PHI_STEP,
-    RTOL,
-    STEP,
-)
-from mount_twin.physics.compiled import kernel
-from mount_twin.physics.dynamics import rhs
+from mount_twin import _core
 
 ORDER = 2
 """Order of the error estimate (the step-size controller's exponent is −1/(ORDER + 1))."""
@@ -82,97 +61,8 @@ def work_rows(n: int) -> int:
     return ROWS + BLOCKS * n
 
 
-@kernel
-def advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> int:
-    """Advance y (in place) from t0 to t1 s with input u held over the interval: the signature
-    and statuses of `dopri54.advance` (k: `work_rows(n)` × n; settings[PHI_STEP]: the step the
-    φ functions held were computed for, 0 for none)."""
-    h, rtol, atol = settings[STEP], settings[RTOL], settings[ATOL]
-    max_steps = settings[MAX_SUBSTEPS]
-    n = y.shape[0]
-    blocks = Blocks(J0, J0 + n, J0 + 4 * n, SCALE)
-    p1, p2, p3 = blocks.p1, blocks.p1 + n, blocks.p1 + 2 * n
-    span = t1 - t0
-    h = span if h <= 0.0 else h
-    h_max = span / settings[MIN_STEPS]
-    settings[CHAINED] = 0.0
-    t = t0
-    err_max, n_acc, n_rej = 0.0, 0, 0
-    rows = (F, FTMP, FT, J0)
-    if not linearise(y, t, m, s, u, k, TYPICAL, rows, settings, JACOBIAN_MAX_AGE):
-        settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
-        return LEFT_CHART
-    not_finite = off_chart = False  # what the last rejection was for
-    while t < t1:
-        too_small = h < MIN_STEP_FRACTION * span
-        status = give_up(n_acc + n_rej, max_steps, too_small, not_finite, off_chart)
-        if status != SUCCESS:
-            settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
-            return status
-        # the rest of the interval in equal steps no longer than the proposal: one set of φ
-        # functions serves them all
-        rest = t1 - t
-        count = max(1.0, math.ceil(rest / min(h, h_max) * (1.0 - 1e-12)))
-        step, last = rest / count, count == 1.0
-        ok = True
-        if abs(step - settings[PHI_STEP]) > PHI_REUSE * step:
-            ok = phi_functions(k, n, step, blocks)
-            settings[PHI_STEP] = step if ok else 0.0
-        not_finite = not ok
-        if ok:
-            for r in range(n):
-                acc = y[r]
-                for c in range(n):
-                    acc += step * k[p1 + r, c] * k[F, c] + step * step * k[p2 + r, c] * k[FT, c]
-                k[U, r] = acc
-            ok = rhs(t + step, k[U], m, s, u, k[FTMP]) == 0
-            off_chart = not ok
-        err = math.inf
-        if ok:
-            for r in range(n):
-                acc = k[FTMP, r] - k[F, r] - step * k[FT, r]
-                for c in range(n):
-                    acc -= k[J0 + r, c] * (k[U, c] - y[c])
-                k[DIFF, r] = acc
-            err = 0.0
-            for r in range(n):
-                e = 0.0
-                for c in range(n):
-                    e += k[p3 + r, c] * k[DIFF, c]
-                e *= 2.0 * step
-                y_new[r] = k[U, r] + e
-                scale = atol + rtol * max(abs(y[r]), abs(y_new[r]))
-                err += (e / scale) ** 2
-            err = math.sqrt(err / n)
-            not_finite = not math.isfinite(err)
-        if not err <= 1.0:
-            renew_if_stale(y, t, m, s, u, k, TYPICAL, rows, settings)
-        if not ok:
-            h = step * OFF_CHART_SHRINK
-            n_rej += 1
-            continue
-        t, h, accepted = conclude(
-            y,
-            y_new,
-            t,
-            t1,
-            step,
-            h,
-            last,
-            err,
-            not_finite,
-            ORDER,
-            MAX_FACTOR,
-            m,
-            s,
-            u,
-            k,
-            (F, FTMP),
-        )
-        if accepted:
-            err_max = max(err_max, err)
-            n_acc += 1
-        else:
-            n_rej += 1
-    settings[STEP], result[0], result[1], result[2] = h, err_max, n_acc, n_rej
-    return SUCCESS
+advance = _core.exprb32_advance
+"""advance(y, t0, t1, settings, m, s, u, k, y_new, result) -> status: the exponential
+Rosenbrock step across one input interval (src/core/integrate/exprb32.hpp), the signature and
+statuses of `dopri54.advance` (k: `work_rows(n)` × n; settings[PHI_STEP]: the step the φ
+functions held were computed for, 0 for none)."""

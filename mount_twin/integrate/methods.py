@@ -3,11 +3,13 @@
 The scene loader offers `METHODS` (and AUTO) as `integration.method`; `integrate.stepper`
 sizes its work arrays and builds its compiled switch from it; every method's compiled `advance`
 returns one of the statuses below and the engine reports `STATUS_TEXT` of a failure. Pure
-Python (no numba): the scene loader imports it.
+Python: the scene loader imports it.
 
-Adding a method: a module with its coefficient table and compiled `advance` (see `dopri54`,
-`ros34pw2`, `exprb32`), an entry here, and a branch in `stepper.advance`
-(test/test_integrate_methods.py checks the tables and that every method here is dispatched).
+Adding a method: a module with its coefficient table (see `dopri54`, `ros34pw2`, `exprb32`), its
+compiled `advance` in the core (src/core/integrate/<method>.hpp, bound as `<method>_advance`), an
+entry here, and a branch in the core's `integrate::advance` (test/test_integrate_methods.py
+checks the tables and that every method here is dispatched; test/test_core_contract.py that
+the core has the same ids).
 """
 
 from __future__ import annotations

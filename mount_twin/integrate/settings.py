@@ -1,5 +1,6 @@
 """The slots of a stepper's `settings` vector, shared by every method's compiled `advance`, the
-stepper holder and the engine's loop (plain integers: numba folds them into the code)."""
+stepper holder and the engine's loop (the core's `mt::Setting` in src/core/constants.hpp:
+test/test_core_contract.py holds the two equal)."""
 
 from __future__ import annotations
 

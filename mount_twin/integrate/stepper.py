@@ -1,11 +1,11 @@
 """Steppers behind one interface: advance the state across one input interval.
 
-A stepper is a compiled free function with the uniform signature of `dopri54.advance` plus this
-small holder of its settings and work arrays (scipy `integrate/_ivp` shape). Numerical failure is
-returned as a status (`integrate.methods.STATUS_TEXT`); misuse raises. `advance` below switches
-on the method id: compiled functions passed as arguments would make every caller uncacheable
-(numba would recompile them in each process, seconds each), so a new method is an entry in
-`integrate.methods.METHODS` and a branch here, and the engine is untouched.
+A stepper is a compiled free function with the uniform signature of `dopri54.advance` (the
+core's, src/core/integrate/) plus this small holder of its settings and work arrays (scipy
+`integrate/_ivp` shape). Numerical failure is returned as a status
+(`integrate.methods.STATUS_TEXT`); misuse raises. `advance` below switches on the method id, in
+the core (src/core/integrate/stepper.hpp): a new method is an entry in
+`integrate.methods.METHODS`, its header and a branch there, and the engine is untouched.
 """
 
 from __future__ import annotations
@@ -14,16 +14,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from mount_twin.integrate import dopri54, exprb32, ros34pw2
-from mount_twin.integrate.control import forget
+from mount_twin import _core
 from mount_twin.integrate.methods import (
     AUTO,
-    DOPRI54,
-    EXPRB32,
     METHODS,
-    ROS34PW2,
     STATUS_TEXT,
-    UNKNOWN_METHOD,
 )
 from mount_twin.integrate.settings import (
     ATOL,
@@ -32,8 +27,6 @@ from mount_twin.integrate.settings import (
     N_SETTINGS,
     RTOL,
 )
-from mount_twin.physics.compiled import kernel
-from mount_twin.physics.dynamics import ModelArrays, Scratch
 
 __all__ = [
     "METHODS",
@@ -111,25 +104,10 @@ def dormand_prince(n: int, rtol: float, atol: float, max_substeps: int) -> Stepp
     return new_stepper("dopri54", n, rtol, atol, max_substeps)
 
 
-@kernel
-def advance(
-    method: int,
-    y: np.ndarray,
-    t0: float,
-    t1: float,
-    settings: np.ndarray,
-    m: ModelArrays,
-    s: Scratch,
-    u: np.ndarray,
-    work2d: np.ndarray,
-    work1d: np.ndarray,
-    result: np.ndarray,
-) -> int:
-    """Advance y from t0 to t1 (s) with the stepper `method`; returns its status (0 = success)."""
-    if method == DOPRI54:
-        return dopri54.advance_inlined(y, t0, t1, settings, m, s, u, work2d, work1d, result)
-    if method == ROS34PW2:
-        return ros34pw2.advance(y, t0, t1, settings, m, s, u, work2d, work1d, result)
-    if method == EXPRB32:
-        return exprb32.advance(y, t0, t1, settings, m, s, u, work2d, work1d, result)
-    return UNKNOWN_METHOD
+advance = _core.advance
+"""advance(method, y, t0, t1, settings, m, s, u, work2d, work1d, result) -> status: advance y
+from t0 to t1 (s) with the stepper `method` (its id; UNKNOWN_METHOD for an id no method has,
+nothing touched); the core checks the work arrays hold the method (`Method.work_rows`)."""
+forget = _core.forget
+"""forget(settings): forget a stepper's history (after its state jumped: a start, a restart, a
+resync): the step proposal, the chained last stage, the Jacobian held and its matrix functions."""

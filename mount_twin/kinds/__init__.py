@@ -2,13 +2,18 @@
 checks (`read`), its parameter row (`pack`), internal states (and which of them a restart
 resets: `RESTUCK`), force law (`load`), event functions (`monitor`) and discrete switches
 between samples (`update`, which says whether it switched: the state then jumped, and a stepper
-must not start from a stage it took before).
+must not start from a stage it took before). A module's `load`, `monitor` and `update` are plain
+Python: the reference the compiled core's port of the kind (src/core/kinds/<kind>.hpp) is held
+to.
 
-The compiled dispatchers below select a kind by its code; adding a kind is a new module, a line
-in KINDS and a branch in each dispatcher. The integrator and the engine never change.
+The core's dispatchers (`kind_load`, `kind_monitor`, `kind_update` below) select a kind by its
+code; adding a kind is a new module here, a line in KINDS, its header in src/core/kinds/ with
+a line in KIND_NAMES and a branch in each dispatcher of dispatch.hpp. The integrator and the
+engine never change.
 
 The contract is checked, so a forgotten step cannot run another kind's law:
-- at import, every module in KINDS has the names of a kind (`MODULE_NAMES`);
+- at import, every module in KINDS has the names of a kind (`MODULE_NAMES`), and the core knows
+  the same kinds in the same code order (`check_core`);
 - a code without a branch reaches each dispatcher's final `else`, which writes NaN (the force,
   the event functions and utilisation, the state): the stepper then fails with NOT_FINITE and
   the engine reports it, never another kind's answer;
@@ -27,12 +32,8 @@ from collections.abc import Mapping
 from types import ModuleType
 
 import numpy as np
-from numba import njit
 
-# First: the cache locator must be in place before any compiled function is decorated.
-from mount_twin.physics import compiled  # noqa: F401
-
-# isort: split
+from mount_twin import _core
 from mount_twin.errors import ModelError
 from mount_twin.kinds import bolted_joint, elastomer, shear_key
 
@@ -72,52 +73,20 @@ class KindContractError(ModelError):
     """A kind module or the dispatchers break the kind contract (a programming error)."""
 
 
-@njit(cache=True, inline="always")
-def kind_load(code, p, y, o, d, v, phi, w, dydt, f, c) -> None:
-    """The kind's `load`: local force f and couple c on the body; internal rates into dydt.
-    phi and w are the body's rotation vector and its rate in the mount's axes, and c is taken
-    as the generalized force conjugate to phi (the right-hand side turns it into the couple
-    on the body: `physics.linear_mount`). An unknown code writes NaN into f and c."""
-    if code == ELASTOMER:
-        elastomer.load(p, y, o, d, v, phi, w, dydt, f, c)
-    elif code == BOLTED_JOINT:
-        bolted_joint.load(p, y, o, d, v, phi, w, dydt, f, c)
-    elif code == SHEAR_KEY:
-        shear_key.load(p, y, o, d, v, phi, w, dydt, f, c)
-    else:
-        for j in range(3):
-            f[j] = math.nan
-            c[j] = math.nan
-
-
-@njit(cache=True, inline="always")
-def kind_monitor(code, p, y, y0, o, d, v, g) -> float:
-    """The kind's `monitor`: event functions into g (y0: state at the previous sample);
-    returns the utilisation. An unknown code writes NaN into g and returns NaN."""
-    if code == ELASTOMER:
-        return elastomer.monitor(p, y, y0, o, d, v, g)
-    if code == BOLTED_JOINT:
-        return bolted_joint.monitor(p, y, y0, o, d, v, g)
-    if code == SHEAR_KEY:
-        return shear_key.monitor(p, y, y0, o, d, v, g)
-    for e in range(g.shape[0]):
-        g[e] = math.nan
-    return math.nan
-
-
-@njit(cache=True, inline="always")
-def kind_update(code, p, y, o, d) -> bool:
-    """The kind's `update`: discrete switches between samples; returns whether one changed the
-    state. An unknown code writes NaN into the state (its own, or y[0] for a kind without
-    states; the next step fails) and returns True."""
-    if code == ELASTOMER:
-        return elastomer.update(p, y, o, d)
-    if code == BOLTED_JOINT:
-        return bolted_joint.update(p, y, o, d)
-    if code == SHEAR_KEY:
-        return shear_key.update(p, y, o, d)
-    y[max(o, 0)] = math.nan
-    return True
+kind_load = _core.kind_load
+"""kind_load(code, p, y, o, d, v, phi, w, dydt, f, c): the kind's `load` as the core runs it:
+local force f and couple c on the body; internal rates into dydt. phi and w are the body's
+rotation vector and its rate in the mount's axes, and c is taken as the generalized force
+conjugate to phi (the right-hand side turns it into the couple on the body). An unknown code
+writes NaN into f and c."""
+kind_monitor = _core.kind_monitor
+"""kind_monitor(code, p, y, y0, o, d, v, g) -> utilisation: the kind's `monitor` as the core
+runs it: event functions into g (y0: state at the previous sample). An unknown code writes NaN
+into g and returns NaN."""
+kind_update = _core.kind_update
+"""kind_update(code, p, y, o, d) -> switched: the kind's `update` as the core runs it: discrete
+switches between samples. An unknown code writes NaN into the state (its own, or y[0] for a
+kind without states; the next step fails) and returns True."""
 
 
 def check_modules(kinds: Mapping[str, ModuleType]) -> None:
@@ -137,6 +106,26 @@ def check_modules(kinds: Mapping[str, ModuleType]) -> None:
 
 
 check_modules(KINDS)
+
+
+def check_core(kinds: Mapping[str, ModuleType]) -> None:
+    """Raise KindContractError unless the core knows exactly these kinds, in this code order
+    and with these parameter and event counts (src/core/kinds/dispatch.hpp)."""
+    names = tuple(kinds)
+    n_par = max(m.N_PAR for m in kinds.values())
+    n_events = max(len(m.EVENTS) for m in kinds.values())
+    core = (tuple(_core.KIND_NAMES), _core.N_PAR, _core.N_EVENTS)
+    if core != (names, n_par, n_events):
+        msg = (
+            f"the compiled core's kinds {core} differ from mount_twin.kinds' "
+            f"{(names, n_par, n_events)}: port the kind to src/core/kinds/ (a header, a line in "
+            "KIND_NAMES and a branch in each dispatcher of dispatch.hpp) and rebuild "
+            "(pip install -e . or colcon build)"
+        )
+        raise KindContractError(msg)
+
+
+check_core(KINDS)
 
 _PROBE_STATE_OFFSET, _PROBE_STATES = 3, 16
 """Where the probe puts a kind's internal states, and the length of its state vector."""
@@ -195,9 +184,8 @@ _checked: set[tuple[str, ...]] = set()
 def check_dispatch(kinds: Mapping[str, ModuleType] | None = None, samples: int = 2) -> None:
     """Raise KindContractError unless kind_load, kind_monitor and kind_update run, for the code
     of each kind in `kinds` (default KINDS; code = index), that kind's own function (same
-    outputs, finite, on `samples` sample inputs). Done once per process for KINDS; the first
-    call compiles the dispatchers and the laws for Python calls (cached on disk like the
-    kernels)."""
+    outputs to 1e-12, finite, on `samples` sample inputs): the core's port of each kind against
+    its Python reference. Done once per process for KINDS (about a millisecond)."""
     kinds = KINDS if kinds is None else kinds
     key = tuple(kinds)
     if kinds is KINDS and key in _checked:

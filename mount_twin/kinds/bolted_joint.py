@@ -31,7 +31,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import njit
 
 if TYPE_CHECKING:  # only annotations: importing mount_twin.scene here is a cycle
     from mount_twin.scene.reader import Reader
@@ -173,7 +172,6 @@ def state_names(j: BoltedJoint) -> tuple[str, ...]:
     return tuple(f"{j.name}.{s}" for s in STATES)
 
 
-@njit(cache=True, inline="always")
 def bolt_force(p: np.ndarray, u: float, e_p: float, broken: float) -> float:
     """Bolt tension F_S, N (0 once broken or slack)."""
     if broken > 0.5:
@@ -181,13 +179,11 @@ def bolt_force(p: np.ndarray, u: float, e_p: float, broken: float) -> float:
     return max(p[FV] + p[KS] * (u - e_p), 0.0)
 
 
-@njit(cache=True, inline="always")
 def yield_limit(p: np.ndarray, e_p: float) -> float:
     """Current yield force, N: linear hardening with the post-yield tangent α·k_S."""
     return p[FY] + p[ALPHA] * p[KS] / (1.0 - p[ALPHA]) * e_p
 
 
-@njit(cache=True, inline="always")
 def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
     """Force f and couple c (N, N·m) on the body in local axes; internal state rates into dydt.
 
@@ -241,7 +237,6 @@ def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
     c[2] = 0.0
 
 
-@njit(cache=True, inline="always")
 def monitor(p, y, y0, o, d, v, g) -> float:
     """Event functions into g (order of EVENTS; ≥ 0: happening); returns the utilisation
     F_S/F_y (1 at first yield).
@@ -263,7 +258,6 @@ def monitor(p, y, y0, o, d, v, g) -> float:
     return f_s / p[FY]
 
 
-@njit(cache=True, inline="always")
 def update(p, y, o, d) -> bool:
     """Between samples: a bolt at its ultimate load or elongation breaks, irreversibly.
     Returns whether it broke now."""

@@ -17,7 +17,6 @@ from itertools import pairwise
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import njit
 from scipy.interpolate import PchipInterpolator
 
 if TYPE_CHECKING:  # only annotations: importing mount_twin.scene here is a cycle
@@ -247,7 +246,6 @@ def pack(e: Elastomer) -> np.ndarray:
     return row
 
 
-@njit(cache=True, inline="always")
 def elastic_force(p: np.ndarray, b: int, x: float) -> float:
     """F_el(x) of the axis block at b, N: PCHIP table (linear beyond it) or k₁x + k₃x³."""
     n = int(p[b + NTAB])
@@ -268,13 +266,11 @@ def elastic_force(p: np.ndarray, b: int, x: float) -> float:
     return _segment(p, b, k, x - p[b + TAB_X + k])
 
 
-@njit(cache=True, inline="always")
 def _segment(p: np.ndarray, b: int, k: int, dx: float) -> float:
     c = b + TAB_C + 4 * k
     return ((p[c] * dx + p[c + 1]) * dx + p[c + 2]) * dx + p[c + 3]
 
 
-@njit(cache=True, inline="always")
 def bouc_wen_rate(p: np.ndarray, b: int, z: float, xd: float) -> float:
     """ż of the axis block at b, m/s."""
     az = abs(z)
@@ -283,7 +279,6 @@ def bouc_wen_rate(p: np.ndarray, b: int, z: float, xd: float) -> float:
     return p[b + BW_A] * xd - p[b + BETA] * abs(xd) * zn1 * z - p[b + GAMMA] * xd * zn
 
 
-@njit(cache=True, inline="always")
 def snubber_force(p: np.ndarray, b: int, x: float, xd: float) -> float:
     """Contact force magnitude of the axis block's snubber, N (≥ 0; 0 without contact)."""
     gap = p[b + GAP]
@@ -296,7 +291,6 @@ def snubber_force(p: np.ndarray, b: int, x: float, xd: float) -> float:
     return max(p[b + KS] * pen ** p[b + PEXP] * (1.0 + p[b + HC] * pen_rate), 0.0)
 
 
-@njit(cache=True, inline="always")
 def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
     """Force f and couple c on the body in local axes (N, N·m); ż into dydt from o."""
     for j in range(3):
@@ -315,7 +309,6 @@ def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
         c[j] = -(p[ROT + j] * phi[j] + p[ROT + 3 + j] * w[j])
 
 
-@njit(cache=True, inline="always")
 def monitor(p, y, y0, o, d, v, g) -> float:
     """Snubber contact (|x| − gap, m) and over-travel (|x|/rated − 1); returns the largest
     |x|/rated (0 if no axis is rated)."""
@@ -333,7 +326,6 @@ def monitor(p, y, y0, o, d, v, g) -> float:
     return util
 
 
-@njit(cache=True, inline="always")
 def update(p, y, o, d) -> bool:
     """No discrete state: never switches."""
     return False

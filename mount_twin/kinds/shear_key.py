@@ -12,7 +12,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import njit
 
 if TYPE_CHECKING:  # only annotations: importing mount_twin.scene here is a cycle
     from mount_twin.scene.reader import Reader
@@ -88,7 +87,6 @@ def state_names(_k: ShearKey) -> tuple[str, ...]:
     return ()
 
 
-@njit(cache=True, inline="always")
 def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
     """Force f (N) on the body in local axes; a key has no couple and no states."""
     engaged = _engaged(p, d)
@@ -104,7 +102,6 @@ def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
                 f[j] = -side * max(k * pen + p[C0 + j] * side * v[j], 0.0)
 
 
-@njit(cache=True, inline="always")
 def monitor(p, y, y0, o, d, v, g) -> float:
     """Contact (penetration past the clearance, m) and overload; returns |F|/allowable."""
     pen = -1.0
@@ -123,13 +120,11 @@ def monitor(p, y, y0, o, d, v, g) -> float:
     return 0.0
 
 
-@njit(cache=True, inline="always")
 def _engaged(p, d) -> bool:
     """Whether the foot is still low enough for the key to hold it."""
     return p[HEIGHT] <= 0.0 or d[2] <= p[HEIGHT]
 
 
-@njit(cache=True, inline="always")
 def update(p, y, o, d) -> bool:
     """No discrete state: never switches."""
     return False

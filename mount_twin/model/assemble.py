@@ -1,4 +1,4 @@
-"""Assemble a Scene into the flat arrays the compiled kernels read, and find its start state."""
+"""Assemble a Scene into the flat arrays the compiled core reads, and find its start state."""
 
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ class Model:
 
     Attributes:
         scene: the description it was built from.
-        arrays: kernel arrays.
+        arrays: the core's arrays.
         state_names: name of each state entry (q of free DOFs, then their rates).
         sensor_rotation: 3×3 rotation of the input sensor frame into F.
     """
@@ -47,7 +47,7 @@ class Model:
 
     @property
     def nonlinear_slots(self) -> list[int]:
-        """Scene index of each mount of a kind in mount_twin.kinds, in kernel order."""
+        """Scene index of each mount of a kind in mount_twin.kinds, in the core's order."""
         nl = self.arrays.nl
         return [] if nl is None else nl.slot.tolist()
 
@@ -57,12 +57,12 @@ class Model:
         return len(self.scene.mounts)
 
     def new_scratch(self) -> Scratch:
-        """Work arrays for the kernels."""
+        """Work arrays for the core."""
         return new_scratch(self.n_state)
 
 
 def assemble(scene: Scene) -> Model:
-    """Build the kernel arrays of `scene` (done once, at load)."""
+    """Build the core's arrays of `scene` (done once, at load)."""
     body = scene.body
     inertia = np.array(body.inertia_tensor())
     cg = np.array(body.cg)

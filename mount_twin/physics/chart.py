@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 
 def rotation_matrix(alpha: float, gamma: float, delta: float) -> np.ndarray:
@@ -23,7 +22,6 @@ def rotation_matrix(alpha: float, gamma: float, delta: float) -> np.ndarray:
     return out
 
 
-@njit(cache=True)
 def rotation_from_chart(
     sa: float, sg: float, cg: float, sd: float, cd: float, out: np.ndarray
 ) -> float:
@@ -48,13 +46,11 @@ def rotation_from_chart(
     return ct
 
 
-@njit(cache=True)
 def chart_from_rotation(rot: np.ndarray) -> tuple[float, float, float]:
     """(α, γ, δ) of a rotation matrix with R33 > 0 (caller checks)."""
     return math.asin(rot[2, 1]), math.asin(rot[2, 0]), math.atan2(rot[1, 0], rot[0, 0])
 
 
-@njit(cache=True)
 def kinematic_matrix(
     sa: float, ca: float, sg: float, cg: float, ct: float, out: np.ndarray
 ) -> None:
@@ -73,7 +69,6 @@ def kinematic_matrix(
     out[2, 2] = ct
 
 
-@njit(cache=True)
 def kinematic_matrix_rate(
     sa: float,
     ca: float,
@@ -100,7 +95,6 @@ def kinematic_matrix_rate(
     out[2, 2] = ct_dot
 
 
-@njit(cache=True)
 def chart_rates(
     alpha: float, gamma: float, ct: float, omega: np.ndarray
 ) -> tuple[float, float, float]:

@@ -11,42 +11,14 @@ equilibrium's Newton steps) and return a plain matrix.
 
 from __future__ import annotations
 
-import numpy as np
+from mount_twin import _core
 
-from mount_twin.physics.compiled import kernel
-from mount_twin.physics.dynamics import OK, ModelArrays, Scratch, rhs
-
-STEP = 1.0e-7
-"""Central-difference step, relative to max(1, |y_c|)."""
+STEP = _core.CENTRAL_STEP
+"""Central-difference step, relative to max(1, |y_c|) (1e-7)."""
 
 
-@kernel
-def central_columns(
-    y: np.ndarray,
-    t: float,
-    m: ModelArrays,
-    s: Scratch,
-    u: np.ndarray,
-    plus: np.ndarray,
-    minus: np.ndarray,
-    jac: np.ndarray,
-) -> bool:
-    """jac[:, c] = ∂(dy/dt)/∂y_c at (t, y) under the input u, for the first jac.shape[1]
-    columns c; plus, minus: (n,) work. y is left as it was. False if an evaluation failed (the
-    α/γ/δ chart's edge): jac is then incomplete."""
-    n = y.shape[0]
-    for c in range(jac.shape[1]):
-        keep = y[c]
-        h = STEP * max(1.0, abs(keep))
-        y[c] = keep + h
-        up = y[c]
-        ok = rhs(t, y, m, s, u, plus) == OK
-        y[c] = keep - h
-        down = y[c]
-        ok = ok and rhs(t, y, m, s, u, minus) == OK
-        y[c] = keep
-        if not ok:
-            return False
-        for r in range(n):
-            jac[r, c] = (plus[r] - minus[r]) / (up - down)
-    return True
+central_columns = _core.central_columns
+"""central_columns(y, t, m, s, u, plus, minus, jac) -> bool: jac[:, c] = ∂(dy/dt)/∂y_c at
+(t, y) under the input u, for the first jac.shape[1] columns c, by central differences of step
+STEP·max(1, |y_c|); plus, minus: (n,) work. y is left as it was. False if an evaluation failed
+(the α/γ/δ chart's edge): jac is then incomplete."""

@@ -2,7 +2,8 @@
 rows in it and every reader (engine, encoders, replay, plots) takes its columns from here.
 
 A row holds the CG position in F (m), the quaternion (x, y, z, w) of R (body → F) and the chart
-angles (α, γ, δ) rad. Plain integers, so numba folds them into the compiled code.
+angles (α, γ, δ) rad. The core writes rows in it (`mt::pose_row` in src/core/constants.hpp:
+test/test_core_contract.py holds the two equal).
 """
 
 from __future__ import annotations

@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 
 def rpy_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
@@ -22,7 +21,6 @@ def rpy_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
     )
 
 
-@njit(cache=True)
 def quaternion_from_matrix(rot: np.ndarray, out: np.ndarray) -> None:
     """Unit quaternion (x, y, z, w), w ≥ 0, of a rotation matrix (Shepperd's method)."""
     tr = rot[0, 0] + rot[1, 1] + rot[2, 2]
@@ -55,7 +53,6 @@ def quaternion_from_matrix(rot: np.ndarray, out: np.ndarray) -> None:
             out[i] = -out[i]
 
 
-@njit(cache=True)
 def rotation_vector(rot: np.ndarray, quat: np.ndarray, out: np.ndarray) -> None:
     """Rotation vector (axis × angle, rad) of `rot`; `quat` is scratch of length 4."""
     quaternion_from_matrix(rot, quat)
@@ -66,7 +63,6 @@ def rotation_vector(rot: np.ndarray, quat: np.ndarray, out: np.ndarray) -> None:
         out[i] = scale * quat[i]
 
 
-@njit(cache=True)
 def couple_map(phi: np.ndarray, quat: np.ndarray, out: np.ndarray) -> None:
     """J(φ)⁻ᵀ = 1 + ½[φ]× + c·[φ]×², c = 1/θ² − cot(θ/2)/(2θ), θ = |φ| (rad): the inverse
     transpose of the left Jacobian of SO(3) at the rotation vector φ of a rotation whose

@@ -53,7 +53,6 @@ from mount_twin.io.messages import (
     output_types,
     static_transforms,
 )
-from mount_twin.replay import kernels_loading
 from mount_twin.ros.parameters import check_qos_overrides, configure
 from mount_twin.ros.rclpy_private import take_waiting
 from mount_twin.stream import TwinStream
@@ -87,8 +86,7 @@ class MountTwinNode(Node):
         """`args`: the process's command line (its `-p` outrank a params file's section)."""
         super().__init__(NODE_NAME, **kwargs)
         self.options, self.scene = configure(self, args)
-        with kernels_loading(say=self.get_logger().info):  # a first start compiles them
-            self.stream = TwinStream(self.scene)
+        self.stream = TwinStream(self.scene)
         self._pubs = self._create_outputs()
         self._batched = self.options.batch_period_s > 0.0
         self._pending: list[bytes] = []

@@ -1,0 +1,190 @@
+// Python bindings of the per-sample loop and the gyro filter (engine/kernel.py,
+// engine/gyro_filter.py re-export them). Every tuple the engine passes is converted field by
+// field with its shape checked against the model, so a wrong array raises naming the field.
+#include <string>
+
+#include "../bind.hpp"
+#include "../convert.hpp"
+#include "kernel.hpp"
+
+namespace mt {
+
+namespace py = pybind11;
+using convert::field;
+
+namespace {
+
+/// A (1,) int64 array as a pointer to its one counter.
+idx* counter(py::handle obj, const char* what) {
+  auto a = convert::checked(obj, what, 'i', 8, 1);
+  if (a.shape(0) < 1) throw py::value_error(std::string(what) + ": empty");
+  return static_cast<idx*>(a.mutable_data());
+}
+
+/// A (1,) float64 array as a pointer to its one value.
+double* scalar(py::handle obj, const char* what) { return convert::vec(obj, what, 1).d; }
+
+engine::Integrator integrator(py::handle obj, const char* what, idx n_state) {
+  engine::Integrator integ;
+  integ.method = field(obj, "method").cast<int>();
+  const std::string w(what);
+  integ.settings = convert::vec(field(obj, "settings"), (w + ".settings").c_str(), N_SETTINGS);
+  integ.work2d = convert::mat(field(obj, "work2d"), (w + ".work2d").c_str(), -1, n_state);
+  integ.work1d = convert::vec(field(obj, "work1d"), (w + ".work1d").c_str(), n_state);
+  integ.result = convert::vec(field(obj, "result"), (w + ".result").c_str(), 3);
+  return integ;
+}
+
+engine::Watch watch(py::handle obj, idx k, idx n_state) {
+  engine::Watch w;
+  w.g = convert::mat(field(obj, "g"), "Watch.g", k);
+  w.g_prev = convert::mat(field(obj, "g_prev"), "Watch.g_prev", k, w.g.cols);
+  w.util = convert::vec(field(obj, "util"), "Watch.util", k);
+  w.util_peak = convert::vec(field(obj, "util_peak"), "Watch.util_peak", k);
+  w.events = convert::mat(field(obj, "events"), "Watch.events", -1, 4);
+  w.n_events = counter(field(obj, "n_events"), "Watch.n_events");
+  w.y_prev = convert::vec(field(obj, "y_prev"), "Watch.y_prev", n_state);
+  w.stop_after = *scalar(field(obj, "stop_after"), "Watch.stop_after");
+  w.stiffens = convert::mat(field(obj, "stiffens"), "Watch.stiffens", k, w.g.cols);
+  w.n_stiffening = counter(field(obj, "n_stiffening"), "Watch.n_stiffening");
+  return w;
+}
+
+engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
+                            idx k, idx n_events) {
+  engine::Companion c;
+  c.integ = integrator(obj, "Companion", n_state);
+  c.y = convert::vec(field(obj, "y"), "Companion.y", n_state);
+  c.s = convert::scratch(field(obj, "s"));
+  c.y_prev = convert::vec(field(obj, "y_prev"), "Companion.y_prev", n_state);
+  c.g = convert::mat(field(obj, "g"), "Companion.g", k, n_events);
+  c.util = convert::vec(field(obj, "util"), "Companion.util", k);
+  c.pose = convert::vec(field(obj, "pose"), "Companion.pose", pose_row::WIDTH);
+  c.wrenches = convert::mat(field(obj, "wrenches"), "Companion.wrenches", n_mounts, 6);
+  c.figures = convert::vec(field(obj, "figures"), "Companion.figures", N_FIGURES);
+  convert::check_scratch(c.s, n_state, "Companion.s");
+  return c;
+}
+
+}  // namespace
+
+void bind_engine(py::module_& mod) {
+  mod.def(
+      "run_samples",
+      [](py::handle integ_, py::handle m_, py::handle s_, py::handle u_, py::handle y_,
+         py::handle samples_, py::handle opts_, py::handle out_, py::handle watch_,
+         py::handle companion_) {
+        const Model m = convert::model(m_);
+        Scratch s = convert::scratch(s_);
+        const Vec y = convert::vec(y_, "y");
+        convert::check_state(m, y);
+        convert::check_scratch(s, y.n, "s");
+        const idx n_state = y.n;
+        const idx k = m.has_nl ? m.nl.k : 0;
+        const idx n_mounts = m.lin_point.rows + k;
+        engine::Integrator integ = integrator(integ_, "Integrator", n_state);
+        engine::Samples smp;
+        smp.t = convert::vec(field(samples_, "t"), "Samples.t");
+        const idx n = smp.t.n;
+        smp.f = convert::mat(field(samples_, "f"), "Samples.f", n, 3);
+        smp.w = convert::mat(field(samples_, "w"), "Samples.w", n, 3);
+        engine::RunOptions opts;
+        opts.zero_order = field(opts_, "zero_order").cast<bool>();
+        opts.decimation = field(opts_, "decimation").cast<idx>();
+        opts.chain = field(opts_, "chain").cast<bool>();
+        if (opts.decimation < 1) throw py::value_error("RunOptions.decimation: below 1");
+        engine::Published out;
+        out.counter = counter(field(out_, "counter"), "Published.counter");
+        out.peak = convert::mat(field(out_, "peak"), "Published.peak", n_mounts, 6);
+        out.pose = convert::mat(field(out_, "pose"), "Published.pose", -1, pose_row::WIDTH);
+        out.wrenches = convert::mats(field(out_, "wrenches"), "Published.wrenches", -1,
+                                     n_mounts, 6);
+        auto publish = convert::checked(field(out_, "publish"), "Published.publish", 'b', 1, 1);
+        out.publish = static_cast<bool*>(publish.mutable_data());
+        out.step_log = convert::mat(field(out_, "step_log"), "Published.step_log", -1, 3);
+        out.wrench_abs_max = convert::mat(field(out_, "wrench_abs_max"),
+                                          "Published.wrench_abs_max", n_mounts, 6);
+        out.cos_tilt_min = scalar(field(out_, "cos_tilt_min"), "Published.cos_tilt_min");
+        if (out.pose.rows < n || out.wrenches.n < n || publish.shape(0) < n ||
+            out.step_log.rows < n) {
+          throw py::value_error("Published: buffers shorter than the samples");
+        }
+        engine::Watch w = watch(watch_, k, n_state);
+        engine::Companion c;
+        engine::Companion* cp = nullptr;
+        if (!companion_.is_none()) {
+          c = companion(companion_, n_state, n_mounts, k, w.g.cols);
+          cp = &c;
+        }
+        const Vec u = convert::vec(u_, "u", INPUT_SIZE);
+        engine::RunResult r;
+        {
+          py::gil_scoped_release release;  // the loop touches no Python object
+          r = engine::run_samples(integ, m, s, u, y, smp, opts, out, w, cp);
+        }
+        return py::make_tuple(r.done, r.status);
+      },
+      "Advance y through samples 1..n−1 of `samples` (row 0: the last one done); returns "
+      "(index of the last sample done, status: 0 all done, AT_EVENT, or the stepper's "
+      "failure).",
+      py::arg("integ"), py::arg("m"), py::arg("s"), py::arg("u"), py::arg("y"),
+      py::arg("samples"), py::arg("opts"), py::arg("out"), py::arg("watch"),
+      py::arg("companion"));
+  mod.def(
+      "watch_mounts",
+      [](py::handle y_, py::handle nl_, py::handle s_, py::handle watch_, double t0, double t1,
+         py::handle wrenches_, py::handle settings_) {
+        const NonLinear nl = convert::nonlinear(nl_);
+        Scratch s = convert::scratch(s_);
+        const Vec y = convert::vec(y_, "y");
+        convert::check_scratch(s, y.n, "s");
+        engine::Watch w = watch(watch_, nl.k, y.n);
+        const Mat wrenches = convert::mat(wrenches_, "wrenches", -1, 6);
+        for (idx i = 0; i < nl.k; ++i) {
+          if (nl.slot[i] >= wrenches.rows || nl.state[i] >= y.n) {
+            throw py::value_error("wrenches or y: shorter than the mounts need");
+          }
+        }
+        engine::watch_mounts(y, nl, s, w, t0, t1, wrenches,
+                             convert::vec(settings_, "settings", N_SETTINGS));
+      },
+      "The mounts' monitors and switches at t1 (s), and their events since t0 logged into "
+      "the watch; a switch clears settings[CHAINED].",
+      py::arg("y"), py::arg("nl"), py::arg("s"), py::arg("watch"), py::arg("t0"), py::arg("t1"),
+      py::arg("wrenches"), py::arg("settings"));
+  mod.def(
+      "monitor_switches",
+      [](py::handle y_, py::handle nl_, py::handle y_prev_, py::handle s_, py::handle g_,
+         py::handle util_, py::handle settings_) {
+        const NonLinear nl = convert::nonlinear(nl_);
+        Scratch s = convert::scratch(s_);
+        const Vec y = convert::vec(y_, "y");
+        convert::check_scratch(s, y.n, "s");
+        for (idx i = 0; i < nl.k; ++i) {
+          if (nl.state[i] >= y.n) throw py::value_error("y: shorter than the mounts' states");
+        }
+        engine::monitor_switches(y, nl, convert::vec(y_prev_, "y_prev", y.n), s,
+                                 convert::mat(g_, "g", nl.k), convert::vec(util_, "util", nl.k),
+                                 convert::vec(settings_, "settings", N_SETTINGS));
+      },
+      "The mounts' monitors and discrete switches at a sample (y_prev: the previous state, "
+      "then y); a switch clears settings[CHAINED].",
+      py::arg("y"), py::arg("nl"), py::arg("y_prev"), py::arg("s"), py::arg("g"),
+      py::arg("util"), py::arg("settings"));
+  mod.def(
+      "fir_rows",
+      [](py::handle raw_, py::handle half_, py::handle out_) {
+        const Mat raw = convert::mat(raw_, "raw", 3);
+        const Vec half = convert::vec(half_, "half");
+        const Mat out = convert::mat(out_, "out", 3);
+        if (half.n < 1) throw py::value_error("half: no taps");
+        if (raw.cols < out.cols + 2 * (half.n - 1)) {
+          throw py::value_error("raw: fewer columns than out needs (out + 2N)");
+        }
+        engine::fir_rows(raw, half, out);
+      },
+      "out[i, k]: the filtered rate (rad/s) of the sample at raw[:, k + N] (N = len(half) − 1).",
+      py::arg("raw"), py::arg("half"), py::arg("out"));
+}
+
+}  // namespace mt

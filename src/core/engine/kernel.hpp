@@ -1,0 +1,239 @@
+// The per-sample loop: integrate a run of accepted samples, evaluate the outputs, watch the
+// mounts' events and follow the error estimate's companion (engine/kernel.py and
+// engine/companion.py hold the Python side: the same fields, what they mean, who owns them).
+#pragma once
+
+#include <cmath>
+
+#include "../constants.hpp"
+#include "../integrate/control.hpp"
+#include "../integrate/stepper.hpp"
+#include "../model.hpp"
+#include "../numeric.hpp"
+#include "../physics/dynamics.hpp"
+
+namespace mt::engine {
+
+/// A stepper's id, settings and work arrays (engine/kernel.py Integrator).
+struct Integrator {
+  int method = 0;
+  Vec settings;
+  Mat work2d;
+  Vec work1d;
+  Vec result;
+};
+
+/// Event watch over the non-linear mounts (engine/kernel.py Watch).
+struct Watch {
+  Mat g_prev, g;
+  Vec util, util_peak;
+  Mat events;        // (cap, 4) [crossing time s, mount slot, event index, |force| N]
+  idx* n_events;     // (1,) rows written (may exceed cap)
+  Vec y_prev;
+  double stop_after;  // s; inf: never
+  Mat stiffens;      // (k, NE) 1.0 where an event may stiffen the scene
+  idx* n_stiffening;  // (1,)
+};
+
+/// The input of one run: row 0 is the last sample already done (engine/kernel.py Samples).
+struct Samples {
+  Vec t;  // (n,) s
+  Mat f;  // (n, 3) specific force, m/s², F
+  Mat w;  // (n, 3) foundation Ω, rad/s, F
+};
+
+struct RunOptions {
+  bool zero_order = false;
+  idx decimation = 1;
+  bool chain = false;
+};
+
+/// What a run publishes and the decimation's carried state (engine/kernel.py Published).
+struct Published {
+  idx* counter;
+  Mat peak;       // (nm, 6)
+  Mat pose;       // (n, WIDTH)
+  Mats wrenches;  // (n, nm, 6)
+  bool* publish;  // (n,)
+  Mat step_log;   // (n, 3)
+  Mat wrench_abs_max;  // (nm, 6)
+  double* cos_tilt_min;  // (1,)
+};
+
+/// The error estimate's companion solution (engine/companion.py Companion).
+struct Companion {
+  Integrator integ;
+  Vec y;
+  Scratch s;
+  Vec y_prev;
+  Mat g;
+  Vec util;
+  Vec pose;
+  Mat wrenches;
+  Vec figures;  // (N_FIGURES,)
+};
+
+/// The mounts' monitors and discrete switches at a sample (y_prev: the state at the previous
+/// one, then y); a switch (y jumped) clears the stepper's chain flag: its last stage is not
+/// at this y.
+inline void monitor_switches(Vec y, const NonLinear& nl, Vec y_prev, Scratch& s, Mat g, Vec util,
+                             Vec settings) {
+  if (physics::mount_monitors(y, y_prev, nl, s, g, util)) settings[CHAINED] = 0.0;
+  for (idx i = 0; i < y.n; ++i) y_prev[i] = y[i];
+}
+
+/// `monitor_switches` at t1, then log each upward zero crossing of an event function since t0
+/// (located by linear interpolation).
+inline void watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, double t0, double t1,
+                         Mat wrenches, Vec settings) {
+  monitor_switches(y, nl, w.y_prev, s, w.g, w.util, settings);
+  for (idx i = 0; i < w.g.rows; ++i) {
+    w.util_peak[i] = py_max(w.util_peak[i], w.util[i]);
+    for (idx e = 0; e < w.g.cols; ++e) {
+      const double g0 = w.g_prev(i, e), g1 = w.g(i, e);
+      w.g_prev(i, e) = g1;
+      if (g0 < 0.0 && 0.0 <= g1) {
+        if (w.stiffens(i, e) > 0.0) *w.n_stiffening += 1;
+        const idx k = *w.n_events;
+        *w.n_events += 1;
+        if (k < w.events.rows) {
+          const idx slot = nl.slot[i];
+          const double* r = &wrenches(slot, 0);
+          w.events(k, 0) = t0 + (t1 - t0) * (-g0) / (g1 - g0);
+          w.events(k, 1) = static_cast<double>(slot);
+          w.events(k, 2) = static_cast<double>(e);
+          w.events(k, 3) = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+        }
+      }
+    }
+  }
+}
+
+/// Advance the companion over [t0, t1] under the input u the twin just took, and fold the
+/// differences of its outputs from the twin's (pose, wrenches at t1; y the twin's state).
+inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
+                   Vec d_wdot, Vec pose, Mat wrenches, Vec y) {
+  const Vec settings = c.integ.settings, figures = c.figures;
+  if (chain && settings[CHAINED] == 1.0) {
+    physics::rhs_after_rate_step(m, c.s, d_wdot, c.integ.work2d.row(0));
+  } else {
+    settings[CHAINED] = 0.0;
+  }
+  const int status = integrate::advance(c.integ.method, c.y, t0, t1, settings, m, c.s, u,
+                                        c.integ.work2d, c.integ.work1d, c.integ.result);
+  if (status != 0) {
+    for (idx i = 0; i < y.n; ++i) {
+      c.y[i] = y[i];
+      c.y_prev[i] = y[i];
+    }
+    integrate::forget(settings);
+    figures[FAILURES] += 1.0;
+    return;
+  }
+  physics::outputs(c.y, m, c.s, c.pose, c.wrenches);
+  if (m.has_nl) monitor_switches(c.y, m.nl, c.y_prev, c.s, c.g, c.util, settings);
+  double force = figures[FORCE_ERROR], scale = figures[FORCE_SCALE];
+  for (idx a = 0; a < wrenches.rows; ++a) {
+    for (int b = 0; b < 3; ++b) {
+      force = py_max(force, std::fabs(wrenches(a, b) - c.wrenches(a, b)));
+      scale = py_max(scale, std::fabs(wrenches(a, b)));
+    }
+  }
+  double attitude = figures[ATTITUDE_ERROR];
+  for (int i = 0; i < 3; ++i) {
+    const int k = pose_row::ANGLES + i;
+    attitude = py_max(attitude, std::fabs(pose[k] - c.pose[k]));
+  }
+  figures[FORCE_ERROR] = force;
+  figures[FORCE_SCALE] = scale;
+  figures[ATTITUDE_ERROR] = attitude;
+}
+
+/// run_samples' result: the index of the last sample done and the status (0 all done;
+/// AT_EVENT ended at an event that may stiffen the scene; else the stepper's failure).
+struct RunResult {
+  idx done;
+  int status;
+};
+
+/// Advance y through samples 1..n−1; sample 0 is the last one already done
+/// (engine/kernel.py run_samples says what each argument holds). The watch is read only
+/// where the model has non-linear mounts; `companion` null: no error estimate.
+inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec u, Vec y,
+                             const Samples& smp, const RunOptions& opts, Published& out,
+                             Watch& watch, Companion* companion) {
+  const idx n = smp.t.n, nm = out.peak.rows;
+  const double hold = opts.zero_order ? 0.0 : 1.0;
+  const Vec d_wdot = s.rate_step, settings = integ.settings;
+  for (idx j = 1; j < n; ++j) {
+    const double dt = smp.t[j] - smp.t[j - 1];
+    u[0] = smp.t[j - 1];
+    for (int i = 0; i < 3; ++i) {
+      u[1 + i] = smp.f(j - 1, i);
+      u[4 + i] = hold * (smp.f(j, i) - smp.f(j - 1, i)) / dt;
+      u[7 + i] = smp.w(j - 1, i);
+      const double w_dot = hold * (smp.w(j, i) - smp.w(j - 1, i)) / dt;
+      d_wdot[i] = w_dot - u[10 + i];
+      u[10 + i] = w_dot;
+    }
+    if (opts.chain && settings[CHAINED] == 1.0) {
+      // First-order hold: only Ω' jumps at the sample; the last stage moves to it.
+      physics::rhs_after_rate_step(m, s, d_wdot, integ.work2d.row(0));
+    } else {
+      settings[CHAINED] = 0.0;
+    }
+    const int status = integrate::advance(integ.method, y, smp.t[j - 1], smp.t[j], settings, m,
+                                          s, u, integ.work2d, integ.work1d, integ.result);
+    if (status != 0) return {j - 1, status};
+    const idx stiffening = *watch.n_stiffening;
+    for (int k = 0; k < 3; ++k) out.step_log(j, k) = integ.result[k];
+    const Mat wrenches_j = out.wrenches.mat(j);
+    physics::outputs(y, m, s, out.pose.row(j), wrenches_j);
+    if (m.has_nl) {
+      watch_mounts(y, m.nl, s, watch, smp.t[j - 1], smp.t[j], wrenches_j, settings);
+    }
+    if (companion != nullptr) {
+      follow(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, d_wdot, out.pose.row(j),
+             wrenches_j, y);
+    }
+    *out.counter += 1;
+    for (idx a = 0; a < nm; ++a) {
+      for (int b = 0; b < 6; ++b) {
+        if (std::fabs(wrenches_j(a, b)) > std::fabs(out.peak(a, b))) {
+          out.peak(a, b) = wrenches_j(a, b);
+        }
+      }
+    }
+    out.publish[j] = *out.counter >= opts.decimation;
+    if (out.publish[j]) {
+      for (idx a = 0; a < nm; ++a) {
+        for (int b = 0; b < 6; ++b) {
+          wrenches_j(a, b) = out.peak(a, b);
+          out.wrench_abs_max(a, b) = py_max(out.wrench_abs_max(a, b), std::fabs(out.peak(a, b)));
+          out.peak(a, b) = 0.0;
+        }
+      }
+      *out.counter = 0;
+      *out.cos_tilt_min = py_min(*out.cos_tilt_min, s.rot(2, 2));
+    }
+    if (*watch.n_stiffening > stiffening && smp.t[j] > watch.stop_after) {
+      return {j, AT_EVENT};
+    }
+  }
+  return {n - 1, 0};
+}
+
+/// out[i, k] = h[N]·raw[i, k + N] + Σ_j h[N + j]·(raw[i, k + N − j] + raw[i, k + N + j]),
+/// j = 1..N in that order (engine/gyro_filter.py fir_rows: any batching, the same bits).
+inline void fir_rows(Mat raw, Vec half, Mat out) {
+  const idx n = half.n - 1, m = out.cols;
+  for (idx i = 0; i < 3; ++i) {
+    for (idx k = 0; k < m; ++k) out(i, k) = half[0] * raw(i, k + n);
+    for (idx j = 1; j <= n; ++j) {
+      const double h = half[j];
+      for (idx k = 0; k < m; ++k) out(i, k) += h * (raw(i, k + n - j) + raw(i, k + n + j));
+    }
+  }
+}
+
+}  // namespace mt::engine

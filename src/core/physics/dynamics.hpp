@@ -1,0 +1,394 @@
+// Equations of motion on the free generalized coordinates, in the moving foundation frame F
+// (physics/dynamics.py holds the derivation, the state layout and which call fills which
+// scratch field; this is the compiled implementation, the same operations in the same order).
+#pragma once
+
+#include <cmath>
+
+#include "../constants.hpp"
+#include "../kinds/dispatch.hpp"
+#include "../model.hpp"
+#include "chart.hpp"
+#include "dynamics_api.hpp"
+#include "linear_mount.hpp"
+#include "rotations.hpp"
+
+namespace mt::physics {
+
+/// cos θ below which the state counts as off the chart (dynamics.py COS_TILT_MIN).
+constexpr double COS_TILT_MIN = 1.0e-6;
+
+/// Fill s.q, s.qd, s.trig, s.rot, s.kin, s.omega, s.omega_f (and s.phi, s.quat, s.phi_rate,
+/// s.couple_map where m.rotation_read, else NaN) from y; returns cos θ (NaN off the chart).
+inline double body_motion(Vec y, const Model& m, Scratch& s) {
+  const Vec q = s.q, qd = s.qd, trig = s.trig, omega = s.omega, omega_f = s.omega_f;
+  const Mat rot = s.rot, kin = s.kin;
+  const idx nt = m.free_trans.n, nr = m.free_rot.n, nf = nt + nr;
+  for (int i = 0; i < 6; ++i) {
+    q[i] = m.q_fixed[i];
+    qd[i] = 0.0;
+  }
+  for (idx k = 0; k < nt; ++k) {
+    q[m.free_trans[k]] = y[k];
+    qd[m.free_trans[k]] = y[nf + k];
+  }
+  for (idx k = 0; k < nr; ++k) {
+    q[3 + m.free_rot[k]] = y[nt + k];
+    qd[3 + m.free_rot[k]] = y[nf + nt + k];
+  }
+  for (int i = 0; i < 3; ++i) {
+    trig[i] = std::sin(q[3 + i]);
+    trig[3 + i] = std::cos(q[3 + i]);
+  }
+  const double sa = trig[0], sg = trig[1], sd = trig[2], ca = trig[3], cg = trig[4],
+               cd = trig[5];
+  const double ct = rotation_from_chart(sa, sg, cg, sd, cd, rot);
+  if (!(ct > COS_TILT_MIN)) return NAN;
+  kinematic_matrix(sa, ca, sg, cg, ct, kin);
+  for (int i = 0; i < 3; ++i) omega[i] = kin(i, 0) * qd[3] + kin(i, 1) * qd[4] + kin(i, 2) * qd[5];
+  for (int i = 0; i < 3; ++i) {
+    omega_f[i] = rot(i, 0) * omega[0] + rot(i, 1) * omega[1] + rot(i, 2) * omega[2];
+  }
+  const Vec phi = s.phi, phi_rate = s.phi_rate;
+  const Mat cmap = s.couple_map;
+  if (m.rotation_read) {
+    rotation_vector(rot, s.quat, phi);
+    couple_map(phi, s.quat, cmap);
+    for (int i = 0; i < 3; ++i) {
+      phi_rate[i] = cmap(0, i) * omega_f[0] + cmap(1, i) * omega_f[1] + cmap(2, i) * omega_f[2];
+    }
+  } else {
+    for (int i = 0; i < 3; ++i) {
+      phi[i] = NAN;
+      phi_rate[i] = NAN;
+      for (int j = 0; j < 3; ++j) cmap(i, j) = NAN;
+    }
+  }
+  return ct;
+}
+
+/// out = Qᵢᵀ·x: a vector of F in non-linear mount i's axes (copied where they are F's).
+inline void into_axes(const NonLinear& nl, idx i, double x0, double x1, double x2, double* out) {
+  if (nl.aligned[i]) {
+    out[0] = x0;
+    out[1] = x1;
+    out[2] = x2;
+    return;
+  }
+  for (int j = 0; j < 3; ++j) {
+    out[j] = nl.axes(i, 0, j) * x0 + nl.axes(i, 1, j) * x1 + nl.axes(i, 2, j) * x2;
+  }
+}
+
+/// out = Qᵢ·local: a vector of mount i's axes in F (copied where they are F's).
+inline void out_of_axes(const NonLinear& nl, idx i, const double* local, double* out) {
+  if (nl.aligned[i]) {
+    out[0] = local[0];
+    out[1] = local[1];
+    out[2] = local[2];
+    return;
+  }
+  for (int j = 0; j < 3; ++j) {
+    out[j] = nl.axes(i, j, 0) * local[0] + nl.axes(i, j, 1) * local[1] +
+             nl.axes(i, j, 2) * local[2];
+  }
+}
+
+/// Deflection, rate, rotation vector and its rate of non-linear mount i in its axes into
+/// s.loc rows 0..3 (rows 2, 3 NaN for a kind without a rotational law); its arm into s.arm.
+inline void local_motion(idx i, const NonLinear& nl, Scratch& s) {
+  double de[6];
+  point_motion(&nl.point(i, 0), s.rot, s.q, s.qd, s.omega_f, s.arm, de);
+  const Mat loc = s.loc;
+  into_axes(nl, i, de[0], de[1], de[2], loc.row(0).d);
+  into_axes(nl, i, de[3], de[4], de[5], loc.row(1).d);
+  if (nl.rotational[i]) {
+    into_axes(nl, i, s.phi[0], s.phi[1], s.phi[2], loc.row(2).d);
+    into_axes(nl, i, s.phi_rate[0], s.phi_rate[1], s.phi_rate[2], loc.row(3).d);
+  } else {
+    for (int j = 0; j < 3; ++j) {
+      loc(2, j) = NAN;
+      loc(3, j) = NAN;
+    }
+  }
+}
+
+/// Load of non-linear mount i in its axes into s.loc rows 4, 5; its state rates into dydt.
+inline void nl_load(idx i, Vec y, const NonLinear& nl, Scratch& s, Vec dydt) {
+  local_motion(i, nl, s);
+  const Mat loc = s.loc;
+  kinds::kind_load(nl.kind[i], &nl.par(i, 0), y, nl.state[i], loc.row(0).d, loc.row(1).d,
+                   loc.row(2).d, loc.row(3).d, dydt, loc.row(4).d, loc.row(5).d);
+}
+
+/// c = J(φ)⁻ᵀ·Qᵢ·s.loc[5]: the couple on the body (F) of mount i's generalized force.
+inline void nl_couple(idx i, const NonLinear& nl, Scratch& s, Vec c) {
+  const Mat cmap = s.couple_map;
+  out_of_axes(nl, i, s.loc.row(5).d, c.d);
+  const double c0 = c[0], c1 = c[1], c2 = c[2];
+  for (int j = 0; j < 3; ++j) c[j] = cmap(j, 0) * c0 + cmap(j, 1) * c1 + cmap(j, 2) * c2;
+}
+
+inline void add_load(Vec arm, Vec f, Vec c, Vec total_f, Vec total_m) {
+  total_f[0] += f[0];
+  total_f[1] += f[1];
+  total_f[2] += f[2];
+  total_m[0] += arm[1] * f[2] - arm[2] * f[1] + c[0];
+  total_m[1] += arm[2] * f[0] - arm[0] * f[2] + c[1];
+  total_m[2] += arm[0] * f[1] - arm[1] * f[0] + c[2];
+}
+
+/// Sum the mount loads on the body into s.total_force, s.total_moment (F, about the CG);
+/// the internal-state rates of the mounts that have them into dydt.
+inline void mount_loads(Vec y, const Model& m, Scratch& s, Vec dydt) {
+  const Vec total_f = s.total_force, total_m = s.total_moment, arm = s.arm, f = s.force,
+            c = s.couple;
+  for (int j = 0; j < 3; ++j) {
+    total_f[j] = 0.0;
+    total_m[j] = 0.0;
+  }
+  for (idx i = 0; i < m.lin_point.rows; ++i) {
+    linear_mount_load(i, m, s, arm, f, c);
+    add_load(arm, f, c, total_f, total_m);
+  }
+  if (!m.has_nl) return;
+  const NonLinear& nl = m.nl;
+  for (idx i = 0; i < nl.k; ++i) {
+    nl_load(i, y, nl, s, dydt);
+    out_of_axes(nl, i, s.loc.row(4).d, f.d);
+    if (nl.rotational[i]) {
+      nl_couple(i, nl, s, c);
+    } else {
+      c[0] = 0.0;
+      c[1] = 0.0;
+      c[2] = 0.0;
+    }
+    add_load(arm, f, c, total_f, total_m);
+  }
+}
+
+/// Each mount's force (N) and own couple (N·m) on the body, in its axes: wrenches row slot.
+inline void mount_wrenches(Vec y, const Model& m, Scratch& s, Mat wrenches) {
+  const Vec arm = s.arm, f = s.force, c = s.couple;
+  for (idx i = 0; i < m.lin_point.rows; ++i) {
+    linear_mount_load(i, m, s, arm, f, c);
+    const idx row = m.lin_slot[i];
+    const Mats& axes = m.lin_axes;
+    for (int j = 0; j < 3; ++j) {
+      wrenches(row, j) = axes(i, 0, j) * f[0] + axes(i, 1, j) * f[1] + axes(i, 2, j) * f[2];
+      wrenches(row, 3 + j) = axes(i, 0, j) * c[0] + axes(i, 1, j) * c[1] + axes(i, 2, j) * c[2];
+    }
+  }
+  if (!m.has_nl) return;
+  const NonLinear& nl = m.nl;
+  const Mat loc = s.loc;
+  for (idx i = 0; i < nl.k; ++i) {
+    nl_load(i, y, nl, s, s.sink);
+    if (nl.rotational[i]) {
+      nl_couple(i, nl, s, c);
+      into_axes(nl, i, c[0], c[1], c[2], loc.row(5).d);
+    }
+    const idx row = nl.slot[i];
+    for (int j = 0; j < 3; ++j) {
+      wrenches(row, j) = loc(4, j);
+      wrenches(row, 3 + j) = loc(5, j);
+    }
+  }
+}
+
+/// Event functions g (k, NE) and utilisation util (k) of each non-linear mount at y (its body
+/// motion computed); then their discrete switches. Returns whether one switched (y jumped).
+inline bool mount_monitors(Vec y, Vec y0, const NonLinear& nl, Scratch& s, Mat g, Vec util) {
+  const Mat loc = s.loc;
+  bool switched = false;
+  for (idx i = 0; i < nl.k; ++i) {
+    local_motion(i, nl, s);
+    const idx code = nl.kind[i], o = nl.state[i];
+    const double* p = &nl.par(i, 0);
+    util[i] = kinds::kind_monitor(code, p, y, y0, o, loc.row(0).d, loc.row(1).d, g.row(i));
+    if (kinds::kind_update(code, p, y, o, loc.row(0).d)) switched = true;
+  }
+  return switched;
+}
+
+inline double cross(const Vec a, const Vec b, idx i) {
+  if (i == 0) return a[1] * b[2] - a[2] * b[1];
+  if (i == 1) return a[2] * b[0] - a[0] * b[2];
+  return a[0] * b[1] - a[1] * b[0];
+}
+
+/// Free translational accelerations into dydt[nf:nf + nt].
+inline void translational(const Model& m, Scratch& s, Vec dydt, idx nf) {
+  const Vec q = s.q, qd = s.qd, f_s = s.f_s, w = s.big_w, w_dot = s.big_w_dot, rel = s.rel,
+            wxr = s.w_x_rel, total_f = s.total_force;
+  for (int i = 0; i < 3; ++i) rel[i] = m.cg_ref[i] + q[i] - m.sensor_position[i];
+  for (int i = 0; i < 3; ++i) wxr[i] = cross(w, rel, i);
+  const double inv_mass = 1.0 / m.mass;
+  for (idx k = 0; k < m.free_trans.n; ++k) {
+    const idx i = m.free_trans[k];
+    const double frame = 2.0 * cross(w, qd, i) + cross(w_dot, rel, i) + cross(w, wxr, i);
+    dydt[nf + k] = total_f[i] * inv_mass - f_s[i] - frame;
+  }
+}
+
+/// Solve L Lᵀ x = b[:n] in place, L the lower triangle of low.
+inline void cholesky_solve(Mat low, Vec b, idx n) {
+  for (idx i = 0; i < n; ++i) {
+    double e = b[i];
+    for (idx k = 0; k < i; ++k) e -= low(i, k) * b[k];
+    b[i] = e / low(i, i);
+  }
+  for (idx i = n - 1; i >= 0; --i) {
+    double e = b[i];
+    for (idx k = i + 1; k < n; ++k) e -= low(k, i) * b[k];
+    b[i] = e / low(i, i);
+  }
+}
+
+/// Solve a[:n, :n] x = b[:n] in place by Cholesky (a keeps its factor); false if a is not
+/// positive definite.
+inline bool solve_spd(Mat a, Vec b, idx n) {
+  for (idx j = 0; j < n; ++j) {
+    double d = a(j, j);
+    for (idx k = 0; k < j; ++k) d -= a(j, k) * a(j, k);
+    if (!(d > 0.0)) return false;
+    d = std::sqrt(d);
+    a(j, j) = d;
+    for (idx i = j + 1; i < n; ++i) {
+      double e = a(i, j);
+      for (idx k = 0; k < j; ++k) e -= a(i, k) * a(j, k);
+      a(i, j) = e / d;
+    }
+  }
+  cholesky_solve(a, b, n);
+  return true;
+}
+
+/// Free rotational accelerations (projected Euler equations) into dydt[first:first + nr];
+/// false if the reduced mass matrix is numerically singular.
+inline bool rotational(const Model& m, Scratch& s, double ct, Vec dydt, idx first) {
+  const Mat rot = s.rot, kin = s.kin, kin_rate = s.kin_rate, inertia = m.inertia,
+            mass_rot = s.mass_rot;
+  const Vec qd = s.qd, omega = s.omega, trig = s.trig, w = s.big_w, w_dot = s.big_w_dot,
+            total_m = s.total_moment, moment_b = s.moment_b, w_b = s.w_b,
+            w_dot_b = s.w_dot_b, acc = s.acc, w_abs = s.w_abs, h = s.h, i_w = s.i_w,
+            rhs_rot = s.rhs_rot;
+  kinematic_matrix_rate(trig[0], trig[3], trig[1], trig[4], ct, qd[3], qd[4], kin_rate);
+  for (int i = 0; i < 3; ++i) {
+    moment_b[i] = rot(0, i) * total_m[0] + rot(1, i) * total_m[1] + rot(2, i) * total_m[2];
+    w_b[i] = rot(0, i) * w[0] + rot(1, i) * w[1] + rot(2, i) * w[2];
+    w_dot_b[i] = rot(0, i) * w_dot[0] + rot(1, i) * w_dot[1] + rot(2, i) * w_dot[2];
+  }
+  for (int i = 0; i < 3; ++i) {
+    const double bdq = kin_rate(i, 0) * qd[3] + kin_rate(i, 1) * qd[4] + kin_rate(i, 2) * qd[5];
+    acc[i] = bdq - cross(omega, w_b, i) + w_dot_b[i];
+    w_abs[i] = omega[i] + w_b[i];
+  }
+  for (int i = 0; i < 3; ++i) {
+    i_w[i] = inertia(i, 0) * w_abs[0] + inertia(i, 1) * w_abs[1] + inertia(i, 2) * w_abs[2];
+  }
+  for (int i = 0; i < 3; ++i) {
+    const double i_acc = inertia(i, 0) * acc[0] + inertia(i, 1) * acc[1] + inertia(i, 2) * acc[2];
+    h[i] = moment_b[i] - cross(w_abs, i_w, i) - i_acc;
+  }
+  const idx nr = m.free_rot.n;
+  for (idx a = 0; a < nr; ++a) {
+    const idx ca = m.free_rot[a];
+    const double k0 = kin(0, ca), k1 = kin(1, ca), k2 = kin(2, ca);
+    rhs_rot[a] = k0 * h[0] + k1 * h[1] + k2 * h[2];
+    const double i0 = inertia(0, 0) * k0 + inertia(0, 1) * k1 + inertia(0, 2) * k2;
+    const double i1 = inertia(1, 0) * k0 + inertia(1, 1) * k1 + inertia(1, 2) * k2;
+    const double i2 = inertia(2, 0) * k0 + inertia(2, 1) * k1 + inertia(2, 2) * k2;
+    for (idx b = 0; b <= a; ++b) {
+      const idx cb = m.free_rot[b];
+      mass_rot(a, b) = i0 * kin(0, cb) + i1 * kin(1, cb) + i2 * kin(2, cb);
+    }
+  }
+  if (!solve_spd(mass_rot, rhs_rot, nr)) return false;
+  for (idx a = 0; a < nr; ++a) dydt[first + a] = rhs_rot[a];
+  return true;
+}
+
+inline int rhs(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt) {
+  const double ct = body_motion(y, m, s);
+  if (!(ct > 0.0)) return OFF_CHART;
+  mount_loads(y, m, s, dydt);
+  const idx nt = m.free_trans.n, nr = m.free_rot.n, nf = nt + nr;
+  for (idx k = 0; k < nf; ++k) dydt[k] = y[nf + k];
+  const double tau = t - u[0];
+  for (int i = 0; i < 3; ++i) {
+    s.f_s[i] = u[1 + i] + u[4 + i] * tau;
+    s.big_w[i] = u[7 + i] + u[10 + i] * tau;
+    s.big_w_dot[i] = u[10 + i];
+  }
+  if (nt > 0) translational(m, s, dydt, nf);
+  if (nr > 0 && !rotational(m, s, ct, dydt, nf + nt)) return OFF_CHART;
+  return OK;
+}
+
+/// Outputs when s already holds the body motion at y (the last rhs was at y): the pose row
+/// (physics/pose_row.py) and each mount's wrench in its axes.
+inline void outputs(Vec y, const Model& m, Scratch& s, Vec pose, Mat wrenches) {
+  mount_wrenches(y, m, s, wrenches);
+  if (!m.rotation_read) quaternion_from_matrix(s.rot, s.quat);
+  for (int i = 0; i < 3; ++i) {
+    pose[pose_row::POSITION + i] = m.cg_ref[i] + s.q[i];
+    pose[pose_row::ANGLES + i] = s.q[3 + i];
+  }
+  for (int i = 0; i < 4; ++i) pose[pose_row::QUATERNION + i] = s.quat[i];
+}
+
+/// Outputs at state y; returns cos θ (NaN off the chart, outputs then untouched).
+inline double evaluate(Vec y, const Model& m, Scratch& s, Vec pose, Mat wrenches) {
+  const double ct = body_motion(y, m, s);
+  if (!(ct > 0.0)) return NAN;
+  outputs(y, m, s, pose, wrenches);
+  return ct;
+}
+
+/// Move dydt, the last rhs's result (whose kinematics and factored reduced mass matrix s
+/// holds), to an input whose Ω' changed by d_wdot (rad/s², F).
+inline void rhs_after_rate_step(const Model& m, Scratch& s, Vec d_wdot, Vec dydt) {
+  const idx nt = m.free_trans.n, nr = m.free_rot.n, nf = nt + nr;
+  for (idx k = 0; k < nt; ++k) dydt[nf + k] -= cross(d_wdot, s.rel, m.free_trans[k]);
+  if (nr == 0) return;
+  const Mat rot = s.rot, kin = s.kin, inertia = m.inertia;
+  const Vec b = s.rhs_rot, dw_b = s.w_dot_b, h = s.h;
+  for (int i = 0; i < 3; ++i) {
+    dw_b[i] = rot(0, i) * d_wdot[0] + rot(1, i) * d_wdot[1] + rot(2, i) * d_wdot[2];
+  }
+  for (int i = 0; i < 3; ++i) {
+    h[i] = -(inertia(i, 0) * dw_b[0] + inertia(i, 1) * dw_b[1] + inertia(i, 2) * dw_b[2]);
+  }
+  for (idx a = 0; a < nr; ++a) {
+    const idx ca = m.free_rot[a];
+    b[a] = kin(0, ca) * h[0] + kin(1, ca) * h[1] + kin(2, ca) * h[2];
+  }
+  cholesky_solve(s.mass_rot, b, nr);
+  for (idx a = 0; a < nr; ++a) dydt[nf + nt + a] += b[a];
+}
+
+/// Central-difference step of central_columns, relative to max(1, |y_c|).
+constexpr double CENTRAL_STEP = 1.0e-7;
+
+/// jac[:, c] = ∂(dy/dt)/∂y_c at (t, y) under u for the first jac.cols columns; plus, minus:
+/// (n,) work; y restored. False if an evaluation failed (jac then incomplete).
+inline bool central_columns(Vec y, double t, const Model& m, Scratch& s, Vec u, Vec plus,
+                            Vec minus, Mat jac) {
+  for (idx c = 0; c < jac.cols; ++c) {
+    const double keep = y[c];
+    const double h = CENTRAL_STEP * py_max(1.0, std::fabs(keep));
+    y[c] = keep + h;
+    const double up = y[c];
+    bool ok = rhs(t, y, m, s, u, plus) == OK;
+    y[c] = keep - h;
+    const double down = y[c];
+    ok = ok && rhs(t, y, m, s, u, minus) == OK;
+    y[c] = keep;
+    if (!ok) return false;
+    for (idx r = 0; r < y.n; ++r) jac(r, c) = (plus[r] - minus[r]) / (up - down);
+  }
+  return true;
+}
+
+}  // namespace mt::physics

@@ -1,0 +1,52 @@
+// Non-owning views of C-contiguous float64, int64 and bool arrays that Python owns (numpy).
+// The core never allocates in the hot path and owns no Python object: the bindings
+// (bindings.cpp) check every array's dtype, shape and contiguity, then hand these views in.
+#pragma once
+
+#include <cstdint>
+
+namespace mt {
+
+using idx = std::int64_t;
+
+/// A 1-D float64 array (or one row of a 2-D one).
+struct Vec {
+  double* d = nullptr;
+  idx n = 0;
+  double& operator[](idx i) const { return d[i]; }
+};
+
+/// A 2-D float64 array, row-major.
+struct Mat {
+  double* d = nullptr;
+  idx rows = 0;
+  idx cols = 0;
+  double& operator()(idx i, idx j) const { return d[i * cols + j]; }
+  Vec row(idx i) const { return Vec{d + i * cols, cols}; }
+};
+
+/// A 3-D float64 array (n, r, c), row-major: a stack of matrices.
+struct Mats {
+  double* d = nullptr;
+  idx n = 0;
+  idx rows = 0;
+  idx cols = 0;
+  double& operator()(idx i, idx r, idx c) const { return d[(i * rows + r) * cols + c]; }
+  Mat mat(idx i) const { return Mat{d + i * rows * cols, rows, cols}; }
+};
+
+/// A 1-D int64 array.
+struct IVec {
+  const idx* d = nullptr;
+  idx n = 0;
+  idx operator[](idx i) const { return d[i]; }
+};
+
+/// A 1-D bool array (numpy's one-byte bool).
+struct BVec {
+  const bool* d = nullptr;
+  idx n = 0;
+  bool operator[](idx i) const { return d[i]; }
+};
+
+}  // namespace mt

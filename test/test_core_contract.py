@@ -1,0 +1,82 @@
+"""The compiled core (src/core, `mount_twin._core`) and the Python side agree on every number
+they share, and the core refuses what does not fit instead of reading the wrong memory.
+
+The Python modules name the slots, codes and layouts (settings, statuses, method ids, pose
+rows, the error estimate's figures, the kinds); the core has its own copies as C++ constants.
+An edit on one side alone fails here, not as wrong physics.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+from io_helpers import default_scene
+
+from mount_twin import _core
+from mount_twin.engine import estimate, kernel
+from mount_twin.integrate import methods, settings
+from mount_twin.kinds import KINDS, N_EVENTS, N_PAR
+from mount_twin.model.assemble import assemble, initial_state
+from mount_twin.physics import dynamics, pose_row
+
+
+def test_the_settings_slots_are_the_cores() -> None:
+    names = ("STEP", "RTOL", "ATOL", "MAX_SUBSTEPS", "CHAINED", "MIN_STEPS", "JACOBIAN_AGE")
+    python = tuple(getattr(settings, n) for n in (*names, "PHI_STEP", "N_SETTINGS"))
+    assert python == _core.SETTING_SLOTS
+
+
+def test_the_statuses_and_method_ids_are_the_cores() -> None:
+    statuses = ("SUCCESS", "TOO_MANY_STEPS", "STEP_TOO_SMALL", "LEFT_CHART", "NOT_FINITE")
+    python = tuple(getattr(methods, n) for n in (*statuses, "UNKNOWN_METHOD"))
+    assert python == _core.STATUSES
+    assert tuple(m.id for m in methods.METHODS.values()) == _core.METHOD_IDS
+    assert (dynamics.OK, dynamics.OFF_CHART) == (0, 1)
+
+
+def test_the_layouts_are_the_cores() -> None:
+    assert (pose_row.POSITION, pose_row.QUATERNION, pose_row.ANGLES, pose_row.WIDTH) == (
+        _core.POSE_ROW
+    )
+    figures = ("FORCE_ERROR", "ATTITUDE_ERROR", "FORCE_SCALE", "FAILURES", "N_FIGURES")
+    assert tuple(getattr(estimate, n) for n in figures) == _core.FIGURE_SLOTS
+    assert (dynamics.INPUT_SIZE, kernel.AT_EVENT) == (13, -100)
+
+
+def test_the_kinds_are_the_cores() -> None:
+    assert tuple(_core.KIND_NAMES) == tuple(KINDS)
+    assert (_core.N_PAR, _core.N_EVENTS) == (N_PAR, N_EVENTS)
+
+
+@pytest.fixture(scope="module")
+def pump():
+    model = assemble(default_scene())
+    u = np.zeros(dynamics.INPUT_SIZE)
+    u[3] = 9.80665
+    return model, initial_state(model, u[1:4]), u
+
+
+def test_a_wrong_array_is_refused_naming_it(pump) -> None:
+    """dtype, length, dimensions and contiguity are checked at the call, by name."""
+    model, y, u = pump
+    s, dydt = model.new_scratch(), np.zeros_like(y)
+    assert dynamics.rhs(0.0, y, model.arrays, s, u, dydt) == dynamics.OK
+    with pytest.raises(TypeError, match=r"^u: dtype int32"):
+        dynamics.rhs(0.0, y, model.arrays, s, u.astype(np.int32), dydt)
+    with pytest.raises(ValueError, match=r"^dydt: length 3 where"):
+        dynamics.rhs(0.0, y, model.arrays, s, u, np.zeros(3))
+    with pytest.raises(ValueError, match=r"^y: array is not C-contiguous"):
+        dynamics.rhs(0.0, np.zeros(2 * y.size)[::2], model.arrays, s, u, dydt)
+    with pytest.raises(ValueError, match=r"^ModelArrays\.lin_k_t: shape"):
+        bad = model.arrays._replace(lin_k_t=model.arrays.lin_k_t[:1].copy())
+        dynamics.rhs(0.0, y, bad, s, u, dydt)
+    with pytest.raises(ValueError, match=r"rot: shape \(2, 3\)"):
+        dynamics.rhs(0.0, y, model.arrays, s._replace(rot=np.zeros((2, 3))), u, dydt)
+    with pytest.raises(ValueError, match=re.escape("y: length 3 is shorter than the model's")):
+        dynamics.rhs(0.0, np.zeros(3), model.arrays, s, u, np.zeros(3))
+    with pytest.raises(ValueError, match=r"^y: array is read-only"):
+        frozen = y.copy()
+        frozen.flags.writeable = False
+        dynamics.rhs(0.0, frozen, model.arrays, s, u, dydt)
