@@ -3,6 +3,7 @@ ament index marker, package.xml, config/, launch/ and bags/ under share/mount_tw
 `pip install` compile the C++17 core (src/core, pybind11) into mount_twin/_core: nothing
 compiles at run time. Needs a C++17 compiler (g++ ≥ 9 or clang ≥ 10) and Python's headers."""
 
+import importlib.util
 import os
 from concurrent.futures import ThreadPoolExecutor
 from glob import glob
@@ -11,6 +12,10 @@ from setuptools import Extension, find_packages, setup
 from setuptools.command.build_ext import build_ext
 
 PACKAGE = "mount_twin"
+_spec = importlib.util.spec_from_file_location("core_sources", f"{PACKAGE}/core_sources.py")
+core_sources = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(core_sources)
+"""mount_twin/core_sources.py, loaded by path (the package's own imports need numpy)."""
 CORE_SOURCES = sorted(["src/core/module.cpp", *glob("src/core/*/bind.cpp")])
 """The compiled core's translation units: the module and one binding file per area (each
 includes the header-only code it binds)."""
@@ -52,11 +57,13 @@ class ParallelBuildExt(build_ext):
 
 
 CORE = Extension(
-    f"{PACKAGE}._core",
+    f"{PACKAGE}._core_ext",
     sources=CORE_SOURCES,
     include_dirs=["src/core", pybind11_include()],
     depends=sorted(glob("src/core/**/*.hpp", recursive=True)),
     language="c++",
+    # the sources' fingerprint: `mount_twin._core` refuses a build older than src/core
+    define_macros=[("MT_SOURCE_SHA256", f'"{core_sources.fingerprint()}"')],
     # -O2 without -ffast-math and without fused multiply-adds: IEEE arithmetic in the order
     # written, the same bits on every machine; no -march: the wheel runs on any x86-64/arm64.
     extra_compile_args=[
@@ -75,7 +82,9 @@ setup(
     name=PACKAGE,
     version="0.1.0",
     packages=find_packages(include=[PACKAGE, f"{PACKAGE}.*"]),
-    package_data={PACKAGE: ["py.typed"]},  # PEP 561: the package ships its type hints
+    package_data={
+        PACKAGE: ["py.typed", "_core_ext.pyi"]
+    },  # PEP 561: its type hints, the core's too
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),

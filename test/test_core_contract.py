@@ -9,12 +9,14 @@ An edit on one side alone fails here, not as wrong physics.
 from __future__ import annotations
 
 import re
+import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
 from io_helpers import default_scene
 
-from mount_twin import _core
+from mount_twin import _core, core_sources
 from mount_twin.engine import estimate, kernel
 from mount_twin.integrate import methods, settings
 from mount_twin.kinds import KINDS, N_EVENTS, N_PAR
@@ -80,3 +82,33 @@ def test_a_wrong_array_is_refused_naming_it(pump) -> None:
         frozen = y.copy()
         frozen.flags.writeable = False
         dynamics.rhs(0.0, frozen, model.arrays, s, u, dydt)
+
+
+def test_the_core_was_built_from_the_sources_beside_it() -> None:
+    """The extension carries the fingerprint of src/core it was built from; `_core` imported."""
+    assert core_sources.fingerprint() == _core.SOURCE_SHA256
+
+
+def test_a_core_older_than_its_sources_is_refused_at_import(tmp_path: Path) -> None:
+    """An edit to any core source after the build makes the import fail and say how to
+    rebuild, instead of running the old core."""
+    copy = tmp_path / "core"
+    shutil.copytree(core_sources.SOURCE_DIR, copy)
+    built = core_sources.fingerprint(copy)
+    core_sources.check_fresh(built, copy)
+    header = copy / "physics" / "dynamics.hpp"
+    header.write_text(header.read_text().replace("1.0e-6", "1.0e-7"))
+    with pytest.raises(ImportError, match=r"built from other sources.*pip install -e \."):
+        core_sources.check_fresh(built, copy)
+    core_sources.check_fresh("anything", tmp_path / "no_sources_here")  # an installed copy
+
+
+def test_kinds_the_core_does_not_know_are_refused_by_name() -> None:
+    """A kind added to KINDS without its port (or ported in another order) fails the check
+    the package runs at import, naming both lists and what to do."""
+    from mount_twin.kinds import KindContractError, check_core
+
+    check_core(KINDS)
+    crossed = dict(reversed(KINDS.items()))
+    with pytest.raises(KindContractError, match=r"port the kind to src/core/kinds/"):
+        check_core(crossed)

@@ -17,7 +17,6 @@ from itertools import pairwise
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 
 if TYPE_CHECKING:  # only annotations: importing mount_twin.scene here is a cycle
     from mount_twin.scene.reader import Reader
@@ -223,6 +222,8 @@ def pack(e: Elastomer) -> np.ndarray:
         row[b + RATED] = e.rated_deflection[j]
         if axis in tables:
             xs, fs = tables[axis]
+            from scipy.interpolate import PchipInterpolator  # 0.5 s to import: on first use
+
             pchip = PchipInterpolator(np.array(xs), np.array(fs))
             n = len(xs)
             row[b + NTAB] = n

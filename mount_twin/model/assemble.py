@@ -5,7 +5,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from mount_twin.errors import ModelError
 from mount_twin.kinds import CODES, KINDS, N_PAR, check_dispatch
@@ -218,6 +217,8 @@ def static_equilibrium(
 
     found = newton.solve(accelerations, stiffness, q_guess, allowed_at)
     if found is None:  # Newton did not get there: the robust solver says why
+        from scipy.optimize import least_squares  # 0.2 s to import: only where Newton fails
+
         sol = least_squares(accelerations, q_guess, xtol=1e-15, ftol=1e-15, gtol=1e-15)
         found = sol.x, sol.fun, sol.jac
     q, residual, jac = found

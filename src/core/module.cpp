@@ -1,8 +1,9 @@
-// mount_twin._core: the compiled hot path (C++17), built ahead of time by setup.py.
+// mount_twin._core_ext: the compiled hot path (C++17), built ahead of time by setup.py, imported
+// through mount_twin/_core.py (which checks SOURCE_SHA256 against the sources beside it).
 #include "bind.hpp"
 #include "constants.hpp"
 
-PYBIND11_MODULE(_core, m) {
+PYBIND11_MODULE(_core_ext, m) {
   m.doc() = "mount_twin's compiled core: mount laws, equations of motion, steppers, the loop";
   m.attr("SETTING_SLOTS") = pybind11::make_tuple(
       int(mt::STEP), int(mt::RTOL), int(mt::ATOL), int(mt::MAX_SUBSTEPS), int(mt::CHAINED),
@@ -18,6 +19,7 @@ PYBIND11_MODULE(_core, m) {
                                                 int(mt::FORCE_SCALE), int(mt::FAILURES),
                                                 int(mt::N_FIGURES));
   m.attr("AT_EVENT") = mt::AT_EVENT;
+  m.attr("SOURCE_SHA256") = MT_SOURCE_SHA256;
   m.attr("INPUT_SIZE") = mt::INPUT_SIZE;
   mt::bind_kinds(m);
   mt::bind_physics(m);
