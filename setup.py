@@ -68,9 +68,10 @@ CORE = Extension(
     # written, the same bits on every machine; no -march: the wheel runs on any x86-64/arm64.
     extra_compile_args=[
         "-std=c++17",
-        "-O2",
+        "-O3",
         "-g0",
         "-ffp-contract=off",
+        "-fno-math-errno",
         "-fvisibility=hidden",
         "-Wall",
         "-Wextra",

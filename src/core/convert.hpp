@@ -72,6 +72,27 @@ inline Mats mats(py::handle obj, const char* what, idx n = -1, idx rows = -1, id
   return Mats{static_cast<double*>(a.mutable_data()), a.shape(0), a.shape(1), a.shape(2)};
 }
 
+/// A float64 (rows, C) array; rows ≥ 0 requires that many.
+template <idx C>
+inline MatC<C> matc(py::handle obj, const char* what, idx rows = -1) {
+  const Mat a = mat(obj, what, rows, C);
+  return MatC<C>{a.d, a.rows};
+}
+
+/// A float64 (n, R, C) array; n ≥ 0 requires that many.
+template <idx R, idx C>
+inline MatsRC<R, C> matsrc(py::handle obj, const char* what, idx n = -1) {
+  const Mats a = mats(obj, what, n, R, C);
+  return MatsRC<R, C>{a.d, a.n};
+}
+
+/// A float64 (n, rows, C) array; n, rows ≥ 0 require those.
+template <idx C>
+inline StackC<C> stackc(py::handle obj, const char* what, idx n = -1, idx rows = -1) {
+  const Mats a = mats(obj, what, n, rows, C);
+  return StackC<C>{a.d, a.n, a.rows};
+}
+
 /// An int64 1-D array; `n` ≥ 0 requires that length.
 inline IVec ivec(py::handle obj, const char* what, idx n = -1) {
   auto a = checked(obj, what, 'i', 8, 1);
@@ -99,8 +120,8 @@ inline NonLinear nonlinear(py::handle nl) {
   NonLinear v;
   v.kind = ivec(field(nl, "kind"), "NonLinearMounts.kind");
   v.k = v.kind.n;
-  v.point = mat(field(nl, "point"), "NonLinearMounts.point", v.k, 3);
-  v.axes = mats(field(nl, "axes"), "NonLinearMounts.axes", v.k, 3, 3);
+  v.point = matc<3>(field(nl, "point"), "NonLinearMounts.point", v.k);
+  v.axes = matsrc<3, 3>(field(nl, "axes"), "NonLinearMounts.axes", v.k);
   v.slot = ivec(field(nl, "slot"), "NonLinearMounts.slot", v.k);
   v.state = ivec(field(nl, "state"), "NonLinearMounts.state", v.k);
   v.par = mat(field(nl, "par"), "NonLinearMounts.par", v.k);
@@ -113,19 +134,19 @@ inline NonLinear nonlinear(py::handle nl) {
 inline Model model(py::handle m) {
   Model out;
   out.mass = field(m, "mass").cast<double>();
-  out.inertia = mat(field(m, "inertia"), "ModelArrays.inertia", 3, 3);
+  out.inertia = matc<3>(field(m, "inertia"), "ModelArrays.inertia", 3);
   out.cg_ref = vec(field(m, "cg_ref"), "ModelArrays.cg_ref", 3);
   out.sensor_position = vec(field(m, "sensor_position"), "ModelArrays.sensor_position", 3);
   out.free_trans = ivec(field(m, "free_trans"), "ModelArrays.free_trans");
   out.free_rot = ivec(field(m, "free_rot"), "ModelArrays.free_rot");
   out.q_fixed = vec(field(m, "q_fixed"), "ModelArrays.q_fixed", 6);
-  out.lin_point = mat(field(m, "lin_point"), "ModelArrays.lin_point", -1, 3);
+  out.lin_point = matc<3>(field(m, "lin_point"), "ModelArrays.lin_point");
   const idx n = out.lin_point.rows;
-  out.lin_axes = mats(field(m, "lin_axes"), "ModelArrays.lin_axes", n, 3, 3);
-  out.lin_k_t = mats(field(m, "lin_k_t"), "ModelArrays.lin_k_t", n, 3, 3);
-  out.lin_c_t = mats(field(m, "lin_c_t"), "ModelArrays.lin_c_t", n, 3, 3);
-  out.lin_k_r = mats(field(m, "lin_k_r"), "ModelArrays.lin_k_r", n, 3, 3);
-  out.lin_c_r = mats(field(m, "lin_c_r"), "ModelArrays.lin_c_r", n, 3, 3);
+  out.lin_axes = matsrc<3, 3>(field(m, "lin_axes"), "ModelArrays.lin_axes", n);
+  out.lin_k_t = matsrc<3, 3>(field(m, "lin_k_t"), "ModelArrays.lin_k_t", n);
+  out.lin_c_t = matsrc<3, 3>(field(m, "lin_c_t"), "ModelArrays.lin_c_t", n);
+  out.lin_k_r = matsrc<3, 3>(field(m, "lin_k_r"), "ModelArrays.lin_k_r", n);
+  out.lin_c_r = matsrc<3, 3>(field(m, "lin_c_r"), "ModelArrays.lin_c_r", n);
   out.lin_slot = ivec(field(m, "lin_slot"), "ModelArrays.lin_slot", n);
   auto nl = field(m, "nl");
   out.has_nl = !nl.is_none();
@@ -175,7 +196,7 @@ inline void check_scratch(const Scratch& s, idx n_state, const char* what) {
 inline Scratch scratch(py::handle s) {
   Scratch o;
   auto v3 = [&](const char* name) { return vec(field(s, name), name, 3); };
-  auto m33 = [&](const char* name) { return mat(field(s, name), name, 3, 3); };
+  auto m33 = [&](const char* name) { return matc<3>(field(s, name), name, 3); };
   o.q = vec(field(s, "q"), "Scratch.q", 6);
   o.trig = vec(field(s, "trig"), "Scratch.trig", 6);
   o.qd = vec(field(s, "qd"), "Scratch.qd", 6);
@@ -208,7 +229,7 @@ inline Scratch scratch(py::handle s) {
   o.mass_rot = m33("mass_rot");
   o.rhs_rot = v3("rhs_rot");
   o.rate_step = v3("rate_step");
-  o.loc = mat(field(s, "loc"), "Scratch.loc", 6, 3);
+  o.loc = matc<3>(field(s, "loc"), "Scratch.loc", 6);
   o.sink = vec(field(s, "sink"), "Scratch.sink");
   return o;
 }

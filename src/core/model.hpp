@@ -11,8 +11,8 @@ namespace mt {
 struct NonLinear {
   idx k = 0;
   IVec kind;        // (k,) kind code
-  Mat point;        // (k, 3) m, attachment point from the CG, in B
-  Mats axes;        // (k, 3, 3) mount axes Q (columns) in F
+  M3 point;         // (k, 3) m, attachment point from the CG, in B
+  M33s axes;        // (k, 3, 3) mount axes Q (columns) in F
   IVec slot;        // (k,) index in the scene
   IVec state;       // (k,) offset of the mount's internal states in y (−1: none)
   Mat par;          // (k, N_PAR) parameter rows
@@ -22,15 +22,15 @@ struct NonLinear {
 
 struct Model {
   double mass = 0.0;     // kg
-  Mat inertia;           // (3, 3) kg·m², about the CG, in B
+  M3 inertia;            // (3, 3) kg·m², about the CG, in B
   Vec cg_ref;            // (3,) m, in F
   Vec sensor_position;   // (3,) m, in F
   IVec free_trans;       // (nt,) free indices among X, Y, Z
   IVec free_rot;         // (nr,) free indices among α, γ, δ
   Vec q_fixed;           // (6,)
-  Mat lin_point;         // (n, 3) m, in B
-  Mats lin_axes;         // (n, 3, 3)
-  Mats lin_k_t, lin_c_t, lin_k_r, lin_c_r;  // (n, 3, 3) in F
+  M3 lin_point;          // (n, 3) m, in B
+  M33s lin_axes;         // (n, 3, 3)
+  M33s lin_k_t, lin_c_t, lin_k_r, lin_c_r;  // (n, 3, 3) in F
   IVec lin_slot;         // (n,)
   bool has_nl = false;   // NonLinearMounts present (None on the Python side: false)
   NonLinear nl;
@@ -40,14 +40,14 @@ struct Model {
 /// Work arrays (physics/dynamics.py Scratch says who fills what and who may read it).
 struct Scratch {
   Vec q, trig, qd;
-  Mat rot, kin, kin_rate;
+  M3 rot, kin, kin_rate;
   Vec omega, omega_f, phi, phi_rate;
-  Mat couple_map;
+  M3 couple_map;
   Vec quat, arm, force, couple, total_force, total_moment, f_s, big_w, big_w_dot, rel, w_x_rel,
       moment_b, w_b, w_dot_b, acc, w_abs, h, i_w;
-  Mat mass_rot;
+  M3 mass_rot;
   Vec rhs_rot, rate_step;
-  Mat loc;   // (6, 3)
+  M3 loc;    // (6, 3)
   Vec sink;  // (n_state,)
 };
 

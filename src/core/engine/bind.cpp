@@ -60,7 +60,7 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
   c.g = convert::mat(field(obj, "g"), "Companion.g", k, n_events);
   c.util = convert::vec(field(obj, "util"), "Companion.util", k);
   c.pose = convert::vec(field(obj, "pose"), "Companion.pose", pose_row::WIDTH);
-  c.wrenches = convert::mat(field(obj, "wrenches"), "Companion.wrenches", n_mounts, 6);
+  c.wrenches = convert::matc<6>(field(obj, "wrenches"), "Companion.wrenches", n_mounts);
   c.figures = convert::vec(field(obj, "figures"), "Companion.figures", N_FIGURES);
   convert::check_scratch(c.s, n_state, "Companion.s");
   return c;
@@ -86,8 +86,8 @@ void bind_engine(py::module_& mod) {
         engine::Samples smp;
         smp.t = convert::vec(field(samples_, "t"), "Samples.t");
         const idx n = smp.t.n;
-        smp.f = convert::mat(field(samples_, "f"), "Samples.f", n, 3);
-        smp.w = convert::mat(field(samples_, "w"), "Samples.w", n, 3);
+        smp.f = convert::matc<3>(field(samples_, "f"), "Samples.f", n);
+        smp.w = convert::matc<3>(field(samples_, "w"), "Samples.w", n);
         engine::RunOptions opts;
         opts.zero_order = field(opts_, "zero_order").cast<bool>();
         opts.decimation = field(opts_, "decimation").cast<idx>();
@@ -95,15 +95,14 @@ void bind_engine(py::module_& mod) {
         if (opts.decimation < 1) throw py::value_error("RunOptions.decimation: below 1");
         engine::Published out;
         out.counter = counter(field(out_, "counter"), "Published.counter");
-        out.peak = convert::mat(field(out_, "peak"), "Published.peak", n_mounts, 6);
-        out.pose = convert::mat(field(out_, "pose"), "Published.pose", -1, pose_row::WIDTH);
-        out.wrenches = convert::mats(field(out_, "wrenches"), "Published.wrenches", -1,
-                                     n_mounts, 6);
+        out.peak = convert::matc<6>(field(out_, "peak"), "Published.peak", n_mounts);
+        out.pose = convert::matc<pose_row::WIDTH>(field(out_, "pose"), "Published.pose");
+        out.wrenches = convert::stackc<6>(field(out_, "wrenches"), "Published.wrenches", -1, n_mounts);
         auto publish = convert::checked(field(out_, "publish"), "Published.publish", 'b', 1, 1);
         out.publish = static_cast<bool*>(publish.mutable_data());
         out.step_log = convert::mat(field(out_, "step_log"), "Published.step_log", -1, 3);
-        out.wrench_abs_max = convert::mat(field(out_, "wrench_abs_max"),
-                                          "Published.wrench_abs_max", n_mounts, 6);
+        out.wrench_abs_max =
+            convert::matc<6>(field(out_, "wrench_abs_max"), "Published.wrench_abs_max", n_mounts);
         out.cos_tilt_min = scalar(field(out_, "cos_tilt_min"), "Published.cos_tilt_min");
         if (out.pose.rows < n || out.wrenches.n < n || publish.shape(0) < n ||
             out.step_log.rows < n) {
@@ -139,7 +138,7 @@ void bind_engine(py::module_& mod) {
         const Vec y = convert::vec(y_, "y");
         convert::check_scratch(s, y.n, "s");
         engine::Watch w = watch(watch_, nl.k, y.n);
-        const Mat wrenches = convert::mat(wrenches_, "wrenches", -1, 6);
+        const M6 wrenches = convert::matc<6>(wrenches_, "wrenches");
         for (idx i = 0; i < nl.k; ++i) {
           if (nl.slot[i] >= wrenches.rows || nl.state[i] >= y.n) {
             throw py::value_error("wrenches or y: shorter than the mounts need");

@@ -38,8 +38,8 @@ struct Watch {
 /// The input of one run: row 0 is the last sample already done (engine/kernel.py Samples).
 struct Samples {
   Vec t;  // (n,) s
-  Mat f;  // (n, 3) specific force, m/s², F
-  Mat w;  // (n, 3) foundation Ω, rad/s, F
+  M3 f;  // (n, 3) specific force, m/s², F
+  M3 w;  // (n, 3) foundation Ω, rad/s, F
 };
 
 struct RunOptions {
@@ -51,12 +51,12 @@ struct RunOptions {
 /// What a run publishes and the decimation's carried state (engine/kernel.py Published).
 struct Published {
   idx* counter;
-  Mat peak;       // (nm, 6)
-  Mat pose;       // (n, WIDTH)
-  Mats wrenches;  // (n, nm, 6)
+  M6 peak;       // (nm, 6)
+  MatC<pose_row::WIDTH> pose;  // (n, WIDTH)
+  StackC<6> wrenches;  // (n, nm, 6)
   bool* publish;  // (n,)
   Mat step_log;   // (n, 3)
-  Mat wrench_abs_max;  // (nm, 6)
+  M6 wrench_abs_max;  // (nm, 6)
   double* cos_tilt_min;  // (1,)
 };
 
@@ -69,7 +69,7 @@ struct Companion {
   Mat g;
   Vec util;
   Vec pose;
-  Mat wrenches;
+  M6 wrenches;
   Vec figures;  // (N_FIGURES,)
 };
 
@@ -85,7 +85,7 @@ inline void monitor_switches(Vec y, const NonLinear& nl, Vec y_prev, Scratch& s,
 /// `monitor_switches` at t1, then log each upward zero crossing of an event function since t0
 /// (located by linear interpolation).
 inline void watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, double t0, double t1,
-                         Mat wrenches, Vec settings) {
+                         M6 wrenches, Vec settings) {
   monitor_switches(y, nl, w.y_prev, s, w.g, w.util, settings);
   for (idx i = 0; i < w.g.rows; ++i) {
     w.util_peak[i] = py_max(w.util_peak[i], w.util[i]);
@@ -112,7 +112,7 @@ inline void watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, doubl
 /// Advance the companion over [t0, t1] under the input u the twin just took, and fold the
 /// differences of its outputs from the twin's (pose, wrenches at t1; y the twin's state).
 inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
-                   Vec d_wdot, Vec pose, Mat wrenches, Vec y) {
+                   Vec d_wdot, Vec pose, M6 wrenches, Vec y) {
   const Vec settings = c.integ.settings, figures = c.figures;
   if (chain && settings[CHAINED] == 1.0) {
     physics::rhs_after_rate_step(m, c.s, d_wdot, c.integ.work2d.row(0));
@@ -187,7 +187,7 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
     if (status != 0) return {j - 1, status};
     const idx stiffening = *watch.n_stiffening;
     for (int k = 0; k < 3; ++k) out.step_log(j, k) = integ.result[k];
-    const Mat wrenches_j = out.wrenches.mat(j);
+    const M6 wrenches_j = out.wrenches.mat(j);
     physics::outputs(y, m, s, out.pose.row(j), wrenches_j);
     if (m.has_nl) {
       watch_mounts(y, m.nl, s, watch, smp.t[j - 1], smp.t[j], wrenches_j, settings);

@@ -27,9 +27,9 @@ Call call(py::handle m_, py::handle s_, py::handle y_, const char* what = "y") {
 }
 
 /// The wrenches array of a model: one (6,) row per mount.
-Mat wrench_rows(const Model& m, py::handle w) {
+M6 wrench_rows(const Model& m, py::handle w) {
   const idx rows = m.lin_point.rows + (m.has_nl ? m.nl.k : 0);
-  return convert::mat(w, "wrenches", rows, 6);
+  return convert::matc<6>(w, "wrenches", rows);
 }
 
 }  // namespace

@@ -11,7 +11,7 @@ namespace mt::physics {
 /// Write R into `out` (3×3) from sin α, sin γ, cos γ, sin δ, cos δ; return cos θ (NaN off the
 /// chart, `out` untouched).
 inline double rotation_from_chart(double sa, double sg, double cg, double sd, double cd,
-                                  Mat out) {
+                                  M3 out) {
   const double c2 = cg * cg - sa * sa;
   if (!(c2 > 0.0 && cg > 0.0)) return NAN;
   const double ct = std::sqrt(c2);
@@ -29,7 +29,7 @@ inline double rotation_from_chart(double sa, double sg, double cg, double sd, do
 }
 
 /// B with ω = B·[α', γ', δ'].
-inline void kinematic_matrix(double sa, double ca, double sg, double cg, double ct, Mat out) {
+inline void kinematic_matrix(double sa, double ca, double sg, double cg, double ct, M3 out) {
   out(0, 0) = ca / ct;
   out(0, 1) = sa * sg / (cg * ct);
   out(0, 2) = sg;
@@ -43,7 +43,7 @@ inline void kinematic_matrix(double sa, double ca, double sg, double cg, double 
 
 /// dB/dt along the motion, 1/s.
 inline void kinematic_matrix_rate(double sa, double ca, double sg, double cg, double ct,
-                                  double alpha_dot, double gamma_dot, Mat out) {
+                                  double alpha_dot, double gamma_dot, M3 out) {
   const double ct_dot = -(alpha_dot * sa * ca + gamma_dot * sg * cg) / ct;
   const double sa_dot = ca * alpha_dot, sg_dot = cg * gamma_dot;
   const double ca_dot = -sa * alpha_dot, cg_dot = -sg * gamma_dot;

@@ -22,7 +22,7 @@ constexpr double COS_TILT_MIN = 1.0e-6;
 /// s.couple_map where m.rotation_read, else NaN) from y; returns cos θ (NaN off the chart).
 inline double body_motion(Vec y, const Model& m, Scratch& s) {
   const Vec q = s.q, qd = s.qd, trig = s.trig, omega = s.omega, omega_f = s.omega_f;
-  const Mat rot = s.rot, kin = s.kin;
+  const M3 rot = s.rot, kin = s.kin;
   const idx nt = m.free_trans.n, nr = m.free_rot.n, nf = nt + nr;
   for (int i = 0; i < 6; ++i) {
     q[i] = m.q_fixed[i];
@@ -50,7 +50,7 @@ inline double body_motion(Vec y, const Model& m, Scratch& s) {
     omega_f[i] = rot(i, 0) * omega[0] + rot(i, 1) * omega[1] + rot(i, 2) * omega[2];
   }
   const Vec phi = s.phi, phi_rate = s.phi_rate;
-  const Mat cmap = s.couple_map;
+  const M3 cmap = s.couple_map;
   if (m.rotation_read) {
     rotation_vector(rot, s.quat, phi);
     couple_map(phi, s.quat, cmap);
@@ -99,7 +99,7 @@ inline void out_of_axes(const NonLinear& nl, idx i, const double* local, double*
 inline void local_motion(idx i, const NonLinear& nl, Scratch& s) {
   double de[6];
   point_motion(&nl.point(i, 0), s.rot, s.q, s.qd, s.omega_f, s.arm, de);
-  const Mat loc = s.loc;
+  const M3 loc = s.loc;
   into_axes(nl, i, de[0], de[1], de[2], loc.row(0).d);
   into_axes(nl, i, de[3], de[4], de[5], loc.row(1).d);
   if (nl.rotational[i]) {
@@ -116,14 +116,14 @@ inline void local_motion(idx i, const NonLinear& nl, Scratch& s) {
 /// Load of non-linear mount i in its axes into s.loc rows 4, 5; its state rates into dydt.
 inline void nl_load(idx i, Vec y, const NonLinear& nl, Scratch& s, Vec dydt) {
   local_motion(i, nl, s);
-  const Mat loc = s.loc;
+  const M3 loc = s.loc;
   kinds::kind_load(nl.kind[i], &nl.par(i, 0), y, nl.state[i], loc.row(0).d, loc.row(1).d,
                    loc.row(2).d, loc.row(3).d, dydt, loc.row(4).d, loc.row(5).d);
 }
 
 /// c = J(φ)⁻ᵀ·Qᵢ·s.loc[5]: the couple on the body (F) of mount i's generalized force.
 inline void nl_couple(idx i, const NonLinear& nl, Scratch& s, Vec c) {
-  const Mat cmap = s.couple_map;
+  const M3 cmap = s.couple_map;
   out_of_axes(nl, i, s.loc.row(5).d, c.d);
   const double c0 = c[0], c1 = c[1], c2 = c[2];
   for (int j = 0; j < 3; ++j) c[j] = cmap(j, 0) * c0 + cmap(j, 1) * c1 + cmap(j, 2) * c2;
@@ -168,12 +168,12 @@ inline void mount_loads(Vec y, const Model& m, Scratch& s, Vec dydt) {
 }
 
 /// Each mount's force (N) and own couple (N·m) on the body, in its axes: wrenches row slot.
-inline void mount_wrenches(Vec y, const Model& m, Scratch& s, Mat wrenches) {
+inline void mount_wrenches(Vec y, const Model& m, Scratch& s, M6 wrenches) {
   const Vec arm = s.arm, f = s.force, c = s.couple;
   for (idx i = 0; i < m.lin_point.rows; ++i) {
     linear_mount_load(i, m, s, arm, f, c);
     const idx row = m.lin_slot[i];
-    const Mats& axes = m.lin_axes;
+    const M33s& axes = m.lin_axes;
     for (int j = 0; j < 3; ++j) {
       wrenches(row, j) = axes(i, 0, j) * f[0] + axes(i, 1, j) * f[1] + axes(i, 2, j) * f[2];
       wrenches(row, 3 + j) = axes(i, 0, j) * c[0] + axes(i, 1, j) * c[1] + axes(i, 2, j) * c[2];
@@ -181,7 +181,7 @@ inline void mount_wrenches(Vec y, const Model& m, Scratch& s, Mat wrenches) {
   }
   if (!m.has_nl) return;
   const NonLinear& nl = m.nl;
-  const Mat loc = s.loc;
+  const M3 loc = s.loc;
   for (idx i = 0; i < nl.k; ++i) {
     nl_load(i, y, nl, s, s.sink);
     if (nl.rotational[i]) {
@@ -199,7 +199,7 @@ inline void mount_wrenches(Vec y, const Model& m, Scratch& s, Mat wrenches) {
 /// Event functions g (k, NE) and utilisation util (k) of each non-linear mount at y (its body
 /// motion computed); then their discrete switches. Returns whether one switched (y jumped).
 inline bool mount_monitors(Vec y, Vec y0, const NonLinear& nl, Scratch& s, Mat g, Vec util) {
-  const Mat loc = s.loc;
+  const M3 loc = s.loc;
   bool switched = false;
   for (idx i = 0; i < nl.k; ++i) {
     local_motion(i, nl, s);
@@ -232,7 +232,7 @@ inline void translational(const Model& m, Scratch& s, Vec dydt, idx nf) {
 }
 
 /// Solve L Lᵀ x = b[:n] in place, L the lower triangle of low.
-inline void cholesky_solve(Mat low, Vec b, idx n) {
+inline void cholesky_solve(M3 low, Vec b, idx n) {
   for (idx i = 0; i < n; ++i) {
     double e = b[i];
     for (idx k = 0; k < i; ++k) e -= low(i, k) * b[k];
@@ -247,7 +247,7 @@ inline void cholesky_solve(Mat low, Vec b, idx n) {
 
 /// Solve a[:n, :n] x = b[:n] in place by Cholesky (a keeps its factor); false if a is not
 /// positive definite.
-inline bool solve_spd(Mat a, Vec b, idx n) {
+inline bool solve_spd(M3 a, Vec b, idx n) {
   for (idx j = 0; j < n; ++j) {
     double d = a(j, j);
     for (idx k = 0; k < j; ++k) d -= a(j, k) * a(j, k);
@@ -267,7 +267,7 @@ inline bool solve_spd(Mat a, Vec b, idx n) {
 /// Free rotational accelerations (projected Euler equations) into dydt[first:first + nr];
 /// false if the reduced mass matrix is numerically singular.
 inline bool rotational(const Model& m, Scratch& s, double ct, Vec dydt, idx first) {
-  const Mat rot = s.rot, kin = s.kin, kin_rate = s.kin_rate, inertia = m.inertia,
+  const M3 rot = s.rot, kin = s.kin, kin_rate = s.kin_rate, inertia = m.inertia,
             mass_rot = s.mass_rot;
   const Vec qd = s.qd, omega = s.omega, trig = s.trig, w = s.big_w, w_dot = s.big_w_dot,
             total_m = s.total_moment, moment_b = s.moment_b, w_b = s.w_b,
@@ -328,7 +328,7 @@ inline int rhs(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt) {
 
 /// Outputs when s already holds the body motion at y (the last rhs was at y): the pose row
 /// (physics/pose_row.py) and each mount's wrench in its axes.
-inline void outputs(Vec y, const Model& m, Scratch& s, Vec pose, Mat wrenches) {
+inline void outputs(Vec y, const Model& m, Scratch& s, Vec pose, M6 wrenches) {
   mount_wrenches(y, m, s, wrenches);
   if (!m.rotation_read) quaternion_from_matrix(s.rot, s.quat);
   for (int i = 0; i < 3; ++i) {
@@ -339,7 +339,7 @@ inline void outputs(Vec y, const Model& m, Scratch& s, Vec pose, Mat wrenches) {
 }
 
 /// Outputs at state y; returns cos θ (NaN off the chart, outputs then untouched).
-inline double evaluate(Vec y, const Model& m, Scratch& s, Vec pose, Mat wrenches) {
+inline double evaluate(Vec y, const Model& m, Scratch& s, Vec pose, M6 wrenches) {
   const double ct = body_motion(y, m, s);
   if (!(ct > 0.0)) return NAN;
   outputs(y, m, s, pose, wrenches);
@@ -352,7 +352,7 @@ inline void rhs_after_rate_step(const Model& m, Scratch& s, Vec d_wdot, Vec dydt
   const idx nt = m.free_trans.n, nr = m.free_rot.n, nf = nt + nr;
   for (idx k = 0; k < nt; ++k) dydt[nf + k] -= cross(d_wdot, s.rel, m.free_trans[k]);
   if (nr == 0) return;
-  const Mat rot = s.rot, kin = s.kin, inertia = m.inertia;
+  const M3 rot = s.rot, kin = s.kin, inertia = m.inertia;
   const Vec b = s.rhs_rot, dw_b = s.w_dot_b, h = s.h;
   for (int i = 0; i < 3; ++i) {
     dw_b[i] = rot(0, i) * d_wdot[0] + rot(1, i) * d_wdot[1] + rot(2, i) * d_wdot[2];

@@ -17,7 +17,7 @@ namespace mt::physics {
 
 /// Displacement d (m) and velocity ḋ (m/s) in F of body point `point` from its reference
 /// position into de[0..2], de[3..5]; the lever arm R·p (m, F) into `arm`.
-inline void point_motion(const double* point, Mat rot, Vec q, Vec qd, Vec omega_f, Vec arm,
+inline void point_motion(const double* point, M3 rot, Vec q, Vec qd, Vec omega_f, Vec arm,
                          double* de) {
   for (int j = 0; j < 3; ++j) {
     arm[j] = rot(j, 0) * point[0] + rot(j, 1) * point[1] + rot(j, 2) * point[2];
@@ -36,7 +36,7 @@ inline void linear_mount_load(idx i, const Model& m, const Scratch& s, Vec arm, 
                               Vec couple) {
   double de[6];
   point_motion(&m.lin_point(i, 0), s.rot, s.q, s.qd, s.omega_f, arm, de);
-  const Mats &k_t = m.lin_k_t, &c_t = m.lin_c_t, &k_r = m.lin_k_r, &c_r = m.lin_c_r;
+  const M33s &k_t = m.lin_k_t, &c_t = m.lin_c_t, &k_r = m.lin_k_r, &c_r = m.lin_c_r;
   for (int j = 0; j < 3; ++j) {
     force[j] = -(k_t(i, j, 0) * de[0] + k_t(i, j, 1) * de[1] + k_t(i, j, 2) * de[2] +
                  c_t(i, j, 0) * de[3] + c_t(i, j, 1) * de[4] + c_t(i, j, 2) * de[5]);
@@ -47,7 +47,7 @@ inline void linear_mount_load(idx i, const Model& m, const Scratch& s, Vec arm, 
     g[j] = k_r(i, j, 0) * phi[0] + k_r(i, j, 1) * phi[1] + k_r(i, j, 2) * phi[2] +
            c_r(i, j, 0) * rate[0] + c_r(i, j, 1) * rate[1] + c_r(i, j, 2) * rate[2];
   }
-  const Mat cmap = s.couple_map;
+  const M3 cmap = s.couple_map;
   for (int j = 0; j < 3; ++j) {
     couple[j] = -(cmap(j, 0) * g[0] + cmap(j, 1) * g[1] + cmap(j, 2) * g[2]);
   }

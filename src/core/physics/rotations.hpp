@@ -10,7 +10,7 @@
 namespace mt::physics {
 
 /// Unit quaternion (x, y, z, w), w ≥ 0, of a rotation matrix (Shepperd's method).
-inline void quaternion_from_matrix(Mat rot, Vec out) {
+inline void quaternion_from_matrix(M3 rot, Vec out) {
   const double tr = rot(0, 0) + rot(1, 1) + rot(2, 2);
   if (tr > py_max(py_max(rot(0, 0), rot(1, 1)), rot(2, 2))) {
     const double s = 2.0 * std::sqrt(1.0 + tr);
@@ -43,7 +43,7 @@ inline void quaternion_from_matrix(Mat rot, Vec out) {
 }
 
 /// Rotation vector (axis × angle, rad) of `rot`; `quat` (4) receives its quaternion.
-inline void rotation_vector(Mat rot, Vec quat, Vec out) {
+inline void rotation_vector(M3 rot, Vec quat, Vec out) {
   quaternion_from_matrix(rot, quat);
   const double sin_half = std::sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2]);
   const double scale = sin_half > 1e-12 ? 2.0 * std::atan2(sin_half, quat[3]) / sin_half : 2.0;
@@ -51,7 +51,7 @@ inline void rotation_vector(Mat rot, Vec quat, Vec out) {
 }
 
 /// J(φ)⁻ᵀ of the rotation vector φ whose quaternion is `quat` (as rotation_vector left it).
-inline void couple_map(Vec phi, Vec quat, Mat out) {
+inline void couple_map(Vec phi, Vec quat, M3 out) {
   const double angle_sq = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2];
   double c;
   if (angle_sq < 1e-4) {
