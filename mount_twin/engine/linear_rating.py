@@ -61,9 +61,15 @@ class LinearRatings:
             return np.zeros(len(self.slots))
         rot = matrices_from_quaternions(pose[:, pose_row.QUATERNION_COLS])
         q = pose[:, pose_row.POSITION_COLS] - self._cg
-        # d = q + R·p − p in F, then along the mount axes: Qᵀ·d.
-        moved = np.einsum("rij,kj->rki", rot, self._point) - self._point + q[:, None, :]
-        travel = np.einsum("kji,rkj->rki", self._axes, moved)
+        # d = q + R·p − p in F, then along the mount axes: Qᵀ·d (as matrix products: einsum
+        # took a quarter of the pump's engine time).
+        moved = np.matmul(rot, self._point.T).transpose(0, 2, 1) - self._point + q[:, None, :]
+        axes = self._axes
+        travel = (
+            moved[:, :, 0, None] * axes[:, 0, :]
+            + moved[:, :, 1, None] * axes[:, 1, :]
+            + moved[:, :, 2, None] * axes[:, 2, :]
+        )
         force = wrenches[:, self.slots, :3]
         util = np.maximum(np.abs(travel) * self._per_travel, np.abs(force) * self._per_load).max(
             axis=2
