@@ -8,6 +8,7 @@ An edit on one side alone fails here, not as wrong physics.
 
 from __future__ import annotations
 
+import importlib
 import re
 import shutil
 from pathlib import Path
@@ -112,3 +113,19 @@ def test_kinds_the_core_does_not_know_are_refused_by_name() -> None:
     crossed = dict(reversed(KINDS.items()))
     with pytest.raises(KindContractError, match=r"port the kind to src/core/kinds/"):
         check_core(crossed)
+
+
+@pytest.mark.parametrize("name", list(methods.METHODS))
+def test_each_methods_tables_are_the_cores(name: str) -> None:
+    """The coefficient tables and constants the core steps with are its Python module's (the
+    ones the order-condition tests check), value for value; and its work rows per state count."""
+    module = importlib.import_module(methods.METHODS[name].module)
+    core = _core.method_tables()[name]
+    assert {"ORDER", "MAX_FACTOR"} <= set(core)
+    for key, value in core.items():
+        mine = np.asarray(getattr(module, key))
+        np.testing.assert_array_equal(np.asarray(value), mine, err_msg=f"{name}.{key}")
+    spec = methods.METHODS[name]
+    for n in (1, 6, 24):
+        assert _core.work_rows(spec.id, n) == spec.work_rows(n)
+    assert _core.work_rows(max(_core.METHOD_IDS) + 1, 6) == -1

@@ -3,6 +3,7 @@
 // phi.py and each method's module re-export them with their Python signatures). Every array is
 // checked here (dtype, contiguity, length, the work array's rows for the method), so the
 // header-only steppers never see a short array.
+#include <cstddef>
 #include <string>
 
 #include "../bind.hpp"
@@ -96,6 +97,56 @@ void def_method_advance(py::module_& mod, const char* name, const char* doc) {
       py::arg("s"), py::arg("u"), py::arg("k"), py::arg("y_new"), py::arg("result"));
 }
 
+template <std::size_t N>
+py::tuple row(const double (&v)[N]) {
+  py::tuple t(N);
+  for (std::size_t i = 0; i < N; ++i) t[i] = v[i];
+  return t;
+}
+
+template <std::size_t R, std::size_t C>
+py::tuple rows(const double (&v)[R][C]) {
+  py::tuple t(R);
+  for (std::size_t i = 0; i < R; ++i) t[i] = row(v[i]);
+  return t;
+}
+
+/// Each method's tables and constants as the core has them, by the names its Python module
+/// uses (test/test_core_contract.py holds them equal to the module's).
+py::dict method_tables() {
+  py::dict dopri, ros, exp, control;
+  dopri["C"] = row(integrate::dopri54::C);
+  dopri["A"] = rows(integrate::dopri54::A);
+  dopri["E"] = row(integrate::dopri54::E);
+  dopri["FSAL"] = integrate::dopri54::FSAL;
+  dopri["ORDER"] = integrate::dopri54::ORDER;
+  dopri["MAX_FACTOR"] = integrate::dopri54::MAX_FACTOR;
+  ros["GAMMA"] = integrate::ros34pw2::GAMMA;
+  ros["ALPHA"] = rows(integrate::ros34pw2::ALPHA);
+  ros["GAMMAS"] = rows(integrate::ros34pw2::GAMMAS);
+  ros["B"] = row(integrate::ros34pw2::B);
+  ros["B_HAT"] = row(integrate::ros34pw2::B_HAT);
+  ros["C"] = row(integrate::ros34pw2::C);
+  ros["D"] = row(integrate::ros34pw2::D);
+  ros["ORDER"] = integrate::ros34pw2::ORDER;
+  ros["STAGES"] = integrate::ros34pw2::STAGES;
+  ros["MAX_FACTOR"] = integrate::ros34pw2::MAX_FACTOR;
+  ros["JACOBIAN_MAX_AGE"] = integrate::ros34pw2::JACOBIAN_MAX_AGE;
+  ros["J0"] = integrate::ros34pw2::J0;
+  exp["ORDER"] = integrate::exprb32::ORDER;
+  exp["MAX_FACTOR"] = integrate::exprb32::MAX_FACTOR;
+  exp["JACOBIAN_MAX_AGE"] = integrate::exprb32::JACOBIAN_MAX_AGE;
+  exp["PHI_REUSE"] = integrate::exprb32::PHI_REUSE;
+  exp["TYPICAL"] = integrate::exprb32::TYPICAL;
+  exp["J0"] = integrate::exprb32::J0;
+  exp["BLOCKS"] = integrate::exprb32::BLOCKS;
+  py::dict out;
+  out["dopri54"] = dopri;
+  out["ros34pw2"] = ros;
+  out["exprb32"] = exp;
+  return out;
+}
+
 }  // namespace integrate_binding
 
 void bind_integrate(py::module_& mod) {
@@ -134,6 +185,14 @@ void bind_integrate(py::module_& mod) {
       "Exponential Rosenbrock EXPRB32 across one input interval: `advance` without the method "
       "id (k: (6 + 8n, n): f0, ∂f/∂t, scratch, U, D, balancing, then J, φ1..φ3 and four work "
       "blocks; t0, t1 in s).");
+  mod.def("method_tables", &method_tables,
+          "Each method's tables and constants as the core has them: {method: {name: value}}, "
+          "by the names of its Python module.");
+  mod.def(
+      "work_rows",
+      [](int method, idx n) { return integrate::work_rows(method, n); },
+      "Rows of a method's work array for n states (−1 for an unknown id).", py::arg("method"),
+      py::arg("n"));
   mod.def(
       "forget",
       [](py::handle settings_) {
