@@ -83,9 +83,8 @@ setup(
     name=PACKAGE,
     version="0.1.0",
     packages=find_packages(include=[PACKAGE, f"{PACKAGE}.*"]),
-    package_data={
-        PACKAGE: ["py.typed", "_core_ext.pyi"]
-    },  # PEP 561: its type hints, the core's too
+    # PEP 561: the package ships its type hints, the compiled core's stubs among them
+    package_data={PACKAGE: ["py.typed", "_core_ext.pyi"]},
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),

@@ -81,9 +81,11 @@ def test_a_lazy_name_is_imported_on_first_use_and_replay_bag_is_the_function() -
     assert done.returncode == 0, done.stderr
 
 
-def test_the_package_ships_py_typed() -> None:
-    assert (Path(mount_twin.__file__).parent / "py.typed").is_file()
-    assert 'package_data={PACKAGE: ["py.typed"]}' in (ROOT / "setup.py").read_text("utf-8")
+def test_the_package_ships_py_typed_and_the_cores_stubs() -> None:
+    package = Path(mount_twin.__file__).parent
+    assert (package / "py.typed").is_file() and (package / "_core_ext.pyi").is_file()
+    setup = (ROOT / "setup.py").read_text("utf-8")
+    assert 'package_data={PACKAGE: ["py.typed", "_core_ext.pyi"]}' in setup
 
 
 def test_the_usage_example_runs_and_the_mounts_carry_the_body(
