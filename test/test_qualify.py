@@ -59,8 +59,12 @@ def test_qualify_judges_the_worst_over_the_inputs(
         # the worst force is the larger of the two output bags' own, read back
         worst = max(_largest_force(out / f"output_seed_{s}", name) for s in runs)
         assert m["force_max_N"] == pytest.approx(worst, rel=1e-9)
+        # and the seed it names is the input whose output bag holds it
+        own = _largest_force(out / f"output_seed_{m['force_max_seed']}", name)
+        assert own == pytest.approx(worst, rel=1e-9)
         if m["utilisation_max"] is not None:
             assert m["margin"] == pytest.approx(1.0 - m["utilisation_max"])
+            assert m["utilisation_max_seed"] in runs
     utilisation = [m["utilisation_max"] for m in result["mounts"].values()]
     assert (max(u for u in utilisation if u is not None) > 1.0) == (verdict == "FAIL")
     assert 0.0 <= result["estimated_force_error_rel"] < 0.1

@@ -86,7 +86,8 @@ class DesignCheck:
         if not n:
             return f"{head}: FAIL (no frequency in the design's range)"
         where = "; ".join(
-            f"{kind} by {abs(worst):.2f} dB at {f0:.4g}–{f1:.4g} Hz"
+            f"{kind} by {abs(worst):.2f} dB at "
+            + (f"{f0:.4g} Hz" if f0 == f1 else f"{f0:.4g}–{f1:.4g} Hz")
             for f0, f1, kind, worst in self.bands()
         )
         return f"{head}: FAIL: {where}"

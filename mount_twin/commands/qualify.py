@@ -79,13 +79,20 @@ def judge(runs: list[tuple[int, ReplaySummary]]) -> dict[str, Any]:
     for seed, s in runs:
         for name, peak in s.peaks.items():
             m = mounts.setdefault(
-                name, {"force_max_N": 0.0, "utilisation_max": None, "events": {}, "seed": seed}
+                name,
+                {
+                    "force_max_N": 0.0,
+                    "force_max_seed": seed,
+                    "utilisation_max": None,
+                    "utilisation_max_seed": None,
+                    "events": {},
+                },
             )
             if float(peak[0]) > m["force_max_N"]:
-                m["force_max_N"], m["seed"] = float(peak[0]), seed
+                m["force_max_N"], m["force_max_seed"] = float(peak[0]), seed
             u = s.utilisation_max.get(name)
-            if u is not None:
-                m["utilisation_max"] = max(u, m["utilisation_max"] or 0.0)
+            if u is not None and (m["utilisation_max"] is None or u > m["utilisation_max"]):
+                m["utilisation_max"], m["utilisation_max_seed"] = u, seed
         for e in s.events:
             key = f"{e.event} ({e.level})"
             events = mounts.setdefault(e.mount, {"events": {}})["events"]
