@@ -33,7 +33,7 @@ from mount_twin.engine.health import INTEGRATION
 from mount_twin.errors import ModelError
 from mount_twin.io.messages import WRENCH
 from mount_twin.io.output_tables import COLUMNS, Table, events_of, read_output_bag
-from mount_twin.scene.description import Scene
+from mount_twin.scene.description import STANDARD_GRAVITY, Scene
 from mount_twin.scene.params import effective_parameters, parameter_description
 
 WINDOW_S = 0.05
@@ -186,7 +186,9 @@ def _srs_section(stamps_ns: np.ndarray, f: np.ndarray) -> list[str]:
         ax = fig.subplots()
         for axis, s in spectra.items():
             if s.maximax.max() > 0.0:
-                ax.loglog(s.frequency_hz, s.maximax / 9.80665, label=f"maximax, {axis} of F")
+                ax.loglog(
+                    s.frequency_hz, s.maximax / STANDARD_GRAVITY, label=f"maximax, {axis} of F"
+                )
         ax.set_xlabel("natural frequency [Hz]")
         ax.set_ylabel("peak absolute acceleration [g]")
         ax.grid(True, which="both", alpha=0.3)
@@ -196,7 +198,7 @@ def _srs_section(stamps_ns: np.ndarray, f: np.ndarray) -> list[str]:
     rows = [
         [
             f"{fk:.4g}",
-            *(f"{spectra[a].maximax[k] / 9.80665:.4g}" for a in "xyz"),
+            *(f"{spectra[a].maximax[k] / STANDARD_GRAVITY:.4g}" for a in "xyz"),
             f"{z.pseudo_velocity[k]:.4g}",
         ]
         for k, fk in enumerate(freqs)
@@ -275,7 +277,7 @@ def write_report(
             stamps, f = input_samples
             t = (stamps - origin) * 1e-9
             for i, axis in enumerate("xyz"):
-                axes[0].plot(t, f[:, i] / 9.80665, label=f"{axis} of F")
+                axes[0].plot(t, f[:, i] / STANDARD_GRAVITY, label=f"{axis} of F")
             axes[0].set_ylabel("foundation specific force [g]")
             axes[0].set_title(f"input {input_name}", fontsize=9)
             k = 1

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from mount_twin.io.epoch import DEFAULT_START_NS
+
 NAME = "generate"
 HELP = "write a bag of a generated foundation motion"
 
@@ -42,9 +44,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=0.0,
         help="share of the vertical half-sine(s) also applied along +y of F (athwartships)",
     )
-    parser.add_argument(
-        "--start", type=int, default=1_700_000_000_000_000_000, help="first stamp, ns"
-    )
+    parser.add_argument("--start", type=int, default=DEFAULT_START_NS, help="first stamp, ns")
     parser.add_argument(
         "--storage", choices=["mcap", "sqlite3"], default="mcap", help="bag storage format"
     )

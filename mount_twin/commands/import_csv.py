@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from mount_twin.io.epoch import DEFAULT_START_NS
+
 NAME = "import-csv"
 HELP = "a recorder's CSV (time, acceleration, optional gyro; units, ; and decimal comma) → Imu bag"
 
@@ -18,7 +20,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--offset",
         type=int,
-        default=1_700_000_000_000_000_000,
+        default=DEFAULT_START_NS,
         help="added to t·1e9 for the header stamp, ns (a stamp of 0 means unset in ROS)",
     )
     parser.add_argument("--delimiter", help="between cells (default: sniffed from the header)")

@@ -17,6 +17,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from mount_twin.commands.synthesize import add_synthesis_arguments
+from mount_twin.io.epoch import DEFAULT_START_NS
 
 if TYPE_CHECKING:
     from mount_twin.replay import ReplaySummary
@@ -57,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
     for seed, shock, sig in synthesized(args):
         out.mkdir(parents=True, exist_ok=True)
         bag_in, bag_out = out / f"input_seed_{seed}", out / f"output_seed_{seed}"
-        write_signal(sig, str(bag_in), scene.input.topic, frame_id, 1_700_000_000 * 10**9, "mcap")
+        write_signal(sig, str(bag_in), scene.input.topic, frame_id, DEFAULT_START_NS, "mcap")
         print(f"seed {seed}: {describe(shock, args)}")
         summary = replay(scene, bag_in, bag_out, progress=False)
         why = f" ({summary.failure})" if summary.failure else ""

@@ -8,6 +8,7 @@ from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 from mount_twin.commands.srs import TOLERANCE_DB
+from mount_twin.io.epoch import DEFAULT_START_NS
 
 if TYPE_CHECKING:
     from mount_twin.analysis.synthesis import Synthesis
@@ -22,9 +23,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_synthesis_arguments(parser)
     parser.add_argument("--topic", default="/deck/imu", help="(the bundled scenes' input)")
     parser.add_argument("--frame-id", default="deck_imu", help="header.frame_id")
-    parser.add_argument(
-        "--start", type=int, default=1_700_000_000_000_000_000, help="first stamp, ns"
-    )
+    parser.add_argument("--start", type=int, default=DEFAULT_START_NS, help="first stamp, ns")
     parser.add_argument(
         "--storage", choices=["mcap", "sqlite3"], default="mcap", help="bag storage format"
     )

@@ -21,9 +21,10 @@ from pathlib import Path
 import numpy as np
 
 from mount_twin.io.signals import Signal
+from mount_twin.scene.description import STANDARD_GRAVITY
 from mount_twin.textfiles import MIB, FileTooLargeError, read_limited
 
-G = 9.80665
+G = STANDARD_GRAVITY
 ROLES = ("t", "ax", "ay", "az", "wx", "wy", "wz")
 ALIASES: dict[str, tuple[str, ...]] = {
     "t": ("t", "time", "timestamp", "time_s", "sec", "seconds"),

@@ -8,6 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mount_twin.scene.description import STANDARD_GRAVITY
+
 MAX_SAMPLES = 10_000_000
 """Most samples a generated signal may have (rate × duration): 1000 s at 10 kHz, ~0.6 GB."""
 
@@ -43,7 +45,7 @@ def half_sine_shock(
     rate_hz: float = 10000.0,
     pre: float = 0.05,
     total: float = 0.4,
-    g: float = 9.80665,
+    g: float = STANDARD_GRAVITY,
     *,
     lateral: float = 0.0,
     rebound: float = 0.0,
@@ -89,7 +91,7 @@ def ship_motion(
     heave_period: float = 6.0,
     vib_amp: float = 0.8,
     vib_hz: float = 23.0,
-    g: float = 9.80665,
+    g: float = STANDARD_GRAVITY,
 ) -> Signal:
     """Rolling, heaving deck with hull vibration, sensed at the roll axis (origin of F).
 

@@ -41,8 +41,6 @@ from mount_twin.sweeps.spec import InputCase, SweepSpec
 BATCHES_PER_WORKER = 4
 """Tasks per worker a sweep is cut into: few enough to share the scheduling cost, enough to
 balance the load and to report progress."""
-START_NS = 1_700_000_000_000_000_000
-"""First stamp of a generated input, as `mount-twin generate` writes it."""
 
 
 def columns(spec: SweepSpec) -> list[str]:
