@@ -103,3 +103,45 @@ def test_utilisation_series_come_from_the_diagnostics(genset_run) -> None:
     series = utilisation_of(tables["diagnostics"])
     for name, peak in summary.utilisation_max.items():
         assert np.max(series[name][1]) == pytest.approx(peak, rel=1e-3), name
+
+
+def _margins(page: str) -> list[float]:
+    """The 'margin z dB' column of the spectra table of a report page."""
+    table = page[page.index("<th>margin z dB</th>") :]
+    table = table[: table.index("</table>")]
+    rows = re.findall(r"<tr>(.*?)</tr>", table)
+    cells = [re.findall(r"<td>([^<]*)</td>", r) for r in rows]
+    return [float(c[-1]) for c in cells if c and c[-1] != "–"]
+
+
+def test_a_design_spectrum_judges_the_inputs_spectra(genset_run, tmp_path: Path) -> None:
+    """With --design, the input's spectra are judged: a PASS/FAIL line per axis and each axis's
+    margin 20 log10(spectrum/design) in the table. Doubling the design lowers every margin by
+    20 log10 2 = 6.02 dB, and a design far below the record is exceeded on every axis."""
+    out, _ = genset_run
+    pages = []
+    for name, level_g in (("d1", 10.0), ("d2", 20.0), ("tiny", 1e-3)):
+        table = tmp_path / f"{name}.csv"
+        table.write_text(f"frequency_hz,accel_g\n10,{level_g}\n1000,{level_g}\n", "utf-8")
+        page = tmp_path / f"{name}.html"
+        args = ["report", str(out), "--scene", str(GENSET), "--input", str(BAG), "-o", str(page)]
+        assert main([*args, "--design", str(table)]) == 0
+        pages.append(page.read_text(encoding="utf-8"))
+    one, two, tiny = pages
+    for axis in "xyz":
+        assert f"<b>design</b>, axis {axis}: " in one
+    m1, m2 = _margins(one), _margins(two)
+    assert len(m1) >= 5 and len(m1) == len(m2)
+    assert np.allclose(np.subtract(m1, m2), 20.0 * np.log10(2.0), atol=0.011)  # 2-decimal cells
+    spectra = tiny.split("<h2>Shock response")[1]
+    assert spectra.count(": FAIL") == 3 and "PASS" not in spectra  # x: no input there, short
+    assert re.search(
+        r"axis z: 0 of \d+ frequencies within -1.5/\+3 dB[^<]*: FAIL: over by", spectra
+    )
+
+
+def test_a_design_needs_the_input(genset_run, capsys: pytest.CaptureFixture[str]) -> None:
+    out, _ = genset_run
+    table = Path(__file__).parent / "data"  # any path: refused before it is read
+    assert main(["report", str(out), "--design", str(table / "none.csv")]) == 2
+    assert "--design judges the input's spectra: it needs --input" in capsys.readouterr().err

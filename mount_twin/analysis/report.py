@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from mount_twin.analysis.design_margin import TOLERANCE_DB, check_design
 from mount_twin.analysis.figures import (
     DISPLACEMENT,
     PEAK_COUPLE,
@@ -169,9 +170,16 @@ def _provenance_section(
     return out
 
 
-def _srs_section(stamps_ns: np.ndarray, f: np.ndarray) -> list[str]:
+def _srs_section(
+    stamps_ns: np.ndarray,
+    f: np.ndarray,
+    design: tuple[list[float], list[float]] | None = None,
+    tolerance_db: tuple[float, float] = TOLERANCE_DB,
+) -> list[str]:
     """The input's shock response spectra (5 % damping; gravity and bias taken out as
-    `mount-twin srs` does by default, the mean of a quiet head), per axis of F."""
+    `mount-twin srs` does by default, the mean of a quiet head), per axis of F; with a design
+    spectrum (Hz, g), the design on the plot, each axis's margin (dB) in the table and its
+    PASS/FAIL line (`analysis.design_margin`, as `mount-twin srs --design`)."""
     from mount_twin.analysis.srs import gravity_offset, octave_frequencies, srs
 
     t = (stamps_ns - stamps_ns[0]) * 1e-9
@@ -181,6 +189,14 @@ def _srs_section(stamps_ns: np.ndarray, f: np.ndarray) -> list[str]:
     freqs = octave_frequencies(5.0, min(2000.0, rate / 10.0), 6)
     offset, removed = gravity_offset(t, f)
     spectra = {axis: srs(f[:, k] - offset[k], rate, freqs, 0.05) for k, axis in enumerate("xyz")}
+    checks = (
+        {
+            a: check_design(freqs, s.maximax / STANDARD_GRAVITY, *design, tolerance_db)
+            for a, s in spectra.items()
+        }
+        if design is not None
+        else {}
+    )
 
     def draw(fig: Any) -> None:
         ax = fig.subplots()
@@ -189,25 +205,42 @@ def _srs_section(stamps_ns: np.ndarray, f: np.ndarray) -> list[str]:
                 ax.loglog(
                     s.frequency_hz, s.maximax / STANDARD_GRAVITY, label=f"maximax, {axis} of F"
                 )
+        if design is not None:
+            ax.loglog(*design, "k--", label="design")
         ax.set_xlabel("natural frequency [Hz]")
         ax.set_ylabel("peak absolute acceleration [g]")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
 
     z = spectra["z"]
+    margins = {
+        a: dict(zip(c.frequency_hz.tolist(), c.margin_db.tolist(), strict=True))
+        for a, c in checks.items()
+    }
     rows = [
         [
             f"{fk:.4g}",
             *(f"{spectra[a].maximax[k] / STANDARD_GRAVITY:.4g}" for a in "xyz"),
             f"{z.pseudo_velocity[k]:.4g}",
+            *(
+                f"{margins[a][fk]:+.2f}" if fk in margins[a] else "–"
+                for a in ("xyz" if checks else "")
+            ),
         ]
-        for k, fk in enumerate(freqs)
+        for k, fk in enumerate(freqs.tolist())
         if k % 3 == 0
+    ]
+    head = ["f Hz", "x g", "y g", "z g", "PV z m/s"]
+    if checks:
+        head += ["margin x dB", "margin y dB", "margin z dB"]
+    verdicts = [
+        f"<p><b>design</b>, axis {a}: {html.escape(c.summary())}</p>" for a, c in checks.items()
     ]
     return [
         f"<h2>Shock response spectra of the input (ζ = 5 %, {html.escape(removed)} removed)</h2>",
+        *verdicts,
         _png(draw, (9, 4.5)),
-        _table(["f Hz", "x g", "y g", "z g", "PV z m/s"], rows),
+        _table(head, rows),
     ]
 
 
@@ -251,11 +284,14 @@ def write_report(
     scene: Scene | None = None,
     input_name: str = "",
     input_path: str | Path | None = None,
+    design: tuple[list[float], list[float]] | None = None,
+    tolerance_db: tuple[float, float] = TOLERANCE_DB,
 ) -> Path:
     """Write the report page. `input_samples`: (stamps ns, specific force (n, 3) m/s² in F) of
     the record, to plot beside the response; `input_path`: the record's bag, hashed for its
-    provenance. The page opens with the verdict, what produced it and with what settings, and
-    the scene as loaded (every value with its meaning and unit)."""
+    provenance; `design` (Hz, g): a design spectrum the input's spectra are judged against
+    (within `tolerance_db`). The page opens with the verdict, what produced it and with what
+    settings, and the scene as loaded (every value with its meaning and unit)."""
     tables = {t.name: t for t in read_output_bag(output_bag)}
     mounts = {k.removeprefix("mount_"): t for k, t in tables.items() if k.startswith("mount_")}
     origin = min(int(t.columns["stamp_ns"][0]) for t in tables.values() if len(t))
@@ -352,7 +388,7 @@ def write_report(
 
         sections += ["<h2>Utilisation</h2>", _png(util, (10, 4))]
     if input_samples is not None:
-        sections += _srs_section(*input_samples)
+        sections += _srs_section(*input_samples, design, tolerance_db)
     if scene is not None:
         sections += _modes_section(scene)
     rows = []

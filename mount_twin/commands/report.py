@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from mount_twin.commands.srs import add_design_arguments, tolerance_of
+
 NAME = "report"
 HELP = "one HTML page of a replay: input and response, signed mount forces, utilisation, events"
 
@@ -15,6 +17,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--input", metavar="BAG", help="the replay's input bag (plotted beside the response)"
     )
+    add_design_arguments(
+        parser,
+        "the input's spectra (--input) are judged against it: the design on their plot, the "
+        "margins in their table, a PASS/FAIL line per axis",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -24,8 +31,13 @@ def run(args: argparse.Namespace) -> int:
 
     require("matplotlib", "mount-twin report")
     from mount_twin.analysis.report import write_report
-    from mount_twin.commands.common import load_scene
+    from mount_twin.commands.common import load_scene, read_design_table
 
+    tolerance = tolerance_of(args)
+    if args.design and not args.input:
+        msg = "--design judges the input's spectra: it needs --input (and --scene)"
+        raise ValueError(msg)
+    design = read_design_table(args.design) if args.design else None
     scene = load_scene(args.scene) if args.scene else None
     samples = None
     if args.input:
@@ -48,6 +60,8 @@ def run(args: argparse.Namespace) -> int:
         scene=scene,
         input_name=name,
         input_path=args.input,
+        design=design,
+        tolerance_db=tolerance,
     )
     print(f"report: {out}")
     return 0

@@ -96,11 +96,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "positive, negative (g); suffixed _x, _y, _z with --axis all",
     )
     parser.add_argument("--plot", metavar="PNG", help="the spectra in g against Hz, log-log")
+    add_design_arguments(
+        parser,
+        "each axis's maximax is judged against it, the margins in the table, --csv and --json, "
+        "a PASS/FAIL line, exit 4 on FAIL",
+    )
+    parser.add_argument("--json", metavar="FILE", help="the spectra, margins and verdict as JSON")
+    parser.epilog = EXIT_STATUS
+
+
+def add_design_arguments(parser: argparse.ArgumentParser, judged: str) -> None:
+    """--design CSV (what is `judged` against it) and --tolerance-db LOW HIGH: `srs` and
+    `report` take a design spectrum the same way."""
     parser.add_argument(
         "--design",
         metavar="CSV",
-        help="a design spectrum (frequency_hz,accel_g): each axis's maximax is judged against "
-        "it, the margins in the table, --csv and --json, a PASS/FAIL line, exit 4 on FAIL",
+        help=f"a design spectrum (frequency_hz,accel_g): {judged}",
     )
     parser.add_argument(
         "--tolerance-db",
@@ -110,8 +121,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=TOLERANCE_DB,
         help="the band about the design spectrum, dB (default -1.5 3)",
     )
-    parser.add_argument("--json", metavar="FILE", help="the spectra, margins and verdict as JSON")
-    parser.epilog = EXIT_STATUS
+
+
+def tolerance_of(args: argparse.Namespace) -> tuple[float, float]:
+    """--tolerance-db, checked: LOW < 0 < HIGH."""
+    low, high = args.tolerance_db
+    if not low < 0.0 < high:
+        msg = f"--tolerance-db {low:g} {high:g}: needs LOW < 0 < HIGH (dB about the design)"
+        raise ValueError(msg)
+    return low, high
 
 
 def run(args: argparse.Namespace) -> int:
@@ -134,10 +152,7 @@ def run(args: argparse.Namespace) -> int:
 
         require("matplotlib", "--plot")
     zeta = damping_ratio(args.damping, args.q)
-    low, high = args.tolerance_db
-    if not low < 0.0 < high:
-        msg = f"--tolerance-db {low:g} {high:g}: needs LOW < 0 < HIGH (dB about the design)"
-        raise ValueError(msg)
+    low, high = tolerance_of(args)
     design = read_design_table(args.design) if args.design else None
     t, accel, name = _record(args)
     record = uniform(t, accel, args.input)
