@@ -32,6 +32,13 @@ engine::Integrator integrator(py::handle obj, const char* what, idx n_state) {
   integ.work2d = convert::mat(field(obj, "work2d"), (w + ".work2d").c_str(), -1, n_state);
   integ.work1d = convert::vec(field(obj, "work1d"), (w + ".work1d").c_str(), n_state);
   integ.result = convert::vec(field(obj, "result"), (w + ".result").c_str(), 3);
+  const idx need = integrate::work_rows(integ.method, n_state);  // −1: unknown, advance says so
+  if (integ.work2d.rows < need) {
+    throw py::value_error(w + ".work2d: " + std::to_string(integ.work2d.rows) + " rows where "
+                          "method " + std::to_string(integ.method) + " needs " +
+                          std::to_string(need) + " for " + std::to_string(n_state) +
+                          " states (Method.work_rows)");
+  }
   return integ;
 }
 
