@@ -23,6 +23,7 @@ from mount_twin.integrate import methods, settings
 from mount_twin.kinds import KINDS, N_EVENTS, N_PAR
 from mount_twin.model.assemble import assemble, initial_state
 from mount_twin.physics import dynamics, pose_row
+from mount_twin.scene.description import DOF_NAMES
 
 
 def test_the_settings_slots_are_the_cores() -> None:
@@ -36,7 +37,6 @@ def test_the_statuses_and_method_ids_are_the_cores() -> None:
     python = tuple(getattr(methods, n) for n in (*statuses, "UNKNOWN_METHOD"))
     assert python == _core.STATUSES
     assert tuple(m.id for m in methods.METHODS.values()) == _core.METHOD_IDS
-    assert (dynamics.OK, dynamics.OFF_CHART) == (0, 1)
 
 
 def test_the_layouts_are_the_cores() -> None:
@@ -59,6 +59,19 @@ def pump():
     u = np.zeros(dynamics.INPUT_SIZE)
     u[3] = 9.80665
     return model, initial_state(model, u[1:4]), u
+
+
+def test_the_right_hand_sides_statuses_are_the_pythons(pump) -> None:
+    """The core's rhs answers dynamics.OK on the chart and dynamics.OFF_CHART past its edge
+    (|α| + |γ| ≥ π/2: the body tilted 90°)."""
+    model, y, u = pump
+    s, dydt = model.new_scratch(), np.zeros_like(y)
+    assert dynamics.rhs(0.0, y, model.arrays, s, u, dydt) == dynamics.OK
+    names = [d for d in DOF_NAMES if d in model.scene.dofs]  # y's order of the free DOFs
+    tilted = y.copy()
+    tilted[names.index("alpha")] = 0.8
+    tilted[names.index("gamma")] = 0.8
+    assert dynamics.rhs(0.0, tilted, model.arrays, s, u, dydt) == dynamics.OFF_CHART != dynamics.OK
 
 
 def test_a_wrong_array_is_refused_naming_it(pump) -> None:

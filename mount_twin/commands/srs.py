@@ -113,13 +113,19 @@ def add_design_arguments(parser: argparse.ArgumentParser, judged: str) -> None:
         metavar="CSV",
         help=f"a design spectrum (frequency_hz,accel_g): {judged}",
     )
+    add_tolerance_argument(parser, "the band about the design spectrum")
+
+
+def add_tolerance_argument(parser: argparse.ArgumentParser, what: str) -> None:
+    """--tolerance-db LOW HIGH (dB about a design spectrum; `tolerance_of` checks it): `srs`,
+    `report`, `synthesize` and `qualify` take it the same way."""
     parser.add_argument(
         "--tolerance-db",
         type=float,
         nargs=2,
         metavar=("LOW", "HIGH"),
         default=TOLERANCE_DB,
-        help="the band about the design spectrum, dB (default -1.5 3)",
+        help=f"{what}, dB (default -1.5 3)",
     )
 
 

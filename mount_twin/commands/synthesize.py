@@ -7,7 +7,7 @@ import argparse
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
-from mount_twin.commands.srs import TOLERANCE_DB
+from mount_twin.commands.srs import add_tolerance_argument, tolerance_of
 from mount_twin.io.epoch import DEFAULT_START_NS
 
 if TYPE_CHECKING:
@@ -47,14 +47,7 @@ def add_synthesis_arguments(parser: argparse.ArgumentParser) -> None:
     damping = parser.add_mutually_exclusive_group()
     damping.add_argument("--damping", type=float, help="damping ratio ζ (default 0.05)")
     damping.add_argument("--q", type=float, help="quality factor Q = 1/(2ζ), instead of ζ")
-    parser.add_argument(
-        "--tolerance-db",
-        type=float,
-        nargs=2,
-        metavar=("LOW", "HIGH"),
-        default=TOLERANCE_DB,
-        help="the band about the design every frequency must meet, dB (default -1.5 3)",
-    )
+    add_tolerance_argument(parser, "the band about the design every frequency must meet")
     parser.add_argument(
         "--head", type=float, default=0.05, help="rest before the shock, s (the start checks)"
     )
@@ -70,16 +63,15 @@ def synthesized(args: argparse.Namespace) -> Iterator[tuple[int, Synthesis, Sign
     if args.seeds < 1 or args.head < 0.0 or not args.rate > 0.0:
         msg = "--seeds must be ≥ 1, --head ≥ 0 s and --rate > 0 Hz"
         raise ValueError(msg)
+    low, high = tolerance_of(args)
     design = read_design_table(args.spectrum)
     zeta = damping_ratio(args.damping, args.q)
     print(
         f"{args.spectrum}: {len(design[0])} points, {design[0][0]:g}–{design[0][-1]:g} Hz, "
-        f"ζ = {zeta:g}, tolerance {args.tolerance_db[0]:+g}/{args.tolerance_db[1]:+g} dB"
+        f"ζ = {zeta:g}, tolerance {low:+g}/{high:+g} dB"
     )
     for seed in range(args.first_seed, args.first_seed + args.seeds):
-        shock = synthesize(
-            *design, args.rate, damping=zeta, seed=seed, tolerance_db=tuple(args.tolerance_db)
-        )
+        shock = synthesize(*design, args.rate, damping=zeta, seed=seed, tolerance_db=(low, high))
         yield seed, shock, imu_record(shock, args.rate, args.axis, args.head)
 
 

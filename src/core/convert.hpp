@@ -39,13 +39,19 @@ inline py::array checked(py::handle obj, const char* what, char kind, int itemsi
   return a;
 }
 
-/// A float64 1-D array; `n` ≥ 0 requires that length.
-inline Vec vec(py::handle obj, const char* what, idx n = -1) {
-  auto a = checked(obj, what, 'f', 8, 1);
+/// A 1-D array of the dtype (kind, itemsize); `n` ≥ 0 requires that length.
+inline py::array vector1d(py::handle obj, const char* what, char kind, int itemsize, idx n) {
+  auto a = checked(obj, what, kind, itemsize, 1);
   if (n >= 0 && a.shape(0) != n) {
     throw py::value_error(std::string(what) + ": length " + std::to_string(a.shape(0)) +
                           " where " + std::to_string(n) + " is needed");
   }
+  return a;
+}
+
+/// A float64 1-D array; `n` ≥ 0 requires that length.
+inline Vec vec(py::handle obj, const char* what, idx n = -1) {
+  auto a = vector1d(obj, what, 'f', 8, n);
   return Vec{static_cast<double*>(a.mutable_data()), a.shape(0)};
 }
 
@@ -95,21 +101,13 @@ inline StackC<C> stackc(py::handle obj, const char* what, idx n = -1, idx rows =
 
 /// An int64 1-D array; `n` ≥ 0 requires that length.
 inline IVec ivec(py::handle obj, const char* what, idx n = -1) {
-  auto a = checked(obj, what, 'i', 8, 1);
-  if (n >= 0 && a.shape(0) != n) {
-    throw py::value_error(std::string(what) + ": length " + std::to_string(a.shape(0)) +
-                          " where " + std::to_string(n) + " is needed");
-  }
+  auto a = vector1d(obj, what, 'i', 8, n);
   return IVec{static_cast<const idx*>(a.data()), a.shape(0)};
 }
 
 /// A bool 1-D array; `n` ≥ 0 requires that length.
 inline BVec bvec(py::handle obj, const char* what, idx n = -1) {
-  auto a = checked(obj, what, 'b', 1, 1);
-  if (n >= 0 && a.shape(0) != n) {
-    throw py::value_error(std::string(what) + ": length " + std::to_string(a.shape(0)) +
-                          " where " + std::to_string(n) + " is needed");
-  }
+  auto a = vector1d(obj, what, 'b', 1, n);
   return BVec{static_cast<const bool*>(a.data()), a.shape(0)};
 }
 

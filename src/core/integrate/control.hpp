@@ -93,6 +93,34 @@ inline Concluded conclude(Vec y, Vec y_new, double t, double t1, double step, do
 
 /// Store the run's figures: settings[STEP] ← h, result ← [largest accepted error norm,
 /// accepted steps, rejected steps].
+/// What every method reads of its settings for one input interval [t0, t1] (s).
+struct Interval {
+  double rtol, atol, max_steps;
+  double span;   // t1 − t0, s
+  double h_max;  // the longest step taken (span / MIN_STEPS); caps steps, not the proposal
+  double h;      // the first step to try: the proposal held, else the whole interval
+};
+inline Interval interval(Vec settings, double t0, double t1) {
+  const double span = t1 - t0;
+  const double h = settings[STEP];
+  return {settings[RTOL], settings[ATOL],     settings[MAX_SUBSTEPS],
+          span,           span / settings[MIN_STEPS], h <= 0.0 ? span : h};
+}
+
+/// Take `conclude`'s outcome: its time and next proposal, the step counted (an accepted
+/// one's error norm into the largest).
+inline void take(const Concluded& done, double err, double& t, double& h, double& err_max,
+                 idx& n_acc, idx& n_rej) {
+  t = done.t;
+  h = done.h;
+  if (done.accepted) {
+    err_max = py_max(err_max, err);
+    n_acc += 1;
+  } else {
+    n_rej += 1;
+  }
+}
+
 inline void record(Vec settings, Vec result, double h, double err_max, idx n_acc, idx n_rej) {
   settings[STEP] = h;
   result[0] = err_max;

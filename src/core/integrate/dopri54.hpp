@@ -50,13 +50,11 @@ inline idx work_rows(idx /*n*/) { return STAGES; }
 /// Returns a Status; y is left at the last accepted time on failure.
 inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Scratch& s, Vec u,
                    Mat k, Vec y_new, Vec result) {
-  double h = settings[STEP];
-  const double rtol = settings[RTOL], atol = settings[ATOL];
-  const double max_steps = settings[MAX_SUBSTEPS];
+  const Interval iv = interval(settings, t0, t1);
+  const double rtol = iv.rtol, atol = iv.atol, max_steps = iv.max_steps, span = iv.span;
+  const double h_max = iv.h_max;
+  double h = iv.h;
   const idx n = y.n;
-  const double span = t1 - t0;
-  h = h <= 0.0 ? span : h;
-  const double h_max = span / settings[MIN_STEPS];  // caps the steps taken, not the proposal
   double t = t0;
   double err_max = 0.0;
   idx n_acc = 0, n_rej = 0;

@@ -125,13 +125,11 @@ inline void lu_solve(Mat a, idx first, idx n, Vec piv_row, Vec b) {
 /// statuses of dopri54::advance (k: work_rows(n) × n; settings[CHAINED] is left at 0).
 inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Scratch& s, Vec u,
                    Mat k, Vec y_new, Vec result) {
-  double h = settings[STEP];
-  const double rtol = settings[RTOL], atol = settings[ATOL];
-  const double max_steps = settings[MAX_SUBSTEPS];
+  const Interval iv = interval(settings, t0, t1);
+  const double rtol = iv.rtol, atol = iv.atol, max_steps = iv.max_steps, span = iv.span;
+  const double h_max = iv.h_max;
+  double h = iv.h;
   const idx n = y.n;
-  const double span = t1 - t0;
-  h = h <= 0.0 ? span : h;
-  const double h_max = span / settings[MIN_STEPS];
   settings[CHAINED] = 0.0;
   double t = t0;
   double err_max = 0.0;
@@ -215,14 +213,7 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
     }
     const Concluded done = conclude(y, y_new, t, t1, step, h, last, err, not_finite, ORDER,
                                     MAX_FACTOR, m, s, u, k, F, FTMP);
-    t = done.t;
-    h = done.h;
-    if (done.accepted) {
-      err_max = py_max(err_max, err);
-      n_acc += 1;
-    } else {
-      n_rej += 1;
-    }
+    take(done, err, t, h, err_max, n_acc, n_rej);
   }
   record(settings, result, h, err_max, n_acc, n_rej);
   return SUCCESS;
