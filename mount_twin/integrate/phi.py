@@ -9,12 +9,13 @@ squaring method for matrix functions related to the exponential", Appl. Numer. M
 1. balance A = hJ by a diagonal similarity of powers of two, D⁻¹AD (Parlett & Reinsch, as
    LAPACK's gebal): a mechanical Jacobian mixes rows of 1 (dx/dt = v) with rows of k/m (1e8 for
    a light body on bolts); balanced, its norm is near its spectral radius;
-2. scale by 2^−s until the 1-norm is at most THETA, and sum TERMS terms of each Taylor series
-   (truncation below 1e-18 of the norm);
+2. scale by 2^−s until the 1-norm is at most THETA = 1, and sum TERMS = 19 terms of each Taylor
+   series (z^0 … z^18: the remainder of e^z at ‖z‖ ≤ 1 is below 1/19! ≈ 8e-18);
 3. square back s times: e^(2z) = (e^z)², φ_k(2z) = 2^−k [e^z φ_k(z) + Σ_{j=1..k} φ_j(z)/(k−j)!];
 4. undo the balancing: φ_k(A) = D φ_k(D⁻¹AD) D⁻¹.
 
 Work: blocks of n rows in the caller's 2-D work array, given by their first row (`Blocks`).
+The implementation and its constants are the core's: src/core/integrate/phi.hpp.
 """
 
 from __future__ import annotations
@@ -22,13 +23,6 @@ from __future__ import annotations
 from typing import NamedTuple
 
 from mount_twin import _core
-
-THETA = 1.0
-"""Largest 1-norm of the scaled matrix summed by Taylor series."""
-TERMS = 19
-"""Taylor terms z^0 … z^18: the remainder of e^z at ‖z‖ ≤ 1 is below 1/19! ≈ 8e-18."""
-MAX_BALANCE_SWEEPS = 64
-"""Sweeps of the balancing at most (it converges in a few)."""
 
 
 class Blocks(NamedTuple):

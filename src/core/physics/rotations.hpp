@@ -1,5 +1,5 @@
 // Rotation helpers: quaternion (x, y, z, w), rotation vector, the couple map J(φ)⁻ᵀ
-// (physics/rotations.py holds the reference and says why).
+// (physics/rotations.py holds the quaternion's Python twin, which the io layer uses).
 #pragma once
 
 #include <cmath>
@@ -50,7 +50,14 @@ inline void rotation_vector(M3 rot, Vec quat, Vec out) {
   for (int i = 0; i < 3; ++i) out[i] = scale * quat[i];
 }
 
-/// J(φ)⁻ᵀ of the rotation vector φ whose quaternion is `quat` (as rotation_vector left it).
+/// J(φ)⁻ᵀ = 1 + ½[φ]× + c·[φ]×², c = 1/θ² − cot(θ/2)/(2θ), θ = |φ| (rad): the inverse
+/// transpose of the left Jacobian of SO(3) at the rotation vector φ of a rotation whose
+/// quaternion (x, y, z, w), w ≥ 0, is `quat` (as `rotation_vector` left it).
+///
+/// A body turned by δθ (in F, small) changes φ by J(φ)⁻¹·δθ, and φ changes at J(φ)⁻¹·ω for
+/// an angular velocity ω in F. So a mount law giving a generalized force g conjugate to φ (a
+/// spring −K·φ: the gradient of ½ φᵀKφ) exerts the couple J(φ)⁻ᵀ·g on the body, and it
+/// conserves energy at any rotation; at small φ the map is 1 + O(φ).
 inline void couple_map(Vec phi, Vec quat, M3 out) {
   const double angle_sq = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2];
   double c;
