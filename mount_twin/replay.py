@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -42,12 +41,17 @@ NODE_NAME = "mount_twin"
 def _estimate_text(est: ErrorEstimate | None) -> str:
     if est is None:
         return "estimated integration error: not estimated (integration.error_estimate: false)"
+    if not est.estimated:
+        return "estimated integration error: none (no input interval was integrated)"
     text = (
         f"estimated integration error: mount forces {est.force_error_rel:.2g} of the largest "
         f"({est.force_error_n:.3g} N), attitude {est.attitude_error_rad:.2g} rad, over the run"
     )
-    if est.resyncs:
-        text += f" (the estimate lost its history {est.resyncs} times: a lower bound)"
+    if est.lower_bound:
+        text += (
+            f" (a lower bound: {est.failed_checks} intervals not measured, "
+            f"{est.uncarried_states} states not carried)"
+        )
     return text
 
 
@@ -177,9 +181,7 @@ class ReplaySummary:
             "max_tilt_rad": self.tilt_max_rad,
             "latency_samples": self.latency[0],
             "latency_s": self.latency[1],
-            "error_estimate": dataclasses.asdict(self.error_estimate)
-            if self.error_estimate
-            else None,
+            "error_estimate": self.error_estimate.as_dict() if self.error_estimate else None,
             "mounts": {
                 name: {
                     PEAK_FORCE: float(peak[0]),

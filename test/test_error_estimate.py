@@ -1,8 +1,9 @@
 """The live error estimate is an error: within a small factor of the true error of the published
 mount forces and attitude (against a reference run at rtol 1e-12 on the input refined 8×,
-itself tied to scipy in test_accuracy.py), on smooth, stiff and non-smooth scenes; it never
-touches the published numbers; it is on /diagnostics and WARNs when the forces are off by more
-than a percent."""
+itself tied to scipy in test_accuracy.py), on smooth, stiff and non-smooth scenes (where
+sampling the intervals over-counts, measuring them all comes within 1.1×); it never touches
+the published numbers; it is on /diagnostics and WARNs when the forces are off by more than a
+percent."""
 
 from __future__ import annotations
 
@@ -14,13 +15,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import scipy.linalg
 from io_helpers import CONFIG, ROOT, default_scene, split
 from kinds_helpers import kind_mount
 from physics_helpers import base_scene, mount
 
+from mount_twin import _core
 from mount_twin.analysis.accuracy import measure, raw_gyro, reference_run, run_at
+from mount_twin.engine import engine as engine_module
 from mount_twin.engine.batch import WARN, SampleBatch
 from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.estimator import new_estimator
 from mount_twin.engine.health import INTEGRATION
 from mount_twin.io.input_samples import read_samples
 from mount_twin.model.assemble import assemble
@@ -31,7 +36,7 @@ from mount_twin.scene.loader import load_scene_file, scene_from_dict
 G = 9.80665
 CORNERS = [(0.4, 0.3), (-0.4, 0.3), (-0.4, -0.3), (0.4, -0.3)]
 FACTOR = 2.0
-"""The estimate is asserted within this factor of the true error (the issue asks for 10)."""
+"""The estimate is asserted within this factor of the true error, where no case says otherwise."""
 
 
 def _first(samples: SampleBatch, n: int) -> SampleBatch:
@@ -101,6 +106,13 @@ CASES = {
     "rubber_on_snubbers": (_rubber_on_snubbers, [1e-3, 1e-6]),
     "pump_ship_motion": (_pump, [1e-4]),
 }
+OVER = {("stiff_light_exponential", 1e-3): 8.0}
+"""Where the estimate is allowed above FACTOR (never below 1/FACTOR): local errors that do not
+add up in phase (a lightly damped 2–6 kHz mode sampled at 1 kHz), which one measured interval
+standing for sixteen over-counts (`engine.estimator`). Measured: 6.6; measuring every interval
+(`check_every=1`), 1.07. (Scenes with non-linear mounts take the companion, `engine.companion`.)"""
+ATTITUDE_FLOOR_RAD = 1e-12
+"""Attitude errors below this are rounding (the stiff scenes': 1e-13), not compared."""
 
 
 @pytest.mark.parametrize(
@@ -111,16 +123,45 @@ def test_the_estimate_is_within_a_factor_two_of_the_true_error(case: str, rtol: 
     scene, samples = build()
     ref = reference_run(scene, samples, 1_000_000)
     acc = measure(scene, samples, rtol, 100_000, ref)
+    high = OVER.get((case, rtol), FACTOR)
     assert acc.failures == 0
     assert acc.force_error > 1e-12, "an error worth estimating, above rounding"
-    assert 1 / FACTOR < acc.est_force_error / acc.force_error < FACTOR, acc
-    if acc.attitude_error_rad > 1e-13:
-        assert 1 / FACTOR < acc.est_attitude_error_rad / acc.attitude_error_rad < FACTOR, acc
+    assert 1 / FACTOR < acc.est_force_error / acc.force_error < high, acc
+    if acc.attitude_error_rad > ATTITUDE_FLOOR_RAD:
+        assert 1 / FACTOR < acc.est_attitude_error_rad / acc.attitude_error_rad < high, acc
+
+
+@pytest.mark.parametrize("case", ["stiff_light_exponential"])
+def test_measuring_every_interval_comes_within_ten_percent_where_sampling_over_counts(
+    case: str,
+) -> None:
+    """The carried error is right: what over-counts in OVER is the sampling, not the
+    linearised propagation or the local errors it carries."""
+    scene, samples = CASES[case][0]()
+    rtol = min(CASES[case][1])
+    ref = reference_run(scene, samples, 1_000_000)
+    every = partial(new_estimator, check_every=1)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(engine_module, "new_estimator", every)
+        acc = measure(scene, samples, rtol, 100_000, ref)
+    assert 0.9 < acc.est_force_error / acc.force_error < 1.1, acc
+
+
+def test_the_propagator_is_the_matrix_exponential() -> None:
+    """Against scipy's Padé exponential, on a stiff, lightly damped oscillator and a random
+    matrix of norm 30 (eight squarings)."""
+    rng = np.random.default_rng(7)
+    k, c = 4e9 / 10.0, 2e3 / 10.0
+    oscillator = np.array([[0.0, 1.0], [-k, -c]])
+    for a, scale in ((oscillator, 1e-3), (rng.normal(size=(12, 12)), 30.0 / 12)):
+        want = scipy.linalg.expm(scale * a)
+        got = _core.expm(a, scale)
+        np.testing.assert_allclose(got, want, rtol=1e-6, atol=1e-9 * abs(want).max())
 
 
 @pytest.mark.parametrize("case", ["rubber_on_snubbers", "pump_ship_motion"])
 def test_the_estimate_never_changes_what_is_published(case: str) -> None:
-    """Bit for bit: the companion has its own state, scratch and mount switches."""
+    """Bit for bit: the estimate has its own state, scratch and checking stepper."""
     scene, samples = CASES[case][0]()
     on, off = (run_at(scene, samples, 1e-5, 100_000, estimate=e) for e in (True, False))
     assert on.estimate is not None and off.estimate is None
@@ -153,7 +194,8 @@ def test_the_bundled_scene_reports_a_tiny_estimate_and_it_can_be_turned_off() ->
     engine, status = _integration_status(scene, samples)
     assert status.level == 0
     assert 0.0 < float(status.values["est_force_error_rel"]) < 1e-6
-    assert status.values["est_resyncs"] == "0"
+    assert status.values["est_failed_checks"] == "0"
+    assert status.values["est_uncarried_states"] == "0"
     off = dataclasses.replace(scene.integration, error_estimate=False)
     engine, status = _integration_status(dataclasses.replace(scene, integration=off), samples)
     assert engine.error_estimate is None
@@ -169,7 +211,7 @@ def test_on_a_stiff_scene_the_linearising_methods_are_stable_where_explicit_ones
     by stability and is 9 % off; the L-stable ros34pw2 takes one step per sample and is within
     1e-3 (it damps the kHz ringing each input kink excites, see the README); the exponential
     exprb32, exact on linear mounts, takes one step per sample and is within 1e-7. Every
-    estimate stays within 10× of its true error (the Rosenbrock's 0.3: the companion damps the
+    estimate stays within 10× of its true error (the Rosenbrock's 0.43: its check damps the
     ringing the twin damps)."""
     scene, samples = _stiff_light("auto")
     ref = reference_run(scene, samples, 1_000_000)

@@ -77,7 +77,7 @@ def _check_rate_step(scene, position: float, rate: float) -> None:
 def test_a_bolt_breaking_between_samples_ends_the_chain() -> None:
     """The stepper's last stage starts the next interval only while the state is continuous: a
     bolt that breaks between samples (its `update`) clears the chain flag, the twin's (the
-    kernel's watch) and the error estimate's companion's (its monitor), and nothing else does."""
+    kernel's watch and its monitor), and nothing else does."""
     model = assemble(load_scene_file(GENSET))
     nl = model.arrays.nl
     g = np.array([0.0, 0.0, model.scene.input.g])

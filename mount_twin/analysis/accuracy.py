@@ -124,7 +124,7 @@ def run_at(
 ) -> Run:
     """The twin over `samples` at `rtol` (atol = rtol·ATOL_PER_RTOL), every sample published
     (`TwinEngine.run`), with its live error estimate if `estimate` (the wall time then
-    includes the estimate's companion solution)."""
+    includes the estimate's checks and propagation)."""
     atol = rtol * ATOL_PER_RTOL
     integ = dataclasses.replace(
         scene.integration,

@@ -14,6 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from mount_twin.engine import companion, estimator
 from mount_twin.engine.auto_method import (
     REEXAMINE_S,
     Choice,
@@ -29,10 +30,10 @@ from mount_twin.engine.batch import (
     OutputBatch,
     SampleBatch,
 )
-from mount_twin.engine.companion import Companion, new_companion, restart
-from mount_twin.engine.companion import switch as switch_companion
+from mount_twin.engine.companion import Companion, new_companion
 from mount_twin.engine.delay_line import Frame, GyroDelay, Run, filter_bands
 from mount_twin.engine.estimate import ErrorEstimate
+from mount_twin.engine.estimator import Estimator, new_estimator
 from mount_twin.engine.gyro_filter import Design
 from mount_twin.engine.health import ENDED, PLATEAU_G, SATURATION_SHARE, HealthWindow
 from mount_twin.engine.kernel import (
@@ -251,7 +252,7 @@ class TwinEngine:
         )
         st = self.stepper
         self._integ = Integrator(st.method, st.settings, st.work2d, st.work1d, st.result)
-        self._companion = self._new_companion()
+        self._estimator = self._new_estimator()
         # Fails now, at load, if the mounts cannot hold the body; and is the restart fallback.
         self._y_nominal = initial_state(model, self._gravity_up)
         self._rho: tuple[float, float] | None = None
@@ -276,8 +277,10 @@ class TwinEngine:
         switch(self.stepper, choice.method)
         st = self.stepper
         self._integ = Integrator(st.method, st.settings, st.work2d, st.work1d, st.result)
-        if self._companion is not None:
-            self._companion = switch_companion(self._companion, st.method)
+        if isinstance(self._estimator, Estimator):
+            self._estimator = estimator.switch(self._estimator, st.method)
+        elif self._estimator is not None:
+            self._estimator = companion.switch(self._estimator, st.method)
 
     def _look_again(self, t: np.ndarray, f: np.ndarray, j: int, events: list[MountEvent]) -> None:
         """`auto` at sample j of the run just ended, which logged `events`, one of which may
@@ -288,20 +291,33 @@ class TwinEngine:
         if choice is not None:
             self._use(choice)
 
-    def _new_companion(self) -> Companion | None:
-        """The error estimate's companion solution, or None if the scene turns it off."""
+    def _new_estimator(self) -> Estimator | Companion | None:
+        """The live error estimate's arrays (`engine.estimator` where the mounts are linear,
+        `engine.companion` where some are not: see there), or None if the scene turns it
+        off."""
         integ = self.scene.integration
         if not integ.error_estimate:
             return None
-        return new_companion(
+        arrays = self.model.arrays
+        if arrays.nl is not None:
+            return new_companion(
+                integ.method,
+                self.model.n_state,
+                integ.rtol,
+                integ.atol,
+                integ.max_substeps,
+                self.model.new_scratch(),
+                self.model.n_mounts,
+                self._watch.g.shape,
+            )
+        return new_estimator(
             integ.method,
-            self.model.n_state,
             integ.rtol,
             integ.atol,
             integ.max_substeps,
             self.model.new_scratch(),
+            arrays.free_trans.shape[0] + arrays.free_rot.shape[0],
             self.model.n_mounts,
-            self._watch.g.shape,
         )
 
     def _buffers(
@@ -334,7 +350,7 @@ class TwinEngine:
     @property
     def error_estimate(self) -> ErrorEstimate | None:
         """The estimated error of everything published so far (None: `error_estimate` off)."""
-        return None if self._companion is None else ErrorEstimate.of(self.health.estimate_run)
+        return None if self._estimator is None else ErrorEstimate.of(self.health.estimate_run)
 
     @property
     def failure_text(self) -> str:
@@ -734,15 +750,15 @@ class TwinEngine:
                 self._options,
                 out_buf,
                 self._watch,
-                self._companion,
+                self._estimator,
             )
             pose, wrenches, publish, step_log, abs_max, cos_tilt = out_buf[2:]
             peaks = abs_max, float(cos_tilt[0])
             events = self._drain_events()
             self.health.add_steps(step_log[1 : done + 1])
-            if self._companion is not None:
-                self.health.add_estimate(self._companion.figures)
-                self._companion.figures[:] = 0.0
+            if self._estimator is not None:
+                self.health.add_estimate(self._estimator.figures)
+                self._estimator.figures[:] = 0.0
             self.counts["substeps"] += int(step_log[1 : done + 1, 1:3].sum())
             if done > 0:
                 self._last = (float(t[done]), ff[done], ww[done])
@@ -963,8 +979,10 @@ class TwinEngine:
         self._counter[0] = 0
         self._last = (stamp, f[i].copy(), w0)
         pose, wrenches = self._start_outputs(self._y, self._scratch, self._watch)
-        if self._companion is not None:
-            restart(self._companion, self._y)
+        if isinstance(self._estimator, Estimator):
+            estimator.restart(self._estimator)
+        elif self._estimator is not None:
+            companion.restart(self._estimator, self._y)
         rows.pose[i + 1], rows.wrenches[i + 1] = pose[0], wrenches[0]
         return _Rows(np.array([i]), rows.pose[i + 1 : i + 2], rows.wrenches[i + 1 : i + 2])
 

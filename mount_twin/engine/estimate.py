@@ -1,19 +1,22 @@
 """The live error estimate's figures: their layout, and what they say (pure Python).
 
-The core's loop fills the figures (`follow` in src/core/engine/kernel.hpp, which has the slots
-as `mt::Figure`: test/test_core_contract.py holds them equal); the health window and the engine
-read them.
+The core's loop fills the figures (`estimate_interval` in src/core/engine/estimator.hpp, which
+has the slots as `mt::Figure`: test/test_core_contract.py holds them equal); the health window
+and the engine read them.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-FORCE_ERROR, ATTITUDE_ERROR, FORCE_SCALE, FAILURES, N_FIGURES = range(5)
+FORCE_ERROR, ATTITUDE_ERROR, FORCE_SCALE, FAILURES, UNCARRIED, N_FIGURES = range(6)
 """Slots of the figures: largest |ΔF| (N), largest |Δα|, |Δγ|, |Δδ| (rad), largest |F|
-component (N), companion failures (re-synchronisations)."""
+component (N), failed checks (intervals whose local error could not be measured), states the
+estimate does not carry (`engine.estimator.DENSE_MAX`)."""
 WARN_FORCE_ERROR_REL = 0.01
 """An estimated mount-force error above this share of the largest force is a WARN: the results
 are not to be trusted to the percent (tighten integration.rtol)."""
@@ -25,31 +28,56 @@ class ErrorEstimate:
 
     Attributes:
         force_error_rel: largest |ΔF| over samples, mounts and force components, relative to the
-            largest |F| component (the definition of `analysis.accuracy.Accuracy.force_error`).
+            largest |F| component (the definition of `analysis.accuracy.Accuracy.force_error`);
+            NaN where no interval was integrated (a run that failed at every sample: nothing
+            was estimated, and 0.0 would read as exact).
         force_error_n: that largest |ΔF|, N.
         attitude_error_rad: largest |Δα|, |Δγ|, |Δδ|, rad.
-        resyncs: intervals where the companion failed and was re-synchronised to the twin
-            (the estimate then misses what it had carried).
+        failed_checks: intervals whose local error could not be measured (the checking
+            stepper failed: the estimate misses what they committed).
+        uncarried_states: the model's states whose error the estimate does not carry from
+            interval to interval (a model of more than `engine.estimator.DENSE_MAX` states:
+            its mounts' internal states).
     """
 
     force_error_rel: float
     force_error_n: float
     attitude_error_rad: float
-    resyncs: int
+    failed_checks: int
+    uncarried_states: int
+
+    @property
+    def estimated(self) -> bool:
+        """Whether any interval was estimated (force_error_rel is a number)."""
+        return not math.isnan(self.force_error_rel)
+
+    def as_dict(self) -> dict[str, float | int | None]:
+        """The fields for JSON: NaN as None (strict JSON has no NaN)."""
+        return {
+            k: None if isinstance(v, float) and math.isnan(v) else v
+            for k, v in dataclasses.asdict(self).items()
+        }
+
+    @property
+    def lower_bound(self) -> bool:
+        """Whether the figures may be short of the error (failed checks, uncarried states)."""
+        return self.failed_checks > 0 or self.uncarried_states > 0
 
     @classmethod
     def of(cls, figures: np.ndarray) -> ErrorEstimate:
-        """From figures as the companion keeps them (N_FIGURES slots)."""
+        """From figures as the core keeps them (N_FIGURES slots)."""
         scale = figures[FORCE_SCALE]
         return cls(
-            float(figures[FORCE_ERROR] / scale) if scale > 0.0 else 0.0,
+            float(figures[FORCE_ERROR] / scale) if scale > 0.0 else math.nan,
             float(figures[FORCE_ERROR]),
             float(figures[ATTITUDE_ERROR]),
             int(figures[FAILURES]),
+            int(figures[UNCARRIED]),
         )
 
 
 def accumulate(total: np.ndarray, figures: np.ndarray) -> None:
-    """Fold figures (as the companion keeps them) into `total`: maxima, and failures added."""
-    np.maximum(total[:FAILURES], figures[:FAILURES], out=total[:FAILURES])
-    total[FAILURES] += figures[FAILURES]
+    """Fold figures (as the core keeps them) into `total`: failures added, the rest maxima."""
+    failures = total[FAILURES] + figures[FAILURES]
+    np.maximum(total, figures, out=total)
+    total[FAILURES] = failures

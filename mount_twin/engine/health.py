@@ -62,7 +62,7 @@ class HealthWindow:
         self._reset()
         self._last_counts: Counter[str] = Counter()
         self.estimate_run = np.zeros(N_FIGURES)
-        """The error estimate's figures over the whole run (`engine.companion`)."""
+        """The error estimate's figures over the whole run (`engine.estimator`)."""
         self.stopped_at: float | None = None
         """Stamp (s) from which the twin follows no more (a given initial motion whose stepper
         failed, a start without equilibrium) until a restart; each report says so at ERROR."""
@@ -121,7 +121,7 @@ class HealthWindow:
             self.samples += step_log.shape[0]
 
     def add_estimate(self, figures: np.ndarray) -> None:
-        """The error estimate's companion figures since the last call (`engine.companion`)."""
+        """The error estimate's figures since the last call (`engine.estimator`)."""
         accumulate(self.estimate, figures)
         accumulate(self.estimate_run, figures)
 
@@ -353,7 +353,8 @@ class HealthWindow:
             "est_force_error_rel": f"{est.force_error_rel:.2g}",
             "est_force_error_n": f"{est.force_error_n:.3g}",
             "est_attitude_error_rad": f"{est.attitude_error_rad:.2g}",
-            "est_resyncs": str(est.resyncs),
+            "est_failed_checks": str(est.failed_checks),
+            "est_uncarried_states": str(est.uncarried_states),
             "est_force_error_rel_run": f"{run.force_error_rel:.2g}",
             "est_force_error_n_run": f"{run.force_error_n:.3g}",
             "est_attitude_error_rad_run": f"{run.attitude_error_rad:.2g}",
@@ -522,7 +523,7 @@ def estimate_warning(run: ErrorEstimate) -> str | None:
     """The integration status' warning on the estimated error of everything published so far
     (`run`), None while it is within WARN_FORCE_ERROR_REL of the largest force: the figure of
     the diagnostics and of the replay summary, one definition."""
-    if run.force_error_rel <= WARN_FORCE_ERROR_REL:
+    if not run.force_error_rel > WARN_FORCE_ERROR_REL:  # NaN: nothing estimated yet
         return None
     return (
         f"estimated mount-force error {run.force_error_rel:.2g} of the largest force over the "

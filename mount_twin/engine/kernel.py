@@ -123,16 +123,17 @@ class Published(NamedTuple):
 
 
 watch_mounts = _core.watch_mounts
-"""watch_mounts(y, nl, s, watch, t0, t1, wrenches, settings): `monitor_switches` at t1 (s),
-then each upward zero crossing of an event function since t0 logged into the watch (located by
-linear interpolation; |force| from the wrenches rows)."""
+"""watch_mounts(y, nl, s, watch, t0, t1, wrenches, settings) -> bool: `monitor_switches` at t1
+(s), then each upward zero crossing of an event function since t0 logged into the watch (located
+by linear interpolation; |force| from the wrenches rows); returns whether a mount switched or an
+event function changed sign (the error estimate measures such an interval on its own)."""
 monitor_switches = _core.monitor_switches
 """monitor_switches(y, nl, y_prev, s, g, util, settings): the mounts' event functions g,
 utilisation util and discrete switches at a sample (y_prev: the state at the previous one, then
-y); a switch (y jumped) clears settings[CHAINED]. The twin's watch and the companion both take
-their switches through it."""
+y); a switch (y jumped) clears settings[CHAINED]; returns whether one switched. The twin's
+watch takes its switches through it."""
 run_samples = _core.run_samples
-"""run_samples(integ, m, s, u, y, samples, opts, out, watch, companion) -> (done, status):
+"""run_samples(integ, m, s, u, y, samples, opts, out, watch, estimate) -> (done, status):
 advance y through samples 1..n−1 of `samples`; sample 0 is the last one already done
 (src/core/engine/kernel.hpp; the loop releases the GIL).
 
@@ -143,8 +144,8 @@ Args:
     watch: the non-linear mounts' event functions, utilisation peaks and event log
         (`Watch`, read only where the model has such mounts); events are located by linear
         interpolation inside the sample interval.
-    companion: the error estimate's companion solution (`engine.companion.Companion`), or
-        None (off).
+    estimate: the live error estimate's arrays: `engine.estimator.Estimator` (a model of linear
+        mounts), `engine.companion.Companion` (with non-linear ones), or None (off).
 
 Returns:
     (index of the last sample done, status: 0 when all are done; AT_EVENT when the run ended

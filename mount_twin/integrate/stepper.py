@@ -87,6 +87,25 @@ def new_stepper(
     return Stepper(spec.name, spec.id, settings, np.zeros((rows, n)), np.zeros(n))
 
 
+def tighter_arrays(
+    method: str,
+    n: int,
+    rtol: float,
+    atol: float,
+    max_substeps: int,
+    divisor: float,
+    min_steps: int,
+) -> tuple[int, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(method id, settings, work2d, work1d, result) of a stepper like the twin's (`method`,
+    rtol, atol, max_substeps) at its tolerances over `divisor` and at least `min_steps` steps
+    per interval (up to min_steps × max_substeps): the error estimate's own stepper, the leading
+    fields of `engine.kernel.Integrator` and of the estimate's arrays."""
+    own = new_stepper(
+        method, n, rtol / divisor, atol / divisor, min_steps * max_substeps, min_steps
+    )
+    return own.method, own.settings, own.work2d, own.work1d, own.result
+
+
 def switch(st: Stepper, method: str) -> None:
     """Run `method` (a name in METHODS) with st from now on, its step history forgotten; st's
     work arrays must hold it (a stepper made for AUTO holds any)."""

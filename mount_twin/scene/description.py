@@ -164,7 +164,7 @@ class InitialState:
 class Integration:
     """Stepper settings: method name (or "auto", see `integrate.methods.choose`), relative and
     absolute tolerance (atol in the state's units: m, rad, m/s, rad/s), substep limit per
-    sample, and whether a companion solution estimates the error live (`engine.companion`)."""
+    sample, and whether the error is estimated live (`engine.estimator`)."""
 
     method: str = "auto"
     rtol: float = 1.0e-6

@@ -65,7 +65,7 @@ PARAMETERS: dict[str, tuple[str, str]] = {
     "integration.rtol": ("double", "Relative tolerance of the stepper"),
     "integration.atol": ("double", "Absolute tolerance of the stepper (m, rad, m/s, rad/s)"),
     "integration.max_substeps": ("integer", "Most substeps between two input samples"),
-    "integration.error_estimate": ("bool", "Estimate the error live (a companion at half step)"),
+    "integration.error_estimate": ("bool", "Estimate the error live (sampled, linearised)"),
     "outputs.pose": ("bool", "Publish PoseStamped"),
     "outputs.angles": ("bool", "Publish α, γ, δ as Vector3Stamped, rad"),
     "outputs.wrenches": ("bool", "Publish one WrenchStamped per mount"),

@@ -28,7 +28,9 @@ constexpr int POSITION = 0, QUATERNION = 3, ANGLES = 7, WIDTH = 10;
 }
 
 // The error estimate's figures (engine/estimate.py).
-enum Figure : int { FORCE_ERROR = 0, ATTITUDE_ERROR, FORCE_SCALE, FAILURES, N_FIGURES };
+enum Figure : int {
+  FORCE_ERROR = 0, ATTITUDE_ERROR, FORCE_SCALE, FAILURES, UNCARRIED, N_FIGURES
+};
 
 // run_samples' status when it ended the run at an event that may stiffen the scene.
 constexpr int AT_EVENT = -100;

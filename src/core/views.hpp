@@ -16,6 +16,11 @@ struct Vec {
   double& operator[](idx i) const { return d[i]; }
 };
 
+/// to[i] = from[i] for i < from.n.
+inline void copy(Vec from, Vec to) {
+  for (idx i = 0; i < from.n; ++i) to[i] = from[i];
+}
+
 /// A 2-D float64 array, row-major.
 struct Mat {
   double* d = nullptr;

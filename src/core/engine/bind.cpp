@@ -57,6 +57,45 @@ engine::Watch watch(py::handle obj, idx k, idx n_state) {
   return w;
 }
 
+engine::Estimator estimator(py::handle obj, idx n_state, idx n_mounts) {
+  engine::Estimator c;
+  c.integ = integrator(obj, "Estimator", n_state);
+  c.y = convert::vec(field(obj, "y"), "Estimator.y", n_state);
+  c.s = convert::scratch(field(obj, "s"));
+  convert::check_scratch(c.s, n_state, "Estimator.s");
+  c.y_start = convert::vec(field(obj, "y_start"), "Estimator.y_start", n_state);
+  c.y_end = convert::vec(field(obj, "y_end"), "Estimator.y_end", n_state);
+  c.e = convert::vec(field(obj, "e"), "Estimator.e", n_state);
+  c.carried = convert::vec(field(obj, "carried"), "Estimator.carried");
+  c.n_body = field(obj, "n_body").cast<idx>();
+  const idx np = c.carried.n, n_out = 3 * n_mounts + 3;
+  if (np < 1 || np > n_state || c.n_body < 0 || c.n_body > np) {
+    throw py::value_error("Estimator.carried: " + std::to_string(np) + " slots for " +
+                          std::to_string(n_state) + " states and n_body " +
+                          std::to_string(c.n_body) + " (need n_body <= slots <= states)");
+  }
+  c.jac = convert::vec(field(obj, "jac"), "Estimator.jac", np * np);
+  c.prop = convert::vec(field(obj, "prop"), "Estimator.prop", np * np);
+  c.work = convert::vec(field(obj, "work"), "Estimator.work", 2 * np * np);
+  c.sens = convert::vec(field(obj, "sens"), "Estimator.sens", n_out * np);
+  c.f0 = convert::vec(field(obj, "f0"), "Estimator.f0", n_state);
+  c.f1 = convert::vec(field(obj, "f1"), "Estimator.f1", n_state);
+  c.out0 = convert::vec(field(obj, "out0"), "Estimator.out0", n_out);
+  c.out1 = convert::vec(field(obj, "out1"), "Estimator.out1", n_out);
+  c.ec = convert::vec(field(obj, "ec"), "Estimator.ec", np);
+  c.pc = convert::vec(field(obj, "pc"), "Estimator.pc", np);
+  c.wrenches = convert::matc<6>(field(obj, "wrenches"), "Estimator.wrenches", n_mounts);
+  c.state = convert::vec(field(obj, "state"), "Estimator.state", engine::N_ESTIMATOR_SLOTS);
+  c.figures = convert::vec(field(obj, "figures"), "Estimator.figures", N_FIGURES);
+  const double nc = c.state[engine::N_CARRIED];
+  if (!(c.state[engine::CHECK_EVERY] >= 1.0) || !(c.state[engine::LINEARISE_EVERY] >= 1.0) ||
+      !(nc >= 0.0 && nc <= static_cast<double>(np))) {
+    throw py::value_error("Estimator.state: CHECK_EVERY and LINEARISE_EVERY must be >= 1, "
+                          "N_CARRIED within the slots");
+  }
+  return c;
+}
+
 engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
                             idx k, idx n_events) {
   engine::Companion c;
@@ -76,11 +115,19 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
 }  // namespace
 
 void bind_engine(py::module_& mod) {
+  mod.attr("ESTIMATOR_SLOTS") = py::make_tuple(
+      int(engine::CHECK_EVERY), int(engine::LINEARISE_EVERY), int(engine::PENDING),
+      int(engine::PENDING_NORM),
+      int(engine::PROPAGATOR_STEP), int(engine::ERROR_NORM_MEAN), int(engine::SINCE_LINEARISED),
+      int(engine::N_CARRIED), int(engine::CHECKS), int(engine::LINEARISATIONS),
+      int(engine::N_ESTIMATOR_SLOTS));
+  mod.attr("ENGAGED_CHECK_EVERY") = engine::ENGAGED_CHECK_EVERY;
+  mod.attr("SPIKE_RATIO") = engine::SPIKE_RATIO;
   mod.def(
       "run_samples",
       [](py::handle integ_, py::handle m_, py::handle s_, py::handle u_, py::handle y_,
          py::handle samples_, py::handle opts_, py::handle out_, py::handle watch_,
-         py::handle companion_) {
+         py::handle estimate_) {
         const Model m = convert::model(m_);
         Scratch s = convert::scratch(s_);
         const Vec y = convert::vec(y_, "y");
@@ -116,17 +163,22 @@ void bind_engine(py::module_& mod) {
           throw py::value_error("Published: buffers shorter than the samples");
         }
         engine::Watch w = watch(watch_, k, n_state);
-        engine::Companion c;
+        engine::Estimator est;
+        engine::Estimator* ep = nullptr;
+        engine::Companion comp;
         engine::Companion* cp = nullptr;
-        if (!companion_.is_none()) {
-          c = companion(companion_, n_state, n_mounts, k, w.g.cols);
-          cp = &c;
+        if (py::hasattr(estimate_, "carried")) {
+          est = estimator(estimate_, n_state, n_mounts);
+          ep = &est;
+        } else if (!estimate_.is_none()) {
+          comp = companion(estimate_, n_state, n_mounts, k, w.g.cols);
+          cp = &comp;
         }
         const Vec u = convert::vec(u_, "u", INPUT_SIZE);
         engine::RunResult r;
         {
           py::gil_scoped_release release;  // the loop touches no Python object
-          r = engine::run_samples(integ, m, s, u, y, smp, opts, out, w, cp);
+          r = engine::run_samples(integ, m, s, u, y, smp, opts, out, w, ep, cp);
         }
         return py::make_tuple(r.done, r.status);
       },
@@ -135,7 +187,7 @@ void bind_engine(py::module_& mod) {
       "failure).",
       py::arg("integ"), py::arg("m"), py::arg("s"), py::arg("u"), py::arg("y"),
       py::arg("samples"), py::arg("opts"), py::arg("out"), py::arg("watch"),
-      py::arg("companion"));
+      py::arg("estimate"));
   mod.def(
       "watch_mounts",
       [](py::handle y_, py::handle nl_, py::handle s_, py::handle watch_, double t0, double t1,
@@ -151,11 +203,12 @@ void bind_engine(py::module_& mod) {
             throw py::value_error("wrenches or y: shorter than the mounts need");
           }
         }
-        engine::watch_mounts(y, nl, s, w, t0, t1, wrenches,
-                             convert::vec(settings_, "settings", N_SETTINGS));
+        return engine::watch_mounts(y, nl, s, w, t0, t1, wrenches,
+                                    convert::vec(settings_, "settings", N_SETTINGS));
       },
       "The mounts' monitors and switches at t1 (s), and their events since t0 logged into "
-      "the watch; a switch clears settings[CHAINED].",
+      "the watch; a switch clears settings[CHAINED]. Returns bits: 1 a mount switched or an "
+      "event function changed sign, 2 an event function is at or above zero.",
       py::arg("y"), py::arg("nl"), py::arg("s"), py::arg("watch"), py::arg("t0"), py::arg("t1"),
       py::arg("wrenches"), py::arg("settings"));
   mod.def(
@@ -169,14 +222,30 @@ void bind_engine(py::module_& mod) {
         for (idx i = 0; i < nl.k; ++i) {
           if (nl.state[i] >= y.n) throw py::value_error("y: shorter than the mounts' states");
         }
-        engine::monitor_switches(y, nl, convert::vec(y_prev_, "y_prev", y.n), s,
-                                 convert::mat(g_, "g", nl.k), convert::vec(util_, "util", nl.k),
-                                 convert::vec(settings_, "settings", N_SETTINGS));
+        return engine::monitor_switches(y, nl, convert::vec(y_prev_, "y_prev", y.n), s,
+                                        convert::mat(g_, "g", nl.k),
+                                        convert::vec(util_, "util", nl.k),
+                                        convert::vec(settings_, "settings", N_SETTINGS));
       },
       "The mounts' monitors and discrete switches at a sample (y_prev: the previous state, "
-      "then y); a switch clears settings[CHAINED].",
+      "then y); a switch clears settings[CHAINED]. Returns whether one switched.",
       py::arg("y"), py::arg("nl"), py::arg("y_prev"), py::arg("s"), py::arg("g"),
       py::arg("util"), py::arg("settings"));
+  mod.def(
+      "expm",
+      [](py::handle a_, double scale) {
+        const Mat a = convert::mat(a_, "a");
+        if (a.rows != a.cols) throw py::value_error("a: not square");
+        py::array_t<double> out({a.rows, a.rows}), w({2 * a.rows, a.rows});
+        const Mat o{out.mutable_data(), a.rows, a.rows};
+        const Mat w0{w.mutable_data(), a.rows, a.rows};
+        const Mat w1{w.mutable_data() + a.rows * a.rows, a.rows, a.rows};
+        if (!linalg::expm(a, scale, o, w0, w1)) throw py::value_error("a: not finite");
+        return out;
+      },
+      "exp(scale·a) of a square float64 array (the error estimate's propagator: scaling and "
+      "squaring of a Taylor polynomial, to about 1e-8 relative).",
+      py::arg("a"), py::arg("scale"));
   mod.def(
       "fir_rows",
       [](py::handle raw_, py::handle half_, py::handle out_) {

@@ -1,6 +1,6 @@
 // The per-sample loop: integrate a run of accepted samples, evaluate the outputs, watch the
-// mounts' events and follow the error estimate's companion (engine/kernel.py and
-// engine/companion.py hold the Python side: the same fields, what they mean, who owns them).
+// mounts' events and step the live error estimate (engine/kernel.py and engine/estimator.py
+// hold the Python side: the same fields, what they mean, who owns them).
 #pragma once
 
 #include <cmath>
@@ -11,17 +11,10 @@
 #include "../model.hpp"
 #include "../numeric.hpp"
 #include "../physics/dynamics.hpp"
+#include "estimator.hpp"
+#include "integrator.hpp"
 
 namespace mt::engine {
-
-/// A stepper's id, settings and work arrays (engine/kernel.py Integrator).
-struct Integrator {
-  int method = 0;
-  Vec settings;
-  Mat work2d;
-  Vec work1d;
-  Vec result;
-};
 
 /// Event watch over the non-linear mounts (engine/kernel.py Watch).
 struct Watch {
@@ -60,7 +53,8 @@ struct Published {
   double* cos_tilt_min;  // (1,)
 };
 
-/// The error estimate's companion solution (engine/companion.py Companion).
+/// The error estimate's companion solution, where the model has non-linear mounts
+/// (engine/companion.py Companion; engine/estimator.py says why).
 struct Companion {
   Integrator integ;
   Vec y;
@@ -76,22 +70,26 @@ struct Companion {
 /// The mounts' monitors and discrete switches at a sample (y_prev: the state at the previous
 /// one, then y); a switch (y jumped) clears the stepper's chain flag: its last stage is not
 /// at this y.
-inline void monitor_switches(Vec y, const NonLinear& nl, Vec y_prev, Scratch& s, Mat g, Vec util,
+inline bool monitor_switches(Vec y, const NonLinear& nl, Vec y_prev, Scratch& s, Mat g, Vec util,
                              Vec settings) {
-  if (physics::mount_monitors(y, y_prev, nl, s, g, util)) settings[CHAINED] = 0.0;
+  const bool switched = physics::mount_monitors(y, y_prev, nl, s, g, util);
+  if (switched) settings[CHAINED] = 0.0;
   for (idx i = 0; i < y.n; ++i) y_prev[i] = y[i];
+  return switched;
 }
 
 /// `monitor_switches` at t1, then log each upward zero crossing of an event function since t0
-/// (located by linear interpolation).
-inline void watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, double t0, double t1,
+/// (located by linear interpolation). Returns `Watched` bits.
+inline int watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, double t0, double t1,
                          M6 wrenches, Vec settings) {
-  monitor_switches(y, nl, w.y_prev, s, w.g, w.util, settings);
+  bool changed = monitor_switches(y, nl, w.y_prev, s, w.g, w.util, settings), engaged = false;
   for (idx i = 0; i < w.g.rows; ++i) {
     w.util_peak[i] = py_max(w.util_peak[i], w.util[i]);
     for (idx e = 0; e < w.g.cols; ++e) {
       const double g0 = w.g_prev(i, e), g1 = w.g(i, e);
       w.g_prev(i, e) = g1;
+      changed = changed || ((g0 < 0.0) != (g1 < 0.0));
+      engaged = engaged || g1 >= 0.0;
       if (g0 < 0.0 && 0.0 <= g1) {
         if (w.stiffens(i, e) > 0.0) *w.n_stiffening += 1;
         const idx k = *w.n_events;
@@ -107,6 +105,7 @@ inline void watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, doubl
       }
     }
   }
+  return (changed ? CHANGED : 0) | (engaged ? ENGAGED : 0);
 }
 
 /// Advance the companion over [t0, t1] under the input u the twin just took, and fold the
@@ -158,10 +157,11 @@ struct RunResult {
 
 /// Advance y through samples 1..n−1; sample 0 is the last one already done
 /// (engine/kernel.py run_samples says what each argument holds). The watch is read only
-/// where the model has non-linear mounts; `companion` null: no error estimate.
+/// where the model has non-linear mounts; the error estimate is `estimator` or `companion`
+/// (null: none).
 inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec u, Vec y,
                              const Samples& smp, const RunOptions& opts, Published& out,
-                             Watch& watch, Companion* companion) {
+                             Watch& watch, Estimator* estimator, Companion* companion) {
   const idx n = smp.t.n, nm = out.peak.rows;
   const double hold = opts.zero_order ? 0.0 : 1.0;
   const Vec d_wdot = s.rate_step, settings = integ.settings;
@@ -182,15 +182,22 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
     } else {
       settings[CHAINED] = 0.0;
     }
+    if (estimator != nullptr) copy(y, estimator->y_start);
     const int status = integrate::advance(integ.method, y, smp.t[j - 1], smp.t[j], settings, m,
                                           s, u, integ.work2d, integ.work1d, integ.result);
     if (status != 0) return {j - 1, status};
+    if (estimator != nullptr) copy(y, estimator->y_end);
     const idx stiffening = *watch.n_stiffening;
     for (int k = 0; k < 3; ++k) out.step_log(j, k) = integ.result[k];
     const M6 wrenches_j = out.wrenches.mat(j);
     physics::outputs(y, m, s, out.pose.row(j), wrenches_j);
+    int watched = 0;
     if (m.has_nl) {
-      watch_mounts(y, m.nl, s, watch, smp.t[j - 1], smp.t[j], wrenches_j, settings);
+      watched = watch_mounts(y, m.nl, s, watch, smp.t[j - 1], smp.t[j], wrenches_j, settings);
+    }
+    if (estimator != nullptr) {
+      estimate_interval(m, *estimator, u, smp.t[j - 1], smp.t[j], watched, integ.result,
+                        wrenches_j, y);
     }
     if (companion != nullptr) {
       follow(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, d_wdot, out.pose.row(j),

@@ -1,0 +1,244 @@
+// The live global error estimate: local errors measured on a sample of the input intervals,
+// carried forward by the linearised dynamics (engine/estimator.py holds the method, its
+// figures and who owns which array; this is the per-interval step the loop calls).
+#pragma once
+
+#include <cmath>
+
+#include "../constants.hpp"
+#include "../integrate/control.hpp"
+#include "../integrate/fd_jacobian.hpp"
+#include "../integrate/stepper.hpp"
+#include "../linalg.hpp"
+#include "../model.hpp"
+#include "../numeric.hpp"
+#include "../physics/dynamics.hpp"
+#include "integrator.hpp"
+
+namespace mt::engine {
+
+/// Slots of the estimator's small state vector (engine/estimator.py: the same names): its
+/// settings (CHECK_EVERY, LINEARISE_EVERY, set once), then what it keeps between intervals.
+enum EstimatorSlot : int {
+  CHECK_EVERY = 0,    // a measured interval counts for at most this many
+  LINEARISE_EVERY,    // regular checks between linearisations
+  PENDING,            // intervals not measured since the last check
+  PENDING_NORM,       // the twin's error norms of those intervals, summed
+  PROPAGATOR_STEP,    // s, the interval the propagator is for (0: none held)
+  ERROR_NORM_MEAN,    // running mean of the twin's error norm
+  SINCE_LINEARISED,   // regular checks since the last linearisation
+  N_CARRIED,          // states carried (their indices: `carried`)
+  CHECKS,             // intervals measured since the start
+  LINEARISATIONS,     // linearisations since the start
+  N_ESTIMATOR_SLOTS
+};
+
+/// What the mounts' watch saw at a sample (engine/kernel.hpp watch_mounts), as bits: a mount
+/// switched or an event function changed sign over the interval (CHANGED); an event function is
+/// at or above zero, a mount's event under way (ENGAGED: in contact, slipping, open).
+enum Watched : int { CHANGED = 1, ENGAGED = 2 };
+
+/// While a mount is ENGAGED its stiffness moves with the state (a Hertzian contact, a slipping
+/// face): a regular check comes every ENGAGED_CHECK_EVERY intervals, and linearises again.
+constexpr double ENGAGED_CHECK_EVERY = 4.0;
+
+/// The twin's error norm of an interval is a spike (the interval is checked on its own) above
+/// this multiple of its running mean.
+constexpr double SPIKE_RATIO = 4.0;
+/// The propagator held serves an interval whose length is within this share of its own.
+constexpr double STEP_MATCH = 1e-6;
+/// Weight of the newest interval in the running mean of the twin's error norm.
+constexpr double MEAN_WEIGHT = 0.1;
+
+/// The estimator's arrays (engine/estimator.py Estimator). n states; at most np_max carried:
+/// the body's and the internal states that move where it last linearised (`carried`).
+struct Estimator {
+  Integrator integ;  // the checking stepper (the twin's method at tighter tolerances)
+  Vec y;             // (n,) the check's state; the Jacobian's trial states
+  Scratch s;         // its scratch
+  Vec y_start;       // (n,) the twin's state at the interval's start
+  Vec y_end;         // (n,) the twin's state after its step, before the mounts' switches
+  Vec e;             // (n,) the estimated global error of the twin's state
+  Vec carried;       // (np_max,) indices into y of the carried states (first N_CARRIED)
+  Vec jac;           // (np_max²,) ∂f/∂y over the carried states (row-major, N_CARRIED²)
+  Vec prop;          // (np_max²,) exp(h·jac): the error's propagator over an interval of h
+  Vec work;          // (2·np_max²,)
+  Vec sens;          // ((3·nm + 3)·np_max,) ∂(mount forces, α γ δ)/∂(carried states)
+  Vec f0, f1;        // (n,)
+  Vec out0, out1;    // (3·nm + 3,)
+  Vec ec, pc;        // (np_max,) the carried error, gathered; its propagation
+  M6 wrenches;       // (nm, 6)
+  Vec state;         // (N_ESTIMATOR_SLOTS,)
+  Vec figures;       // (N_FIGURES,)
+  idx n_body;        // the body's states (2 × free coordinates): always carried first
+};
+
+/// Square n×n view on the first n² entries of a buffer.
+inline Mat square(Vec buffer, idx n) { return Mat{buffer.d, n, n}; }
+
+/// The estimated outputs at y (s holding its body motion): every mount's force components
+/// (N, mount axes), then α, γ, δ (rad).
+inline void estimated_outputs(Vec y, const Model& m, Scratch& s, M6 wrenches, Vec out) {
+  physics::mount_wrenches(y, m, s, wrenches);
+  const idx nm = wrenches.rows;
+  for (idx a = 0; a < nm; ++a) {
+    for (int b = 0; b < 3; ++b) out[3 * a + b] = wrenches(a, b);
+  }
+  for (int i = 0; i < 3; ++i) out[3 * nm + i] = s.q[3 + i];
+}
+
+/// The propagator over an interval of h from the Jacobian held; false if it is not finite.
+inline bool propagator(Estimator& est, double h) {
+  const idx nc = static_cast<idx>(est.state[N_CARRIED]);
+  const Mat w0{est.work.d, nc, nc}, w1{est.work.d + nc * nc, nc, nc};
+  est.state[LINEARISATIONS] += 1.0;
+  if (!linalg::expm(square(est.jac, nc), h, square(est.prop, nc), w0, w1)) return false;
+  est.state[PROPAGATOR_STEP] = h;
+  return true;
+}
+
+/// Choose the carried states at est.y (f0 = f there): the body's, then each internal state
+/// whose rate is not zero (a Bouc–Wen z under motion, a slip while slipping; not a stuck
+/// joint, a fracture flag), up to np_max; returns how many moving ones did not fit.
+inline idx choose_carried(Estimator& est) {
+  const idx n = est.y.n, np_max = est.carried.n;
+  idx nc = 0, left_out = 0;
+  for (idx i = 0; i < n; ++i) {
+    if (i >= est.n_body && est.f0[i] == 0.0) continue;
+    if (nc < np_max) {
+      est.carried[nc++] = static_cast<double>(i);
+    } else {
+      ++left_out;
+    }
+  }
+  est.state[N_CARRIED] = static_cast<double>(nc);
+  return left_out;
+}
+
+/// Jacobian and output sensitivities at (t, est.y) by forward differences (the steppers'
+/// JAC_STEP) over the carried states, chosen afresh, then the propagator over h. False if an
+/// evaluation failed (off the chart).
+inline bool linearise_at(const Model& m, Estimator& est, Vec u, double t, double h) {
+  Scratch& s = est.s;
+  const Vec y = est.y;
+  const idx n_out = est.out0.n;
+  if (physics::rhs(t, y, m, s, u, est.f0) != OK) return false;
+  estimated_outputs(y, m, s, est.wrenches, est.out0);
+  est.figures[UNCARRIED] = py_max(est.figures[UNCARRIED],
+                                  static_cast<double>(choose_carried(est)));
+  const idx nc = static_cast<idx>(est.state[N_CARRIED]);
+  const Mat jac = square(est.jac, nc), sens{est.sens.d, n_out, nc};
+  const Vec set = est.integ.settings;
+  const double typical = py_min(py_max(set[ATOL] / set[RTOL], 1e-6), 1.0);
+  for (idx c = 0; c < nc; ++c) {
+    const idx col = static_cast<idx>(est.carried[c]);
+    const double keep = y[col];
+    y[col] = keep + integrate::JAC_STEP * py_max(std::fabs(keep), typical);
+    const double d = y[col] - keep;
+    const bool bad = physics::rhs(t, y, m, s, u, est.f1) != OK;
+    if (!bad) estimated_outputs(y, m, s, est.wrenches, est.out1);
+    y[col] = keep;
+    if (bad) return false;
+    for (idx r = 0; r < nc; ++r) {
+      const idx row = static_cast<idx>(est.carried[r]);
+      jac(r, c) = (est.f1[row] - est.f0[row]) / d;
+    }
+    for (idx r = 0; r < n_out; ++r) sens(r, c) = (est.out1[r] - est.out0[r]) / d;
+  }
+  est.state[SINCE_LINEARISED] = 0.0;
+  return propagator(est, h);
+}
+
+/// The twin's local error over [t0, t1]: est.y_end less the checking stepper's solution from
+/// est.y_start under the same input u; false (nothing measured) if the check failed.
+inline bool local_error(const Model& m, Estimator& est, Vec u, double t0, double t1) {
+  const Integrator& c = est.integ;
+  copy(est.y_start, est.y);
+  c.settings[CHAINED] = 0.0;  // the state jumped: no last stage, no Jacobian held (the step
+  c.settings[JACOBIAN_AGE] = 0.0;  // proposal is kept: it suits the next check)
+  c.settings[PHI_STEP] = 0.0;
+  est.state[CHECKS] += 1.0;
+  const int status = integrate::advance(c.method, est.y, t0, t1, c.settings, m, est.s, u,
+                                        c.work2d, c.work1d, c.result);
+  if (status != SUCCESS) integrate::forget(c.settings);
+  return status == SUCCESS;
+}
+
+/// How many intervals a regular check's local error stands for: the `pending` ones (itself
+/// included) in proportion to the twin's error norms, their sum `pending_norm` over its own
+/// `norm` (a ratio estimate: ℓ follows the norm as the motion's envelope changes, so a shock's
+/// onset after quiet intervals is not counted as many loud ones), within 1 and `pending` (a
+/// quiet check does not stand for more than the intervals it follows: the loud ones among
+/// them were spikes, measured on their own).
+inline double stands_for(double pending, double pending_norm, double norm) {
+  if (!(norm > 0.0)) return pending;
+  return py_min(py_max(pending_norm / norm, 1.0), pending);
+}
+
+/// e ← propagator · e over the carried states (the others are held).
+inline void carry(Estimator& est) {
+  const idx nc = static_cast<idx>(est.state[N_CARRIED]);
+  for (idx c = 0; c < nc; ++c) est.ec[c] = est.e[static_cast<idx>(est.carried[c])];
+  linalg::matvec(square(est.prop, nc), est.ec.d, est.pc.d);
+  for (idx c = 0; c < nc; ++c) est.e[static_cast<idx>(est.carried[c])] = est.pc[c];
+}
+
+/// One input interval [t0, t1] of the estimate, after the twin's step: carry the error over
+/// it; measure the twin's local error where the interval is special (`watched` CHANGED, or the
+/// twin rejected a step, or its error norm spiked) or where CHECK_EVERY intervals are pending
+/// (ENGAGED_CHECK_EVERY while a mount is engaged; it then counts for them); linearise again at
+/// the twin's state y after a mount's event, at every check while one is engaged, and every
+/// LINEARISE_EVERY regular checks; fold the estimated errors of the outputs into the figures.
+/// twin_result: the twin's stepper result [error norm, accepted, rejected]; wrenches: the
+/// twin's at t1.
+inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, double t1,
+                              int watched, Vec twin_result, M6 wrenches, Vec y) {
+  const bool changed = (watched & CHANGED) != 0, engaged = (watched & ENGAGED) != 0;
+  const Vec st = est.state, fig = est.figures, e = est.e;
+  const idx nm = wrenches.rows, n_out = est.out1.n;
+  const double h = t1 - t0;
+  bool linearised = st[PROPAGATOR_STEP] > 0.0;
+  if (linearised && std::fabs(h - st[PROPAGATOR_STEP]) > STEP_MATCH * h) {
+    linearised = propagator(est, h);
+  }
+  if (linearised) carry(est);
+  const double err = twin_result[0];
+  const bool spike = err > SPIKE_RATIO * st[ERROR_NORM_MEAN];
+  st[ERROR_NORM_MEAN] += MEAN_WEIGHT * (err - st[ERROR_NORM_MEAN]);
+  const bool special = changed || twin_result[2] > 0.0 || spike;
+  st[PENDING] += 1.0;
+  if (!special) st[PENDING_NORM] += err;
+  const double every = engaged ? py_min(st[CHECK_EVERY], ENGAGED_CHECK_EVERY) : st[CHECK_EVERY];
+  const bool regular = !special && st[PENDING] >= every;
+  if (special || regular || !linearised) {
+    if (local_error(m, est, u, t0, t1)) {
+      const double weight = special ? 1.0 : stands_for(st[PENDING], st[PENDING_NORM], err);
+      for (idx i = 0; i < y.n; ++i) e[i] += weight * (est.y_end[i] - est.y[i]);
+    } else {
+      fig[FAILURES] += 1.0;
+    }
+    st[PENDING] = special ? st[PENDING] - 1.0 : 0.0;
+    if (!special) st[PENDING_NORM] = 0.0;
+    if (regular) st[SINCE_LINEARISED] += 1.0;
+    if (changed || engaged || !linearised || st[SINCE_LINEARISED] >= st[LINEARISE_EVERY]) {
+      copy(y, est.y);
+      if (!linearise_at(m, est, u, t1, h)) st[PROPAGATOR_STEP] = 0.0;
+    }
+  }
+  const idx nc = static_cast<idx>(st[N_CARRIED]);
+  for (idx c = 0; c < nc; ++c) est.ec[c] = e[static_cast<idx>(est.carried[c])];
+  linalg::matvec(Mat{est.sens.d, n_out, nc}, est.ec.d, est.out1.d);
+  double force = fig[FORCE_ERROR], scale = fig[FORCE_SCALE], attitude = fig[ATTITUDE_ERROR];
+  for (idx a = 0; a < nm; ++a) {
+    for (int b = 0; b < 3; ++b) {
+      force = py_max(force, std::fabs(est.out1[3 * a + b]));
+      scale = py_max(scale, std::fabs(wrenches(a, b)));
+    }
+  }
+  for (idx i = 3 * nm; i < n_out; ++i) attitude = py_max(attitude, std::fabs(est.out1[i]));
+  fig[FORCE_ERROR] = force;
+  fig[FORCE_SCALE] = scale;
+  fig[ATTITUDE_ERROR] = attitude;
+}
+
+}  // namespace mt::engine
