@@ -46,7 +46,6 @@ from mount_twin.engine.kernel import (
     new_watch,
     run_samples,
 )
-from mount_twin.engine.linear_rating import LinearRatings
 from mount_twin.engine.restart import start_state
 from mount_twin.integrate.methods import AUTO
 from mount_twin.integrate.stepper import STATUS_TEXT, new_stepper, switch
@@ -237,10 +236,17 @@ class TwinEngine:
         self._watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state, stiffens)
         self.events: list[MountEvent] = []
         """Every mount event so far, in time order (the first MAX_EVENTS; the rest counted)."""
-        self._ratings = LinearRatings(scene)
-        self._rated = np.array([*model.nonlinear_slots, *self._ratings.slots], dtype=np.int64)
+        lin_slots = model.arrays.lin_slot.tolist()
+        rated = model.arrays.lin_per_rating.any(axis=1)
+        self._lin_rated = np.flatnonzero(rated)
+        """The rated linear mounts, as indices among the linear ones (the core's order)."""
+        self._rated = np.array(
+            [*model.nonlinear_slots, *(lin_slots[i] for i in self._lin_rated)], dtype=np.int64
+        )
         """Mounts with a utilisation: the non-linear ones (their watch), then rated linear ones."""
-        self._linear_util = np.zeros(len(self._ratings.slots))
+        self._linear_util = np.zeros(len(lin_slots))
+        """Every linear mount's peak utilisation since the window's last report (the core
+        folds it in at every sample; unrated ones stay 0)."""
         self._util_max = np.zeros(self._rated.shape[0])
         # Chaining the stepper's last stage into the next interval needs a continuous input
         # (first-order hold); a discrete switch of the state between samples (a bolt breaking)
@@ -340,6 +346,7 @@ class TwinEngine:
             np.zeros((n, 3)),
             np.zeros((nm, 6)),
             np.ones(1),
+            self._linear_util,
         )
 
     @property
@@ -380,7 +387,7 @@ class TwinEngine:
 
     def _window_utilisation(self) -> np.ndarray:
         """Peak utilisation since the last report of the mounts in `_rated`, in its order."""
-        return np.concatenate([self._watch.util_peak, self._linear_util])
+        return np.concatenate([self._watch.util_peak, self._linear_util[self._lin_rated]])
 
     def count(self, what: str, n: int = 1) -> None:
         """Count events found outside the engine (e.g. undecodable messages) with its own.
@@ -496,11 +503,6 @@ class TwinEngine:
                     frame.stamps[published.sample[-1]],
                     *published.peaks,
                 )
-            np.maximum(
-                self._linear_util,
-                self._ratings.utilisation(published.pose, published.wrenches),
-                out=self._linear_util,
-            )
 
     def _outputs(
         self, frame: Frame, rows: _BatchRows, parts: list[_Rows], reports: list[HealthReport]
@@ -752,7 +754,12 @@ class TwinEngine:
                 self._watch,
                 self._estimator,
             )
-            pose, wrenches, publish, step_log, abs_max, cos_tilt = out_buf[2:]
+            pose, wrenches, publish = out_buf.pose, out_buf.wrenches, out_buf.publish
+            step_log, abs_max, cos_tilt = (
+                out_buf.step_log,
+                out_buf.wrench_abs_max,
+                out_buf.cos_tilt_min,
+            )
             peaks = abs_max, float(cos_tilt[0])
             events = self._drain_events()
             self.health.add_steps(step_log[1 : done + 1])

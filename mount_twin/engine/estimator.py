@@ -31,7 +31,7 @@ fan"). The estimate follows that recursion with
   to a later time, the local errors of a free oscillation arrive in phase (Φ(t, tₙ)·ℓₙ is
   constant in n), a forced one's drift at the beat of forcing and mode. Where they do not add
   up in phase (a lightly damped mode above the sample rate's Nyquist, contact chatter) it
-  over-counts, up to 6.6× measured; measuring every interval (`check_every=1`) is then within
+  over-counts, up to 13× measured; measuring every interval (`check_every=1`) is then within
   1.07–1.33 (test/test_error_estimate.py).
 
 The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities differenced with J).
@@ -70,14 +70,14 @@ MIN_STEPS = 2
 """The checking stepper's fewest steps per input interval."""
 DENSE_MAX = 64
 """The most states carried (the body's first, then the internal states that move)."""
-CHECK_EVERY = 16
+CHECK_EVERY = 32
 """A measured interval counts for at most this many (one in CHECK_EVERY is measured)."""
 ENGAGED_CHECK_EVERY = _core.ENGAGED_CHECK_EVERY
 """The same while a mount is engaged (the core's constant)."""
 SPIKE_RATIO = _core.SPIKE_RATIO
 """An interval whose twin's error norm is above this multiple of its running mean is measured
 on its own (the core's constant)."""
-LINEARISE_EVERY = 4
+LINEARISE_EVERY = 2
 """Regular checks between linearisations (a mount's event linearises at once)."""
 (
     CHECK_EVERY_SLOT,

@@ -108,6 +108,9 @@ class Published(NamedTuple):
     step_log: out (n, 3) per sample: error norm, accepted and rejected substeps.
     wrench_abs_max: out (nm, 6), zeros on entry: the largest |component| of the published
         wrenches (N, N·m), folded in while they are in cache (the health window's peaks).
+    lin_util: (n_lin,) each linear mount's utilisation (its largest |travel|/rated travel and
+        |force|/rated load over its axes, `ModelArrays.lin_per_rating`) folded in as a running
+        maximum at every sample (carried; the reader resets it).
     cos_tilt_min: out (1,), 1 on entry: the smallest cos θ (R₃₃, body z against F's z) of the
         published poses.
     """
@@ -120,6 +123,7 @@ class Published(NamedTuple):
     step_log: np.ndarray
     wrench_abs_max: np.ndarray
     cos_tilt_min: np.ndarray
+    lin_util: np.ndarray
 
 
 watch_mounts = _core.watch_mounts

@@ -60,6 +60,11 @@ class Model:
         return new_scratch(self.n_state)
 
 
+def _inverse(rated: tuple[float, ...]) -> list[float]:
+    """1/rating per axis, 0 where unrated (0)."""
+    return [1.0 / v if v > 0.0 else 0.0 for v in rated]
+
+
 def assemble(scene: Scene) -> Model:
     """Build the core's arrays of `scene` (done once, at load)."""
     body = scene.body
@@ -97,6 +102,9 @@ def assemble(scene: Scene) -> Model:
         lin_k_r=in_f(lin_axes, stiffness[:, 3:]),
         lin_c_r=in_f(lin_axes, damping[:, 3:]),
         lin_slot=np.array(lin, dtype=np.int64),
+        lin_per_rating=np.array(
+            [_inverse((*mounts[i].rated_travel, *mounts[i].rated_load)) for i in lin]  # type: ignore[union-attr]
+        ).reshape(-1, 6),
         nl=nl,
         rotation_read=bool(lin) or (nl is not None and bool(nl.rotational.any())),
     )

@@ -60,6 +60,8 @@ class ModelArrays(NamedTuple):
     lin_k_r: np.ndarray  # (n, 3, 3) N·m/rad in F
     lin_c_r: np.ndarray  # (n, 3, 3) N·m·s/rad in F
     lin_slot: np.ndarray  # int64 (n,): each linear mount's index in the scene (wrench row)
+    lin_per_rating: np.ndarray  # (n, 6): 1/rated travel (1/m), then 1/rated load (1/N), along
+    # the mount's axes x, y, z; 0 where unrated (`engine.kernel.Published.lin_util`)
     nl: NonLinearMounts | None  # the other kinds; None compiles their code away
     rotation_read: bool  # a mount reads the body's rotation vector (linear ones, rotational kinds)
 

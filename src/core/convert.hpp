@@ -146,6 +146,7 @@ inline Model model(py::handle m) {
   out.lin_k_r = matsrc<3, 3>(field(m, "lin_k_r"), "ModelArrays.lin_k_r", n);
   out.lin_c_r = matsrc<3, 3>(field(m, "lin_c_r"), "ModelArrays.lin_c_r", n);
   out.lin_slot = ivec(field(m, "lin_slot"), "ModelArrays.lin_slot", n);
+  out.lin_per_rating = matc<6>(field(m, "lin_per_rating"), "ModelArrays.lin_per_rating", n);
   auto nl = field(m, "nl");
   out.has_nl = !nl.is_none();
   if (out.has_nl) out.nl = nonlinear(nl);

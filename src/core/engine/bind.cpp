@@ -158,6 +158,8 @@ void bind_engine(py::module_& mod) {
         out.wrench_abs_max =
             convert::matc<6>(field(out_, "wrench_abs_max"), "Published.wrench_abs_max", n_mounts);
         out.cos_tilt_min = scalar(field(out_, "cos_tilt_min"), "Published.cos_tilt_min");
+        out.lin_util =
+            convert::vec(field(out_, "lin_util"), "Published.lin_util", m.lin_point.rows);
         if (out.pose.rows < n || out.wrenches.n < n || publish.shape(0) < n ||
             out.step_log.rows < n) {
           throw py::value_error("Published: buffers shorter than the samples");

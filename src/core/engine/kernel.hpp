@@ -51,6 +51,7 @@ struct Published {
   Mat step_log;   // (n, 3)
   M6 wrench_abs_max;  // (nm, 6)
   double* cos_tilt_min;  // (1,)
+  Vec lin_util;        // (n_lin,) running maxima of the linear mounts' utilisation
 };
 
 /// The error estimate's companion solution, where the model has non-linear mounts
@@ -191,6 +192,7 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
     for (int k = 0; k < 3; ++k) out.step_log(j, k) = integ.result[k];
     const M6 wrenches_j = out.wrenches.mat(j);
     physics::outputs(y, m, s, out.pose.row(j), wrenches_j);
+    physics::linear_utilisation(m, s, wrenches_j, out.lin_util);
     int watched = 0;
     if (m.has_nl) {
       watched = watch_mounts(y, m.nl, s, watch, smp.t[j - 1], smp.t[j], wrenches_j, settings);

@@ -11,7 +11,10 @@
 // undamped body on anisotropic rotational springs turned 0.4 rad drifted by 9 % of its energy).
 #pragma once
 
+#include <cmath>
+
 #include "../model.hpp"
+#include "../numeric.hpp"
 
 namespace mt::physics {
 
@@ -50,6 +53,27 @@ inline void linear_mount_load(idx i, const Model& m, const Scratch& s, Vec arm, 
   const M3 cmap = s.couple_map;
   for (int j = 0; j < 3; ++j) {
     couple[j] = -(cmap(j, 0) * g[0] + cmap(j, 1) * g[1] + cmap(j, 2) * g[2]);
+  }
+}
+
+/// Fold each linear mount's utilisation at the body motion in s into peak (running maxima):
+/// the largest over its axes of |travel| / rated travel and |force| / rated load (the travel
+/// Qᵀ·d from the reference pose, the force from its wrench row in its axes; m.lin_per_rating
+/// holds the inverse ratings, 0 where unrated).
+inline void linear_utilisation(const Model& m, const Scratch& s, M6 wrenches, Vec peak) {
+  double arm_d[3], de[6];
+  const Vec arm{arm_d, 3};
+  const M33s& axes = m.lin_axes;
+  for (idx i = 0; i < m.lin_point.rows; ++i) {
+    point_motion(&m.lin_point(i, 0), s.rot, s.q, s.qd, s.omega_f, arm, de);
+    const idx row = m.lin_slot[i];
+    double u = peak[i];
+    for (int j = 0; j < 3; ++j) {
+      const double travel = axes(i, 0, j) * de[0] + axes(i, 1, j) * de[1] + axes(i, 2, j) * de[2];
+      u = py_max(u, std::fabs(travel) * m.lin_per_rating(i, j));
+      u = py_max(u, std::fabs(wrenches(row, j)) * m.lin_per_rating(i, 3 + j));
+    }
+    peak[i] = u;
   }
 }
 
