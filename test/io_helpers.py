@@ -27,7 +27,8 @@ ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / "config"
 SCENE_FILE = CONFIG / "pump_8_mounts.scene.yaml"
 PARAMS_FILE = CONFIG / "params.yaml"
-REAL_DIR = ROOT.parent / "shared" / "data" / "real"
+DATA_DIR = ROOT / "test" / "data"
+"""Excerpts of real records, each with its provenance and license (`*.md` beside it)."""
 G = 9.80665
 REST = np.array([0.0, 0.0, G])
 """Specific force of a foundation at rest, m/s², in F (gravity included: +g up)."""

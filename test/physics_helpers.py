@@ -1,6 +1,6 @@
 """Independent reference helpers for the physics tests (not a conftest: import explicitly).
 
-Everything here is written from the physics notes (/work/shared/docs/physics.md) and textbook
+Everything here is written from the physics notes (docs/physics.md) and textbook
 mechanics, without calling the package's numerics, so the tests compare the twin against an
 independent truth. The only package calls are thin drivers (scene building, stepping).
 """

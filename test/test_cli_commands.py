@@ -8,13 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from io_helpers import REAL_DIR, SCENE_FILE, read_bag, stamp_ns
+from io_helpers import DATA_DIR, SCENE_FILE, read_bag, stamp_ns
 from rosbags.highlevel import AnyReader
 
 from mount_twin.cli import main
 from mount_twin.io.messages import IMU, TYPESTORE
 
-WATER_ENTRY = REAL_DIR / "water_entry_shock_20khz.csv"
+WATER_ENTRY = DATA_DIR / "water_entry_shock_20khz_excerpt.csv"
 
 
 def _scene_file(tmp_path: Path, **input_changes: object) -> Path:
@@ -280,14 +280,13 @@ def test_imported_small_csv_replays_through_a_scene_with_matching_input(
     ]
 
 
-@pytest.mark.skipif(not WATER_ENTRY.exists(), reason=f"{WATER_ENTRY} not present")
 def test_water_entry_csv_imports_and_replays(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     bag = tmp_path / "water_entry"
     assert main(["import-csv", str(WATER_ENTRY), "-o", str(bag)]) == 0
-    assert "wrote 19999 sensor_msgs/msg/Imu messages on /deck/imu" in capsys.readouterr().out
-    # Only the pose is needed here: keep the output small (20 kHz × 10 topics is 200k messages).
+    assert "wrote 5000 sensor_msgs/msg/Imu messages on /deck/imu" in capsys.readouterr().out
+    # Only the pose is needed here: keep the output small (20 kHz × 10 topics is 50k messages).
     data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
     data["input"].update(topic="/deck/imu", frame_id="deck_imu")
     data["outputs"].update(angles=False, wrenches=False, tf=False)
@@ -296,7 +295,7 @@ def test_water_entry_csv_imports_and_replays(
     out = tmp_path / "out"
     assert main(["replay", str(bag), "--scene", str(scene), "-o", str(out), "--no-progress"]) == 0
     text = capsys.readouterr().out
-    assert "19999 received, 19999 accepted" in text
+    assert "5000 received, 5000 accepted" in text
     assert "gaps: 0, restarts: 0, integration failures: 0" in text
     _, msgs = read_bag(out)
     pos = np.array(
@@ -305,6 +304,6 @@ def test_water_entry_csv_imports_and_replays(
             for _, m in msgs["/mount_twin/pose"]
         ]
     )
-    assert pos.shape == (19999, 3) and np.isfinite(pos).all()
+    assert pos.shape == (5000, 3) and np.isfinite(pos).all()
     disp = np.linalg.norm(pos - np.array(data["body"]["cg"]), axis=1).max()
     assert disp < 0.2, f"a 47 g, ms-long shock moved the CG by {disp} m"

@@ -11,12 +11,11 @@ independent formulation is test_physics_rotating_foundation.py's), gyro noise at
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
-from io_helpers import batch, engine_for, scene_with, split
+from io_helpers import DATA_DIR, batch, engine_for, scene_with, split
 
 from mount_twin.analysis.deck_motion import SHIP, DeckMotion, deck_samples, rolling
 from mount_twin.commands.common import share_dir
@@ -26,7 +25,7 @@ from mount_twin.errors import SceneError
 from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import load_scene_file, scene_from_dict
 
-RESTING = Path(__file__).resolve().parent / "data" / "water_entry_rest_20khz_excerpt.csv"
+RESTING = DATA_DIR / "water_entry_rest_20khz_excerpt.csv"
 PASSBAND_HZ, STOPBAND_HZ = 20.0, 100.0
 
 
