@@ -6,6 +6,7 @@ estimate that bounds the true one-step error on y' = λy and on the twin's own o
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import math
 from collections.abc import Iterator
@@ -16,7 +17,7 @@ import numpy as np
 import pytest
 from physics_helpers import base_scene, build, gravity_u, mount
 
-from mount_twin.errors import SceneError
+from mount_twin.errors import ModelError, SceneError
 from mount_twin.integrate import methods, stepper
 from mount_twin.integrate.methods import METHODS, STATUS_TEXT, UNKNOWN_METHOD
 from mount_twin.integrate.settings import JACOBIAN_AGE
@@ -133,6 +134,19 @@ def test_an_unknown_method_is_refused_by_name() -> None:
         scene_from_dict(data, "x.yaml")
     with pytest.raises(ValueError, match="unknown integration method 'rk4'"):
         stepper.new_stepper("rk4", 3, 1e-6, 1e-9, 10)
+
+
+def test_a_method_registered_without_its_core_branch_is_refused_at_import() -> None:
+    """An entry in METHODS whose id the core does not dispatch, or whose work rows disagree
+    with the core's, is refused by name before any scene runs it (it would otherwise load, then
+    fail every interval)."""
+    rk4 = dataclasses.replace(METHODS["dopri54"], name="rk4", id=len(METHODS), stages=4)
+    with pytest.raises(ModelError, match=r"'rk4' \(id 3\) has no branch"):
+        stepper.check_methods({**METHODS, "rk4": rk4})
+    short = dataclasses.replace(METHODS["dopri54"], stages=4)
+    with pytest.raises(ModelError, match="'dopri54': the core needs 7 work rows, its entry says"):
+        stepper.check_methods({"dopri54": short})
+    stepper.check_methods(METHODS)
 
 
 def oscillator(omega: float = 2.0 * math.pi * 50.0) -> tuple:

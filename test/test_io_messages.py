@@ -11,6 +11,7 @@ from io_helpers import REST, G, batch, default_scene, engine_for, scene_with, st
 from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus, OutputBatch
 from mount_twin.io.messages import (
     ACCEL,
+    ANGLES_OUTPUT,
     DIAGNOSTICS,
     IMU,
     OUTPUTS,
@@ -19,11 +20,13 @@ from mount_twin.io.messages import (
     TYPESTORE,
     VECTOR3,
     WRENCH,
+    WRENCHES_OUTPUT,
     TimeBase,
     decode_inputs,
     encode_outputs,
     imu_messages,
     output_streams,
+    output_table,
     output_types,
     resolve,
 )
@@ -264,12 +267,34 @@ def test_the_output_registry_has_one_entry_per_output_flag_of_a_scene() -> None:
     flags = {
         f.name for f in dataclasses.fields(default_scene().outputs) if isinstance(f.default, bool)
     }
-    assert set(OUTPUTS) == flags
-    for flag in flags:
-        only = scene_with(outputs={k: k == flag for k in flags})
+    assert len(OUTPUTS) == len(flags) and {out.flag for out in OUTPUTS} == flags
+    for out in OUTPUTS:
+        only = scene_with(outputs={k: k == out.flag for k in flags})
         names = [(st.topic, st.msgtype, st.frames) for st in output_streams(only)]
-        assert names == [(st.topic, st.msgtype, st.frames) for st in OUTPUTS[flag](only)]
+        assert names == [(st.topic, st.msgtype, st.frames) for st in out.streams(only)]
         assert names  # every flag brings at least one topic
+
+
+def test_a_bag_is_read_back_by_the_registry_not_by_message_type() -> None:
+    """Each topic is filed under its output's table with its declared columns: a Vector3Stamped
+    on another topic (a quantity added later, another node's) is not mixed into `angles`, and a
+    mount named like a table is still a mount."""
+    scene = default_scene()
+    for st in output_streams(scene):
+        resolved = resolve(st.topic, "mount_twin")
+        found = output_table(resolved, st.msgtype)
+        if st.table is None:
+            assert found is None
+        else:
+            assert found is not None and found[0] == st.table
+    assert output_table("/mount_twin/angles", VECTOR3) == ("angles", ANGLES_OUTPUT.columns)
+    assert output_table("/mount_twin/accel", VECTOR3) is None
+    assert output_table("/mount_twin/angles", WRENCH) is None
+    assert output_table("/ns/twin/mounts/pose/wrench", WRENCH) == (
+        "mount_pose",
+        WRENCHES_OUTPUT.columns,
+    )
+    assert output_table("/mount_twin/mounts/a/b/wrench", WRENCH) is None
 
 
 def test_output_names_resolve_under_the_node_name_and_namespace() -> None:

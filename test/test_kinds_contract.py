@@ -248,6 +248,7 @@ def fake_kind(name: str = "end_stop") -> ModuleType:
     module.pack = lambda m: np.array([1.0e6, 1e-3])
     module.state_names = lambda m: ()
     module.load, module.monitor, module.update = _stop_load, _stop_monitor, _stop_update
+    module.nominal_tangent = lambda m: ((1.0e6,) * 3 + (0.0,) * 3, ("stiffness",) * 6)
     return module
 
 
@@ -277,11 +278,13 @@ def test_crossed_branches_are_refused() -> None:
         check_dispatch(crossed)
 
 
-def test_a_module_lacking_part_of_the_contract_is_refused() -> None:
-    """check_modules (run at import) names what a kind module lacks, and a KIND mismatch."""
+@pytest.mark.parametrize("name", ["update", "nominal_tangent"])
+def test_a_module_lacking_part_of_the_contract_is_refused(name: str) -> None:
+    """check_modules (run at import) names what a kind module lacks, and a KIND mismatch: a
+    kind without its own nominal tangent cannot be taken for another (statics asks each)."""
     module = fake_kind()
-    del module.update
-    with pytest.raises(KindContractError, match="lacks update"):
+    delattr(module, name)
+    with pytest.raises(KindContractError, match=f"lacks {name}"):
         check_modules({"end_stop": module})
     with pytest.raises(KindContractError, match="whose KIND is"):
         check_modules({"other_name": fake_kind()})

@@ -32,8 +32,8 @@ from mount_twin.analysis.figures import (
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
 from mount_twin.engine.health import INTEGRATION
 from mount_twin.errors import ModelError
-from mount_twin.io.messages import WRENCH
-from mount_twin.io.output_tables import COLUMNS, Table, events_of, read_output_bag
+from mount_twin.io.messages import WRENCHES_OUTPUT
+from mount_twin.io.output_tables import Table, events_of, read_output_bag
 from mount_twin.scene.description import STANDARD_GRAVITY, Scene
 from mount_twin.scene.params import effective_parameters, parameter_description
 
@@ -394,7 +394,7 @@ def write_report(
     rows = []
     for name, table in mounts.items():
         c = table.columns
-        wrenches = np.stack([c[k] for k in COLUMNS[WRENCH]], axis=1)[:, None, :]
+        wrenches = np.stack([c[k] for k in WRENCHES_OUTPUT.columns], axis=1)[:, None, :]
         (force, couple), u = peak_magnitudes(wrenches)[0], utilisation.get(name)
         rows.append(
             [

@@ -15,10 +15,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mount_twin import _core
+from mount_twin.errors import ModelError
 from mount_twin.integrate.methods import (
     AUTO,
     METHODS,
     STATUS_TEXT,
+    Method,
 )
 from mount_twin.integrate.settings import (
     ATOL,
@@ -37,6 +39,24 @@ __all__ = [
     "new_stepper",
     "switch",
 ]
+
+
+def check_methods(methods: dict[str, Method]) -> None:
+    """Raise ModelError unless the core dispatches every method of `methods` with the work rows
+    its entry says: a method registered without its branch in the core (which would load, then
+    fail every interval with UNKNOWN_METHOD) is refused at import, by name."""
+    for name, m in methods.items():
+        rows = _core.work_rows(m.id, 1)
+        if rows < 0:
+            msg = f"integration method {name!r} (id {m.id}) has no branch in the core's advance"
+            raise ModelError(msg)
+        if rows != m.work_rows(1):
+            msg = f"integration method {name!r}: the core needs {rows} work rows, its entry says"
+            msg += f" {m.work_rows(1)}"
+            raise ModelError(msg)
+
+
+check_methods(METHODS)
 
 
 @dataclass

@@ -7,6 +7,7 @@ the .msg names, the same in rosbags and rclpy.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache, partial
@@ -294,48 +295,141 @@ class Stream:
         msgtype: its message type, one of the fixed-layout types of `_BUILDERS`.
         frames: the frame id(s) its messages carry (a transform's parent and child).
         values: the float fields of its messages from an OutputBatch, one row per message.
+        table: the table a bag reader files its messages under (`io.output_tables`), or None
+            (not read back: /tf).
     """
 
     topic: str
     msgtype: str
     frames: tuple[str, ...]
     values: Callable[[OutputBatch], np.ndarray]
+    table: str | None
 
 
-def _pose_fields(out: OutputBatch) -> np.ndarray:
+@dataclass(frozen=True)
+class Output:
+    """What one per-row output is, declared once: the writer (`output_streams`), the bag reader
+    (`output_table`, then `export`, `report`, dashboards) and `info` read it.
+
+    Attributes:
+        flag: its switch in `scene.outputs`.
+        topic: its topic before resolution; `{mount}` stands for each mount's name (one stream
+            per mount).
+        msgtype: its message type (a fixed-layout type of `_BUILDERS`).
+        table: the table its messages are read into (`{mount}` as in topic), or None: not read
+            back.
+        columns: the table's numeric columns, unit in the name, in the message's field order.
+        frames: the frame id(s) its messages carry, from the scene (and the mount's name).
+        values: its rows' float fields from an OutputBatch (and the mount's index).
+    """
+
+    flag: str
+    topic: str
+    msgtype: str
+    table: str | None
+    columns: tuple[str, ...]
+    frames: Callable[[Scene, str], tuple[str, ...]]
+    values: Callable[[OutputBatch, int], np.ndarray]
+
+    @property
+    def per_mount(self) -> bool:
+        """One stream per mount."""
+        return "{mount}" in self.topic
+
+    def streams(self, scene: Scene) -> list[Stream]:
+        """Its streams for `scene`."""
+        names = [m.name for m in scene.mounts] if self.per_mount else [""]
+        return [
+            Stream(
+                self.topic.format(mount=name),
+                self.msgtype,
+                self.frames(scene, name),
+                self._values_of(i),
+                None if self.table is None else self.table.format(mount=name),
+            )
+            for i, name in enumerate(names)
+        ]
+
+    def _values_of(self, i: int) -> Callable[[OutputBatch], np.ndarray]:
+        """Its rows' values for the i-th mount (or the one stream)."""
+        return lambda out: self.values(out, i)
+
+    def table_of(self, topic: str, msgtype: str) -> str | None:
+        """The table a resolved topic of msgtype is read into, if it is this output's: its
+        topic after the node's namespace and name ('~'), a mount's name where `{mount}` is."""
+        if self.table is None or msgtype != self.msgtype:
+            return None
+        head, _, tail = self.topic.lstrip("~").partition("{mount}")
+        pattern = re.escape(head) + (
+            "(?P<mount>[^/]+)" + re.escape(tail) if self.per_mount else ""
+        )
+        found = re.search(pattern + "$", topic)
+        return None if found is None else self.table.format(**found.groupdict())
+
+
+def _pose_fields(out: OutputBatch, i: int) -> np.ndarray:
     return out.pose[:, pose_row.POSE_COLS]
 
 
-def _wrench_of(i: int) -> Callable[[OutputBatch], np.ndarray]:
-    return lambda out: out.wrenches[:, i]
+POSE_COLUMNS = ("x_m", "y_m", "z_m", "qx", "qy", "qz", "qw")
+"""The pose table's numeric columns: CG position (m, F), quaternion x, y, z, w (body → F)."""
 
-
-OUTPUTS: dict[str, Callable[[Scene], list[Stream]]] = {
-    "pose": lambda sc: [Stream("~/pose", POSE, (sc.frames.foundation,), _pose_fields)],
-    "angles": lambda sc: [
-        Stream("~/angles", VECTOR3, (sc.frames.foundation,), lambda out: out.angles)
-    ],
-    "wrenches": lambda sc: [
-        Stream(
-            f"~/mounts/{m.name}/wrench", WRENCH, (sc.frames.mount_frame(m.name),), _wrench_of(i)
-        )
-        for i, m in enumerate(sc.mounts)
-    ],
-    "tf": lambda sc: [Stream(TF_TOPIC, TF, (sc.frames.foundation, sc.frames.body), _pose_fields)],
-}
-"""The per-row outputs by their flag in `scene.outputs` (tested to be the same set), in the
-order their messages follow each other. A new output is a builder in `_BUILDERS`, an entry here
-and its flag in the scene's `Outputs`."""
+POSE_OUTPUT = Output(
+    "pose",
+    "~/pose",
+    POSE,
+    "pose",
+    POSE_COLUMNS,
+    lambda sc, _: (sc.frames.foundation,),
+    _pose_fields,
+)
+ANGLES_OUTPUT = Output(
+    "angles",
+    "~/angles",
+    VECTOR3,
+    "angles",
+    ("alpha_rad", "gamma_rad", "delta_rad"),
+    lambda sc, _: (sc.frames.foundation,),
+    lambda out, i: out.angles,
+)
+WRENCHES_OUTPUT = Output(
+    "wrenches",
+    "~/mounts/{mount}/wrench",
+    WRENCH,
+    "mount_{mount}",
+    ("fx_N", "fy_N", "fz_N", "tx_Nm", "ty_Nm", "tz_Nm"),
+    lambda sc, name: (sc.frames.mount_frame(name),),
+    lambda out, i: out.wrenches[:, i],
+)
+TF_OUTPUT = Output(
+    "tf",
+    TF_TOPIC,
+    TF,
+    None,
+    POSE_COLUMNS,
+    lambda sc, _: (sc.frames.foundation, sc.frames.body),
+    _pose_fields,
+)
+OUTPUTS: tuple[Output, ...] = (POSE_OUTPUT, ANGLES_OUTPUT, WRENCHES_OUTPUT, TF_OUTPUT)
+"""The per-row outputs, in the order their messages follow each other (each flag is one of
+`scene.outputs`: tested to be the same set). A new output is a builder in `_BUILDERS` for a new
+message type, an entry here and its flag in the scene's `Outputs`: its table is then read back
+under its own name."""
 
 
 def output_streams(scene: Scene) -> list[Stream]:
     """Every per-row output topic the scene enables, in publishing order."""
-    return [
-        st
-        for flag, streams in OUTPUTS.items()
-        if getattr(scene.outputs, flag)
-        for st in streams(scene)
-    ]
+    return [st for out in OUTPUTS if getattr(scene.outputs, out.flag) for st in out.streams(scene)]
+
+
+def output_table(topic: str, msgtype: str) -> tuple[str, tuple[str, ...]] | None:
+    """The table (and its numeric columns) a resolved output topic of msgtype is read into, or
+    None: not a per-row output of the twin (another node's topic, /tf, diagnostics)."""
+    for out in OUTPUTS:
+        table = out.table_of(topic, msgtype)
+        if table is not None:
+            return table, out.columns
+    return None
 
 
 def resolve(name: str, node_name: str, namespace: str = "/") -> str:

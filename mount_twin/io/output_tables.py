@@ -22,15 +22,9 @@ from rosbags.highlevel import AnyReader
 
 from mount_twin.engine.batch import event_level
 from mount_twin.errors import BagError
-from mount_twin.io.messages import DIAGNOSTICS, POSE, TYPESTORE, VECTOR3, WRENCH
+from mount_twin.io.messages import DIAGNOSTICS, OUTPUTS, TYPESTORE, output_table
 from mount_twin.kinds.events import EVENT_IS_ERROR
 
-COLUMNS = {
-    POSE: ("x_m", "y_m", "z_m", "qx", "qy", "qz", "qw"),
-    VECTOR3: ("alpha_rad", "gamma_rad", "delta_rad"),
-    WRENCH: ("fx_N", "fy_N", "fz_N", "tx_Nm", "ty_Nm", "tz_Nm"),
-}
-"""Numeric columns per output message type, after stamp_ns and t_s."""
 LEVELS = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
 EVENT = re.compile(r"(\w+) ×(\d+) \(first (\d+\.\d+) s, \|F\| max ([\d.e+-]+) N\)")
 """An event group in a mount status message (engine.health._events_text)."""
@@ -47,15 +41,8 @@ class Table:
         return int(self.columns["stamp_ns"].shape[0])
 
 
-def table_name(topic: str, msgtype: str) -> str:
-    """`pose`, `angles`, `mount_<name>` (from …/mounts/<name>/wrench) or `diagnostics`."""
-    if msgtype == WRENCH:
-        parts = topic.strip("/").split("/")
-        return f"mount_{parts[-2]}" if len(parts) >= 2 else topic.strip("/")
-    return {POSE: "pose", VECTOR3: "angles", DIAGNOSTICS: "diagnostics"}[msgtype]
-
-
 def _row(msg: Any) -> tuple[float, ...]:
+    """The float fields of an output message, in the order of its table's columns."""
     if hasattr(msg, "pose"):
         p, q = msg.pose.position, msg.pose.orientation
         return (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
@@ -67,21 +54,29 @@ def _row(msg: Any) -> tuple[float, ...]:
 
 
 def read_output_bag(path: str | Path) -> list[Table]:
-    """The output tables of a bag (errors name the bag), in topic order; `t_s` counts from the
-    earliest stamp of any of them."""
+    """The output tables of a bag (errors name the bag), in the order of `io.messages.OUTPUTS`
+    (each output's tables by name), then diagnostics and events; `t_s` counts from the earliest
+    stamp of any of them. Each topic is filed by what the registry says it is
+    (`io.messages.output_table`); other topics are left out."""
     stamps: dict[str, list[int]] = {}
     rows: dict[str, list[tuple[Any, ...]]] = {}
-    kinds: dict[str, str] = {}
-    wanted = {POSE, VECTOR3, WRENCH, DIAGNOSTICS}
+    columns_of: dict[str, tuple[str, ...] | None] = {}
+    rank: dict[str, int] = {}
     try:
         with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
-            conns = [c for c in reader.connections if c.msgtype in wanted]
+            tables_of: dict[int, tuple[str, tuple[str, ...] | None]] = {}
+            for c in reader.connections:
+                if c.msgtype == DIAGNOSTICS:
+                    tables_of[c.id] = ("diagnostics", None)
+                elif (found := output_table(c.topic, c.msgtype)) is not None:
+                    tables_of[c.id] = found
+            conns = [c for c in reader.connections if c.id in tables_of]
             # (no connection list would mean every connection to rosbags)
             for conn, _, raw in reader.messages(connections=conns) if conns else ():
                 msg: Any = reader.deserialize(raw, conn.msgtype)
                 stamp = int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec)
-                name = table_name(conn.topic, conn.msgtype)
-                kinds[name] = conn.msgtype
+                name, columns_of[name] = tables_of[conn.id]
+                rank[name] = _rank(conn.msgtype, conn.topic)
                 if conn.msgtype == DIAGNOSTICS:
                     for st in msg.status:
                         stamps.setdefault(name, []).append(stamp)
@@ -99,20 +94,28 @@ def read_output_bag(path: str | Path) -> list[Table]:
         raise BagError(msg_text)
     origin = min(s[0] for s in stamps.values())
     tables = []
-    order = {POSE: 0, VECTOR3: 1, WRENCH: 2, DIAGNOSTICS: 3}
-    for name in sorted(stamps, key=lambda n: (order[kinds[n]], n)):
+    for name in sorted(stamps, key=lambda n: (rank[n], n)):
         ns = np.array(stamps[name], dtype=np.int64)
         columns: dict[str, np.ndarray] = {"stamp_ns": ns, "t_s": (ns - origin) * 1e-9}
-        if kinds[name] == DIAGNOSTICS:
+        numeric = columns_of[name]
+        if numeric is None:  # diagnostics
             for k, col in enumerate(("status", "level", "message", "values")):
                 columns[col] = np.array([r[k] for r in rows[name]], dtype=object)
         else:
             values = np.array(rows[name], dtype=float)
-            columns.update(zip(COLUMNS[kinds[name]], values.T, strict=True))
+            columns.update(zip(numeric, values.T, strict=True))
         tables.append(Table(name, columns))
-        if kinds[name] == DIAGNOSTICS:
+        if numeric is None:
             tables.append(events_table(tables[-1], origin))
     return tables
+
+
+def _rank(msgtype: str, topic: str) -> int:
+    """A table's place: its output's in OUTPUTS, diagnostics after them."""
+    return next(
+        (i for i, out in enumerate(OUTPUTS) if out.table_of(topic, msgtype) is not None),
+        len(OUTPUTS),
+    )
 
 
 @dataclass(frozen=True)

@@ -1,10 +1,11 @@
 """Mount kinds besides the linear one: each module is one place for a kind's scene keys and
 checks (`read`), its parameter row (`pack`), internal states (and which of them a restart
-resets: `RESTUCK`), force law (`load`), event functions (`monitor`) and discrete switches
+resets: `RESTUCK`), force law (`load`), event functions (`monitor`), discrete switches
 between samples (`update`, which says whether it switched: the state then jumped, and a stepper
-must not start from a stage it took before). A module's `load`, `monitor` and `update` are plain
-Python: the reference the compiled core's port of the kind (src/core/kinds/<kind>.hpp) is held
-to.
+must not start from a stage it took before) and its stiffness at the unstressed pose
+(`nominal_tangent`: statics, modes and `auto`'s first choice read it). A module's `load`,
+`monitor` and `update` are plain Python: the reference the compiled core's port of the kind
+(src/core/kinds/<kind>.hpp) is held to.
 
 The core's dispatchers (`kind_load`, `kind_monitor`, `kind_update` below) select a kind by its
 code; adding a kind is a new module here, a line in KINDS, its header in src/core/kinds/ with
@@ -65,6 +66,7 @@ MODULE_NAMES = (
     "load",
     "monitor",
     "update",
+    "nominal_tangent",
 )
 """What a kind module defines (see the module docstring of any kind)."""
 

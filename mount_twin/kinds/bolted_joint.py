@@ -167,6 +167,25 @@ def pack(j: BoltedJoint) -> np.ndarray:
     return row
 
 
+def nominal_tangent(j: BoltedJoint) -> tuple[tuple[float, ...], tuple[str, ...]]:
+    """Stiffness at the unstressed pose, (kx, ky, kz) N/m then (krx, kry, krz) N·m/rad (none: a
+    joint has no rotational law), and the scene key each value comes from: the stuck face's
+    shear stiffness (without friction, the bolt bearing on its hole, or nothing across a
+    clearance); axially, the bolt and the clamped parts together."""
+    shear, key = j.shear_stiffness, "shear_stiffness"
+    if j.friction == 0.0:
+        shear = j.bearing_stiffness if j.hole_clearance == 0.0 else 0.0
+        key = "bearing_stiffness"
+    axial = j.bolt_stiffness + j.clamp_stiffness
+    rot = tuple(f"rotational_stiffness[{i}]" for i in range(3))
+    return (shear, shear, axial, 0.0, 0.0, 0.0), (
+        key,
+        key,
+        "bolt_stiffness + clamp_stiffness",
+        *rot,
+    )
+
+
 def state_names(j: BoltedJoint) -> tuple[str, ...]:
     """Internal states of one joint (all joints have them)."""
     return tuple(f"{j.name}.{s}" for s in STATES)

@@ -199,6 +199,24 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> Elastomer:
     )
 
 
+def nominal_tangent(e: Elastomer) -> tuple[tuple[float, ...], tuple[str, ...]]:
+    """Stiffness at the unstressed pose, (kx, ky, kz) N/m then (krx, kry, krz) N·m/rad, and the
+    scene key each value comes from: the hysteretic spring at z = 0 (α·k₀ + (1 − α)·k₀·A), or
+    a force table's slope at zero."""
+    row = pack(e)
+    k = []
+    for j in range(3):
+        b = j * N_AXIS
+        ratio, k0 = row[b + RATIO], row[b + K0]
+        k.append(float(ratio * k0 + (1.0 - ratio) * k0 * row[b + BW_A]))
+    tables = {axis for axis, _, _ in e.force_table}
+    keys = tuple(
+        f"force_table.{a}" if a in tables else f"stiffness_linear[{j}]" for j, a in enumerate(AXES)
+    )
+    rot = tuple(f"rotational_stiffness[{j}]" for j in range(3))
+    return (*k, *e.rotational_stiffness), (*keys, *rot)
+
+
 def state_names(e: Elastomer) -> tuple[str, ...]:
     """Bouc–Wen z per hysteretic axis (none without hysteresis)."""
     if e.hysteresis is None:

@@ -82,6 +82,15 @@ def pack(k: ShearKey) -> np.ndarray:
     )
 
 
+def nominal_tangent(k: ShearKey) -> tuple[tuple[float, ...], tuple[str, ...]]:
+    """Stiffness at the unstressed pose, (kx, ky, kz) N/m then (krx, kry, krz) N·m/rad (none: a
+    key has no rotational law), and the scene key each value comes from: its bearing stiffness
+    per axis, counted whatever the clearance (a key that closes must be stable closed)."""
+    keys = tuple(f"stiffness[{j}]" for j in range(3))
+    rot = tuple(f"rotational_stiffness[{j}]" for j in range(3))
+    return (*k.stiffness, 0.0, 0.0, 0.0), (*keys, *rot)
+
+
 def state_names(_k: ShearKey) -> tuple[str, ...]:
     """A key has no internal state."""
     return ()

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mount_twin.kinds import bolted_joint, elastomer
+from mount_twin.kinds import KINDS
 from mount_twin.physics.rotations import rpy_matrix
 from mount_twin.scene.description import DOF_NAMES, LinearMount, Mount, Scene
 
@@ -89,35 +89,12 @@ class Statics:
 
 
 def nominal_tangent(mount: Mount) -> Tangent:
-    """The nominal tangent of `mount` at its unstressed pose (module docstring)."""
-    rot = tuple(f"rotational_stiffness[{j}]" for j in range(3))
+    """The nominal tangent of `mount` at its unstressed pose (module docstring): a linear
+    mount's stiffness, or what its kind's module says (`nominal_tangent`, a name every kind
+    must define: `kinds.MODULE_NAMES`)."""
     if isinstance(mount, LinearMount):
         return Tangent(mount.stiffness, tuple(f"stiffness[{j}]" for j in range(6)))
-    if isinstance(mount, elastomer.Elastomer):
-        row = elastomer.pack(mount)
-        k = []
-        for j in range(3):
-            b = j * elastomer.N_AXIS
-            ratio, k0 = row[b + elastomer.RATIO], row[b + elastomer.K0]
-            k.append(float(ratio * k0 + (1.0 - ratio) * k0 * row[b + elastomer.BW_A]))
-        tables = {axis for axis, _, _ in mount.force_table}
-        keys = tuple(
-            f"force_table.{a}" if a in tables else f"stiffness_linear[{j}]"
-            for j, a in enumerate(AXES)
-        )
-        return Tangent((*k, *mount.rotational_stiffness), (*keys, *rot))
-    if isinstance(mount, bolted_joint.BoltedJoint):
-        shear, key = mount.shear_stiffness, "shear_stiffness"
-        if mount.friction == 0.0:
-            shear = mount.bearing_stiffness if mount.hole_clearance == 0.0 else 0.0
-            key = "bearing_stiffness"
-        axial = mount.bolt_stiffness + mount.clamp_stiffness
-        return Tangent(
-            (shear, shear, axial, 0.0, 0.0, 0.0),
-            (key, key, "bolt_stiffness + clamp_stiffness", *rot),
-        )
-    keys = tuple(f"stiffness[{j}]" for j in range(3))  # a shear key
-    return Tangent((*mount.stiffness, 0.0, 0.0, 0.0), (*keys, *rot))
+    return Tangent(*KINDS[mount.kind].nominal_tangent(mount))
 
 
 def _skew(v: np.ndarray) -> np.ndarray:
