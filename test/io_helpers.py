@@ -176,7 +176,7 @@ def push_all(
 def fuzz_settings(max_examples: int, **kwargs: Any) -> settings:
     """Hypothesis settings of a fuzz suite: in the suite a fixed (derandomized) campaign of
     `max_examples`; with MOUNT_TWIN_FUZZ_EXAMPLES=N a fresh campaign of N examples, seeded by
-    pytest's --hypothesis-seed (how the README's hostile-input figures are re-measured:
+    pytest's --hypothesis-seed (how docs/benchmarks.md's hostile-input figures are re-measured:
     `MOUNT_TWIN_FUZZ_EXAMPLES=1000 python3 -m pytest test/test_fuzz_stream.py
     --hypothesis-seed=7`)."""
     campaign = os.environ.get("MOUNT_TWIN_FUZZ_EXAMPLES")

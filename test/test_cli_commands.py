@@ -52,7 +52,7 @@ def test_demo_replays_the_bundled_bag_and_prints_a_summary(
     assert "5000 received, 5000 accepted" in text and "integration failures: 0" in text
     assert "diagnostics, worst over the run: OK" in text
     assert "    OK    mount_twin: input: ok" in text
-    # 1.0e-9 against a reference (README, Benchmarks): the estimate says as much
+    # 1.0e-9 against a reference (docs/benchmarks.md): the estimate says as much
     est = re.search(r"estimated integration error: mount forces (\S+) of the largest", text)
     assert est is not None and 3e-10 < float(est.group(1)) < 3e-9
     assert list(out.glob("*.mcap")), "demo must write an mcap bag"

@@ -210,7 +210,7 @@ def test_the_genset_scene_file_loads_with_the_estimate_on_by_default() -> None:
 def test_on_a_stiff_scene_the_linearising_methods_are_stable_where_explicit_ones_hunt() -> None:
     """10 kg on 4 × 1e9 N/m at rtol 1e-3: Dormand–Prince is held to ~14 steps per 1 ms sample
     by stability and is 9 % off; the L-stable ros34pw2 takes one step per sample and is within
-    1e-3 (it damps the kHz ringing each input kink excites, see the README); the exponential
+    1e-3 (it damps the kHz ringing each input kink excites, see docs/scene.md); the exponential
     exprb32, exact on linear mounts, takes one step per sample and is within 1e-7. Every
     estimate stays within 10× of its true error, the exponential's within OVER (see there)."""
     scene, samples = _stiff_light("auto")

@@ -80,7 +80,7 @@ def test_replay_json_summary_times_events_from_the_first_output(tmp_path: Path) 
         for _, m in msgs["/mount_twin/mounts/foot_fl/wrench"]
     )
     assert doc["mounts"]["foot_fl"]["peak_force_magnitude_N"] == pytest.approx(f, rel=1e-12)
-    # the live error estimate over the run, as the README's genset figures put it (1.5e-3)
+    # the live error estimate over the run, as docs/scene.md's genset figures put it (1.5e-3)
     est = doc["error_estimate"]
     assert 3e-4 < est["force_error_rel"] < 1e-2 and est["failed_checks"] == 0
     assert est["force_error_n"] > 0.0 and 0.0 < est["attitude_error_rad"] < 1e-5

@@ -285,7 +285,7 @@ def test_bolts_fracturing_mid_run_keep_the_twin_finite_and_broken() -> None:
     """The bundled genset under three rising double half-sines (test_kinds_whole_body.py: the
     third breaks all six bolts): finite to the end, running, the breaks kept in the state, and
     an estimate on the record (no reference converges affordably across fracture to judge it:
-    the genset's figures are in the README)."""
+    the genset's figures are in docs/benchmarks.md)."""
     run = escalation()
     assert np.isfinite(run.pose).all() and np.isfinite(run.wrenches).all()
     broken = {e.mount for e in run.engine.events if e.event == "bolt_fractured"}

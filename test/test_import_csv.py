@@ -113,7 +113,7 @@ def test_every_error_names_file_row_and_column(tmp_path: Path, text: str, says: 
 def test_the_bundled_sample_imports_and_replays_through_the_default_scene(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """The README's two commands, as written there (topic and frame are import-csv's
+    """The two commands of docs/offline.md, as written there (topic and frame are import-csv's
     defaults, the bundled scenes' input)."""
     bag, out = tmp_path / "shock_bag", tmp_path / "out"
     assert main(["import-csv", str(CONFIG / "sample_shock.csv"), "-o", str(bag)]) == 0

@@ -634,7 +634,7 @@ def test_building_tf2_msgs_again_finds_the_build() -> None:
 
 
 def test_a_slow_subscriber_loses_outputs_and_no_event_says_so() -> None:
-    """What the README's `output_queue_depth` says a user must size for: a reliable keep-last
+    """What docs/node.md's `output_queue_depth` says a user must size for: a reliable keep-last
     subscriber that cannot take messages while a burst comes keeps its last `depth` of them,
     and it gets no lost-message event (Fast DDS; the publisher has none to offer) — so the
     node has nothing to count and the depths must be chosen."""

@@ -13,10 +13,10 @@ divided by TOLERANCE_DIVISOR = 8 (an adaptive step's error, hence the global err
 r ≈ 8, the estimate 0.88·e) and at least two steps per input interval (the one step an interval
 bounds is halved: r = 2⁵ for Dormand–Prince 5, the estimate 0.97·e). Measured against a
 reference on smooth, stiff and non-smooth scenes, the estimate is 0.77–1.03 of the true error
-(test/test_error_estimate.py, README "Error estimate"). A divisor of 32 gave 0.93–1.3 but cost
-10× the integration on the bolted genset, where tight tolerances hunt across switches; 4 cost
-3× there and gave 0.54. The companion reads the same held input, takes the same discrete
-mount switches between samples, and restarts with the twin.
+(test/test_error_estimate.py, docs/scene.md "Error estimate"). A divisor of 32 gave 0.93–1.3
+but cost 10× the integration on the bolted genset, where tight tolerances hunt across
+switches; 4 cost 3× there and gave 0.54. The companion reads the same held input, takes the
+same discrete mount switches between samples, and restarts with the twin.
 
 Cost: about 2× the engine's integration time on smooth scenes, 4× on the bolted genset at
 rtol 1e-6; `integration.error_estimate: false` turns it off. It never touches the twin's state:

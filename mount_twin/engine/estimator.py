@@ -37,7 +37,7 @@ fan"). The estimate follows that recursion with
 The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities differenced with J).
 Cost per interval: a matrix-vector product of the carried states; per check, the check's steps;
 per linearisation, n + 1 right-hand sides and an exponential. Engine time with it over without:
-1.18–1.20× on the pump, 2.7–2.9× where the twin rejects steps every interval (README "Error
+1.18–1.20× on the pump, 2.7–2.9× where the twin rejects steps every interval (docs/scene.md "Error
 estimate", bench/error_estimate.py). The engaged-mount and internal-state handling below works
 for any model (measured on the non-linear scenes above) though the engine gives those the
 companion. It never touches the twin's state: the

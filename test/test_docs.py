@@ -1,0 +1,81 @@
+"""The README and docs/ say what runs: every `mount-twin` command in them parses with the
+command line as written and names files that exist, their Python examples run, their scene
+excerpt is the bundled scene's, and their links point at files of the repository."""
+
+from __future__ import annotations
+
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+import yaml
+from io_helpers import ROOT
+
+from mount_twin.cli import build_parser
+
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+REPO_DIRS = ("config/", "bags/", "test/data/", "docs/", "bench/")
+"""A command argument starting with one of these names a file of the repository."""
+FENCE = re.compile(r"```(\w+)\n(.*?)```", re.S)
+
+
+def _commands(page: Path) -> list[str]:
+    """The `mount-twin …` command lines of a page (indented or fenced code), comments cut."""
+    found = []
+    for line in page.read_text(encoding="utf-8").splitlines():
+        text = line.strip()
+        for part in text.split(" && "):
+            if part.startswith("mount-twin "):
+                found.append(part.split("  #")[0].split(" # ")[0].strip())
+    return found
+
+
+COMMANDS = [(p.relative_to(ROOT).as_posix(), c) for p in PAGES for c in _commands(p)]
+
+
+def test_the_pages_hold_commands() -> None:
+    assert len(COMMANDS) > 25
+    assert {p for p, _ in COMMANDS} >= {"README.md", "docs/offline.md"}
+
+
+@pytest.mark.parametrize(("page", "command"), COMMANDS)
+def test_every_command_parses_and_names_files_that_exist(page: str, command: str) -> None:
+    """Optional parts written `[--flag VALUE]` are taken as given; placeholders in capitals
+    (IN_BAG, SCENE) are any text to the parser."""
+    args = shlex.split(command.replace("[", "").replace("]", ""))[1:]
+    parser, _ = build_parser()
+    try:
+        parser.parse_args(args)
+    except SystemExit as stop:  # --version and --help exit 0 once parsed
+        if stop.code != 0:
+            pytest.fail(f"{page}: `{command}` does not parse (exit {stop.code})")
+    for arg in args:
+        if arg.startswith(REPO_DIRS):
+            assert (ROOT / arg).exists(), f"{page}: `{command}` names {arg}, which is not there"
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_the_python_examples_run(page: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(ROOT)
+    for lang, code in FENCE.findall(page.read_text(encoding="utf-8")):
+        if lang == "python":
+            exec(compile(code, str(page), "exec"), {})
+
+
+def test_the_readme_scene_excerpt_is_the_bundled_scene() -> None:
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    (excerpt,) = [code for lang, code in FENCE.findall(text) if lang == "yaml"]
+    shown = yaml.safe_load(excerpt)
+    bundled = yaml.safe_load((ROOT / "config/pump_8_mounts.scene.yaml").read_text("utf-8"))
+    assert shown["mounts"] == bundled["mounts"][: len(shown["mounts"])]
+    for key in ("name", "frames", "body", "dofs"):
+        assert shown[key] == bundled[key], key
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_links_point_at_files_of_the_repository(page: Path) -> None:
+    for target in re.findall(r"\]\(([^)#]+)(?:#[^)]*)?\)", page.read_text(encoding="utf-8")):
+        if "://" in target:
+            continue
+        assert (page.parent / target).exists(), f"{page.name}: link to {target}, not there"
