@@ -113,3 +113,35 @@ def test_the_usage_example_runs_and_the_mounts_carry_the_body(
     np.testing.assert_allclose(
         force, [0.0, 0.0, scene.body.mass * scene.input.g], rtol=0.0, atol=1e-6
     )
+
+
+@pytest.mark.parametrize(
+    ("field", "bad", "says"),
+    [
+        ("accel", np.zeros((5, 2)), r"SampleBatch\.accel: shape \(5, 2\), expected \(5, 3\)"),
+        ("gyro", np.zeros((4, 3)), r"SampleBatch\.gyro: shape \(4, 3\), expected \(5, 3\)"),
+        ("stamps", np.zeros((5, 1)), r"SampleBatch\.stamps: shape \(5, 1\), expected \(n,\)"),
+        ("accel", np.full((5, 3), "a"), r"SampleBatch\.accel: dtype <U1, expected real"),
+        ("frame_ids", ["deck_imu"] * 4, r"SampleBatch\.frame_ids: 4 entries, expected 5"),
+    ],
+)
+def test_a_malformed_batch_is_refused_naming_the_field_and_changes_nothing(
+    field: str, bad: object, says: str
+) -> None:
+    """The way MuJoCo's rollout checks shapes: before the engine touches its state (a wrong
+    accel surfaced as a numpy broadcasting error from deep inside)."""
+    engine = mount_twin.TwinEngine(
+        mount_twin.assemble(mount_twin.load_scene_file(ROOT / "config/pump_8_mounts.scene.yaml"))
+    )
+    t = np.arange(5) * 1e-3
+    good = {
+        "stamps": t,
+        "accel": np.tile([0.0, 0.0, 9.80665], (5, 1)),
+        "gyro": np.zeros((5, 3)),
+        "frame_ids": ["deck_imu"] * 5,
+    }
+    with pytest.raises(ValueError, match=says):
+        engine.push(mount_twin.SampleBatch(**{**good, field: bad}))
+    assert engine.counts["received"] == 0
+    out = engine.run(mount_twin.SampleBatch(**good))
+    assert len(out) == 5

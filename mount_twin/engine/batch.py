@@ -37,6 +37,27 @@ class SampleBatch:
     def __len__(self) -> int:
         return int(self.stamps.shape[0])
 
+    def check(self) -> None:
+        """Raise ValueError naming the field unless this is a batch of n samples: stamps (n,),
+        accel and gyro (n, 3) of real numbers, n frame ids (strings). Values are not judged here
+        (NaN, a stamp going back: the engine counts and reports those per sample)."""
+        stamps, accel, gyro = (np.asarray(a) for a in (self.stamps, self.accel, self.gyro))
+        if stamps.ndim != 1:
+            msg = f"SampleBatch.stamps: shape {stamps.shape}, expected (n,) seconds"
+            raise ValueError(msg)
+        n = stamps.shape[0]
+        for name, a in (("stamps", stamps), ("accel", accel), ("gyro", gyro)):
+            if a.dtype.kind not in "fiu":
+                msg = f"SampleBatch.{name}: dtype {a.dtype}, expected real numbers"
+                raise ValueError(msg)
+        for name, a in (("accel", accel), ("gyro", gyro)):
+            if a.shape != (n, 3):
+                msg = f"SampleBatch.{name}: shape {a.shape}, expected ({n}, 3) for {n} stamps"
+                raise ValueError(msg)
+        if len(self.frame_ids) != n or not all(isinstance(f, str) for f in self.frame_ids):
+            msg = f"SampleBatch.frame_ids: {len(self.frame_ids)} entries, expected {n} strings"
+            raise ValueError(msg)
+
     @classmethod
     def concat(cls, parts: list[SampleBatch]) -> SampleBatch:
         """One batch of several, in order."""

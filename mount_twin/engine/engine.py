@@ -411,8 +411,11 @@ class TwinEngine:
         """Process samples in arrival order; return what is to be published for them.
 
         Diagnostics come at the stamps where they would for one sample per push, so a replay in
-        chunks publishes what the live node does. An empty batch changes nothing.
+        chunks publishes what the live node does. An empty batch changes nothing; a malformed
+        one (shapes, types: `SampleBatch.check`) raises ValueError naming the field, and
+        changes nothing either.
         """
+        batch.check()
         nm = self.model.n_mounts
         if len(batch) == 0:
             return OutputBatch.empty(nm)
