@@ -11,7 +11,13 @@ from __future__ import annotations
 import json
 from xml.etree import ElementTree as ET
 
-from mount_twin.io.messages import resolve
+from mount_twin.io.messages import (
+    ANGLES_OUTPUT,
+    POSE_OUTPUT,
+    WRENCHES_OUTPUT,
+    Output,
+    resolve,
+)
 from mount_twin.replay import NODE_NAME
 from mount_twin.scene.description import Scene
 
@@ -20,24 +26,27 @@ COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e
 
 def panels(scene: Scene) -> list[tuple[str, list[tuple[str, tuple[str, ...]]]]]:
     """(panel title, [(topic, field path)]) of each plot: pose, angles, then force x, y, z."""
-    pose = resolve("~/pose", NODE_NAME)
-    angles = resolve("~/angles", NODE_NAME)
+    pose = resolve(POSE_OUTPUT.topic, NODE_NAME)
+    angles = resolve(ANGLES_OUTPUT.topic, NODE_NAME)
     Series = list[tuple[str, tuple[str, ...]]]
     out: list[tuple[str, Series]] = [
-        ("CG position in F [m]", [(pose, ("pose", "position", a)) for a in "xyz"]),
-        ("α (x), γ (y), δ (z) [rad]", [(angles, ("vector", a)) for a in "xyz"]),
+        ("CG position in F [m]", [(pose, _path(POSE_OUTPUT, k)) for k in range(3)]),
+        ("α (x), γ (y), δ (z) [rad]", [(angles, _path(ANGLES_OUTPUT, k)) for k in range(3)]),
     ]
-    for axis in "xyz":
+    wrenches = WRENCHES_OUTPUT.streams(scene)
+    for k, axis in enumerate("xyz"):
         out.append(
             (
                 f"mount force along mount {axis} [N]",
-                [
-                    (resolve(f"~/mounts/{m.name}/wrench", NODE_NAME), ("wrench", "force", axis))
-                    for m in scene.mounts
-                ],
+                [(resolve(st.topic, NODE_NAME), _path(WRENCHES_OUTPUT, k)) for st in wrenches],
             )
         )
     return out
+
+
+def _path(output: Output, column: int) -> tuple[str, ...]:
+    """The message field path of one of an output's columns (the output registry's)."""
+    return tuple(output.fields[column].split("."))
 
 
 def plotjuggler_layout(scene: Scene) -> str:

@@ -10,7 +10,8 @@ from __future__ import annotations
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import lru_cache, partial
+from functools import cached_property, lru_cache, partial
+from operator import attrgetter
 from typing import Any
 
 import numpy as np
@@ -318,7 +319,8 @@ class Output:
         msgtype: its message type (a fixed-layout type of `_BUILDERS`).
         table: the table its messages are read into (`{mount}` as in topic), or None: not read
             back.
-        columns: the table's numeric columns, unit in the name, in the message's field order.
+        columns: the table's numeric columns, unit in the name.
+        fields: the message field (dotted path) each column is read from, in column order.
         frames: the frame id(s) its messages carry, from the scene (and the mount's name).
         values: its rows' float fields from an OutputBatch (and the mount's index).
     """
@@ -328,8 +330,18 @@ class Output:
     msgtype: str
     table: str | None
     columns: tuple[str, ...]
+    fields: tuple[str, ...]
     frames: Callable[[Scene, str], tuple[str, ...]]
     values: Callable[[OutputBatch, int], np.ndarray]
+
+    @cached_property
+    def _getter(self) -> Callable[[Any], Any]:
+        return attrgetter(*self.fields)
+
+    def read(self, msg: Any) -> tuple[float, ...]:
+        """A message's values in column order (deserialized: rosbags' message classes)."""
+        got = self._getter(msg)
+        return tuple(got) if len(self.fields) > 1 else (got,)
 
     @property
     def per_mount(self) -> bool:
@@ -373,6 +385,9 @@ def _pose_fields(out: OutputBatch, i: int) -> np.ndarray:
 
 POSE_COLUMNS = ("x_m", "y_m", "z_m", "qx", "qy", "qz", "qw")
 """The pose table's numeric columns: CG position (m, F), quaternion x, y, z, w (body → F)."""
+POSE_FIELDS = tuple(f"pose.position.{a}" for a in "xyz") + tuple(
+    f"pose.orientation.{a}" for a in "xyzw"
+)
 
 POSE_OUTPUT = Output(
     "pose",
@@ -380,6 +395,7 @@ POSE_OUTPUT = Output(
     POSE,
     "pose",
     POSE_COLUMNS,
+    POSE_FIELDS,
     lambda sc, _: (sc.frames.foundation,),
     _pose_fields,
 )
@@ -389,6 +405,7 @@ ANGLES_OUTPUT = Output(
     VECTOR3,
     "angles",
     ("alpha_rad", "gamma_rad", "delta_rad"),
+    tuple(f"vector.{a}" for a in "xyz"),
     lambda sc, _: (sc.frames.foundation,),
     lambda out, i: out.angles,
 )
@@ -398,6 +415,7 @@ WRENCHES_OUTPUT = Output(
     WRENCH,
     "mount_{mount}",
     ("fx_N", "fy_N", "fz_N", "tx_Nm", "ty_Nm", "tz_Nm"),
+    tuple(f"wrench.{p}.{a}" for p in ("force", "torque") for a in "xyz"),
     lambda sc, name: (sc.frames.mount_frame(name),),
     lambda out, i: out.wrenches[:, i],
 )
@@ -406,7 +424,8 @@ TF_OUTPUT = Output(
     TF_TOPIC,
     TF,
     None,
-    POSE_COLUMNS,
+    (),
+    (),
     lambda sc, _: (sc.frames.foundation, sc.frames.body),
     _pose_fields,
 )
@@ -422,13 +441,14 @@ def output_streams(scene: Scene) -> list[Stream]:
     return [st for out in OUTPUTS if getattr(scene.outputs, out.flag) for st in out.streams(scene)]
 
 
-def output_table(topic: str, msgtype: str) -> tuple[str, tuple[str, ...]] | None:
-    """The table (and its numeric columns) a resolved output topic of msgtype is read into, or
-    None: not a per-row output of the twin (another node's topic, /tf, diagnostics)."""
+def output_table(topic: str, msgtype: str) -> tuple[str, Output] | None:
+    """The table a resolved output topic of msgtype is read into, and its output (columns and
+    fields), or None: not a per-row output of the twin (another node's topic, /tf,
+    diagnostics)."""
     for out in OUTPUTS:
         table = out.table_of(topic, msgtype)
         if table is not None:
-            return table, out.columns
+            return table, out
     return None
 
 

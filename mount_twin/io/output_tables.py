@@ -22,7 +22,7 @@ from rosbags.highlevel import AnyReader
 
 from mount_twin.engine.batch import event_level
 from mount_twin.errors import BagError
-from mount_twin.io.messages import DIAGNOSTICS, OUTPUTS, TYPESTORE, output_table
+from mount_twin.io.messages import DIAGNOSTICS, OUTPUTS, TYPESTORE, Output, output_table
 from mount_twin.kinds.events import EVENT_IS_ERROR
 
 LEVELS = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
@@ -41,18 +41,6 @@ class Table:
         return int(self.columns["stamp_ns"].shape[0])
 
 
-def _row(msg: Any) -> tuple[float, ...]:
-    """The float fields of an output message, in the order of its table's columns."""
-    if hasattr(msg, "pose"):
-        p, q = msg.pose.position, msg.pose.orientation
-        return (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
-    if hasattr(msg, "wrench"):
-        f, t = msg.wrench.force, msg.wrench.torque
-        return (f.x, f.y, f.z, t.x, t.y, t.z)
-    v = msg.vector
-    return (v.x, v.y, v.z)
-
-
 def read_output_bag(path: str | Path) -> list[Table]:
     """The output tables of a bag (errors name the bag), in the order of `io.messages.OUTPUTS`
     (each output's tables by name), then diagnostics and events; `t_s` counts from the earliest
@@ -60,11 +48,11 @@ def read_output_bag(path: str | Path) -> list[Table]:
     (`io.messages.output_table`); other topics are left out."""
     stamps: dict[str, list[int]] = {}
     rows: dict[str, list[tuple[Any, ...]]] = {}
-    columns_of: dict[str, tuple[str, ...] | None] = {}
+    columns_of: dict[str, Output | None] = {}
     rank: dict[str, int] = {}
     try:
         with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
-            tables_of: dict[int, tuple[str, tuple[str, ...] | None]] = {}
+            tables_of: dict[int, tuple[str, Output | None]] = {}
             for c in reader.connections:
                 if c.msgtype == DIAGNOSTICS:
                     tables_of[c.id] = ("diagnostics", None)
@@ -75,9 +63,10 @@ def read_output_bag(path: str | Path) -> list[Table]:
             for conn, _, raw in reader.messages(connections=conns) if conns else ():
                 msg: Any = reader.deserialize(raw, conn.msgtype)
                 stamp = int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec)
-                name, columns_of[name] = tables_of[conn.id]
+                name, output = tables_of[conn.id]
+                columns_of[name] = output
                 rank[name] = _rank(conn.msgtype, conn.topic)
-                if conn.msgtype == DIAGNOSTICS:
+                if output is None:  # diagnostics
                     for st in msg.status:
                         stamps.setdefault(name, []).append(stamp)
                         level = LEVELS.get(int(st.level), str(st.level))
@@ -85,7 +74,7 @@ def read_output_bag(path: str | Path) -> list[Table]:
                         rows.setdefault(name, []).append((st.name, level, st.message, pairs))
                 else:
                     stamps.setdefault(name, []).append(stamp)
-                    rows.setdefault(name, []).append(_row(msg))
+                    rows.setdefault(name, []).append(output.read(msg))
     except Exception as err:  # rosbags raises its own types for unreadable bags
         msg_text = f"{path}: cannot read the output bag: {err}"
         raise BagError(msg_text) from err
@@ -97,15 +86,15 @@ def read_output_bag(path: str | Path) -> list[Table]:
     for name in sorted(stamps, key=lambda n: (rank[n], n)):
         ns = np.array(stamps[name], dtype=np.int64)
         columns: dict[str, np.ndarray] = {"stamp_ns": ns, "t_s": (ns - origin) * 1e-9}
-        numeric = columns_of[name]
-        if numeric is None:  # diagnostics
+        output = columns_of[name]
+        if output is None:  # diagnostics
             for k, col in enumerate(("status", "level", "message", "values")):
                 columns[col] = np.array([r[k] for r in rows[name]], dtype=object)
         else:
-            values = np.array(rows[name], dtype=float)
-            columns.update(zip(numeric, values.T, strict=True))
+            values = np.array(rows[name], dtype=float).reshape(-1, len(output.columns))
+            columns.update(zip(output.columns, values.T, strict=True))
         tables.append(Table(name, columns))
-        if numeric is None:
+        if output is None:
             tables.append(events_table(tables[-1], origin))
     return tables
 
