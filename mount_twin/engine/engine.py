@@ -412,13 +412,13 @@ class TwinEngine:
 
         Diagnostics come at the stamps where they would for one sample per push, so a replay in
         chunks publishes what the live node does. An empty batch changes nothing; a malformed
-        one (shapes, types: `SampleBatch.check`) raises ValueError naming the field, and
-        changes nothing either.
+        non-empty one (shapes, types: `SampleBatch.check`) raises ValueError naming the field,
+        and changes nothing either.
         """
-        batch.check()
         nm = self.model.n_mounts
-        if len(batch) == 0:
+        if len(batch) == 0:  # whatever its arrays' shapes (a decoder's empty result may be flat)
             return OutputBatch.empty(nm)
+        batch.check()
         first_id = self._pushed
         self._pushed += len(batch)
         if self._held is None:
