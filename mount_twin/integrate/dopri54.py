@@ -1,9 +1,10 @@
 """Dormand–Prince 5(4) with error control, advancing across one input-sample interval.
 
-The method is its coefficient table and one free compiled function (scipy `integrate/_ivp`
-shape), the core's (src/core/integrate/dopri54.hpp), which calls the model's right-hand side
-directly. The state advances with the 5th-order solution; the embedded
-4th-order one estimates the local error. Error norm: RMS of err / (atol + rtol·|y|).
+The method is its coefficient table (src/core/integrate/dopri54.hpp holds the same) over the
+core's one explicit step (src/core/integrate/explicit_rk.hpp, scipy `integrate/_ivp` shape),
+which calls the model's right-hand side directly. The state advances with the 5th-order
+solution; the embedded 4th-order one estimates the local error. Error norm: RMS of
+err / (atol + rtol·|y|).
 """
 
 from __future__ import annotations

@@ -1,0 +1,117 @@
+// The explicit Runge–Kutta step with error control, advancing across one input-sample
+// interval, for any embedded pair given as its table (dopri54.hpp gives Dormand–Prince 5(4)):
+// a new explicit method is its table and a branch in stepper.hpp, not another copy of this loop.
+//
+// A table T has STAGES, C[STAGES], A[STAGES][STAGES − 1] (row i: the weights of stage i), E[STAGES]
+// (the propagated weights minus the embedded ones), ORDER (of the error estimate), MAX_FACTOR and
+// FSAL. Only first-same-as-last tables are taken (the last row of A is the propagated weights and
+// its stage is dy/dt at the new point, the next step's first): the static_assert says so, where a
+// table without it would need the weighted update this loop leaves out.
+#pragma once
+
+#include <cmath>
+
+#include "../constants.hpp"
+#include "../model.hpp"
+#include "../numeric.hpp"
+#include "../physics/dynamics_api.hpp"
+#include "../views.hpp"
+#include "control.hpp"
+
+namespace mt::integrate::explicit_rk {
+
+/// Advance y (in place) from t0 to t1 s with input u held over the interval.
+///
+/// settings: the slots of constants.hpp Setting (STEP: first trial step s, 0 for the whole
+/// interval, updated to the next proposal; CHAINED: on entry 1 if k[0] holds dy/dt at (t0, y)
+/// for this input, left at 1 on success with k[0] = dy/dt at (t1, y)). k: (T::STAGES, n) stages;
+/// y_new: (n,); result: [largest accepted error norm, accepted, rejected steps].
+/// Returns a Status; y is left at the last accepted time on failure.
+template <class T>
+inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Scratch& s, Vec u,
+                   Mat k, Vec y_new, Vec result) {
+  static_assert(T::FSAL, "explicit_rk::advance takes first-same-as-last tables only");
+  const Interval iv = interval(settings, t0, t1);
+  const double rtol = iv.rtol, atol = iv.atol, max_steps = iv.max_steps, span = iv.span;
+  const double h_max = iv.h_max;
+  double h = iv.h;
+  const idx n = y.n;
+  double t = t0;
+  double err_max = 0.0;
+  idx n_acc = 0, n_rej = 0;
+  bool rhs_failed = false;
+  bool not_finite = false;  // the last rejection was for NaN or inf (stage state or error norm)
+  if (settings[CHAINED] == 0.0) {  // else the caller put dy/dt at (t0, y) for this input in k[0]
+    rhs_failed = physics::rhs(t, y, m, s, u, k.row(0)) != 0;
+  }
+  settings[CHAINED] = 0.0;  // set again below on success: k[0] is then dy/dt at (t1, y)
+  while (t < t1) {
+    // a step too small, or the start state itself off the chart (no step can help)
+    const bool too_small = h < MIN_STEP_FRACTION * span || (rhs_failed && n_acc == 0 && t == t0);
+    const int status = give_up(n_acc + n_rej, max_steps, too_small, not_finite, rhs_failed);
+    if (status != SUCCESS) {
+      record(settings, result, h, err_max, n_acc, n_rej);
+      return status;
+    }
+    const Trial trial = trial_step(t, t1, h, h_max, span);
+    const double step = trial.step;
+    const bool last = trial.last;
+    bool ok = true;
+    for (int stage = 1; stage < T::STAGES; ++stage) {
+      for (idx i = 0; i < n; ++i) y_new[i] = y[i];
+      for (int j = 0; j < stage; ++j) {  // row by row: the inner loop runs along k[j]
+        const double a = step * T::A[stage][j];
+        if (a != 0.0) {
+          const Vec kj = k.row(j);
+          for (idx i = 0; i < n; ++i) y_new[i] += a * kj[i];
+        }
+      }
+      if (physics::rhs(t + T::C[stage] * step, y_new, m, s, u, k.row(stage)) != 0) {
+        ok = false;
+        break;
+      }
+    }
+    rhs_failed = !ok;
+    if (rhs_failed) {
+      // a NaN stage state also reads as off the chart: tell them apart (only on failure)
+      not_finite = false;
+      for (idx i = 0; i < n; ++i) {
+        if (!std::isfinite(y_new[i])) not_finite = true;
+      }
+      h = step * OFF_CHART_SHRINK;
+      n_rej += 1;
+      continue;
+    }
+    // y_new holds the propagated solution (FSAL: the last stage row of A is the weights B).
+    double err = 0.0;
+    for (idx i = 0; i < n; ++i) {
+      double e = 0.0;
+      for (int j = 0; j < T::STAGES; ++j) e += T::E[j] * k(j, i);
+      const double scale = atol + rtol * py_max(std::fabs(y[i]), std::fabs(y_new[i]));
+      const double x = step * e / scale;
+      err += x * x;  // numba's x ** 2 (a literal integer exponent): x·x
+    }
+    err = std::sqrt(err / static_cast<double>(n));
+    // NaN or inf: rejected below and shrunk by the most; if it persists, NOT_FINITE
+    not_finite = !std::isfinite(err);
+    const double factor = step_factor(err, not_finite, T::ORDER, T::MAX_FACTOR);
+    if (err <= 1.0) {
+      t = last ? t1 : t + step;
+      for (idx i = 0; i < n; ++i) {
+        y[i] = y_new[i];
+        k(0, i) = k(T::STAGES - 1, i);
+      }
+      err_max = py_max(err_max, err);
+      n_acc += 1;
+      h = next_proposal(step, h, factor, last);
+    } else {
+      h = step * py_min(1.0, factor);
+      n_rej += 1;
+    }
+  }
+  record(settings, result, h, err_max, n_acc, n_rej);
+  settings[CHAINED] = 1.0;
+  return SUCCESS;
+}
+
+}  // namespace mt::integrate::explicit_rk
