@@ -25,6 +25,7 @@ from mount_twin.engine.batch import (
     HealthReport,
     HealthStatus,
     MountEvent,
+    OutputBatch,
 )
 from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.health import INTEGRATION, tilt_from_quaternions
@@ -244,6 +245,59 @@ def _until_damage(
         damage.append(err)
 
 
+@dataclass
+class _Figures:
+    """Figures of the published rows so far: per mount peak |F| (N) and |M| (N·m), largest
+    tilt (rad) and CG displacement from the first published position (m), first and last
+    stamps (s, engine time)."""
+
+    peak: np.ndarray
+    tilt: float = 0.0
+    disp: float = 0.0
+    first_stamp: float | None = None
+    last_stamp: float | None = None
+    start: np.ndarray | None = None
+
+    def add(self, batch: OutputBatch) -> None:
+        """Fold in a batch of published rows (an empty one changes nothing)."""
+        if not len(batch):
+            return
+        self.first_stamp = batch.stamps[0] if self.first_stamp is None else self.first_stamp
+        start = batch.position[0].copy() if self.start is None else self.start
+        self.start = start
+        self.last_stamp = batch.stamps[-1]
+        np.maximum(self.peak, peak_magnitudes(batch.wrenches), out=self.peak)
+        self.disp = max(self.disp, displacement_from_start(batch.position, start))
+        self.tilt = max(self.tilt, float(tilt_from_quaternions(batch.quaternion).max()))
+
+    @property
+    def span_s(self) -> float:
+        """Stamps spanned by the rows, s (0 without rows)."""
+        if self.first_stamp is None or self.last_stamp is None:
+            return 0.0
+        return float(self.last_stamp - self.first_stamp)
+
+
+def _open(
+    scene: Scene,
+    input_path: str | Path,
+    output_path: str | Path,
+    checkpoint: Callable[[], None] | None,
+) -> tuple[InputBag, TwinStream]:
+    """The input bag, opened, and the twin, built once the output bag is known to be new; the
+    input bag is closed again if that fails or `checkpoint` raises."""
+    bag = InputBag(input_path, scene.input.topic, scene.input.msg_type)
+    try:
+        check_new_bag(output_path)
+        stream = TwinStream(scene)
+        if checkpoint is not None:  # a signal while the twin was built: no output bag yet
+            checkpoint()
+    except BaseException:
+        bag.close()
+        raise
+    return bag, stream
+
+
 def replay(
     scene: Scene,
     input_path: str | Path,
@@ -263,23 +317,12 @@ def replay(
     chunks, where stopping is safe: it may raise to stop the replay (a signal noted by
     the command line); once the output bag exists, it is then finished and marked partial.
     """
-    bag = InputBag(input_path, scene.input.topic, scene.input.msg_type)
-    try:
-        check_new_bag(output_path)
-        stream = TwinStream(scene)
-        if checkpoint is not None:  # a signal while the twin was built: no output bag yet
-            checkpoint()
-    except BaseException:
-        bag.close()
-        raise
+    bag, stream = _open(scene, input_path, output_path, checkpoint)
     resolved = {t: resolve(t, NODE_NAME) for t in output_types(scene)}
     topics = {resolved[t]: msgtype for t, msgtype in output_types(scene).items()}
     topics[TF_STATIC_TOPIC] = TF
     static_due = True
-    nm = len(scene.mounts)
-    peak = np.zeros((nm, 2))
-    tilt, disp = 0.0, 0.0
-    first_stamp = last_stamp = start = None
+    figures = _Figures(np.zeros((len(scene.mounts), 2)))
     wall0 = time.perf_counter()
     worst: dict[str, HealthStatus] = {}
     with (
@@ -299,16 +342,10 @@ def replay(
                 static_due = False
             for topic, stamp, raw in outputs:
                 out.write(resolved[topic], stamp, raw)
-            batch = stream.last_outputs
-            if batch is not None and len(batch):
-                first_stamp = batch.stamps[0] if first_stamp is None else first_stamp
-                start = batch.position[0].copy() if start is None else start
-                last_stamp = batch.stamps[-1]
-                np.maximum(peak, peak_magnitudes(batch.wrenches), out=peak)
-                disp = max(disp, displacement_from_start(batch.position, start))
-                tilt = max(tilt, float(tilt_from_quaternions(batch.quaternion).max()))
-            for report in batch.health if batch is not None else []:
-                _keep_worst(worst, report)
+            if (batch := stream.last_outputs) is not None:
+                figures.add(batch)
+                for report in batch.health:
+                    _keep_worst(worst, report)
             bar.update(len(raws or ()))
         if stream.final_report is not None:
             _keep_worst(worst, stream.final_report)
@@ -316,24 +353,38 @@ def replay(
             raise damage[0]
         written = out.written
     wall = time.perf_counter() - wall0
-    span = float(last_stamp - first_stamp) if first_stamp is not None else 0.0
+    return _summary(scene, input_path, output_path, stream, figures, worst, written, wall)
+
+
+def _summary(
+    scene: Scene,
+    input_path: str | Path,
+    output_path: str | Path,
+    stream: TwinStream,
+    figures: _Figures,
+    worst: dict[str, HealthStatus],
+    written: int,
+    wall_s: float,
+) -> ReplaySummary:
+    """The summary of a replay that wrote `written` messages in `wall_s` seconds."""
+    engine = stream.engine
     return ReplaySummary(
         str(input_path),
         str(output_path),
-        dict(stream.engine.counts),
+        dict(engine.counts),
         written,
-        span,
-        wall,
-        {m.name: peak[i] for i, m in enumerate(scene.mounts)},
-        tilt,
-        disp,
+        figures.span_s,
+        wall_s,
+        {m.name: figures.peak[i] for i, m in enumerate(scene.mounts)},
+        figures.tilt,
+        figures.disp,
         worst,
-        list(stream.engine.events),
-        stream.engine.utilisation_max,
-        stream.engine.health.origin_s,
-        stream.engine.health.last_wrong_frame_id,
-        float(first_stamp) if first_stamp is not None else 0.0,
-        stream.engine.error_estimate,
-        stream.engine.failure_text,
-        stream.engine.health.latency,
+        list(engine.events),
+        engine.utilisation_max,
+        engine.health.origin_s,
+        engine.health.last_wrong_frame_id,
+        float(figures.first_stamp) if figures.first_stamp is not None else 0.0,
+        engine.error_estimate,
+        engine.failure_text,
+        engine.health.latency,
     )

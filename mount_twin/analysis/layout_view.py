@@ -48,83 +48,15 @@ def draw_layout(scene: Scene, png: str | Path) -> Path:
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.lines
     import matplotlib.pyplot as plt
 
-    size = layout_size(scene)
-    arrow, reach = 0.12 * size, 0.9 * size
     fig = plt.figure(figsize=(15, 5.5))
     ax3 = fig.add_subplot(1, 3, 1, projection="3d")
-    flat = [fig.add_subplot(1, 3, 2 + k) for k in range(2)]
-
-    def segment(a: np.ndarray, b: np.ndarray, **style: Any) -> None:
-        ax3.plot(*zip(a, b, strict=True), **style)
-        for ax, (_, i, j) in zip(flat, VIEWS, strict=True):
-            ax.plot([a[i], b[i]], [a[j], b[j]], **style)
-
-    labels: list[dict[tuple[float, float], list[str]]] = [{} for _ in VIEWS]
-
-    def point(p: np.ndarray, label: str, **style: Any) -> None:
-        ax3.scatter(*p, **style)
-        ax3.text(*p, f" {label}", fontsize=7)
-        for ax, (_, i, j), named in zip(flat, VIEWS, labels, strict=True):
-            ax.scatter(p[i], p[j], **style)
-            # Points that fall on one another in a view share one label.
-            named.setdefault((round(p[i], 6), round(p[j], 6)), []).append(label)
-
-    def frame(origin: np.ndarray, rot: np.ndarray, length: float, width: float) -> None:
-        for k in range(3):
-            segment(origin, origin + length * rot[:, k], color=AXIS_COLOURS[k], linewidth=width)
-
-    frame(np.zeros(3), np.eye(3), 2.0 * arrow, 2.0)
-    point(np.zeros(3), f"F ({scene.frames.foundation})", color="black", marker="+", s=60)
-    for m in scene.mounts:
-        p, rot = np.array(m.position), rpy_matrix(*m.orientation_rpy)
-        colour = KIND_COLOURS.get(m.kind, "tab:gray")
-        segment(
-            p - reach * rot[:, 2],
-            p + reach * rot[:, 2],
-            color=colour,
-            linestyle="--",
-            linewidth=0.8,
-        )
-        frame(p, rot, arrow, 1.2)
-        point(p, m.name, color=colour, s=30)
-    sensor = np.array(scene.input.sensor_position)
-    frame(sensor, rpy_matrix(*scene.input.sensor_rpy), 0.7 * arrow, 1.0)
-    point(sensor, "sensor", color="teal", marker="^", s=40)
-    point(np.array(scene.body.cg), f"CG ({scene.frames.body})", color="black", marker="o", s=70)
-
-    for ax, named in zip(flat, labels, strict=True):
-        for (u, v), names in named.items():
-            ax.annotate(
-                ", ".join(names), (u, v), fontsize=7, xytext=(3, 3), textcoords="offset points"
-            )
-    ax3.set_xlabel("x [m]")
-    ax3.set_ylabel("y [m]")
-    ax3.set_zlabel("z [m]")
-    ax3.set_box_aspect((1.0, 1.0, 1.0))
-    _equal_3d(ax3)
-    ax3.set_title("3-D (F: x red, y green, z blue)", fontsize=9)
-    for ax, (title, i, j) in zip(flat, VIEWS, strict=True):
-        ax.set_title(f"{title}; dashed: each mount's z line of action", fontsize=9)
-        ax.set_xlabel(f"{'xyz'[i]} [m]")
-        ax.set_ylabel(f"{'xyz'[j]} [m]")
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.grid(True, alpha=0.3)
+    views = _Views(ax3, [fig.add_subplot(1, 3, 2 + k) for k in range(2)])
+    _draw_scene(views, scene)
+    views.annotate()
     kinds = sorted({m.kind for m in scene.mounts})
-    flat[0].legend(
-        handles=[
-            matplotlib.lines.Line2D(
-                [], [], color=KIND_COLOURS.get(k, "tab:gray"), marker="o", linestyle="--", label=k
-            )
-            for k in kinds
-        ],
-        fontsize=7,
-        loc="lower right",
-        title="mount kind",
-        title_fontsize=7,
-    )
+    _dress(views, kinds)
     fig.suptitle(
         f"{scene.name}: {scene.body.mass:g} kg, {len(scene.mounts)} mounts "
         f"({', '.join(kinds)}), "
@@ -136,6 +68,104 @@ def draw_layout(scene: Scene, png: str | Path) -> Path:
     fig.savefig(out, dpi=110)
     plt.close(fig)
     return out
+
+
+class _Views:
+    """The 3-D axes and the 2-D axes of `VIEWS`, drawn into together (positions in m, F)."""
+
+    def __init__(self, ax3: Any, flat: list[Any]) -> None:
+        self.ax3 = ax3
+        self.flat = flat
+        self.labels: list[dict[tuple[float, float], list[str]]] = [{} for _ in VIEWS]
+        """Per 2-D view: the labels of the points at each position (rounded to 1 µm)."""
+
+    def segment(self, a: np.ndarray, b: np.ndarray, **style: Any) -> None:
+        """A line from `a` to `b` in every view."""
+        self.ax3.plot(*zip(a, b, strict=True), **style)
+        for ax, (_, i, j) in zip(self.flat, VIEWS, strict=True):
+            ax.plot([a[i], b[i]], [a[j], b[j]], **style)
+
+    def point(self, p: np.ndarray, label: str, **style: Any) -> None:
+        """A marker at `p` in every view, labelled at once in 3-D and by `annotate` in 2-D."""
+        self.ax3.scatter(*p, **style)
+        self.ax3.text(*p, f" {label}", fontsize=7)
+        for ax, (_, i, j), named in zip(self.flat, VIEWS, self.labels, strict=True):
+            ax.scatter(p[i], p[j], **style)
+            # Points that fall on one another in a view share one label.
+            named.setdefault((round(p[i], 6), round(p[j], 6)), []).append(label)
+
+    def frame(self, origin: np.ndarray, rot: np.ndarray, length: float, width: float) -> None:
+        """The axes of a frame at `origin` rotated by `rot` into F, `length` m long."""
+        for k in range(3):
+            self.segment(
+                origin, origin + length * rot[:, k], color=AXIS_COLOURS[k], linewidth=width
+            )
+
+    def annotate(self) -> None:
+        """The 2-D views' point labels, one per position."""
+        for ax, named in zip(self.flat, self.labels, strict=True):
+            for (u, v), names in named.items():
+                ax.annotate(
+                    ", ".join(names), (u, v), fontsize=7, xytext=(3, 3), textcoords="offset points"
+                )
+
+
+def _draw_scene(views: _Views, scene: Scene) -> None:
+    """F's axes at its origin; each mount's line of action, axes and name; the sensor and the
+    CG (arrows and lines scaled to `layout_size`)."""
+    size = layout_size(scene)
+    arrow, reach = 0.12 * size, 0.9 * size
+    views.frame(np.zeros(3), np.eye(3), 2.0 * arrow, 2.0)
+    views.point(np.zeros(3), f"F ({scene.frames.foundation})", color="black", marker="+", s=60)
+    for m in scene.mounts:
+        p, rot = np.array(m.position), rpy_matrix(*m.orientation_rpy)
+        colour = KIND_COLOURS.get(m.kind, "tab:gray")
+        views.segment(
+            p - reach * rot[:, 2],
+            p + reach * rot[:, 2],
+            color=colour,
+            linestyle="--",
+            linewidth=0.8,
+        )
+        views.frame(p, rot, arrow, 1.2)
+        views.point(p, m.name, color=colour, s=30)
+    sensor = np.array(scene.input.sensor_position)
+    views.frame(sensor, rpy_matrix(*scene.input.sensor_rpy), 0.7 * arrow, 1.0)
+    views.point(sensor, "sensor", color="teal", marker="^", s=40)
+    cg = np.array(scene.body.cg)
+    views.point(cg, f"CG ({scene.frames.body})", color="black", marker="o", s=70)
+
+
+def _dress(views: _Views, kinds: list[str]) -> None:
+    """Axis labels, equal scales and titles of every view, and the legend of the mount
+    `kinds`' colours."""
+    import matplotlib.lines
+
+    ax3 = views.ax3
+    ax3.set_xlabel("x [m]")
+    ax3.set_ylabel("y [m]")
+    ax3.set_zlabel("z [m]")
+    ax3.set_box_aspect((1.0, 1.0, 1.0))
+    _equal_3d(ax3)
+    ax3.set_title("3-D (F: x red, y green, z blue)", fontsize=9)
+    for ax, (title, i, j) in zip(views.flat, VIEWS, strict=True):
+        ax.set_title(f"{title}; dashed: each mount's z line of action", fontsize=9)
+        ax.set_xlabel(f"{'xyz'[i]} [m]")
+        ax.set_ylabel(f"{'xyz'[j]} [m]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, alpha=0.3)
+    views.flat[0].legend(
+        handles=[
+            matplotlib.lines.Line2D(
+                [], [], color=KIND_COLOURS.get(k, "tab:gray"), marker="o", linestyle="--", label=k
+            )
+            for k in kinds
+        ],
+        fontsize=7,
+        loc="lower right",
+        title="mount kind",
+        title_fontsize=7,
+    )
 
 
 def _equal_3d(ax: object) -> None:

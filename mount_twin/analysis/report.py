@@ -17,11 +17,11 @@ from collections.abc import Callable
 from datetime import datetime, timezone
 from importlib.metadata import version as package_version
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from mount_twin.analysis.design_margin import TOLERANCE_DB, check_design
+from mount_twin.analysis.design_margin import TOLERANCE_DB, DesignCheck, check_design
 from mount_twin.analysis.figures import (
     DISPLACEMENT,
     PEAK_COUPLE,
@@ -33,9 +33,12 @@ from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
 from mount_twin.engine.health import INTEGRATION
 from mount_twin.errors import ModelError
 from mount_twin.io.messages import WRENCHES_OUTPUT
-from mount_twin.io.output_tables import Table, events_of, read_output_bag
+from mount_twin.io.output_tables import Event, Table, events_of, read_output_bag
 from mount_twin.scene.description import STANDARD_GRAVITY, Scene
 from mount_twin.scene.params import effective_parameters, parameter_description
+
+if TYPE_CHECKING:
+    from mount_twin.analysis.srs import Spectrum
 
 WINDOW_S = 0.05
 """Half-width of the zoom around the first event, s."""
@@ -197,27 +200,48 @@ def _srs_section(
         if design is not None
         else {}
     )
+    head = ["f Hz", "x g", "y g", "z g", "PV z m/s"]
+    if checks:
+        head += ["margin x dB", "margin y dB", "margin z dB"]
+    verdicts = [
+        f"<p><b>design</b>, axis {a}: {html.escape(c.summary())}</p>" for a, c in checks.items()
+    ]
+    return [
+        f"<h2>Shock response spectra of the input (ζ = 5 %, {html.escape(removed)} removed)</h2>",
+        *verdicts,
+        _png(lambda fig: _draw_srs(fig, spectra, design), (9, 4.5)),
+        _table(head, _srs_rows(freqs, spectra, checks)),
+    ]
 
-    def draw(fig: Any) -> None:
-        ax = fig.subplots()
-        for axis, s in spectra.items():
-            if s.maximax.max() > 0.0:
-                ax.loglog(
-                    s.frequency_hz, s.maximax / STANDARD_GRAVITY, label=f"maximax, {axis} of F"
-                )
-        if design is not None:
-            ax.loglog(*design, "k--", label="design")
-        ax.set_xlabel("natural frequency [Hz]")
-        ax.set_ylabel("peak absolute acceleration [g]")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
 
+def _draw_srs(
+    fig: Any, spectra: dict[str, Spectrum], design: tuple[list[float], list[float]] | None
+) -> None:
+    """The maximax spectra (g) of the axes with any response, and the design (Hz, g) if any,
+    log-log against natural frequency (Hz)."""
+    ax = fig.subplots()
+    for axis, s in spectra.items():
+        if s.maximax.max() > 0.0:
+            ax.loglog(s.frequency_hz, s.maximax / STANDARD_GRAVITY, label=f"maximax, {axis} of F")
+    if design is not None:
+        ax.loglog(*design, "k--", label="design")
+    ax.set_xlabel("natural frequency [Hz]")
+    ax.set_ylabel("peak absolute acceleration [g]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+
+
+def _srs_rows(
+    freqs: np.ndarray, spectra: dict[str, Spectrum], checks: dict[str, DesignCheck]
+) -> list[list[str]]:
+    """Every third frequency's row: f (Hz), maximax per axis (g), pseudo-velocity of z (m/s),
+    and with `checks` each axis's margin (dB; '–' where the design does not reach)."""
     z = spectra["z"]
     margins = {
         a: dict(zip(c.frequency_hz.tolist(), c.margin_db.tolist(), strict=True))
         for a, c in checks.items()
     }
-    rows = [
+    return [
         [
             f"{fk:.4g}",
             *(f"{spectra[a].maximax[k] / STANDARD_GRAVITY:.4g}" for a in "xyz"),
@@ -229,18 +253,6 @@ def _srs_section(
         ]
         for k, fk in enumerate(freqs.tolist())
         if k % 3 == 0
-    ]
-    head = ["f Hz", "x g", "y g", "z g", "PV z m/s"]
-    if checks:
-        head += ["margin x dB", "margin y dB", "margin z dB"]
-    verdicts = [
-        f"<p><b>design</b>, axis {a}: {html.escape(c.summary())}</p>" for a, c in checks.items()
-    ]
-    return [
-        f"<h2>Shock response spectra of the input (ζ = 5 %, {html.escape(removed)} removed)</h2>",
-        *verdicts,
-        _png(draw, (9, 4.5)),
-        _table(head, rows),
     ]
 
 
@@ -304,93 +316,154 @@ def write_report(
         title += f" (input {input_name})"
     sections = [f"<h1>{html.escape(title)}</h1>"]
     sections += _provenance_section(diagnostics, output_bag, input_path, scene)
-
-    def response(fig: Any) -> None:
-        n = 3 if input_samples is not None else 2
-        axes = fig.subplots(n, 1, sharex=True)
-        k = 0
-        if input_samples is not None:
-            stamps, f = input_samples
-            t = (stamps - origin) * 1e-9
-            for i, axis in enumerate("xyz"):
-                axes[0].plot(t, f[:, i] / STANDARD_GRAVITY, label=f"{axis} of F")
-            axes[0].set_ylabel("foundation specific force [g]")
-            axes[0].set_title(f"input {input_name}", fontsize=9)
-            k = 1
-        pose = tables["pose"].columns
-        for axis in "xyz":
-            v = pose[f"{axis}_m"]
-            axes[k].plot(pose["t_s"], (v - v[0]) * 1e3, label=f"CG {axis}")
-        axes[k].set_ylabel("CG displacement from its\nfirst published position [mm]")
-        ang = tables["angles"].columns
-        for name in ("alpha", "gamma", "delta"):
-            axes[k + 1].plot(ang["t_s"], np.degrees(ang[f"{name}_rad"]), label=name)
-        axes[k + 1].set_ylabel("attitude [deg]")
-        axes[-1].set_xlabel("time from the first output [s]")
-        for ax in axes:
-            ax.grid(True, alpha=0.3)
-            ax.legend(fontsize=7, loc="upper right")
-
     if "pose" in tables and "angles" in tables:
-        sections += ["<h2>Input and response</h2>", _png(response, (10, 8))]
-
-    def forces(fig: Any, window: tuple[float, float] | None = None) -> None:
-        axes = fig.subplots(3, 1, sharex=True)
-        for name, table in mounts.items():
-            c = table.columns
-            keep = (
-                slice(None)
-                if window is None
-                else (c["t_s"] >= window[0]) & (c["t_s"] <= window[1])
-            )
-            for i, comp in enumerate(("fx_N", "fy_N", "fz_N")):
-                axes[i].plot(c["t_s"][keep], c[comp][keep] * 1e-3, label=name, linewidth=0.9)
-        for i, comp in enumerate("xyz"):
-            axes[i].set_ylabel(f"force along mount {comp} [kN]")
-            axes[i].grid(True, alpha=0.3)
-        if window is not None:
-            for e in (e for e in events if window[0] <= e.t_s <= window[1]):
-                for ax in axes:
-                    ax.axvline(e.t_s, color="red" if e.level == "ERROR" else "orange", alpha=0.4)
-        axes[0].legend(fontsize=7, ncol=4, loc="upper right")
-        axes[-1].set_xlabel("time from the first output [s]")
-
-    if mounts:
         sections += [
-            "<h2>Mount forces (on the body, signed, in each mount's axes)</h2>",
-            _png(forces, (10, 8)),
+            "<h2>Input and response</h2>",
+            _png(
+                lambda fig: _draw_response(fig, tables, input_samples, origin, input_name), (10, 8)
+            ),
         ]
-    if events:
-        first = events[0]
-        window = (first.t_s - WINDOW_S, first.t_s + WINDOW_S)
-        sections += [
-            f"<h2>Around the first event: {html.escape(first.mount)} {html.escape(first.event)} "
-            f"at {first.t_s:.6f} s (lines: events)</h2>",
-            _png(lambda fig: forces(fig, window), (10, 8)),
-        ]
+    sections += _forces_sections(mounts, events)
     if utilisation:
-
-        def util(fig: Any) -> None:
-            ax = fig.subplots()
-            for name, (t, u) in utilisation.items():
-                # Each report holds the peak of the period that ends at it.
-                ax.step(
-                    np.r_[0.0, t],
-                    np.r_[u[0], u],
-                    where="pre",
-                    label=f"{name} ({kinds.get(name, '?')})",
-                )
-            ax.axhline(1.0, color="red", linestyle="--", label="rated (1)")
-            ax.set_ylabel("peak utilisation per diagnostics period [-]")
-            ax.set_xlabel("time from the first output [s]")
-            ax.grid(True, alpha=0.3)
-            ax.legend(fontsize=7, ncol=3)
-
-        sections += ["<h2>Utilisation</h2>", _png(util, (10, 4))]
+        sections += [
+            "<h2>Utilisation</h2>",
+            _png(lambda fig: _draw_utilisation(fig, utilisation, kinds), (10, 4)),
+        ]
     if input_samples is not None:
         sections += _srs_section(*input_samples, design, tolerance_db)
     if scene is not None:
         sections += _modes_section(scene)
+    if "pose" in tables:
+        sections.append(_displacement_line(tables["pose"]))
+    sections += [
+        "<h2>Peaks (largest magnitude at one instant)</h2>",
+        _table(
+            ["mount", "kind", PEAK_FORCE, PEAK_COUPLE, "utilisation max"],
+            _peak_rows(mounts, kinds, utilisation),
+        ),
+        "<h2>Events</h2>",
+        _events_table(events) if events else "<p>none</p>",
+    ]
+    out = Path(html_path)
+    out.write_text(_page(title, sections), encoding="utf-8")
+    return out
+
+
+def _draw_response(
+    fig: Any,
+    tables: dict[str, Table],
+    input_samples: tuple[np.ndarray, np.ndarray] | None,
+    origin_ns: int,
+    input_name: str,
+) -> None:
+    """The input's specific force (g; with `input_samples`), the CG's displacement from its
+    first published position (mm) and the attitude (deg), against time from the first output
+    (s; it is at `origin_ns`)."""
+    n = 3 if input_samples is not None else 2
+    axes = fig.subplots(n, 1, sharex=True)
+    k = 0
+    if input_samples is not None:
+        stamps, f = input_samples
+        t = (stamps - origin_ns) * 1e-9
+        for i, axis in enumerate("xyz"):
+            axes[0].plot(t, f[:, i] / STANDARD_GRAVITY, label=f"{axis} of F")
+        axes[0].set_ylabel("foundation specific force [g]")
+        axes[0].set_title(f"input {input_name}", fontsize=9)
+        k = 1
+    pose = tables["pose"].columns
+    for axis in "xyz":
+        v = pose[f"{axis}_m"]
+        axes[k].plot(pose["t_s"], (v - v[0]) * 1e3, label=f"CG {axis}")
+    axes[k].set_ylabel("CG displacement from its\nfirst published position [mm]")
+    ang = tables["angles"].columns
+    for name in ("alpha", "gamma", "delta"):
+        axes[k + 1].plot(ang["t_s"], np.degrees(ang[f"{name}_rad"]), label=name)
+    axes[k + 1].set_ylabel("attitude [deg]")
+    axes[-1].set_xlabel("time from the first output [s]")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7, loc="upper right")
+
+
+def _draw_forces(
+    fig: Any,
+    mounts: dict[str, Table],
+    events: list[Event],
+    window: tuple[float, float] | None = None,
+) -> None:
+    """Each mount's force components (kN, mount axes) against time from the first output (s):
+    all of it, or within `window` (s) with the events there as lines."""
+    axes = fig.subplots(3, 1, sharex=True)
+    for name, table in mounts.items():
+        c = table.columns
+        keep = slice(None) if window is None else (c["t_s"] >= window[0]) & (c["t_s"] <= window[1])
+        for i, comp in enumerate(("fx_N", "fy_N", "fz_N")):
+            axes[i].plot(c["t_s"][keep], c[comp][keep] * 1e-3, label=name, linewidth=0.9)
+    for i, comp in enumerate("xyz"):
+        axes[i].set_ylabel(f"force along mount {comp} [kN]")
+        axes[i].grid(True, alpha=0.3)
+    if window is not None:
+        for e in (e for e in events if window[0] <= e.t_s <= window[1]):
+            for ax in axes:
+                ax.axvline(e.t_s, color="red" if e.level == "ERROR" else "orange", alpha=0.4)
+    axes[0].legend(fontsize=7, ncol=4, loc="upper right")
+    axes[-1].set_xlabel("time from the first output [s]")
+
+
+def _forces_sections(mounts: dict[str, Table], events: list[Event]) -> list[str]:
+    """The mount forces over the run, and around the first event (± WINDOW_S)."""
+    out = []
+    if mounts:
+        out += [
+            "<h2>Mount forces (on the body, signed, in each mount's axes)</h2>",
+            _png(lambda fig: _draw_forces(fig, mounts, events), (10, 8)),
+        ]
+    if events:
+        first = events[0]
+        window = (first.t_s - WINDOW_S, first.t_s + WINDOW_S)
+        out += [
+            f"<h2>Around the first event: {html.escape(first.mount)} {html.escape(first.event)} "
+            f"at {first.t_s:.6f} s (lines: events)</h2>",
+            _png(lambda fig: _draw_forces(fig, mounts, events, window), (10, 8)),
+        ]
+    return out
+
+
+def _draw_utilisation(
+    fig: Any, utilisation: dict[str, tuple[np.ndarray, np.ndarray]], kinds: dict[str, str]
+) -> None:
+    """Each rated mount's peak utilisation per diagnostics period (-) against time from the
+    first output (s), and the rating (1)."""
+    ax = fig.subplots()
+    for name, (t, u) in utilisation.items():
+        # Each report holds the peak of the period that ends at it.
+        ax.step(
+            np.r_[0.0, t],
+            np.r_[u[0], u],
+            where="pre",
+            label=f"{name} ({kinds.get(name, '?')})",
+        )
+    ax.axhline(1.0, color="red", linestyle="--", label="rated (1)")
+    ax.set_ylabel("peak utilisation per diagnostics period [-]")
+    ax.set_xlabel("time from the first output [s]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, ncol=3)
+
+
+def _displacement_line(pose: Table) -> str:
+    """The CG's largest displacement from its first published position (m), a paragraph."""
+    position = np.stack([pose.columns[f"{a}_m"] for a in "xyz"], axis=1)
+    moved = displacement_from_start(position, position[0])
+    return f"<p>{DISPLACEMENT} (CG): {moved:.6g}</p>"
+
+
+def _peak_rows(
+    mounts: dict[str, Table],
+    kinds: dict[str, str],
+    utilisation: dict[str, tuple[np.ndarray, np.ndarray]],
+) -> list[list[str]]:
+    """Per mount: name, kind, the largest |F| (N) and |M| (N·m) at one instant, and the
+    largest utilisation (-; 'n/a' without a rating)."""
     rows = []
     for name, table in mounts.items():
         c = table.columns
@@ -405,25 +478,24 @@ def write_report(
                 "n/a" if u is None else f"{float(u[1].max()):.3g}",
             ]
         )
-    if "pose" in tables:
-        position = np.stack([tables["pose"].columns[f"{a}_m"] for a in "xyz"], axis=1)
-        moved = displacement_from_start(position, position[0])
-        sections.append(f"<p>{DISPLACEMENT} (CG): {moved:.6g}</p>")
-    sections += [
-        "<h2>Peaks (largest magnitude at one instant)</h2>",
-        _table(["mount", "kind", PEAK_FORCE, PEAK_COUPLE, "utilisation max"], rows),
-        "<h2>Events</h2>",
-        _table(
-            ["time s", "mount", "event", "count in period", "|F| max N", "level"],
-            [
-                [f"{e.t_s:.6f}", e.mount, e.event, str(e.count), f"{e.force_n:.4g}", e.level]
-                for e in events
-            ],
-        )
-        if events
-        else "<p>none</p>",
-    ]
-    page = (
+    return rows
+
+
+def _events_table(events: list[Event]) -> str:
+    """The mount events: time from the first output (s), mount, event, count in the period,
+    largest |F| (N) and level."""
+    return _table(
+        ["time s", "mount", "event", "count in period", "|F| max N", "level"],
+        [
+            [f"{e.t_s:.6f}", e.mount, e.event, str(e.count), f"{e.force_n:.4g}", e.level]
+            for e in events
+        ],
+    )
+
+
+def _page(title: str, sections: list[str]) -> str:
+    """The HTML document of `sections`, styled inline."""
+    return (
         "<!DOCTYPE html><html><head><meta charset='utf-8'>"
         f"<title>{html.escape(title)}</title><style>"
         "body{font-family:sans-serif;margin:2em;max-width:1100px}"
@@ -432,6 +504,3 @@ def write_report(
         + "\n".join(sections)
         + "</body></html>"
     )
-    out = Path(html_path)
-    out.write_text(page, encoding="utf-8")
-    return out

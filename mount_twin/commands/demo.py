@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from mount_twin.commands.common import DEFAULT_BAG, DEFAULT_SCENE, share_dir
-from mount_twin.commands.replay import add_plot_argument, replay_and_report
+from mount_twin.commands.replay import ReplayOptions, add_plot_argument, replay_and_report
 
 NAME = "demo"
 HELP = "replay the bundled bag through the bundled default scene"
@@ -23,8 +23,5 @@ def run(args: argparse.Namespace) -> int:
         share / "config" / DEFAULT_SCENE,
         share / "bags" / DEFAULT_BAG,
         args.output,
-        chunk=2000,
-        progress=True,
-        plot=args.plot,
-        fail_on="never",
+        ReplayOptions(chunk=2000, progress=True, plot=args.plot, fail_on="never"),
     )

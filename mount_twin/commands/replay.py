@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -60,33 +61,39 @@ def add_plot_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--plot", metavar="PNG", help="also plot the outputs into this PNG")
 
 
+@dataclass(frozen=True)
+class ReplayOptions:
+    """How `replay_and_report` runs: messages per engine batch, whether to show progress, a PNG
+    to plot the outputs into and a file for the summary as JSON (None: neither), and the
+    `--fail-on` level."""
+
+    chunk: int = 2000
+    progress: bool = True
+    plot: str | None = None
+    json_path: str | None = None
+    fail_on: str = "never"
+
+
 def run(args: argparse.Namespace) -> int:
     overrides = {
         k: v for k, v in (("topic", args.topic), ("frame_id", args.frame_id)) if v is not None
     }
-    return replay_and_report(
-        args.scene,
-        args.input,
-        args.output,
-        args.chunk,
-        not args.no_progress,
-        args.plot,
-        args.fail_on,
-        overrides,
-        args.json,
+    options = ReplayOptions(
+        chunk=args.chunk,
+        progress=not args.no_progress,
+        plot=args.plot,
+        json_path=args.json,
+        fail_on=args.fail_on,
     )
+    return replay_and_report(args.scene, args.input, args.output, options, overrides)
 
 
 def replay_and_report(
     scene_path: str | Path,
     bag: str | Path,
     output: str,
-    chunk: int,
-    progress: bool,
-    plot: str | None,
-    fail_on: str,
+    options: ReplayOptions = ReplayOptions(),
     input_overrides: dict[str, str] | None = None,
-    json_path: str | None = None,
 ) -> int:
     """Replay, print the summary (and plot), and return the exit status (see `verdict`).
     `input_overrides`: scene `input` fields replaced (topic, frame_id), checked like the
@@ -97,21 +104,24 @@ def replay_and_report(
     scene = load_scene(scene_path, input_overrides)
     from mount_twin.commands.stopping import checkpoint
 
-    summary = replay(scene, bag, output, chunk=chunk, progress=progress, checkpoint=checkpoint)
+    summary = replay(
+        scene, bag, output, chunk=options.chunk, progress=options.progress, checkpoint=checkpoint
+    )
     print(summary.text())
-    if json_path:
+    if options.json_path:
         import json
 
-        Path(json_path).write_text(json.dumps(summary.to_dict(), indent=2), encoding="utf-8")
-        print(f"json: {json_path}")
-    if plot:
+        text = json.dumps(summary.to_dict(), indent=2)
+        Path(options.json_path).write_text(text, encoding="utf-8")
+        print(f"json: {options.json_path}")
+    if options.plot:
         from mount_twin.plot import plot_output_bag  # matplotlib only when asked for
 
         png = plot_output_bag(
-            output, plot, Path(scene_path).name, summary.events, summary.origin_s
+            output, options.plot, Path(scene_path).name, summary.events, summary.origin_s
         )
         print(f"plot: {png}")
-    return verdict(summary, fail_on)
+    return verdict(summary, options.fail_on)
 
 
 EXIT_NOTHING_ACCEPTED, EXIT_FAIL_ON, EXIT_FAILED = 3, 4, 6

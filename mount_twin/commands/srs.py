@@ -139,19 +139,9 @@ def tolerance_of(args: argparse.Namespace) -> tuple[float, float]:
 
 
 def run(args: argparse.Namespace) -> int:
-    import numpy as np
-
-    from mount_twin.analysis.design_margin import check_design
     from mount_twin.analysis.sampling import uniform
-    from mount_twin.analysis.srs import (
-        ACCURATE_SHARE,
-        damping_ratio,
-        gravity_offset,
-        octave_frequencies,
-        srs,
-    )
+    from mount_twin.analysis.srs import ACCURATE_SHARE, damping_ratio, gravity_offset, srs
     from mount_twin.commands.common import read_design_table
-    from mount_twin.io.csv_import import G
 
     if args.plot:
         from mount_twin.commands.extras import require
@@ -164,35 +154,14 @@ def run(args: argparse.Namespace) -> int:
     record = uniform(t, accel, args.input)
     t, accel, rate = record.t, record.values, record.rate_hz
     offset, removed = gravity_offset(t, accel, args.gravity, args.head)
-    freqs = (
-        np.array(args.freqs)
-        if args.freqs
-        else octave_frequencies(args.fmin, args.fmax or ACCURATE_SHARE * rate, args.octave)
-    )
+    freqs = _frequencies(args, rate)
     axes = AXES if args.axis == "all" else (args.axis,)
     spectra = {
         axis: srs(accel[:, AXES.index(axis)] - offset[AXES.index(axis)], rate, freqs, zeta)
         for axis in axes
     }
-    columns = [
-        Column(
-            kind,
-            kind if len(axes) == 1 else f"{kind}_{axis}",
-            "m/s" if kind == "pseudo_velocity" else "g",
-            getattr(s, kind) / (1.0 if kind == "pseudo_velocity" else G),
-        )
-        for axis, s in spectra.items()
-        for kind in SPECTRA
-    ]
-    checks = (
-        {
-            axis: check_design(freqs, s.maximax / G, *design, (low, high))
-            for axis, s in spectra.items()
-        }
-        if design is not None
-        else {}
-    )
-    columns += _margin_columns(freqs, checks)
+    checks = _design_checks(freqs, spectra, design, (low, high))
+    columns = _spectrum_columns(spectra) + _margin_columns(freqs, checks)
     q_text = f"{1 / (2 * zeta):g}" if zeta > 0.0 else "∞"
     print(
         f"{name}: {len(t)} samples at {rate:.6g} Hz, axis {args.axis}, ζ = {zeta:g} (Q = {q_text})"
@@ -200,15 +169,7 @@ def run(args: argparse.Namespace) -> int:
     if record.note:
         print(record.note)
     print(f"gravity and bias taken out ({removed}): {', '.join(f'{v:.6g}' for v in offset)} m/s²")
-    shown = [c for c in columns if c.kind in (TABLE if len(axes) == 1 else TABLE_ALL)]
-    print(f"{'f Hz':>9}" + "".join(f" {c.label:>{c.width}}" for c in shown))
-    accurate = spectra[axes[0]].accurate
-    for k, fk in enumerate(freqs):
-        cells = "".join(f" {c.values[k]:>{c.width}.4g}" for c in shown)
-        print(f"{fk:>9.4g}{cells}{'' if accurate[k] else '  *'}")
-    if not accurate.all():
-        limit = ACCURATE_SHARE * rate
-        print(f"* above fs/10 = {limit:g} Hz the filter is less accurate (peaks picked low)")
+    _print_table(freqs, columns, len(axes) == 1, spectra[axes[0]].accurate, ACCURATE_SHARE * rate)
     for axis, check in checks.items():
         print(f"design {args.design}, axis {axis} maximax: {check.summary()}")
     if args.csv:
@@ -223,6 +184,72 @@ def run(args: argparse.Namespace) -> int:
         _plot(args.plot, spectra, design, band, title, ACCURATE_SHARE * rate)
         print(f"plot: {args.plot}")
     return EXIT_OUT_OF_TOLERANCE if any(not c.passed for c in checks.values()) else 0
+
+
+def _frequencies(args: argparse.Namespace, rate_hz: float) -> np.ndarray:
+    """The natural frequencies, Hz: --freqs, else --octave spacing from --fmin to --fmax
+    (default: where the filter is accurate at `rate_hz`)."""
+    import numpy as np
+
+    from mount_twin.analysis.srs import ACCURATE_SHARE, octave_frequencies
+
+    if args.freqs:
+        return np.array(args.freqs)
+    return octave_frequencies(args.fmin, args.fmax or ACCURATE_SHARE * rate_hz, args.octave)
+
+
+def _spectrum_columns(spectra: dict[str, Spectrum]) -> list[Column]:
+    """Every spectrum (SPECTRA) of each axis, in g (pseudo-velocity in m/s); the names are
+    suffixed with the axis where there are several."""
+    from mount_twin.io.csv_import import G
+
+    return [
+        Column(
+            kind,
+            kind if len(spectra) == 1 else f"{kind}_{axis}",
+            "m/s" if kind == "pseudo_velocity" else "g",
+            getattr(s, kind) / (1.0 if kind == "pseudo_velocity" else G),
+        )
+        for axis, s in spectra.items()
+        for kind in SPECTRA
+    ]
+
+
+def _design_checks(
+    freqs: np.ndarray,
+    spectra: dict[str, Spectrum],
+    design: tuple[list[float], list[float]] | None,
+    band_db: tuple[float, float],
+) -> dict[str, DesignCheck]:
+    """Each axis's maximax (g) judged against the design (Hz, g) within `band_db` (dB); none
+    without a design."""
+    from mount_twin.analysis.design_margin import check_design
+    from mount_twin.io.csv_import import G
+
+    if design is None:
+        return {}
+    return {
+        axis: check_design(freqs, s.maximax / G, *design, band_db) for axis, s in spectra.items()
+    }
+
+
+def _print_table(
+    freqs: np.ndarray,
+    columns: list[Column],
+    one_axis: bool,
+    accurate: np.ndarray,
+    accurate_hz: float,
+) -> None:
+    """The printed table (TABLE's spectra of `one_axis`, else TABLE_ALL's of each axis), a `*`
+    on the frequencies where the filter is not `accurate` (above `accurate_hz`, Hz) and a note
+    on them."""
+    shown = [c for c in columns if c.kind in (TABLE if one_axis else TABLE_ALL)]
+    print(f"{'f Hz':>9}" + "".join(f" {c.label:>{c.width}}" for c in shown))
+    for k, fk in enumerate(freqs):
+        cells = "".join(f" {c.values[k]:>{c.width}.4g}" for c in shown)
+        print(f"{fk:>9.4g}{cells}{'' if accurate[k] else '  *'}")
+    if not accurate.all():
+        print(f"* above fs/10 = {accurate_hz:g} Hz the filter is less accurate (peaks picked low)")
 
 
 def _margin_columns(freqs: np.ndarray, checks: dict[str, DesignCheck]) -> list[Column]:

@@ -281,28 +281,26 @@ class HealthWindow:
         inp = self._input_status(
             new, counts, span, lost_from_stamps, nominal_interval_s, stalled_s
         )
+        step = self._integration_status(counts, span)
+        att = self._attitude_status()
+        mounts = self._mount_statuses(utilisation, active)
+        self._reset()
+        return HealthReport(stamp, sample, [inp, step, att, *mounts])
+
+    def _integration_status(self, counts: Counter[str], span: float) -> HealthStatus:
+        """The integration status of this window (`span`: its stamps, s): stepper failures and
+        a stop (ERROR), notes on how the input is taken and an estimated error past
+        WARN_FORCE_ERROR_REL (WARN); the solver's settings and figures as values."""
         integ = self.scene.integration
         rtf = span / self.wall if self.wall > 0 and span > 0 else math.nan
-        fail_text = "; ".join(f"{self.origin_s + t:.6f} s: {m}" for t, m in self.failures)
-        if self.stopped_at is not None:
-            step_text = (
-                f"not following since {self.origin_s + self.stopped_at:.6f} s: "
-                f"{self.stopped_why}; no pose, angles or wrenches until a restart (a gap or "
-                "the stamps jumping back) finds a state to start from"
-                + (f" ({fail_text})" if self.failures else "")
-            )
-        elif self.failures:
-            step_text = f"stepper failed and the twin restarted: {fail_text}"
-        else:
-            step_text = "ok"
-        level = ERROR if self.failures or self.stopped_at is not None else OK
+        level, step_text = self._stepper_status()
         estimate = self._estimate_values()
         warning = estimate_warning(ErrorEstimate.of(self.estimate_run)) if estimate else None
         for note in (*self.notes, warning):
             if note is not None:
                 level = max(level, WARN)
                 step_text = note + ("" if step_text == "ok" else f"; {step_text}")
-        step = HealthStatus(
+        return HealthStatus(
             INTEGRATION,
             level,
             step_text,
@@ -322,8 +320,29 @@ class HealthWindow:
                 "latency_s": f"{self.latency[1]:.6g}",
             },
         )
+
+    def _stepper_status(self) -> tuple[int, str]:
+        """Level and text of the stepper in this window: ERROR with its failures (stamps in s)
+        or a stop, else OK."""
+        fail_text = "; ".join(f"{self.origin_s + t:.6f} s: {m}" for t, m in self.failures)
+        if self.stopped_at is not None:
+            step_text = (
+                f"not following since {self.origin_s + self.stopped_at:.6f} s: "
+                f"{self.stopped_why}; no pose, angles or wrenches until a restart (a gap or "
+                "the stamps jumping back) finds a state to start from"
+                + (f" ({fail_text})" if self.failures else "")
+            )
+        elif self.failures:
+            step_text = f"stepper failed and the twin restarted: {fail_text}"
+        else:
+            step_text = "ok"
+        return (ERROR if self.failures or self.stopped_at is not None else OK), step_text
+
+    def _attitude_status(self) -> HealthStatus:
+        """The attitude status of this window: WARN past `outputs.tilt_warn_rad` of tilt, where
+        the α/γ/δ chart degrades."""
         warn = self.scene.outputs.tilt_warn_rad
-        att = HealthStatus(
+        return HealthStatus(
             f"{PREFIX}: attitude",
             WARN if self.tilt_max > warn else OK,
             f"tilt {math.degrees(self.tilt_max):.1f}° past {math.degrees(warn):.1f}°: the α/γ/δ "
@@ -332,9 +351,6 @@ class HealthWindow:
             else "ok",
             {"tilt_max_rad": f"{self.tilt_max:.6g}"},
         )
-        mounts = self._mount_statuses(utilisation, active)
-        self._reset()
-        return HealthReport(stamp, sample, [inp, step, att, *mounts])
 
     def _estimate_values(self) -> dict[str, str]:
         """The estimated errors of the period and, `_run`, of the run so far as diagnostic
@@ -416,28 +432,14 @@ class HealthWindow:
             k: v for k, v in sorted(new.items()) if k.startswith("lost_") and k != "lost_estimated"
         }
         lost = max(lost_from_stamps, sum(reported.values()))
-        share = lost / (new["accepted"] + lost) if lost else 0.0
 
         parts: list[str] = []
         level = OK
         all_rejected = False
         if stalled_s is not None:
             level = ERROR
-            waited = (
-                "by the end of the input" if stalled_s == ENDED else f"for {_seconds(stalled_s)}"
-            )
-            if not new["received"]:
-                parts.append(f"no input received {waited}")
-            elif not new["accepted"]:
-                all_rejected = n_rejected > 0
-                why = ", ".join(self._reason(r, n) for r, n in new_rejected.items())
-                parts.append(
-                    f"no sample accepted {waited}: {new['received']} received, "
-                    + (f"all rejected ({why})" if all_rejected else "none accepted")
-                )
-            else:
-                waited = _seconds(stalled_s)
-                parts.append(f"input stalled: only {new['accepted']} samples accepted in {waited}")
+            stall, all_rejected = self._stall_text(new, new_rejected, stalled_s)
+            parts.append(stall)
         for stamp, _, _, notes in self.starts:
             for note_level, text in notes:
                 level = max(level, note_level)
@@ -450,37 +452,70 @@ class HealthWindow:
             parts.append(
                 f"{n_rejected} samples rejected{detail}, {new['gaps']} gaps in this period"
             )
-        spec = self.scene.input
-        if new["saturated"]:
+        for finding in self._sensor_findings(new):
             level = max(level, WARN)
+            parts.append(finding)
+        if lost:
+            share = lost / (new["accepted"] + lost)
+            level = max(level, ERROR if share > LOST_ERROR else WARN)
+            parts.append(_lost_text(lost, share, lost_from_stamps, nominal_s, reported))
+        values = self._input_values(new, counts, span, lost, nominal_s, stalled_s)
+        return HealthStatus(f"{PREFIX}: input", level, "; ".join(parts) or "ok", values)
+
+    def _stall_text(
+        self, new: Counter[str], new_rejected: dict[str, int], stalled_s: float
+    ) -> tuple[str, bool]:
+        """What a stall (`stalled_s`: s since the last report, or ENDED) found in this window,
+        and whether every sample received was rejected (`new_rejected`: count per reason)."""
+        waited = "by the end of the input" if stalled_s == ENDED else f"for {_seconds(stalled_s)}"
+        if not new["received"]:
+            return f"no input received {waited}", False
+        if not new["accepted"]:
+            all_rejected = sum(new_rejected.values()) > 0
+            why = ", ".join(self._reason(r, n) for r, n in new_rejected.items())
+            text = f"no sample accepted {waited}: {new['received']} received, " + (
+                f"all rejected ({why})" if all_rejected else "none accepted"
+            )
+            return text, all_rejected
+        waited = _seconds(stalled_s)
+        return f"input stalled: only {new['accepted']} samples accepted in {waited}", False
+
+    def _sensor_findings(self, new: Counter[str]) -> list[str]:
+        """Warnings on the readings of this window: samples at the sensor's range (clipped)
+        and readings repeated exactly beyond PLATEAU_G (clipped or stuck)."""
+        found = []
+        if new["saturated"]:
+            spec = self.scene.input
             ranges = " or ".join(
                 f"{v:g} {unit}"
                 for v, unit in ((spec.accel_range_m_s2, "m/s²"), (spec.gyro_range_rad_s, "rad/s"))
                 if v > 0.0
             )
-            parts.append(
+            found.append(
                 f"{new['saturated']} samples at the sensor's range ({ranges}): clipped, the true "
                 "peaks were higher"
             )
         if new["plateau"]:
-            level = max(level, WARN)
-            parts.append(
+            found.append(
                 f"{new['plateau']} readings beyond {PLATEAU_G:g} g repeated exactly from the "
                 "sample before "
                 "(a clipped or stuck sensor?)"
             )
-        if lost:
-            level = max(level, ERROR if share > LOST_ERROR else WARN)
-            sources = []
-            if lost_from_stamps:
-                sources.append(f"from stamp gaps at a {nominal_s * 1e3:.3f} ms nominal interval")
-            if reported:
-                sources.append("reported " + ", ".join(f"{k} {v}" for k, v in reported.items()))
-            parts.append(
-                f"~{lost} samples lost in this period ({100.0 * share:.1f} %, "
-                f"{'; '.join(sources)})"
-            )
+        return found
 
+    def _input_values(
+        self,
+        new: Counter[str],
+        counts: Counter[str],
+        span: float,
+        lost: int,
+        nominal_s: float,
+        stalled_s: float | None,
+    ) -> dict[str, str]:
+        """The input status' values: the topic, the rate of this window (`span`, s), the
+        cumulative counts, the samples `lost` in this window at the nominal interval
+        `nominal_s` (s), the time since the last report (`stalled_s`, s) and the last start's
+        specific force (m/s²) and tilt (rad)."""
         values = {
             "topic": self.scene.input.topic,
             "rate_hz": f"{new['accepted'] / span:.1f}" if span > 0 else "n/a",
@@ -506,7 +541,7 @@ class HealthWindow:
             _, magnitude, tilt, _ = self.starts[-1]
             values["start_specific_force_m_s2"] = f"{magnitude:.6g}"
             values["start_tilt_rad"] = f"{tilt:.6g}"
-        return HealthStatus(f"{PREFIX}: input", level, "; ".join(parts) or "ok", values)
+        return values
 
     def _reason(self, reason: str, n: int) -> str:
         """'non_finite 3', or for wrong frames "wrong_frame 3: expected frame_id 'a', got 'b'"."""
@@ -534,6 +569,20 @@ def estimate_warning(run: ErrorEstimate) -> str | None:
 def _seconds(t: float) -> str:
     """A duration for a message: '1.0 s', '12.5 s', '250 ms'."""
     return f"{t:.1f} s" if t >= 1.0 else f"{t * 1e3:.0f} ms"
+
+
+def _lost_text(
+    lost: int, share: float, from_stamps: int, nominal_s: float, reported: dict[str, int]
+) -> str:
+    """'~12 samples lost in this period (1.2 %, from stamp gaps at a 1.000 ms nominal interval;
+    reported lost_middleware 3)': `share` of the samples due, `from_stamps` of them estimated
+    from the stamps at the nominal interval `nominal_s` (s), `reported` by the adapter."""
+    sources = []
+    if from_stamps:
+        sources.append(f"from stamp gaps at a {nominal_s * 1e3:.3f} ms nominal interval")
+    if reported:
+        sources.append("reported " + ", ".join(f"{k} {v}" for k, v in reported.items()))
+    return f"~{lost} samples lost in this period ({100.0 * share:.1f} %, {'; '.join(sources)})"
 
 
 def _events_text(events: list[MountEvent], utilisation: float, origin_s: int) -> str:

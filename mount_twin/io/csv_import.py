@@ -90,18 +90,9 @@ def _fail(path: Path, where: str, what: str) -> ValueError:
 def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Imported:
     """Read a recorder's CSV (see the module docstring); every error names file, row, column."""
     path = Path(path)
-    try:
-        # utf-8-sig drops a byte-order mark
-        text = read_limited(path, CSV_MAX_BYTES, "CSV_MAX_BYTES", "utf-8-sig")
-    except FileTooLargeError as err:
-        raise _fail(path, "<file>", f"cannot read: {err}") from err
-    except OSError as err:
-        raise _fail(path, "<file>", f"cannot read: {err.strerror}") from err
-    except UnicodeDecodeError as err:
-        raise _fail(path, "<file>", f"not UTF-8 text ({err.reason} at byte {err.start})") from err
     lines = [
         (n, line)
-        for n, line in enumerate(text.splitlines(), 1)
+        for n, line in enumerate(_read_text(path).splitlines(), 1)
         if line.strip() and not line.lstrip().startswith("#")
     ]
     if not lines:
@@ -119,11 +110,56 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     decimal = fmt.decimal or (
         "," if delimiter != "," and any("," in line for _, line in data[:50]) else "."
     )
+    units = {
+        role: _unit(QUANTITY[role], header_units[col], fmt.units) for role, col in roles.items()
+    }
+    scale, notes = _factors(path, header_row, names, roles, units)
+    columns = [(col, scale[role]) for role, col in roles.items()]
+    values = _values(path, data, names, delimiter, decimal, columns)
+    t = values[:, 0]
+    back = np.flatnonzero(np.diff(t) <= 0.0)
+    if back.size:
+        row = data[int(back[0]) + 1][0]
+        raise _fail(path, f"row {row}, column {names[roles['t']]}", "time does not increase")
+    accel_role = f"a{fmt.axis or 'x'}"
+    accel, gyro, found = _motion(values, fmt.axis, names[roles[accel_role]])
+    notes += found
+    shown = {QUANTITY[r]: units[r] for r in ("t", accel_role, "wx") if r in roles}
+    notes.append("units: " + ", ".join(f"{q} {u}" for q, u in shown.items()))
+    if decimal == ",":
+        notes.append("decimal comma")
+    return Imported(Signal(t, accel, gyro), notes)
+
+
+def _read_text(path: Path) -> str:
+    """The file's text (at most CSV_MAX_BYTES, UTF-8, a byte-order mark dropped); errors name
+    the file."""
+    try:
+        # utf-8-sig drops a byte-order mark
+        return read_limited(path, CSV_MAX_BYTES, "CSV_MAX_BYTES", "utf-8-sig")
+    except FileTooLargeError as err:
+        raise _fail(path, "<file>", f"cannot read: {err}") from err
+    except OSError as err:
+        raise _fail(path, "<file>", f"cannot read: {err.strerror}") from err
+    except UnicodeDecodeError as err:
+        raise _fail(path, "<file>", f"not UTF-8 text ({err.reason} at byte {err.start})") from err
+
+
+def _unit(quantity: str, header_unit: str, overrides: dict[str, str]) -> str:
+    """The unit of a column of `quantity`: the override (`CsvFormat.units`), else the header's,
+    else the SI one."""
+    return overrides.get(quantity) or header_unit or next(iter(UNITS[quantity]))
+
+
+def _factors(
+    path: Path, header_row: int, names: list[str], roles: dict[str, int], units: dict[str, str]
+) -> tuple[dict[str, float], list[str]]:
+    """Factor to SI per role from its unit, and the note that an accelerometer range in the
+    header (`100g`) was read as g; an unknown unit is an error."""
     notes: list[str] = []
     scale = {}
     for role, col in roles.items():
-        quantity = QUANTITY[role]
-        unit = fmt.units.get(quantity) or header_units[col] or next(iter(UNITS[quantity]))
+        quantity, unit = QUANTITY[role], units[role]
         factor = UNITS[quantity].get(unit.lower().replace(" ", ""))
         if factor is None and quantity == "accel" and RANGE_UNIT.match(unit.lower()):
             factor = G
@@ -134,15 +170,27 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
             where = f"row {header_row}, column {names[col]}"
             raise _fail(path, where, f"unknown {quantity} unit {unit!r} (known: {known})")
         scale[role] = factor
-    values = np.empty((len(data), len(roles)))
-    order = list(roles.items())
+    return scale, notes
+
+
+def _values(
+    path: Path,
+    data: list[tuple[int, str]],
+    names: list[str],
+    delimiter: str | None,
+    decimal: str,
+    columns: list[tuple[int, float]],
+) -> np.ndarray:
+    """The data rows' (line number, text) cells of `columns` (index, factor to SI), in SI
+    units, (rows, columns); every cell checked to be a finite number, in SI units too."""
+    values = np.empty((len(data), len(columns)))
     for i, (row, line) in enumerate(data):
         cells = line.split(delimiter) if delimiter else line.split()
         if len(cells) != len(names):
             raise _fail(
                 path, f"row {row}", f"{len(cells)} cells where the header has {len(names)}"
             )
-        for j, (role, col) in enumerate(order):
+        for j, (col, factor) in enumerate(columns):
             cell = cells[col].strip()
             try:
                 v = float(cell.replace(decimal, ".") if decimal == "," else cell)
@@ -152,36 +200,32 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
                 ) from None
             if not math.isfinite(v):
                 raise _fail(path, f"row {row}, column {names[col]}", f"{cell!r} is not finite")
-            values[i, j] = v * scale[role]
+            values[i, j] = v * factor
             if not math.isfinite(values[i, j]):  # 1e308 g: finite, but not in m/s²
-                what = f"{cell!r} is beyond a float in SI units (×{scale[role]:g})"
+                what = f"{cell!r} is beyond a float in SI units (×{factor:g})"
                 raise _fail(path, f"row {row}, column {names[col]}", what)
-    t = values[:, 0]
-    back = np.flatnonzero(np.diff(t) <= 0.0)
-    if back.size:
-        row = data[int(back[0]) + 1][0]
-        raise _fail(path, f"row {row}, column {names[roles['t']]}", "time does not increase")
-    if fmt.axis is not None:
-        accel = np.zeros((len(data), 3))
-        accel[:, "xyz".index(fmt.axis)] = values[:, 1]
-        column = names[roles[f"a{fmt.axis}"]]
-        notes.append(f"single axis: {column} along the sensor's {fmt.axis}, the others 0")
+    return values
+
+
+def _motion(
+    values: np.ndarray, axis: str | None, accel_column: str
+) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Specific force (n, 3) m/s² and angular velocity (n, 3) rad/s from the SI `values` (t,
+    then the acceleration columns, then any gyro's), and notes on what was taken as 0. `axis`:
+    a single-axis record's sensor axis, whose one column is `accel_column`."""
+    notes = []
+    if axis is not None:
+        accel = np.zeros((values.shape[0], 3))
+        accel[:, "xyz".index(axis)] = values[:, 1]
+        notes.append(f"single axis: {accel_column} along the sensor's {axis}, the others 0")
     else:
         accel = values[:, 1:4]
-    if len(roles) == 7:
+    if values.shape[1] == 7:
         gyro = values[:, 4:7]
     else:
         gyro = np.zeros_like(accel)
         notes.append("no gyro columns: angular velocity taken as 0")
-    units = {
-        q: fmt.units.get(q) or header_units[roles[r]] or next(iter(UNITS[q]))
-        for r, q in (("t", "time"), (f"a{fmt.axis or 'x'}", "accel"), ("wx", "gyro"))
-        if r in roles
-    }
-    notes.append("units: " + ", ".join(f"{q} {u}" for q, u in units.items()))
-    if decimal == ",":
-        notes.append("decimal comma")
-    return Imported(Signal(t, accel, gyro), notes)
+    return accel, gyro, notes
 
 
 def _header(line: str, delimiter: str | None) -> tuple[list[str], list[str]]:

@@ -82,33 +82,43 @@ def half_sine_shock(
     return Signal(t, accel, np.zeros((t.size, 3)))
 
 
+@dataclass(frozen=True)
+class SeaState:
+    """A deck's motion for `ship_motion`: roll amplitude (rad) and period (s), heave amplitude
+    (m) and period (s), hull vibration amplitude (m/s²) and frequency (Hz)."""
+
+    roll_amp: float = 0.09
+    roll_period: float = 8.0
+    heave_amp: float = 0.5
+    heave_period: float = 6.0
+    vib_amp: float = 0.8
+    vib_hz: float = 23.0
+
+
 def ship_motion(
     rate_hz: float = 1000.0,
     total: float = 5.0,
-    roll_amp: float = 0.09,
-    roll_period: float = 8.0,
-    heave_amp: float = 0.5,
-    heave_period: float = 6.0,
-    vib_amp: float = 0.8,
-    vib_hz: float = 23.0,
+    sea: SeaState = SeaState(),
     g: float = STANDARD_GRAVITY,
 ) -> Signal:
     """Rolling, heaving deck with hull vibration, sensed at the roll axis (origin of F).
 
     Roll φ = roll_amp·sin(2πt/roll_period) rad about x of F;
     heave z = heave_amp·sin(2πt/heave_period)
-    m in the earth frame; vertical vibration vib_amp·sin(2π·vib_hz·t) m/s² along z of F.
+    m in the earth frame; vertical vibration vib_amp·sin(2π·vib_hz·t) m/s² along z of F
+    (amplitudes and periods: `sea`).
     """
     t = _sample_times(rate_hz, total)
-    wr, wh, wv = 2 * math.pi / roll_period, 2 * math.pi / heave_period, 2 * math.pi * vib_hz
-    phi = roll_amp * np.sin(wr * t)
-    phi_dot = roll_amp * wr * np.cos(wr * t)
-    heave_acc = -heave_amp * wh**2 * np.sin(wh * t)
+    wr, wh = 2 * math.pi / sea.roll_period, 2 * math.pi / sea.heave_period
+    wv = 2 * math.pi * sea.vib_hz
+    phi = sea.roll_amp * np.sin(wr * t)
+    phi_dot = sea.roll_amp * wr * np.cos(wr * t)
+    heave_acc = -sea.heave_amp * wh**2 * np.sin(wh * t)
     up = g + heave_acc  # earth-vertical specific force
     accel = np.zeros((t.size, 3))
     # Earth vertical seen from F rolled by φ about x: (0, sin φ, cos φ).
     accel[:, 1] = up * np.sin(phi)
-    accel[:, 2] = up * np.cos(phi) + vib_amp * np.sin(wv * t)
+    accel[:, 2] = up * np.cos(phi) + sea.vib_amp * np.sin(wv * t)
     gyro = np.zeros((t.size, 3))
     gyro[:, 0] = phi_dot
     return Signal(t, accel, gyro)

@@ -136,48 +136,11 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> Elastomer:
     tables = []
     tr = r.sub("force_table")
     for axis in AXES:
-        if not tr.has(axis):
-            continue
-        t = tr.sub(axis)
-        raw_x = t.raw("deflection")
-        n = len(raw_x) if isinstance(raw_x, list) else 0
-        if not 3 <= n <= TABLE_MAX:
-            raise t.error("deflection", f"expected 3 to {TABLE_MAX} points, got {raw_x!r}")
-        xs, fs = t.vector("deflection", n), t.vector("force", n)
-        if any(b <= a for a, b in pairwise(xs)):
-            raise t.error("deflection", f"must increase strictly, got {list(xs)!r}")
-        if any(b <= a for a, b in pairwise(fs)):
-            raise t.error("force", f"must increase strictly (a stable mount), got {list(fs)!r}")
-        if 0.0 not in xs or fs[xs.index(0.0)] != 0.0:
-            raise t.error("deflection", "must contain 0.0 with force 0.0 (unstressed at rest)")
-        t.finish()
-        tables.append((axis, xs, fs))
+        if tr.has(axis):
+            tables.append((axis, *_force_table(tr.sub(axis))))
     tr.finish()
-    hyst = None
-    if r.has("hysteresis"):
-        h = r.sub("hysteresis")
-        hyst = Hysteresis(
-            ratio=h.number("ratio", lo=0.0, hi=1.0),
-            a=h.positive("A", 1.0),
-            beta=h.number("beta"),
-            gamma=h.number("gamma"),
-            n=h.number("n", 1.0, lo=1.0),
-            axes=_axes(h, "axes"),
-        )
-        if not hyst.beta + hyst.gamma > 0.0:
-            raise h.error("beta", "beta + gamma must be > 0 (z stays bounded)")
-        h.finish()
-    snub = None
-    if r.has("snubber"):
-        sn = r.sub("snubber")
-        snub = Snubber(
-            gap=sn.number("gap", lo=0.0),
-            stiffness=sn.positive("stiffness"),
-            exponent=sn.number("exponent", 1.5, lo=1.0),
-            damping=sn.number("damping", 0.0, lo=0.0),
-            axes=_axes(sn, "axes"),
-        )
-        sn.finish()
+    hyst = _hysteresis(r.sub("hysteresis")) if r.has("hysteresis") else None
+    snub = _snubber(r.sub("snubber")) if r.has("snubber") else None
     table_axes = {t[0] for t in tables}
     k1 = r.vector("stiffness_linear", 3, (0.0, 0.0, 0.0), lo=0.0)
     for j, axis in enumerate(AXES):
@@ -197,6 +160,53 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> Elastomer:
         hysteresis=hyst,
         snubber=snub,
     )
+
+
+def _force_table(t: Reader) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """One axis's force table, (deflections m, forces N): 3 to TABLE_MAX points, both
+    increasing strictly, through (0, 0)."""
+    raw_x = t.raw("deflection")
+    n = len(raw_x) if isinstance(raw_x, list) else 0
+    if not 3 <= n <= TABLE_MAX:
+        raise t.error("deflection", f"expected 3 to {TABLE_MAX} points, got {raw_x!r}")
+    xs, fs = t.vector("deflection", n), t.vector("force", n)
+    if any(b <= a for a, b in pairwise(xs)):
+        raise t.error("deflection", f"must increase strictly, got {list(xs)!r}")
+    if any(b <= a for a, b in pairwise(fs)):
+        raise t.error("force", f"must increase strictly (a stable mount), got {list(fs)!r}")
+    if 0.0 not in xs or fs[xs.index(0.0)] != 0.0:
+        raise t.error("deflection", "must contain 0.0 with force 0.0 (unstressed at rest)")
+    t.finish()
+    return xs, fs
+
+
+def _hysteresis(h: Reader) -> Hysteresis:
+    """The `hysteresis` keys, checked (β + γ > 0: z stays bounded)."""
+    hyst = Hysteresis(
+        ratio=h.number("ratio", lo=0.0, hi=1.0),
+        a=h.positive("A", 1.0),
+        beta=h.number("beta"),
+        gamma=h.number("gamma"),
+        n=h.number("n", 1.0, lo=1.0),
+        axes=_axes(h, "axes"),
+    )
+    if not hyst.beta + hyst.gamma > 0.0:
+        raise h.error("beta", "beta + gamma must be > 0 (z stays bounded)")
+    h.finish()
+    return hyst
+
+
+def _snubber(sn: Reader) -> Snubber:
+    """The `snubber` keys, checked."""
+    snub = Snubber(
+        gap=sn.number("gap", lo=0.0),
+        stiffness=sn.positive("stiffness"),
+        exponent=sn.number("exponent", 1.5, lo=1.0),
+        damping=sn.number("damping", 0.0, lo=0.0),
+        axes=_axes(sn, "axes"),
+    )
+    sn.finish()
+    return snub
 
 
 def nominal_tangent(e: Elastomer) -> tuple[tuple[float, ...], tuple[str, ...]]:
