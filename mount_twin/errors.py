@@ -29,3 +29,12 @@ class DamagedBagError(BagError):
 class Terminated(BaseException):
     """SIGTERM, raised in the main thread (like KeyboardInterrupt for SIGINT) so that the
     command stops cleanly: output bags are finished and marked partial."""
+
+
+def require(value: object, expected: type, where: str) -> None:
+    """Raise TypeError naming `where` (the function and argument) unless `value` is an
+    `expected`: the public API's entry points refuse a wrong object with a message that says
+    what they take, not with an AttributeError from deep inside."""
+    if not isinstance(value, expected):
+        msg = f"{where}: got a {type(value).__name__}, expected a {expected.__name__}"
+        raise TypeError(msg)

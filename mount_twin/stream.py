@@ -10,6 +10,7 @@ import numpy as np
 
 from mount_twin.engine.batch import HealthReport, OutputBatch
 from mount_twin.engine.engine import TwinEngine
+from mount_twin.errors import require
 from mount_twin.io.messages import TimeBase, decode_inputs, encode_outputs, encode_report
 from mount_twin.model.assemble import assemble
 from mount_twin.scene.description import Scene
@@ -24,6 +25,7 @@ class TwinStream:
     """
 
     def __init__(self, scene: Scene) -> None:
+        require(scene, Scene, "TwinStream(scene)")
         self.scene = scene
         self.engine = TwinEngine(assemble(scene))
         # rosbags generates a type's serializer at its first use and the output layouts are

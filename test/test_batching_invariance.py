@@ -59,7 +59,7 @@ def test_a_switching_rotating_scene_gives_the_same_bits_in_any_batching(
     reference: tuple[OutputBatch, TwinEngine], pieces: list[int]
 ) -> None:
     want, ref_engine = reference
-    stiffening = [e for e in ref_engine.events if ref_engine._stiffens(e)]
+    stiffening = [e for e in ref_engine.events if ref_engine.stiffens(e)]
     assert len(stiffening) >= 2, "the record must make auto look again mid-run"
     got, engine = _run(pieces)
     np.testing.assert_array_equal(got.stamps, want.stamps)

@@ -22,7 +22,7 @@ from physics_helpers import base_scene, mount
 
 from mount_twin import _core
 from mount_twin.analysis.accuracy import measure, raw_gyro, reference_run, run_at
-from mount_twin.engine import engine as engine_module
+from mount_twin.engine import driver as driver_module
 from mount_twin.engine.batch import WARN, SampleBatch
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.estimator import new_estimator
@@ -143,7 +143,7 @@ def test_measuring_every_interval_comes_within_ten_percent_where_sampling_over_c
     ref = reference_run(scene, samples, 1_000_000)
     every = partial(new_estimator, check_every=1)
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(engine_module, "new_estimator", every)
+        mp.setattr(driver_module, "new_estimator", every)
         acc = measure(scene, samples, rtol, 100_000, ref)
     assert 0.9 < acc.est_force_error / acc.force_error < 1.1, acc
 

@@ -9,6 +9,7 @@ import pytest
 from io_helpers import REST, G, batch, default_scene, engine_for, scene_with, stamp_ns
 
 from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus, OutputBatch
+from mount_twin.engine.intake import Intake
 from mount_twin.io.messages import (
     ACCEL,
     ANGLES_OUTPUT,
@@ -170,7 +171,8 @@ def test_includes_gravity_false_uses_the_configured_g() -> None:
     lunar = 1.62
     scene = scene_with(input={"includes_gravity": False, "g": lunar})
     engine = engine_for(scene)
-    f, _, _ = engine._screen(batch([0.0, 0.001], accel=np.zeros((2, 3))))
+    intake = Intake(engine.model, engine.health, engine.counts)
+    f, _, _ = intake.screen(batch([0.0, 0.001], accel=np.zeros((2, 3))))
     np.testing.assert_array_equal(f, [[0.0, 0.0, lunar]] * 2)
 
 
@@ -273,6 +275,29 @@ def test_the_output_registry_has_one_entry_per_output_flag_of_a_scene() -> None:
         names = [(st.topic, st.msgtype, st.frames) for st in output_streams(only)]
         assert names == [(st.topic, st.msgtype, st.frames) for st in out.streams(only)]
         assert names  # every flag brings at least one topic
+
+
+@pytest.mark.parametrize(
+    ("change", "says"),
+    [
+        ({"flag": "accel"}, r"output 'accel' \(~/angles\): no switch 'accel' in scene\.outputs"),
+        ({"msgtype": "geometry_msgs/msg/TwistStamped"}, r"no builder for geometry_msgs/msg/Twist"),
+        ({"fields": ("vector.x", "vector.y")}, r"3 columns but 2 fields to read them from"),
+        (
+            {"fields": ("vector.x", "vector.y", "vector.w")},
+            r"Vector3Stamped has no field vector\.w",
+        ),
+        ({"table": None}, r"a table needs columns, and columns a table"),
+        ({"table": "angles_{mount}"}, r"the table and the topic must both name \{mount\}"),
+    ],
+)
+def test_an_output_registered_half_way_fails_at_import_naming_what_is_missing(
+    change: dict, says: str
+) -> None:
+    """A new quantity declared without its scene switch, its message builder or a readable
+    field is refused when the registry is built, not when a bag is read back wrong."""
+    with pytest.raises(ValueError, match=says):
+        dataclasses.replace(ANGLES_OUTPUT, **change)
 
 
 def test_a_bag_is_read_back_by_the_registry_not_by_message_type() -> None:

@@ -145,3 +145,26 @@ def test_a_malformed_batch_is_refused_naming_the_field_and_changes_nothing(
     assert engine.counts["received"] == 0
     out = engine.run(mount_twin.SampleBatch(**good))
     assert len(out) == 5
+
+
+def test_the_entry_points_refuse_a_wrong_object_naming_the_argument() -> None:
+    """A scene where a model goes (or a dict where a batch goes) is refused at the door, with
+    what was given and what is taken, not with an AttributeError from deep inside."""
+    scene = mount_twin.load_scene_file(ROOT / "config/pump_8_mounts.scene.yaml")
+    engine = mount_twin.TwinEngine(mount_twin.assemble(scene))
+    cases = [
+        (
+            lambda: mount_twin.TwinEngine(scene),
+            r"TwinEngine\(model\): got a Scene, expected a Model",
+        ),
+        (
+            lambda: mount_twin.assemble({"body": {}}),
+            r"assemble\(scene\): got a dict, expected a Scene",
+        ),
+        (lambda: mount_twin.TwinStream("pump.yaml"), r"TwinStream\(scene\): got a str, expected"),
+        (lambda: engine.push({"stamps": []}), r"TwinEngine\.push\(batch\): got a dict, expected"),
+    ]
+    for call, says in cases:
+        with pytest.raises(TypeError, match=says):
+            call()
+    assert engine.counts["received"] == 0

@@ -58,6 +58,12 @@ class SampleBatch:
             msg = f"SampleBatch.frame_ids: {len(self.frame_ids)} entries, expected {n} strings"
             raise ValueError(msg)
 
+    def tail(self, start: int) -> SampleBatch:
+        """The samples from position `start` on."""
+        return SampleBatch(
+            self.stamps[start:], self.accel[start:], self.gyro[start:], self.frame_ids[start:]
+        )
+
     @classmethod
     def concat(cls, parts: list[SampleBatch]) -> SampleBatch:
         """One batch of several, in order."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from dataclasses import fields as dataclass_fields
 from functools import cached_property, lru_cache, partial
 from operator import attrgetter
 from typing import Any
@@ -21,7 +22,7 @@ from mount_twin.engine.batch import HealthReport, OutputBatch, SampleBatch
 from mount_twin.io.fixed_layout import FixedLayout
 from mount_twin.physics import pose_row
 from mount_twin.physics.rotations import quaternion_from_matrix, rpy_matrix
-from mount_twin.scene.description import Scene
+from mount_twin.scene.description import Outputs, Scene
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 _T = TYPESTORE.types
@@ -334,6 +335,13 @@ class Output:
     frames: Callable[[Scene, str], tuple[str, ...]]
     values: Callable[[OutputBatch, int], np.ndarray]
 
+    def __post_init__(self) -> None:
+        """Refuse an output registered half-way, at import, naming what is missing."""
+        missing = _output_gaps(self)
+        if missing:
+            msg = f"io.messages: output {self.flag!r} ({self.topic}): {'; '.join(missing)}"
+            raise ValueError(msg)
+
     @cached_property
     def _getter(self) -> Callable[[Any], Any]:
         return attrgetter(*self.fields)
@@ -377,6 +385,36 @@ class Output:
         )
         found = re.search(pattern + "$", topic)
         return None if found is None else self.table.format(**found.groupdict())
+
+
+def _has_field(msgtype: str, path: str) -> bool:
+    """Whether the dotted field path exists in `msgtype` (the typestore's definitions)."""
+    node: Any = msgtype  # a type's name, then each field's (node type, subtype) subtype
+    for name in path.split("."):
+        fields = dict(TYPESTORE.fielddefs[node][1]) if node in TYPESTORE.fielddefs else {}
+        if name not in fields:
+            return False
+        node = fields[name][1]
+    return True
+
+
+def _output_gaps(out: Output) -> list[str]:
+    """What an output's declaration lacks or contradicts (empty: complete)."""
+    gaps = []
+    if out.flag not in {f.name for f in dataclass_fields(Outputs)}:
+        gaps.append(f"no switch {out.flag!r} in scene.outputs (mount_twin.scene.description)")
+    if out.msgtype not in _BUILDERS:
+        gaps.append(f"no builder for {out.msgtype} in _BUILDERS")
+    if len(out.columns) != len(out.fields):
+        gaps.append(f"{len(out.columns)} columns but {len(out.fields)} fields to read them from")
+    if (out.table is None) != (not out.columns):
+        gaps.append("a table needs columns, and columns a table")
+    if out.table is not None and ("{mount}" in out.table) != out.per_mount:
+        gaps.append("the table and the topic must both name {mount}, or neither")
+    gaps.extend(
+        f"{out.msgtype} has no field {f}" for f in out.fields if not _has_field(out.msgtype, f)
+    )
+    return gaps
 
 
 def _pose_fields(out: OutputBatch, i: int) -> np.ndarray:

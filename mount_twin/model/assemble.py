@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mount_twin.errors import ModelError
+from mount_twin.errors import ModelError, require
 from mount_twin.kinds import CODES, KINDS, N_PAR, check_dispatch
 from mount_twin.model import newton
 from mount_twin.physics.dynamics import (
@@ -32,12 +33,17 @@ class Model:
         arrays: the core's arrays.
         state_names: name of each state entry (q of free DOFs, then their rates).
         sensor_rotation: 3×3 rotation of the input sensor frame into F.
+        nominal_state: the start state of a new machine under nominal gravity (the scene's
+            input.g along +z of F): its given motion, or its static equilibrium, solved at
+            assembly so that a scene whose mounts cannot hold the body fails at load. The
+            twin starts here when no equilibrium holds under its first samples.
     """
 
     scene: Scene
     arrays: ModelArrays
     state_names: tuple[str, ...]
     sensor_rotation: np.ndarray
+    nominal_state: np.ndarray
 
     @property
     def n_state(self) -> int:
@@ -66,7 +72,9 @@ def _inverse(rated: tuple[float, ...]) -> list[float]:
 
 
 def assemble(scene: Scene) -> Model:
-    """Build the core's arrays of `scene` (done once, at load)."""
+    """Build the core's arrays of `scene` and solve its nominal start state (done once, at
+    load; raises ModelError where the mounts cannot hold the body)."""
+    require(scene, Scene, "assemble(scene)")
     body = scene.body
     inertia = np.array(body.inertia_tensor())
     cg = np.array(body.cg)
@@ -108,7 +116,9 @@ def assemble(scene: Scene) -> Model:
         nl=nl,
         rotation_read=bool(lin) or (nl is not None and bool(nl.rotational.any())),
     )
-    return Model(scene, arrays, tuple(names), rpy_matrix(*scene.input.sensor_rpy))
+    unsolved = Model(scene, arrays, tuple(names), rpy_matrix(*scene.input.sensor_rpy), np.empty(0))
+    gravity_up = np.array([0.0, 0.0, scene.input.g])
+    return replace(unsolved, nominal_state=initial_state(unsolved, gravity_up))
 
 
 def in_f(axes: np.ndarray, values: np.ndarray) -> np.ndarray:
@@ -211,18 +221,7 @@ def static_equilibrium(
             return np.full((nf, nf), np.nan)
         return by_q[nf : 2 * nf].copy()
 
-    g = float(np.linalg.norm(specific_force))
-    # Relative to what floating point can resolve: a mount force is k·(R·p − p) with lever arms
-    # p of up to `reach` metres, so each acceleration carries a rounding floor of about
-    # ε·reach·|∂a/∂q| (10 kg on 1e11 N/m mounts: ~1e-4 m/s²); an absolute threshold refused
-    # stiff, light scenes whose equilibrium was as exact as their arithmetic.
-    positions = [abs(v) for mt in model.scene.mounts for v in mt.position]
-    reach = max(1.0, float(np.abs(m.cg_ref).max()), *positions)
-
-    def allowed_at(jac: np.ndarray) -> np.ndarray:
-        floor = 64.0 * np.finfo(float).eps * reach * np.abs(jac).max(axis=1)
-        return 1e-9 * max(g, 1.0) + floor
-
+    allowed_at = _allowed_residual(model, specific_force)
     found = newton.solve(accelerations, stiffness, q_guess, allowed_at)
     if found is None:  # Newton did not get there: the robust solver says why
         from scipy.optimize import least_squares  # 0.2 s to import: only where Newton fails
@@ -242,6 +241,27 @@ def static_equilibrium(
     _check_restrained(model, jac)
     y[:nf] = q
     return y.copy()
+
+
+def _allowed_residual(
+    model: Model, specific_force: np.ndarray
+) -> Callable[[np.ndarray], np.ndarray]:
+    """The residual accepted per free generalized acceleration (m/s² or rad/s²), given the
+    Jacobian ∂(accelerations)/∂q there: 1e-9 of |specific force| (at least of 1 m/s²) plus
+    the rounding floor of the arithmetic."""
+    g = float(np.linalg.norm(specific_force))
+    # Relative to what floating point can resolve: a mount force is k·(R·p − p) with lever arms
+    # p of up to `reach` metres, so each acceleration carries a rounding floor of about
+    # ε·reach·|∂a/∂q| (10 kg on 1e11 N/m mounts: ~1e-4 m/s²); an absolute threshold refused
+    # stiff, light scenes whose equilibrium was as exact as their arithmetic.
+    positions = [abs(v) for mt in model.scene.mounts for v in mt.position]
+    reach = max(1.0, float(np.abs(model.arrays.cg_ref).max()), *positions)
+
+    def allowed_at(jac: np.ndarray) -> np.ndarray:
+        floor = 64.0 * np.finfo(float).eps * reach * np.abs(jac).max(axis=1)
+        return 1e-9 * max(g, 1.0) + floor
+
+    return allowed_at
 
 
 def _check_restrained(model: Model, jac: np.ndarray) -> None:

@@ -1,0 +1,344 @@
+"""The driver of the compiled core: the twin's state and the arrays the core loop works on.
+
+`CoreDriver` holds the state vector, the stepper, the live error estimator, the mount watch
+and the decimation state; `begin` puts the twin at a start state, `advance` runs one segment of
+samples through `kernel.run_samples` and hands what the core logged (steps, error figures,
+mount events) to the health window. Under `integration.method: auto` it makes the method choice
+at the first interval and looks again after mount events that may stiffen the scene
+(`auto_method`). Which samples to run, and what to do at a failure, is the engine's business.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from typing import NamedTuple
+
+import numpy as np
+
+from mount_twin.engine import companion, estimator
+from mount_twin.engine.auto_method import (
+    REEXAMINE_S,
+    Choice,
+    after_event,
+    at_start,
+    tangent_rate,
+)
+from mount_twin.engine.batch import MountEvent
+from mount_twin.engine.companion import Companion, new_companion
+from mount_twin.engine.estimator import Estimator, new_estimator
+from mount_twin.engine.health import HealthWindow
+from mount_twin.engine.kernel import (
+    Integrator,
+    Published,
+    RunOptions,
+    Samples,
+    new_watch,
+    run_samples,
+)
+from mount_twin.engine.rows import BatchRows, Rows
+from mount_twin.integrate.methods import AUTO
+from mount_twin.integrate.stepper import new_stepper, switch
+from mount_twin.kinds import KINDS, N_EVENTS
+from mount_twin.model.assemble import Model
+from mount_twin.model.stiffness import spectral_radius
+from mount_twin.physics import pose_row
+from mount_twin.physics.dynamics import INPUT_SIZE, evaluate, mount_monitors
+
+MAX_EVENTS = 100_000
+"""Mount events kept in CoreDriver.events (later ones are counted only)."""
+
+
+class Stepped(NamedTuple):
+    """What one `CoreDriver.advance` did.
+
+    done: index of the last sample of the segment done (0: none).
+    status: 0 when all were done; `kernel.AT_EVENT` when the segment ended at sample `done`
+        for `auto` to look again; else the stepper's failure at sample done + 1.
+    rows: the published rows (views of the push's rows where the samples are consecutive).
+    events: the mount events logged (those the core's log could hold).
+    """
+
+    done: int
+    status: int
+    rows: Rows
+    events: list[MountEvent]
+
+
+def published_buffers(
+    n: int,
+    counter: np.ndarray,
+    peak: np.ndarray,
+    linear_util: np.ndarray,
+    rows: tuple[np.ndarray, np.ndarray] | None = None,
+) -> Published:
+    """Output buffers for a run of n rows, with the decimation state to carry (`counter`, the
+    (n_mounts, 6) `peak`) and the linear mounts' utilisation to fold into; `rows`: the pose and
+    wrench rows to write into (`BatchRows.of_run`), else new ones."""
+    nm = peak.shape[0]
+    pose, wrenches = rows or (np.empty((n, pose_row.WIDTH)), np.empty((n, nm, 6)))
+    return Published(
+        counter,
+        peak,
+        pose,
+        wrenches,
+        np.zeros(n, dtype=np.bool_),
+        np.zeros((n, 3)),
+        np.zeros((nm, 6)),
+        np.ones(1),
+        linear_util,
+    )
+
+
+def _new_estimator(model: Model, n_watched: tuple[int, int]) -> Estimator | Companion | None:
+    """The live error estimate's arrays (`engine.estimator` where the mounts are linear,
+    `engine.companion` where some are not: see there), or None if the scene turns it off.
+    `n_watched`: the shape of the mount watch's event functions."""
+    integ = model.scene.integration
+    if not integ.error_estimate:
+        return None
+    arrays = model.arrays
+    if arrays.nl is not None:
+        return new_companion(
+            integ.method,
+            model.n_state,
+            integ.rtol,
+            integ.atol,
+            integ.max_substeps,
+            model.new_scratch(),
+            model.n_mounts,
+            n_watched,
+        )
+    return new_estimator(
+        integ.method,
+        integ.rtol,
+        integ.atol,
+        integ.max_substeps,
+        model.new_scratch(),
+        arrays.free_trans.shape[0] + arrays.free_rot.shape[0],
+        model.n_mounts,
+    )
+
+
+class CoreDriver:
+    """The twin's state and the core's arrays, for one model.
+
+    Args:
+        model: the assembled scene.
+        health: the health window, where steps, error figures and mount events go.
+        counts: the engine's counters (substeps, method_switches, mount_events, ...).
+    """
+
+    def __init__(self, model: Model, health: HealthWindow, counts: Counter[str]) -> None:
+        scene = model.scene
+        integ = scene.integration
+        self.model = model
+        self._health = health
+        self._counts = counts
+        self.stepper = new_stepper(
+            integ.method, model.n_state, integ.rtol, integ.atol, integ.max_substeps
+        )
+        self._integ = self._integrator()
+        self._scratch = model.new_scratch()
+        self._u = np.zeros(INPUT_SIZE)
+        self.y = np.zeros(model.n_state)
+        """The state vector (names in `model.state_names`)."""
+        self._peak = np.zeros((model.n_mounts, 6))
+        self._counter = np.zeros(1, dtype=np.int64)
+        self.last: tuple[float, np.ndarray, np.ndarray] | None = None
+        """(stamp s, f m/s², Ω rad/s in F) of the last sample done; None: not started."""
+        self._event_meta = {
+            slot: (scene.mounts[slot].name, KINDS[scene.mounts[slot].kind])
+            for slot in model.nonlinear_slots
+        }
+        stiffens = np.zeros((len(model.nonlinear_slots), N_EVENTS))
+        for i, (_, kind) in enumerate(self._event_meta.values()):
+            stiffens[i, : len(kind.EVENTS)] = kind.EVENT_STIFFENS
+        self._watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state, stiffens)
+        self.events: list[MountEvent] = []
+        """Every mount event so far, in time order (the first MAX_EVENTS; the rest counted)."""
+        lin_slots = model.arrays.lin_slot.tolist()
+        self._lin_rated = np.flatnonzero(model.arrays.lin_per_rating.any(axis=1))
+        """The rated linear mounts, as indices among the linear ones (the core's order)."""
+        self.rated = np.array(
+            [*model.nonlinear_slots, *(lin_slots[i] for i in self._lin_rated)], dtype=np.int64
+        )
+        """Mounts with a utilisation: the non-linear ones (their watch), then rated linear ones."""
+        self._linear_util = np.zeros(len(lin_slots))
+        """Every linear mount's peak utilisation since the window's last report (the core
+        folds it in at every sample; unrated ones stay 0)."""
+        self._util_max = np.zeros(self.rated.shape[0])
+        # Chaining the stepper's last stage into the next interval needs a continuous input
+        # (first-order hold); a discrete switch of the state between samples (a bolt breaking)
+        # clears the flag in the compiled loop.
+        self._options = RunOptions(
+            scene.input.hold == "zero_order",
+            scene.outputs.decimation,
+            scene.input.hold == "first_order",
+        )
+        self.estimator = _new_estimator(model, (self._watch.g.shape[0], self._watch.g.shape[1]))
+        self._choosing = integ.method == AUTO
+        """`auto` has not made its first choice yet (made at the first interval)."""
+        if self._choosing:
+            self._watch.stop_after[0] = -math.inf  # `auto` looks again after mount events
+
+    def _integrator(self) -> Integrator:
+        """The stepper's arrays as the core takes them."""
+        st = self.stepper
+        return Integrator(st.method, st.settings, st.work2d, st.work1d, st.result)
+
+    def begin(
+        self, y: np.ndarray, stamp: float, f: np.ndarray, w: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Put the twin at state y at sample `stamp` (s) under specific force f (m/s², F) and
+        Ω w (rad/s, F): the stepper's history, the decimation and the error estimate start
+        anew. Returns the start's outputs: its pose row and (n_mounts, 6) wrenches."""
+        self.y = y
+        self.stepper.reset()
+        self._peak[:] = 0.0
+        self._counter[0] = 0
+        self.last = (stamp, f.copy(), w.copy())
+        outputs = self._start_outputs()
+        if isinstance(self.estimator, Estimator):
+            estimator.restart(self.estimator)
+        elif self.estimator is not None:
+            companion.restart(self.estimator, self.y)
+        return outputs
+
+    def _start_outputs(self) -> tuple[np.ndarray, np.ndarray]:
+        """Outputs (pose row, wrenches) of the state; arms the mount monitors there."""
+        model, y = self.model, self.y
+        pose, wrenches = np.zeros(pose_row.WIDTH), np.zeros((model.n_mounts, 6))
+        ct = evaluate(y, model.arrays, self._scratch, pose, wrenches)
+        if not math.isfinite(ct):
+            msg = f"{model.scene.source}: initial_state.pose is off the α/γ/δ chart"
+            raise ValueError(msg)
+        nl = model.arrays.nl
+        if nl is not None:
+            self._watch.y_prev[:] = y
+            mount_monitors(y, y, nl, self._scratch, self._watch.g_prev, self._watch.util)
+        return pose, wrenches
+
+    def choose_at_start(self, stamp: float) -> None:
+        """`auto`'s first choice, at the interval from the start into the sample at `stamp`
+        (s); nothing otherwise."""
+        if self._choosing and self.last is not None:
+            gravity_up = np.array([0.0, 0.0, self.model.scene.input.g])
+            rho = spectral_radius(self.model, self.model.nominal_state, gravity_up)
+            interval = stamp - self.last[0]
+            self._use(at_start(self.model, rho, tangent_rate(self.model), interval))
+
+    def advance(self, segment: Samples, index: np.ndarray, rows: BatchRows) -> Stepped:
+        """Integrate through the samples of `segment` (row 0: the last one done), which are
+        the push's samples `index`, publishing into `rows` where they are consecutive."""
+        buf = published_buffers(
+            len(segment.t), self._counter, self._peak, self._linear_util, rows.of_run(index)
+        )
+        done, status = run_samples(
+            self._integ,
+            self.model.arrays,
+            self._scratch,
+            self._u,
+            self.y,
+            segment,
+            self._options,
+            buf,
+            self._watch,
+            self.estimator,
+        )
+        events = self._drain_events()
+        self._health.add_steps(buf.step_log[1 : done + 1])
+        if self.estimator is not None:
+            self._health.add_estimate(self.estimator.figures)
+            self.estimator.figures[:] = 0.0
+        self._counts["substeps"] += int(buf.step_log[1 : done + 1, 1:3].sum())
+        if done > 0:
+            self.last = (float(segment.t[done]), segment.f[done], segment.w[done])
+        peaks = buf.wrench_abs_max, float(buf.cos_tilt_min[0])
+        keep = np.flatnonzero(buf.publish[: done + 1])  # never row 0: the previous sample
+        if keep.shape[0] == done:  # every sample published: views of this run's buffers
+            done_rows = slice(1, done + 1)
+            published = Rows(index[:done], buf.pose[done_rows], buf.wrenches[done_rows], peaks)
+        else:
+            published = Rows(index[keep - 1], buf.pose[keep], buf.wrenches[keep], peaks)
+        return Stepped(done, status, published, events)
+
+    def look_again(self, segment: Samples, j: int, events: list[MountEvent]) -> None:
+        """`auto` at sample j of the segment just ended, which logged `events`, one of which
+        may stiffen the scene (`auto_method`)."""
+        t, f = segment.t, segment.f
+        self._watch.stop_after[0] = t[j] + REEXAMINE_S
+        event = next((e for e in reversed(events) if self.stiffens(e)), events[-1])
+        choice = after_event(self.model, self.y, f[j], float(t[j] - t[j - 1]), event)
+        if choice is not None:
+            self._use(choice)
+
+    def _use(self, choice: Choice) -> None:
+        """Run `auto`'s choice from now on: the first, or a change after a mount event (its
+        step history forgotten; counted)."""
+        self._health.method = choice.status
+        if not self._choosing:
+            if choice.method == self.stepper.name:
+                return
+            self._counts["method_switches"] += 1
+        self._choosing = False
+        switch(self.stepper, choice.method)
+        self._integ = self._integrator()
+        if isinstance(self.estimator, Estimator):
+            self.estimator = estimator.switch(self.estimator, self.stepper.method)
+        elif self.estimator is not None:
+            self.estimator = companion.switch(self.estimator, self.stepper.method)
+
+    def stiffens(self, event: MountEvent) -> bool:
+        """Whether a mount event may stiffen the scene (its kind's EVENT_STIFFENS)."""
+        kind = next(k for name, k in self._event_meta.values() if name == event.mount)
+        return bool(kind.EVENT_STIFFENS[kind.EVENTS.index(event.event)])
+
+    def _drain_events(self) -> list[MountEvent]:
+        """Move the core's event log into MountEvents (health window and `events`); returns
+        the new ones (those the log could hold)."""
+        watch = self._watch
+        n = int(watch.n_events[0])
+        if n == 0:
+            return []
+        cap = watch.events.shape[0]
+        if n > cap:
+            self._counts["mount_events_dropped"] += n - cap
+        new = []
+        for t, slot, e, force in watch.events[: min(n, cap)].tolist():
+            name, kind = self._event_meta[int(slot)]
+            new.append(MountEvent(t, name, kind.EVENTS[int(e)], force, kind.EVENT_ERROR[int(e)]))
+        watch.n_events[0] = 0
+        self._counts["mount_events"] += len(new)
+        room = MAX_EVENTS - len(self.events)
+        self.events.extend(new[: max(room, 0)])
+        self._health.add_events(new)
+        return new
+
+    def active(self) -> dict[str, list[tuple[str, bool]]]:
+        """Conditions holding at the last sample, per mount: (event name, is an error)."""
+        g = self._watch.g
+        out = {}
+        for k, slot in enumerate(self.model.nonlinear_slots):
+            name, kind = self._event_meta[slot]
+            out[name] = [
+                (event, error)
+                for event, error, value in zip(kind.EVENTS, kind.EVENT_ERROR, g[k], strict=False)
+                if value >= 0.0
+            ]
+        return out
+
+    def window_utilisation(self) -> np.ndarray:
+        """Peak utilisation since the window's last end of the mounts in `rated`, in its
+        order."""
+        return np.concatenate([self._watch.util_peak, self._linear_util[self._lin_rated]])
+
+    def end_window(self) -> None:
+        """End the utilisation window: fold its peaks into the run's and start anew."""
+        np.maximum(self._util_max, self.window_utilisation(), out=self._util_max)
+        self._watch.util_peak[:] = 0.0
+        self._linear_util[:] = 0.0
+
+    def utilisation_max(self) -> np.ndarray:
+        """Peak utilisation so far of the mounts in `rated`, in its order."""
+        return np.maximum(self._util_max, self.window_utilisation())

@@ -1,0 +1,363 @@
+"""Input intake: a pushed batch's samples screened, rotated into F and judged.
+
+Each sample gets a verdict: taken (ACCEPT, a START or restart, a gap bridged or reset), held
+back (HOLD: a stamp jump to confirm), or rejected for a reason (non_finite, wrong_frame,
+duplicate_stamp, ...). Taken samples are grouped into runs split at restarts; the stamp
+intervals into them feed the lost-sample estimate; readings at the sensor's full scale or on a
+plateau are flagged. The twin itself is not touched here (`engine.TwinEngine` drives it).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from typing import NamedTuple
+
+import numpy as np
+
+from mount_twin.engine.batch import SampleBatch
+from mount_twin.engine.delay_line import Run
+from mount_twin.engine.health import PLATEAU_G, SATURATION_SHARE, HealthWindow
+from mount_twin.model.assemble import Model
+from mount_twin.scene.description import InputSpec
+
+ACCEPT, START, JUMPED_BACK, GAP_RESET, GAP_BRIDGED = (
+    "accept",
+    "start",
+    "jumped_back",
+    "gap_reset",
+    "gap_bridged",
+)
+"""Verdicts on a sample besides the rejection reasons (non_finite, wrong_frame, ...)."""
+HOLD = "hold"
+"""The last sample of a push whose stamp jumped forward: kept for the next push to confirm."""
+JUMP_FACTOR = 2.0
+"""A stamp interval more than this many times the previous one is a jump to confirm: taken if
+the next stamp is later still, rejected as `stamp_glitch` if the next one falls back before it
+(one bad stamp then costs that one sample, not the samples until time catches up with it). At
+2, a stamp glitched forward by 3 intervals or more is caught (at 20, one of 18 ms on a 1 kHz
+stream was taken and the 17 valid samples after it rejected as going back); a jump followed by
+later stamps, jitter included, only delays its sample by one when it ends a push."""
+
+RESTARTS = frozenset((START, JUMPED_BACK, GAP_RESET))
+"""Verdicts whose sample (re)starts the twin."""
+_INTERVALS = frozenset((ACCEPT, GAP_RESET, GAP_BRIDGED))
+"""Verdicts whose interval from the previous taken sample enters the lost-sample estimate: a
+gap is input lost (the samples a sensor would have sent in it), however the twin goes on."""
+_COUNTS = {
+    ACCEPT: ("accepted",),
+    START: ("accepted",),
+    JUMPED_BACK: ("accepted", "reset_stamp_jumped_back"),
+    GAP_RESET: ("accepted", "gaps"),
+    GAP_BRIDGED: ("accepted", "gaps"),
+}
+"""Counters each taken verdict increments; a rejection increments rejected_<reason>."""
+
+READING_LIMIT = 1e150
+"""Largest |component| of an accepted reading, m/s² or rad/s: a larger one (a garbled message) is
+rejected as non_finite, and the rotation into F cannot overflow."""
+
+
+class Intervals(NamedTuple):
+    """Stamp intervals of a pushed batch, for the lost-sample estimate.
+
+    steps: (n,) per sample with a plain ACCEPT or a gap verdict (`_INTERVALS`), the interval (s)
+        from the previous taken sample; NaN for the other samples.
+    skipped: sample → samples rejected since the previous taken one, where not 0 (those
+        samples only).
+    plain: every sample has a plain ACCEPT verdict (no NaN in steps).
+    """
+
+    steps: np.ndarray
+    skipped: dict[int, int]
+    plain: bool
+
+    def between(self, start: int, stop: int) -> tuple[np.ndarray, dict[int, int]]:
+        """The intervals into the taken samples in [start, stop) and the rejected samples
+        before them (keyed by position among those intervals), as the health window takes
+        them."""
+        steps = self.steps[start:stop]
+        skipped = {i - start: n for i, n in self.skipped.items() if start <= i < stop}
+        if self.plain:
+            return steps, skipped
+        keep = ~np.isnan(steps)
+        position = np.cumsum(keep) - 1  # among the kept steps
+        return steps[keep], {int(position[i]): n for i, n in skipped.items()}
+
+
+class Judged(NamedTuple):
+    """A pushed batch as intake judged it.
+
+    f, w: (n, 3) specific force (m/s²) and Ω (rad/s) in F per sample (zero where unreadable).
+    verdicts: per sample (the last may be HOLD).
+    due: the samples after which a diagnostics report is due.
+    intervals: the stamp intervals for the lost-sample estimate.
+    suspect: per flag ('saturated', 'plateau'), (n,) bool of the samples it flags.
+    """
+
+    f: np.ndarray
+    w: np.ndarray
+    verdicts: list[str]
+    due: list[int]
+    intervals: Intervals
+    suspect: dict[str, np.ndarray]
+
+
+def rotated(rows: np.ndarray, rot: np.ndarray) -> np.ndarray:
+    """rows (n, 3) · rotᵀ, as three elementwise products: each row's bits are the same whatever
+    the batch (a BLAS product may pick its kernel by size), and no BLAS thread wakes to spin
+    beside the compiled loop on a two-core machine."""
+    return rows[:, 0:1] * rot[:, 0] + rows[:, 1:2] * rot[:, 1] + rows[:, 2:3] * rot[:, 2]
+
+
+def runs(verdicts: list[str], start: int, stop: int) -> list[Run]:
+    """Group the taken samples in [start, stop) into runs split at restarts."""
+    segment = verdicts[start:stop]
+    if not segment:
+        return []
+    head = segment[0]
+    restart = head in RESTARTS
+    if (head == ACCEPT or restart) and segment.count(ACCEPT) == len(segment) - restart:
+        # the usual cases, without a Python loop: all accepted, or a start and the rest
+        return [Run(np.arange(start, stop), restart)]
+    grouped: list[tuple[list[int], bool]] = []
+    for i in range(start, stop):
+        verdict = verdicts[i]
+        if verdict not in _COUNTS:
+            continue
+        if verdict in RESTARTS or not grouped:
+            grouped.append(([i], verdict in RESTARTS))
+        else:
+            grouped[-1][0].append(i)
+    return [Run(np.array(index, dtype=np.int64), restart) for index, restart in grouped]
+
+
+def stamp_verdict(
+    spec: InputSpec, t: float, last_t: float, last_step: float | None, next_t: float | None
+) -> str:
+    """Verdict on a readable sample of stamp t (s) by its stamp alone: after the last taken
+    sample's `last_t`, into which the interval was `last_step` (None: it was a start), and
+    before the next sample's `next_t` (None: it ends the push)."""
+    if t == last_t:
+        return "duplicate_stamp"
+    if t < last_t - spec.back_jump_reset_s:
+        return JUMPED_BACK
+    if t < last_t:
+        return "stamp_went_back"
+    if (
+        last_step is not None
+        and t - last_t > JUMP_FACTOR * last_step
+        and (next_t is None or last_t < next_t < t)
+    ):
+        return HOLD if next_t is None else "stamp_glitch"
+    if t - last_t > spec.max_gap_s:
+        return GAP_RESET if spec.gap_policy == "reset" else GAP_BRIDGED
+    return ACCEPT
+
+
+class Intake:
+    """Judges the samples of a stream, push by push, for one model.
+
+    Args:
+        model: the assembled scene (its input spec and sensor rotation).
+        health: the health window: its report cadence, and where intervals and wrong frames go.
+        counts: the engine's counters (received, accepted, rejected_<reason>, ...).
+    """
+
+    def __init__(self, model: Model, health: HealthWindow, counts: Counter[str]) -> None:
+        self.spec = model.scene.input
+        self._rot = model.sensor_rotation
+        self._gravity_up = np.array([0.0, 0.0, self.spec.g])
+        self._health = health
+        self._counts = counts
+        self.last_stamp: float | None = None
+        """Stamp (s) of the last taken sample (None before the first)."""
+        self._last_step: float | None = None
+        """Interval (s) into the last taken sample from the one before (None after a start)."""
+        self.held: SampleBatch | None = None
+        """A sample held back at the end of the last push (a jump to confirm, see JUMP_FACTOR)."""
+        self._last_reading = np.full(3, np.nan)
+        """The last accelerometer reading pushed and not held back (sensor frame, m/s²)."""
+        self.skipped = 0
+        """Samples rejected since the last taken one: they fill a stamp hole, are not lost."""
+
+    def judge(self, batch: SampleBatch) -> Judged:
+        """Screen, classify and flag a non-empty batch (any held sample first)."""
+        f, w, finite = self.screen(batch)
+        verdicts, due, intervals = self._classify(batch, finite)
+        return Judged(f, w, verdicts, due, intervals, self._suspect_readings(batch))
+
+    def tally(self, batch: SampleBatch, judged: Judged, start: int, stop: int) -> None:
+        """Count the verdicts and flags of samples [start, stop) and hand their stamp
+        intervals and wrong frames to the health window."""
+        for what, flags in judged.suspect.items():
+            if n_flagged := int(flags[start:stop].sum()):
+                self._counts[what] += n_flagged
+        verdicts = judged.verdicts
+        if self._count(verdicts[start:stop]).get("wrong_frame"):
+            self._health.add_wrong_frames(
+                [batch.frame_ids[i] for i in range(start, stop) if verdicts[i] == "wrong_frame"]
+            )
+        self._health.add_intervals(*judged.intervals.between(start, stop))
+
+    def screen(self, batch: SampleBatch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Specific force (m/s²) and Ω (rad/s) in F per sample, and which samples are finite:
+        a finite stamp and readings within ±READING_LIMIT.
+
+        Other readings are zeroed before the rotation, which would otherwise warn (numpy
+        RuntimeWarning: inf·0, inf − inf, overflow); their samples are rejected anyway.
+        """
+        accel, gyro = batch.accel, batch.gyro
+        finite = np.isfinite(batch.stamps)
+        # NaN compares false: one test for NaN, ±inf and the absurdly large.
+        if not (np.abs(accel).max() <= READING_LIMIT and np.abs(gyro).max() <= READING_LIMIT):
+            readable = (np.abs(accel) <= READING_LIMIT).all(axis=1) & (
+                np.abs(gyro) <= READING_LIMIT
+            ).all(axis=1)
+            accel = np.where(readable[:, None], accel, 0.0)
+            gyro = np.where(readable[:, None], gyro, 0.0)
+            finite &= readable
+        f = rotated(accel, self._rot)
+        if not self.spec.includes_gravity:
+            f = f + self._gravity_up
+        if self.spec.gyro_filter == "ignore":  # the foundation's rotation neglected
+            return f, np.zeros_like(f), finite
+        return f, rotated(gyro, self._rot), finite
+
+    def _suspect_readings(self, batch: SampleBatch) -> dict[str, np.ndarray]:
+        """Per sample (bool, not held back): 'saturated', a reading at the sensor's full scale;
+        'plateau', an accelerometer reading beyond PLATEAU_G repeated from the sample before.
+        Such samples are taken (their value is the best there is) but counted and reported."""
+        spec = self.spec
+        accel, n = batch.accel, len(batch)
+        saturated = np.zeros(n, dtype=bool)
+        for reading, full_scale in (
+            (accel, spec.accel_range_m_s2),
+            (batch.gyro, spec.gyro_range_rad_s),
+        ):
+            if full_scale > 0.0:
+                saturated |= (np.abs(reading) >= SATURATION_SHARE * full_scale).any(axis=1)
+        before = np.concatenate([self._last_reading[None, :], accel[:-1]])
+        with np.errstate(invalid="ignore", over="ignore"):
+            plateau = (accel == before).all(axis=1) & (
+                np.linalg.norm(accel, axis=1) > PLATEAU_G * spec.g_scale
+            )
+        taken = np.ones(n, dtype=bool)
+        if self.held is not None:  # HOLD is only ever the last sample
+            taken[-1] = False
+        kept = np.flatnonzero(taken)
+        if kept.shape[0]:
+            self._last_reading = accel[kept[-1]].copy()
+        return {"saturated": saturated & taken, "plateau": plateau & taken}
+
+    def _classify(
+        self, batch: SampleBatch, finite: np.ndarray
+    ) -> tuple[list[str], list[int], Intervals]:
+        """Verdict on each sample, the samples after which diagnostics are due, and the stamp
+        intervals into samples with a plain ACCEPT or a gap verdict."""
+        usual = self._classify_in_order(batch, finite)
+        return usual if usual is not None else self._classify_each(batch, finite)
+
+    def _classify_in_order(
+        self, batch: SampleBatch, finite: np.ndarray
+    ) -> tuple[list[str], list[int], Intervals] | None:
+        """`_classify` of the usual batch, every sample readable and in order, without a
+        per-sample Python loop; None where the batch is not that."""
+        spec, last_t, n = self.spec, self.last_stamp, len(batch)
+        first = int(last_t is None)  # 1: the batch's first sample starts the twin
+        if not (
+            n > first
+            and finite.all()
+            and (not spec.frame_id or batch.frame_ids.count(spec.frame_id) == n)
+        ):
+            return None
+        before = np.empty(n)
+        before[0] = batch.stamps[0] if first else last_t
+        before[1:] = batch.stamps[:-1]
+        steps = batch.stamps - before
+        prev = np.empty(n)
+        prev[0] = math.inf if self._last_step is None else self._last_step
+        prev[1:] = steps[:-1]
+        if first:
+            prev[1] = math.inf  # the start has no interval before it
+        checked = steps[first:]
+        # With every stamp later than the one before, no sample is a glitch (its next one
+        # would fall back): only a jump into the last sample is one to hold.
+        if not (
+            (checked > 0.0).all()
+            and (checked <= spec.max_gap_s).all()
+            and steps[-1] <= JUMP_FACTOR * prev[-1]
+        ):
+            return None
+        self.last_stamp = float(batch.stamps[-1])
+        self._last_step = float(steps[-1])
+        # A START has no interval, and what was skipped before it is not counted.
+        before_first = {0: self.skipped} if self.skipped and not first else {}
+        if first:
+            steps[0] = math.nan
+        self.skipped = 0
+        return (
+            [START if first else ACCEPT] + [ACCEPT] * (n - 1),
+            self._health.ticks(batch.stamps),
+            Intervals(steps, before_first, not first),
+        )
+
+    def _verdict(
+        self, batch: SampleBatch, finite: np.ndarray, i: int, last_step: float | None
+    ) -> str:
+        """Verdict on sample i of `batch` after the taken samples before it (the last one's
+        stamp `self.last_stamp`, the interval into it `last_step`)."""
+        if not finite[i]:
+            return "non_finite"
+        if self.spec.frame_id and batch.frame_ids[i] != self.spec.frame_id:
+            return "wrong_frame"
+        if self.last_stamp is None:
+            return START
+        next_t = float(batch.stamps[i + 1]) if i + 1 < len(batch) else None
+        return stamp_verdict(self.spec, float(batch.stamps[i]), self.last_stamp, last_step, next_t)
+
+    def _classify_each(
+        self, batch: SampleBatch, finite: np.ndarray
+    ) -> tuple[list[str], list[int], Intervals]:
+        """`_classify`, sample by sample."""
+        n = len(batch)
+        verdicts: list[str] = []
+        due: list[int] = []
+        into = np.full(n, np.nan)
+        skipped: dict[int, int] = {}
+        last_step = self._last_step
+        for i in range(n):
+            verdict = self._verdict(batch, finite, i, last_step)
+            verdicts.append(verdict)
+            if verdict == HOLD:
+                self.held = batch.tail(i)
+                break
+            if verdict not in _COUNTS:
+                self.skipped += 1
+                continue
+            t = float(batch.stamps[i])
+            last_t = self.last_stamp
+            last_step = None if verdict in RESTARTS else t - last_t  # type: ignore[operator]
+            if verdict in _INTERVALS:
+                into[i] = t - last_t  # type: ignore[operator]  # not START: last_t is set
+                if self.skipped:
+                    skipped[i] = self.skipped
+            self.skipped = 0
+            self.last_stamp = t
+            if self._health.tick(t):
+                due.append(i)
+        self._last_step = last_step
+        plain = verdicts.count(ACCEPT) == n
+        return verdicts, due, Intervals(into, skipped, plain)
+
+    def _count(self, verdicts: list[str]) -> Counter[str]:
+        """Count the verdicts of samples processed; return how many of each there were. A held
+        sample is counted when the next push decides on it."""
+        counts = self._counts
+        tally = Counter(verdicts)
+        tally.pop(HOLD, None)
+        counts["received"] += tally.total()
+        for verdict, n in tally.items():
+            for key in _COUNTS.get(verdict, (f"rejected_{verdict}",)):
+                counts[key] += n
+        return tally

@@ -1,0 +1,86 @@
+"""Outputs and health: a push's published rows into the health window, its OutputBatch, and
+the diagnostics reports due in it."""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+
+import numpy as np
+
+from mount_twin.engine.batch import HealthReport, OutputBatch
+from mount_twin.engine.delay_line import Frame
+from mount_twin.engine.driver import CoreDriver
+from mount_twin.engine.health import HealthWindow
+from mount_twin.engine.rows import BatchRows, Rows
+
+
+class Reporting:
+    """What one twin publishes.
+
+    Args:
+        driver: the core driver (utilisation peaks and the conditions holding per mount).
+        health: the health window the reports come from.
+        counts: the engine's counters (reported; lost_estimated is added here).
+    """
+
+    def __init__(self, driver: CoreDriver, health: HealthWindow, counts: Counter[str]) -> None:
+        self._driver = driver
+        self._health = health
+        self._counts = counts
+        self._n_mounts = driver.model.n_mounts
+
+    def add(self, parts: list[Rows], frame: Frame) -> None:
+        """Hand published rows (of `frame`'s samples) to the health window: their peaks where
+        the compiled loop gave them, else the rows."""
+        for published in parts:
+            if published.peaks is None:
+                self._health.add_outputs(
+                    frame.stamps[published.sample], published.pose, published.wrenches
+                )
+            elif published.sample.shape[0]:
+                self._health.add_output_peaks(
+                    frame.stamps[published.sample[0]],
+                    frame.stamps[published.sample[-1]],
+                    *published.peaks,
+                )
+
+    def batch(
+        self, frame: Frame, rows: BatchRows, parts: list[Rows], reports: list[HealthReport]
+    ) -> OutputBatch:
+        """The OutputBatch of a push's (or a flush's) published parts and reports."""
+        if not parts:
+            empty = OutputBatch.empty(self._n_mounts)
+            empty.health = reports
+            return empty
+        sample, pose, wrenches = rows.gather(parts)
+        return OutputBatch(frame.stamps[sample], frame.relative(sample), pose, wrenches, reports)
+
+    def report(
+        self,
+        stamp: float,
+        sample: int,
+        parts: list[Rows] | None = None,
+        stalled_s: float | None = None,
+    ) -> HealthReport:
+        """The report due at `stamp` (s), after sample `sample` and the output rows of `parts`
+        (those published before it in its batch); `stalled_s`: the input stalled that long (s,
+        `health.ENDED`: the record ended) without a report falling due. Ends the window."""
+        per_mount = np.full(self._n_mounts, math.nan)
+        per_mount[self._driver.rated] = self._driver.window_utilisation()
+        lost, nominal = self._health.lost_estimate()
+        if lost:
+            self._counts["lost_estimated"] += lost
+        report = self._health.report(
+            stamp,
+            sample,
+            self._counts,
+            per_mount,
+            self._driver.active(),
+            lost_from_stamps=lost,
+            nominal_interval_s=nominal,
+            stalled_s=stalled_s,
+        )
+        report.rows = sum(p.sample.shape[0] for p in parts or ())
+        self._driver.end_window()
+        return report
