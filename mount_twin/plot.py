@@ -42,7 +42,8 @@ def plot_output_bag(
             c = table.columns
             force = np.sqrt(c["fx_N"] ** 2 + c["fy_N"] ** 2 + c["fz_N"] ** 2)
             axes[2].plot(c["t_s"], force, label=name.removeprefix("mount_"))
-    t0 = min(int(t.columns["stamp_ns"][0]) for t in tables.values()) * 1e-9
+    firsts = [int(t.columns["stamp_ns"][0]) for t in tables.values() if len(t.columns["stamp_ns"])]
+    t0 = min(firsts, default=0) * 1e-9  # an empty table (no mount events) has no first stamp
     for error, marker, color in ((True, "v", "red"), (False, ".", "darkorange")):
         mine = [e for e in events if e.error == error]
         if mine:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_helpers import read_bag, read_raw, scene_with, stamp_ns
+from io_helpers import ROOT, read_bag, read_raw, scene_with, stamp_ns
 
 from mount_twin.cli import main
 from mount_twin.errors import BagError
@@ -312,3 +312,15 @@ def test_input_samples_decoded_from_the_bag_match_the_generator(bags: dict[str, 
     np.testing.assert_array_equal(
         dec.stamps_ns - dec.stamps_ns[0], np.arange(500, dtype=np.int64) * 1_000_000
     )
+
+
+def test_replay_plot_of_a_run_without_mount_events_is_drawn(
+    bags: dict[str, Path], tmp_path: Path
+) -> None:
+    """The pump on linear mounts logs no event: its empty events table has no first stamp
+    (the plot's time origin once took one from every table and raised IndexError)."""
+    scene = ROOT / "config/pump_8_mounts.scene.yaml"
+    png = tmp_path / "run.png"
+    args = ["replay", str(bags["in_mcap"]), "--scene", str(scene), "-o", str(tmp_path / "out")]
+    assert main([*args, "--no-progress", "--plot", str(png)]) == 0
+    assert png.stat().st_size > 10_000
