@@ -52,3 +52,13 @@ def test_the_pump_end_mounts_lean_outward_and_their_lines_cross_below() -> None:
     crossing = np.array(fl.position) + s * z_fl
     assert crossing[1] == pytest.approx(0.0, abs=1e-9)
     assert crossing[2] == pytest.approx(-0.4 / np.tan(np.radians(30.0)), rel=1e-4)
+
+
+def test_every_mount_kind_has_its_own_colour() -> None:
+    """A new kind registered in mount_twin.kinds is drawn in a colour of its own, not in the
+    grey kept for what no scene can hold."""
+    from mount_twin.analysis.layout_view import KIND_COLOURS
+    from mount_twin.kinds import KINDS
+
+    assert set(KIND_COLOURS) == {"linear", *KINDS}
+    assert len(set(KIND_COLOURS.values())) == len(KIND_COLOURS)
