@@ -79,3 +79,19 @@ def test_links_point_at_files_of_the_repository(page: Path) -> None:
         if "://" in target:
             continue
         assert (page.parent / target).exists(), f"{page.name}: link to {target}, not there"
+
+
+def test_the_diagnostics_keys_the_pages_name_are_the_ones_the_twin_reports() -> None:
+    """A renamed diagnostics key (est_resyncs became est_failed_checks) fails here, not in a
+    user's dashboard: every `est_…` key a page names is one the integration status carries."""
+    import numpy as np
+
+    from mount_twin import SampleBatch, TwinEngine, assemble, load_scene_file
+
+    engine = TwinEngine(assemble(load_scene_file(ROOT / "config/pump_8_mounts.scene.yaml")))
+    t = np.arange(2000) * 1e-3
+    rest = np.tile([0.0, 0.0, 9.80665], (t.size, 1))
+    out = engine.run(SampleBatch(t, rest, np.zeros((t.size, 3)), ["deck_imu"] * t.size))
+    reported = {k for s in out.health[-1].statuses for k in s.values}
+    named = {k for page in PAGES for k in re.findall(r"`(est_[a-z_]+)`", page.read_text())}
+    assert named and named <= reported, sorted(named - reported)
