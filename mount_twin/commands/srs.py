@@ -17,10 +17,13 @@ import argparse
 from typing import TYPE_CHECKING, NamedTuple
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     import numpy as np
 
     from mount_twin.analysis.design_margin import DesignCheck
     from mount_twin.analysis.srs import Spectrum
+    from mount_twin.scene.description import Scene
 
 NAME = "srs"
 HELP = "shock response spectra (maximax, primary, residual, pseudo-velocity) of a record"
@@ -96,6 +99,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "positive, negative (g); suffixed _x, _y, _z with --axis all",
     )
     parser.add_argument("--plot", metavar="PNG", help="the spectra in g against Hz, log-log")
+    parser.add_argument(
+        "--response",
+        metavar="WHAT",
+        help="spectra of the twin's response instead of the record: cg (the CG's specific "
+        "force, F axes) or mount:NAME (its force, N, its axes); INPUT is then the twin's "
+        "output bag, or an input bag replayed in memory; needs --scene",
+    )
+    parser.add_argument("--scene", help="the twin's scene YAML, for --response")
     add_design_arguments(
         parser,
         "each axis's maximax is judged against it, the margins in the table, --csv and --json, "
@@ -150,7 +161,10 @@ def run(args: argparse.Namespace) -> int:
     zeta = damping_ratio(args.damping, args.q)
     low, high = tolerance_of(args)
     design = read_design_table(args.design) if args.design else None
-    t, accel, name = _record(args)
+    t, accel, name, unit = _record(args)
+    if design is not None and unit != "m/s²":
+        msg = f"--design is a spectrum in g: {name} is a force (N)"
+        raise ValueError(msg)
     record = uniform(t, accel, args.input)
     t, accel, rate = record.t, record.values, record.rate_hz
     offset, removed = gravity_offset(t, accel, args.gravity, args.head)
@@ -161,27 +175,28 @@ def run(args: argparse.Namespace) -> int:
         for axis in axes
     }
     checks = _design_checks(freqs, spectra, design, (low, high))
-    columns = _spectrum_columns(spectra) + _margin_columns(freqs, checks)
+    columns = _spectrum_columns(spectra, unit) + _margin_columns(freqs, checks)
     q_text = f"{1 / (2 * zeta):g}" if zeta > 0.0 else "∞"
     print(
         f"{name}: {len(t)} samples at {rate:.6g} Hz, axis {args.axis}, ζ = {zeta:g} (Q = {q_text})"
     )
     if record.note:
         print(record.note)
-    print(f"gravity and bias taken out ({removed}): {', '.join(f'{v:.6g}' for v in offset)} m/s²")
+    what = "gravity and bias" if unit == "m/s²" else "static load"
+    print(f"{what} taken out ({removed}): {', '.join(f'{v:.6g}' for v in offset)} {unit}")
     _print_table(freqs, columns, len(axes) == 1, spectra[axes[0]].accurate, ACCURATE_SHARE * rate)
     for axis, check in checks.items():
         print(f"design {args.design}, axis {axis} maximax: {check.summary()}")
     if args.csv:
         _write_csv(args.csv, freqs, columns)
-        print(f"csv: {args.csv} (accelerations in g, pseudo-velocity in m/s)")
+        print(f"csv: {args.csv} (units: {', '.join(sorted({c.unit for c in columns}))})")
     if args.json:
         _write_json(args, freqs, columns, checks, rate, zeta)
         print(f"json: {args.json}")
     if args.plot:
         title = f"SRS of {name}, ζ = {zeta:g}, {removed} taken out"
         band = (low, high) if design is not None else None
-        _plot(args.plot, spectra, design, band, title, ACCURATE_SHARE * rate)
+        _plot(args.plot, spectra, design, band, title, ACCURATE_SHARE * rate, unit)
         print(f"plot: {args.plot}")
     return EXIT_OUT_OF_TOLERANCE if any(not c.passed for c in checks.values()) else 0
 
@@ -198,17 +213,19 @@ def _frequencies(args: argparse.Namespace, rate_hz: float) -> np.ndarray:
     return octave_frequencies(args.fmin, args.fmax or ACCURATE_SHARE * rate_hz, args.octave)
 
 
-def _spectrum_columns(spectra: dict[str, Spectrum]) -> list[Column]:
-    """Every spectrum (SPECTRA) of each axis, in g (pseudo-velocity in m/s); the names are
-    suffixed with the axis where there are several."""
+def _spectrum_columns(spectra: dict[str, Spectrum], unit: str) -> list[Column]:
+    """Every spectrum (SPECTRA) of each axis: of a record in m/s², in g (pseudo-velocity in
+    m/s); of a force in N, in N (pseudo-velocity in N·s). The names are suffixed with the axis
+    where there are several."""
     from mount_twin.io.csv_import import G
 
+    shown, scale, pv_unit = ("g", G, "m/s") if unit == "m/s²" else (unit, 1.0, f"{unit}·s")
     return [
         Column(
             kind,
             kind if len(spectra) == 1 else f"{kind}_{axis}",
-            "m/s" if kind == "pseudo_velocity" else "g",
-            getattr(s, kind) / (1.0 if kind == "pseudo_velocity" else G),
+            pv_unit if kind == "pseudo_velocity" else shown,
+            getattr(s, kind) / (1.0 if kind == "pseudo_velocity" else scale),
         )
         for axis, s in spectra.items()
         for kind in SPECTRA
@@ -336,16 +353,19 @@ class Column(NamedTuple):
         return max(10, len(self.label))
 
 
-def _record(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, str]:
-    """(stamps s, specific force (n, 3) m/s² in the sensor frame, a name) of the input."""
+def _record(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, str, str]:
+    """(stamps s, (n, 3) values, a name, their unit) of the input: the record's specific force
+    (m/s², sensor frame), or with --response the twin's response (`_response`)."""
     from pathlib import Path
 
     path = Path(args.input)
+    if args.response or args.scene:
+        return _response(args, path)
     if path.suffix.lower() == ".csv":
         from mount_twin.io.csv_import import read_recorder_csv
 
         sig = read_recorder_csv(path).signal
-        return sig.t, sig.accel, path.name
+        return sig.t, sig.accel, path.name, "m/s²"
     from mount_twin.io.bag_info import bag_info
     from mount_twin.io.input_samples import read_input
     from mount_twin.io.messages import ACCEL, IMU
@@ -362,7 +382,51 @@ def _record(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, str]:
     (topic,) = chosen
     decoded = read_input(path, InputSpec(msg_type=topic.msgtype, topic=topic.name))
     t = (decoded.stamps_ns - decoded.stamps_ns[0]) * 1e-9
-    return t, decoded.accel, f"{path.name} {topic.name}"
+    return t, decoded.accel, f"{path.name} {topic.name}", "m/s²"
+
+
+def _response(args: argparse.Namespace, path: Path) -> tuple[np.ndarray, np.ndarray, str, str]:
+    """`_record` of --response: from the twin's output bag at `path` (its wrench topics), or
+    from the scene's input topic of `path` replayed in memory. A run whose integration failed
+    is refused: its figures are not the machine's."""
+    from mount_twin.analysis.response import check_response, response_of, wrenches_of
+    from mount_twin.commands.common import load_scene
+    from mount_twin.io.bag_info import bag_info
+    from mount_twin.io.messages import output_table
+
+    if not (args.response and args.scene):
+        msg = "--response and --scene go together: the response of the twin on that scene"
+        raise ValueError(msg)
+    scene = load_scene(args.scene)
+    check_response(args.response, scene)
+    topics = bag_info(path).topics
+    if any(output_table(t.name, t.msgtype) for t in topics):
+        from mount_twin.io.output_tables import read_output_bag
+
+        stamps, wrenches = wrenches_of(read_output_bag(path), scene, str(path))
+        source = f"{path.name} (output bag)"
+    else:
+        stamps, wrenches = _replayed(scene, path)
+        source = f"{path.name} replayed on {scene.name}"
+    r = response_of(scene, stamps, wrenches, args.response)
+    return r.t, r.values, f"{source}: {r.name}", r.unit
+
+
+def _replayed(scene: Scene, path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """(stamps s, wrenches) of the scene's twin run on the input topic of the bag at `path`."""
+    from mount_twin.engine.engine import TwinEngine
+    from mount_twin.io.input_samples import read_input
+    from mount_twin.io.messages import TimeBase
+    from mount_twin.model.assemble import assemble
+
+    decoded = read_input(path, scene.input)
+    engine = TwinEngine(assemble(scene))
+    out = engine.run(decoded.batch(TimeBase.at(int(decoded.stamps_ns[0]))))
+    if engine.failure_text:
+        why = engine.failure_text
+        msg = f"{path}: the twin's run failed, its response is not the machine's: {why}"
+        raise ValueError(msg)
+    return out.stamps, out.wrenches
 
 
 def _write_csv(path: str, freqs: np.ndarray, columns: list[Column]) -> None:
@@ -385,9 +449,10 @@ def _plot(
     band_db: tuple[float, float] | None,
     title: str,
     accurate_hz: float,
+    unit: str,
 ) -> None:
-    """Maximax, primary and residual of one axis (maximax of each with all) in g, log-log,
-    against the design spectrum; the frequencies above fs/10 shaded."""
+    """Maximax, primary and residual of one axis (maximax of each with all) in g (a force's in
+    its `unit`), log-log, against the design spectrum; the frequencies above fs/10 shaded."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -395,6 +460,11 @@ def _plot(
 
     from mount_twin.io.csv_import import G
 
+    scale, ylabel = (
+        (G, "peak absolute acceleration [g]")
+        if unit == "m/s²"
+        else (1.0, f"peak response [{unit}]")
+    )
     fig, ax = plt.subplots(figsize=(8, 5.5))
     # maximax wide and pale under the primary and residual that make it up
     styles: dict[str, dict[str, float | str]] = {
@@ -405,9 +475,9 @@ def _plot(
     for axis, s in spectra.items():
         for kind in styles if len(spectra) == 1 else ("maximax",):
             ax.loglog(
-                s.frequency_hz, getattr(s, kind) / G, label=f"{kind}, {axis}", **styles[kind]
+                s.frequency_hz, getattr(s, kind) / scale, label=f"{kind}, {axis}", **styles[kind]
             )
-    top = max(float(s.maximax.max()) for s in spectra.values()) / G
+    top = max(float(s.maximax.max()) for s in spectra.values()) / scale
     if design is not None:
         ax.loglog(*design, "k--", label="design")
         top = max(top, *design[1])
@@ -422,7 +492,7 @@ def _plot(
         ax.axvspan(accurate_hz, f_top, color="0.9", label="f > fs/10: less accurate")
     ax.set_ylim(top * 1e-3, top * 2.0)  # the residual of a short record falls off to nothing
     ax.set_xlabel("natural frequency [Hz]")
-    ax.set_ylabel("peak absolute acceleration [g]")
+    ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)

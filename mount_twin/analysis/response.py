@@ -1,0 +1,101 @@
+"""The twin's response as a record to take spectra of: the CG's specific force or a mount's
+force, from an output bag's tables or from a replay in memory.
+
+The CG's specific force needs no differentiation of the pose. The mounts are the only forces on
+the body besides gravity, so Newton gives it exactly from the published wrenches:
+m (a − g) = Σᵢ Qᵢ fᵢ, with fᵢ the force mount i exerts on the body in its local axes and Qᵢ
+those axes in F (fixed in F, `docs/physics.md` §7). It is what an accelerometer at the CG reads
+(specific force, +g up at rest), in the axes of F: the motion secondary equipment on the machine
+feels, the input of a response spectrum as the deck's record is of the machine's. A DOF the
+scene freezes is held by a constraint, not a mount: its axis is refused.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mount_twin.io.messages import WRENCHES_OUTPUT
+from mount_twin.io.output_tables import Table
+from mount_twin.physics.rotations import rpy_matrix
+from mount_twin.scene.description import Scene
+
+CG = "cg"
+MOUNT_PREFIX = "mount:"
+AXES = ("x", "y", "z")
+
+
+@dataclass(frozen=True)
+class Response:
+    """A response record.
+
+    Attributes:
+        t: (k,) seconds from the first row.
+        values: (k, 3) the CG's specific force in F (m/s²), or a mount's force in its local
+            axes (N).
+        unit: "m/s²" or "N".
+        name: what it is, for titles.
+    """
+
+    t: np.ndarray
+    values: np.ndarray
+    unit: str
+    name: str
+
+
+def check_response(text: str, scene: Scene) -> str | None:
+    """The mount named by `text` ("cg" or "mount:NAME") is one of the scene's; None for the
+    CG. Raises ValueError naming what is wrong."""
+    if text == CG:
+        return None
+    names = [m.name for m in scene.mounts]
+    name = text.removeprefix(MOUNT_PREFIX)
+    if not text.startswith(MOUNT_PREFIX) or name not in names:
+        msg = f"--response {text!r}: give cg or mount:NAME, NAME one of {', '.join(names)}"
+        raise ValueError(msg)
+    return name
+
+
+def cg_specific_force(wrenches: np.ndarray, mount_axes: np.ndarray, mass_kg: float) -> np.ndarray:
+    """(k, 3) specific force of the CG in F, m/s², from (k, n, 6) wrenches (force on the body
+    in each mount's axes first) and the (n, 3, 3) mount axes in F (columns)."""
+    return np.einsum("nij,knj->ki", mount_axes, wrenches[..., :3]) / mass_kg
+
+
+def response_of(scene: Scene, stamps_s: np.ndarray, wrenches: np.ndarray, text: str) -> Response:
+    """The response `text` ("cg" or "mount:NAME") of a run whose rows are at `stamps_s` (s)
+    with (k, n, 6) `wrenches`."""
+    mount = check_response(text, scene)
+    t = stamps_s - stamps_s[0]
+    if mount is not None:
+        i = [m.name for m in scene.mounts].index(mount)
+        return Response(t, wrenches[:, i, :3], "N", f"mount {mount} force (its axes)")
+    frozen = [a for a in AXES if a not in scene.dofs]
+    axes = np.array([rpy_matrix(*m.orientation_rpy) for m in scene.mounts]).reshape(-1, 3, 3)
+    values = cg_specific_force(wrenches, axes, scene.body.mass)
+    values[:, [AXES.index(a) for a in frozen]] = np.nan  # a constraint force is not published
+    return Response(t, values, "m/s²", "CG specific force (F axes)")
+
+
+def wrenches_of(tables: list[Table], scene: Scene, source: str) -> tuple[np.ndarray, np.ndarray]:
+    """(stamps s, (k, n, 6) wrenches) from an output bag's tables (`io.output_tables`): every
+    mount of the scene, on the same rows. Raises ValueError naming `source` otherwise."""
+    by_name = {t.name: t for t in tables}
+    names = [str(WRENCHES_OUTPUT.table).format(mount=m.name) for m in scene.mounts]
+    missing = [n for n in names if n not in by_name]
+    if missing:
+        msg = f"{source}: no wrench table for {', '.join(missing)} (is it the scene's output?)"
+        raise ValueError(msg)
+    stamps = by_name[names[0]].columns["stamp_ns"]
+    if any(not np.array_equal(by_name[n].columns["stamp_ns"], stamps) for n in names):
+        msg = f"{source}: the mounts' wrenches are not on the same stamps"
+        raise ValueError(msg)
+    wrenches = np.stack(
+        [
+            np.stack([by_name[n].columns[c] for c in WRENCHES_OUTPUT.columns], axis=1)
+            for n in names
+        ],
+        axis=1,
+    )
+    return (stamps - stamps[0]) * 1e-9, wrenches
