@@ -8,14 +8,8 @@ anywhere. matplotlib is imported here only (the `plot` extra).
 
 from __future__ import annotations
 
-import base64
-import hashlib
 import html
-import io
 import json
-from collections.abc import Callable
-from datetime import datetime, timezone
-from importlib.metadata import version as package_version
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -29,13 +23,14 @@ from mount_twin.analysis.figures import (
     displacement_from_start,
     peak_magnitudes,
 )
+from mount_twin.analysis.html_page import digest, page, png, produced_by, scene_section
+from mount_twin.analysis.html_page import table as html_table
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
 from mount_twin.engine.health import INTEGRATION
 from mount_twin.errors import ModelError
 from mount_twin.io.messages import WRENCHES_OUTPUT
 from mount_twin.io.output_tables import Event, Table, events_of, read_output_bag
 from mount_twin.scene.description import STANDARD_GRAVITY, Scene
-from mount_twin.scene.params import effective_parameters, parameter_description
 
 if TYPE_CHECKING:
     from mount_twin.analysis.srs import Spectrum
@@ -55,32 +50,6 @@ def utilisation_of(diagnostics: Table) -> dict[str, tuple[np.ndarray, np.ndarray
             times.append(float(t))
             utils.append(float(u))
     return {k: (np.array(t), np.array(u)) for k, (t, u) in series.items()}
-
-
-def _png(draw: Callable[[Any], None], size: tuple[float, float]) -> str:
-    """A figure drawn by `draw(fig)`, as an <img> with the PNG inline."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig = plt.figure(figsize=size)
-    draw(fig)
-    fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=100)
-    plt.close(fig)
-    return (
-        f'<img alt="plot" src="data:image/png;base64,{base64.b64encode(buf.getvalue()).decode()}">'
-    )
-
-
-def _table(head: list[str], rows: list[list[str]]) -> str:
-    cells = "".join(f"<th>{html.escape(h)}</th>" for h in head)
-    body = "".join(
-        "<tr>" + "".join(f"<td>{html.escape(v)}</td>" for v in r) + "</tr>" for r in rows
-    )
-    return f"<table><tr>{cells}</tr>{body}</table>"
 
 
 def _verdict(diagnostics: Table | None) -> tuple[str, dict[str, str]]:
@@ -103,18 +72,6 @@ def _verdict(diagnostics: Table | None) -> tuple[str, dict[str, str]]:
     return LEVEL_NAMES[worst], integration
 
 
-def _digest(path: Path) -> str:
-    """sha256 over a bag's files' names and sha256s (one file, or a directory's in name order),
-    first 16 hex digits."""
-    h = hashlib.sha256()
-    for f in sorted(path.rglob("*")) if path.is_dir() else [path]:
-        if f.is_file():
-            h.update(f.name.encode())
-            with f.open("rb") as fh:  # in blocks: a bag may be larger than memory
-                h.update(hashlib.file_digest(fh, "sha256").digest())
-    return h.hexdigest()[:16]
-
-
 def _provenance_section(
     diagnostics: Table | None,
     output_bag: str | Path,
@@ -124,14 +81,13 @@ def _provenance_section(
     """The verdict, what produced the page from what, the solver's settings and estimated
     error, and the scene as loaded."""
     verdict, integration = _verdict(diagnostics)
-    now = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     rows = [
         ["verdict (worst over the run)", verdict],
-        ["produced by", f"mount_twin {package_version('mount_twin')}, {now}"],
-        ["output bag", f"{output_bag} (sha256 {_digest(Path(output_bag))})"],
+        ["produced by", produced_by()],
+        ["output bag", f"{output_bag} (sha256 {digest(Path(output_bag))})"],
     ]
     if input_path is not None:
-        rows.append(["input bag", f"{input_path} (sha256 {_digest(Path(input_path))})"])
+        rows.append(["input bag", f"{input_path} (sha256 {digest(Path(input_path))})"])
     if scene is not None:
         spec, integ = scene.input, scene.integration
         rows += [
@@ -156,20 +112,9 @@ def _provenance_section(
                 f"attitude {integration.get('est_attitude_error_rad_run', '?')} rad",
             ]
         )
-    out = [f"<h2>Verdict: {html.escape(verdict)}</h2>", _table(["", ""], rows)]
-    if scene is not None and Path(scene.source).is_file():
-        effective = effective_parameters({"scene_file": scene.source}, "report").values
-        out += [
-            "<h2>Scene as loaded</h2>",
-            _table(
-                ["parameter", "value", "meaning, unit"],
-                [
-                    [name, str(value), parameter_description(name, effective)]
-                    for name, value in effective.items()
-                    if name != "scene_file"
-                ],
-            ),
-        ]
+    out = [f"<h2>Verdict: {html.escape(verdict)}</h2>", html_table(["", ""], rows)]
+    if scene is not None:
+        out += scene_section(scene)
     return out
 
 
@@ -209,8 +154,8 @@ def _srs_section(
     return [
         f"<h2>Shock response spectra of the input (ζ = 5 %, {html.escape(removed)} removed)</h2>",
         *verdicts,
-        _png(lambda fig: _draw_srs(fig, spectra, design), (9, 4.5)),
-        _table(head, _srs_rows(freqs, spectra, checks)),
+        png(lambda fig: _draw_srs(fig, spectra, design), (9, 4.5)),
+        html_table(head, _srs_rows(freqs, spectra, checks)),
     ]
 
 
@@ -285,7 +230,7 @@ def _modes_section(scene: Scene) -> list[str]:
         "m_eff y kg",
         "m_eff z kg",
     ]
-    return ["<h2>Modes (about the static equilibrium)</h2>", _table(head, rows)]
+    return ["<h2>Modes (about the static equilibrium)</h2>", html_table(head, rows)]
 
 
 def write_report(
@@ -319,7 +264,7 @@ def write_report(
     if "pose" in tables and "angles" in tables:
         sections += [
             "<h2>Input and response</h2>",
-            _png(
+            png(
                 lambda fig: _draw_response(fig, tables, input_samples, origin, input_name), (10, 8)
             ),
         ]
@@ -327,7 +272,7 @@ def write_report(
     if utilisation:
         sections += [
             "<h2>Utilisation</h2>",
-            _png(lambda fig: _draw_utilisation(fig, utilisation, kinds), (10, 4)),
+            png(lambda fig: _draw_utilisation(fig, utilisation, kinds), (10, 4)),
         ]
     if input_samples is not None:
         sections += _srs_section(*input_samples, design, tolerance_db)
@@ -337,15 +282,15 @@ def write_report(
         sections.append(_displacement_line(tables["pose"]))
     sections += [
         "<h2>Peaks (largest magnitude at one instant)</h2>",
-        _table(
+        html_table(
             ["mount", "kind", PEAK_FORCE, PEAK_COUPLE, "utilisation max"],
             _peak_rows(mounts, kinds, utilisation),
         ),
         "<h2>Events</h2>",
-        _events_table(events) if events else "<p>none</p>",
+        _eventstable(events) if events else "<p>none</p>",
     ]
     out = Path(html_path)
-    out.write_text(_page(title, sections), encoding="utf-8")
+    out.write_text(page(title, sections), encoding="utf-8")
     return out
 
 
@@ -416,7 +361,7 @@ def _forces_sections(mounts: dict[str, Table], events: list[Event]) -> list[str]
     if mounts:
         out += [
             "<h2>Mount forces (on the body, signed, in each mount's axes)</h2>",
-            _png(lambda fig: _draw_forces(fig, mounts, events), (10, 8)),
+            png(lambda fig: _draw_forces(fig, mounts, events), (10, 8)),
         ]
     if events:
         first = events[0]
@@ -424,7 +369,7 @@ def _forces_sections(mounts: dict[str, Table], events: list[Event]) -> list[str]
         out += [
             f"<h2>Around the first event: {html.escape(first.mount)} {html.escape(first.event)} "
             f"at {first.t_s:.6f} s (lines: events)</h2>",
-            _png(lambda fig: _draw_forces(fig, mounts, events, window), (10, 8)),
+            png(lambda fig: _draw_forces(fig, mounts, events, window), (10, 8)),
         ]
     return out
 
@@ -481,26 +426,13 @@ def _peak_rows(
     return rows
 
 
-def _events_table(events: list[Event]) -> str:
+def _eventstable(events: list[Event]) -> str:
     """The mount events: time from the first output (s), mount, event, count in the period,
     largest |F| (N) and level."""
-    return _table(
+    return html_table(
         ["time s", "mount", "event", "count in period", "|F| max N", "level"],
         [
             [f"{e.t_s:.6f}", e.mount, e.event, str(e.count), f"{e.force_n:.4g}", e.level]
             for e in events
         ],
-    )
-
-
-def _page(title: str, sections: list[str]) -> str:
-    """The HTML document of `sections`, styled inline."""
-    return (
-        "<!DOCTYPE html><html><head><meta charset='utf-8'>"
-        f"<title>{html.escape(title)}</title><style>"
-        "body{font-family:sans-serif;margin:2em;max-width:1100px}"
-        "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:3px 8px;"
-        "text-align:right}img{max-width:100%}</style></head><body>"
-        + "\n".join(sections)
-        + "</body></html>"
     )

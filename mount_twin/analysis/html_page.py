@@ -1,0 +1,94 @@
+"""The pieces of a self-contained HTML page (`report`, `qualify --report`): inline PNGs,
+tables, provenance (software, date, file digests) and the scene as loaded."""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+import html
+import io
+from collections.abc import Callable
+from datetime import datetime, timezone
+from importlib.metadata import version as package_version
+from pathlib import Path
+from typing import Any
+
+from mount_twin.scene.description import Scene
+from mount_twin.scene.params import effective_parameters, parameter_description
+
+
+def png(draw: Callable[[Any], None], size: tuple[float, float]) -> str:
+    """A figure drawn by `draw(fig)`, as an <img> with the PNG inline."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=size)
+    draw(fig)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=100)
+    plt.close(fig)
+    return (
+        f'<img alt="plot" src="data:image/png;base64,{base64.b64encode(buf.getvalue()).decode()}">'
+    )
+
+
+def table(head: list[str], rows: list[list[str]]) -> str:
+    """An HTML table of text cells (escaped) under a header row."""
+    cells = "".join(f"<th>{html.escape(h)}</th>" for h in head)
+    body = "".join(
+        "<tr>" + "".join(f"<td>{html.escape(v)}</td>" for v in r) + "</tr>" for r in rows
+    )
+    return f"<table><tr>{cells}</tr>{body}</table>"
+
+
+def digest(path: Path) -> str:
+    """sha256 over a bag's files' names and sha256s (one file, or a directory's in name order),
+    first 16 hex digits."""
+    h = hashlib.sha256()
+    for f in sorted(path.rglob("*")) if path.is_dir() else [path]:
+        if f.is_file():
+            h.update(f.name.encode())
+            with f.open("rb") as fh:  # in blocks: a bag may be larger than memory
+                h.update(hashlib.file_digest(fh, "sha256").digest())
+    return h.hexdigest()[:16]
+
+
+def page(title: str, sections: list[str]) -> str:
+    """The HTML document of `sections`, styled inline."""
+    return (
+        "<!DOCTYPE html><html><head><meta charset='utf-8'>"
+        f"<title>{html.escape(title)}</title><style>"
+        "body{font-family:sans-serif;margin:2em;max-width:1100px}"
+        "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:3px 8px;"
+        "text-align:right}img{max-width:100%}</style></head><body>"
+        + "\n".join(sections)
+        + "</body></html>"
+    )
+
+
+def produced_by() -> str:
+    """The software and the time (UTC) that produced a page."""
+    now = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    return f"mount_twin {package_version('mount_twin')}, {now}"
+
+
+def scene_section(scene: Scene) -> list[str]:
+    """The scene as loaded: every parameter with its value, meaning and unit (none for a scene
+    not read from a file)."""
+    if not Path(scene.source).is_file():
+        return []
+    effective = effective_parameters({"scene_file": scene.source}, "report").values
+    return [
+        "<h2>Scene as loaded</h2>",
+        table(
+            ["parameter", "value", "meaning, unit"],
+            [
+                [name, str(value), parameter_description(name, effective)]
+                for name, value in effective.items()
+                if name != "scene_file"
+            ],
+        ),
+    ]
