@@ -15,7 +15,9 @@ from mount_twin.analysis.figures import (
     DISPLACEMENT,
     PEAK_COUPLE,
     PEAK_FORCE,
+    TRAVEL,
     displacement_from_start,
+    mount_travel,
     peak_magnitudes,
 )
 from mount_twin.engine.batch import (
@@ -32,6 +34,7 @@ from mount_twin.engine.health import INTEGRATION, tilt_from_quaternions
 from mount_twin.errors import DamagedBagError
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import TF, TF_STATIC_TOPIC, output_types, resolve, static_transforms
+from mount_twin.physics.rotations import quaternion_matrices
 from mount_twin.scene.description import Scene
 from mount_twin.stream import TwinStream
 
@@ -78,6 +81,7 @@ class ReplaySummary:
     error_estimate: ErrorEstimate | None = None  # the live estimate over the run (None: off)
     failure: str = ""  # how often the integration failed and why ('' if never)
     latency: tuple[int, float] = (0, 0.0)  # samples, s: outputs after their input (gyro delay)
+    travel_max_m: dict[str, float] = field(default_factory=dict)  # per mount (`figures.TRAVEL`)
 
     @property
     def worst_level(self) -> int:
@@ -187,6 +191,7 @@ class ReplaySummary:
                 name: {
                     PEAK_FORCE: float(peak[0]),
                     PEAK_COUPLE: float(peak[1]),
+                    TRAVEL: self.travel_max_m.get(name),
                     "utilisation_max": util.get(name),
                 }
                 for name, peak in self.peaks.items()
@@ -247,11 +252,15 @@ def _until_damage(
 
 @dataclass
 class _Figures:
-    """Figures of the published rows so far: per mount peak |F| (N) and |M| (N·m), largest
-    tilt (rad) and CG displacement from the first published position (m), first and last
-    stamps (s, engine time)."""
+    """Figures of the published rows so far: per mount peak |F| (N) and |M| (N·m) and travel
+    (m; of mounts at `points`, m in F, under a body whose scene CG is `cg`), largest tilt (rad)
+    and CG displacement from the first published position (m), first and last stamps (s,
+    engine time)."""
 
     peak: np.ndarray
+    cg: np.ndarray
+    points: np.ndarray
+    travel: np.ndarray
     tilt: float = 0.0
     disp: float = 0.0
     first_stamp: float | None = None
@@ -267,6 +276,9 @@ class _Figures:
         self.start = start
         self.last_stamp = batch.stamps[-1]
         np.maximum(self.peak, peak_magnitudes(batch.wrenches), out=self.peak)
+        rotation = quaternion_matrices(batch.quaternion)
+        travel = mount_travel(batch.position, rotation, self.cg, self.points)
+        np.maximum(self.travel, travel, out=self.travel)
         self.disp = max(self.disp, displacement_from_start(batch.position, start))
         self.tilt = max(self.tilt, float(tilt_from_quaternions(batch.quaternion).max()))
 
@@ -322,7 +334,9 @@ def replay(
     topics = {resolved[t]: msgtype for t, msgtype in output_types(scene).items()}
     topics[TF_STATIC_TOPIC] = TF
     static_due = True
-    figures = _Figures(np.zeros((len(scene.mounts), 2)))
+    n = len(scene.mounts)
+    points = np.array([m.position for m in scene.mounts]).reshape(-1, 3)
+    figures = _Figures(np.zeros((n, 2)), np.array(scene.body.cg), points, np.zeros(n))
     wall0 = time.perf_counter()
     worst: dict[str, HealthStatus] = {}
     with (
@@ -387,4 +401,5 @@ def _summary(
         engine.error_estimate,
         engine.failure_text,
         engine.health.latency,
+        {m.name: float(figures.travel[i]) for i, m in enumerate(scene.mounts)},
     )

@@ -7,7 +7,11 @@ name).
 - peak couple: the same of its couple |M| (N·m);
 - CG displacement: the largest distance of the CG from its first published position (m): the
   static equilibrium the twin starts at (`initial.mode: equilibrium`; with `given`, the given
-  pose), so the static sag under gravity is not counted as motion.
+  pose), so the static sag under gravity is not counted as motion;
+- travel: per mount, the largest distance of its attachment point from its foundation point
+  (m), d = r + R p − p (`docs/physics.md` §7: r the CG's displacement from the scene's CG, R the
+  attitude, p the mount's position from the CG): the deflection a rubber mount's stroke, a
+  snubber's gap or a key's clearance is measured against, static sag included.
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ import numpy as np
 PEAK_FORCE = "peak_force_magnitude_N"
 PEAK_COUPLE = "peak_couple_magnitude_Nm"
 DISPLACEMENT = "max_cg_displacement_from_start_m"
+TRAVEL = "travel_max_m"
 
 
 def peak_magnitudes(wrenches: np.ndarray) -> np.ndarray:
@@ -35,3 +40,16 @@ def displacement_from_start(position: np.ndarray, start: np.ndarray) -> float:
     if not position.shape[0]:
         return 0.0
     return float(np.linalg.norm(position - start, axis=1).max())
+
+
+def mount_travel(
+    position: np.ndarray, rotation: np.ndarray, cg: np.ndarray, points: np.ndarray
+) -> np.ndarray:
+    """Per mount, the largest |d| (m) over k rows of CG positions (k, 3) in F and attitudes
+    (k, 3, 3) body → F, for mounts at `points` (n, 3) in F and a scene CG `cg` (3,) (the
+    reference pose, where every mount is unstressed); zeros for k = 0."""
+    if not position.shape[0]:
+        return np.zeros(points.shape[0])
+    arm = points - cg  # (n, 3)
+    d = (position - cg)[:, None, :] + np.einsum("kij,nj->kni", rotation, arm) - arm
+    return np.linalg.norm(d, axis=2).max(axis=0)

@@ -52,3 +52,16 @@ def quaternion_from_matrix(rot: np.ndarray, out: np.ndarray) -> None:
     if out[3] < 0.0:
         for i in range(4):
             out[i] = -out[i]
+
+
+def quaternion_matrices(quat: np.ndarray) -> np.ndarray:
+    """(k, 3, 3) rotation matrices of (k, 4) unit quaternions (x, y, z, w)."""
+    x, y, z, w = (quat[:, i] for i in range(4))
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        axis=1,
+    )
