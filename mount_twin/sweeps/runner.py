@@ -13,7 +13,6 @@ from __future__ import annotations
 import csv
 import json
 import math
-import os
 import time
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
@@ -36,6 +35,7 @@ from mount_twin.physics import pose_row
 from mount_twin.scene.description import InputSpec, Scene
 from mount_twin.scene.loader import scene_from_dict
 from mount_twin.sweeps.cases import Case, apply, expand
+from mount_twin.sweeps.cluster import dask_client, results_as_completed
 from mount_twin.sweeps.spec import InputCase, SweepSpec
 
 BATCHES_PER_WORKER = 4
@@ -167,45 +167,27 @@ def run_sweep(
     rows run now. `scheduler`: a Dask scheduler address (default: a local cluster of
     `workers` processes, one thread each; default one per core). `progress(done, total)` is
     called after each case."""
-    from dask.distributed import Client, LocalCluster, as_completed
-
     path = Path(results)
     todo = [c for c in expand(spec) if c.case_id not in finished_cases(path)]
     if not todo:
         return []
     head = columns(spec)
-    cluster = None
-    if scheduler is None:
-        n = workers or os.cpu_count() or 1
-        cluster = LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
-        )
-    client = Client(scheduler or cluster)
     rows = []
-    try:
+    with dask_client(scheduler, workers) as client:
         # Cases go out in batches, a few per worker, so that the scheduler's cost per task is
         # shared by several cases (a case takes ~40 ms: one task each cost a third of that).
         n_workers = max(len(client.scheduler_info()["workers"]), 1)
         size = max(1, math.ceil(len(todo) / (BATCHES_PER_WORKER * n_workers)))
         batches = [todo[k : k + size] for k in range(0, len(todo), size)]
-        futures = client.map(
-            run_cases,
-            [spec.base] * len(batches),
-            [spec.source] * len(batches),
-            batches,
-            pure=False,
-        )
+        n = len(batches)
+        done = results_as_completed(client, run_cases, [spec.base] * n, [spec.source] * n, batches)
         with _appender(path, head) as append:
-            for future in as_completed(futures):
-                for row in future.result():
+            for batch_rows in done:
+                for row in batch_rows:
                     append(row)
                     rows.append(row)
                     if progress:
                         progress(len(rows), len(todo))
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
     return rows
 
 

@@ -1,0 +1,40 @@
+"""A Dask cluster for the duration of some work: the one a sweep and a qualification run on."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from typing import Any
+
+
+@contextmanager
+def dask_client(scheduler: str | None = None, workers: int | None = None) -> Iterator[Any]:
+    """A `dask.distributed.Client` of the scheduler at `scheduler`, or of a local cluster of
+    `workers` processes, one thread each (default one per core), closed afterwards."""
+    from dask.distributed import Client, LocalCluster
+
+    cluster = None
+    if scheduler is None:
+        n = workers or os.cpu_count() or 1
+        cluster = LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
+        )
+    client = Client(scheduler or cluster)
+    try:
+        yield client
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def results_as_completed(
+    client: Any, fn: Callable[..., Any], *arg_lists: list[Any]
+) -> Iterator[Any]:
+    """fn over the argument lists on the cluster (impure: every call runs), each result as its
+    task completes; a task's exception is raised here."""
+    from dask.distributed import as_completed
+
+    for future in as_completed(client.map(fn, *arg_lists, pure=False)):
+        yield future.result()
