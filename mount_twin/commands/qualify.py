@@ -1,26 +1,27 @@
-"""`mount-twin qualify SCENE --spectrum TABLE.csv -o DIR`: a resiliently mounted machine
-against a shock specification, in the time domain.
+"""`mount-twin qualify SCENE (--spectrum TABLE.csv | --plan PLAN.yaml) -o DIR`: a resiliently
+mounted machine against a shock specification, in the time domain.
 
-Synthesises `--seeds` inputs that meet the design spectrum (`mount-twin synthesize`), replays
-each through the twin on the scene (its own output bag beside its input bag in DIR), and judges
-the machine on the worst over the inputs, per mount: the largest force, the largest
-utilisation (bolt F/F_y, rubber deflection/rated, key F/allowable, linear ratings) and its
-margin 1 − utilisation, the mount events; with the twin's own error estimate. The verdict:
-FAILED (exit 6) if an integration failed (no figure of that run can be trusted), FAIL (exit 4)
-if any run reached ERROR (a limit passed: utilisation over 1, a bolt yielded or broke, a joint
-opened, a key overloaded), else PASS (exit 0; WARNs are listed).
+Synthesises inputs that meet the design spectra (`mount-twin synthesize`: `--seeds` per axis),
+replays each through the twin on the scene (its output bag beside its input bag in DIR), on a
+Dask cluster where dask is installed (`--workers`, `--scheduler`; else one after the other), and
+judges the machine on the worst over the inputs, per mount: the largest force, travel and
+utilisation (bolt F/F_y, rubber deflection/rated, key F/allowable, linear ratings) with its
+margin, the mount events; with the twin's own error estimate. The plan, its criteria and the
+verdict: `mount_twin.analysis.qualification`. Exit 0 PASS, 4 FAIL, 6 FAILED (an integration
+failed: not judged).
 """
 
 from __future__ import annotations
 
 import argparse
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from mount_twin.commands.synthesize import add_synthesis_arguments
-from mount_twin.io.epoch import DEFAULT_START_NS
 
 if TYPE_CHECKING:
-    from mount_twin.replay import ReplaySummary
+    from pathlib import Path
+
+    from mount_twin.analysis.qualification import InputRun, Plan
 
 NAME = "qualify"
 HELP = "qualify the scene's machine against a shock spectrum: synthesise, run, judge each mount"
@@ -32,11 +33,129 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "-o", "--output", required=True, help="directory (new) of the input and output bags"
     )
-    add_synthesis_arguments(parser)
+    add_synthesis_arguments(parser, required=False)
+    parser.add_argument(
+        "--plan",
+        metavar="YAML",
+        help="a qualification plan (spectra per axis, synthesis, criteria) instead of --spectrum",
+    )
     parser.add_argument("--json", metavar="FILE", help="the verdict and per-mount results")
+    parser.add_argument("--report", metavar="HTML", help="a report to hand over, one file")
+    parser.add_argument(
+        "--workers",
+        type=int,
+        help="local Dask workers (default: one per core, at most one per input; 1: no cluster)",
+    )
+    parser.add_argument("--scheduler", help="a Dask scheduler's address (bags on shared disk)")
     parser.epilog = (
-        f"exit status: 0 PASS; 2 bad input; {EXIT_FAIL} FAIL (a limit passed in some run); "
+        f"exit status: 0 PASS; 2 bad input; {EXIT_FAIL} FAIL (a criterion broken in some run); "
         f"{EXIT_FAILED} FAILED (an integration failed: not judged)"
+    )
+
+
+def plan_of(args: argparse.Namespace) -> Plan:
+    """The plan: --plan's file, or the synthesis options of the command line."""
+    from mount_twin.analysis.qualification import Plan, load_plan
+    from mount_twin.analysis.srs import damping_ratio
+    from mount_twin.commands.srs import tolerance_of
+
+    if (args.plan is None) == (args.spectrum is None):
+        msg = "give either --spectrum (one axis, options on the command line) or --plan"
+        raise ValueError(msg)
+    if args.plan is not None:
+        return load_plan(args.plan)
+    if args.seeds < 1 or args.head < 0.0 or not args.rate > 0.0:
+        msg = "--seeds must be ≥ 1, --head ≥ 0 s and --rate > 0 Hz"
+        raise ValueError(msg)
+    zeta = damping_ratio(args.damping, args.q)
+    return Plan(
+        {args.axis: args.spectrum},
+        zeta,
+        args.seeds,
+        args.first_seed,
+        args.rate,
+        tolerance_of(args),
+        args.head,
+    )
+
+
+def run_input(scene_path: str, plan: Plan, axis: str, seed: int, out: str) -> InputRun:
+    """Synthesise the input (axis, seed) of the plan, write it into `out`, replay it through
+    the twin beside it, and return its figures (a Dask task: arguments and result pickle)."""
+    from pathlib import Path
+
+    from mount_twin.analysis.qualification import InputRun
+    from mount_twin.analysis.synthesis import imu_record, synthesize
+    from mount_twin.commands.common import load_scene, read_design_table, write_signal
+    from mount_twin.io.epoch import DEFAULT_START_NS
+    from mount_twin.replay import replay
+
+    scene = load_scene(scene_path)
+    design = read_design_table(plan.spectra[axis])
+    shock = synthesize(
+        *design, plan.rate_hz, damping=plan.damping, seed=seed, tolerance_db=plan.tolerance_db
+    )
+    sig = imu_record(shock, plan.rate_hz, axis, plan.head_s)
+    bag_in, bag_out = (
+        Path(out) / f"input_{axis}_seed_{seed}",
+        Path(out) / f"output_{axis}_seed_{seed}",
+    )
+    frame_id = scene.input.frame_id or "deck_imu"
+    write_signal(sig, str(bag_in), scene.input.topic, frame_id, DEFAULT_START_NS, "mcap")
+    s = replay(scene, bag_in, bag_out, progress=False)
+    margin = shock.check.margin_db
+    return InputRun(
+        axis,
+        seed,
+        s.verdict,
+        s.failure,
+        str(bag_out),
+        (float(margin.min()), float(margin.max())),
+        (shock.check.frequency_hz.tolist(), shock.check.spectrum.tolist()),
+        {name: float(peak[0]) for name, peak in s.peaks.items()},
+        dict(s.utilisation_max),
+        dict(s.travel_max_m),
+        [(e.mount, e.event, e.level) for e in s.events],
+        s.error_estimate.force_error_rel if s.error_estimate else float("nan"),
+    )
+
+
+def _runs(args: argparse.Namespace, plan: Plan, out: Path) -> list[InputRun]:
+    """Every input of the plan, run on Dask where it is installed (and more than one input on
+    more than one worker), else one by one in this process; in the plan's order."""
+    import importlib.util
+    import os
+
+    inputs = plan.inputs
+    n = len(inputs)
+    runs: list[InputRun] = []
+    if importlib.util.find_spec("dask") is None or n == 1 or args.workers == 1:
+        if n > 1:
+            print("  (dask not installed: one input after the other)")
+        for axis, seed in inputs:
+            runs.append(run_input(args.scene, plan, axis, seed, str(out)))
+            _said(runs[-1], len(runs), n)
+    else:
+        from mount_twin.sweeps.cluster import dask_client, results_as_completed
+
+        axes, seeds = (list(v) for v in zip(*inputs, strict=True))
+        workers = min(n, args.workers or os.cpu_count() or 1)
+        with dask_client(args.scheduler, workers) as client:
+            lists = [[args.scene] * n, [plan] * n, axes, seeds, [str(out)] * n]
+            for r in results_as_completed(client, run_input, *lists):
+                runs.append(r)
+                _said(r, len(runs), n)
+    order = {key: i for i, key in enumerate(inputs)}
+    return sorted(runs, key=lambda r: order[(r.axis, r.seed)])
+
+
+def _said(r: InputRun, done: int, total: int) -> None:
+    """One input's line of progress."""
+    why = f" ({r.failure})" if r.failure else ""
+    print(
+        f"[{done}/{total}] {r.axis} seed {r.seed}: spectrum {r.margin_db[0]:+.2f}/"
+        f"{r.margin_db[1]:+.2f} dB of the design; twin {r.verdict}{why} → {r.output_bag}",
+        flush=True,
     )
 
 
@@ -44,85 +163,27 @@ def run(args: argparse.Namespace) -> int:
     import json
     from pathlib import Path
 
-    from mount_twin.commands.common import load_scene, write_signal
-    from mount_twin.commands.synthesize import describe, synthesized
-    from mount_twin.replay import replay
+    from mount_twin.analysis.qualification import judge, verdict_text
+    from mount_twin.commands.common import load_scene
 
-    scene = load_scene(args.scene)
+    plan = plan_of(args)
+    load_scene(args.scene)  # a bad scene fails here, before anything is synthesised
     out = Path(args.output)
     if out.exists():
         msg = f"{out}: exists; qualify writes a new directory"
         raise ValueError(msg)
-    frame_id = scene.input.frame_id or "deck_imu"
-    runs = []
-    for seed, shock, sig in synthesized(args):
-        out.mkdir(parents=True, exist_ok=True)
-        bag_in, bag_out = out / f"input_seed_{seed}", out / f"output_seed_{seed}"
-        write_signal(sig, str(bag_in), scene.input.topic, frame_id, DEFAULT_START_NS, "mcap")
-        print(f"seed {seed}: {describe(shock, args)}")
-        summary = replay(scene, bag_in, bag_out, progress=False)
-        why = f" ({summary.failure})" if summary.failure else ""
-        print(f"  replayed into {bag_out}: {summary.verdict}{why}")
-        runs.append((seed, summary))
-    result = judge(runs)
-    print(result["text"])
+    out.mkdir(parents=True)
+    axes = ", ".join(plan.spectra)
+    print(f"plan {plan.source}: {len(plan.inputs)} inputs ({axes}), ζ = {plan.damping:g}")
+    runs = _runs(args, plan, out)
+    doc = judge(runs, plan)
+    print(verdict_text(doc))
     if args.json:
-        Path(args.json).write_text(json.dumps(result["doc"], indent=1), encoding="utf-8")
+        Path(args.json).write_text(json.dumps(doc, indent=1), encoding="utf-8")
         print(f"json: {args.json}")
-    return {"PASS": 0, "FAIL": EXIT_FAIL, "FAILED": EXIT_FAILED}[result["doc"]["verdict"]]
+    if args.report:
+        from mount_twin.analysis.qualification_report import write_qualification_report
 
-
-def judge(runs: list[tuple[int, ReplaySummary]]) -> dict[str, Any]:
-    """The worst over the runs per mount, the verdict, as text and as a JSON document."""
-    verdicts = [s.verdict for _, s in runs]
-    verdict = "FAILED" if "FAILED" in verdicts else "FAIL" if "ERROR" in verdicts else "PASS"
-    mounts: dict[str, dict[str, Any]] = {}
-    for seed, s in runs:
-        for name, peak in s.peaks.items():
-            m = mounts.setdefault(
-                name,
-                {
-                    "force_max_N": 0.0,
-                    "force_max_seed": seed,
-                    "utilisation_max": None,
-                    "utilisation_max_seed": None,
-                    "events": {},
-                },
-            )
-            if float(peak[0]) > m["force_max_N"]:
-                m["force_max_N"], m["force_max_seed"] = float(peak[0]), seed
-            u = s.utilisation_max.get(name)
-            if u is not None and (m["utilisation_max"] is None or u > m["utilisation_max"]):
-                m["utilisation_max"], m["utilisation_max_seed"] = u, seed
-        for e in s.events:
-            key = f"{e.event} ({e.level})"
-            events = mounts.setdefault(e.mount, {"events": {}})["events"]
-            events[key] = events.get(key, 0) + 1
-    estimates = [s.error_estimate.force_error_rel for _, s in runs if s.error_estimate]
-    lines = [
-        f"qualification: {verdict} over {len(runs)} inputs ({', '.join(verdicts)})",
-        f"  {'mount':>12} {'max |F| N':>12} {'utilisation':>11} {'margin':>7}  "
-        "events (all inputs)",
-    ]
-    for name, m in mounts.items():
-        u = m["utilisation_max"]
-        m["margin"] = None if u is None else 1.0 - u
-        shown_u = "unrated" if u is None else f"{u:.3f}"
-        shown_m = "" if u is None else f"{1.0 - u:+.3f}"
-        events = ", ".join(f"{k} ×{n}" for k, n in m["events"].items()) or "none"
-        lines.append(f"  {name:>12} {m['force_max_N']:12.1f} {shown_u:>11} {shown_m:>7}  {events}")
-    if estimates:
-        lines.append(
-            f"  the twin's estimated force error: at most {max(estimates):.2g} of the largest "
-            "force over the inputs"
-        )
-    doc = {
-        "verdict": verdict,
-        "runs": [
-            {"seed": seed, "verdict": s.verdict, "failure": s.failure, "output_bag": s.output_bag}
-            for seed, s in runs
-        ],
-        "mounts": mounts,
-        "estimated_force_error_rel": max(estimates) if estimates else None,
-    }
-    return {"text": "\n".join(lines), "doc": doc}
+        write_qualification_report(args.report, load_scene(args.scene), plan, runs, doc)
+        print(f"report: {args.report}")
+    return {"PASS": 0, "FAIL": EXIT_FAIL, "FAILED": EXIT_FAILED}[doc["verdict"]]

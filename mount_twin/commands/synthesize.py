@@ -29,12 +29,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def add_synthesis_arguments(parser: argparse.ArgumentParser) -> None:
-    """The options of a synthesis (also `qualify`'s): spectrum, seeds, rate, axis, damping,
-    tolerance, head."""
+def add_synthesis_arguments(parser: argparse.ArgumentParser, *, required: bool = True) -> None:
+    """The options of a synthesis (also `qualify`'s, whose --plan may stand for them, so
+    --spectrum is not `required` there): spectrum, seeds, rate, axis, damping, tolerance,
+    head."""
     parser.add_argument(
         "--spectrum",
-        required=True,
+        required=required,
         metavar="CSV",
         help="the design spectrum (frequency_hz,accel_g), maximax, interpolated log-log",
     )
