@@ -186,6 +186,10 @@ EXTRA_VALUES = {
     "outputs.alarm_margin": 0.2,
     "outputs.tf": False,
     "frames.mount_prefix": "pump/",
+    "body_sensor.topic": "/pump/imu",
+    "body_sensor.frame_id": "pump_imu",
+    "body_sensor.position": [0.3, 0.1, 0.9],
+    "body_sensor.orientation_rpy": [0.0, 0.0, 0.5],
 }
 
 

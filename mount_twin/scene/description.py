@@ -220,6 +220,24 @@ class Frames:
 
 
 @dataclass(frozen=True)
+class BodySensor:
+    """An IMU on the machine's body: what shows what the body really did (`calibrate`).
+
+    Attributes:
+        topic: its topic (sensor_msgs/Imu).
+        frame_id: its header.frame_id ("": any).
+        position: its position at the reference pose, m, in F (as the mounts' are).
+        orientation_rpy: its axes relative to the body frame B, fixed-axis roll, pitch, yaw,
+            rad (B is parallel to F at the reference pose).
+    """
+
+    topic: str = "/machine/imu"
+    frame_id: str = ""
+    position: Vec3 = (0.0, 0.0, 0.0)
+    orientation_rpy: Vec3 = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
 class SceneWarning:
     """A scene value that loads but is likely a mistake (units, a message type's convention),
     found at load and kept on the Scene for the command or node to report.
@@ -253,5 +271,6 @@ class Scene:
     integration: Integration = field(default_factory=Integration)
     outputs: Outputs = field(default_factory=Outputs)
     frames: Frames = field(default_factory=Frames)
+    body_sensor: BodySensor | None = None
     source: str = "<memory>"
     warnings: tuple[SceneWarning, ...] = field(default=(), compare=False)

@@ -18,6 +18,7 @@ from mount_twin.scene.description import (
     DOF_NAMES,
     GYRO_FILTERS,
     Body,
+    BodySensor,
     Frames,
     InitialState,
     InputSpec,
@@ -128,6 +129,7 @@ def scene_from_dict(
         integration=_integration(top.sub("integration")),
         outputs=_outputs(top.sub("outputs")),
         frames=_frames(top.sub("frames")),
+        body_sensor=_body_sensor(top.sub("body_sensor")) if top.has("body_sensor") else None,
         source=source,
     )
     top.finish()
@@ -380,6 +382,18 @@ def _outputs(r: Reader) -> Outputs:
     )
     r.finish()
     return spec
+
+
+def _body_sensor(r: Reader) -> BodySensor:
+    d = BodySensor()
+    sensor = BodySensor(
+        topic=_topic(r, "topic", d.topic),
+        frame_id=_header_frame_id(r, "frame_id", d.frame_id),
+        position=_position(r, "position", d.position),
+        orientation_rpy=_angles(r, "orientation_rpy", d.orientation_rpy),
+    )
+    r.finish()
+    return sensor
 
 
 def _frames(r: Reader) -> Frames:

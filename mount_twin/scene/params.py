@@ -54,6 +54,13 @@ PARAMETERS: dict[str, tuple[str, str]] = {
     "input.gyro_stopband_hz": ("double", "linear_phase gyro filter stops from this, Hz"),
     "input.accel_range_m_s2": ("double", "Accelerometer full scale (0: unknown), m/s²"),
     "input.gyro_range_rad_s": ("double", "Gyro full scale (0: unknown), rad/s"),
+    "body_sensor.topic": ("string", "Topic of an IMU on the body (sensor_msgs/Imu)"),
+    "body_sensor.frame_id": ("string", "Expected header.frame_id of the body IMU; empty: any"),
+    "body_sensor.position": ("double_array", "Body IMU position at the reference pose, m, in F"),
+    "body_sensor.orientation_rpy": (
+        "double_array",
+        "Body IMU axes relative to B as fixed-axis roll, pitch, yaw, rad",
+    ),
     "initial_state.mode": ("string", "equilibrium or given"),
     "initial_state.gravity": ("string", "Equilibrium gravity: first_sample or nominal"),
     "initial_state.pose": ("double_array", "[X, Y, Z] m, [α, γ, δ] rad: start pose, frozen DOFs"),
