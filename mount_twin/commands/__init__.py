@@ -25,6 +25,7 @@ COMMANDS = (
     "srs",
     "synthesize",
     "qualify",
+    "calibrate",
     "modes",
     "accuracy",
     "sweep",

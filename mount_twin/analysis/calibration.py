@@ -1,0 +1,222 @@
+"""Calibrate a scene on a recorded pair: the foundation's IMU in, the body's IMU out.
+
+The twin is the model: it runs on the foundation record, predicts what the body sensor reads
+(`analysis.body_sensor`), and `scipy.optimize.least_squares` moves the parameters a user cannot
+read off a data sheet until the prediction matches the body record, in the time domain (the
+twin's non-linear mounts and the recorders' clocks live there; a lag is a phase that grows
+with frequency, which a time-domain fit takes as one number):
+
+- `stiffness`, `damping`: one scale factor each on every linear mount's stiffness and damping
+  (fitted as logarithms: a scale stays positive);
+- `yaw`: the body sensor's rotation about the body's z axis, added to its orientation_rpy, rad;
+- `lag`: the body recorder's clock behind the foundation's, s (its samples are the motion
+  `lag` seconds before their stamps).
+
+Both signals are compared with their means taken out (gravity and the sensors' biases), each
+axis in units of the measured signal's spread. Each parameter's uncertainty (1σ) comes from the
+fit's Jacobian and residual (`(JᵀJ)⁻¹ s²`; the residual's own correlation makes it a lower
+bound). A parameter the record cannot identify (relative 1σ past `MAX_REL_SIGMA`, an angle
+past 2°, a lag past a sample) is refused by name and held at its nominal value, and the rest is
+fitted again; a fit that predicts the body no better than the nominal scene is refused whole.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import cast
+
+import numpy as np
+
+from mount_twin.analysis.body_sensor import predicted_reading
+from mount_twin.engine.batch import SampleBatch
+from mount_twin.engine.engine import TwinEngine
+from mount_twin.io.signals import Signal
+from mount_twin.model.assemble import assemble
+from mount_twin.scene.description import BodySensor, LinearMount, Scene, Vec6
+
+PARAMETERS = ("stiffness", "damping", "yaw", "lag")
+MAX_REL_SIGMA = 0.05
+"""A scale factor whose relative 1σ exceeds this is not identified by the record."""
+MAX_YAW_SIGMA_RAD = math.radians(2.0)
+EDGE_S = 0.25
+"""Body samples this close to either end of the foundation record are left out of the fit."""
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """A fit's result.
+
+    Attributes:
+        values: parameter → value (stiffness and damping as scale factors, yaw rad, lag s);
+            a refused parameter keeps its nominal value (1, 1, 0, 0).
+        sigma: parameter → 1σ of the fitted ones, in the value's unit.
+        refused: parameter → why the record cannot identify it.
+        nrms_before, nrms_after: the body sensor's normalised RMS error (‖pred − meas‖ /
+            ‖meas‖, means out, all axes) with the nominal scene and the calibrated one.
+        scene: the calibrated scene.
+    """
+
+    values: dict[str, float]
+    sigma: dict[str, float]
+    refused: dict[str, str]
+    nrms_before: float
+    nrms_after: float
+    scene: Scene
+
+
+def _times(values: Vec6, factor: float) -> Vec6:
+    """Six values, each times `factor`."""
+    return cast("Vec6", tuple(factor * v for v in values))
+
+
+def calibrated_scene(scene: Scene, values: dict[str, float]) -> Scene:
+    """`scene` with its linear mounts' stiffness and damping scaled and its body sensor
+    yawed by `values` (missing parameters: nominal)."""
+    k, c = values.get("stiffness", 1.0), values.get("damping", 1.0)
+    mounts = tuple(
+        dataclasses.replace(
+            m,
+            stiffness=_times(m.stiffness, k),
+            damping=_times(m.damping, c),
+        )
+        if isinstance(m, LinearMount)
+        else m
+        for m in scene.mounts
+    )
+    sensor = scene.body_sensor or BodySensor()
+    roll, pitch, yaw = sensor.orientation_rpy
+    yawed = dataclasses.replace(
+        sensor, orientation_rpy=(roll, pitch, yaw + values.get("yaw", 0.0))
+    )
+    return dataclasses.replace(scene, mounts=mounts, body_sensor=yawed)
+
+
+def predict(scene: Scene, foundation: Signal) -> tuple[np.ndarray, np.ndarray]:
+    """(stamps s, (k, 3) specific force m/s² in the body sensor's axes) of the scene's twin
+    run on the foundation record. Raises ValueError where its integration failed."""
+    model = assemble(scene)
+    engine = TwinEngine(model)
+    n = foundation.t.shape[0]
+    frames = [scene.input.frame_id] * n  # a record's samples are the scene's input
+    out = engine.run(SampleBatch(foundation.t, foundation.accel, foundation.gyro, frames))
+    if engine.failure_text or len(out) < 3:
+        why = engine.failure_text or f"{len(out)} rows published ({dict(engine.counts)})"
+        msg = f"the twin's run on the foundation record failed: {why}"
+        raise ValueError(msg)
+    rate = np.zeros((len(out), 3))  # the foundation's Ω at the rows, rad/s in F
+    if scene.input.gyro_filter != "ignore":
+        gyro = np.stack([np.interp(out.stamps, foundation.t, w) for w in foundation.gyro.T], 1)
+        rate = np.einsum("ij,kj->ki", model.sensor_rotation, gyro)
+    sensor = scene.body_sensor or BodySensor()
+    pose = (out.position, out.quaternion)
+    f, _ = predicted_reading(scene, sensor, out.stamps, pose, out.wrenches, rate)
+    return out.stamps, f
+
+
+def _at(stamps: np.ndarray, values: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """(k, 3) values at t, by cubic interpolation of their (stamps, values)."""
+    from scipy.interpolate import CubicSpline
+
+    return CubicSpline(stamps, values, axis=0)(t)
+
+
+def nrms(predicted: np.ndarray, measured: np.ndarray) -> float:
+    """‖p − m‖ / ‖m‖ with each axis' mean taken out of both."""
+    p = predicted - predicted.mean(axis=0)
+    m = measured - measured.mean(axis=0)
+    return float(np.linalg.norm(p - m) / np.linalg.norm(m))
+
+
+class _Problem:
+    """The fit's residual as a function of the free parameters."""
+
+    def __init__(self, scene: Scene, foundation: Signal, body: Signal, free: list[str]) -> None:
+        self.scene, self.foundation, self.free = scene, foundation, free
+        keep = (body.t > foundation.t[0] + EDGE_S) & (body.t < foundation.t[-1] - EDGE_S)
+        self.t, self.measured = body.t[keep], body.accel[keep]
+        self.scale = self.measured.std(axis=0) + 1e-12
+
+    def values(self, x: np.ndarray) -> dict[str, float]:
+        """Parameter values of the free vector x (scales as logarithms)."""
+        out = {}
+        for name, v in zip(self.free, x, strict=True):
+            out[name] = math.exp(v) if name in ("stiffness", "damping") else float(v)
+        return out
+
+    def predicted(self, values: dict[str, float]) -> np.ndarray:
+        """The body sensor's prediction at the measured stamps."""
+        stamps, f = predict(calibrated_scene(self.scene, values), self.foundation)
+        return _at(stamps, f, self.t - values.get("lag", 0.0))
+
+    def residual(self, x: np.ndarray) -> np.ndarray:
+        p = self.predicted(self.values(x))
+        p = p - p.mean(axis=0)
+        m = self.measured - self.measured.mean(axis=0)
+        return ((p - m) / self.scale).ravel()
+
+
+def _too_uncertain(name: str, sigma: float, value: float, step_s: float) -> str | None:
+    """Why a fitted parameter is not identified (None: it is)."""
+    if name in ("stiffness", "damping") and sigma > MAX_REL_SIGMA * value:
+        return f"1σ is {sigma / value:.0%} of its value (the record barely moves it)"
+    if name == "yaw" and sigma > MAX_YAW_SIGMA_RAD:
+        return f"1σ is {math.degrees(sigma):.1f}° (the motion has no direction to tell it by)"
+    if name == "lag" and sigma > step_s:
+        return f"1σ is {sigma * 1e3:.1f} ms, more than a sample ({step_s * 1e3:.1f} ms)"
+    return None
+
+
+def _fit(problem: _Problem, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The least-squares solution and its parameters' 1σ (in the fitted coordinates)."""
+    from scipy.optimize import least_squares
+
+    step = float(np.median(np.diff(problem.t)))
+    scales = [0.1 if n != "lag" else step for n in problem.free]
+    sol = least_squares(problem.residual, x0, x_scale=scales, diff_step=1e-4, method="trf")
+    dof = max(sol.fun.size - sol.x.size, 1)
+    s2 = 2.0 * sol.cost / dof
+    cov = np.linalg.pinv(sol.jac.T @ sol.jac) * s2
+    return sol.x, np.sqrt(np.clip(np.diag(cov), 0.0, None))
+
+
+def calibrate(
+    scene: Scene, foundation: Signal, body: Signal, fit: tuple[str, ...] = PARAMETERS
+) -> Calibration:
+    """Fit `fit` (of PARAMETERS) so that the twin on `foundation` predicts `body` (module
+    docstring); refuse, by name, what the record cannot identify."""
+    unknown = [n for n in fit if n not in PARAMETERS]
+    if unknown:
+        msg = f"cannot fit {', '.join(unknown)}: the parameters are {', '.join(PARAMETERS)}"
+        raise ValueError(msg)
+    free = list(fit)
+    refused: dict[str, str] = {}
+    step = float(np.median(np.diff(body.t)))
+    while True:
+        problem = _Problem(scene, foundation, body, free)
+        if not free:
+            values, sigma = {}, {}
+            break
+        x, sigma_x = _fit(problem, np.zeros(len(free)))
+        values = problem.values(x)
+        sigma = {
+            n: s * values[n] if n in ("stiffness", "damping") else float(s)
+            for n, s in zip(free, sigma_x, strict=True)
+        }
+        why = {n: w for n in free if (w := _too_uncertain(n, sigma[n], values[n], step))}
+        if not why:
+            break
+        refused.update(why)
+        free = [n for n in free if n not in why]
+    nominal = _Problem(scene, foundation, body, [])
+    before = nrms(nominal.predicted({}), nominal.measured)
+    after = nrms(problem.predicted(values), problem.measured) if values else before
+    if values and not after < before:
+        # A fit that predicts the body worse than the nominal scene fitted the foundation
+        # record's noise (or a model the machine is not): nothing it found is kept.
+        said = f"the fit predicts the body no better (NRMS {before:.3g} → {after:.3g})"
+        refused.update(dict.fromkeys(values, said))
+        values, sigma, after = {}, {}, before
+    full = {"stiffness": 1.0, "damping": 1.0, "yaw": 0.0, "lag": 0.0, **values}
+    return Calibration(full, sigma, refused, before, after, calibrated_scene(scene, full))

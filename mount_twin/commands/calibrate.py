@@ -1,0 +1,170 @@
+"""`mount-twin calibrate SCENE --foundation IN --body IN -o calibrated.scene.yaml`: identify the
+parameters a data sheet does not give from a recorded pair (the foundation's IMU, the body's),
+with the twin as the model (`mount_twin.analysis.calibration`). IN: a bag (the scene's input
+topic, or its body_sensor.topic), a recorder CSV (as `import-csv` reads it) or a Movella/Xsens
+DOT CSV export (stamps on the device clock, which synchronised sensors share).
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from mount_twin.analysis.calibration import Calibration
+    from mount_twin.io.signals import Signal
+    from mount_twin.scene.description import Scene
+
+NAME = "calibrate"
+HELP = "fit mount stiffness and damping scales, the body IMU's yaw and lag to a recorded pair"
+
+
+FITTED = ("stiffness", "damping", "yaw", "lag")
+"""`analysis.calibration.PARAMETERS` (a test holds them equal: numpy is not imported to build
+the command line)."""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("scene", help="scene YAML (with its body_sensor)")
+    parser.add_argument("--foundation", required=True, help="the foundation's record")
+    parser.add_argument("--body", required=True, help="the body IMU's record")
+    parser.add_argument("-o", "--output", required=True, help="the calibrated scene YAML (new)")
+    parser.add_argument(
+        "--fit",
+        nargs="+",
+        choices=FITTED,
+        default=list(FITTED),
+        help="what to fit (default: all)",
+    )
+    parser.add_argument("--plot", metavar="PNG", help="the body record against the prediction")
+    parser.epilog = (
+        "exit status: 0 calibrated; 2 bad input (a refused parameter is said, not an error)"
+    )
+
+
+def read_record(path: str, topic: str, msg_type: str) -> Signal:
+    """A record: an Xsens DOT CSV, a recorder CSV, or a bag's `topic`."""
+    from pathlib import Path
+
+    from mount_twin.io.signals import Signal
+    from mount_twin.io.xsens_csv import is_xsens_csv, read_xsens_csv
+
+    if Path(path).suffix.lower() == ".csv":
+        if is_xsens_csv(path):
+            return read_xsens_csv(path)[0]
+        from mount_twin.io.csv_import import read_recorder_csv
+
+        return read_recorder_csv(path).signal
+    from mount_twin.io.input_samples import read_input
+    from mount_twin.scene.description import InputSpec
+
+    decoded = read_input(path, InputSpec(msg_type=msg_type, topic=topic))
+    return Signal(decoded.stamps_ns * 1e-9, decoded.accel, decoded.gyro)
+
+
+def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from mount_twin.analysis.calibration import calibrate
+    from mount_twin.commands.common import load_scene
+
+    scene = load_scene(args.scene)
+    if scene.body_sensor is None:
+        msg = f"{args.scene}: no body_sensor: where is the body's IMU and how is it turned?"
+        raise ValueError(msg)
+    out = Path(args.output)
+    if out.exists():
+        msg = f"{out}: exists; calibrate writes a new scene file"
+        raise ValueError(msg)
+    foundation = read_record(args.foundation, scene.input.topic, scene.input.msg_type)
+    body = read_record(args.body, scene.body_sensor.topic, "sensor_msgs/msg/Imu")
+    cal = calibrate(scene, foundation, body, tuple(args.fit))
+    lines = describe(cal)
+    print("\n".join(lines))
+    _write_scene(args.scene, out, cal, lines)
+    print(f"calibrated scene: {out}")
+    if args.plot:
+        _plot(args.plot, scene, cal, foundation, body)
+        print(f"plot: {args.plot}")
+    return 0
+
+
+def describe(cal: Calibration) -> list[str]:
+    """Each parameter with its 1σ or why it is refused, and the residual before and after."""
+    units = {"stiffness": ("×", 1.0), "damping": ("×", 1.0), "yaw": ("°", 57.29577951308232)}
+    units["lag"] = ("ms", 1e3)
+    lines = []
+    for name, value in cal.values.items():
+        unit, k = units[name]
+        if name in cal.sigma:
+            lines.append(f"{name}: {k * value:.4g} {unit} ± {k * cal.sigma[name]:.2g} (1σ)")
+        elif name in cal.refused:
+            lines.append(f"{name}: refused, {cal.refused[name]}; kept at {k * value:g} {unit}")
+    lines.append(
+        f"body sensor, normalised RMS error: {cal.nrms_before:.3f} before, {cal.nrms_after:.3f}"
+        " after"
+    )
+    return lines
+
+
+def _write_scene(source: str, out: Path, cal: Calibration, lines: list[str]) -> None:
+    """The scene file with the calibrated values, and what was fitted as a comment on top."""
+    import yaml
+
+    from mount_twin.scene.loader import read_scene_yaml
+
+    data = read_scene_yaml(source)
+    for raw, mount in zip(data["mounts"], cal.scene.mounts, strict=True):
+        if raw.get("kind", "linear") == "linear":
+            raw["stiffness"] = list(mount.stiffness)  # type: ignore[union-attr]
+            raw["damping"] = list(mount.damping)  # type: ignore[union-attr]
+    sensor = cal.scene.body_sensor
+    if sensor is not None:
+        data.setdefault("body_sensor", {})["orientation_rpy"] = list(sensor.orientation_rpy)
+    head = [f"# calibrated from {source} by mount-twin calibrate", *(f"# {ln}" for ln in lines)]
+    head.append(f"# the body recorder's lag ({cal.values['lag'] * 1e3:.3g} ms) is the recorders',")
+    head.append("# not the machine's: it is not a scene value")
+    text = "\n".join(head) + "\n" + yaml.safe_dump(data, sort_keys=False)
+    out.write_text(text, encoding="utf-8")
+
+
+def _plot(png: str, scene: Scene, cal: Calibration, foundation: Signal, body: Signal) -> None:
+    """The body record's axes against the prediction, nominal and calibrated."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from scipy.interpolate import CubicSpline
+
+    from mount_twin.analysis.calibration import predict
+
+    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(10, 8))
+    shown = [
+        (scene, 0.0, "nominal", "tab:gray"),
+        (cal.scene, cal.values["lag"], "calibrated", "tab:red"),
+    ]
+    for i, ax in enumerate(axes):
+        ax.plot(
+            body.t - body.t[0],
+            body.accel[:, i] - body.accel[:, i].mean(),
+            "k",
+            lw=1.0,
+            label="measured",
+        )
+        for sc, lag, label, colour in shown:
+            t, f = predict(sc, foundation)
+            p = CubicSpline(t, f[:, i])(body.t - lag)
+            ax.plot(body.t - body.t[0], p - p.mean(), color=colour, lw=0.8, label=label)
+        ax.set_ylabel(f"{'xyz'[i]} [m/s²]")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8, loc="upper right")
+    axes[0].set_title(
+        f"body sensor: NRMS {cal.nrms_before:.3f} nominal, {cal.nrms_after:.3f} calibrated",
+        fontsize=9,
+    )
+    axes[-1].set_xlabel("time [s]")
+    fig.tight_layout()
+    fig.savefig(png, dpi=100)
+    plt.close(fig)

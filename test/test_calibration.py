@@ -1,0 +1,121 @@
+"""`calibrate`: the twin as the model of a recorded pair. Synthetic truth made by the twin with
+known changes is recovered; what a record cannot identify is refused by name; on the real
+shake-table pair, calibrating on one run improves the prediction of the other."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from io_helpers import DATA_DIR, ROOT
+from scipy.interpolate import CubicSpline
+from scipy.signal import butter, sosfiltfilt
+
+from mount_twin import load_scene_file
+from mount_twin.analysis import calibration as cal_mod
+from mount_twin.cli import main
+from mount_twin.commands.calibrate import FITTED
+from mount_twin.io.signals import SeaState, Signal, ship_motion
+from mount_twin.io.xsens_csv import read_xsens_csv
+from mount_twin.scene.description import BodySensor
+
+RATE = 200.0
+TRUTH = {"stiffness": 0.7, "damping": 1.5, "yaw": math.radians(30.0), "lag": 0.012}
+SHAKE = DATA_DIR / "shake_table_1story"
+
+
+def _pump():
+    scene = load_scene_file(ROOT / "config/pump_8_mounts.scene.yaml")
+    return dataclasses.replace(
+        scene,
+        body_sensor=BodySensor(position=(0.8, 0.3, 1.0)),
+        input=dataclasses.replace(scene.input, gyro_filter="none"),
+    )
+
+
+def _pair(scene, foundation: Signal, truth: dict[str, float]) -> tuple[Signal, Signal]:
+    """The body record the changed machine gives (its recorder `lag` late), and both records
+    with 0.01 m/s² of sensor noise (a MEMS IMU's, per sample at this rate)."""
+    t, f = cal_mod.predict(cal_mod.calibrated_scene(scene, truth), foundation)
+    rng = np.random.default_rng(1)
+    tb = t[t > 0.05]
+    fb = CubicSpline(t, f, axis=0)(tb - truth.get("lag", 0.0))
+    body = Signal(tb, fb + rng.normal(0.0, 0.01, fb.shape), np.zeros_like(fb))
+    noisy = foundation.accel + rng.normal(0.0, 0.01, foundation.accel.shape)
+    return Signal(foundation.t, noisy, foundation.gyro), body
+
+
+def test_the_parameters_the_command_offers_are_the_fits() -> None:
+    assert FITTED == cal_mod.PARAMETERS
+
+
+def test_twenty_seconds_of_ship_motion_recover_the_changed_machine() -> None:
+    """Ship motion with the machinery's broadband vibration (1-40 Hz, 0.3 m/s² RMS) under a
+    pump whose mounts all lost 30 % of their stiffness, with 1.5 times their damping, whose
+    body IMU is yawed 30° and recorded 12 ms late: each is recovered within 2 % (the angle
+    within 0.5°, the lag within a sample)."""
+    sea = ship_motion(rate_hz=RATE, total=20.0)
+    sos = butter(4, [1.0, 40.0], btype="band", fs=RATE, output="sos")
+    vib = sosfiltfilt(sos, np.random.default_rng(5).normal(0, 1, sea.accel.shape), axis=0)
+    foundation = Signal(sea.t, sea.accel + 0.3 * vib / vib.std(axis=0), sea.gyro)
+    cal = cal_mod.calibrate(_pump(), *_pair(_pump(), foundation, TRUTH))
+    assert not cal.refused
+    assert cal.values["stiffness"] == pytest.approx(0.7, rel=0.02)
+    assert cal.values["damping"] == pytest.approx(1.5, rel=0.02)
+    assert abs(math.degrees(cal.values["yaw"] - TRUTH["yaw"])) < 0.5
+    assert abs(cal.values["lag"] - TRUTH["lag"]) < 1.0 / RATE
+    assert cal.nrms_after < 0.1 < cal.nrms_before
+    for name, sigma in cal.sigma.items():  # the 1σ says how well, and the truth is within 5σ
+        assert abs(cal.values[name] - TRUTH[name]) < 5 * sigma + 1e-3 * abs(TRUTH[name])
+
+
+def test_what_the_record_cannot_identify_is_refused_by_name() -> None:
+    """Slow roll and heave alone (no vibration near the mounts' modes): the body follows the
+    deck, and what moves the mounts' stiffness and damping in the fit is the foundation
+    sensor's noise, which the body never felt. The fit predicts the body no better than the
+    nominal scene, and nothing of it is kept: every parameter is refused by name, with why,
+    and held at its nominal value (it was: the machine is unchanged)."""
+    foundation = ship_motion(rate_hz=RATE, total=20.0, sea=SeaState(vib_amp=0.0))
+    cal = cal_mod.calibrate(_pump(), *_pair(_pump(), foundation, {}))
+    assert {"stiffness", "damping", "lag"} <= set(cal.refused)
+    assert all(
+        "no better" in why or "barely" in why or "sample" in why for why in cal.refused.values()
+    )
+    assert cal.values["stiffness"] == 1.0 and cal.values["damping"] == 1.0
+    assert cal.values["lag"] == 0.0 and cal.nrms_after <= cal.nrms_before
+
+
+def test_the_real_shake_table_pair_is_calibrated_on_one_run_and_predicts_the_other(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Calibrated on sine trial 1, the block's acceleration along the shaking direction in
+    trial 2 is predicted better than by the notebook's values, broadband and below 10 Hz; the
+    lag found is the pair's ~2 samples."""
+    scene_path = SHAKE / "block.scene.yaml"
+    out = tmp_path / "calibrated.scene.yaml"
+    args = ["calibrate", str(scene_path), "-o", str(out), "--plot", str(tmp_path / "c.png")]
+    ground, top = (str(SHAKE / f"sine_2hz_trial1_{s}_excerpt.csv") for s in ("ground", "top"))
+    assert main([*args, "--foundation", ground, "--body", top]) == 0
+    said = capsys.readouterr().out
+    lag_ms = float(re.search(r"lag: ([\d.]+) ms", said).group(1))
+    assert 1.5 / 120 * 1e3 < lag_ms < 2.5 / 120 * 1e3
+    calibrated = load_scene_file(out)
+    assert calibrated.mounts[0].stiffness[0] != load_scene_file(scene_path).mounts[0].stiffness[0]
+    g, _ = read_xsens_csv(SHAKE / "sine_2hz_trial2_ground_excerpt.csv")
+    b, _ = read_xsens_csv(SHAKE / "sine_2hz_trial2_top_excerpt.csv")
+    sos = butter(4, 10.0, fs=120.0, output="sos")
+
+    def errors(scene, lag: float) -> tuple[float, float]:
+        problem = cal_mod._Problem(scene, g, b, [])
+        p, m = problem.predicted({"lag": lag})[:, :1], problem.measured[:, :1]
+        low = [sosfiltfilt(sos, v - v.mean(axis=0), axis=0) for v in (p, m)]
+        return cal_mod.nrms(p, m), cal_mod.nrms(*low)
+
+    before = errors(load_scene_file(scene_path), 0.0)
+    after = errors(calibrated, lag_ms * 1e-3)
+    assert after[0] < 0.8 * before[0] and after[1] < 0.5 * before[1], (before, after)
+    assert (tmp_path / "c.png").stat().st_size > 10_000
