@@ -129,6 +129,30 @@ def nrms(predicted: np.ndarray, measured: np.ndarray) -> float:
     return float(np.linalg.norm(p - m) / np.linalg.norm(m))
 
 
+def prediction_error(
+    scene: Scene,
+    records: tuple[Signal, Signal],
+    lag_s: float = 0.0,
+    axes: slice = slice(None),
+    below_hz: float | None = None,
+) -> float:
+    """The body sensor's NRMS error (`nrms`) of the scene's twin on a (foundation, body) pair
+    of records, the body recorder `lag_s` late: over its `axes`, and with both signals
+    low-passed below `below_hz` (4th-order Butterworth, zero phase) where given."""
+    problem = _Problem(scene, records[0], records[1], [])
+    predicted = problem.predicted({"lag": lag_s})[:, axes]
+    measured = problem.measured[:, axes]
+    if below_hz is not None:
+        from scipy.signal import butter, sosfiltfilt
+
+        rate = 1.0 / float(np.median(np.diff(problem.t)))
+        sos = butter(4, below_hz, fs=rate, output="sos")
+        predicted, measured = (
+            sosfiltfilt(sos, v - v.mean(axis=0), axis=0) for v in (predicted, measured)
+        )
+    return nrms(predicted, measured)
+
+
 class _Problem:
     """The fit's residual as a function of the free parameters."""
 
