@@ -26,6 +26,7 @@ COMMANDS = (
     "synthesize",
     "qualify",
     "calibrate",
+    "track",
     "modes",
     "accuracy",
     "sweep",

@@ -1,0 +1,107 @@
+"""Mounts that age: the calibration re-fitted window by window along a recorded pair.
+
+Rubber hardens or creeps and a bolt loosens slowly; a calibrated scene and a body IMU show it as
+a stiffness or damping scale that leaves 1. `track` fits `fit` (`analysis.calibration`) on
+consecutive windows of the records, each after a settling lead (the twin starts at rest at the
+window's first sample, so the first `LEAD_S` are fitted out), and gives each window a level:
+WARN where a scale's 3σ interval lies wholly outside `Band.warn`, ERROR where it lies outside
+`Band.error`. A window whose fit refuses a parameter says so and is not judged on it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from mount_twin.analysis.calibration import calibrate
+from mount_twin.io.signals import Signal
+from mount_twin.scene.description import Scene
+
+LEAD_S = 2.0
+"""Each window's records start this much earlier: the twin's start transient settles there,
+and the fit skips it."""
+LEVELS = ("OK", "WARN", "ERROR")
+
+
+@dataclass(frozen=True)
+class Band:
+    """Scale factors a mount may drift to: inside `warn` OK, outside it WARN, outside `error`
+    ERROR (each (low, high), a factor on the calibrated scene's value)."""
+
+    warn: tuple[float, float] = (0.85, 1.15)
+    error: tuple[float, float] = (0.75, 1.25)
+
+
+@dataclass(frozen=True)
+class WindowFit:
+    """One window's fit: its span (s, on the records' clock), each parameter's value and 1σ
+    (refused ones left out, with why in `refused`), its level and why."""
+
+    start_s: float
+    end_s: float
+    values: dict[str, float]
+    sigma: dict[str, float]
+    refused: dict[str, str] = field(default_factory=dict)
+    level: str = "OK"
+    why: str = ""
+
+
+def _window(record: Signal, start: float, end: float) -> Signal:
+    """The samples of `record` with stamps in [start, end)."""
+    keep = (record.t >= start) & (record.t < end)
+    return Signal(record.t[keep], record.accel[keep], record.gyro[keep])
+
+
+def judged(name: str, value: float, sigma: float, band: Band) -> tuple[int, str]:
+    """The level of a scale `value` ± 3`sigma` against the band, and why (empty: OK)."""
+    low, high = value - 3.0 * sigma, value + 3.0 * sigma
+    for level, (lo, hi) in ((2, band.error), (1, band.warn)):
+        if high < lo or low > hi:
+            return level, f"{name} ×{value:.3f} ± {sigma:.2g} (1σ) is outside {lo:g}–{hi:g}"
+    return 0, ""
+
+
+def track(
+    scene: Scene,
+    foundation: Signal,
+    body: Signal,
+    window_s: float = 30.0,
+    fit: tuple[str, ...] = ("stiffness", "damping"),
+    band: Band = Band(),
+) -> list[WindowFit]:
+    """The fit of each `window_s` window of the pair, in order (module docstring)."""
+    if window_s <= 2.0 * LEAD_S:
+        msg = f"window {window_s:g} s: give more than {2.0 * LEAD_S:g} s (the lead settles)"
+        raise ValueError(msg)
+    start, stop = float(body.t[0]) + LEAD_S, float(min(foundation.t[-1], body.t[-1]))
+    fits = []
+    while start + window_s <= stop + 1e-9:
+        end = start + window_s
+        cal = calibrate(
+            scene, _window(foundation, start - LEAD_S, end), _window(body, start, end), fit
+        )
+        scales = [n for n in cal.sigma if n in ("stiffness", "damping")]
+        verdicts = [judged(n, cal.values[n], cal.sigma[n], band) for n in scales]
+        level = max((v for v, _ in verdicts), default=0)
+        why = "; ".join(w for _, w in verdicts if w)
+        fitted = {n: cal.values[n] for n in cal.sigma}
+        fits.append(
+            WindowFit(start, end, fitted, dict(cal.sigma), dict(cal.refused), LEVELS[level], why)
+        )
+        start = end
+    return fits
+
+
+def first_flag(fits: list[WindowFit]) -> WindowFit | None:
+    """The first window that is not OK (None: all are)."""
+    return next((f for f in fits if f.level != "OK"), None)
+
+
+def window_table(fits: list[WindowFit]) -> list[str]:
+    """One line per window: span, values ± 1σ, refused, level and why."""
+    lines = []
+    for f in fits:
+        shown = ", ".join(f"{n} ×{v:.3f} ± {f.sigma[n]:.2g}" for n, v in f.values.items())
+        refused = "; ".join(f"{n} refused ({w})" for n, w in f.refused.items())
+        tail = " — ".join(x for x in (refused, f.why) if x)
+        lines.append(f"{f.start_s:9.1f}–{f.end_s:<9.1f} {f.level:<5} {shown}  {tail}".rstrip())
+    return lines

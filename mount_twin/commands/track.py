@@ -1,0 +1,52 @@
+"""`mount-twin track SCENE --foundation IN --body IN`: the calibration re-fitted window by
+window along a recorded pair, each window judged against a band (`mount_twin.analysis.ageing`):
+mounts that harden, creep or loosen show as a stiffness or damping scale leaving 1. Exit 0 all
+windows OK, 1 some WARN, 4 some ERROR.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+NAME = "track"
+HELP = "re-fit the mounts' stiffness and damping window by window: flag mounts that age"
+EXIT_WARN, EXIT_ERROR = 1, 4
+BANDS = {"warn": (0.85, 1.15), "error": (0.75, 1.25)}
+"""--warn and --error's defaults: `analysis.ageing.Band`'s (a test holds them equal; numpy is
+not imported to build the command line)."""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("scene", help="the calibrated scene YAML (with its body_sensor)")
+    parser.add_argument("--foundation", required=True, help="the foundation's record")
+    parser.add_argument("--body", required=True, help="the body IMU's record")
+    parser.add_argument("--window", type=float, default=30.0, help="window length, s")
+    for level, band in BANDS.items():
+        parser.add_argument(
+            f"--{level}",
+            type=float,
+            nargs=2,
+            default=band,
+            metavar=("LOW", "HIGH"),
+            help=f"scale band outside which a window is judged {level.upper()}",
+        )
+    parser.epilog = f"exit status: 0 OK; {EXIT_WARN} WARN; {EXIT_ERROR} ERROR; 2 bad input"
+
+
+def run(args: argparse.Namespace) -> int:
+    from mount_twin.analysis.ageing import Band, track, window_table
+    from mount_twin.commands.calibrate import read_record
+    from mount_twin.commands.common import load_scene
+
+    scene = load_scene(args.scene)
+    if scene.body_sensor is None:
+        msg = f"{args.scene}: no body_sensor: where is the body's IMU and how is it turned?"
+        raise ValueError(msg)
+    foundation = read_record(args.foundation, scene.input.topic, scene.input.msg_type)
+    body = read_record(args.body, scene.body_sensor.topic, "sensor_msgs/msg/Imu")
+    band = Band(tuple(args.warn), tuple(args.error))
+    fits = track(scene, foundation, body, args.window, band=band)
+    print(f"{'window s':<19} level fit")
+    print("\n".join(window_table(fits)))
+    levels = {f.level for f in fits}
+    return EXIT_ERROR if "ERROR" in levels else EXIT_WARN if "WARN" in levels else 0

@@ -1,0 +1,76 @@
+"""Mounts that age (`track`): the calibration re-fitted window by window flags a machine whose
+mounts lose 30 % of their stiffness part-way through a record, in the first window after, and
+not before."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from io_helpers import ROOT
+from scipy.signal import butter, sosfiltfilt
+
+from mount_twin import load_scene_file
+from mount_twin.analysis import calibration as cal_mod
+from mount_twin.cli import main
+from mount_twin.io.signals import Signal, ship_motion
+from mount_twin.scene.loader import read_scene_yaml
+
+RATE, TOTAL, CHANGE = 200.0, 92.5, 45.0
+
+
+@pytest.fixture(scope="module")
+def ageing_pair(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Signal, Signal]:
+    """The pump (its body IMU on the frame) under ship motion with machinery vibration; at 40 s
+    every mount loses 30 % of its stiffness. Both records carry 0.01 m/s² of noise. Also
+    written as recorder CSVs and a scene file, for the command."""
+    data = read_scene_yaml(ROOT / "config/pump_8_mounts.scene.yaml")
+    data["input"]["gyro_filter"] = "none"
+    data["body_sensor"] = {"position": [0.8, 0.3, 1.0]}
+    d = tmp_path_factory.mktemp("ageing")
+    (d / "pump.scene.yaml").write_text(yaml.safe_dump(data), encoding="utf-8")
+    scene = load_scene_file(d / "pump.scene.yaml")
+    sea = ship_motion(rate_hz=RATE, total=TOTAL)
+    sos = butter(4, [1.0, 40.0], btype="band", fs=RATE, output="sos")
+    vib = sosfiltfilt(sos, np.random.default_rng(5).normal(0, 1, sea.accel.shape), axis=0)
+    foundation = Signal(sea.t, sea.accel + 0.3 * vib / vib.std(axis=0), sea.gyro)
+    t, intact = cal_mod.predict(scene, foundation)
+    _, aged = cal_mod.predict(cal_mod.calibrated_scene(scene, {"stiffness": 0.7}), foundation)
+    rng = np.random.default_rng(1)
+    f = np.where((t >= CHANGE)[:, None], aged, intact) + rng.normal(0, 0.01, intact.shape)
+    body = Signal(t, f, np.zeros_like(f))
+    noisy = Signal(sea.t, foundation.accel + rng.normal(0, 0.01, sea.accel.shape), sea.gyro)
+    for name, rec in (("foundation", noisy), ("body", body)):
+        rows = np.column_stack([rec.t, rec.accel, rec.gyro])
+        head = "t,ax,ay,az,wx,wy,wz"
+        np.savetxt(d / f"{name}.csv", rows, delimiter=",", header=head, comments="")
+    return d, noisy, body
+
+
+def test_mounts_losing_30_percent_are_flagged_within_a_minute_and_not_before(
+    ageing_pair: tuple[Path, Signal, Signal], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Windows of 30 s: the one before the change is OK, the first wholly after it is an
+    ERROR naming the stiffness at 0.70 (within 2 %), and the command exits 4. (The issue asks
+    for one mount of several; the fit has one scale for all mounts: see the module.)"""
+    d, _, _ = ageing_pair
+    files = ["--foundation", str(d / "foundation.csv"), "--body", str(d / "body.csv")]
+    assert main(["track", str(d / "pump.scene.yaml"), "--window", "30", *files]) == 4
+    rows = [ln.split() for ln in capsys.readouterr().out.splitlines()[1:]]
+    spans = [tuple(float(v) for v in r[0].split("–")) for r in rows]
+    levels = [r[1] for r in rows]
+    assert spans[0] == (2.0, 32.0) and levels[0] == "OK"
+    first = next(i for i, level in enumerate(levels) if level != "OK")
+    assert spans[first][1] - CHANGE <= 60.0
+    after = next(i for i, (start, _) in enumerate(spans) if start >= CHANGE)
+    assert levels[after] == "ERROR" and rows[after][2:4] == ["stiffness", rows[after][3]]
+    assert float(rows[after][3].lstrip("×").rstrip(",")) == pytest.approx(0.7, rel=0.02)
+
+
+def test_the_commands_default_bands_are_the_ageing_modules() -> None:
+    from mount_twin.analysis.ageing import Band
+    from mount_twin.commands.track import BANDS
+
+    assert Band() == Band(BANDS["warn"], BANDS["error"])
