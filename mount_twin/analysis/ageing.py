@@ -91,11 +91,6 @@ def track(
     return fits
 
 
-def first_flag(fits: list[WindowFit]) -> WindowFit | None:
-    """The first window that is not OK (None: all are)."""
-    return next((f for f in fits if f.level != "OK"), None)
-
-
 def window_table(fits: list[WindowFit]) -> list[str]:
     """One line per window: span, values ± 1σ, refused, level and why."""
     lines = []
