@@ -7,7 +7,8 @@ twin's non-linear mounts and the recorders' clocks live there; a lag is a phase 
 with frequency, which a time-domain fit takes as one number):
 
 - `stiffness`, `damping`: one scale factor each on every linear mount's stiffness and damping
-  (fitted as logarithms: a scale stays positive);
+  (fitted as logarithms: a scale stays positive); `stiffness:fl+fr` (or `damping:…`) scales
+  only the mounts it names, so that groups (or single mounts) are fitted apart;
 - `yaw`: the body sensor's rotation about the body's z axis, added to its orientation_rpy, rad;
 - `lag`: the body recorder's clock behind the foundation's, s (its samples are the motion
   `lag` seconds before their stamps).
@@ -71,15 +72,40 @@ def _times(values: Vec6, factor: float) -> Vec6:
     return cast("Vec6", tuple(factor * v for v in values))
 
 
+def is_scale(name: str) -> bool:
+    """Whether a parameter is a stiffness or damping scale (of all mounts or of a group)."""
+    return name.partition(":")[0] in ("stiffness", "damping")
+
+
+def scaled_mounts(name: str, mount_names: list[str]) -> list[str]:
+    """The mounts a scale parameter applies to: all of them, or those `name` lists after its
+    colon, joined by `+`. Raises ValueError naming a mount the scene lacks."""
+    _, _, group = name.partition(":")
+    if not group:
+        return mount_names
+    listed = group.split("+")
+    unknown = [m for m in listed if m not in mount_names]
+    if unknown:
+        msg = f"{name}: no mount {', '.join(unknown)} in the scene ({', '.join(mount_names)})"
+        raise ValueError(msg)
+    return listed
+
+
 def calibrated_scene(scene: Scene, values: dict[str, float]) -> Scene:
-    """`scene` with its linear mounts' stiffness and damping scaled and its body sensor
-    yawed by `values` (missing parameters: nominal)."""
-    k, c = values.get("stiffness", 1.0), values.get("damping", 1.0)
+    """`scene` with its linear mounts' stiffness and damping scaled (every scale parameter in
+    `values` multiplies the mounts it names) and its body sensor yawed by `values` (missing
+    parameters: nominal)."""
+    names = [m.name for m in scene.mounts]
+    factor = {(kind, m): 1.0 for kind in ("stiffness", "damping") for m in names}
+    for name, value in values.items():
+        if is_scale(name):
+            for m in scaled_mounts(name, names):
+                factor[name.partition(":")[0], m] *= value
     mounts = tuple(
         dataclasses.replace(
             m,
-            stiffness=_times(m.stiffness, k),
-            damping=_times(m.damping, c),
+            stiffness=_times(m.stiffness, factor["stiffness", m.name]),
+            damping=_times(m.damping, factor["damping", m.name]),
         )
         if isinstance(m, LinearMount)
         else m
@@ -166,7 +192,7 @@ class _Problem:
         """Parameter values of the free vector x (scales as logarithms)."""
         out = {}
         for name, v in zip(self.free, x, strict=True):
-            out[name] = math.exp(v) if name in ("stiffness", "damping") else float(v)
+            out[name] = math.exp(v) if is_scale(name) else float(v)
         return out
 
     def predicted(self, values: dict[str, float]) -> np.ndarray:
@@ -183,7 +209,7 @@ class _Problem:
 
 def _too_uncertain(name: str, sigma: float, value: float, step_s: float) -> str | None:
     """Why a fitted parameter is not identified (None: it is)."""
-    if name in ("stiffness", "damping") and sigma > MAX_REL_SIGMA * value:
+    if is_scale(name) and sigma > MAX_REL_SIGMA * value:
         return f"1σ is {sigma / value:.0%} of its value (the record barely moves it)"
     if name == "yaw" and sigma > MAX_YAW_SIGMA_RAD:
         return f"1σ is {math.degrees(sigma):.1f}° (the motion has no direction to tell it by)"
@@ -210,10 +236,18 @@ def calibrate(
 ) -> Calibration:
     """Fit `fit` (of PARAMETERS) so that the twin on `foundation` predicts `body` (module
     docstring); refuse, by name, what the record cannot identify."""
-    unknown = [n for n in fit if n not in PARAMETERS]
+    unknown = [
+        n for n in fit if n.partition(":")[0] not in PARAMETERS or (":" in n and not is_scale(n))
+    ]
     if unknown:
-        msg = f"cannot fit {', '.join(unknown)}: the parameters are {', '.join(PARAMETERS)}"
+        msg = (
+            f"cannot fit {', '.join(unknown)}: the parameters are {', '.join(PARAMETERS)}, "
+            "and stiffness:MOUNT+MOUNT… or damping:… for a group"
+        )
         raise ValueError(msg)
+    for name in fit:
+        if is_scale(name):
+            scaled_mounts(name, [m.name for m in scene.mounts])
     free = list(fit)
     refused: dict[str, str] = {}
     step = float(np.median(np.diff(body.t)))
@@ -225,7 +259,7 @@ def calibrate(
         x, sigma_x = _fit(problem, np.zeros(len(free)))
         values = problem.values(x)
         sigma = {
-            n: s * values[n] if n in ("stiffness", "damping") else float(s)
+            n: s * values[n] if is_scale(n) else float(s)
             for n, s in zip(free, sigma_x, strict=True)
         }
         why = {n: w for n in free if (w := _too_uncertain(n, sigma[n], values[n], step))}
@@ -233,8 +267,8 @@ def calibrate(
             break
         refused.update(why)
         free = [n for n in free if n not in why]
-    nominal = _Problem(scene, foundation, body, [])
-    before = nrms(nominal.predicted({}), nominal.measured)
+    unfitted = _Problem(scene, foundation, body, [])
+    before = nrms(unfitted.predicted({}), unfitted.measured)
     after = nrms(problem.predicted(values), problem.measured) if values else before
     if values and not after < before:
         # A fit that predicts the body worse than the nominal scene fitted the foundation
@@ -242,5 +276,6 @@ def calibrate(
         said = f"the fit predicts the body no better (NRMS {before:.3g} → {after:.3g})"
         refused.update(dict.fromkeys(values, said))
         values, sigma, after = {}, {}, before
-    full = {"stiffness": 1.0, "damping": 1.0, "yaw": 0.0, "lag": 0.0, **values}
+    nominal = {n: 0.0 if n in ("yaw", "lag") else 1.0 for n in (*fit, "yaw", "lag")}
+    full = {**nominal, **values}
     return Calibration(full, sigma, refused, before, after, calibrated_scene(scene, full))

@@ -34,9 +34,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--fit",
         nargs="+",
-        choices=FITTED,
         default=list(FITTED),
-        help="what to fit (default: all)",
+        metavar="PARAMETER",
+        help=f"what to fit, among {', '.join(FITTED)} (default: all); stiffness:fl+fr (or "
+        "damping:…) scales only those mounts, to fit groups or single mounts apart",
     )
     parser.add_argument("--plot", metavar="PNG", help="the body record against the prediction")
     parser.epilog = (
@@ -93,11 +94,10 @@ def run(args: argparse.Namespace) -> int:
 
 def describe(cal: Calibration) -> list[str]:
     """Each parameter with its 1σ or why it is refused, and the residual before and after."""
-    units = {"stiffness": ("×", 1.0), "damping": ("×", 1.0), "yaw": ("°", 57.29577951308232)}
-    units["lag"] = ("ms", 1e3)
+    units = {"yaw": ("°", 57.29577951308232), "lag": ("ms", 1e3)}
     lines = []
     for name, value in cal.values.items():
-        unit, k = units[name]
+        unit, k = units.get(name, ("×", 1.0))  # the rest are scale factors
         if name in cal.sigma:
             lines.append(f"{name}: {k * value:.4g} {unit} ± {k * cal.sigma[name]:.2g} (1σ)")
         elif name in cal.refused:
