@@ -95,7 +95,7 @@ def test_one_mount_at_70_percent_is_told_from_the_seven_intact_ones() -> None:
 
 
 def test_a_group_naming_a_mount_the_scene_lacks_is_refused() -> None:
-    with pytest.raises(ValueError, match=r"stiffness:fl\+nope: no mount nope in the scene"):
+    with pytest.raises(ValueError, match=r"stiffness:fl\+nope: nope is no linear mount"):
         cal_mod.calibrate(
             _pump(), Signal(*[np.zeros(3)] * 3), Signal(*[np.zeros(3)] * 3), ("stiffness:fl+nope",)
         )

@@ -46,8 +46,7 @@ def predicted_reading(
     x, y, z, w of body → F), (k, n, 6) mount `wrenches`, and the foundation's rate (k, 3),
     rad/s in F (zeros where the scene neglects it)."""
     rotation = quaternion_matrices(pose[1])
-    axes = np.array([rpy_matrix(*m.orientation_rpy) for m in scene.mounts]).reshape(-1, 3, 3)
-    f_cg = cg_specific_force(wrenches, axes, scene.body.mass)
+    f_cg = cg_specific_force(scene, wrenches)
     omega = foundation_rate + relative_rate(stamps, rotation)
     alpha = np.gradient(omega, stamps, axis=0, edge_order=2) + np.cross(foundation_rate, omega)
     r = np.einsum("kij,j->ki", rotation, np.array(sensor.position) - np.array(scene.body.cg))

@@ -31,10 +31,10 @@ from typing import cast
 import numpy as np
 
 from mount_twin.analysis.body_sensor import predicted_reading
+from mount_twin.analysis.response import followed
 from mount_twin.engine.batch import SampleBatch
-from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.intake import rotated
 from mount_twin.io.signals import Signal
-from mount_twin.model.assemble import assemble
 from mount_twin.scene.description import BodySensor, LinearMount, Scene, Vec6
 
 PARAMETERS = ("stiffness", "damping", "yaw", "lag")
@@ -77,16 +77,19 @@ def is_scale(name: str) -> bool:
     return name.partition(":")[0] in ("stiffness", "damping")
 
 
-def scaled_mounts(name: str, mount_names: list[str]) -> list[str]:
-    """The mounts a scale parameter applies to: all of them, or those `name` lists after its
-    colon, joined by `+`. Raises ValueError naming a mount the scene lacks."""
+def scaled_mounts(name: str, scene: Scene) -> list[str]:
+    """The linear mounts a scale parameter applies to: all of them, or those `name` lists
+    after its colon, joined by `+`. Raises ValueError naming a mount the scene lacks, or one
+    whose kind has no stiffness and damping scales (a bolt, a key, rubber with its own law)."""
+    linear = [m.name for m in scene.mounts if isinstance(m, LinearMount)]
     _, _, group = name.partition(":")
-    if not group:
-        return mount_names
-    listed = group.split("+")
-    unknown = [m for m in listed if m not in mount_names]
-    if unknown:
-        msg = f"{name}: no mount {', '.join(unknown)} in the scene ({', '.join(mount_names)})"
+    listed = group.split("+") if group else linear
+    wrong = [m for m in listed if m not in linear]
+    if not listed:
+        msg = f"{name}: the scene has no linear mount to scale"
+        raise ValueError(msg)
+    if wrong:
+        msg = f"{name}: {', '.join(wrong)} is no linear mount of the scene ({', '.join(linear)})"
         raise ValueError(msg)
     return listed
 
@@ -99,7 +102,7 @@ def calibrated_scene(scene: Scene, values: dict[str, float]) -> Scene:
     factor = {(kind, m): 1.0 for kind in ("stiffness", "damping") for m in names}
     for name, value in values.items():
         if is_scale(name):
-            for m in scaled_mounts(name, names):
+            for m in scaled_mounts(name, scene):
                 factor[name.partition(":")[0], m] *= value
     mounts = tuple(
         dataclasses.replace(
@@ -122,19 +125,13 @@ def calibrated_scene(scene: Scene, values: dict[str, float]) -> Scene:
 def predict(scene: Scene, foundation: Signal) -> tuple[np.ndarray, np.ndarray]:
     """(stamps s, (k, 3) specific force m/s² in the body sensor's axes) of the scene's twin
     run on the foundation record. Raises ValueError where its integration failed."""
-    model = assemble(scene)
-    engine = TwinEngine(model)
-    n = foundation.t.shape[0]
-    frames = [scene.input.frame_id] * n  # a record's samples are the scene's input
-    out = engine.run(SampleBatch(foundation.t, foundation.accel, foundation.gyro, frames))
-    if engine.failure_text or len(out) < 3:
-        why = engine.failure_text or f"{len(out)} rows published ({dict(engine.counts)})"
-        msg = f"the twin's run on the foundation record failed: {why}"
-        raise ValueError(msg)
+    frames = [scene.input.frame_id] * foundation.t.shape[0]  # the scene's input, all of it
+    batch = SampleBatch(foundation.t, foundation.accel, foundation.gyro, frames)
+    model, out = followed(scene, batch, "the foundation record")
     rate = np.zeros((len(out), 3))  # the foundation's Ω at the rows, rad/s in F
     if scene.input.gyro_filter != "ignore":
         gyro = np.stack([np.interp(out.stamps, foundation.t, w) for w in foundation.gyro.T], 1)
-        rate = np.einsum("ij,kj->ki", model.sensor_rotation, gyro)
+        rate = rotated(gyro, model.sensor_rotation)
     sensor = scene.body_sensor or BodySensor()
     pose = (out.position, out.quaternion)
     f, _ = predicted_reading(scene, sensor, out.stamps, pose, out.wrenches, rate)
@@ -247,7 +244,7 @@ def calibrate(
         raise ValueError(msg)
     for name in fit:
         if is_scale(name):
-            scaled_mounts(name, [m.name for m in scene.mounts])
+            scaled_mounts(name, scene)
     free = list(fit)
     refused: dict[str, str] = {}
     step = float(np.median(np.diff(body.t)))

@@ -16,9 +16,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mount_twin.engine.batch import OutputBatch, SampleBatch
+from mount_twin.engine.engine import TwinEngine
 from mount_twin.io.messages import WRENCHES_OUTPUT
 from mount_twin.io.output_tables import Table
-from mount_twin.physics.rotations import rpy_matrix
+from mount_twin.model.assemble import Model, assemble
+from mount_twin.physics.rotations import rpy_matrices
 from mount_twin.scene.description import Scene
 
 CG = "cg"
@@ -57,10 +60,25 @@ def check_response(text: str, scene: Scene) -> str | None:
     return name
 
 
-def cg_specific_force(wrenches: np.ndarray, mount_axes: np.ndarray, mass_kg: float) -> np.ndarray:
-    """(k, 3) specific force of the CG in F, m/s², from (k, n, 6) wrenches (force on the body
-    in each mount's axes first) and the (n, 3, 3) mount axes in F (columns)."""
-    return np.einsum("nij,knj->ki", mount_axes, wrenches[..., :3]) / mass_kg
+def followed(scene: Scene, batch: SampleBatch, source: str) -> tuple[Model, OutputBatch]:
+    """The scene's model and its twin's outputs on a whole record in memory. A run whose
+    integration failed, or that published fewer than 3 rows, is refused (ValueError naming
+    `source`): its response is not the machine's."""
+    model = assemble(scene)
+    engine = TwinEngine(model)
+    out = engine.run(batch)
+    if engine.failure_text or len(out) < 3:
+        why = engine.failure_text or f"{len(out)} rows published ({dict(engine.counts)})"
+        msg = f"{source}: the twin's run failed, its response is not the machine's: {why}"
+        raise ValueError(msg)
+    return model, out
+
+
+def cg_specific_force(scene: Scene, wrenches: np.ndarray) -> np.ndarray:
+    """(k, 3) specific force of the CG in F, m/s², from the scene's (k, n, 6) mount wrenches
+    (force on the body in each mount's axes first; the axes fixed in F)."""
+    axes = rpy_matrices([m.orientation_rpy for m in scene.mounts])
+    return np.einsum("nij,knj->ki", axes, wrenches[..., :3]) / scene.body.mass
 
 
 def response_of(scene: Scene, stamps_s: np.ndarray, wrenches: np.ndarray, text: str) -> Response:
@@ -72,8 +90,7 @@ def response_of(scene: Scene, stamps_s: np.ndarray, wrenches: np.ndarray, text: 
         i = [m.name for m in scene.mounts].index(mount)
         return Response(t, wrenches[:, i, :3], "N", f"mount {mount} force (its axes)")
     frozen = [a for a in AXES if a not in scene.dofs]
-    axes = np.array([rpy_matrix(*m.orientation_rpy) for m in scene.mounts]).reshape(-1, 3, 3)
-    values = cg_specific_force(wrenches, axes, scene.body.mass)
+    values = cg_specific_force(scene, wrenches)
     values[:, [AXES.index(a) for a in frozen]] = np.nan  # a constraint force is not published
     return Response(t, values, "m/s²", "CG specific force (F axes)")
 

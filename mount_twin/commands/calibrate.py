@@ -14,6 +14,7 @@ if TYPE_CHECKING:
     from pathlib import Path
 
     from mount_twin.analysis.calibration import Calibration
+    from mount_twin.io.messages import TimeBase
     from mount_twin.io.signals import Signal
     from mount_twin.scene.description import Scene
 
@@ -45,42 +46,58 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def read_record(path: str, topic: str, msg_type: str) -> Signal:
-    """A record: an Xsens DOT CSV, a recorder CSV, or a bag's `topic`."""
+def _read_record(
+    path: str, topic: str, msg_type: str, base: TimeBase | None
+) -> tuple[Signal, TimeBase | None]:
+    """A record: an Xsens DOT CSV, a recorder CSV (their stamps as written), or a bag's `topic`
+    (stamps in seconds from `base`, else from its first stamp's whole second: the base
+    returned, for the other record of a pair to share)."""
     from pathlib import Path
 
+    from mount_twin.io.messages import TimeBase
     from mount_twin.io.signals import Signal
     from mount_twin.io.xsens_csv import is_xsens_csv, read_xsens_csv
 
     if Path(path).suffix.lower() == ".csv":
         if is_xsens_csv(path):
-            return read_xsens_csv(path)[0]
+            return read_xsens_csv(path)[0], base
         from mount_twin.io.csv_import import read_recorder_csv
 
-        return read_recorder_csv(path).signal
+        return read_recorder_csv(path).signal, base
     from mount_twin.io.input_samples import read_input
     from mount_twin.scene.description import InputSpec
 
     decoded = read_input(path, InputSpec(msg_type=msg_type, topic=topic))
-    return Signal(decoded.stamps_ns * 1e-9, decoded.accel, decoded.gyro)
+    base = base or TimeBase.at(int(decoded.stamps_ns[0]))
+    return Signal(base.seconds(decoded.stamps_ns), decoded.accel, decoded.gyro), base
+
+
+def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
+    """The scene (it must have a body_sensor) and its (foundation, body) records, on one
+    clock, from `args.scene`, `args.foundation` and `args.body`."""
+    from mount_twin.commands.common import load_scene
+    from mount_twin.io.messages import IMU
+
+    scene = load_scene(args.scene)
+    if scene.body_sensor is None:
+        msg = f"{args.scene}: no body_sensor: where is the body's IMU and how is it turned?"
+        raise ValueError(msg)
+    spec = scene.input
+    foundation, base = _read_record(args.foundation, spec.topic, spec.msg_type, None)
+    body, _ = _read_record(args.body, scene.body_sensor.topic, IMU, base)
+    return scene, foundation, body
 
 
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from mount_twin.analysis.calibration import calibrate
-    from mount_twin.commands.common import load_scene
 
-    scene = load_scene(args.scene)
-    if scene.body_sensor is None:
-        msg = f"{args.scene}: no body_sensor: where is the body's IMU and how is it turned?"
-        raise ValueError(msg)
     out = Path(args.output)
     if out.exists():
         msg = f"{out}: exists; calibrate writes a new scene file"
         raise ValueError(msg)
-    foundation = read_record(args.foundation, scene.input.topic, scene.input.msg_type)
-    body = read_record(args.body, scene.body_sensor.topic, "sensor_msgs/msg/Imu")
+    scene, foundation, body = read_pair(args)
     cal = calibrate(scene, foundation, body, tuple(args.fit))
     lines = describe(cal)
     print("\n".join(lines))

@@ -129,9 +129,11 @@ def _runs(args: argparse.Namespace, plan: Plan, out: Path) -> list[InputRun]:
     inputs = plan.inputs
     n = len(inputs)
     runs: list[InputRun] = []
-    if importlib.util.find_spec("dask") is None or n == 1 or args.workers == 1:
+    no_dask = importlib.util.find_spec("dask") is None
+    if no_dask or n == 1 or args.workers == 1:
         if n > 1:
-            print("  (dask not installed: one input after the other)")
+            why = "dask is not installed" if no_dask else "--workers 1"
+            print(f"  ({why}: one input after the other, in this process)")
         for axis, seed in inputs:
             runs.append(run_input(args.scene, plan, axis, seed, str(out)))
             _said(runs[-1], len(runs), n)

@@ -414,18 +414,12 @@ def _response(args: argparse.Namespace, path: Path) -> tuple[np.ndarray, np.ndar
 
 def _replayed(scene: Scene, path: Path) -> tuple[np.ndarray, np.ndarray]:
     """(stamps s, wrenches) of the scene's twin run on the input topic of the bag at `path`."""
-    from mount_twin.engine.engine import TwinEngine
+    from mount_twin.analysis.response import followed
     from mount_twin.io.input_samples import read_input
     from mount_twin.io.messages import TimeBase
-    from mount_twin.model.assemble import assemble
 
     decoded = read_input(path, scene.input)
-    engine = TwinEngine(assemble(scene))
-    out = engine.run(decoded.batch(TimeBase.at(int(decoded.stamps_ns[0]))))
-    if engine.failure_text:
-        why = engine.failure_text
-        msg = f"{path}: the twin's run failed, its response is not the machine's: {why}"
-        raise ValueError(msg)
+    _, out = followed(scene, decoded.batch(TimeBase.at(int(decoded.stamps_ns[0]))), str(path))
     return out.stamps, out.wrenches
 
 

@@ -35,15 +35,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from mount_twin.analysis.ageing import Band, track, window_table
-    from mount_twin.commands.calibrate import read_record
-    from mount_twin.commands.common import load_scene
+    from mount_twin.commands.calibrate import read_pair
 
-    scene = load_scene(args.scene)
-    if scene.body_sensor is None:
-        msg = f"{args.scene}: no body_sensor: where is the body's IMU and how is it turned?"
-        raise ValueError(msg)
-    foundation = read_record(args.foundation, scene.input.topic, scene.input.msg_type)
-    body = read_record(args.body, scene.body_sensor.topic, "sensor_msgs/msg/Imu")
+    scene, foundation, body = read_pair(args)
     band = Band(tuple(args.warn), tuple(args.error))
     fits = track(scene, foundation, body, args.window, band=band)
     print(f"{'window s':<19} level fit")

@@ -20,7 +20,7 @@ from mount_twin.physics.dynamics import (
     rhs,
 )
 from mount_twin.physics.jacobian import central_columns
-from mount_twin.physics.rotations import rpy_matrix
+from mount_twin.physics.rotations import rpy_matrices, rpy_matrix
 from mount_twin.scene.description import DOF_NAMES, LinearMount, Scene
 
 
@@ -79,7 +79,7 @@ def assemble(scene: Scene) -> Model:
     inertia = np.array(body.inertia_tensor())
     cg = np.array(body.cg)
     mounts = scene.mounts
-    axes = np.array([rpy_matrix(*mt.orientation_rpy) for mt in mounts]).reshape(-1, 3, 3)
+    axes = rpy_matrices([mt.orientation_rpy for mt in mounts])
 
     lin = [i for i, mt in enumerate(mounts) if isinstance(mt, LinearMount)]
     other = [i for i, mt in enumerate(mounts) if not isinstance(mt, LinearMount)]

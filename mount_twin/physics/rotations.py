@@ -22,6 +22,11 @@ def rpy_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
     )
 
 
+def rpy_matrices(angles: list[tuple[float, float, float]]) -> np.ndarray:
+    """(n, 3, 3) `rpy_matrix` of each (roll, pitch, yaw), rad; (0, 3, 3) for none."""
+    return np.array([rpy_matrix(*a) for a in angles]).reshape(-1, 3, 3)
+
+
 def quaternion_from_matrix(rot: np.ndarray, out: np.ndarray) -> None:
     """Unit quaternion (x, y, z, w), w ≥ 0, of a rotation matrix (Shepperd's method)."""
     tr = rot[0, 0] + rot[1, 1] + rot[2, 2]

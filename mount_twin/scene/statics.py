@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mount_twin.kinds import KINDS
-from mount_twin.physics.rotations import rpy_matrix
+from mount_twin.physics.rotations import rpy_matrices
 from mount_twin.scene.description import DOF_NAMES, LinearMount, Mount, Scene
 
 RESOLVED = 1.0e-10
@@ -110,7 +110,7 @@ def statics(scene: Scene) -> Statics:
     mass = np.zeros((6, 6))
     mass[:3, :3] = body.mass * np.eye(3)
     mass[3:, 3:] = body.inertia_tensor()
-    axes = np.array([rpy_matrix(*m.orientation_rpy) for m in mounts])
+    axes = rpy_matrices([m.orientation_rpy for m in mounts])
     tangents = tuple(nominal_tangent(m) for m in mounts)
     k = np.array([t.stiffness for t in tangents])
     k_t = np.einsum("nij,nj,nkj->nik", axes, k[:, :3], axes)
