@@ -44,12 +44,11 @@ def main() -> None:
         unit = "°" if name == "yaw" else " ms" if name == "lag" else "×"
         print(f"  {name} {shown:.4g}{unit}", cal.refused.get(name, ""))
     print(f"{'run':<18} {'axes':<6} {'band':<8} {'before':>7} {'after':>7}")
-    lag = cal.values["lag"]
     for run, pair in pairs.items():
         for axes, label in ((slice(None), "xyz"), (slice(0, 1), "x")):
             for below, band in ((None, "all"), (10.0, "<10 Hz")):
-                before = prediction_error(scene, pair, 0.0, axes, below)
-                after = prediction_error(cal.scene, pair, lag, axes, below)
+                before = prediction_error(scene, pair, axes, below)
+                after = prediction_error(cal.scene, pair, axes, below)
                 print(f"{run:<18} {label:<6} {band:<8} {before:7.3f} {after:7.3f}")
 
 

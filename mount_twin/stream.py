@@ -9,9 +9,19 @@ from __future__ import annotations
 import numpy as np
 
 from mount_twin.engine.batch import HealthReport, OutputBatch
+from mount_twin.engine.body_check import BodyCheck, BodyComparison
 from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.intake import rotated
 from mount_twin.errors import require
-from mount_twin.io.messages import TimeBase, decode_inputs, encode_outputs, encode_report
+from mount_twin.io.messages import (
+    IMU,
+    Decoded,
+    TimeBase,
+    decode_inputs,
+    encode_body,
+    encode_outputs,
+    encode_report,
+)
 from mount_twin.model.assemble import assemble
 from mount_twin.scene.description import Scene
 
@@ -22,6 +32,9 @@ class TwinStream:
     Attributes:
         engine: the streaming engine (counts, state, health).
         last_outputs: the engine's last OutputBatch (for summaries and plots).
+        body: the body IMU's comparison with the twin (None: the scene has no body_sensor).
+        body_reports: the body comparison's window reports of the last call, as HealthReports
+            (for summaries).
     """
 
     def __init__(self, scene: Scene) -> None:
@@ -39,7 +52,15 @@ class TwinStream:
         self._tail_ns = np.zeros(0, np.int64)
         """Stamps (ns) of the last samples pushed that later outputs may answer
         (`TwinEngine.lookback`: the gyro delay, a sample held back), oldest first."""
+        self._tail_rate = np.zeros((0, 3))
+        """The foundation's rate (rad/s, F) of those samples."""
         self.final_report: HealthReport | None = None
+        sensor = scene.body_sensor
+        self.body = None if sensor is None else BodyCheck(scene, sensor)
+        self.body_reports: list[HealthReport] = []
+        self._body_waiting: list[Decoded] = []
+        """Body samples that came before the first foundation sample set the time base."""
+        self._body_last_ns = 0
 
     def process(self, raws: list[bytes]) -> list[tuple[str, int, bytes]]:
         """Outputs for raw input messages, as (unresolved topic, stamp ns, CDR bytes)."""
@@ -61,6 +82,7 @@ class TwinStream:
             decoded = decoded.select(decoded.stamps_ns > 0)
         if decoded.stamps_ns.shape[0]:
             self._received_ns = int(decoded.stamps_ns[-1])
+        self.body_reports = []
         if self.base is None:
             if not decoded.stamps_ns.shape[0]:
                 return []
@@ -72,8 +94,82 @@ class TwinStream:
         # negative samples: the earlier stamps appended find them (−1: the last one).
         stamps_ns = np.concatenate([decoded.stamps_ns, self._tail_ns])
         tail = np.concatenate([self._tail_ns, decoded.stamps_ns])
-        self._tail_ns = tail[tail.shape[0] - self.engine.lookback :]
-        return self._encode(out, stamps_ns)
+        keep = tail.shape[0] - self.engine.lookback
+        self._tail_ns = tail[keep:]
+        msgs = self._encode(out, stamps_ns)
+        if self.body is None:
+            return msgs
+        rate = self._foundation_rate(decoded)
+        rates = np.concatenate([rate, self._tail_rate])
+        self._tail_rate = np.concatenate([self._tail_rate, rate])[keep:]
+        rows = self.body.add_rows(out.stamps, out.pose, out.wrenches, rates[out.sample])
+        waiting, self._body_waiting = self._body_waiting, []
+        return msgs + self._encode_body(rows) + [m for d in waiting for m in self._body_in(d)]
+
+    def _foundation_rate(self, decoded: Decoded) -> np.ndarray:
+        """The foundation's rate Ω_F (rad/s, F) of each decoded sample: its gyro in F, or
+        zeros where the scene ignores it (input.gyro_filter: ignore)."""
+        if self.scene.input.gyro_filter == "ignore":
+            return np.zeros((decoded.stamps_ns.shape[0], 3))
+        return rotated(decoded.gyro, self.engine.model.sensor_rotation)
+
+    def process_body(self, raws: list[bytes]) -> list[tuple[str, int, bytes]]:
+        """The body IMU's raw messages (sensor_msgs/Imu): the prediction and residual at each
+        sample the twin has answered, and the windows judged (none without a body_sensor).
+        A message that cannot be compared is counted (BodyCheck.counts) and skipped: not
+        valid CDR, an unset or pre-1970 stamp, a stamp not after the last, a value not
+        finite, a header.frame_id other than body_sensor.frame_id."""
+        if self.body is None:
+            return []
+        self.body_reports = []
+        decoded = decode_inputs(raws, IMU)
+        counts = self.body.counts
+        counts["received"] += len(raws)
+        counts["rejected_undecodable"] += decoded.undecodable
+        keep = np.ones(decoded.stamps_ns.shape[0], bool)
+        expected = self.body.sensor.frame_id
+        reasons = {
+            "nonpositive_stamp": decoded.stamps_ns <= 0,
+            "nonfinite": ~np.isfinite(np.hstack([decoded.accel, decoded.gyro])).all(axis=1),
+            "wrong_frame_id": np.array(
+                [bool(expected) and f != expected for f in decoded.frame_ids], bool
+            ),
+        }
+        for reason, bad in reasons.items():
+            counts[f"rejected_{reason}"] += int((bad & keep).sum())
+            keep &= ~bad
+        # a stamp not after every accepted one before it (those rejected for going back are
+        # not after it either, so a running maximum over the others is the same)
+        stamps = np.where(keep, decoded.stamps_ns, 0)
+        before = np.maximum.accumulate(np.concatenate([[self._body_last_ns], stamps]))[:-1]
+        back = keep & (decoded.stamps_ns <= before)
+        counts["rejected_stamp_back"] += int(back.sum())
+        keep &= ~back
+        decoded = decoded.select(keep)
+        if not decoded.stamps_ns.shape[0]:
+            return []
+        self._body_last_ns = int(decoded.stamps_ns[-1])
+        if self.base is None:  # no foundation sample yet: the time base waits for it
+            self._body_waiting.append(decoded)
+            return []
+        return self._body_in(decoded)
+
+    def _body_in(self, decoded: Decoded) -> list[tuple[str, int, bytes]]:
+        """Accepted body samples into the comparison, on the twin's time base."""
+        assert self.body is not None and self.base is not None
+        measured = np.hstack([decoded.accel, decoded.gyro])
+        rows = self.body.add_body(
+            decoded.stamps_ns, self.base.seconds(decoded.stamps_ns), measured
+        )
+        return self._encode_body(rows)
+
+    def _encode_body(self, rows: BodyComparison) -> list[tuple[str, int, bytes]]:
+        """The comparison's messages; its reports kept in body_reports."""
+        reports = [
+            HealthReport(stamp_ns * 1e-9, -1, [status]) for stamp_ns, status in rows.reports
+        ]
+        self.body_reports += reports
+        return encode_body(self.scene, rows)
 
     def _encode(self, out: OutputBatch, stamps_ns: np.ndarray) -> list[tuple[str, int, bytes]]:
         """encode_outputs, keeping the last stamp answered."""
@@ -94,6 +190,15 @@ class TwinStream:
         out = self.engine.flush()
         reports, out.health = out.health, []
         msgs = self._encode(out, self._tail_ns)
+        self.body_reports = []
+        if self.body is not None:
+            rates = self._tail_rate[out.sample] if len(out) else np.zeros((0, 3))
+            msgs += self._encode_body(
+                self.body.add_rows(out.stamps, out.pose, out.wrenches, rates)
+            )
+            self.body.counts["unanswered"] += sum(len(d.stamps_ns) for d in self._body_waiting)
+            self._body_waiting = []
+            msgs += self._encode_body(self.body.finish())
         self._tail_ns = self._tail_ns[:0]
         self.last_outputs = out
         self.final_report = reports[0] if reports else None

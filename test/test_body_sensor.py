@@ -1,4 +1,4 @@
-"""The body IMU's predicted reading (`analysis.body_sensor`) against an independent formulation:
+"""The body IMU's predicted reading (`engine.sensor_reading`) against an independent formulation:
 on a foundation that translates without turning, a point of the body reads the input's specific
 force plus the second derivative of its own position in F (differentiated numerically from the
 published poses), whatever the body's rotation."""
@@ -11,7 +11,7 @@ import numpy as np
 from io_helpers import ROOT
 
 from mount_twin import SampleBatch, TwinEngine, assemble, load_scene_file
-from mount_twin.analysis.body_sensor import predicted_reading
+from mount_twin.engine.sensor_reading import predicted_reading
 from mount_twin.physics.rotations import quaternion_matrices, rpy_matrix
 from mount_twin.scene.description import BodySensor
 

@@ -190,6 +190,11 @@ EXTRA_VALUES = {
     "body_sensor.frame_id": "pump_imu",
     "body_sensor.position": [0.3, 0.1, 0.9],
     "body_sensor.orientation_rpy": [0.0, 0.0, 0.5],
+    "body_sensor.lag_s": 0.017,
+    "body_sensor.window_s": 30.0,
+    "body_sensor.band_hz": [0.5, 25.0],
+    "body_sensor.warn_nrms": 0.2,
+    "body_sensor.error_nrms": 0.5,
 }
 
 

@@ -1,7 +1,7 @@
 """Calibrate a scene on a recorded pair: the foundation's IMU in, the body's IMU out.
 
 The twin is the model: it runs on the foundation record, predicts what the body sensor reads
-(`analysis.body_sensor`), and `scipy.optimize.least_squares` moves the parameters a user cannot
+(`engine.sensor_reading`), and `scipy.optimize.least_squares` moves the parameters a user cannot
 read off a data sheet until the prediction matches the body record, in the time domain (the
 twin's non-linear mounts and the recorders' clocks live there; a lag is a phase that grows
 with frequency, which a time-domain fit takes as one number):
@@ -11,7 +11,7 @@ with frequency, which a time-domain fit takes as one number):
   only the mounts it names, so that groups (or single mounts) are fitted apart;
 - `yaw`: the body sensor's rotation about the body's z axis, added to its orientation_rpy, rad;
 - `lag`: the body recorder's clock behind the foundation's, s (its samples are the motion
-  `lag` seconds before their stamps).
+  `lag` seconds before their stamps), added to the scene's body_sensor.lag_s.
 
 Both signals are compared with their means taken out (gravity and the sensors' biases), each
 axis in units of the measured signal's spread. Each parameter's uncertainty (1σ) comes from the
@@ -30,10 +30,10 @@ from typing import cast
 
 import numpy as np
 
-from mount_twin.analysis.body_sensor import predicted_reading
 from mount_twin.analysis.response import followed
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.engine.intake import rotated
+from mount_twin.engine.sensor_reading import predicted_reading
 from mount_twin.io.signals import Signal
 from mount_twin.scene.description import BodySensor, LinearMount, Scene, Vec6
 
@@ -96,8 +96,8 @@ def scaled_mounts(name: str, scene: Scene) -> list[str]:
 
 def calibrated_scene(scene: Scene, values: dict[str, float]) -> Scene:
     """`scene` with its linear mounts' stiffness and damping scaled (every scale parameter in
-    `values` multiplies the mounts it names) and its body sensor yawed by `values` (missing
-    parameters: nominal)."""
+    `values` multiplies the mounts it names), its body sensor yawed and its lag lengthened by
+    `values` (missing parameters: nominal)."""
     names = [m.name for m in scene.mounts]
     factor = {(kind, m): 1.0 for kind in ("stiffness", "damping") for m in names}
     for name, value in values.items():
@@ -117,7 +117,9 @@ def calibrated_scene(scene: Scene, values: dict[str, float]) -> Scene:
     sensor = scene.body_sensor or BodySensor()
     roll, pitch, yaw = sensor.orientation_rpy
     yawed = dataclasses.replace(
-        sensor, orientation_rpy=(roll, pitch, yaw + values.get("yaw", 0.0))
+        sensor,
+        orientation_rpy=(roll, pitch, yaw + values.get("yaw", 0.0)),
+        lag_s=sensor.lag_s + values.get("lag", 0.0),
     )
     return dataclasses.replace(scene, mounts=mounts, body_sensor=yawed)
 
@@ -155,15 +157,14 @@ def nrms(predicted: np.ndarray, measured: np.ndarray) -> float:
 def prediction_error(
     scene: Scene,
     records: tuple[Signal, Signal],
-    lag_s: float = 0.0,
     axes: slice = slice(None),
     below_hz: float | None = None,
 ) -> float:
     """The body sensor's NRMS error (`nrms`) of the scene's twin on a (foundation, body) pair
-    of records, the body recorder `lag_s` late: over its `axes`, and with both signals
-    low-passed below `below_hz` (4th-order Butterworth, zero phase) where given."""
+    of records (the body recorder body_sensor.lag_s late): over its `axes`, and with both
+    signals low-passed below `below_hz` (4th-order Butterworth, zero phase) where given."""
     problem = _Problem(scene, records[0], records[1], [])
-    predicted = problem.predicted({"lag": lag_s})[:, axes]
+    predicted = problem.predicted({})[:, axes]
     measured = problem.measured[:, axes]
     if below_hz is not None:
         from scipy.signal import butter, sosfiltfilt
@@ -194,8 +195,10 @@ class _Problem:
 
     def predicted(self, values: dict[str, float]) -> np.ndarray:
         """The body sensor's prediction at the measured stamps."""
-        stamps, f = predict(calibrated_scene(self.scene, values), self.foundation)
-        return _at(stamps, f, self.t - values.get("lag", 0.0))
+        scene = calibrated_scene(self.scene, values)
+        stamps, f = predict(scene, self.foundation)
+        lag = scene.body_sensor.lag_s if scene.body_sensor else 0.0
+        return _at(stamps, f, self.t - lag)
 
     def residual(self, x: np.ndarray) -> np.ndarray:
         p = self.predicted(self.values(x))

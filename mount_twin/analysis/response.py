@@ -12,16 +12,17 @@ scene freezes is held by a constraint, not a mount: its axis is refused.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
 from mount_twin.engine.batch import OutputBatch, SampleBatch
 from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.sensor_reading import cg_specific_force
 from mount_twin.io.messages import WRENCHES_OUTPUT
 from mount_twin.io.output_tables import Table
 from mount_twin.model.assemble import Model, assemble
-from mount_twin.physics.rotations import rpy_matrices
 from mount_twin.scene.description import Scene
 
 CG = "cg"
@@ -61,10 +62,12 @@ def check_response(text: str, scene: Scene) -> str | None:
 
 
 def followed(scene: Scene, batch: SampleBatch, source: str) -> tuple[Model, OutputBatch]:
-    """The scene's model and its twin's outputs on a whole record in memory. A run whose
+    """The scene's model and its twin's outputs on a whole record in memory, a row for every
+    sample (whatever the scene's decimation: a response is simultaneous wrenches). A run whose
     integration failed, or that published fewer than 3 rows, is refused (ValueError naming
     `source`): its response is not the machine's."""
-    model = assemble(scene)
+    every_sample = dataclasses.replace(scene.outputs, decimation=1)  # peaks are not one instant
+    model = assemble(dataclasses.replace(scene, outputs=every_sample))
     engine = TwinEngine(model)
     out = engine.run(batch)
     if engine.failure_text or len(out) < 3:
@@ -72,13 +75,6 @@ def followed(scene: Scene, batch: SampleBatch, source: str) -> tuple[Model, Outp
         msg = f"{source}: the twin's run failed, its response is not the machine's: {why}"
         raise ValueError(msg)
     return model, out
-
-
-def cg_specific_force(scene: Scene, wrenches: np.ndarray) -> np.ndarray:
-    """(k, 3) specific force of the CG in F, m/s², from the scene's (k, n, 6) mount wrenches
-    (force on the body in each mount's axes first; the axes fixed in F)."""
-    axes = rpy_matrices([m.orientation_rpy for m in scene.mounts])
-    return np.einsum("nij,knj->ki", axes, wrenches[..., :3]) / scene.body.mass
 
 
 def response_of(scene: Scene, stamps_s: np.ndarray, wrenches: np.ndarray, text: str) -> Response:
@@ -98,6 +94,13 @@ def response_of(scene: Scene, stamps_s: np.ndarray, wrenches: np.ndarray, text: 
 def wrenches_of(tables: list[Table], scene: Scene, source: str) -> tuple[np.ndarray, np.ndarray]:
     """(stamps s, (k, n, 6) wrenches) from an output bag's tables (`io.output_tables`): every
     mount of the scene, on the same rows. Raises ValueError naming `source` otherwise."""
+    if scene.outputs.decimation > 1:
+        msg = (
+            f"{source}: written at outputs.decimation {scene.outputs.decimation}, its wrenches "
+            "are each component's peak over the interval, not one instant: give the input bag "
+            "(replayed at decimation 1)"
+        )
+        raise ValueError(msg)
     by_name = {t.name: t for t in tables}
     names = [str(WRENCHES_OUTPUT.table).format(mount=m.name) for m in scene.mounts]
     missing = [n for n in names if n not in by_name]

@@ -139,10 +139,10 @@ def _write_scene(source: str, out: Path, cal: Calibration, lines: list[str]) -> 
             raw["damping"] = list(mount.damping)  # type: ignore[union-attr]
     sensor = cal.scene.body_sensor
     if sensor is not None:
-        data.setdefault("body_sensor", {})["orientation_rpy"] = list(sensor.orientation_rpy)
+        written = data.setdefault("body_sensor", {})
+        written["orientation_rpy"] = list(sensor.orientation_rpy)
+        written["lag_s"] = sensor.lag_s
     head = [f"# calibrated from {source} by mount-twin calibrate", *(f"# {ln}" for ln in lines)]
-    head.append(f"# the body recorder's lag ({cal.values['lag'] * 1e3:.3g} ms) is the recorders',")
-    head.append("# not the machine's: it is not a scene value")
     text = "\n".join(head) + "\n" + yaml.safe_dump(data, sort_keys=False)
     out.write_text(text, encoding="utf-8")
 
@@ -158,10 +158,7 @@ def _plot(png: str, scene: Scene, cal: Calibration, foundation: Signal, body: Si
     from mount_twin.analysis.calibration import predict
 
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(10, 8))
-    shown = [
-        (scene, 0.0, "nominal", "tab:gray"),
-        (cal.scene, cal.values["lag"], "calibrated", "tab:red"),
-    ]
+    shown = [(scene, "nominal", "tab:gray"), (cal.scene, "calibrated", "tab:red")]
     for i, ax in enumerate(axes):
         ax.plot(
             body.t - body.t[0],
@@ -170,8 +167,9 @@ def _plot(png: str, scene: Scene, cal: Calibration, foundation: Signal, body: Si
             lw=1.0,
             label="measured",
         )
-        for sc, lag, label, colour in shown:
+        for sc, label, colour in shown:
             t, f = predict(sc, foundation)
+            lag = sc.body_sensor.lag_s if sc.body_sensor else 0.0
             p = CubicSpline(t, f[:, i])(body.t - lag)
             ax.plot(body.t - body.t[0], p - p.mean(), color=colour, lw=0.8, label=label)
         ax.set_ylabel(f"{'xyz'[i]} [m/s²]")

@@ -19,6 +19,7 @@ import numpy as np
 from rosbags.typesys import Stores, get_typestore
 
 from mount_twin.engine.batch import HealthReport, OutputBatch, SampleBatch
+from mount_twin.engine.body_check import BodyComparison
 from mount_twin.io.fixed_layout import FixedLayout
 from mount_twin.physics import pose_row
 from mount_twin.physics.rotations import quaternion_from_matrix, rpy_matrix
@@ -556,11 +557,49 @@ def diagnostics_message(report: HealthReport, stamp_ns: int) -> Any:
 
 
 def output_types(scene: Scene) -> dict[str, str]:
-    """Unresolved topic → message type for every output the scene enables (diagnostics first)."""
+    """Unresolved topic → message type for every output the scene enables (diagnostics first;
+    the body IMU's prediction and residual last, with a body_sensor)."""
+    body = {BODY_PREDICTED_TOPIC: IMU, BODY_RESIDUAL_TOPIC: IMU} if scene.body_sensor else {}
     return {
         DIAGNOSTICS_TOPIC: DIAGNOSTICS,
         **{st.topic: st.msgtype for st in output_streams(scene)},
+        **body,
     }
+
+
+BODY_PREDICTED_TOPIC = "~/body_imu/predicted"
+"""The twin's prediction of each body IMU sample (sensor_msgs/Imu, its stamp and axes)."""
+BODY_RESIDUAL_TOPIC = "~/body_imu/residual"
+"""The body IMU's sample minus the prediction (sensor_msgs/Imu, its stamp and axes)."""
+
+
+def body_frame_id(scene: Scene) -> str:
+    """The frame id of the body IMU's prediction and residual: its own, else <frames.body>_imu."""
+    sensor = scene.body_sensor
+    return (sensor.frame_id if sensor else "") or f"{scene.frames.body}_imu"
+
+
+def encode_body(scene: Scene, rows: BodyComparison) -> list[tuple[str, int, bytes]]:
+    """The body comparison as (unresolved topic, stamp ns, CDR bytes): per compared sample its
+    prediction and residual (stamped as the sample; linear_acceleration the specific force,
+    m/s², angular_velocity the rate, rad/s, in the sensor's axes; no orientation), then each
+    window's report on /diagnostics."""
+    frame = body_frame_id(scene)
+    msgs: list[tuple[str, int, bytes]] = []
+    if rows.stamps_ns.shape[0]:
+        pairs = zip(
+            imu_messages(rows.stamps_ns, rows.predicted[:, :3], rows.predicted[:, 3:], frame),
+            imu_messages(rows.stamps_ns, rows.residual[:, :3], rows.residual[:, 3:], frame),
+            strict=True,
+        )
+        for (stamp, predicted), (_, residual) in pairs:
+            msgs += [
+                (BODY_PREDICTED_TOPIC, stamp, predicted),
+                (BODY_RESIDUAL_TOPIC, stamp, residual),
+            ]
+    for stamp, status in rows.reports:
+        msgs.append(encode_report(scene, HealthReport(stamp * 1e-9, -1, [status]), stamp))
+    return msgs
 
 
 def mount_quaternion(orientation_rpy: Sequence[float]) -> np.ndarray:

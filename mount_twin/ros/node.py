@@ -47,6 +47,7 @@ from mount_twin.engine.batch import ERROR, OK, HealthReport, HealthStatus
 from mount_twin.errors import MountTwinError
 from mount_twin.io.messages import (
     DIAGNOSTICS_TOPIC,
+    IMU,
     TF,
     TF_STATIC_TOPIC,
     encode_report,
@@ -91,6 +92,7 @@ class MountTwinNode(Node):
         self._batched = self.options.batch_period_s > 0.0
         self._pending: list[bytes] = []
         self._sub = self._create_input()
+        self._body_sub = self._create_body_input()
         check_qos_overrides(self)
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         if self._batched:
@@ -110,6 +112,7 @@ class MountTwinNode(Node):
             f"{self._sub.qos_profile.reliability.name.lower()}, depth "
             f"{self.options.input_queue_depth}); "
             + (f"batches every {self.options.batch_period_s} s; " if self._batched else "")
+            + (f"body IMU {self._body_sub.topic_name}; " if self._body_sub else "")
             + "outputs "
             + ", ".join(p.topic_name for p in self._pubs.values())
         )
@@ -153,26 +156,46 @@ class MountTwinNode(Node):
         return pubs
 
     def _create_input(self) -> Subscription:
-        """The raw input subscription with its message-lost and type events: best effort (a
-        sensor stream), unless `qos_overrides.<topic>.subscription.reliability` (ROS 2's QoS
-        override parameter) says reliable, for a publisher whose every message must count."""
+        """The foundation IMU's raw subscription, with its message-lost and type events."""
+        events = SubscriptionEventCallbacks(
+            message_lost=self._on_lost, incompatible_type=self._on_incompatible_type
+        )
         spec = self.scene.input
+        return self._subscribe("input.topic", spec.topic, spec.msg_type, self._on_input, events)
+
+    def _create_body_input(self) -> Subscription | None:
+        """The body IMU's raw subscription (the scene's body_sensor; none without one)."""
+        sensor = self.scene.body_sensor
+        if sensor is None:
+            return None
+        events = SubscriptionEventCallbacks(message_lost=self._on_body_lost)
+        return self._subscribe("body_sensor.topic", sensor.topic, IMU, self._on_body, events)
+
+    def _subscribe(
+        self,
+        parameter: str,
+        topic: str,
+        msgtype: str,
+        callback: Callable[[bytes], None],
+        events: SubscriptionEventCallbacks,
+    ) -> Subscription:
+        """A raw input subscription: best effort (a sensor stream), keep last
+        input_queue_depth, unless `qos_overrides.<topic>.subscription.reliability` (ROS 2's
+        QoS override parameter) says reliable, for a publisher whose every message must count.
+        A topic name rclpy refuses names `parameter`."""
         qos = QoSProfile(
             depth=self.options.input_queue_depth,
             reliability=ReliabilityPolicy.BEST_EFFORT,
             history=HistoryPolicy.KEEP_LAST,
         )
-        events = SubscriptionEventCallbacks(
-            message_lost=self._on_lost, incompatible_type=self._on_incompatible_type
-        )
-        override = f"qos_overrides.{self.resolve_topic_name(spec.topic)}.subscription.reliability"
+        override = f"qos_overrides.{self.resolve_topic_name(topic)}.subscription.reliability"
         try:
             return self._named(
-                "input.topic",
+                parameter,
                 lambda: self.create_subscription(
-                    message_class(spec.msg_type),
-                    spec.topic,
-                    self._on_input,
+                    message_class(msgtype),
+                    topic,
+                    callback,
                     qos,
                     raw=True,
                     event_callbacks=events,
@@ -197,6 +220,10 @@ class MountTwinNode(Node):
             self._pending.extend(raws)
         else:
             self._process(raws)
+
+    def _on_body(self, raw: bytes) -> None:
+        assert self._body_sub is not None
+        self._publish(self.stream.process_body([raw, *take_waiting(self._body_sub, TAKE_LIMIT)]))
 
     def _drain(self) -> None:
         if self._pending:
@@ -228,6 +255,10 @@ class MountTwinNode(Node):
 
     def _on_lost(self, info: QoSMessageLostInfo) -> None:
         self.stream.engine.count("lost_middleware", int(info.total_count_change))
+
+    def _on_body_lost(self, info: QoSMessageLostInfo) -> None:
+        if self.stream.body is not None:
+            self.stream.body.counts["lost_middleware"] += int(info.total_count_change)
 
     def _on_incompatible_type(self, _info: object) -> None:
         self._problems["incompatible_type"] = (
@@ -271,6 +302,8 @@ class MountTwinNode(Node):
         has acknowledged it all; a topic still unacknowledged then is named in a warning."""
         self._pending.extend(take_waiting(self._sub, TAKE_LIMIT))
         self._drain()
+        if self._body_sub is not None:
+            self._publish(self.stream.process_body(take_waiting(self._body_sub, TAKE_LIMIT)))
         self._publish(self.stream.finish())
         deadline = time.monotonic() + SHUTDOWN_ACK_S
         unacked = [

@@ -70,6 +70,7 @@ def check_scene(
             (else it is a warning).
     """
     _check_compactness(scene)
+    _check_body_sensor(scene)
     st = statics(scene)
     _check_stiffness_limits(scene, st, mount_paths)
     if not st.finite:
@@ -86,6 +87,16 @@ def check_scene(
         *_geometry(scene, mount_paths),
         *_gravity_convention(scene),
     )
+
+
+def _check_body_sensor(scene: Scene) -> None:
+    if scene.body_sensor is not None and scene.outputs.decimation > 1:
+        raise SceneError(
+            scene.source,
+            "outputs.decimation",
+            f"{scene.outputs.decimation} with a body_sensor: its prediction needs every "
+            "sample's mount forces (decimated rows hold each component's peak), so 1",
+        )
 
 
 def _check_compactness(scene: Scene) -> None:

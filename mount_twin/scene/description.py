@@ -229,12 +229,24 @@ class BodySensor:
         position: its position at the reference pose, m, in F (as the mounts' are).
         orientation_rpy: its axes relative to the body frame B, fixed-axis roll, pitch, yaw,
             rad (B is parallel to F at the reference pose).
+        lag_s: its stamps behind the foundation IMU's, s: a sample stamped t measured the
+            motion at t − lag_s (the recorders' or drivers' latency; `calibrate` fits it).
+        window_s: the live comparison's window, s: its agreement is judged window by window.
+        band_hz: (low, high) Hz, the band the comparison is judged in (the mounting's modes
+            and below, `mount-twin modes`); the broadband figure is reported beside it.
+        warn_nrms, error_nrms: normalised RMS error (‖pred − meas‖ / ‖meas‖ in the band, per
+            axis, means out) past which the comparison WARNs, ERRORs.
     """
 
     topic: str = "/machine/imu"
     frame_id: str = ""
     position: Vec3 = (0.0, 0.0, 0.0)
     orientation_rpy: Vec3 = (0.0, 0.0, 0.0)
+    lag_s: float = 0.0
+    window_s: float = 10.0
+    band_hz: tuple[float, float] = (0.0, 10.0)
+    warn_nrms: float = 0.3
+    error_nrms: float = 0.6
 
 
 @dataclass(frozen=True)

@@ -384,6 +384,10 @@ def _outputs(r: Reader) -> Outputs:
     return spec
 
 
+MAX_SENSOR_LAG_S = 1.0
+"""A body IMU's lag beyond this (s) is a clock, not a latency: align the clocks."""
+
+
 def _body_sensor(r: Reader) -> BodySensor:
     d = BodySensor()
     sensor = BodySensor(
@@ -391,9 +395,24 @@ def _body_sensor(r: Reader) -> BodySensor:
         frame_id=_header_frame_id(r, "frame_id", d.frame_id),
         position=_position(r, "position", d.position),
         orientation_rpy=_angles(r, "orientation_rpy", d.orientation_rpy),
+        lag_s=r.number("lag_s", d.lag_s, lo=-MAX_SENSOR_LAG_S, hi=MAX_SENSOR_LAG_S),
+        window_s=r.number("window_s", d.window_s, lo=0.1, hi=3600.0),
+        band_hz=_band(r, "band_hz", d.band_hz),
+        warn_nrms=r.positive("warn_nrms", d.warn_nrms),
+        error_nrms=r.positive("error_nrms", d.error_nrms),
     )
+    if sensor.error_nrms < sensor.warn_nrms:
+        raise r.error("error_nrms", f"{sensor.error_nrms} is below warn_nrms {sensor.warn_nrms}")
     r.finish()
     return sensor
+
+
+def _band(r: Reader, key: str, default: tuple[float, float]) -> tuple[float, float]:
+    """A frequency band (low, high), Hz, 0 ≤ low < high."""
+    low, high = r.vector(key, 2, default, lo=0.0)
+    if high <= low:
+        raise r.error(key, f"[{low}, {high}]: expected low < high, Hz")
+    return low, high
 
 
 def _frames(r: Reader) -> Frames:

@@ -1,0 +1,126 @@
+"""How well the twin's body sensor prediction and the machine's body IMU agree over a window.
+
+Per axis (specific force fx, fy, fz in m/s², then rate wx, wy, wz in rad/s, the sensor's axes),
+with each signal's mean taken out (gravity, the sensor's biases: constant offsets the twin does
+not model), the normalised RMS error ‖pred − meas‖ / ‖meas‖:
+
+- in the scene's judged band (`body_sensor.band_hz`: the mounting's modes and below), from the
+  discrete Fourier transform of the window (Parseval: the band's share of both norms), and
+- broadband (every frequency the body IMU samples), reported beside it.
+
+An axis is judged only where the body moved in the band: its measured RMS there at least the
+axis floor (`FLOORS`, above a MEMS IMU's noise); elsewhere the ratio is noise over noise. The
+window's level is that of its worst judged axis against `warn_nrms` and `error_nrms`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mount_twin.engine.batch import ERROR, OK, WARN, HealthStatus
+from mount_twin.scene.description import BodySensor
+
+AXES = ("fx", "fy", "fz", "wx", "wy", "wz")
+"""The compared axes: specific force (m/s²), then angular rate (rad/s), in the sensor's axes."""
+FLOORS = np.array([0.05, 0.05, 0.05, 0.005, 0.005, 0.005])
+"""Smallest measured RMS in the band (m/s², rad/s) of an axis that is judged."""
+MIN_SAMPLES = 16
+"""Fewest compared samples a window needs to be judged (a shorter last window is not)."""
+NAME = "mount_twin: body sensor"
+
+
+@dataclass(frozen=True)
+class Agreement:
+    """A window's figures, one per axis (`AXES`).
+
+    Attributes:
+        nrms_band: normalised RMS error in the judged band.
+        nrms_broadband: normalised RMS error at every frequency.
+        rms_band: the measured signal's RMS in the band (m/s², rad/s).
+        judged: the axis moved enough in the band to be judged (`FLOORS`).
+    """
+
+    nrms_band: np.ndarray
+    nrms_broadband: np.ndarray
+    rms_band: np.ndarray
+    judged: np.ndarray
+
+    @property
+    def worst(self) -> tuple[float, str]:
+        """The largest in-band NRMS of a judged axis and its name ((nan, "") if none is)."""
+        if not self.judged.any():
+            return float("nan"), ""
+        i = int(np.argmax(np.where(self.judged, self.nrms_band, -np.inf)))
+        return float(self.nrms_band[i]), AXES[i]
+
+
+def _ratio(num: np.ndarray, den: np.ndarray) -> np.ndarray:
+    """√(num/den) per axis; inf where den is 0 but num is not, 0 where both are."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(
+            den > 0, np.sqrt(num / np.where(den > 0, den, 1.0)), np.where(num > 0, np.inf, 0.0)
+        )
+
+
+def agreement(
+    t: np.ndarray, measured: np.ndarray, residual: np.ndarray, band_hz: tuple[float, float]
+) -> Agreement:
+    """The figures of k compared samples at stamps `t` (s, increasing, k ≥ 2): `measured` and
+    `residual` (measured − predicted), each (k, 6). The frequencies are those of the mean
+    sampling interval (a body IMU's stamps jitter; its samples are taken as uniform)."""
+    k = t.shape[0]
+    x = measured - measured.mean(axis=0)
+    r = residual - residual.mean(axis=0)
+    dt = float(t[-1] - t[0]) / (k - 1)
+    freq = np.fft.rfftfreq(k, dt)
+    in_band = (freq >= band_hz[0]) & (freq <= band_hz[1]) & (freq > 0)
+    px = np.abs(np.fft.rfft(x, axis=0)) ** 2
+    pr = np.abs(np.fft.rfft(r, axis=0)) ** 2
+    x_band = px[in_band].sum(axis=0)
+    return Agreement(
+        nrms_band=_ratio(pr[in_band].sum(axis=0), x_band),
+        nrms_broadband=_ratio((r**2).sum(axis=0), (x**2).sum(axis=0)),
+        rms_band=np.sqrt(2.0 * x_band) / k,
+        judged=np.sqrt(2.0 * x_band) / k >= FLOORS,
+    )
+
+
+def window_status(
+    figures: Agreement, sensor: BodySensor, span: tuple[float, int], problems: dict[str, int]
+) -> HealthStatus:
+    """The window's diagnostics status: `span` is its (seconds, compared samples), `problems`
+    the body messages counted against it (rejected or not compared, by reason)."""
+    low, high = sensor.band_hz
+    band = f"{low:g}–{high:g} Hz"
+    worst, axis = figures.worst
+    if not axis:
+        level = OK
+        message = f"the body moved too little in {band} to judge (measured RMS below the floors)"
+    else:
+        level = ERROR if worst > sensor.error_nrms else WARN if worst > sensor.warn_nrms else OK
+        verb = "agree" if level == OK else "disagree"
+        limit = {
+            OK: "",
+            WARN: f" > warn {sensor.warn_nrms:g}",
+            ERROR: f" > error {sensor.error_nrms:g}",
+        }
+        message = (
+            f"model and machine {verb} in {band}: worst normalised RMS error {worst:.3f} "
+            f"({axis}){limit[level]} over {span[0]:.1f} s"
+        )
+    bad = {k: v for k, v in problems.items() if v}
+    if bad:
+        level = max(level, WARN)
+        message += "; body messages not compared: " + ", ".join(f"{k} {v}" for k, v in bad.items())
+    values = {"band_hz": f"{low:g} {high:g}", "span_s": f"{span[0]:.3f}", "samples": str(span[1])}
+    values["lag_s"] = f"{sensor.lag_s:.6g}"
+    for i, name in enumerate(AXES):
+        values[f"nrms_{name}"] = (
+            f"{figures.nrms_band[i]:.4g}" if figures.judged[i] else "not judged"
+        )
+        values[f"nrms_broadband_{name}"] = f"{figures.nrms_broadband[i]:.4g}"
+        values[f"rms_{name}"] = f"{figures.rms_band[i]:.4g}"
+    values.update({f"body_{k}": str(v) for k, v in problems.items()})
+    return HealthStatus(NAME, level, message, values)

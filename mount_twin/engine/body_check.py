@@ -1,0 +1,340 @@
+"""The machine's body IMU against the twin, as a stream: at each body sample the twin's
+prediction of that sample and the residual, and window by window how well they agree.
+
+Three stages, each fed in stamp order; each gives the same numbers however its input comes
+batched, and whichever of the two streams comes first (live = replay), within `RETAIN_S`:
+
+1. `_Lead` predicts the body sensor at the twin's rows (`sensor_reading.predicted_reading`).
+   Its rates and angular acceleration are central differences, so a row is predicted once the
+   two rows after it are published (the run's first and last rows by one-sided differences):
+   the prediction trails the twin by two rows.
+2. `_Matcher`: a body sample stamped s measured the motion at s − lag_s; the prediction there
+   is interpolated linearly between the rows around it, once a row at or past it exists. A
+   sample before the twin's first row, more than `RETAIN_S` behind the prediction, or between
+   rows farther apart than input.max_gap_s (a gap, a restart) is counted and not compared.
+3. `_Windows` judges the compared samples in windows of body_sensor.window_s of stamps
+   (`agreement`), on a grid from the first compared sample; the last, partial window at the
+   end of the stream if it holds `agreement.MIN_SAMPLES`.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from mount_twin.engine.agreement import MIN_SAMPLES, agreement, window_status
+from mount_twin.engine.batch import HealthStatus
+from mount_twin.engine.sensor_reading import predicted_reading
+from mount_twin.physics import pose_row
+from mount_twin.scene.description import BodySensor, Scene
+
+RETAIN_S = 60.0
+"""Predictions are kept this long (s of stamps) behind the newest for body samples still to
+come (once body samples flow, only from the last one compared on): a body stream that trails
+the foundation's by more loses those samples (counted `late`)."""
+PENDING_LIMIT = 100_000
+"""Most body samples held waiting for the twin (a twin that stopped): the oldest go first."""
+PROBLEMS = ("before_twin", "late", "in_gap", "unanswered", "dropped_waiting", "lost_middleware")
+"""Why a body sample accepted was not compared: before the twin's first row, behind the kept
+predictions, inside a gap of the twin's rows, after its last row, or held too long."""
+
+
+@dataclass
+class _Rows:
+    """Published rows of the twin: stamps (s), pose rows, (k, n, 6) wrenches, the
+    foundation's rate Ω_F at each (rad/s, F)."""
+
+    t: np.ndarray
+    pose: np.ndarray
+    wrenches: np.ndarray
+    rate: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.t.shape[0])
+
+    def then(self, later: _Rows) -> _Rows:
+        return _Rows(
+            np.concatenate([self.t, later.t]),
+            np.concatenate([self.pose, later.pose]),
+            np.concatenate([self.wrenches, later.wrenches]),
+            np.concatenate([self.rate, later.rate]),
+        )
+
+    def tail(self, n: int) -> _Rows:
+        """The last n rows (copies: the engine reuses its buffers)."""
+        k = len(self) - n
+        return _Rows(
+            self.t[k:].copy(), self.pose[k:].copy(), self.wrenches[k:].copy(), self.rate[k:].copy()
+        )
+
+
+Predict = Callable[[_Rows], np.ndarray]
+_NO_PREDICTION = (np.zeros(0), np.zeros((0, 6)))
+
+
+class _Lead:
+    """Predictions of rows as soon as their difference stencils are whole (two rows on)."""
+
+    HELD = 4
+    """Rows kept for the next batch's stencils: two predicted already, two not yet."""
+
+    def __init__(self, predict: Predict) -> None:
+        self._predict = predict
+        self._held: _Rows | None = None
+        self._at_start = True
+
+    def add(self, rows: _Rows) -> tuple[np.ndarray, np.ndarray]:
+        """(stamps s, (k, 6) predictions) of the rows that `rows` completes."""
+        window = rows.tail(len(rows)) if self._held is None else self._held.then(rows)
+        n = len(window)
+        if n < self.HELD + 1:
+            self._held = window
+            return _NO_PREDICTION
+        first = 0 if self._at_start else 2
+        values = self._predict(window)
+        self._held, self._at_start = window.tail(self.HELD), False
+        return window.t[first : n - 2], values[first : n - 2]
+
+    def finish(self) -> tuple[np.ndarray, np.ndarray]:
+        """The rows still held, the last by one-sided differences (fewer than 3 rows in the
+        whole run: none)."""
+        window, self._held = self._held, None
+        if window is None or len(window) < 3:
+            return _NO_PREDICTION
+        first = 0 if self._at_start else 2
+        return window.t[first:], self._predict(window)[first:]
+
+
+class _Series:
+    """A growing (stamps, (k, 6) values) series whose oldest part is dropped in place."""
+
+    def __init__(self) -> None:
+        self._t = np.zeros(1024)
+        self._v = np.zeros((1024, 6))
+        self._start = self._end = 0
+
+    @property
+    def t(self) -> np.ndarray:
+        return self._t[self._start : self._end]
+
+    @property
+    def v(self) -> np.ndarray:
+        return self._v[self._start : self._end]
+
+    def append(self, t: np.ndarray, v: np.ndarray) -> None:
+        k = t.shape[0]
+        if self._end + k > self._t.shape[0]:
+            n = self._end - self._start
+            size = max(2 * (n + k), 1024)
+            self._t = np.concatenate([self.t, np.zeros(size - n)])
+            self._v = np.concatenate([self.v, np.zeros((size - n, 6))])
+            self._start, self._end = 0, n
+        self._t[self._end : self._end + k], self._v[self._end : self._end + k] = t, v
+        self._end += k
+
+    def drop_before(self, i: int) -> None:
+        """Drop the first i entries."""
+        self._start += i
+
+
+class _Matcher:
+    """Body samples matched to the prediction at the motion they measured."""
+
+    def __init__(self, lag_s: float, max_gap_s: float, problems: Counter[str]) -> None:
+        self._lag, self._max_gap, self._problems = lag_s, max_gap_s, problems
+        self._pred = _Series()
+        self._first: float | None = None
+        self._body: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        """Waiting body samples: (stamps ns, stamps s, measured (k, 6)) chunks."""
+
+    def add_predictions(self, t: np.ndarray, v: np.ndarray) -> None:
+        if t.shape[0]:
+            self._first = float(t[0]) if self._first is None else self._first
+            self._pred.append(t, v)
+
+    def add_body(self, ns: np.ndarray, t: np.ndarray, v: np.ndarray) -> None:
+        self._body.append((ns, t, v))
+        waiting = sum(c[0].shape[0] for c in self._body)
+        if waiting > PENDING_LIMIT:
+            ns, t, v = (np.concatenate(a) for a in zip(*self._body, strict=True))
+            cut = waiting - PENDING_LIMIT
+            self._problems["dropped_waiting"] += cut
+            self._body = [(ns[cut:], t[cut:], v[cut:])]
+
+    def take(self, final: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(stamps ns, stamps s, measured, predicted) of the body samples the prediction now
+        covers (`final`: the end of the stream, the rest are counted unanswered)."""
+        pt, pv = self._pred.t, self._pred.v
+        if not self._body or self._first is None:
+            if final:
+                self._problems["unanswered"] += sum(c[0].shape[0] for c in self._body)
+                self._body = []
+            self._trim(None)
+            return np.zeros(0, np.int64), np.zeros(0), np.zeros((0, 6)), np.zeros((0, 6))
+        ns, t, v = (np.concatenate(a) for a in zip(*self._body, strict=True))
+        ready = t - self._lag <= pt[-1]
+        self._body = [] if final else [(ns[~ready], t[~ready], v[~ready])]
+        self._problems["unanswered"] += int((~ready).sum()) if final else 0
+        ns, t, v = ns[ready], t[ready], v[ready]
+        tau = t - self._lag
+        before = tau < self._first
+        late = ~before & (tau < pt[0])
+        self._problems["before_twin"] += int(before.sum())
+        self._problems["late"] += int(late.sum())
+        keep = ~(before | late)
+        ns, t, tau, v = ns[keep], t[keep], tau[keep], v[keep]
+        j = np.clip(np.searchsorted(pt, tau, side="right"), 1, max(pt.shape[0] - 1, 1))
+        if pt.shape[0] == 1:  # one prediction: only a sample exactly at it
+            pred = np.repeat(pv, tau.shape[0], axis=0)
+            gap = np.zeros(tau.shape[0], bool)
+        else:
+            t0, t1 = pt[j - 1], pt[j]
+            w = ((tau - t0) / (t1 - t0))[:, None]
+            pred = (1.0 - w) * pv[j - 1] + w * pv[j]  # at a row exactly its value, either side
+            gap = (t1 - t0) > self._max_gap
+        self._problems["in_gap"] += int(gap.sum())
+        self._trim(float(tau[-1]) if tau.shape[0] else None)
+        return ns[~gap], t[~gap], v[~gap], pred[~gap]
+
+    def _trim(self, last_tau: float | None) -> None:
+        """Drop the predictions no future body sample needs: those before the one at or
+        before the last sample compared, and those more than RETAIN_S behind the newest."""
+        pt = self._pred.t
+        if not pt.shape[0]:
+            return
+        cut = int(np.searchsorted(pt, pt[-1] - RETAIN_S, side="left"))
+        if last_tau is not None:
+            cut = max(cut, int(np.searchsorted(pt, last_tau, side="right")) - 1)
+        self._pred.drop_before(min(cut, pt.shape[0] - 1))
+
+
+@dataclass
+class _Window:
+    """Compared samples of the window being filled: chunks of (stamps ns, seconds,
+    measured, residual)."""
+
+    index: int
+    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
+
+
+class _Windows:
+    """The agreement of compared samples, window by window of body stamps."""
+
+    def __init__(self, sensor: BodySensor, problems: Counter[str]) -> None:
+        self._sensor, self._problems = sensor, problems
+        self._origin: float | None = None
+        self._window: _Window | None = None
+        self._reported: Counter[str] = Counter()
+
+    def add(
+        self, ns: np.ndarray, t: np.ndarray, measured: np.ndarray, residual: np.ndarray
+    ) -> list[tuple[int, HealthStatus]]:
+        """Reports (stamp ns, status) of the windows these samples close."""
+        if not t.shape[0]:
+            return []
+        self._origin = float(t[0]) if self._origin is None else self._origin
+        index = np.floor((t - self._origin) / self._sensor.window_s).astype(np.int64)
+        reports = []
+        for i in np.unique(index).tolist():
+            part = index == i
+            if self._window is not None and self._window.index != i:
+                reports += self._close()
+            if self._window is None:
+                self._window = _Window(i, [])
+            self._window.chunks.append((ns[part], t[part], measured[part], residual[part]))
+        return reports
+
+    def finish(self) -> list[tuple[int, HealthStatus]]:
+        """The last, partial window's report, if it holds enough samples."""
+        return self._close(final=True)
+
+    def _close(self, final: bool = False) -> list[tuple[int, HealthStatus]]:
+        window, self._window = self._window, None
+        if window is None:
+            return []
+        ns, t, measured, residual = (np.concatenate(a) for a in zip(*window.chunks, strict=True))
+        if t.shape[0] < MIN_SAMPLES:
+            return []
+        problems = {
+            k: self._problems[k] - self._reported[k]
+            for k in self._problems
+            if k in PROBLEMS or k.startswith("rejected_")
+        }
+        self._reported = Counter(self._problems)
+        figures = agreement(t, measured, residual, self._sensor.band_hz)
+        span = (float(t[-1] - t[0]), int(t.shape[0]))
+        status = window_status(figures, self._sensor, span, problems)
+        if final:
+            status.message += " (the last window, closed by the end of the stream)"
+        return [(int(ns[-1]), status)]
+
+
+@dataclass
+class BodyComparison:
+    """The body IMU's samples compared, and the windows judged.
+
+    Attributes:
+        stamps_ns: (k,) the compared body samples' header stamps, ns.
+        predicted: (k, 6) the twin's prediction: specific force (m/s²), rate (rad/s), in the
+            sensor's axes.
+        residual: (k, 6) measured − predicted.
+        reports: (stamp ns, status) of each window closed.
+    """
+
+    stamps_ns: np.ndarray
+    predicted: np.ndarray
+    residual: np.ndarray
+    reports: list[tuple[int, HealthStatus]]
+
+
+class BodyCheck:
+    """The body IMU against the twin (module docstring).
+
+    Attributes:
+        counts: body messages received and accepted, and why others were not compared
+            (`PROBLEMS`; the stream counts its rejections here too, as rejected_<reason>).
+    """
+
+    def __init__(self, scene: Scene, sensor: BodySensor) -> None:
+        self.sensor = sensor
+        self.counts: Counter[str] = Counter()
+
+        def predict(rows: _Rows) -> np.ndarray:
+            pose = (rows.pose[:, pose_row.POSITION_COLS], rows.pose[:, pose_row.QUATERNION_COLS])
+            f, w = predicted_reading(scene, sensor, rows.t, pose, rows.wrenches, rows.rate)
+            return np.hstack([f, w])
+
+        self._lead = _Lead(predict)
+        self._matcher = _Matcher(sensor.lag_s, scene.input.max_gap_s, self.counts)
+        self._windows = _Windows(sensor, self.counts)
+
+    def add_rows(
+        self, t: np.ndarray, pose: np.ndarray, wrenches: np.ndarray, rate: np.ndarray
+    ) -> BodyComparison:
+        """The twin's published rows: stamps (s), pose rows, wrenches and the foundation's
+        rate (rad/s, F) at each."""
+        self._matcher.add_predictions(*self._lead.add(_Rows(t, pose, wrenches, rate)))
+        return self._compared()
+
+    def add_body(self, ns: np.ndarray, t: np.ndarray, measured: np.ndarray) -> BodyComparison:
+        """Accepted body samples: stamps (ns and s on the twin's base), (k, 6) readings."""
+        self.counts["accepted"] += int(ns.shape[0])
+        self._matcher.add_body(ns, t, measured)
+        return self._compared()
+
+    def finish(self) -> BodyComparison:
+        """The end of both streams: the last rows predicted, every sample left compared or
+        counted, the last window judged."""
+        self._matcher.add_predictions(*self._lead.finish())
+        out = self._compared(final=True)
+        out.reports += self._windows.finish()
+        return out
+
+    def _compared(self, final: bool = False) -> BodyComparison:
+        ns, t, measured, predicted = self._matcher.take(final)
+        residual = measured - predicted
+        reports = self._windows.add(ns, t, measured, residual)
+        return BodyComparison(ns, predicted, residual, reports)

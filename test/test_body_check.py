@@ -1,0 +1,256 @@
+"""The body IMU against the twin, live (`engine.body_check` through `TwinStream`): the stream's
+prediction is the whole record's (`engine.sensor_reading`, checked against independent
+kinematics in test_body_sensor.py) at every body sample, to the bit however the two streams
+come batched or interleaved; the agreement windows pass an unchanged machine and flag a
+softened one; the body recorder's lag is taken out; bad body messages are counted and
+skipped."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+from io_helpers import SCENE_FILE
+from scipy.signal import butter, sosfiltfilt
+
+from mount_twin import load_scene_file
+from mount_twin.analysis.calibration import calibrated_scene
+from mount_twin.analysis.response import followed
+from mount_twin.engine.agreement import NAME
+from mount_twin.engine.batch import ERROR, OK, WARN, SampleBatch
+from mount_twin.engine.intake import rotated
+from mount_twin.engine.sensor_reading import predicted_reading
+from mount_twin.errors import SceneError
+from mount_twin.io.messages import (
+    BODY_PREDICTED_TOPIC,
+    BODY_RESIDUAL_TOPIC,
+    DIAGNOSTICS,
+    DIAGNOSTICS_TOPIC,
+    IMU,
+    TYPESTORE,
+    TimeBase,
+    imu_messages,
+)
+from mount_twin.io.signals import Signal, ship_motion
+from mount_twin.scene.description import BodySensor, Scene
+from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
+from mount_twin.stream import TwinStream
+
+RATE = 200.0
+NS0 = 1_700_000_000_250_000_000
+Messages = list[tuple[str, int, bytes]]
+
+
+def _pump(**sensor: object) -> Scene:
+    scene = load_scene_file(SCENE_FILE)
+    body = BodySensor(position=(0.8, 0.3, 1.0), window_s=5.0, **sensor)  # type: ignore[arg-type]
+    return dataclasses.replace(
+        scene, body_sensor=body, input=dataclasses.replace(scene.input, gyro_filter="none")
+    )
+
+
+def _deck(total: float = 20.0) -> Signal:
+    """Ship motion with the machinery's broadband vibration (1-40 Hz, 0.3 m/s² RMS)."""
+    sea = ship_motion(rate_hz=RATE, total=total)
+    sos = butter(4, [1.0, 40.0], btype="band", fs=RATE, output="sos")
+    vib = sosfiltfilt(sos, np.random.default_rng(5).normal(0, 1, sea.accel.shape), axis=0)
+    return Signal(sea.t, sea.accel + 0.3 * vib / vib.std(axis=0), sea.gyro)
+
+
+def _stamps(deck: Signal) -> np.ndarray:
+    return NS0 + np.round(deck.t * 1e9).astype(np.int64)
+
+
+def _whole_record(scene: Scene, deck: Signal) -> tuple[np.ndarray, np.ndarray]:
+    """(row stamps s, (k, 6) prediction) of the scene's twin on the whole deck record at once,
+    its stamps on the stream's time base."""
+    frames = [scene.input.frame_id] * deck.t.shape[0]
+    t = TimeBase.at(NS0).seconds(_stamps(deck))
+    model, out = followed(scene, SampleBatch(t, deck.accel, deck.gyro, frames), "deck")
+    rate = rotated(deck.gyro, model.sensor_rotation)
+    assert scene.body_sensor is not None
+    pose = (out.position, out.quaternion)
+    f, w = predicted_reading(scene, scene.body_sensor, out.stamps, pose, out.wrenches, rate)
+    return out.stamps, np.hstack([f, w])
+
+
+def _body_raws(stamps_ns: np.ndarray, values: np.ndarray, frame: str = "") -> list[bytes]:
+    return [r for _, r in imu_messages(stamps_ns, values[:, :3], values[:, 3:], frame)]
+
+
+def _interleaved(
+    scene: Scene, deck_raws: list[bytes], deck_ns: np.ndarray, body: tuple[list[bytes], np.ndarray]
+) -> Messages:
+    """Message by message, each body sample once the deck sample at or after its stamp went."""
+    stream, out, j = TwinStream(scene), [], 0
+    for raw, ns in zip(deck_raws, deck_ns.tolist(), strict=True):
+        out += stream.process([raw])
+        while j < len(body[0]) and body[1][j] <= ns:
+            out += stream.process_body([body[0][j]])
+            j += 1
+    return out + stream.process_body(body[0][j:]) + stream.finish()
+
+
+def _chunked(
+    scene: Scene, deck_raws: list[bytes], body_raws: list[bytes], size: int, body_first: bool
+) -> Messages:
+    """In chunks of `size` of each stream, the body's chunk before or after the deck's."""
+    stream, out = TwinStream(scene), []
+    for i in range(0, max(len(deck_raws), len(body_raws)), size):
+        steps: list[Callable[[], Messages]] = [
+            lambda i=i: stream.process(deck_raws[i : i + size]),
+            lambda i=i: stream.process_body(body_raws[i : i + size]),
+        ]
+        for step in reversed(steps) if body_first else steps:
+            out += step()
+    return out + stream.finish()
+
+
+def _imu_values(out: Messages, topic: str) -> tuple[np.ndarray, np.ndarray]:
+    msgs = [TYPESTORE.deserialize_cdr(raw, IMU) for t, _, raw in out if t == topic]
+    stamps = np.array([m.header.stamp.sec * 10**9 + m.header.stamp.nanosec for m in msgs])
+    values = [
+        [getattr(v, a) for v in (m.linear_acceleration, m.angular_velocity) for a in "xyz"]
+        for m in msgs
+    ]
+    return stamps, np.array(values).reshape(-1, 6)
+
+
+def _windows(out: Messages) -> list[tuple[int, str, dict[str, str]]]:
+    """(level, message, values) of each body sensor status on /diagnostics."""
+    found = []
+    for topic, _, raw in out:
+        if topic == DIAGNOSTICS_TOPIC:
+            for s in TYPESTORE.deserialize_cdr(raw, DIAGNOSTICS).status:
+                if s.name == NAME:
+                    found.append((s.level, s.message, {kv.key: kv.value for kv in s.values}))
+    return found
+
+
+def _deck_raws(scene: Scene, deck: Signal) -> list[bytes]:
+    return [r for _, r in imu_messages(_stamps(deck), deck.accel, deck.gyro, "deck_imu")]
+
+
+def test_the_live_prediction_is_the_whole_records_at_every_body_sample() -> None:
+    """A body IMU sampled at the deck's stamps: each sample's prediction is, to the bit, the
+    whole record's at that row (the first and last rows by one-sided differences), and its
+    residual the sample minus it."""
+    scene, deck = _pump(), _deck(6.0)
+    _, whole = _whole_record(scene, deck)
+    ns = _stamps(deck)
+    measured = whole + np.random.default_rng(2).normal(0.0, 0.01, whole.shape)
+    out = _interleaved(scene, _deck_raws(scene, deck), ns, (_body_raws(ns, measured), ns))
+    got_ns, predicted = _imu_values(out, BODY_PREDICTED_TOPIC)
+    _, residual = _imu_values(out, BODY_RESIDUAL_TOPIC)
+    assert np.array_equal(got_ns, ns)
+    assert np.array_equal(predicted, whole)
+    assert np.array_equal(residual, measured - whole)
+
+
+def test_batching_and_interleaving_do_not_change_a_bit() -> None:
+    """Every body message (prediction, residual, window report) is the same bytes whether the
+    two streams come message by message, or in chunks with the body's first or last."""
+    scene, deck = _pump(), _deck(12.0)
+    t, whole = _whole_record(scene, deck)
+    ns = _stamps(deck)[::2] + 1_234_567  # a slower body IMU, between the deck's samples
+    measured = np.stack([np.interp(TimeBase.at(NS0).seconds(ns), t, v) for v in whole.T], 1)
+    body = _body_raws(ns, measured)
+    deck_raws = _deck_raws(scene, deck)
+    runs = [
+        _interleaved(scene, deck_raws, _stamps(deck), (body, ns)),
+        _chunked(scene, deck_raws, body, 700, body_first=True),
+        _chunked(scene, deck_raws, body, 333, body_first=False),
+    ]
+    kept = [[m for m in run if m[0] != DIAGNOSTICS_TOPIC or NAME.encode() in m[2]] for run in runs]
+    body_msgs = [
+        [m for m in k if m[0] in (BODY_PREDICTED_TOPIC, BODY_RESIDUAL_TOPIC)] for k in kept
+    ]
+    assert len(body_msgs[0]) == 2 * ns.shape[0]
+    assert body_msgs[1] == body_msgs[0] and body_msgs[2] == body_msgs[0]
+    reports = [sorted(m for m in k if m[0] == DIAGNOSTICS_TOPIC) for k in kept]
+    assert len(reports[0]) == 3 and reports[1] == reports[0] and reports[2] == reports[0]
+
+
+def _judged(scene: Scene, machine: Scene, deck: Signal, lag_s: float = 0.0) -> Messages:
+    """The stream of `scene` compared with a body IMU on `machine` (the same twin with its
+    changes) recorded `lag_s` late, with a MEMS IMU's noise (0.01 m/s², 0.001 rad/s)."""
+    t, truth = _whole_record(machine, deck)
+    ns = _stamps(deck)[20:]
+    motion_t = TimeBase.at(NS0).seconds(ns) - lag_s
+    measured = np.stack([np.interp(motion_t, t, v) for v in truth.T], 1)
+    rng = np.random.default_rng(3)
+    measured += np.hstack(
+        [rng.normal(0, 0.01, (ns.shape[0], 3)), rng.normal(0, 1e-3, (ns.shape[0], 3))]
+    )
+    return _chunked(scene, _deck_raws(scene, deck), _body_raws(ns, measured), 500, False)
+
+
+def test_an_unchanged_machine_agrees_and_one_on_softened_mounts_is_an_error() -> None:
+    """20 s of ship motion with machinery vibration, windows of 5 s: the machine the scene
+    describes agrees in every window (worst NRMS in 0-10 Hz below 0.1); the same machine with
+    every mount at 0.7× stiffness is an ERROR in every window."""
+    scene, deck = _pump(), _deck()
+    same = _windows(_judged(scene, scene, deck))
+    softened = _windows(_judged(scene, calibrated_scene(scene, {"stiffness": 0.7}), deck))
+    assert len(same) == len(softened) == 4
+    for level, message, values in same:
+        assert level == OK, message
+        judged = [float(v) for k, v in values.items() if k.startswith("nrms_f")]
+        assert judged and max(judged) < 0.1, values
+    assert all(level == ERROR and "disagree" in message for level, message, _ in softened)
+
+
+def test_the_body_recorders_lag_is_taken_out() -> None:
+    """A body IMU 12 ms late (2.4 samples): compared as if on time, the unchanged machine
+    WARNs or ERRs; with body_sensor.lag_s 0.012 it agrees as well as one on time."""
+    deck, machine = _deck(), _pump()
+    late = [_windows(_judged(_pump(lag_s=lag), machine, deck, 0.012)) for lag in (0.0, 0.012)]
+    worst = [max(float(v[f"nrms_{a}"]) for _, _, v in w for a in ("fx", "fy", "fz")) for w in late]
+    assert any(level >= WARN for level, _, _ in late[0])
+    assert all(level == OK for level, _, _ in late[1])
+    assert worst[1] < 0.1 < worst[0]
+
+
+def test_bad_body_messages_are_counted_skipped_and_reported() -> None:
+    """Garbage, NaN, an unset stamp, a stamp going back and another frame_id: each counted under
+    its reason, the window WARNs naming them, and every good sample is still compared."""
+    scene, deck = _pump(frame_id="pump_imu"), _deck(6.0)
+    _, whole = _whole_record(scene, deck)
+    ns = _stamps(deck)
+    good = _body_raws(ns, whole, "pump_imu")
+    nan = whole[100:103].copy()
+    nan[:, 1] = np.nan
+    bad = [
+        b"\x00\x01garbage",
+        *_body_raws(ns[100:103], nan, "pump_imu"),
+        _body_raws(np.array([0]), whole[:1], "pump_imu")[0],
+        good[50],
+        *_body_raws(ns[104:106], whole[104:106], "other_imu"),
+    ]
+    stream = TwinStream(scene)
+    out = stream.process(_deck_raws(scene, deck))
+    for raw in [*good[:100], *bad, *good[106:]]:
+        out += stream.process_body([raw])
+    out += stream.finish()
+    assert stream.body is not None
+    counts = stream.body.counts
+    assert counts["received"] == 100 + len(bad) + len(good) - 106
+    assert counts["accepted"] == len(good) - 6
+    assert counts["rejected_undecodable"] == 1 and counts["rejected_nonfinite"] == 3
+    assert counts["rejected_nonpositive_stamp"] == 1 and counts["rejected_stamp_back"] == 1
+    assert counts["rejected_wrong_frame_id"] == 2
+    assert _imu_values(out, BODY_RESIDUAL_TOPIC)[0].shape[0] == len(good) - 6
+    first = _windows(out)[0]
+    assert first[0] == WARN and "rejected_wrong_frame_id 2" in first[1]
+
+
+def test_a_body_sensor_needs_every_samples_wrenches() -> None:
+    """Decimated rows hold each wrench component's peak: a scene with a body sensor and
+    outputs.decimation past 1 fails at load, naming the key."""
+    data = read_scene_yaml(SCENE_FILE)
+    data["body_sensor"] = {"position": [0.8, 0.3, 1.0]}
+    data["outputs"]["decimation"] = 5
+    with pytest.raises(SceneError, match=r"outputs\.decimation: 5 with a body_sensor"):
+        scene_from_dict(data, "pump")
