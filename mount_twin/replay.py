@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from itertools import chain
 from pathlib import Path
@@ -20,6 +21,7 @@ from mount_twin.analysis.figures import (
     mount_travel,
     peak_magnitudes,
 )
+from mount_twin.engine.agreement import NAME as BODY_STATUS
 from mount_twin.engine.batch import (
     FAILED,
     LEVEL_NAMES,
@@ -31,9 +33,16 @@ from mount_twin.engine.batch import (
 )
 from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.health import INTEGRATION, tilt_from_quaternions
-from mount_twin.errors import DamagedBagError
+from mount_twin.errors import BagError, DamagedBagError
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
-from mount_twin.io.messages import TF, TF_STATIC_TOPIC, output_types, resolve, static_transforms
+from mount_twin.io.messages import (
+    IMU,
+    TF,
+    TF_STATIC_TOPIC,
+    output_types,
+    resolve,
+    static_transforms,
+)
 from mount_twin.physics.rotations import quaternion_matrices
 from mount_twin.scene.description import Scene
 from mount_twin.stream import TwinStream
@@ -82,6 +91,8 @@ class ReplaySummary:
     failure: str = ""  # how often the integration failed and why ('' if never)
     latency: tuple[int, float] = (0, 0.0)  # samples, s: outputs after their input (gyro delay)
     travel_max_m: dict[str, float] = field(default_factory=dict)  # per mount (`figures.TRAVEL`)
+    body_counts: dict[str, int] | None = None  # the body IMU's (None: no body_sensor)
+    body_topic: str = ""
 
     @property
     def worst_level(self) -> int:
@@ -160,12 +171,29 @@ class ReplaySummary:
                 f"first {self.origin_s + same[0].stamp:.6f} s  "
                 f"|F| max {max(e.force for e in same):.4g} N"
             )
+        lines += self._body_lines()
         lines.append(f"  diagnostics, worst over the run: {LEVEL_NAMES[self.worst_level]}")
         lines += [
             f"    {LEVEL_NAMES[s.level]:5} {s.name}: {s.message}" for s in self.worst.values()
         ]
         lines.append(f"  verdict: {self.verdict}")
         return "\n".join(lines)
+
+    def _body_lines(self) -> list[str]:
+        """What became of the body IMU's messages (none without a body_sensor)."""
+        c = self.body_counts
+        if c is None:
+            return []
+        if not c.get("received", 0):
+            return [f"  body IMU {self.body_topic}: no message (not in the bag; --body names one)"]
+        missed = {
+            k: v for k, v in c.items() if v and k not in ("received", "accepted", "compared")
+        }
+        return [
+            f"  body IMU {self.body_topic}: {c['received']} received, {c.get('compared', 0)} "
+            f"compared with the twin, not compared: {missed or 'none'} (its agreement: "
+            f"{BODY_STATUS} below)"
+        ]
 
     def to_dict(self) -> dict[str, object]:
         """The summary as JSON-ready data, units in the key names; event times `t_s` count
@@ -187,6 +215,9 @@ class ReplaySummary:
             "latency_samples": self.latency[0],
             "latency_s": self.latency[1],
             "error_estimate": self.error_estimate.as_dict() if self.error_estimate else None,
+            "body_sensor": None
+            if self.body_counts is None
+            else {"topic": self.body_topic, "counts": dict(self.body_counts)},
             "mounts": {
                 name: {
                     PEAK_FORCE: float(peak[0]),
@@ -310,6 +341,27 @@ def _open(
     return bag, stream
 
 
+def _body_bag(
+    scene: Scene, input_path: str | Path, body_path: str | Path | None
+) -> InputBag | None:
+    """The body IMU's bag: `body_path`'s body_sensor.topic, else the input bag's if it has it
+    (None: no body_sensor, or no such topic in the input bag)."""
+    sensor = scene.body_sensor
+    if sensor is None:
+        if body_path is not None:
+            msg = f"{body_path}: the scene has no body_sensor to compare it with"
+            raise BagError(msg)
+        return None
+    if body_path is not None:
+        return InputBag(body_path, sensor.topic, IMU, "body_sensor.topic")
+    try:
+        return InputBag(input_path, sensor.topic, IMU, "body_sensor.topic")
+    except BagError as err:
+        if "no topic" in str(err) or "no message" in str(err):
+            return None  # the replay's summary says the body IMU was not in the bag
+        raise
+
+
 def replay(
     scene: Scene,
     input_path: str | Path,
@@ -318,6 +370,7 @@ def replay(
     chunk: int = 2000,
     progress: bool = True,
     checkpoint: Callable[[], None] | None = None,
+    body_path: str | Path | None = None,
 ) -> ReplaySummary:
     """Replay `input_path`'s scene.input.topic into a new mcap bag at `output_path`.
 
@@ -328,8 +381,17 @@ def replay(
     checked before the twin is built. `checkpoint` is called once it is built and between
     chunks, where stopping is safe: it may raise to stop the replay (a signal noted by
     the command line); once the output bag exists, it is then finished and marked partial.
+
+    With a body_sensor, its IMU (body_sensor.topic of `body_path`, else of the input bag if it
+    has it) is compared with the twin as the node compares it live (`TwinStream.process_body`):
+    it is fed after each input chunk up to that chunk's last stamp.
     """
     bag, stream = _open(scene, input_path, output_path, checkpoint)
+    try:
+        body_bag = _body_bag(scene, input_path, body_path)
+    except BaseException:
+        bag.close()
+        raise
     resolved = {t: resolve(t, NODE_NAME) for t in output_types(scene)}
     topics = {resolved[t]: msgtype for t, msgtype in output_types(scene).items()}
     topics[TF_STATIC_TOPIC] = TF
@@ -341,16 +403,24 @@ def replay(
     worst: dict[str, HealthStatus] = {}
     with (
         bag,
+        body_bag or nullcontext(),
         OutputBag(output_path, topics, {TF_STATIC_TOPIC: [LATCHED_QOS]}) as out,
         tqdm(total=bag.count, unit="msg", disable=not progress, desc="replay", leave=False) as bar,
     ):
         # the chunks, then the end (also where a damaged bag ends): the outputs the gyro delay
         # holds and the last, partial diagnostics period
         damage: list[DamagedBagError] = []
+        body_chunks = _until_damage(body_bag.chunks(chunk), damage) if body_bag else iter(())
         for raws in chain(_until_damage(bag.chunks(chunk), damage), [None]):
             if checkpoint is not None:
                 checkpoint()
-            outputs = stream.finish() if raws is None else stream.process(raws)
+            if raws is None:  # the body IMU's rest, then the end
+                outputs = [m for b in body_chunks for m in stream.process_body(b)]
+                outputs += stream.finish()
+            else:
+                outputs = stream.process(raws)
+                while stream.body_behind and (body := next(body_chunks, None)) is not None:
+                    outputs += stream.process_body(body)
             if static_due and outputs:
                 out.write(*static_transforms(scene, outputs[0][1]))
                 static_due = False
@@ -360,6 +430,8 @@ def replay(
                 figures.add(batch)
                 for report in batch.health:
                     _keep_worst(worst, report)
+            for report in stream.take_body_reports():
+                _keep_worst(worst, report)
             bar.update(len(raws or ()))
         if stream.final_report is not None:
             _keep_worst(worst, stream.final_report)
@@ -402,4 +474,6 @@ def _summary(
         engine.failure_text,
         engine.health.latency,
         {m.name: float(figures.travel[i]) for i, m in enumerate(scene.mounts)},
+        None if stream.body is None else dict(stream.body.counts),
+        scene.body_sensor.topic if scene.body_sensor else "",
     )

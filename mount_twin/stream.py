@@ -33,8 +33,8 @@ class TwinStream:
         engine: the streaming engine (counts, state, health).
         last_outputs: the engine's last OutputBatch (for summaries and plots).
         body: the body IMU's comparison with the twin (None: the scene has no body_sensor).
-        body_reports: the body comparison's window reports of the last call, as HealthReports
-            (for summaries).
+        body_reports: the body comparison's window reports not yet taken (`take_body_reports`;
+            for summaries).
     """
 
     def __init__(self, scene: Scene) -> None:
@@ -82,7 +82,6 @@ class TwinStream:
             decoded = decoded.select(decoded.stamps_ns > 0)
         if decoded.stamps_ns.shape[0]:
             self._received_ns = int(decoded.stamps_ns[-1])
-        self.body_reports = []
         if self.base is None:
             if not decoded.stamps_ns.shape[0]:
                 return []
@@ -106,6 +105,17 @@ class TwinStream:
         waiting, self._body_waiting = self._body_waiting, []
         return msgs + self._encode_body(rows) + [m for d in waiting for m in self._body_in(d)]
 
+    @property
+    def body_behind(self) -> bool:
+        """Whether the body IMU's last accepted stamp is not past the foundation's last
+        received one (a replay feeds the body stream until it is)."""
+        return self._body_last_ns <= self._received_ns
+
+    def take_body_reports(self) -> list[HealthReport]:
+        """The body comparison's window reports since the last call."""
+        reports, self.body_reports = self.body_reports, []
+        return reports
+
     def _foundation_rate(self, decoded: Decoded) -> np.ndarray:
         """The foundation's rate Ω_F (rad/s, F) of each decoded sample: its gyro in F, or
         zeros where the scene ignores it (input.gyro_filter: ignore)."""
@@ -121,7 +131,6 @@ class TwinStream:
         finite, a header.frame_id other than body_sensor.frame_id."""
         if self.body is None:
             return []
-        self.body_reports = []
         decoded = decode_inputs(raws, IMU)
         counts = self.body.counts
         counts["received"] += len(raws)
@@ -190,7 +199,6 @@ class TwinStream:
         out = self.engine.flush()
         reports, out.health = out.health, []
         msgs = self._encode(out, self._tail_ns)
-        self.body_reports = []
         if self.body is not None:
             rates = self._tail_rate[out.sample] if len(out) else np.zeros((0, 3))
             msgs += self._encode_body(

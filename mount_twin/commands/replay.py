@@ -41,6 +41,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True, help="output bag directory (new)")
     parser.add_argument("--topic", help="input topic (default: the scene's input.topic)")
     parser.add_argument(
+        "--body",
+        metavar="BAG",
+        help="the body IMU's bag (its body_sensor.topic; default: the input bag's, if it has it)",
+    )
+    parser.add_argument(
         "--frame-id",
         help="expected header.frame_id, '' for any (default: the scene's input.frame_id)",
     )
@@ -64,14 +69,15 @@ def add_plot_argument(parser: argparse.ArgumentParser) -> None:
 @dataclass(frozen=True)
 class ReplayOptions:
     """How `replay_and_report` runs: messages per engine batch, whether to show progress, a PNG
-    to plot the outputs into and a file for the summary as JSON (None: neither), and the
-    `--fail-on` level."""
+    to plot the outputs into and a file for the summary as JSON (None: neither), the
+    `--fail-on` level, and the body IMU's bag (None: the input bag's body_sensor.topic)."""
 
     chunk: int = 2000
     progress: bool = True
     plot: str | None = None
     json_path: str | None = None
     fail_on: str = "never"
+    body: str | None = None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -84,6 +90,7 @@ def run(args: argparse.Namespace) -> int:
         plot=args.plot,
         json_path=args.json,
         fail_on=args.fail_on,
+        body=args.body,
     )
     return replay_and_report(args.scene, args.input, args.output, options, overrides)
 
@@ -105,7 +112,13 @@ def replay_and_report(
     from mount_twin.commands.stopping import checkpoint
 
     summary = replay(
-        scene, bag, output, chunk=options.chunk, progress=options.progress, checkpoint=checkpoint
+        scene,
+        bag,
+        output,
+        chunk=options.chunk,
+        progress=options.progress,
+        checkpoint=checkpoint,
+        body_path=options.body,
     )
     print(summary.text())
     if options.json_path:

@@ -29,6 +29,9 @@ FLOORS = np.array([0.05, 0.05, 0.05, 0.005, 0.005, 0.005])
 MIN_SAMPLES = 16
 """Fewest compared samples a window needs to be judged (a shorter last window is not)."""
 NAME = "mount_twin: body sensor"
+OUTSIDE_THE_RUN = {"before_twin", "unanswered"}
+"""Body samples not compared because they lie before the twin's first row or after its last:
+said, not warned of (the two recorders never start and stop together)."""
 
 
 @dataclass(frozen=True)
@@ -91,7 +94,8 @@ def window_status(
     figures: Agreement, sensor: BodySensor, span: tuple[float, int], problems: dict[str, int]
 ) -> HealthStatus:
     """The window's diagnostics status: `span` is its (seconds, compared samples), `problems`
-    the body messages counted against it (rejected or not compared, by reason)."""
+    the body messages counted against it (rejected or not compared, by reason): any but those
+    `OUTSIDE_THE_RUN` make it at least a WARN."""
     low, high = sensor.band_hz
     band = f"{low:g}–{high:g} Hz"
     worst, axis = figures.worst
@@ -110,10 +114,13 @@ def window_status(
             f"model and machine {verb} in {band}: worst normalised RMS error {worst:.3f} "
             f"({axis}){limit[level]} over {span[0]:.1f} s"
         )
-    bad = {k: v for k, v in problems.items() if v}
-    if bad:
+    missed = {k: v for k, v in problems.items() if v}
+    if missed:
+        message += "; body messages not compared: " + ", ".join(
+            f"{k} {v}" for k, v in missed.items()
+        )
+    if set(missed) - OUTSIDE_THE_RUN:
         level = max(level, WARN)
-        message += "; body messages not compared: " + ", ".join(f"{k} {v}" for k, v in bad.items())
     values = {"band_hz": f"{low:g} {high:g}", "span_s": f"{span[0]:.3f}", "samples": str(span[1])}
     values["lag_s"] = f"{sensor.lag_s:.6g}"
     for i, name in enumerate(AXES):

@@ -294,7 +294,7 @@ class BodyCheck:
     """The body IMU against the twin (module docstring).
 
     Attributes:
-        counts: body messages received and accepted, and why others were not compared
+        counts: body messages received, accepted and compared, and why others were not
             (`PROBLEMS`; the stream counts its rejections here too, as rejected_<reason>).
     """
 
@@ -335,6 +335,7 @@ class BodyCheck:
 
     def _compared(self, final: bool = False) -> BodyComparison:
         ns, t, measured, predicted = self._matcher.take(final)
+        self.counts["compared"] += int(ns.shape[0])
         residual = measured - predicted
         reports = self._windows.add(ns, t, measured, residual)
         return BodyComparison(ns, predicted, residual, reports)

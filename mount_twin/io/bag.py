@@ -59,9 +59,16 @@ class InputBag:
         path: bag directory, or one storage file (.mcap, .db3, ROS 1 .bag).
         topic: input topic.
         msgtype: expected message type; a different one is an error naming both.
+        setting: what sets the topic, for errors.
     """
 
-    def __init__(self, path: str | Path, topic: str, msgtype: str) -> None:
+    def __init__(
+        self,
+        path: str | Path,
+        topic: str,
+        msgtype: str,
+        setting: str = "input.topic; `replay --topic` overrides it",
+    ) -> None:
         self.path = Path(path)
         self.topic = topic
         self.msgtype = msgtype
@@ -84,7 +91,7 @@ class InputBag:
             self._reader.close()  # after listing: a closed reader has no connections
             what = "no message on topic" if conns else "no topic"
             msg = (
-                f"{self.path}: {what} {topic!r} (input.topic; `replay --topic` overrides it); "
+                f"{self.path}: {what} {topic!r} ({setting}); "
                 f"the bag has: {have or 'no topic'}"
             )
             raise BagError(msg)
@@ -92,7 +99,7 @@ class InputBag:
         if wrong:
             self._reader.close()
             msg = (
-                f"{self.path}: topic {topic!r} has type {wrong[0]}, input.msg_type says {msgtype}"
+                f"{self.path}: topic {topic!r} has type {wrong[0]}, expected {msgtype}"
             )
             raise BagError(msg)
         self._conns = conns

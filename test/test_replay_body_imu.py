@@ -1,0 +1,98 @@
+"""`mount-twin replay` with a body IMU: from the input bag's body_sensor.topic or from another
+bag (`--body`), the same messages; the summary and its JSON say what became of the body
+IMU's messages and carry the agreement's worst window; a body bag for a scene without a
+body_sensor is refused."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from io_helpers import SCENE_FILE, read_raw
+
+from mount_twin.cli import main
+from mount_twin.engine.agreement import NAME
+from mount_twin.io.bag import OutputBag
+from mount_twin.io.messages import IMU, imu_messages
+from mount_twin.io.signals import ship_motion
+
+RATE = 200.0
+STAMP0 = 1_700_000_000_000_000_000
+BODY_TOPIC = "/machine/imu"
+BODY_OUT = ("/mount_twin/body_imu/predicted", "/mount_twin/body_imu/residual")
+
+
+def _scene(tmp: Path, body: bool = True) -> Path:
+    data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
+    if body:
+        data["body_sensor"] = {"topic": BODY_TOPIC, "position": [0.8, 0.3, 1.0], "window_s": 2.0}
+    path = tmp / "pump.scene.yaml"
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    return path
+
+
+def _bags(tmp: Path) -> None:
+    """in_both: deck and body IMU; deck: the deck's alone; body: the body IMU's alone."""
+    deck = ship_motion(rate_hz=RATE, total=6.0)
+    ns = STAMP0 + np.round(deck.t * 1e9).astype(np.int64)
+    body = deck.accel + np.random.default_rng(4).normal(0.0, 0.05, deck.accel.shape)
+    streams = {
+        "/deck/imu": imu_messages(ns, deck.accel, deck.gyro, "deck_imu"),
+        BODY_TOPIC: imu_messages(ns + 2_000_000, body, deck.gyro, ""),
+    }
+    for name, topics in (("in_both", streams), ("deck", ["/deck/imu"]), ("body", [BODY_TOPIC])):
+        with OutputBag(tmp / name, dict.fromkeys(topics, IMU)) as bag:
+            for stamp, topic, raw in sorted((s, t, r) for t in topics for s, r in streams[t]):
+                bag.write(topic, stamp, raw)
+
+
+def _replay(tmp: Path, name: str, *extra: str) -> tuple[int, dict]:
+    out = tmp / f"out_{name}"
+    args = ["replay", str(tmp / name), "--scene", str(_scene(tmp)), "-o", str(out)]
+    code = main([*args, "--no-progress", "--json", str(tmp / f"{name}.json"), *extra])
+    return code, json.loads((tmp / f"{name}.json").read_text(encoding="utf-8"))
+
+
+def test_a_body_imu_in_the_bag_or_in_its_own_bag_is_compared_alike(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _bags(tmp_path)
+    code, both = _replay(tmp_path, "in_both")
+    assert code == 0
+    said = capsys.readouterr().out
+    assert f"body IMU {BODY_TOPIC}: 1200 received, " in said and NAME in said
+    code, apart = _replay(tmp_path, "deck", "--body", str(tmp_path / "body"))
+    assert code == 0
+    for summary in (both, apart):
+        counts = summary["body_sensor"]["counts"]
+        assert counts["received"] == counts["accepted"] == 1200
+        assert counts["compared"] + counts["unanswered"] == 1200 and counts["compared"] > 1150
+        assert NAME in summary["diagnostics_worst"]
+    assert both["diagnostics_worst"][NAME] == apart["diagnostics_worst"][NAME]
+    got = [read_raw(tmp_path / f"out_{n}") for n in ("in_both", "deck")]
+    for topic in BODY_OUT:
+        assert len(got[0][topic]) == both["body_sensor"]["counts"]["compared"]
+        assert got[0][topic] == got[1][topic]
+
+
+def test_without_the_body_topic_the_summary_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _bags(tmp_path)
+    code, summary = _replay(tmp_path, "deck")
+    assert code == 0
+    assert f"body IMU {BODY_TOPIC}: no message" in capsys.readouterr().out
+    assert summary["body_sensor"]["counts"].get("received", 0) == 0
+
+
+def test_a_body_bag_for_a_scene_without_a_body_sensor_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _bags(tmp_path)
+    args = ["replay", str(tmp_path / "deck"), "--scene", str(_scene(tmp_path, body=False))]
+    code = main([*args, "-o", str(tmp_path / "o"), "--body", str(tmp_path / "body")])
+    assert code == 2
+    assert "no body_sensor" in capsys.readouterr().err

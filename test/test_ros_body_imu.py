@@ -1,0 +1,139 @@
+"""The node with a body IMU, run for real (Jazzy rclpy, Fast DDS, the node in its own
+process): it subscribes to body_sensor.topic and publishes the twin's prediction of each body
+sample, the residual and the agreement windows, byte for byte what `mount-twin replay` writes
+for the same messages of both topics. In CI rclpy must be importable (see test_ros_node.py)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+if os.environ.get("CI"):
+    import rclpy  # noqa: F401  (CI installs it: a node test that skips there is a failure)
+else:
+    pytest.importorskip("rclpy")
+
+from io_helpers import SCENE_FILE, read_raw
+from ros_harness import (
+    LOSSLESS,
+    NodeProcess,
+    Peer,
+    fresh_domain,
+    stop_and_take,
+    wait_for,
+    wait_for_node,
+)
+
+from mount_twin.engine.agreement import NAME
+from mount_twin.engine.delay_line import delay_samples
+from mount_twin.io.bag import OutputBag
+from mount_twin.io.messages import (
+    BODY_PREDICTED_TOPIC,
+    BODY_RESIDUAL_TOPIC,
+    DIAGNOSTICS,
+    IMU,
+    TYPESTORE,
+    imu_messages,
+    resolve,
+)
+from mount_twin.io.signals import ship_motion
+from mount_twin.replay import NODE_NAME, replay
+from mount_twin.scene import load_scene_file
+
+RATE = 500.0
+STAMP0 = 1_700_000_000_000_000_000
+BODY_TOPIC = "/machine/imu"
+
+
+def _scene_file(tmp: Path) -> Path:
+    data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
+    data["body_sensor"] = {"topic": BODY_TOPIC, "position": [0.8, 0.3, 1.0], "window_s": 1.0}
+    path = tmp / "pump_with_body_imu.scene.yaml"
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    return path
+
+
+def _inputs() -> list[tuple[str, int, bytes]]:
+    """(topic, stamp ns, raw) of 3 s of deck motion and of a body IMU 1 ms after each deck
+    sample (the deck's reading with noise: a machine the twin does not describe), in stamp
+    order."""
+    deck = ship_motion(rate_hz=RATE, total=3.0)
+    ns = STAMP0 + np.round(deck.t * 1e9).astype(np.int64)
+    rng = np.random.default_rng(4)
+    body = deck.accel + rng.normal(0.0, 0.05, deck.accel.shape)
+    deck_msgs = imu_messages(ns, deck.accel, deck.gyro, "deck_imu")
+    body_msgs = imu_messages(ns + 1_000_000, body, deck.gyro, "")
+    return [
+        (topic, stamp, raw)
+        for pair in zip(deck_msgs, body_msgs, strict=True)
+        for topic, (stamp, raw) in zip(("/deck/imu", BODY_TOPIC), pair, strict=True)
+    ]
+
+
+def _statuses(raws: list[bytes]) -> list[tuple[int, int, str, dict[str, str]]]:
+    """(stamp ns, level, message, values) of each body sensor status."""
+    out = []
+    for raw in raws:
+        msg = TYPESTORE.deserialize_cdr(raw, DIAGNOSTICS)
+        stamp = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
+        out += [
+            (stamp, int(s.level), s.message, {kv.key: kv.value for kv in s.values})
+            for s in msg.status
+            if s.name == NAME
+        ]
+    return out
+
+
+def test_the_live_body_imu_comparison_equals_the_replays(tmp_path: Path) -> None:
+    """Deck and body IMU published live at 500 Hz each: every prediction and residual message
+    is byte-equal to the replay's of a bag holding both topics, and so are the windows'
+    statuses on /diagnostics."""
+    scene_path = _scene_file(tmp_path)
+    scene = load_scene_file(scene_path)
+    inputs = _inputs()
+    with OutputBag(tmp_path / "in", {"/deck/imu": IMU, BODY_TOPIC: IMU}) as bag:
+        for topic, stamp, raw in inputs:
+            bag.write(topic, stamp, raw)
+    replay(scene, tmp_path / "in", tmp_path / "out", progress=False)
+    want = {t: [raw for _, raw in msgs] for t, msgs in read_raw(tmp_path / "out").items()}
+    body_topics = [resolve(t, NODE_NAME) for t in (BODY_PREDICTED_TOPIC, BODY_RESIDUAL_TOPIC)]
+    assert all(len(want[t]) > 1000 for t in body_topics)
+    assert len(_statuses(want["/diagnostics"])) == 3  # windows of 1 s over 3 s
+
+    domain = fresh_domain()
+    peer = Peer(domain)
+    peer.record({**dict.fromkeys(body_topics, IMU), "/diagnostics": DIAGNOSTICS})
+    reliable_body = ["-p", f"qos_overrides.{BODY_TOPIC}.subscription.reliability:=reliable"]
+    args = ["-p", f"scene_file:={scene_path}", "-p", "stall_period_s:=3600.0"]
+    node = NodeProcess(domain, [*args, *LOSSLESS, *reliable_body])
+    pubs = {t: peer.publisher(IMU, t) for t in ("/deck/imu", BODY_TOPIC)}
+    last_report = _statuses(want["/diagnostics"])[-1][0]
+    try:
+        assert wait_for_node(pubs["/deck/imu"], node), node.failed()
+        assert wait_for(lambda: pubs[BODY_TOPIC].get_subscription_count() > 0, 30.0)
+        assert wait_for(lambda: all(peer.connected(t) for t in body_topics), 30.0)
+        for topic, _, raw in inputs:
+            pubs[topic].publish(raw)
+            peer.take()
+        # the last samples' predictions wait for the twin's rows the gyro filter holds
+        held = delay_samples(scene.input, RATE) + 3
+        before = len(want[body_topics[1]]) - held
+        peer.take_until(lambda: len(peer.got[body_topics[1]]) >= before, 120.0)
+        code = stop_and_take(
+            node,
+            peer,
+            lambda: last_report in [s[0] for s in _statuses(peer.got["/diagnostics"])],
+        )
+    finally:
+        node.stop()
+        peer.close()
+    assert code == 0, node.stderr
+    assert "Traceback" not in node.stderr, node.stderr
+    assert f"body IMU {BODY_TOPIC}" in node.stderr  # the start-up line names it
+    for topic in body_topics:
+        assert peer.got[topic] == want[topic], f"{topic}: live bytes differ from the replay's"
+    assert _statuses(peer.got["/diagnostics"]) == _statuses(want["/diagnostics"])
