@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from mount_twin.analysis.ageing_live import WindowJob, run_job
 from mount_twin.analysis.figures import (
     DISPLACEMENT,
     PEAK_COUPLE,
@@ -36,9 +37,11 @@ from mount_twin.engine.health import INTEGRATION, tilt_from_quaternions
 from mount_twin.errors import BagError, DamagedBagError
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import (
+    DIAGNOSTICS_TOPIC,
     IMU,
     TF,
     TF_STATIC_TOPIC,
+    encode_report,
     output_types,
     resolve,
     static_transforms,
@@ -341,6 +344,10 @@ def _open(
     return bag, stream
 
 
+def _encoded(scene: Scene, report: HealthReport, job: WindowJob) -> bytes:
+    return encode_report(scene, report, job.stamp_ns)[2]
+
+
 def _body_bag(
     scene: Scene, input_path: str | Path, body_path: str | Path | None
 ) -> InputBag | None:
@@ -431,6 +438,10 @@ def replay(
                 for report in batch.health:
                     _keep_worst(worst, report)
             for report in stream.take_body_reports():
+                _keep_worst(worst, report)
+            for job in stream.take_ageing_jobs():  # a fit each: seconds
+                report = run_job(job)
+                out.write(resolved[DIAGNOSTICS_TOPIC], job.stamp_ns, _encoded(scene, report, job))
                 _keep_worst(worst, report)
             bar.update(len(raws or ()))
         if stream.final_report is not None:

@@ -6,12 +6,14 @@ the bag replay hands it chunks of raw messages from a bag. Only the transport di
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from mount_twin.engine.batch import HealthReport, OutputBatch
 from mount_twin.engine.body_check import BodyCheck, BodyComparison
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.engine.intake import rotated
+from mount_twin.engine.intake import rising, rotated
 from mount_twin.errors import require
 from mount_twin.io.messages import (
     IMU,
@@ -24,6 +26,9 @@ from mount_twin.io.messages import (
 )
 from mount_twin.model.assemble import assemble
 from mount_twin.scene.description import Scene
+
+if TYPE_CHECKING:
+    from mount_twin.analysis.ageing_live import AgeingTracker, WindowJob
 
 
 class TwinStream:
@@ -61,6 +66,13 @@ class TwinStream:
         self._body_waiting: list[Decoded] = []
         """Body samples that came before the first foundation sample set the time base."""
         self._body_last_ns = 0
+        self.ageing: AgeingTracker | None = None
+        if scene.ageing is not None:  # scipy and the fit, only for a scene that tracks
+            from mount_twin.analysis.ageing_live import AgeingTracker
+
+            self.ageing = AgeingTracker(scene)
+        self._ageing_jobs: list[WindowJob] = []
+        self._ageing_last_ns = 0
 
     def process(self, raws: list[bytes]) -> list[tuple[str, int, bytes]]:
         """Outputs for raw input messages, as (unresolved topic, stamp ns, CDR bytes)."""
@@ -96,6 +108,8 @@ class TwinStream:
         keep = tail.shape[0] - self.engine.lookback
         self._tail_ns = tail[keep:]
         msgs = self._encode(out, stamps_ns)
+        if self.ageing is not None:
+            self._track_foundation(decoded)
         if self.body is None:
             return msgs
         rate = self._foundation_rate(decoded)
@@ -115,6 +129,24 @@ class TwinStream:
         """The body comparison's window reports since the last call."""
         reports, self.body_reports = self.body_reports, []
         return reports
+
+    def _track_foundation(self, decoded: Decoded) -> None:
+        """Deck samples into the ageing tracker: those with finite values and rising stamps."""
+        assert self.ageing is not None and self.base is not None
+        finite = np.isfinite(np.hstack([decoded.accel, decoded.gyro])).all(axis=1)
+        keep = rising(decoded.stamps_ns, finite, self._ageing_last_ns)
+        if keep.any():
+            ns = decoded.stamps_ns[keep]
+            self._ageing_last_ns = int(ns[-1])
+            t = self.base.seconds(ns)
+            jobs = self.ageing.add_foundation(ns, t, decoded.accel[keep], decoded.gyro[keep])
+            self._ageing_jobs += jobs
+
+    def take_ageing_jobs(self) -> list[WindowJob]:
+        """The ageing windows due since the last call (`analysis.ageing_live.run_job` fits
+        one), oldest first."""
+        jobs, self._ageing_jobs = self._ageing_jobs, []
+        return jobs
 
     def _foundation_rate(self, decoded: Decoded) -> np.ndarray:
         """The foundation's rate Ω_F (rad/s, F) of each decoded sample: its gyro in F, or
@@ -147,11 +179,7 @@ class TwinStream:
         for reason, bad in reasons.items():
             counts[f"rejected_{reason}"] += int((bad & keep).sum())
             keep &= ~bad
-        # a stamp not after every accepted one before it (those rejected for going back are
-        # not after it either, so a running maximum over the others is the same)
-        stamps = np.where(keep, decoded.stamps_ns, 0)
-        before = np.maximum.accumulate(np.concatenate([[self._body_last_ns], stamps]))[:-1]
-        back = keep & (decoded.stamps_ns <= before)
+        back = keep & ~rising(decoded.stamps_ns, keep, self._body_last_ns)
         counts["rejected_stamp_back"] += int(back.sum())
         keep &= ~back
         decoded = decoded.select(keep)
@@ -167,9 +195,11 @@ class TwinStream:
         """Accepted body samples into the comparison, on the twin's time base."""
         assert self.body is not None and self.base is not None
         measured = np.hstack([decoded.accel, decoded.gyro])
-        rows = self.body.add_body(
-            decoded.stamps_ns, self.base.seconds(decoded.stamps_ns), measured
-        )
+        t = self.base.seconds(decoded.stamps_ns)
+        if self.ageing is not None:
+            jobs = self.ageing.add_body(decoded.stamps_ns, t, decoded.accel, decoded.gyro)
+            self._ageing_jobs += jobs
+        rows = self.body.add_body(decoded.stamps_ns, t, measured)
         return self._encode_body(rows)
 
     def _encode_body(self, rows: BodyComparison) -> list[tuple[str, int, bytes]]:

@@ -214,3 +214,55 @@ def comparable_messages(path: Path) -> dict[str, list[tuple[int, object]]]:
             for stamp, raw in messages
         ]
     return out
+
+
+def ageing_bag(
+    path: Path, scene: Scene, total_s: float, change_s: float, body_topic: str
+) -> list[tuple[str, int, bytes]]:
+    """A bag at `path` of the deck IMU (/deck/imu, 200 Hz of ship motion with 1-40 Hz
+    machinery vibration at 0.3 m/s² RMS) and the body IMU (`body_topic`) of the scene's
+    machine whose mounts all lose 30 % of their stiffness at `change_s`; 0.01 m/s² of noise on
+    both. Returns its (topic, stamp ns, raw) messages in stamp order."""
+    from scipy.signal import butter, sosfiltfilt
+
+    from mount_twin.analysis.calibration import calibrated_scene, predict
+    from mount_twin.io.bag import OutputBag
+    from mount_twin.io.messages import IMU, imu_messages
+    from mount_twin.io.signals import Signal, ship_motion
+
+    rate, stamp0 = 200.0, 1_700_000_000_000_000_000
+    sea = ship_motion(rate_hz=rate, total=total_s)
+    sos = butter(4, [1.0, 40.0], btype="band", fs=rate, output="sos")
+    vib = sosfiltfilt(sos, np.random.default_rng(5).normal(0, 1, sea.accel.shape), axis=0)
+    deck = Signal(sea.t, sea.accel + 0.3 * vib / vib.std(axis=0), sea.gyro)
+    t, intact = predict(scene, deck)
+    _, aged = predict(calibrated_scene(scene, {"stiffness": 0.7}), deck)
+    rng = np.random.default_rng(1)
+    body = np.where((t >= change_s)[:, None], aged, intact) + rng.normal(0, 0.01, intact.shape)
+    noisy = deck.accel + rng.normal(0, 0.01, deck.accel.shape)
+    ns = stamp0 + np.round(deck.t * 1e9).astype(np.int64)
+    body_ns = stamp0 + np.round(t * 1e9).astype(np.int64)
+    msgs = sorted(
+        [("/deck/imu", s, r) for s, r in imu_messages(ns, noisy, deck.gyro, "deck_imu")]
+        + [(body_topic, s, r) for s, r in imu_messages(body_ns, body, np.zeros_like(body), "")],
+        key=lambda m: (m[1], m[0]),
+    )
+    with OutputBag(path, {"/deck/imu": IMU, body_topic: IMU}) as bag:
+        for topic, stamp, raw in msgs:
+            bag.write(topic, stamp, raw)
+    return msgs
+
+
+def statuses_named(raws: list[bytes], name: str) -> list[tuple[int, int, str, dict[str, str]]]:
+    """(stamp ns, level, message, values) of each diagnostics status called `name` in raw
+    DiagnosticArray messages."""
+    out = []
+    for raw in raws:
+        msg = TYPESTORE.deserialize_cdr(raw, DIAGNOSTICS)
+        stamp = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
+        out += [
+            (stamp, int(s.level), s.message, {kv.key: kv.value for kv in s.values})
+            for s in msg.status
+            if s.name == name
+        ]
+    return out

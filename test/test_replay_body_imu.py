@@ -11,10 +11,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from io_helpers import SCENE_FILE, read_raw
+from io_helpers import SCENE_FILE, ageing_bag, read_raw, statuses_named
 
+from mount_twin import load_scene_file
+from mount_twin.analysis.ageing_live import NAME as AGEING
 from mount_twin.cli import main
 from mount_twin.engine.agreement import NAME
+from mount_twin.engine.batch import ERROR, OK
 from mount_twin.io.bag import OutputBag
 from mount_twin.io.messages import IMU, imu_messages
 from mount_twin.io.signals import ship_motion
@@ -96,3 +99,29 @@ def test_a_body_bag_for_a_scene_without_a_body_sensor_is_refused(
     code = main([*args, "-o", str(tmp_path / "o"), "--body", str(tmp_path / "body")])
     assert code == 2
     assert "no body_sensor" in capsys.readouterr().err
+
+
+def test_mounts_that_age_are_tracked_window_by_window(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """With an `ageing` section (windows of 20 s), a replay re-fits the mounts' stiffness and
+    damping window by window on the bag's deck and body IMU: the window before the mounts lose
+    30 % of their stiffness (at 22 s) is OK, the one after an ERROR reading stiffness ×0.70
+    (within 2 %), and the run's verdict is ERROR."""
+    data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
+    data["input"]["gyro_filter"] = "none"
+    data["body_sensor"] = {"topic": BODY_TOPIC, "position": [0.8, 0.3, 1.0]}
+    data["ageing"] = {"window_s": 20.0}
+    scene_path = tmp_path / "pump.scene.yaml"
+    scene_path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    ageing_bag(tmp_path / "in", load_scene_file(scene_path), 42.5, 22.0, BODY_TOPIC)
+    out = tmp_path / "out"
+    args = ["replay", str(tmp_path / "in"), "--scene", str(scene_path), "-o", str(out)]
+    assert main([*args, "--no-progress"]) == 0
+    assert "verdict: ERROR" in capsys.readouterr().out
+    raws = [raw for _, raw in read_raw(out)["/diagnostics"]]
+    windows = [(s[1], s[3]) for s in statuses_named(raws, AGEING)]
+    assert [level for level, _ in windows] == [OK, ERROR]
+    assert [v["window_start_s"] for _, v in windows] == ["2.000", "22.000"]
+    assert float(windows[0][1]["stiffness"]) == pytest.approx(1.0, abs=0.01)
+    assert float(windows[1][1]["stiffness"]) == pytest.approx(0.7, rel=0.02)

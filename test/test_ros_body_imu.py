@@ -17,7 +17,7 @@ if os.environ.get("CI"):
 else:
     pytest.importorskip("rclpy")
 
-from io_helpers import SCENE_FILE, read_raw
+from io_helpers import SCENE_FILE, ageing_bag, read_raw, statuses_named
 from ros_harness import (
     LOSSLESS,
     NodeProcess,
@@ -28,7 +28,9 @@ from ros_harness import (
     wait_for_node,
 )
 
+from mount_twin.analysis.ageing_live import NAME as AGEING
 from mount_twin.engine.agreement import NAME
+from mount_twin.engine.batch import ERROR, OK
 from mount_twin.engine.delay_line import delay_samples
 from mount_twin.io.bag import OutputBag
 from mount_twin.io.messages import (
@@ -36,7 +38,6 @@ from mount_twin.io.messages import (
     BODY_RESIDUAL_TOPIC,
     DIAGNOSTICS,
     IMU,
-    TYPESTORE,
     imu_messages,
     resolve,
 )
@@ -75,17 +76,7 @@ def _inputs() -> list[tuple[str, int, bytes]]:
 
 
 def _statuses(raws: list[bytes]) -> list[tuple[int, int, str, dict[str, str]]]:
-    """(stamp ns, level, message, values) of each body sensor status."""
-    out = []
-    for raw in raws:
-        msg = TYPESTORE.deserialize_cdr(raw, DIAGNOSTICS)
-        stamp = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
-        out += [
-            (stamp, int(s.level), s.message, {kv.key: kv.value for kv in s.values})
-            for s in msg.status
-            if s.name == NAME
-        ]
-    return out
+    return statuses_named(raws, NAME)
 
 
 def test_the_live_body_imu_comparison_equals_the_replays(tmp_path: Path) -> None:
@@ -137,3 +128,48 @@ def test_the_live_body_imu_comparison_equals_the_replays(tmp_path: Path) -> None
     for topic in body_topics:
         assert peer.got[topic] == want[topic], f"{topic}: live bytes differ from the replay's"
     assert _statuses(peer.got["/diagnostics"]) == _statuses(want["/diagnostics"])
+
+
+def test_the_node_tracks_mounts_that_age_as_the_replay_does(tmp_path: Path) -> None:
+    """With an `ageing` section, the node re-fits the mounts window by window in a worker
+    process while it keeps following: on a machine whose mounts lose 30 % of their stiffness
+    at 22 s, its `mount_twin: ageing` reports (OK, then ERROR) equal the replay's."""
+    data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
+    data["input"]["gyro_filter"] = "none"
+    data["body_sensor"] = {"topic": BODY_TOPIC, "position": [0.8, 0.3, 1.0]}
+    data["ageing"] = {"window_s": 20.0}
+    scene_path = tmp_path / "pump.scene.yaml"
+    scene_path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    scene = load_scene_file(scene_path)
+    inputs = ageing_bag(tmp_path / "in", scene, 42.5, 22.0, BODY_TOPIC)
+    replay(scene, tmp_path / "in", tmp_path / "out", progress=False)
+    want = statuses_named([r for _, r in read_raw(tmp_path / "out")["/diagnostics"]], AGEING)
+    assert [level for _, level, _, _ in want] == [OK, ERROR]
+
+    domain = fresh_domain()
+    peer = Peer(domain)
+    peer.record({"/diagnostics": DIAGNOSTICS})
+    reliable_body = ["-p", f"qos_overrides.{BODY_TOPIC}.subscription.reliability:=reliable"]
+    args = ["-p", f"scene_file:={scene_path}", "-p", "stall_period_s:=3600.0"]
+    node = NodeProcess(domain, [*args, *LOSSLESS, *reliable_body])
+    pubs = {t: peer.publisher(IMU, t) for t in ("/deck/imu", BODY_TOPIC)}
+    try:
+        assert wait_for_node(pubs["/deck/imu"], node), node.failed()
+        assert wait_for(lambda: pubs[BODY_TOPIC].get_subscription_count() > 0, 30.0)
+        assert wait_for(lambda: peer.connected("/diagnostics"), 30.0)
+        for topic, _, raw in inputs:
+            pubs[topic].publish(raw)
+            peer.take()
+
+        def got() -> list[tuple[int, int, str, dict[str, str]]]:
+            return statuses_named(peer.got["/diagnostics"], AGEING)
+
+        assert peer.take_until(lambda: len(got()) == len(want), 120.0), node.failed()
+        assert node.alive  # the fits ran beside the twin, not in place of it
+        code = stop_and_take(node, peer, lambda: True)
+    finally:
+        node.stop()
+        peer.close()
+    assert code == 0, node.stderr
+    assert "Traceback" not in node.stderr, node.stderr
+    assert got() == want

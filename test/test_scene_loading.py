@@ -195,6 +195,10 @@ EXTRA_VALUES = {
     "body_sensor.band_hz": [0.5, 25.0],
     "body_sensor.warn_nrms": 0.2,
     "body_sensor.error_nrms": 0.5,
+    "ageing.window_s": 30.0,
+    "ageing.fit": ["stiffness:fl+fr", "damping"],
+    "ageing.warn": [0.9, 1.1],
+    "ageing.error": [0.8, 1.2],
 }
 
 
@@ -205,6 +209,8 @@ def test_every_declared_parameter_is_accepted_by_the_loader(name: str) -> None:
     if name not in flat:
         assert name in EXTRA_VALUES, f"test needs a value for the new parameter {name}"
         flat[name] = EXTRA_VALUES[name]
+    if name.startswith("ageing."):  # the ageing is tracked from the body IMU
+        flat.setdefault("body_sensor.position", EXTRA_VALUES["body_sensor.position"])
     scene = scene_from_params(flat, "params")
     section, _, field = name.partition(".")
     if name in EXTRA_VALUES:

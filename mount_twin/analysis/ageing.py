@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from mount_twin.analysis.calibration import calibrate
+from mount_twin.analysis.calibration import calibrate, is_scale
 from mount_twin.io.signals import Signal
 from mount_twin.scene.description import Scene
 
@@ -60,6 +60,24 @@ def judged(name: str, value: float, sigma: float, band: Band) -> tuple[int, str]
     return 0, ""
 
 
+def fit_window(
+    scene: Scene,
+    records: tuple[Signal, Signal],
+    span: tuple[float, float],
+    fit: tuple[str, ...],
+    band: Band,
+) -> WindowFit:
+    """The fit of one window `span` (start, end s) of the (foundation, body) `records` (the
+    foundation's from LEAD_S before the start) and its level."""
+    cal = calibrate(scene, *records, fit)
+    scales = [n for n in cal.sigma if is_scale(n)]
+    verdicts = [judged(n, cal.values[n], cal.sigma[n], band) for n in scales]
+    level = max((v for v, _ in verdicts), default=0)
+    why = "; ".join(w for _, w in verdicts if w)
+    fitted = {n: cal.values[n] for n in cal.sigma}
+    return WindowFit(*span, fitted, dict(cal.sigma), dict(cal.refused), LEVELS[level], why)
+
+
 def track(
     scene: Scene,
     foundation: Signal,
@@ -76,17 +94,8 @@ def track(
     fits = []
     while start + window_s <= stop + 1e-9:
         end = start + window_s
-        cal = calibrate(
-            scene, _window(foundation, start - LEAD_S, end), _window(body, start, end), fit
-        )
-        scales = [n for n in cal.sigma if n in ("stiffness", "damping")]
-        verdicts = [judged(n, cal.values[n], cal.sigma[n], band) for n in scales]
-        level = max((v for v, _ in verdicts), default=0)
-        why = "; ".join(w for _, w in verdicts if w)
-        fitted = {n: cal.values[n] for n in cal.sigma}
-        fits.append(
-            WindowFit(start, end, fitted, dict(cal.sigma), dict(cal.refused), LEVELS[level], why)
-        )
+        records = (_window(foundation, start - LEAD_S, end), _window(body, start, end))
+        fits.append(fit_window(scene, records, (start, end), fit, band))
         start = end
     return fits
 

@@ -110,6 +110,15 @@ def rotated(rows: np.ndarray, rot: np.ndarray) -> np.ndarray:
     return rows[:, 0:1] * rot[:, 0] + rows[:, 1:2] * rot[:, 1] + rows[:, 2:3] * rot[:, 2]
 
 
+def rising(stamps: np.ndarray, keep: np.ndarray, last: int) -> np.ndarray:
+    """Of the samples `keep` marks, those (bool mask) whose integer stamp is after `last` and
+    after every kept stamp before it (one going back is not after the others either, so the
+    running maximum over all kept ones is the same as over the rising ones)."""
+    kept = np.where(keep, stamps, np.iinfo(np.int64).min)
+    before = np.maximum.accumulate(np.concatenate([[last], kept]))[:-1]
+    return keep & (stamps > before)
+
+
 def runs(verdicts: list[str], start: int, stop: int) -> list[Run]:
     """Group the taken samples in [start, stop) into runs split at restarts."""
     segment = verdicts[start:stop]

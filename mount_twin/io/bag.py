@@ -90,17 +90,12 @@ class InputBag:
             have = _topic_list(self._reader)
             self._reader.close()  # after listing: a closed reader has no connections
             what = "no message on topic" if conns else "no topic"
-            msg = (
-                f"{self.path}: {what} {topic!r} ({setting}); "
-                f"the bag has: {have or 'no topic'}"
-            )
+            msg = f"{self.path}: {what} {topic!r} ({setting}); the bag has: {have or 'no topic'}"
             raise BagError(msg)
         wrong = [c.msgtype for c in conns if c.msgtype != msgtype]
         if wrong:
             self._reader.close()
-            msg = (
-                f"{self.path}: topic {topic!r} has type {wrong[0]}, expected {msgtype}"
-            )
+            msg = f"{self.path}: topic {topic!r} has type {wrong[0]}, expected {msgtype}"
             raise BagError(msg)
         self._conns = conns
         self.ros1 = not self._reader.is2

@@ -22,7 +22,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from functools import partial
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import rclpy
 from rclpy.clock import Clock, ClockType
@@ -58,6 +58,9 @@ from mount_twin.ros.parameters import check_qos_overrides, configure
 from mount_twin.ros.rclpy_private import take_waiting
 from mount_twin.stream import TwinStream
 
+if TYPE_CHECKING:
+    from mount_twin.ros.ageing_fits import AgeingFits
+
 T = TypeVar("T")
 NODE_NAME = "mount_twin"
 TAKE_LIMIT = 100_000
@@ -66,6 +69,8 @@ SHUTDOWN_ACK_S = 10.0
 """At shutdown, how long (s, steady clock) the node waits for every reliable subscriber to
 acknowledge what it published last (the final, partial diagnostics period among it) before it
 destroys its publishers; what is still unacknowledged then is named in a warning."""
+FIT_POLL_S = 0.2
+"""Steady-clock period at which finished ageing fits are published."""
 WATCH_PERIOD_S = 1.0
 """Steady-clock period of the checks only a live node can make (publisher types, /clock)."""
 
@@ -105,6 +110,12 @@ class MountTwinNode(Node):
         self._reported: dict[str, str] = {}
         self._started = time.monotonic()
         self.create_timer(WATCH_PERIOD_S, self._watch, clock=steady)
+        self._fits: AgeingFits | None = None
+        if self.scene.ageing is not None:  # the fit's modules, only for a scene that tracks
+            from mount_twin.ros.ageing_fits import AgeingFits
+
+            self._fits = AgeingFits(self.scene)
+            self.create_timer(FIT_POLL_S, self._publish_fits, clock=steady)
         self.get_logger().info(
             f"scene {self.scene.name!r} from {self.scene.source}: "
             f"{len(self.scene.mounts)} mounts, DOFs {list(self.scene.dofs)}; input "
@@ -224,6 +235,7 @@ class MountTwinNode(Node):
     def _on_body(self, raw: bytes) -> None:
         assert self._body_sub is not None
         self._publish(self.stream.process_body([raw, *take_waiting(self._body_sub, TAKE_LIMIT)]))
+        self._submit_fits()
 
     def _drain(self) -> None:
         if self._pending:
@@ -235,6 +247,18 @@ class MountTwinNode(Node):
         messages = self.stream.process(raws)
         self._reports += sum(topic == DIAGNOSTICS_TOPIC for topic, _, _ in messages)
         self._publish(messages)
+        self._submit_fits()
+
+    def _submit_fits(self) -> None:
+        """The ageing windows now due, to the worker process."""
+        if self._fits is not None:
+            for job in self.stream.take_ageing_jobs():
+                self._fits.submit(job)
+
+    def _publish_fits(self, wait: bool = False) -> None:
+        """The ageing reports whose fits are done (`wait`: all of them), in window order."""
+        if self._fits is not None:
+            self._publish(self._fits.done(wait))
 
     def _publish(self, messages: list[tuple[str, int, bytes]]) -> None:
         for topic, _stamp, data in messages:
@@ -305,6 +329,8 @@ class MountTwinNode(Node):
         if self._body_sub is not None:
             self._publish(self.stream.process_body(take_waiting(self._body_sub, TAKE_LIMIT)))
         self._publish(self.stream.finish())
+        self._submit_fits()
+        self._publish_fits(wait=True)
         deadline = time.monotonic() + SHUTDOWN_ACK_S
         unacked = [
             pub.topic_name

@@ -90,6 +90,10 @@ def check_scene(
 
 
 def _check_body_sensor(scene: Scene) -> None:
+    if scene.ageing is not None and scene.body_sensor is None:
+        raise SceneError(
+            scene.source, "ageing", "tracks mounts from the body IMU: give the body_sensor"
+        )
     if scene.body_sensor is not None and scene.outputs.decimation > 1:
         raise SceneError(
             scene.source,

@@ -250,6 +250,25 @@ class BodySensor:
 
 
 @dataclass(frozen=True)
+class Ageing:
+    """Live tracking of mounts that age: the calibration re-fitted window by window on the
+    deck and body IMUs (`analysis.ageing`), each window judged against a band.
+
+    Attributes:
+        window_s: each fit's window of body stamps, s (after a 2 s lead that settles the twin).
+        fit: the scales re-fitted: stiffness, damping (all linear mounts), or stiffness:A+B
+            (damping:…) for a group or one mount.
+        warn, error: (low, high) scale factors on the scene's values: a scale whose 3σ
+            interval lies wholly outside `warn` is a WARN, outside `error` an ERROR.
+    """
+
+    window_s: float = 60.0
+    fit: tuple[str, ...] = ("stiffness", "damping")
+    warn: tuple[float, float] = (0.85, 1.15)
+    error: tuple[float, float] = (0.75, 1.25)
+
+
+@dataclass(frozen=True)
 class SceneWarning:
     """A scene value that loads but is likely a mistake (units, a message type's convention),
     found at load and kept on the Scene for the command or node to report.
@@ -284,5 +303,6 @@ class Scene:
     outputs: Outputs = field(default_factory=Outputs)
     frames: Frames = field(default_factory=Frames)
     body_sensor: BodySensor | None = None
+    ageing: Ageing | None = None
     source: str = "<memory>"
     warnings: tuple[SceneWarning, ...] = field(default=(), compare=False)

@@ -17,6 +17,7 @@ from mount_twin.scene.checks import check_scene
 from mount_twin.scene.description import (
     DOF_NAMES,
     GYRO_FILTERS,
+    Ageing,
     Body,
     BodySensor,
     Frames,
@@ -130,6 +131,7 @@ def scene_from_dict(
         outputs=_outputs(top.sub("outputs")),
         frames=_frames(top.sub("frames")),
         body_sensor=_body_sensor(top.sub("body_sensor")) if top.has("body_sensor") else None,
+        ageing=_ageing(top.sub("ageing"), mounts) if top.has("ageing") else None,
         source=source,
     )
     top.finish()
@@ -407,12 +409,40 @@ def _body_sensor(r: Reader) -> BodySensor:
     return sensor
 
 
-def _band(r: Reader, key: str, default: tuple[float, float]) -> tuple[float, float]:
-    """A frequency band (low, high), Hz, 0 ≤ low < high."""
+def _band(
+    r: Reader, key: str, default: tuple[float, float], unit: str = "Hz"
+) -> tuple[float, float]:
+    """A band (low, high), 0 ≤ low < high (a frequency band, Hz, or scale factors)."""
     low, high = r.vector(key, 2, default, lo=0.0)
     if high <= low:
-        raise r.error(key, f"[{low}, {high}]: expected low < high, Hz")
+        raise r.error(key, f"[{low}, {high}]: expected low < high, {unit}")
     return low, high
+
+
+def _ageing(r: Reader, mounts: tuple[Mount, ...]) -> Ageing:
+    d = Ageing()
+    ageing = Ageing(
+        window_s=r.number("window_s", d.window_s, lo=10.0, hi=3600.0),
+        fit=r.names("fit", d.fit),
+        warn=_band(r, "warn", d.warn, "scale factors"),
+        error=_band(r, "error", d.error, "scale factors"),
+    )
+    linear = {m.name for m in mounts if isinstance(m, LinearMount)}
+    for i, name in enumerate(ageing.fit):
+        kind, _, group = name.partition(":")
+        wrong = [m for m in group.split("+") if m not in linear] if group else []
+        if kind not in ("stiffness", "damping") or wrong or not linear:
+            why = f"{', '.join(wrong)}: no linear mount of the scene" if wrong else ""
+            raise r.error(
+                f"fit[{i}]",
+                why
+                or f"{shown(name)}: expected stiffness or damping (of all linear mounts), "
+                "or stiffness:A+B (damping:A+B) for a group",
+            )
+    if not (ageing.error[0] <= ageing.warn[0] and ageing.warn[1] <= ageing.error[1]):
+        raise r.error("error", f"{list(ageing.error)} must hold the warn band {list(ageing.warn)}")
+    r.finish()
+    return ageing
 
 
 def _frames(r: Reader) -> Frames:

@@ -1,0 +1,50 @@
+"""The node's ageing fits (`analysis.ageing_live`), each in a worker process: a window's fit
+takes seconds, and run in the executor's thread it would hold the node's input for them (a
+kHz input queue overflows). The reports go out in window order as their fits finish, each
+stamped with its window's last body stamp, so they equal a replay's.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+from collections import deque
+from concurrent.futures import Future, ProcessPoolExecutor
+
+from mount_twin.analysis.ageing_live import NAME, WindowJob, run_job
+from mount_twin.engine.batch import ERROR, HealthReport, HealthStatus
+from mount_twin.io.messages import encode_report
+from mount_twin.scene.description import Scene
+
+
+class AgeingFits:
+    """The fits submitted and not yet published, oldest first."""
+
+    def __init__(self, scene: Scene) -> None:
+        self.scene = scene
+        self._pool: ProcessPoolExecutor | None = None
+        self._pending: deque[tuple[int, Future[HealthReport]]] = deque()
+
+    def submit(self, job: WindowJob) -> None:
+        """Fit `job` in the worker process (started at the first: a fresh interpreter, not a
+        fork of a process running DDS threads)."""
+        if self._pool is None:
+            spawn = multiprocessing.get_context("spawn")
+            self._pool = ProcessPoolExecutor(max_workers=1, mp_context=spawn)
+        self._pending.append((job.stamp_ns, self._pool.submit(run_job, job)))
+
+    def done(self, wait: bool = False) -> list[tuple[str, int, bytes]]:
+        """The reports of the fits finished in order (`wait`: all, then the worker stops), as
+        /diagnostics messages; a fit that raised is an ERROR saying so."""
+        msgs = []
+        while self._pending and (wait or self._pending[0][1].done()):
+            stamp_ns, future = self._pending.popleft()
+            try:
+                report = future.result()
+            except Exception as err:  # the worker died or the fit raised: said, not lost
+                status = HealthStatus(NAME, ERROR, f"the ageing fit failed: {err!r}", {})
+                report = HealthReport(stamp_ns * 1e-9, -1, [status])
+            msgs.append(encode_report(self.scene, report, stamp_ns))
+        if wait and self._pool is not None:
+            self._pool.shutdown()
+            self._pool = None
+        return msgs
