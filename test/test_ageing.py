@@ -72,5 +72,23 @@ def test_mounts_losing_30_percent_are_flagged_within_a_minute_and_not_before(
 def test_the_commands_default_bands_are_the_ageing_modules() -> None:
     from mount_twin.analysis.ageing import Band
     from mount_twin.commands.track import BANDS
+    from mount_twin.scene.description import Ageing
 
-    assert Band() == Band(BANDS["warn"], BANDS["error"])
+    assert Band() == Band(BANDS["warn"], BANDS["error"]) == Band(Ageing().warn, Ageing().error)
+
+
+def test_groups_of_mounts_are_tracked_apart(
+    ageing_pair: tuple[Path, Signal, Signal], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--fit` with a stiffness scale per group (the front pair, the other six): in the first
+    window wholly after the change both read 0.70 (within 2 %), and the window is an ERROR."""
+    d, _, _ = ageing_pair
+    files = ["--foundation", str(d / "foundation.csv"), "--body", str(d / "body.csv")]
+    groups = ["stiffness:fl+fr", "stiffness:ml1+mr1+ml2+mr2+rl+rr"]
+    assert main(["track", str(d / "pump.scene.yaml"), *files, "--fit", *groups]) == 4
+    rows = capsys.readouterr().out.splitlines()[1:]
+    after = next(r for r in rows if float(r.split()[0].split("–")[0]) >= CHANGE)
+    assert after.split()[1] == "ERROR"
+    for group in groups:
+        value = float(after.split(f"{group} ×")[1].split()[0])
+        assert value == pytest.approx(0.7, rel=0.02), group

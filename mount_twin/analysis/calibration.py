@@ -10,6 +10,10 @@ with frequency, which a time-domain fit takes as one number):
   (fitted as logarithms: a scale stays positive); `stiffness:fl+fr` (or `damping:…`) scales
   only the mounts it names, so that groups (or single mounts) are fitted apart;
 - `yaw`: the body sensor's rotation about the body's z axis, added to its orientation_rpy, rad;
+  `roll` and `pitch` (on request) likewise;
+- `sensor_x`, `sensor_y`, `sensor_z` (on request): the body sensor's position, m in F, added
+  to body_sensor.position (seen through the rotation's terms α × r and ω × (ω × r): a body
+  that barely turns leaves them refused);
 - `lag`: the body recorder's clock behind the foundation's, s (its samples are the motion
   `lag` seconds before their stamps), added to the scene's body_sensor.lag_s.
 
@@ -35,9 +39,16 @@ from mount_twin.engine.batch import SampleBatch
 from mount_twin.engine.intake import rotated
 from mount_twin.engine.sensor_reading import predicted_reading
 from mount_twin.io.signals import Signal
-from mount_twin.scene.description import BodySensor, LinearMount, Scene, Vec6
+from mount_twin.scene.description import BodySensor, LinearMount, Scene, Vec3, Vec6
 
 PARAMETERS = ("stiffness", "damping", "yaw", "lag")
+"""What `calibrate` fits unless told otherwise."""
+ON_REQUEST = ("roll", "pitch", "sensor_x", "sensor_y", "sensor_z")
+"""What it fits when named too: the rest of the body sensor's mounting."""
+ANGLES = ("roll", "pitch", "yaw")
+OFFSETS = ("sensor_x", "sensor_y", "sensor_z")
+MAX_POSITION_SIGMA_M = 0.01
+"""A sensor position offset whose 1σ exceeds this (m) is not identified by the record."""
 MAX_REL_SIGMA = 0.05
 """A scale factor whose relative 1σ exceeds this is not identified by the record."""
 MAX_YAW_SIGMA_RAD = math.radians(2.0)
@@ -115,13 +126,17 @@ def calibrated_scene(scene: Scene, values: dict[str, float]) -> Scene:
         for m in scene.mounts
     )
     sensor = scene.body_sensor or BodySensor()
-    roll, pitch, yaw = sensor.orientation_rpy
-    yawed = dataclasses.replace(
+    turned = tuple(
+        a + values.get(n, 0.0) for a, n in zip(sensor.orientation_rpy, ANGLES, strict=True)
+    )
+    moved = tuple(p + values.get(n, 0.0) for p, n in zip(sensor.position, OFFSETS, strict=True))
+    mounted = dataclasses.replace(
         sensor,
-        orientation_rpy=(roll, pitch, yaw + values.get("yaw", 0.0)),
+        orientation_rpy=cast("Vec3", turned),
+        position=cast("Vec3", moved),
         lag_s=sensor.lag_s + values.get("lag", 0.0),
     )
-    return dataclasses.replace(scene, mounts=mounts, body_sensor=yawed)
+    return dataclasses.replace(scene, mounts=mounts, body_sensor=mounted)
 
 
 def predict(scene: Scene, foundation: Signal) -> tuple[np.ndarray, np.ndarray]:
@@ -211,8 +226,10 @@ def _too_uncertain(name: str, sigma: float, value: float, step_s: float) -> str 
     """Why a fitted parameter is not identified (None: it is)."""
     if is_scale(name) and sigma > MAX_REL_SIGMA * value:
         return f"1σ is {sigma / value:.0%} of its value (the record barely moves it)"
-    if name == "yaw" and sigma > MAX_YAW_SIGMA_RAD:
+    if name in ANGLES and sigma > MAX_YAW_SIGMA_RAD:
         return f"1σ is {math.degrees(sigma):.1f}° (the motion has no direction to tell it by)"
+    if name in OFFSETS and sigma > MAX_POSITION_SIGMA_M:
+        return f"1σ is {sigma * 1e3:.0f} mm (the body barely turns: its point hardly matters)"
     if name == "lag" and sigma > step_s:
         return f"1σ is {sigma * 1e3:.1f} ms, more than a sample ({step_s * 1e3:.1f} ms)"
     return None
@@ -236,12 +253,13 @@ def calibrate(
 ) -> Calibration:
     """Fit `fit` (of PARAMETERS) so that the twin on `foundation` predicts `body` (module
     docstring); refuse, by name, what the record cannot identify."""
+    known = (*PARAMETERS, *ON_REQUEST)
     unknown = [
-        n for n in fit if n.partition(":")[0] not in PARAMETERS or (":" in n and not is_scale(n))
+        n for n in fit if n.partition(":")[0] not in known or (":" in n and not is_scale(n))
     ]
     if unknown:
         msg = (
-            f"cannot fit {', '.join(unknown)}: the parameters are {', '.join(PARAMETERS)}, "
+            f"cannot fit {', '.join(unknown)}: the parameters are {', '.join(known)}, "
             "and stiffness:MOUNT+MOUNT… or damping:… for a group"
         )
         raise ValueError(msg)
@@ -276,6 +294,6 @@ def calibrate(
         said = f"the fit predicts the body no better (NRMS {before:.3g} → {after:.3g})"
         refused.update(dict.fromkeys(values, said))
         values, sigma, after = {}, {}, before
-    nominal = {n: 0.0 if n in ("yaw", "lag") else 1.0 for n in (*fit, "yaw", "lag")}
+    nominal = {n: 1.0 if is_scale(n) else 0.0 for n in (*fit, "yaw", "lag")}
     full = {**nominal, **values}
     return Calibration(full, sigma, refused, before, after, calibrated_scene(scene, full))

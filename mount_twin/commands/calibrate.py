@@ -25,6 +25,8 @@ HELP = "fit mount stiffness and damping scales, the body IMU's yaw and lag to a 
 FITTED = ("stiffness", "damping", "yaw", "lag")
 """`analysis.calibration.PARAMETERS` (a test holds them equal: numpy is not imported to build
 the command line)."""
+ON_REQUEST = ("roll", "pitch", "sensor_x", "sensor_y", "sensor_z")
+"""`analysis.calibration.ON_REQUEST` (held equal likewise)."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -37,8 +39,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         nargs="+",
         default=list(FITTED),
         metavar="PARAMETER",
-        help=f"what to fit, among {', '.join(FITTED)} (default: all); stiffness:fl+fr (or "
-        "damping:…) scales only those mounts, to fit groups or single mounts apart",
+        help=f"what to fit, among {', '.join(FITTED)} (the default) and "
+        f"{', '.join(ON_REQUEST)} (the body IMU's mounting: angles added to its orientation_rpy, "
+        "offsets to its position); stiffness:fl+fr (or damping:…) scales only those mounts, to "
+        "fit groups or single mounts apart",
     )
     parser.add_argument("--plot", metavar="PNG", help="the body record against the prediction")
     parser.epilog = (
@@ -111,7 +115,10 @@ def run(args: argparse.Namespace) -> int:
 
 def describe(cal: Calibration) -> list[str]:
     """Each parameter with its 1σ or why it is refused, and the residual before and after."""
-    units = {"yaw": ("°", 57.29577951308232), "lag": ("ms", 1e3)}
+    degrees = ("°", 57.29577951308232)
+    millimetres = ("mm", 1e3)
+    units = {"roll": degrees, "pitch": degrees, "yaw": degrees, "lag": ("ms", 1e3)}
+    units.update(dict.fromkeys(("sensor_x", "sensor_y", "sensor_z"), millimetres))
     lines = []
     for name, value in cal.values.items():
         unit, k = units.get(name, ("×", 1.0))  # the rest are scale factors
@@ -141,6 +148,7 @@ def _write_scene(source: str, out: Path, cal: Calibration, lines: list[str]) -> 
     if sensor is not None:
         written = data.setdefault("body_sensor", {})
         written["orientation_rpy"] = list(sensor.orientation_rpy)
+        written["position"] = list(sensor.position)
         written["lag_s"] = sensor.lag_s
     head = [f"# calibrated from {source} by mount-twin calibrate", *(f"# {ln}" for ln in lines)]
     text = "\n".join(head) + "\n" + yaml.safe_dump(data, sort_keys=False)

@@ -20,15 +20,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", help="the calibrated scene YAML (with its body_sensor)")
     parser.add_argument("--foundation", required=True, help="the foundation's record")
     parser.add_argument("--body", required=True, help="the body IMU's record")
-    parser.add_argument("--window", type=float, default=30.0, help="window length, s")
+    parser.add_argument(
+        "--window", type=float, help="window length, s (default: the scene's ageing, else 30)"
+    )
+    parser.add_argument(
+        "--fit",
+        nargs="+",
+        metavar="SCALE",
+        help="the scales re-fitted: stiffness, damping, or stiffness:fl+fr (damping:…) for a "
+        "group or one mount (default: the scene's ageing.fit, else stiffness damping)",
+    )
     for level, band in BANDS.items():
         parser.add_argument(
             f"--{level}",
             type=float,
             nargs=2,
-            default=band,
             metavar=("LOW", "HIGH"),
-            help=f"scale band outside which a window is judged {level.upper()}",
+            help=f"scale band outside which a window is judged {level.upper()} (default: the "
+            f"scene's ageing.{level}, else {band[0]:g} {band[1]:g})",
         )
     parser.epilog = f"exit status: 0 OK; {EXIT_WARN} WARN; {EXIT_ERROR} ERROR; 2 bad input"
 
@@ -36,10 +45,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from mount_twin.analysis.ageing import Band, track, window_table
     from mount_twin.commands.calibrate import read_pair
+    from mount_twin.scene.description import Ageing
 
     scene, foundation, body = read_pair(args)
-    band = Band(tuple(args.warn), tuple(args.error))
-    fits = track(scene, foundation, body, args.window, band=band)
+    ageing = scene.ageing or Ageing(window_s=30.0)
+    band = Band(tuple(args.warn or ageing.warn), tuple(args.error or ageing.error))
+    fit = tuple(args.fit or ageing.fit)
+    fits = track(scene, foundation, body, args.window or ageing.window_s, fit, band)
     print(f"{'window s':<19} level fit")
     print("\n".join(window_table(fits)))
     levels = {f.level for f in fits}
