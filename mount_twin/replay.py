@@ -348,6 +348,9 @@ def _encoded(scene: Scene, report: HealthReport, job: WindowJob) -> bytes:
     return encode_report(scene, report, job.stamp_ns)[2]
 
 
+BODY_KEYS = ("body_sensor.topic; `replay --body` reads another bag", "a body_sensor (an IMU)")
+
+
 def _body_bag(
     scene: Scene, input_path: str | Path, body_path: str | Path | None
 ) -> InputBag | None:
@@ -360,9 +363,9 @@ def _body_bag(
             raise BagError(msg)
         return None
     if body_path is not None:
-        return InputBag(body_path, sensor.topic, IMU, "body_sensor.topic")
+        return InputBag(body_path, sensor.topic, IMU, BODY_KEYS)
     try:
-        return InputBag(input_path, sensor.topic, IMU, "body_sensor.topic")
+        return InputBag(input_path, sensor.topic, IMU, BODY_KEYS)
     except BagError as err:
         if "no topic" in str(err) or "no message" in str(err):
             return None  # the replay's summary says the body IMU was not in the bag

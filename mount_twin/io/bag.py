@@ -59,7 +59,7 @@ class InputBag:
         path: bag directory, or one storage file (.mcap, .db3, ROS 1 .bag).
         topic: input topic.
         msgtype: expected message type; a different one is an error naming both.
-        setting: what sets the topic, for errors.
+        keys: what sets the topic and the type, for errors.
     """
 
     def __init__(
@@ -67,7 +67,7 @@ class InputBag:
         path: str | Path,
         topic: str,
         msgtype: str,
-        setting: str = "input.topic; `replay --topic` overrides it",
+        keys: tuple[str, str] = ("input.topic; `replay --topic` overrides it", "input.msg_type"),
     ) -> None:
         self.path = Path(path)
         self.topic = topic
@@ -90,12 +90,12 @@ class InputBag:
             have = _topic_list(self._reader)
             self._reader.close()  # after listing: a closed reader has no connections
             what = "no message on topic" if conns else "no topic"
-            msg = f"{self.path}: {what} {topic!r} ({setting}); the bag has: {have or 'no topic'}"
+            msg = f"{self.path}: {what} {topic!r} ({keys[0]}); the bag has: {have or 'no topic'}"
             raise BagError(msg)
         wrong = [c.msgtype for c in conns if c.msgtype != msgtype]
         if wrong:
             self._reader.close()
-            msg = f"{self.path}: topic {topic!r} has type {wrong[0]}, expected {msgtype}"
+            msg = f"{self.path}: topic {topic!r} has type {wrong[0]}, {keys[1]} says {msgtype}"
             raise BagError(msg)
         self._conns = conns
         self.ros1 = not self._reader.is2
