@@ -65,7 +65,6 @@ class TwinStream:
         self.body_reports: list[HealthReport] = []
         self._body_waiting: list[Decoded] = []
         """Body samples that came before the first foundation sample set the time base."""
-        self._body_last_ns = 0
         self.ageing: AgeingTracker | None = None
         if scene.ageing is not None:  # scipy and the fit, only for a scene that tracks
             from mount_twin.analysis.ageing_live import AgeingTracker
@@ -123,7 +122,7 @@ class TwinStream:
     def body_behind(self) -> bool:
         """Whether the body IMU's last accepted stamp is not past the foundation's last
         received one (a replay feeds the body stream until it is)."""
-        return self._body_last_ns <= self._received_ns
+        return self.body is None or self.body.last_ns <= self._received_ns
 
     def take_body_reports(self) -> list[HealthReport]:
         """The body comparison's window reports since the last call."""
@@ -164,28 +163,12 @@ class TwinStream:
         if self.body is None:
             return []
         decoded = decode_inputs(raws, IMU)
-        counts = self.body.counts
-        counts["received"] += len(raws)
-        counts["rejected_undecodable"] += decoded.undecodable
-        keep = np.ones(decoded.stamps_ns.shape[0], bool)
-        expected = self.body.sensor.frame_id
-        reasons = {
-            "nonpositive_stamp": decoded.stamps_ns <= 0,
-            "nonfinite": ~np.isfinite(np.hstack([decoded.accel, decoded.gyro])).all(axis=1),
-            "wrong_frame_id": np.array(
-                [bool(expected) and f != expected for f in decoded.frame_ids], bool
-            ),
-        }
-        for reason, bad in reasons.items():
-            counts[f"rejected_{reason}"] += int((bad & keep).sum())
-            keep &= ~bad
-        back = keep & ~rising(decoded.stamps_ns, keep, self._body_last_ns)
-        counts["rejected_stamp_back"] += int(back.sum())
-        keep &= ~back
-        decoded = decoded.select(keep)
+        self.body.counts["received"] += len(raws)
+        self.body.counts["rejected_undecodable"] += decoded.undecodable
+        measured = np.hstack([decoded.accel, decoded.gyro])
+        decoded = decoded.select(self.body.screen(decoded.stamps_ns, measured, decoded.frame_ids))
         if not decoded.stamps_ns.shape[0]:
             return []
-        self._body_last_ns = int(decoded.stamps_ns[-1])
         if self.base is None:  # no foundation sample yet: the time base waits for it
             self._body_waiting.append(decoded)
             return []

@@ -27,6 +27,7 @@ import numpy as np
 
 from mount_twin.engine.agreement import MIN_SAMPLES, agreement, window_status
 from mount_twin.engine.batch import HealthStatus
+from mount_twin.engine.intake import rising
 from mount_twin.engine.sensor_reading import predicted_reading
 from mount_twin.physics import pose_row
 from mount_twin.scene.description import BodySensor, Scene
@@ -301,6 +302,8 @@ class BodyCheck:
     def __init__(self, scene: Scene, sensor: BodySensor) -> None:
         self.sensor = sensor
         self.counts: Counter[str] = Counter()
+        self.last_ns = 0
+        """The last accepted body stamp, ns (0: none yet)."""
 
         def predict(rows: _Rows) -> np.ndarray:
             pose = (rows.pose[:, pose_row.POSITION_COLS], rows.pose[:, pose_row.QUATERNION_COLS])
@@ -310,6 +313,32 @@ class BodyCheck:
         self._lead = _Lead(predict)
         self._matcher = _Matcher(sensor.lag_s, scene.input.max_gap_s, self.counts)
         self._windows = _Windows(sensor, self.counts)
+
+    def screen(
+        self, stamps_ns: np.ndarray, measured: np.ndarray, frame_ids: list[str]
+    ) -> np.ndarray:
+        """Which body messages (stamps ns, (k, 6) readings, header.frame_ids) can be compared
+        (bool mask); the others counted as rejected_<reason>: an unset or pre-1970 stamp, a
+        value not finite, a frame_id other than body_sensor.frame_id ("": any), a stamp not
+        after every one accepted before it."""
+        expected = self.sensor.frame_id
+        reasons = {
+            "nonpositive_stamp": stamps_ns <= 0,
+            "nonfinite": ~np.isfinite(measured).all(axis=1),
+            "wrong_frame_id": np.array(
+                [bool(expected) and f != expected for f in frame_ids], bool
+            ),
+        }
+        keep = np.ones(stamps_ns.shape[0], bool)
+        for reason, bad in reasons.items():
+            self.counts[f"rejected_{reason}"] += int((bad & keep).sum())
+            keep &= ~bad
+        back = keep & ~rising(stamps_ns, keep, self.last_ns)
+        self.counts["rejected_stamp_back"] += int(back.sum())
+        keep &= ~back
+        if keep.any():
+            self.last_ns = int(stamps_ns[keep][-1])
+        return keep
 
     def add_rows(
         self, t: np.ndarray, pose: np.ndarray, wrenches: np.ndarray, rate: np.ndarray
