@@ -152,7 +152,7 @@ def test_the_live_prediction_is_the_whole_records_at_every_body_sample() -> None
 def test_batching_and_interleaving_do_not_change_a_bit() -> None:
     """Every body message (prediction, residual, window report) is the same bytes whether the
     two streams come message by message, or in chunks with the body's first or last."""
-    scene, deck = _pump(), _deck(12.0)
+    scene, deck = _pump(), _deck(13.5)  # the last window, 3.5 s, is judged too
     t, whole = _whole_record(scene, deck)
     ns = _stamps(deck)[::2] + 1_234_567  # a slower body IMU, between the deck's samples
     measured = np.stack([np.interp(TimeBase.at(NS0).seconds(ns), t, v) for v in whole.T], 1)

@@ -195,6 +195,7 @@ EXTRA_VALUES = {
     "body_sensor.band_hz": [0.5, 25.0],
     "body_sensor.warn_nrms": 0.2,
     "body_sensor.error_nrms": 0.5,
+    "body_sensor.axes": ["fx", "fy"],
     "ageing.window_s": 30.0,
     "ageing.fit": ["stiffness:fl+fr", "damping"],
     "ageing.warn": [0.9, 1.1],

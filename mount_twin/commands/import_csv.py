@@ -7,7 +7,10 @@ import argparse
 from mount_twin.io.epoch import DEFAULT_START_NS
 
 NAME = "import-csv"
-HELP = "a recorder's CSV (time, acceleration, optional gyro; units, ; and decimal comma) → Imu bag"
+HELP = (
+    "a recorder's CSV (time, acceleration, optional gyro; units, ; and decimal comma) or a "
+    "Movella/Xsens DOT export → Imu bag"
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -52,6 +55,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from mount_twin.commands.common import write_signal
     from mount_twin.io.csv_import import CsvFormat, read_recorder_csv
+    from mount_twin.io.xsens_csv import is_xsens_csv, read_xsens_csv
 
     columns = {}
     for pair in (args.columns or "").split(","):
@@ -72,11 +76,14 @@ def run(args: argparse.Namespace) -> int:
     }
     delimiter = "\t" if args.delimiter in ("\\t", "tab") else args.delimiter
     fmt = CsvFormat(delimiter, args.decimal, columns, units, args.single_axis)
-    imported = read_recorder_csv(args.csv, fmt)
-    n = write_signal(
-        imported.signal, args.output, args.topic, args.frame_id, args.offset, args.storage
-    )
+    if is_xsens_csv(args.csv):  # its own layout: the device clock, Acc_*, Gyr_* in deg/s
+        signal, tag = read_xsens_csv(args.csv)
+        notes = [f"a Movella/Xsens DOT export (device {tag or 'untagged'}): stamps on its clock"]
+    else:
+        imported = read_recorder_csv(args.csv, fmt)
+        signal, notes = imported.signal, imported.notes
+    n = write_signal(signal, args.output, args.topic, args.frame_id, args.offset, args.storage)
     print(f"wrote {n} sensor_msgs/msg/Imu messages on {args.topic} to {args.output}")
-    for note in imported.notes:
+    for note in notes:
         print(f"  {note}")
     return 0

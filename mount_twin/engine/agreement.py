@@ -8,8 +8,9 @@ not model), the normalised RMS error ‖pred − meas‖ / ‖meas‖:
   discrete Fourier transform of the window (Parseval: the band's share of both norms), and
 - broadband (every frequency the body IMU samples), reported beside it.
 
-An axis is judged only where the body moved in the band: its measured RMS there at least the
-axis floor (`FLOORS`, above a MEMS IMU's noise); elsewhere the ratio is noise over noise. The
+An axis is judged only where the scene says so (`body_sensor.axes`) and the body moved in the
+band: its measured RMS there at least the axis floor (`FLOORS`, above a MEMS IMU's noise);
+elsewhere the ratio is noise over noise. The
 window's level is that of its worst judged axis against `warn_nrms` and `error_nrms`.
 """
 
@@ -20,9 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from mount_twin.engine.batch import ERROR, OK, WARN, HealthStatus
-from mount_twin.scene.description import BodySensor
+from mount_twin.scene.description import SENSOR_AXES, BodySensor
 
-AXES = ("fx", "fy", "fz", "wx", "wy", "wz")
+AXES = SENSOR_AXES
 """The compared axes: specific force (m/s²), then angular rate (rad/s), in the sensor's axes."""
 FLOORS = np.array([0.05, 0.05, 0.05, 0.005, 0.005, 0.005])
 """Smallest measured RMS in the band (m/s², rad/s) of an axis that is judged."""
@@ -68,11 +69,13 @@ def _ratio(num: np.ndarray, den: np.ndarray) -> np.ndarray:
 
 
 def agreement(
-    t: np.ndarray, measured: np.ndarray, residual: np.ndarray, band_hz: tuple[float, float]
+    t: np.ndarray, measured: np.ndarray, residual: np.ndarray, sensor: BodySensor
 ) -> Agreement:
     """The figures of k compared samples at stamps `t` (s, increasing, k ≥ 2): `measured` and
-    `residual` (measured − predicted), each (k, 6). The frequencies are those of the mean
-    sampling interval (a body IMU's stamps jitter; its samples are taken as uniform)."""
+    `residual` (measured − predicted), each (k, 6), in the sensor's band_hz, its `axes`
+    judged. The frequencies are those of the mean sampling interval (a body IMU's stamps
+    jitter; its samples are taken as uniform)."""
+    band_hz = sensor.band_hz
     k = t.shape[0]
     x = measured - measured.mean(axis=0)
     r = residual - residual.mean(axis=0)
@@ -86,7 +89,7 @@ def agreement(
         nrms_band=_ratio(pr[in_band].sum(axis=0), x_band),
         nrms_broadband=_ratio((r**2).sum(axis=0), (x**2).sum(axis=0)),
         rms_band=np.sqrt(2.0 * x_band) / k,
-        judged=np.sqrt(2.0 * x_band) / k >= FLOORS,
+        judged=(np.sqrt(2.0 * x_band) / k >= FLOORS) & np.isin(AXES, sensor.axes),
     )
 
 

@@ -14,7 +14,7 @@ batched, and whichever of the two streams comes first (live = replay), within `R
    rows farther apart than input.max_gap_s (a gap, a restart) is counted and not compared.
 3. `_Windows` judges the compared samples in windows of body_sensor.window_s of stamps
    (`agreement`), on a grid from the first compared sample; the last, partial window at the
-   end of the stream if it holds `agreement.MIN_SAMPLES`.
+   end of the stream if it spans half a window (and holds `agreement.MIN_SAMPLES`).
 """
 
 from __future__ import annotations
@@ -249,7 +249,7 @@ class _Windows:
         return reports
 
     def finish(self) -> list[tuple[int, HealthStatus]]:
-        """The last, partial window's report, if it holds enough samples."""
+        """The last, partial window's report, if it spans half a window."""
         return self._close(final=True)
 
     def _close(self, final: bool = False) -> list[tuple[int, HealthStatus]]:
@@ -257,15 +257,15 @@ class _Windows:
         if window is None:
             return []
         ns, t, measured, residual = (np.concatenate(a) for a in zip(*window.chunks, strict=True))
-        if t.shape[0] < MIN_SAMPLES:
-            return []
+        if t.shape[0] < MIN_SAMPLES or (final and t[-1] - t[0] < 0.5 * self._sensor.window_s):
+            return []  # too short to judge (the last: its band barely resolved)
         problems = {
             k: self._problems[k] - self._reported[k]
             for k in self._problems
             if k in PROBLEMS or k.startswith("rejected_")
         }
         self._reported = Counter(self._problems)
-        figures = agreement(t, measured, residual, self._sensor.band_hz)
+        figures = agreement(t, measured, residual, self._sensor)
         span = (float(t[-1] - t[0]), int(t.shape[0]))
         status = window_status(figures, self._sensor, span, problems)
         if final:

@@ -219,6 +219,11 @@ class Frames:
         return self.mount_prefix + mount_name
 
 
+SENSOR_AXES = ("fx", "fy", "fz", "wx", "wy", "wz")
+"""An IMU's axes as the body sensor comparison names them: specific force along x, y, z (m/s²),
+then rate about them (rad/s), in the sensor's axes."""
+
+
 @dataclass(frozen=True)
 class BodySensor:
     """An IMU on the machine's body: what shows what the body really did (`calibrate`).
@@ -236,6 +241,8 @@ class BodySensor:
             and below, `mount-twin modes`); the broadband figure is reported beside it.
         warn_nrms, error_nrms: normalised RMS error (‖pred − meas‖ / ‖meas‖ in the band, per
             axis, means out) past which the comparison WARNs, ERRORs.
+        axes: the sensor axes judged (`SENSOR_AXES`; a scene that models fewer DOFs than the
+            machine moves in judges those it models).
     """
 
     topic: str = "/machine/imu"
@@ -247,6 +254,7 @@ class BodySensor:
     band_hz: tuple[float, float] = (0.0, 10.0)
     warn_nrms: float = 0.3
     error_nrms: float = 0.6
+    axes: tuple[str, ...] = SENSOR_AXES
 
 
 @dataclass(frozen=True)

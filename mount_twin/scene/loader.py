@@ -17,6 +17,7 @@ from mount_twin.scene.checks import check_scene
 from mount_twin.scene.description import (
     DOF_NAMES,
     GYRO_FILTERS,
+    SENSOR_AXES,
     Ageing,
     Body,
     BodySensor,
@@ -402,7 +403,11 @@ def _body_sensor(r: Reader) -> BodySensor:
         band_hz=_band(r, "band_hz", d.band_hz),
         warn_nrms=r.positive("warn_nrms", d.warn_nrms),
         error_nrms=r.positive("error_nrms", d.error_nrms),
+        axes=r.names("axes", d.axes),
     )
+    wrong = [a for a in sensor.axes if a not in SENSOR_AXES]
+    if wrong or not sensor.axes:
+        raise r.error("axes", f"{list(sensor.axes)}: give some of {', '.join(SENSOR_AXES)}")
     if sensor.error_nrms < sensor.warn_nrms:
         raise r.error("error_nrms", f"{sensor.error_nrms} is below warn_nrms {sensor.warn_nrms}")
     r.finish()

@@ -69,6 +69,7 @@ PARAMETERS: dict[str, tuple[str, str]] = {
     "body_sensor.window_s": ("double", "Body IMU comparison: judged window, s"),
     "body_sensor.band_hz": ("double_array", "Body IMU comparison: judged band [low, high], Hz"),
     "body_sensor.warn_nrms": ("double", "Body IMU comparison: WARN past this NRMS in the band"),
+    "body_sensor.axes": ("string_array", "Body IMU comparison: axes judged (fx … wz)"),
     "body_sensor.error_nrms": ("double", "Body IMU comparison: ERROR past this NRMS in the band"),
     "initial_state.mode": ("string", "equilibrium or given"),
     "initial_state.gravity": ("string", "Equilibrium gravity: first_sample or nominal"),
