@@ -32,6 +32,7 @@ from mount_twin.model.assemble import assemble
 from mount_twin.replay import replay
 from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import load_scene_file, scene_from_dict
+from mount_twin.sweeps import runner as sweep_runner
 
 G = 9.80665
 CORNERS = [(0.4, 0.3), (-0.4, 0.3), (-0.4, -0.3), (0.4, -0.3)]
@@ -427,3 +428,17 @@ def test_the_worst_estimate_over_a_replay_is_one_figure_in_summary_json_and_diag
     assert data["error_estimate"]["force_error_rel"] == est.force_error_rel
     assert data["diagnostics_worst"][INTEGRATION]["message"] == worst.message
     assert "not estimated" not in data["accuracy"]
+
+
+def test_a_sweep_row_reads_the_replays_estimate(tmp_path: Path) -> None:
+    """A sweep's row (one push of the whole record) and the replay's summary (chunks of 2000)
+    give the same estimate for the same run, to the bit."""
+    scene, _ = _stiff_light()
+    loose = dataclasses.replace(
+        scene, integration=dataclasses.replace(scene.integration, rtol=1e-3)
+    )
+    bag = ROOT / "bags" / "ship_motion_1khz"
+    row = sweep_runner._figures(loose, read_samples(bag, loose.input))
+    summary = replay(loose, bag, tmp_path / "out", progress=False)
+    assert summary.error_estimate is not None
+    assert row["est_force_error_rel"] == summary.error_estimate.force_error_rel > 0.0
