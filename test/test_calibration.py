@@ -149,6 +149,24 @@ def test_the_body_imus_whole_mounting_is_found_from_one_shock() -> None:
     )
 
 
+def test_the_mass_and_cg_are_found_with_the_mounts_held() -> None:
+    """A body 1.2× heavier (mass and inertia) with its CG 3, −2, 5 cm off, from one shock:
+    the mass within 2 %, the CG within 5 mm; with stiffness and damping beside it the mass is
+    refused before any fit, saying why (the three are one ratio to the body IMU)."""
+    truth = {"mass": 1.2, "cg_x": 0.03, "cg_y": -0.02, "cg_z": 0.05, "lag": TRUTH["lag"]}
+    fit = ("mass", "cg_x", "cg_y", "cg_z", "lag")
+    cal = cal_mod.calibrate(_pump(), *_pair(_pump(), _one_shock(), truth), fit)
+    assert not cal.refused
+    assert cal.values["mass"] == pytest.approx(1.2, rel=0.02)
+    for name in ("cg_x", "cg_y", "cg_z"):
+        assert abs(cal.values[name] - truth[name]) < 0.005, name
+    assert cal.scene.body.mass == pytest.approx(1.2 * _pump().body.mass, rel=0.02)
+    with pytest.raises(ValueError, match="cannot fit mass with stiffness and damping"):
+        cal_mod.calibrate(
+            _pump(), *_pair(_pump(), _one_shock(), {}), ("stiffness", "damping", "mass")
+        )
+
+
 def test_a_group_naming_a_mount_the_scene_lacks_is_refused() -> None:
     with pytest.raises(ValueError, match=r"stiffness:fl\+nope: nope is no linear mount"):
         cal_mod.calibrate(

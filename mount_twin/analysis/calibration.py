@@ -14,6 +14,11 @@ with frequency, which a time-domain fit takes as one number):
 - `sensor_x`, `sensor_y`, `sensor_z` (on request): the body sensor's position, m in F, added
   to body_sensor.position (seen through the rotation's terms α × r and ω × (ω × r): a body
   that barely turns leaves them refused);
+- `mass` (on request): a scale factor on the body's mass and inertia (a uniformly heavier
+  body); with `stiffness` and `damping` beside it the three are one ratio to the body IMU
+  (scaling all three moves nothing it reads), so they are refused together: fit it with the
+  mounts held;
+- `cg_x`, `cg_y`, `cg_z` (on request): the CG's offset, m in F, added to body.cg;
 - `lag`: the body recorder's clock behind the foundation's, s (its samples are the motion
   `lag` seconds before their stamps), added to the scene's body_sensor.lag_s.
 
@@ -43,10 +48,12 @@ from mount_twin.scene.description import BodySensor, LinearMount, Scene, Vec3, V
 
 PARAMETERS = ("stiffness", "damping", "yaw", "lag")
 """What `calibrate` fits unless told otherwise."""
-ON_REQUEST = ("roll", "pitch", "sensor_x", "sensor_y", "sensor_z")
+ON_REQUEST = ("roll", "pitch", "sensor_x", "sensor_y", "sensor_z", "mass", "cg_x", "cg_y", "cg_z")
 """What it fits when named too: the rest of the body sensor's mounting."""
 ANGLES = ("roll", "pitch", "yaw")
 OFFSETS = ("sensor_x", "sensor_y", "sensor_z")
+CG_OFFSETS = ("cg_x", "cg_y", "cg_z")
+MOUNT_SCALES = ("stiffness", "damping")
 MAX_POSITION_SIGMA_M = 0.01
 """A sensor position offset whose 1σ exceeds this (m) is not identified by the record."""
 MAX_REL_SIGMA = 0.05
@@ -83,9 +90,14 @@ def _times(values: Vec6, factor: float) -> Vec6:
     return cast("Vec6", tuple(factor * v for v in values))
 
 
-def is_scale(name: str) -> bool:
+def is_mount_scale(name: str) -> bool:
     """Whether a parameter is a stiffness or damping scale (of all mounts or of a group)."""
-    return name.partition(":")[0] in ("stiffness", "damping")
+    return name.partition(":")[0] in MOUNT_SCALES
+
+
+def is_scale(name: str) -> bool:
+    """Whether a parameter is a scale factor (fitted as a logarithm): a mount scale or mass."""
+    return is_mount_scale(name) or name == "mass"
 
 
 def scaled_mounts(name: str, scene: Scene) -> list[str]:
@@ -112,7 +124,7 @@ def calibrated_scene(scene: Scene, values: dict[str, float]) -> Scene:
     names = [m.name for m in scene.mounts]
     factor = {(kind, m): 1.0 for kind in ("stiffness", "damping") for m in names}
     for name, value in values.items():
-        if is_scale(name):
+        if is_mount_scale(name):
             for m in scaled_mounts(name, scene):
                 factor[name.partition(":")[0], m] *= value
     mounts = tuple(
@@ -136,7 +148,15 @@ def calibrated_scene(scene: Scene, values: dict[str, float]) -> Scene:
         position=cast("Vec3", moved),
         lag_s=sensor.lag_s + values.get("lag", 0.0),
     )
-    return dataclasses.replace(scene, mounts=mounts, body_sensor=mounted)
+    mass = values.get("mass", 1.0)
+    cg = tuple(c + values.get(n, 0.0) for c, n in zip(scene.body.cg, CG_OFFSETS, strict=True))
+    body = dataclasses.replace(
+        scene.body,
+        mass=scene.body.mass * mass,
+        inertia=_times(scene.body.inertia, mass),
+        cg=cast("Vec3", cg),
+    )
+    return dataclasses.replace(scene, body=body, mounts=mounts, body_sensor=mounted)
 
 
 def predict(scene: Scene, foundation: Signal) -> tuple[np.ndarray, np.ndarray]:
@@ -228,7 +248,7 @@ def _too_uncertain(name: str, sigma: float, value: float, step_s: float) -> str 
         return f"1σ is {sigma / value:.0%} of its value (the record barely moves it)"
     if name in ANGLES and sigma > MAX_YAW_SIGMA_RAD:
         return f"1σ is {math.degrees(sigma):.1f}° (the motion has no direction to tell it by)"
-    if name in OFFSETS and sigma > MAX_POSITION_SIGMA_M:
+    if name in (*OFFSETS, *CG_OFFSETS) and sigma > MAX_POSITION_SIGMA_M:
         return f"1σ is {sigma * 1e3:.0f} mm (the body barely turns: its point hardly matters)"
     if name == "lag" and sigma > step_s:
         return f"1σ is {sigma * 1e3:.1f} ms, more than a sample ({step_s * 1e3:.1f} ms)"
@@ -255,7 +275,7 @@ def calibrate(
     docstring); refuse, by name, what the record cannot identify."""
     known = (*PARAMETERS, *ON_REQUEST)
     unknown = [
-        n for n in fit if n.partition(":")[0] not in known or (":" in n and not is_scale(n))
+        n for n in fit if n.partition(":")[0] not in known or (":" in n and not is_mount_scale(n))
     ]
     if unknown:
         msg = (
@@ -263,8 +283,15 @@ def calibrate(
             "and stiffness:MOUNT+MOUNT… or damping:… for a group"
         )
         raise ValueError(msg)
+    kinds = {n.partition(":")[0] for n in fit}
+    if {"mass", *MOUNT_SCALES} <= kinds:
+        msg = (
+            "cannot fit mass with stiffness and damping: scaling all three alike moves nothing "
+            "the body IMU reads; fit the mass with the mounts held, or the mounts with the mass"
+        )
+        raise ValueError(msg)
     for name in fit:
-        if is_scale(name):
+        if is_mount_scale(name):
             scaled_mounts(name, scene)
     free = list(fit)
     refused: dict[str, str] = {}

@@ -25,7 +25,7 @@ HELP = "fit mount stiffness and damping scales, the body IMU's yaw and lag to a 
 FITTED = ("stiffness", "damping", "yaw", "lag")
 """`analysis.calibration.PARAMETERS` (a test holds them equal: numpy is not imported to build
 the command line)."""
-ON_REQUEST = ("roll", "pitch", "sensor_x", "sensor_y", "sensor_z")
+ON_REQUEST = ("roll", "pitch", "sensor_x", "sensor_y", "sensor_z", "mass", "cg_x", "cg_y", "cg_z")
 """`analysis.calibration.ON_REQUEST` (held equal likewise)."""
 
 
@@ -41,8 +41,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="PARAMETER",
         help=f"what to fit, among {', '.join(FITTED)} (the default) and "
         f"{', '.join(ON_REQUEST)} (the body IMU's mounting: angles added to its orientation_rpy, "
-        "offsets to its position); stiffness:fl+fr (or damping:…) scales only those mounts, to "
-        "fit groups or single mounts apart",
+        "offsets to its position; the body's mass and inertia scaled, its CG offset); "
+        "stiffness:fl+fr (or damping:…) scales only those mounts, to fit groups or single "
+        "mounts apart",
     )
     parser.add_argument("--plot", metavar="PNG", help="the body record against the prediction")
     parser.epilog = (
@@ -118,7 +119,8 @@ def describe(cal: Calibration) -> list[str]:
     degrees = ("°", 57.29577951308232)
     millimetres = ("mm", 1e3)
     units = {"roll": degrees, "pitch": degrees, "yaw": degrees, "lag": ("ms", 1e3)}
-    units.update(dict.fromkeys(("sensor_x", "sensor_y", "sensor_z"), millimetres))
+    offsets = ("sensor_x", "sensor_y", "sensor_z", "cg_x", "cg_y", "cg_z")
+    units.update(dict.fromkeys(offsets, millimetres))
     lines = []
     for name, value in cal.values.items():
         unit, k = units.get(name, ("×", 1.0))  # the rest are scale factors
@@ -144,6 +146,8 @@ def _write_scene(source: str, out: Path, cal: Calibration, lines: list[str]) -> 
         if raw.get("kind", "linear") == "linear":
             raw["stiffness"] = list(mount.stiffness)  # type: ignore[union-attr]
             raw["damping"] = list(mount.damping)  # type: ignore[union-attr]
+    body = cal.scene.body
+    data["body"].update(mass=body.mass, cg=list(body.cg), inertia=list(body.inertia))
     sensor = cal.scene.body_sensor
     if sensor is not None:
         written = data.setdefault("body_sensor", {})
