@@ -14,7 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
+from mount_twin.io.csv_import import CSV_MAX_BYTES
 from mount_twin.io.signals import Signal
+from mount_twin.textfiles import FileTooLargeError, read_limited
 
 CLOCK_WRAP_US = 2**32
 ACCEL = ("Acc_X", "Acc_Y", "Acc_Z")
@@ -22,10 +24,11 @@ GYRO = ("Gyr_X", "Gyr_Y", "Gyr_Z")
 
 
 def is_xsens_csv(path: str | Path) -> bool:
-    """Whether the file starts as an Xsens DOT export does."""
-    with open(path, encoding="utf-8-sig", errors="replace") as fh:
-        head = [fh.readline() for _ in range(2)]
-    return head[0].strip().startswith("sep=") and head[1].startswith("DeviceTag")
+    """Whether the file starts as an Xsens DOT export does (its first 4 kB read, no more: a
+    device or a huge file is not read whole here)."""
+    with open(path, "rb") as fh:
+        head = fh.read(4096).decode("utf-8-sig", errors="replace").splitlines()
+    return len(head) > 1 and head[0].strip().startswith("sep=") and head[1].startswith("DeviceTag")
 
 
 def read_xsens_csv(path: str | Path) -> tuple[Signal, str]:
@@ -33,8 +36,11 @@ def read_xsens_csv(path: str | Path) -> tuple[Signal, str]:
     records share it; specific force m/s², rate rad/s, sensor frame) and its device tag;
     errors name the file and what is missing."""
     path = Path(path)
-    with open(path, encoding="utf-8-sig", newline="") as fh:
-        lines = fh.read().splitlines()
+    try:
+        lines = read_limited(path, CSV_MAX_BYTES, "CSV_MAX_BYTES", "utf-8-sig").splitlines()
+    except FileTooLargeError as err:
+        msg = f"{path}: cannot read: {err}"
+        raise ValueError(msg) from err
     tag = next((ln.split(",", 1)[1] for ln in lines if ln.startswith("DeviceTag:")), "")
     start = next((i for i, ln in enumerate(lines) if ln.startswith("PacketCounter,")), None)
     if start is None:
