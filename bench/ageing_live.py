@@ -56,6 +56,8 @@ def main() -> None:
         body = statuses_named(raws, BODY)
         worst = max(body, key=lambda s: s[1])
         print(f"body sensor: {len(body)} windows, worst {LEVEL_NAMES[worst[1]]}: {worst[2]}")
+        levels = " ".join(LEVEL_NAMES[level][0] for _, level, _, _ in body)
+        print(f"body sensor windows (O/W/E), one per 10 s (the default): {levels}")
         print(f"replay of {total:.1f} s: {cpu:.1f} s CPU, verdict {summary.verdict}")
 
 
