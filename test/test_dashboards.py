@@ -3,6 +3,7 @@ messages, on the node's topics, for every mount; regenerating them gives the fil
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from xml.etree import ElementTree as ET
 
@@ -10,8 +11,9 @@ import pytest
 from io_helpers import CONFIG
 
 from mount_twin.analysis.dashboards import foxglove_layout, plotjuggler_layout
-from mount_twin.io.messages import TYPESTORE, output_streams, resolve
+from mount_twin.io.messages import IMU, TYPESTORE, output_streams, output_types, resolve
 from mount_twin.replay import NODE_NAME
+from mount_twin.scene.description import BodySensor
 from mount_twin.scene.loader import load_scene_file
 
 SCENES = ("pump_8_mounts", "genset_bolted_keyed")
@@ -68,3 +70,25 @@ def test_the_bundled_layouts_are_what_the_command_writes(scene_name: str) -> Non
     assert (CONFIG / f"{scene_name}.foxglove.json").read_text(encoding="utf-8") == (
         foxglove_layout(scene)
     )
+
+
+def test_a_body_imu_adds_its_prediction_and_residual_on_their_topics() -> None:
+    """With a body_sensor, both layouts plot the body IMU's predicted and residual specific
+    force, fields of the node's sensor_msgs/Imu outputs."""
+    pump = load_scene_file(CONFIG / "pump_8_mounts.scene.yaml")
+    scene = dataclasses.replace(pump, body_sensor=BodySensor(position=(0.8, 0.3, 1.0)))
+    types = {resolve(t, NODE_NAME): m for t, m in output_types(scene).items()}
+    root = ET.fromstring(plotjuggler_layout(scene))
+    names = [c.get("name", "") for c in root.iter("curve")]
+    paths = [
+        p["value"]
+        for panel in json.loads(foxglove_layout(scene))["configById"].values()
+        for p in panel["paths"]
+    ]
+    for topic in ("/mount_twin/body_imu/predicted", "/mount_twin/body_imu/residual"):
+        assert types[topic] == IMU
+        for a in "xyz":
+            assert f"{topic}/linear_acceleration/{a}" in names
+            assert f"{topic}.linear_acceleration.{a}" in paths
+            assert _field_exists(IMU, ["linear_acceleration", a])
+    assert len(names) == len(paths) == 2 * 3 + 3 * len(scene.mounts) + 2 * 3

@@ -1,6 +1,7 @@
 """Ready dashboards for a scene's outputs: a PlotJuggler layout (XML) and a Foxglove layout
 (JSON), each plotting the CG position, the attitude angles and every mount's force components
-from the node's topics (live) or an output bag (the same topics).
+(with a body IMU, its predicted specific force and the residual too) from the node's topics
+(live) or an output bag (the same topics).
 
 Series are named the way each tool names message fields: PlotJuggler `/topic/field/sub`,
 Foxglove message paths `/topic.field.sub` (plotted against the header stamp).
@@ -13,6 +14,8 @@ from xml.etree import ElementTree as ET
 
 from mount_twin.io.messages import (
     ANGLES_OUTPUT,
+    BODY_PREDICTED_TOPIC,
+    BODY_RESIDUAL_TOPIC,
     POSE_OUTPUT,
     WRENCHES_OUTPUT,
     Output,
@@ -25,7 +28,8 @@ COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e
 
 
 def panels(scene: Scene) -> list[tuple[str, list[tuple[str, tuple[str, ...]]]]]:
-    """(panel title, [(topic, field path)]) of each plot: pose, angles, then force x, y, z."""
+    """(panel title, [(topic, field path)]) of each plot: pose, angles, force x, y, z, and with
+    a body_sensor the body IMU's predicted and residual specific force."""
     pose = resolve(POSE_OUTPUT.topic, NODE_NAME)
     angles = resolve(ANGLES_OUTPUT.topic, NODE_NAME)
     Series = list[tuple[str, tuple[str, ...]]]
@@ -41,6 +45,13 @@ def panels(scene: Scene) -> list[tuple[str, list[tuple[str, tuple[str, ...]]]]]:
                 [(resolve(st.topic, NODE_NAME), _path(WRENCHES_OUTPUT, k)) for st in wrenches],
             )
         )
+    if scene.body_sensor is not None:  # the body IMU against the twin (its axes)
+        for topic, what in (
+            (BODY_PREDICTED_TOPIC, "predicted"),
+            (BODY_RESIDUAL_TOPIC, "residual"),
+        ):
+            series = [(resolve(topic, NODE_NAME), ("linear_acceleration", a)) for a in "xyz"]
+            out.append((f"body IMU specific force, {what} [m/s²]", series))
     return out
 
 
