@@ -50,7 +50,9 @@ def panels(scene: Scene) -> list[tuple[str, list[tuple[str, tuple[str, ...]]]]]:
             (BODY_PREDICTED_TOPIC, "predicted"),
             (BODY_RESIDUAL_TOPIC, "residual"),
         ):
-            series = [(resolve(topic, NODE_NAME), ("linear_acceleration", a)) for a in "xyz"]
+            series: Series = [
+                (resolve(topic, NODE_NAME), ("linear_acceleration", a)) for a in "xyz"
+            ]
             out.append((f"body IMU specific force, {what} [m/s²]", series))
     return out
 

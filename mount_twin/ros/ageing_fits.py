@@ -15,6 +15,9 @@ from mount_twin.engine.batch import ERROR, HealthReport, HealthStatus
 from mount_twin.io.messages import encode_report
 from mount_twin.scene.description import Scene
 
+FIT_WAIT_S = 120.0
+"""At shutdown, how long (s) the node waits for each ageing fit still running."""
+
 
 class AgeingFits:
     """The fits submitted and not yet published, oldest first."""
@@ -33,18 +36,19 @@ class AgeingFits:
         self._pending.append((job.stamp_ns, self._pool.submit(run_job, job)))
 
     def done(self, wait: bool = False) -> list[tuple[str, int, bytes]]:
-        """The reports of the fits finished in order (`wait`: all, then the worker stops), as
-        /diagnostics messages; a fit that raised is an ERROR saying so."""
+        """The reports of the fits finished in order (`wait`: all, each within FIT_WAIT_S,
+        then the worker stops), as /diagnostics messages; a fit that raised or did not finish
+        in time is an ERROR saying so."""
         msgs = []
         while self._pending and (wait or self._pending[0][1].done()):
             stamp_ns, future = self._pending.popleft()
             try:
-                report = future.result()
-            except Exception as err:  # the worker died or the fit raised: said, not lost
+                report = future.result(timeout=FIT_WAIT_S)
+            except Exception as err:  # the worker died, the fit raised or hung: said, not lost
                 status = HealthStatus(NAME, ERROR, f"the ageing fit failed: {err!r}", {})
                 report = HealthReport(stamp_ns * 1e-9, -1, [status])
             msgs.append(encode_report(self.scene, report, stamp_ns))
         if wait and self._pool is not None:
-            self._pool.shutdown()
+            self._pool.shutdown(wait=False, cancel_futures=True)
             self._pool = None
         return msgs
