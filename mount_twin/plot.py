@@ -1,4 +1,5 @@
-"""Plot a replay's output bag: CG displacement, attitude angles and mount forces over time."""
+"""Plot a replay's output bag: CG displacement, attitude angles, mount forces and (with a body
+IMU) its measured specific force against the twin's, over time."""
 
 from __future__ import annotations
 
@@ -20,14 +21,16 @@ def plot_output_bag(
 ) -> Path:
     """Write a PNG of the output bag's pose, angles and per-mount force magnitudes, with the
     mount events (engine stamps + origin_s = header stamps, s) marked on the forces at their
-    reported |F|: ERROR red triangles, WARN orange dots."""
+    reported |F|: ERROR red triangles, WARN orange dots; with a body IMU comparison in the bag,
+    its measured specific force against the twin's prediction below."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     tables = {t.name: t for t in read_output_bag(bag)}
-    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(10, 9))
+    body = "body_imu_predicted" in tables and "body_imu_residual" in tables
+    fig, axes = plt.subplots(4 if body else 3, 1, sharex=True, figsize=(10, 12 if body else 9))
     if "pose" in tables:
         pose = tables["pose"].columns
         for axis in "xyz":
@@ -56,10 +59,22 @@ def plot_output_bag(
                 label=f"{'ERROR' if error else 'WARN'} events: "
                 + ", ".join(sorted({e.event for e in mine})),
             )
+    if body:  # the body IMU: measured (the prediction plus the residual) against the twin,
+        # each about its mean (gravity and biases out, as the comparison takes them)
+        predicted = tables["body_imu_predicted"].columns
+        residual = tables["body_imu_residual"].columns
+        for axis in "xyz":
+            twin = predicted[f"f{axis}_m_s2"]
+            measured = twin + residual[f"f{axis}_m_s2"]
+            t = predicted["t_s"]
+            line = axes[3].plot(t, measured - measured.mean(), lw=0.8, label=f"measured {axis}")
+            colour = line[0].get_color()
+            axes[3].plot(t, twin - twin.mean(), "--", color=colour, lw=0.8, label=f"twin {axis}")
+        axes[3].set_ylabel("body IMU specific force\nabout its mean [m/s²]")
     axes[0].set_ylabel("displacement [mm]")
     axes[1].set_ylabel("angle [deg]")
     axes[2].set_ylabel("|mount force| [N]")
-    axes[2].set_xlabel("time from first output [s]")
+    axes[-1].set_xlabel("time from first output [s]")
     for ax in axes:
         ax.grid(True, alpha=0.3)
         ax.legend(loc="upper right", fontsize=7, ncol=4)

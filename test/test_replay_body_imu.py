@@ -162,3 +162,25 @@ def test_the_real_pair_calibrated_on_one_run_agrees_live_on_the_other(
     capsys.readouterr()
     assert worst["calibrated"][0] == OK and worst["calibrated"][1] < 0.1
     assert worst["nominal"][1] > 0.2
+
+
+def test_the_body_imu_comparison_is_exported_and_plotted(tmp_path: Path) -> None:
+    """`export` writes the prediction and the residual as tables (specific force m/s², rate
+    rad/s, one row per compared sample); `replay --plot` adds the measured specific force
+    against the twin's."""
+    _bags(tmp_path)
+    code, summary = _replay(tmp_path, "in_both", "--plot", str(tmp_path / "p.png"))
+    assert code == 0 and (tmp_path / "p.png").stat().st_size > 20_000
+    assert main(["export", str(tmp_path / "out_in_both"), "--csv", str(tmp_path / "csv")]) == 0
+    compared = summary["body_sensor"]["counts"]["compared"]
+    for name in ("body_imu_predicted", "body_imu_residual"):
+        lines = (tmp_path / "csv" / f"{name}.csv").read_text(encoding="utf-8").splitlines()
+        assert lines[0].split(",")[2:] == [
+            "fx_m_s2",
+            "fy_m_s2",
+            "fz_m_s2",
+            "wx_rad_s",
+            "wy_rad_s",
+            "wz_rad_s",
+        ]
+        assert len(lines) == 1 + compared

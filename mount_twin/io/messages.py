@@ -310,37 +310,33 @@ class Stream:
 
 
 @dataclass(frozen=True)
-class Output:
-    """What one per-row output is, declared once: the writer (`output_streams`), the bag reader
-    (`output_table`, then `export`, `report`, dashboards) and `info` read it.
+class Readback:
+    """A topic the bag reader files into a table (`output_table`, then `export`, `report`,
+    the plots).
 
     Attributes:
-        flag: its switch in `scene.outputs`.
-        topic: its topic before resolution; `{mount}` stands for each mount's name (one stream
-            per mount).
-        msgtype: its message type (a fixed-layout type of `_BUILDERS`).
+        topic: its topic before resolution ('~' is the node's namespace/name); `{mount}`
+            stands for each mount's name (one stream per mount).
+        msgtype: its message type.
         table: the table its messages are read into (`{mount}` as in topic), or None: not read
             back.
         columns: the table's numeric columns, unit in the name.
         fields: the message field (dotted path) each column is read from, in column order.
-        frames: the frame id(s) its messages carry, from the scene (and the mount's name).
-        values: its rows' float fields from an OutputBatch (and the mount's index).
     """
 
-    flag: str
     topic: str
     msgtype: str
     table: str | None
     columns: tuple[str, ...]
     fields: tuple[str, ...]
-    frames: Callable[[Scene, str], tuple[str, ...]]
-    values: Callable[[OutputBatch, int], np.ndarray]
 
     def __post_init__(self) -> None:
-        """Refuse an output registered half-way, at import, naming what is missing."""
+        """Refuse a readback (or output) registered half-way, at import, naming what is
+        missing."""
         missing = _output_gaps(self)
         if missing:
-            msg = f"io.messages: output {self.flag!r} ({self.topic}): {'; '.join(missing)}"
+            name = f"{self.flag!r} ({self.topic})" if isinstance(self, Output) else self.topic
+            msg = f"io.messages: output {name}: {'; '.join(missing)}"
             raise ValueError(msg)
 
     @cached_property
@@ -356,6 +352,34 @@ class Output:
     def per_mount(self) -> bool:
         """One stream per mount."""
         return "{mount}" in self.topic
+
+    def table_of(self, topic: str, msgtype: str) -> str | None:
+        """The table a resolved topic of msgtype is read into, if it is this output's: its
+        topic after the node's namespace and name ('~'), a mount's name where `{mount}` is."""
+        if self.table is None or msgtype != self.msgtype:
+            return None
+        head, _, tail = self.topic.lstrip("~").partition("{mount}")
+        pattern = re.escape(head) + (
+            "(?P<mount>[^/]+)" + re.escape(tail) if self.per_mount else ""
+        )
+        found = re.search(pattern + "$", topic)
+        return None if found is None else self.table.format(**found.groupdict())
+
+
+@dataclass(frozen=True)
+class Output(Readback):
+    """What one per-row output is, declared once: the writer (`output_streams`), the bag reader
+    (`output_table`, then `export`, `report`, dashboards) and `info` read it.
+
+    Attributes (besides `Readback`'s):
+        flag: its switch in `scene.outputs`.
+        frames: the frame id(s) its messages carry, from the scene (and the mount's name).
+        values: its rows' float fields from an OutputBatch (and the mount's index).
+    """
+
+    flag: str
+    frames: Callable[[Scene, str], tuple[str, ...]]
+    values: Callable[[OutputBatch, int], np.ndarray]
 
     def streams(self, scene: Scene) -> list[Stream]:
         """Its streams for `scene`."""
@@ -375,18 +399,6 @@ class Output:
         """Its rows' values for the i-th mount (or the one stream)."""
         return lambda out: self.values(out, i)
 
-    def table_of(self, topic: str, msgtype: str) -> str | None:
-        """The table a resolved topic of msgtype is read into, if it is this output's: its
-        topic after the node's namespace and name ('~'), a mount's name where `{mount}` is."""
-        if self.table is None or msgtype != self.msgtype:
-            return None
-        head, _, tail = self.topic.lstrip("~").partition("{mount}")
-        pattern = re.escape(head) + (
-            "(?P<mount>[^/]+)" + re.escape(tail) if self.per_mount else ""
-        )
-        found = re.search(pattern + "$", topic)
-        return None if found is None else self.table.format(**found.groupdict())
-
 
 def _has_field(msgtype: str, path: str) -> bool:
     """Whether the dotted field path exists in `msgtype` (the typestore's definitions)."""
@@ -399,10 +411,10 @@ def _has_field(msgtype: str, path: str) -> bool:
     return True
 
 
-def _output_gaps(out: Output) -> list[str]:
-    """What an output's declaration lacks or contradicts (empty: complete)."""
+def _output_gaps(out: Readback) -> list[str]:
+    """What a readback's or an output's declaration lacks or contradicts (empty: complete)."""
     gaps = []
-    if out.flag not in {f.name for f in dataclass_fields(Outputs)}:
+    if isinstance(out, Output) and out.flag not in {f.name for f in dataclass_fields(Outputs)}:
         gaps.append(f"no switch {out.flag!r} in scene.outputs (mount_twin.scene.description)")
     if out.msgtype not in _BUILDERS:
         gaps.append(f"no builder for {out.msgtype} in _BUILDERS")
@@ -429,44 +441,44 @@ POSE_FIELDS = tuple(f"pose.position.{a}" for a in "xyz") + tuple(
 )
 
 POSE_OUTPUT = Output(
-    "pose",
-    "~/pose",
-    POSE,
-    "pose",
-    POSE_COLUMNS,
-    POSE_FIELDS,
-    lambda sc, _: (sc.frames.foundation,),
-    _pose_fields,
+    flag="pose",
+    topic="~/pose",
+    msgtype=POSE,
+    table="pose",
+    columns=POSE_COLUMNS,
+    fields=POSE_FIELDS,
+    frames=lambda sc, _: (sc.frames.foundation,),
+    values=_pose_fields,
 )
 ANGLES_OUTPUT = Output(
-    "angles",
-    "~/angles",
-    VECTOR3,
-    "angles",
-    ("alpha_rad", "gamma_rad", "delta_rad"),
-    tuple(f"vector.{a}" for a in "xyz"),
-    lambda sc, _: (sc.frames.foundation,),
-    lambda out, i: out.angles,
+    flag="angles",
+    topic="~/angles",
+    msgtype=VECTOR3,
+    table="angles",
+    columns=("alpha_rad", "gamma_rad", "delta_rad"),
+    fields=tuple(f"vector.{a}" for a in "xyz"),
+    frames=lambda sc, _: (sc.frames.foundation,),
+    values=lambda out, i: out.angles,
 )
 WRENCHES_OUTPUT = Output(
-    "wrenches",
-    "~/mounts/{mount}/wrench",
-    WRENCH,
-    "mount_{mount}",
-    ("fx_N", "fy_N", "fz_N", "tx_Nm", "ty_Nm", "tz_Nm"),
-    tuple(f"wrench.{p}.{a}" for p in ("force", "torque") for a in "xyz"),
-    lambda sc, name: (sc.frames.mount_frame(name),),
-    lambda out, i: out.wrenches[:, i],
+    flag="wrenches",
+    topic="~/mounts/{mount}/wrench",
+    msgtype=WRENCH,
+    table="mount_{mount}",
+    columns=("fx_N", "fy_N", "fz_N", "tx_Nm", "ty_Nm", "tz_Nm"),
+    fields=tuple(f"wrench.{p}.{a}" for p in ("force", "torque") for a in "xyz"),
+    frames=lambda sc, name: (sc.frames.mount_frame(name),),
+    values=lambda out, i: out.wrenches[:, i],
 )
 TF_OUTPUT = Output(
-    "tf",
-    TF_TOPIC,
-    TF,
-    None,
-    (),
-    (),
-    lambda sc, _: (sc.frames.foundation, sc.frames.body),
-    _pose_fields,
+    flag="tf",
+    topic=TF_TOPIC,
+    msgtype=TF,
+    table=None,
+    columns=(),
+    fields=(),
+    frames=lambda sc, _: (sc.frames.foundation, sc.frames.body),
+    values=_pose_fields,
 )
 OUTPUTS: tuple[Output, ...] = (POSE_OUTPUT, ANGLES_OUTPUT, WRENCHES_OUTPUT, TF_OUTPUT)
 """The per-row outputs, in the order their messages follow each other (each flag is one of
@@ -480,11 +492,11 @@ def output_streams(scene: Scene) -> list[Stream]:
     return [st for out in OUTPUTS if getattr(scene.outputs, out.flag) for st in out.streams(scene)]
 
 
-def output_table(topic: str, msgtype: str) -> tuple[str, Output] | None:
+def output_table(topic: str, msgtype: str) -> tuple[str, Readback] | None:
     """The table a resolved output topic of msgtype is read into, and its output (columns and
-    fields), or None: not a per-row output of the twin (another node's topic, /tf,
-    diagnostics)."""
-    for out in OUTPUTS:
+    fields), or None: not an output of the twin read back (another node's topic, /tf,
+    diagnostics). The per-row outputs, then the body IMU comparison's (`BODY_READBACKS`)."""
+    for out in (*OUTPUTS, *BODY_READBACKS):
         table = out.table_of(topic, msgtype)
         if table is not None:
             return table, out
@@ -571,6 +583,15 @@ BODY_PREDICTED_TOPIC = "~/body_imu/predicted"
 """The twin's prediction of each body IMU sample (sensor_msgs/Imu, its stamp and axes)."""
 BODY_RESIDUAL_TOPIC = "~/body_imu/residual"
 """The body IMU's sample minus the prediction (sensor_msgs/Imu, its stamp and axes)."""
+_BODY_COLUMNS = ("fx_m_s2", "fy_m_s2", "fz_m_s2", "wx_rad_s", "wy_rad_s", "wz_rad_s")
+_BODY_FIELDS = tuple(
+    f"{v}.{a}" for v in ("linear_acceleration", "angular_velocity") for a in "xyz"
+)
+BODY_READBACKS = (
+    Readback(BODY_PREDICTED_TOPIC, IMU, "body_imu_predicted", _BODY_COLUMNS, _BODY_FIELDS),
+    Readback(BODY_RESIDUAL_TOPIC, IMU, "body_imu_residual", _BODY_COLUMNS, _BODY_FIELDS),
+)
+"""The body IMU comparison's topics, read back as tables (specific force, rate; its axes)."""
 
 
 def body_frame_id(scene: Scene) -> str:

@@ -22,7 +22,7 @@ from rosbags.highlevel import AnyReader
 
 from mount_twin.engine.batch import event_level
 from mount_twin.errors import BagError
-from mount_twin.io.messages import DIAGNOSTICS, OUTPUTS, TYPESTORE, Output, output_table
+from mount_twin.io.messages import DIAGNOSTICS, OUTPUTS, TYPESTORE, Readback, output_table
 from mount_twin.kinds.events import EVENT_IS_ERROR
 
 LEVELS = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
@@ -48,11 +48,11 @@ def read_output_bag(path: str | Path) -> list[Table]:
     (`io.messages.output_table`); other topics are left out."""
     stamps: dict[str, list[int]] = {}
     rows: dict[str, list[tuple[Any, ...]]] = {}
-    columns_of: dict[str, Output | None] = {}
+    columns_of: dict[str, Readback | None] = {}
     rank: dict[str, int] = {}
     try:
         with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
-            tables_of: dict[int, tuple[str, Output | None]] = {}
+            tables_of: dict[int, tuple[str, Readback | None]] = {}
             for c in reader.connections:
                 if c.msgtype == DIAGNOSTICS:
                     tables_of[c.id] = ("diagnostics", None)
