@@ -130,10 +130,14 @@ class TwinStream:
         return reports
 
     def _track_foundation(self, decoded: Decoded) -> None:
-        """Deck samples into the ageing tracker: those with finite values and rising stamps."""
+        """Deck samples into the ageing tracker: those with finite values, the input's
+        frame_id (if it names one) and rising stamps."""
         assert self.ageing is not None and self.base is not None
-        finite = np.isfinite(np.hstack([decoded.accel, decoded.gyro])).all(axis=1)
-        keep = rising(decoded.stamps_ns, finite, self._ageing_last_ns)
+        good = np.isfinite(np.hstack([decoded.accel, decoded.gyro])).all(axis=1)
+        expected = self.scene.input.frame_id
+        if expected:
+            good &= np.array([f == expected for f in decoded.frame_ids], bool)
+        keep = rising(decoded.stamps_ns, good, self._ageing_last_ns)
         if keep.any():
             ns = decoded.stamps_ns[keep]
             self._ageing_last_ns = int(ns[-1])

@@ -266,3 +266,25 @@ def statuses_named(raws: list[bytes], name: str) -> list[tuple[int, int, str, di
             if s.name == name
         ]
     return out
+
+
+def pump_scene_file(tmp: Path, **sections: dict[str, Any] | None) -> Path:
+    """The bundled pump's scene file with `sections` merged into its own (a section None is
+    removed), written to tmp/pump.scene.yaml."""
+    data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
+    for name, values in sections.items():
+        if values is None:
+            data.pop(name, None)
+        else:
+            data[name] = {**data.get(name, {}), **values}
+    path = tmp / "pump.scene.yaml"
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    return path
+
+
+AGEING_PUMP = {
+    "input": {"gyro_filter": "none"},
+    "body_sensor": {"topic": "/machine/imu", "position": [0.8, 0.3, 1.0]},
+    "ageing": {"window_s": 20.0},
+}
+"""The pump with its body IMU on /machine/imu and ageing tracked in windows of 20 s."""

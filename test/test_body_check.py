@@ -21,7 +21,7 @@ from mount_twin.analysis.response import followed
 from mount_twin.engine.agreement import NAME
 from mount_twin.engine.batch import ERROR, OK, WARN, SampleBatch
 from mount_twin.engine.intake import rotated
-from mount_twin.engine.sensor_reading import predicted_reading
+from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.errors import SceneError
 from mount_twin.io.messages import (
     BODY_PREDICTED_TOPIC,
@@ -72,7 +72,9 @@ def _whole_record(scene: Scene, deck: Signal) -> tuple[np.ndarray, np.ndarray]:
     rate = rotated(deck.gyro, model.sensor_rotation)
     assert scene.body_sensor is not None
     pose = (out.position, out.quaternion)
-    f, w = predicted_reading(scene, scene.body_sensor, out.stamps, pose, out.wrenches, rate)
+    f, w = predicted_reading(
+        SensorGeometry.of(scene, scene.body_sensor), out.stamps, pose, out.wrenches, rate
+    )
     return out.stamps, np.hstack([f, w])
 
 

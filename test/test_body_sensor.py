@@ -11,7 +11,7 @@ import numpy as np
 from io_helpers import ROOT
 
 from mount_twin import SampleBatch, TwinEngine, assemble, load_scene_file
-from mount_twin.engine.sensor_reading import predicted_reading
+from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.physics.rotations import quaternion_matrices, rpy_matrix
 from mount_twin.scene.description import BodySensor
 
@@ -36,7 +36,9 @@ def test_the_predicted_reading_is_the_points_own_acceleration() -> None:
     out = TwinEngine(model).run(SampleBatch(t, accel, np.zeros_like(accel), ["deck_imu"] * t.size))
     sensor = BodySensor(position=(0.9, -0.4, 1.1), orientation_rpy=(0.3, -0.2, 1.0))
     pose = (out.position, out.quaternion)
-    f, w = predicted_reading(scene, sensor, out.stamps, pose, out.wrenches, np.zeros((t.size, 3)))
+    f, w = predicted_reading(
+        SensorGeometry.of(scene, sensor), out.stamps, pose, out.wrenches, np.zeros((t.size, 3))
+    )
     # Independent: the point's position in F, differentiated twice, plus the input.
     rotation = quaternion_matrices(out.quaternion)
     arm = np.array(sensor.position) - np.array(scene.body.cg)

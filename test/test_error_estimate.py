@@ -70,30 +70,47 @@ def _stiff_light(method: str = "dopri54") -> tuple[Scene, SampleBatch]:
     return _ship_motion(_with_pump_input(data), 1.0)
 
 
-def _rubber_on_snubbers() -> tuple[Scene, SampleBatch]:
-    """200 kg on four hysteretic elastomers that hit their snubbers (3 mm gap, Hertzian
-    contact) under a 30 g, 5 ms half-sine at 10 kHz: non-smooth in the state (|ẋ| of
-    Bouc–Wen, contact onset)."""
+def _on_hysteretic_rubber(
+    body: tuple[float, list[float], list[float]],
+    stiffness_damping: tuple[list[float], list[float]],
+    snubber: dict,
+) -> Scene:
+    """A body (mass kg, CG m, principal inertia kg·m²) on four Bouc–Wen elastomers at the
+    corners (linear stiffness N/m and damping N·s/m per axis) with snubbers, pump input."""
     mounts = [
         kind_mount(
             "elastomer",
             f"r{i}",
             (x, y, 0.0),
-            stiffness_linear=[1e5, 1e5, 2e5],
-            damping=[300.0, 300.0, 500.0],
+            stiffness_linear=stiffness_damping[0],
+            damping=stiffness_damping[1],
             hysteresis={"ratio": 0.6, "beta": 120.0, "gamma": 80.0},
-            snubber={"gap": 3e-3, "stiffness": 1e9, "exponent": 1.5, "axes": ["z"]},
+            snubber=snubber,
         )
         for i, (x, y) in enumerate(CORNERS)
     ]
-    scene = _with_pump_input(
-        base_scene(200.0, [0.0, 0.0, 0.3], [20.0, 30.0, 40.0, 0, 0, 0], mounts)
+    mass, cg, inertia = body
+    return _with_pump_input(base_scene(mass, cg, [*inertia, 0, 0, 0], mounts))
+
+
+def _record(scene: Scene, t: np.ndarray, accel: np.ndarray) -> tuple[Scene, SampleBatch]:
+    """The scene with its gyro raw, and a deck record of `accel` (m/s², F) at stamps t."""
+    frames = [scene.input.frame_id] * t.shape[0]
+    return raw_gyro(scene), SampleBatch(t, accel, np.zeros_like(accel), frames)
+
+
+def _rubber_on_snubbers() -> tuple[Scene, SampleBatch]:
+    """200 kg on four hysteretic elastomers that hit their snubbers (3 mm gap, Hertzian
+    contact) under a 30 g, 5 ms half-sine at 10 kHz: non-smooth in the state (|ẋ| of
+    Bouc–Wen, contact onset)."""
+    scene = _on_hysteretic_rubber(
+        (200.0, [0.0, 0.0, 0.3], [20.0, 30.0, 40.0]),
+        ([1e5, 1e5, 2e5], [300.0, 300.0, 500.0]),
+        {"gap": 3e-3, "stiffness": 1e9, "exponent": 1.5, "axes": ["z"]},
     )
     t = 1.0 + np.arange(2001) / 10_000.0
     pulse = np.where((t > 1.02) & (t < 1.025), 30 * G * np.sin(math.pi * (t - 1.02) / 0.005), 0.0)
-    accel = np.column_stack([0.3 * pulse, np.zeros_like(t), G + pulse])
-    frames = [scene.input.frame_id] * t.shape[0]
-    return raw_gyro(scene), SampleBatch(t, accel, np.zeros_like(accel), frames)
+    return _record(scene, t, np.column_stack([0.3 * pulse, np.zeros_like(t), G + pulse]))
 
 
 def _hysteresis_snubbers_real_shock() -> tuple[Scene, SampleBatch]:
@@ -104,23 +121,12 @@ def _hysteresis_snubbers_real_shock() -> tuple[Scene, SampleBatch]:
     rec = np.loadtxt(DATA_DIR / "water_entry_shock_20khz_excerpt.csv", delimiter=",", skiprows=1)
     t, shock = rec[:, 0], rec[:, 1:4] - rec[:40, 1:4].mean(axis=0)
     accel = np.column_stack([shock[:, 1], shock[:, 2], G + shock[:, 0]])
-    mounts = [
-        kind_mount(
-            "elastomer",
-            f"r{i}",
-            (x, y, 0.0),
-            stiffness_linear=[2e5, 2e5, 4e5],
-            damping=[400.0, 400.0, 800.0],
-            hysteresis={"ratio": 0.6, "beta": 120.0, "gamma": 80.0},
-            snubber={"gap": 2e-3, "stiffness": 2e8, "exponent": 1.5, "axes": ["x", "y", "z"]},
-        )
-        for i, (x, y) in enumerate(CORNERS)
-    ]
-    scene = _with_pump_input(
-        base_scene(80.0, [0.0, 0.0, 0.25], [8.0, 10.0, 12.0, 0, 0, 0], mounts)
+    scene = _on_hysteretic_rubber(
+        (80.0, [0.0, 0.0, 0.25], [8.0, 10.0, 12.0]),
+        ([2e5, 2e5, 4e5], [400.0, 400.0, 800.0]),
+        {"gap": 2e-3, "stiffness": 2e8, "exponent": 1.5, "axes": ["x", "y", "z"]},
     )
-    frames = [scene.input.frame_id] * t.shape[0]
-    return raw_gyro(scene), SampleBatch(t, accel, np.zeros_like(accel), frames)
+    return _record(scene, t, accel)
 
 
 def _pump() -> tuple[Scene, SampleBatch]:

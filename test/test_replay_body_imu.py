@@ -10,8 +10,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
-from io_helpers import DATA_DIR, SCENE_FILE, ageing_bag, read_raw, statuses_named
+from io_helpers import (
+    AGEING_PUMP,
+    DATA_DIR,
+    ageing_bag,
+    pump_scene_file,
+    read_raw,
+    statuses_named,
+)
 
 from mount_twin import load_scene_file
 from mount_twin.analysis.ageing_live import NAME as AGEING
@@ -29,12 +35,8 @@ BODY_OUT = ("/mount_twin/body_imu/predicted", "/mount_twin/body_imu/residual")
 
 
 def _scene(tmp: Path, body: bool = True) -> Path:
-    data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
-    if body:
-        data["body_sensor"] = {"topic": BODY_TOPIC, "position": [0.8, 0.3, 1.0], "window_s": 2.0}
-    path = tmp / "pump.scene.yaml"
-    path.write_text(yaml.safe_dump(data), encoding="utf-8")
-    return path
+    sensor = {"topic": BODY_TOPIC, "position": [0.8, 0.3, 1.0], "window_s": 2.0}
+    return pump_scene_file(tmp, body_sensor=sensor if body else None)
 
 
 def _bags(tmp: Path) -> None:
@@ -108,12 +110,7 @@ def test_mounts_that_age_are_tracked_window_by_window(
     damping window by window on the bag's deck and body IMU: the window before the mounts lose
     30 % of their stiffness (at 22 s) is OK, the one after an ERROR reading stiffness ×0.70
     (within 2 %), and the run's verdict is ERROR."""
-    data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
-    data["input"]["gyro_filter"] = "none"
-    data["body_sensor"] = {"topic": BODY_TOPIC, "position": [0.8, 0.3, 1.0]}
-    data["ageing"] = {"window_s": 20.0}
-    scene_path = tmp_path / "pump.scene.yaml"
-    scene_path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    scene_path = pump_scene_file(tmp_path, **AGEING_PUMP)
     ageing_bag(tmp_path / "in", load_scene_file(scene_path), 42.5, 22.0, BODY_TOPIC)
     out = tmp_path / "out"
     args = ["replay", str(tmp_path / "in"), "--scene", str(scene_path), "-o", str(out)]

@@ -10,14 +10,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
 if os.environ.get("CI"):
     import rclpy  # noqa: F401  (CI installs it: a node test that skips there is a failure)
 else:
     pytest.importorskip("rclpy")
 
-from io_helpers import SCENE_FILE, ageing_bag, read_raw, statuses_named
+from io_helpers import AGEING_PUMP, ageing_bag, pump_scene_file, read_raw, statuses_named
 from ros_harness import (
     LOSSLESS,
     NodeProcess,
@@ -51,11 +50,8 @@ BODY_TOPIC = "/machine/imu"
 
 
 def _scene_file(tmp: Path) -> Path:
-    data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
-    data["body_sensor"] = {"topic": BODY_TOPIC, "position": [0.8, 0.3, 1.0], "window_s": 1.0}
-    path = tmp / "pump_with_body_imu.scene.yaml"
-    path.write_text(yaml.safe_dump(data), encoding="utf-8")
-    return path
+    sensor = {"topic": BODY_TOPIC, "position": [0.8, 0.3, 1.0], "window_s": 1.0}
+    return pump_scene_file(tmp, body_sensor=sensor)
 
 
 def _inputs() -> list[tuple[str, int, bytes]]:
@@ -134,12 +130,7 @@ def test_the_node_tracks_mounts_that_age_as_the_replay_does(tmp_path: Path) -> N
     """With an `ageing` section, the node re-fits the mounts window by window in a worker
     process while it keeps following: on a machine whose mounts lose 30 % of their stiffness
     at 22 s, its `mount_twin: ageing` reports (OK, then ERROR) equal the replay's."""
-    data = yaml.safe_load(SCENE_FILE.read_text(encoding="utf-8"))
-    data["input"]["gyro_filter"] = "none"
-    data["body_sensor"] = {"topic": BODY_TOPIC, "position": [0.8, 0.3, 1.0]}
-    data["ageing"] = {"window_s": 20.0}
-    scene_path = tmp_path / "pump.scene.yaml"
-    scene_path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    scene_path = pump_scene_file(tmp_path, **AGEING_PUMP)
     scene = load_scene_file(scene_path)
     inputs = ageing_bag(tmp_path / "in", scene, 42.5, 22.0, BODY_TOPIC)
     replay(scene, tmp_path / "in", tmp_path / "out", progress=False)

@@ -42,7 +42,7 @@ import numpy as np
 from mount_twin.analysis.response import followed
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.engine.intake import rotated
-from mount_twin.engine.sensor_reading import predicted_reading
+from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.io.signals import Signal
 from mount_twin.scene.description import BodySensor, LinearMount, Scene, Vec3, Vec6
 
@@ -171,7 +171,9 @@ def predict(scene: Scene, foundation: Signal) -> tuple[np.ndarray, np.ndarray]:
         rate = rotated(gyro, model.sensor_rotation)
     sensor = scene.body_sensor or BodySensor()
     pose = (out.position, out.quaternion)
-    f, _ = predicted_reading(scene, sensor, out.stamps, pose, out.wrenches, rate)
+    f, _ = predicted_reading(
+        SensorGeometry.of(scene, sensor), out.stamps, pose, out.wrenches, rate
+    )
     return out.stamps, f
 
 

@@ -28,7 +28,7 @@ import numpy as np
 from mount_twin.engine.agreement import MIN_SAMPLES, agreement, window_status
 from mount_twin.engine.batch import HealthStatus
 from mount_twin.engine.intake import rising
-from mount_twin.engine.sensor_reading import predicted_reading
+from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.physics import pose_row
 from mount_twin.scene.description import BodySensor, Scene
 
@@ -305,9 +305,11 @@ class BodyCheck:
         self.last_ns = 0
         """The last accepted body stamp, ns (0: none yet)."""
 
+        geometry = SensorGeometry.of(scene, sensor)
+
         def predict(rows: _Rows) -> np.ndarray:
             pose = (rows.pose[:, pose_row.POSITION_COLS], rows.pose[:, pose_row.QUATERNION_COLS])
-            f, w = predicted_reading(scene, sensor, rows.t, pose, rows.wrenches, rows.rate)
+            f, w = predicted_reading(geometry, rows.t, pose, rows.wrenches, rows.rate)
             return np.hstack([f, w])
 
         self._lead = _Lead(predict)

@@ -17,6 +17,8 @@ the step).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from mount_twin.engine.intake import rotated
@@ -31,6 +33,45 @@ def _products(m: np.ndarray, v: np.ndarray) -> np.ndarray:
     return m[:, :, 0] * v[:, 0:1] + m[:, :, 1] * v[:, 1:2] + m[:, :, 2] * v[:, 2:3]
 
 
+@dataclass(frozen=True)
+class SensorGeometry:
+    """What the prediction needs of the scene, taken once at load.
+
+    Attributes:
+        mount_axes: (n, 3, 3) each mount's axes in F (columns), fixed in F.
+        mass: the body's mass, kg.
+        arm: the sensor's point from the CG at the reference pose, m, in F.
+        axes: the sensor's axes in the body frame B (columns, Rₛ).
+    """
+
+    mount_axes: np.ndarray
+    mass: float
+    arm: np.ndarray
+    axes: np.ndarray
+
+    @classmethod
+    def of(cls, scene: Scene, sensor: BodySensor) -> SensorGeometry:
+        """The geometry of `sensor` on `scene`'s body."""
+        return cls(
+            _mount_axes(scene),
+            scene.body.mass,
+            np.array(sensor.position) - np.array(scene.body.cg),
+            rpy_matrix(*sensor.orientation_rpy),
+        )
+
+
+def _mount_axes(scene: Scene) -> np.ndarray:
+    return rpy_matrices([m.orientation_rpy for m in scene.mounts])
+
+
+def _specific_force(mount_axes: np.ndarray, mass: float, wrenches: np.ndarray) -> np.ndarray:
+    """Σᵢ Qᵢ fᵢ / m, mount by mount in scene order (the same bits per row whatever the batch)."""
+    total = np.zeros((wrenches.shape[0], 3))
+    for i, q in enumerate(mount_axes):
+        total += rotated(wrenches[:, i, :3], q)
+    return total / mass
+
+
 def cg_specific_force(scene: Scene, wrenches: np.ndarray) -> np.ndarray:
     """(k, 3) specific force of the CG in F, m/s², from the scene's (k, n, 6) mount wrenches
     (force on the body in each mount's axes first; the axes fixed in F).
@@ -39,11 +80,7 @@ def cg_specific_force(scene: Scene, wrenches: np.ndarray) -> np.ndarray:
     m (a − g) = Σᵢ Qᵢ fᵢ, Qᵢ mount i's axes in F (fixed in F, `docs/physics.md` §7). It is
     what an accelerometer at the CG reads (+g up at rest). The wrenches must be every
     sample's: decimated rows hold each component's peak, not a simultaneous wrench."""
-    axes = rpy_matrices([m.orientation_rpy for m in scene.mounts])
-    total = np.zeros((wrenches.shape[0], 3))
-    for i, q in enumerate(axes):  # mount by mount, in scene order: the same bits per row
-        total += rotated(wrenches[:, i, :3], q)
-    return total / scene.body.mass
+    return _specific_force(_mount_axes(scene), scene.body.mass, wrenches)
 
 
 def derivative(t: np.ndarray, f: np.ndarray) -> np.ndarray:
@@ -90,27 +127,25 @@ def relative_rate(stamps: np.ndarray, rotation: np.ndarray) -> np.ndarray:
 
 
 def predicted_reading(
-    scene: Scene,
-    sensor: BodySensor,
+    geometry: SensorGeometry,
     stamps: np.ndarray,
     pose: tuple[np.ndarray, np.ndarray],
     wrenches: np.ndarray,
     foundation_rate: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
     """(specific force m/s², angular rate rad/s), each (k, 3) in the sensor's axes, of the body
-    sensor at k rows: `stamps` (s), `pose` (CG positions (k, 3) in F, quaternions (k, 4)
-    x, y, z, w of body → F), (k, n, 6) mount `wrenches`, and the foundation's rate (k, 3),
-    rad/s in F (zeros where the scene neglects it). Row by row the same bits whatever rows
-    come with it, but for the differences' neighbours."""
+    sensor (`geometry`) at k rows: `stamps` (s), `pose` (CG positions (k, 3) in F, quaternions
+    (k, 4) x, y, z, w of body → F), (k, n, 6) mount `wrenches`, and the foundation's rate
+    (k, 3), rad/s in F (zeros where the scene neglects it). Row by row the same bits whatever
+    rows come with it, but for the differences' neighbours."""
     rotation = quaternion_matrices(pose[1])
-    f_cg = cg_specific_force(scene, wrenches)
+    f_cg = _specific_force(geometry.mount_axes, geometry.mass, wrenches)
     omega = foundation_rate + relative_rate(stamps, rotation)
     alpha = derivative(stamps, omega) + np.cross(foundation_rate, omega)
-    arm = np.array(sensor.position) - np.array(scene.body.cg)
-    r = _products(rotation, np.broadcast_to(arm, omega.shape))
+    r = _products(rotation, np.broadcast_to(geometry.arm, omega.shape))
     f_p = f_cg + np.cross(alpha, r) + np.cross(omega, np.cross(omega, r))
     to_body = np.swapaxes(rotation, 1, 2)  # R_kᵀ: F → B
-    to_sensor = rpy_matrix(*sensor.orientation_rpy).T  # Rₛᵀ: B → the sensor's axes
+    to_sensor = geometry.axes.T  # Rₛᵀ: B → the sensor's axes
     return (
         rotated(_products(to_body, f_p), to_sensor),
         rotated(_products(to_body, omega), to_sensor),
