@@ -432,10 +432,9 @@ def replay(
                 while stream.body_behind and (body := next(body_chunks, None)) is not None:
                     outputs += stream.process_body(body)
             if static_due and outputs:
-                out.write(*static_transforms(scene, outputs[0][1]))
+                out.write([static_transforms(scene, outputs[0][1])])
                 static_due = False
-            for topic, stamp, raw in outputs:
-                out.write(resolved[topic], stamp, raw)
+            out.write([(resolved[topic], stamp, raw) for topic, stamp, raw in outputs])
             if (batch := stream.last_outputs) is not None:
                 figures.add(batch)
                 for report in batch.health:
@@ -444,7 +443,9 @@ def replay(
                 _keep_worst(worst, report)
             for job in stream.take_ageing_jobs():  # a fit each: seconds
                 report = run_job(job)
-                out.write(resolved[DIAGNOSTICS_TOPIC], job.stamp_ns, _encoded(scene, report, job))
+                out.write(
+                    [(resolved[DIAGNOSTICS_TOPIC], job.stamp_ns, _encoded(scene, report, job))]
+                )
                 _keep_worst(worst, report)
             bar.update(len(raws or ()))
         if stream.final_report is not None:

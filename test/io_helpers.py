@@ -248,8 +248,7 @@ def ageing_bag(
         key=lambda m: (m[1], m[0]),
     )
     with OutputBag(path, {"/deck/imu": IMU, body_topic: IMU}) as bag:
-        for topic, stamp, raw in msgs:
-            bag.write(topic, stamp, raw)
+        bag.write(msgs)
     return msgs
 
 

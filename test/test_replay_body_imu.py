@@ -50,8 +50,9 @@ def _bags(tmp: Path) -> None:
     }
     for name, topics in (("in_both", streams), ("deck", ["/deck/imu"]), ("body", [BODY_TOPIC])):
         with OutputBag(tmp / name, dict.fromkeys(topics, IMU)) as bag:
-            for stamp, topic, raw in sorted((s, t, r) for t in topics for s, r in streams[t]):
-                bag.write(topic, stamp, raw)
+            bag.write(
+                sorted(((t, s, r) for t in topics for s, r in streams[t]), key=lambda m: m[1])
+            )
 
 
 def _replay(tmp: Path, name: str, *extra: str) -> tuple[int, dict]:

@@ -23,6 +23,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from mount_twin.cli import main
 from mount_twin.errors import BagError
+from mount_twin.io import bag as bag_module
 from mount_twin.io.bag import PARTIAL_KEY, InputBag, OutputBag, write_bag
 from mount_twin.io.messages import IMU, POSE, TYPESTORE, imu_messages
 from mount_twin.replay import replay
@@ -104,9 +105,9 @@ def test_an_output_bag_refuses_a_stamp_before_1970_naming_it_and_stays_readable(
     ((stamp, raw),) = read_raw(_one_message_bag(tmp_path / "one"))["/deck/imu"]
     out = tmp_path / "out"
     with OutputBag(out, {"/deck/imu": IMU}) as bag:
-        bag.write("/deck/imu", stamp, raw)
+        bag.write([("/deck/imu", stamp, raw)])
         with pytest.raises(BagError, match=rf"{out}: /deck/imu: stamp -1 ns is before 1970"):
-            bag.write("/deck/imu", -1, raw)
+            bag.write([("/deck/imu", stamp + 1, raw), ("/deck/imu", -1, raw)])
     assert read_raw(out) == {"/deck/imu": [(stamp, raw)]}
 
 
@@ -153,18 +154,44 @@ def test_a_corrupted_mcap_record_stops_at_it_with_exit_5_after_the_messages_befo
     assert _partial(out).startswith("stopped by DamagedBagError")
 
 
-def test_bytes_zeroed_inside_an_mcap_chunk_are_no_silent_loss(
-    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    """rosbags skips zeroed records without an error (its chunks carry no checksum when
-    rosbags wrote them): the count against the bag's index catches it."""
-    raw = read_raw(ship["mcap"], ["/deck/imu"])["/deck/imu"][1000][1]
+def _zeroed_at_message_1000(bag: Path, dst: Path) -> Path:
+    """A copy of `bag` with 4096 bytes zeroed from the record of its message 1000 on."""
+    raw = read_raw(bag, ["/deck/imu"])["/deck/imu"][1000][1]
 
     def zero(data: bytes) -> bytes:
         at = _record_of(data, raw)
         return data[:at] + bytes(4096) + data[at + 4096 :]
 
-    bag = _edited_copy(ship["mcap"], tmp_path / "zeroed", zero)
+    return _edited_copy(bag, dst, zero)
+
+
+def test_bytes_zeroed_inside_an_mcap_chunk_are_no_silent_loss(
+    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """rosbags skips zeroed records without an error (its chunks carry no checksum when
+    rosbags wrote them); our reader of plain bags walks every record of the chunk, stops at
+    them, and the messages before them are replayed."""
+    bag = _zeroed_at_message_1000(ship["mcap"], tmp_path / "zeroed")
+    out = tmp_path / "out"
+    assert _replay(bag, out) == 5
+    err = capsys.readouterr().err
+    assert f"{bag}: damaged (chunk at byte " in err and "Traceback" not in err
+    assert _damaged_count(err) == 1000
+    _, got = read_bag(out)
+    assert len(got[POSES]) == 1000
+    assert _partial(out).startswith("stopped by DamagedBagError")
+
+
+def test_bytes_zeroed_where_rosbags_reads_are_caught_by_the_index_count(
+    ship: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Where rosbags reads the bag (one our reader leaves to it), it skips the zeroed records
+    without an error: the count against the bag's index catches the loss."""
+    monkeypatch.setattr(bag_module, "plain_messages", lambda file, topic: None)
+    bag = _zeroed_at_message_1000(ship["mcap"], tmp_path / "zeroed")
     out = tmp_path / "out"
     assert _replay(bag, out) == 5
     err = capsys.readouterr().err

@@ -83,8 +83,7 @@ def test_the_live_body_imu_comparison_equals_the_replays(tmp_path: Path) -> None
     scene = load_scene_file(scene_path)
     inputs = _inputs()
     with OutputBag(tmp_path / "in", {"/deck/imu": IMU, BODY_TOPIC: IMU}) as bag:
-        for topic, stamp, raw in inputs:
-            bag.write(topic, stamp, raw)
+        bag.write(inputs)
     replay(scene, tmp_path / "in", tmp_path / "out", progress=False)
     want = {t: [raw for _, raw in msgs] for t, msgs in read_raw(tmp_path / "out").items()}
     body_topics = [resolve(t, NODE_NAME) for t in (BODY_PREDICTED_TOPIC, BODY_RESIDUAL_TOPIC)]

@@ -53,6 +53,7 @@ from mount_twin.io.messages import (
     imu_messages,
     output_types,
     resolve,
+    stamp_ns,
     static_transforms,
 )
 from mount_twin.replay import NODE_NAME, replay
@@ -95,9 +96,9 @@ def replayed(scene: Any, raws: list[bytes], tmp: Path) -> dict[str, list[bytes]]
     stamps = [TYPESTORE.deserialize_cdr(r, IMU).header.stamp for r in raws[:1]]
     assert stamps
     with OutputBag(tmp / "in", {"/deck/imu": IMU}) as out:
-        for raw in raws:
-            msg = TYPESTORE.deserialize_cdr(raw, IMU)
-            out.write("/deck/imu", msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec, raw)
+        out.write(
+            [("/deck/imu", stamp_ns(TYPESTORE.deserialize_cdr(r, IMU).header), r) for r in raws]
+        )
     replay(scene, tmp / "in", tmp / "out", progress=False)
     return {t: [raw for _, raw in msgs] for t, msgs in read_raw(tmp / "out").items()}
 

@@ -9,8 +9,10 @@ import sqlite3
 import struct
 import tempfile
 from collections import Counter
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Generator, Iterator, Mapping, Sequence
 from contextlib import suppress
+from itertools import accumulate
+from operator import itemgetter
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -27,7 +29,9 @@ from rosbags.interfaces import (
 from rosbags.rosbag2 import StoragePlugin, Writer
 
 from mount_twin.errors import BagError, DamagedBagError
+from mount_twin.io.mcap_reader import plain_messages
 from mount_twin.io.mcap_salvage import Salvage, salvage
+from mount_twin.io.mcap_writer import McapBagWriter
 from mount_twin.io.messages import TYPESTORE
 
 _INFINITE = QosTime(9223372036, 854775807)
@@ -132,17 +136,16 @@ class InputBag:
         if self._salvage is not None:
             yield from self._salvaged_chunks(self._salvage, 0, size)
             return
-        chunk: list[bytes] = []
+        pending: list[bytes] = []
         read, last, held = 0, None, 0
-        messages = self._reader.messages(connections=self._conns)
+        batches = self._batches()
         while True:
             try:
-                _, log_time, raw = next(messages)
+                batch = next(batches)
             except StopIteration:
                 break
             except Exception as err:  # rosbags' readers raise their own types on damage
-                if chunk:
-                    yield chunk
+                yield from _pieces(pending, size, everything=True)
                 rest = self._salvage_after(read)
                 if rest is not None:
                     yield from self._salvaged_chunks(rest, read, size)
@@ -151,19 +154,30 @@ class InputBag:
                     f"{self.topic}{_up_to(last)}: {err}"
                 )
                 raise DamagedBagError(msg) from err
-            chunk.append(self._ros1_to_cdr(raw) if self.ros1 else raw)
-            read, last, held = read + 1, log_time, held + len(raw)
-            if len(chunk) == size or held >= CHUNK_MAX_BYTES:
-                yield chunk
-                chunk, held = [], 0
-        if chunk:
-            yield chunk
+            raws = [self._ros1_to_cdr(raw) if self.ros1 else raw for _, raw in batch]
+            pending += raws
+            read, last, held = read + len(batch), batch[-1][0], held + sum(map(len, raws))
+            if len(pending) >= size or held >= CHUNK_MAX_BYTES:
+                pending = yield from _pieces(pending, size)
+                held = sum(map(len, pending))
+        yield from _pieces(pending, size, everything=True)
         if read < self.count:  # records lost without an error: zeroed or overwritten bytes
             msg = (
                 f"{self.path}: damaged: its index lists {self.count} messages of {self.topic}, "
                 f"only {read} could be read: those lost inside the file were skipped"
             )
             raise DamagedBagError(msg)
+
+    def _batches(self) -> Iterator[list[tuple[int, bytes]]]:
+        """The topic's (log time, raw) in log-time order, in batches: a chunk's from a bag of
+        one plain mcap file (`io.mcap_reader`), one at a time from rosbags otherwise."""
+        files = _storage_files(self.path)
+        if not self.ros1 and len(files) == 1 and files[0].suffix == ".mcap":
+            with suppress(ValueError, struct.error, UnicodeDecodeError, OSError):
+                plain = plain_messages(files[0], self.topic)
+                if plain is not None:
+                    return plain
+        return ([(log_time, raw)] for _, log_time, raw in self._reader.messages(self._conns))
 
     def _salvage_after(self, read: int) -> Salvage | None:
         """After rosbags failed past `read` messages: the messages after those (in file order,
@@ -235,6 +249,22 @@ CHUNK_MAX_BYTES = 32 << 20
 """Most bytes of raw messages in one chunk (2000 Imu messages with short frame ids: 0.7 MB)."""
 STORAGE_SUFFIXES = (".mcap", ".db3")
 """rosbag2 storage files that can be read without the bag's metadata.yaml."""
+
+
+def _pieces(
+    pending: list[bytes], size: int, *, everything: bool = False
+) -> Generator[list[bytes], None, list[bytes]]:
+    """Yield `size` messages at a time of `pending`, fewer where they reach CHUNK_MAX_BYTES;
+    return what is left short of a piece (nothing with `everything`)."""
+    at = 0
+    while len(pending) - at >= size or (everything and at < len(pending)):
+        piece = pending[at : at + size]
+        if sum(map(len, piece)) >= CHUNK_MAX_BYTES:
+            held = accumulate(map(len, piece))
+            piece = piece[: next(k for k, h in enumerate(held) if h >= CHUNK_MAX_BYTES) + 1]
+        yield piece
+        at += len(piece)
+    return pending[at:]
 
 
 def _storage_files(path: Path) -> list[Path]:
@@ -364,10 +394,10 @@ PARTIAL_KEY = "mount_twin.partial"
 
 
 class OutputBag:
-    """An mcap bag written topic by topic; log time = the message's stamp.
+    """An mcap bag written message by message (`io.mcap_writer`); log time = the message's stamp.
 
     Args:
-        path: new bag directory (must not exist: rosbags refuses to overwrite).
+        path: new bag directory (must not exist: an output bag is never overwritten).
         topics: resolved topic → message type.
         offered_qos: resolved topic → QoS profiles its publisher offered (recorded in the bag's
             metadata, replayed by `ros2 bag play`); topics not listed record none (the player's
@@ -382,39 +412,37 @@ class OutputBag:
     ) -> None:
         self.path = Path(path)
         check_new_bag(self.path)
-        self._writer = Writer(
-            self.path, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP
-        )
-        self._writer.open()
-        qos = offered_qos or {}
-        self._conns = {
-            topic: self._writer.add_connection(
-                topic, msgtype, typestore=TYPESTORE, offered_qos_profiles=qos.get(topic, ())
-            )
-            for topic, msgtype in topics.items()
-        }
+        qos = {topic: list(profiles) for topic, profiles in (offered_qos or {}).items()}
+        try:
+            self._writer = McapBagWriter(self.path, topics, qos)
+        except OSError as err:
+            msg = f"{self.path}: cannot create the bag: {err.strerror or err}"
+            raise BagError(msg) from err
         self.written = 0
         self.last_stamp_ns: int | None = None
         self.partial: str | None = None
         """Why the bag is partial (then recorded in its metadata), or None: complete."""
         self._failed: OSError | None = None
 
-    def write(self, topic: str, stamp_ns: int, raw: bytes | memoryview) -> None:
-        """Write one serialized message; a failed write (a full disk) names the bag, which
-        is then closed without its index (`close`)."""
-        check_stamp(self.path, topic, stamp_ns)
+    def write(self, messages: Sequence[tuple[str, int, bytes | memoryview]]) -> None:
+        """Write serialized messages, each (topic, stamp ns, CDR bytes), in order. A stamp before
+        1970 is refused before any of them is written; a failed write (a full disk) names the
+        bag, which is then closed without its index (`close`)."""
+        if messages and min(map(itemgetter(1), messages)) < 0:
+            for topic, stamp_ns, _ in messages:
+                check_stamp(self.path, topic, stamp_ns)
         try:
-            self._writer.write(self._conns[topic], stamp_ns, raw)
+            self._writer.write(messages)
         except OSError as err:
             self._failed = err
             msg = (
-                f"{self.path}: cannot write: {err.strerror or err}, after {self.written} "
-                f"messages{_up_to(self.last_stamp_ns)}; the bag is left unfinished (no index, "
-                "no metadata.yaml)"
+                f"{self.path}: cannot write: {err.strerror or err}, after {self._writer.durable} "
+                f"messages; the bag is left unfinished (no index, no metadata.yaml)"
             )
             raise BagError(msg) from err
-        self.written += 1
-        self.last_stamp_ns = stamp_ns
+        if messages:
+            self.written += len(messages)
+            self.last_stamp_ns = messages[-1][1]
 
     def mark_partial(self, reason: str) -> None:
         """Record in the bag's metadata (custom_data `mount_twin.partial`, which `ros2 bag
@@ -425,7 +453,7 @@ class OutputBag:
             else (f"outputs up to stamp {self.last_stamp_ns} ns")
         )
         self.partial = f"{reason}; {upto}"
-        self._writer.set_custom_data(PARTIAL_KEY, self.partial)
+        self._writer.custom_data[PARTIAL_KEY] = self.partial
 
     def close(self) -> None:
         """Finish the bag (writes its index and metadata); after a failed write, only close

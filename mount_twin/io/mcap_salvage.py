@@ -2,12 +2,7 @@
 short): its records are read in order from the start, without the summary at the end that a
 normal reader needs, until one is incomplete or unreadable.
 
-MCAP's record layout (mcap.dev/spec): after the 8-byte magic, records of opcode (1 byte), length
-(uint64 LE) and body. Used here: Schema 0x03 (id u16, name, encoding, data), Channel 0x04 (id
-u16, schema id u16, topic, message encoding, metadata), Message 0x05 (channel id u16, sequence
-u32, log time u64, publish time u64, data) and Chunk 0x06 (start u64, end u64, uncompressed size
-u64, crc u32, compression, records), whose records are read the same way (uncompressed, or lz4 or
-zstd where those modules are installed). Strings are a uint32 length and UTF-8 bytes.
+The record layout: `io.mcap_format`; read here: Schema, Channel, Message and Chunk records.
 """
 
 from __future__ import annotations
@@ -16,8 +11,16 @@ import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
-MAGIC = b"\x89MCAP0\r\n"
-SCHEMA, CHANNEL, MESSAGE, CHUNK = 0x03, 0x04, 0x05, 0x06
+from mount_twin.io.mcap_format import (
+    CHANNEL,
+    CHUNK,
+    CHUNK_HEAD,
+    MAGIC,
+    MESSAGE,
+    SCHEMA,
+    decompress,
+    read_string,
+)
 
 
 @dataclass
@@ -27,26 +30,6 @@ class Salvage:
     messages: list[tuple[int, bytes]] = field(default_factory=list)
     msgtype: str = ""
     damage: str = ""
-
-
-def _string(body: bytes, at: int) -> tuple[str, int]:
-    (n,) = struct.unpack_from("<I", body, at)
-    return body[at + 4 : at + 4 + n].decode(), at + 4 + n
-
-
-def _decompress(compression: str, data: bytes, size: int) -> bytes:
-    if compression == "":
-        return data
-    if compression == "lz4":
-        import lz4.frame
-
-        return bytes(lz4.frame.decompress(data))
-    if compression == "zstd":
-        from backports import zstd  # Python < 3.14; the standard library's compression.zstd after
-
-        return bytes(zstd.decompress(data))
-    msg = f"unknown chunk compression {compression!r}"
-    raise ValueError(msg)
 
 
 def salvage(path: Path, topic: str) -> Salvage:
@@ -73,7 +56,7 @@ def salvage(path: Path, topic: str) -> Salvage:
                 cut = f"{where}: a record (opcode {op:#04x}) cut short at byte {at}"
                 if op == CHUNK:  # the messages of a chunk cut short, up to the cut
                     try:
-                        compression, k = _string(body, 28)
+                        compression, k = read_string(body, CHUNK_HEAD)
                         if compression == "":
                             records(bytes(body[k + 8 :]), 0, cut)
                     except (ValueError, struct.error, UnicodeDecodeError):
@@ -81,10 +64,10 @@ def salvage(path: Path, topic: str) -> Salvage:
                 raise ValueError(cut)
             if op == SCHEMA:
                 (sid,) = struct.unpack_from("<H", body, 0)
-                schemas[sid], _ = _string(body, 2)
+                schemas[sid], _ = read_string(body, 2)
             elif op == CHANNEL:
                 cid, sid = struct.unpack_from("<HH", body, 0)
-                name, _ = _string(body, 4)
+                name, _ = read_string(body, 4)
                 if name == topic:
                     wanted.add(cid)
                     out.msgtype = schemas.get(sid, "")
@@ -94,10 +77,9 @@ def salvage(path: Path, topic: str) -> Salvage:
                     (log_time,) = struct.unpack_from("<Q", body, 6)
                     out.messages.append((log_time, bytes(body[22:])))
             elif op == CHUNK:
-                (size,) = struct.unpack_from("<Q", body, 16)
-                compression, k = _string(body, 28)
+                compression, k = read_string(body, CHUNK_HEAD)
                 (n,) = struct.unpack_from("<Q", body, k)
-                inner = _decompress(compression, bytes(body[k + 8 : k + 8 + n]), size)
+                inner = decompress(compression, bytes(body[k + 8 : k + 8 + n]))
                 records(inner, 0, f"chunk at byte {at}")
             at += 9 + length
 

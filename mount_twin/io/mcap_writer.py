@@ -1,0 +1,302 @@
+"""A rosbag2 bag in mcap storage, written by us a message at a small, fixed cost: the bag's
+layout is the one rosbags writes (records, summary, metadata.yaml), each message's record packed
+by one `struct` call into the open chunk instead of rosbags' dozen small writes per message.
+
+Why not rosbags' Writer: at a 1 kHz input and 11 output topics its per-message cost (about
+10 µs) made writing half of a replay's time; this writer takes about a tenth of that. The
+message bytes are CDR encoded as before (`io.messages`, layouts checked against rosbags'
+serializer); each type's definition and hash come from the Jazzy typestore, the QoS text from
+rosbags' own dumper, so rosbags and `ros2 bag` read the bag as one rosbags wrote (tested:
+test/test_mcap_writer.py reads it back with rosbags and compares it with rosbags' bag of the
+same messages).
+
+The record layout: `io.mcap_format`.
+"""
+
+from __future__ import annotations
+
+import struct
+import zlib
+from bisect import bisect_left
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from itertools import accumulate, chain, repeat
+from pathlib import Path
+from typing import Any, BinaryIO
+
+import numpy as np
+import yaml
+from rosbags.interfaces import Qos
+from rosbags.rosbag2.metadata import dump_qos_v9
+
+from mount_twin.io.mcap_format import (
+    CHANNEL,
+    CHUNK,
+    CHUNK_INDEX,
+    DATA_END,
+    FOOTER,
+    HEADER,
+    MAGIC,
+    MESSAGE,
+    MESSAGE_HEAD,
+    MESSAGE_INDEX,
+    METADATA,
+    METADATA_INDEX,
+    SCHEMA,
+    STATISTICS,
+    SUMMARY_OFFSET,
+    pack_string,
+    record,
+)
+from mount_twin.io.messages import TYPESTORE
+
+_DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+
+CHUNK_BYTES = 1 << 20
+"""A chunk is closed once its records reach this many bytes (rosbags' size)."""
+VERSION = 9
+"""metadata.yaml's version (rosbag2 in Jazzy)."""
+_MESSAGE_FIELDS = MESSAGE_HEAD.size - 9  # the body's bytes before the data
+
+
+@dataclass
+class _Channel:
+    """One topic: its channel id, type, offered QoS (as metadata.yaml lists it) and count."""
+
+    id: int
+    topic: str
+    msgtype: str
+    qos: list[Any]
+    count: int = 0
+
+
+@dataclass
+class _Chunk:
+    """The open chunk: its records and their bytes; each message's channel, log time and offset
+    in the records."""
+
+    parts: list[bytes | memoryview] = field(default_factory=list)
+    size: int = 0
+    channels: list[int] = field(default_factory=list)
+    times: list[int] = field(default_factory=list)
+    offsets: list[int] = field(default_factory=list)
+
+
+def _yaml_text(data: object) -> str:
+    """`data` as YAML in block style, keys sorted (as rosbags writes metadata.yaml)."""
+    return yaml.dump(data, Dumper=_DUMPER, default_flow_style=False)
+
+
+class McapBagWriter:
+    """A new rosbag2 directory `path` holding `path.name`.mcap.
+
+    Args:
+        path: the bag directory (created; its parent must exist).
+        topics: topic → message type (Jazzy), in channel order.
+        offered_qos: topic → the QoS profiles its publisher offered (none if not listed).
+
+    `write` messages; `close` writes the summary and metadata.yaml; `abort` closes
+    the file as it is (complete chunks stay readable record by record). An OSError of the file
+    system propagates; `durable` says how many messages were in the file before it.
+    """
+
+    def __init__(
+        self, path: Path, topics: dict[str, str], offered_qos: dict[str, list[Qos]]
+    ) -> None:
+        self.path = path
+        self.file = path / f"{path.name}.mcap"
+        path.mkdir()
+        self._out: BinaryIO = self.file.open("xb")
+        self.custom_data: dict[str, str] = {}
+        self.durable = 0
+        """Messages in the file (in closed chunks): `channels`' counts sum to it."""
+        self._start, self._end = 2**63 - 1, 0
+        self._schemas: list[bytes] = []
+        self._channels: list[bytes] = []
+        self._chunk_indexes: list[bytes] = []
+        self.channels: dict[str, _Channel] = {}
+        schema_ids: dict[str, int] = {}
+        for topic, msgtype in topics.items():
+            if msgtype not in schema_ids:
+                schema_ids[msgtype] = len(schema_ids) + 1
+                msgdef, _ = TYPESTORE.generate_msgdef(msgtype, ros_version=2)
+                encoding = "ros2idl" if msgdef.startswith("=" * 80 + "\nIDL: ") else "ros2msg"
+                body = struct.pack("<H", schema_ids[msgtype])
+                body += pack_string(msgtype) + pack_string(encoding) + pack_string(msgdef)
+                self._schemas.append(record(SCHEMA, body))
+            qos = dump_qos_v9(list(offered_qos.get(topic, ())))
+            ch = _Channel(len(self.channels) + 1, topic, msgtype, qos)
+            self.channels[topic] = ch
+            metadata = pack_string("offered_qos_profiles") + pack_string(_yaml_text(qos).strip())
+            body = struct.pack("<HH", ch.id, schema_ids[msgtype]) + pack_string(topic)
+            body += pack_string("cdr") + pack_string(metadata)
+            self._channels.append(record(CHANNEL, body))
+        self._ids = {topic: ch.id for topic, ch in self.channels.items()}
+        self._by_id = {ch.id: ch for ch in self.channels.values()}
+        self._out.write(MAGIC + record(HEADER, pack_string("ros2") + pack_string("mount_twin")))
+        self._out.write(b"".join(self._schemas + self._channels))
+        self._chunk = _Chunk()
+
+    def write(self, messages: Sequence[tuple[str, int, bytes | memoryview]]) -> None:
+        """Add messages, each (topic, log time ns, CDR bytes): log time is also its publish
+        time. A chunk is closed where its records reach CHUNK_BYTES."""
+        while messages:
+            chunk = self._chunk
+            sizes = [MESSAGE_HEAD.size + len(data) for _, _, data in messages]
+            ends = list(accumulate(sizes, initial=chunk.size))  # the records' ends
+            full = bisect_left(ends, CHUNK_BYTES, 1)
+            part, messages = messages[:full], messages[full:]
+            channels = [self._ids[topic] for topic, _, _ in part]
+            times = [log_time for _, log_time, _ in part]
+            heads = map(
+                MESSAGE_HEAD.pack,
+                repeat(MESSAGE),
+                [n - 9 for n in sizes],
+                channels,
+                repeat(0),
+                times,
+                times,
+            )
+            chunk.parts += chain.from_iterable(
+                zip(heads, (data for _, _, data in part), strict=True)
+            )
+            chunk.channels += channels
+            chunk.times += times
+            chunk.offsets += ends[: len(part)]
+            chunk.size = ends[len(part)]
+            if chunk.size >= CHUNK_BYTES:
+                self._close_chunk()
+
+    def _close_chunk(self) -> None:
+        """Write the open chunk, its message indexes, and keep its chunk index."""
+        chunk, self._chunk = self._chunk, _Chunk()
+        if not chunk.times:
+            return
+        channels = np.array(chunk.channels)
+        times = np.array(chunk.times, dtype="<u8")
+        pairs = np.column_stack((times, np.array(chunk.offsets, dtype="<u8")))
+        start, end = int(times.min()), int(times.max())
+        records = b"".join(chunk.parts)
+        head = struct.pack("<QQQI", start, end, chunk.size, zlib.crc32(records))
+        head += pack_string("") + struct.pack("<Q", chunk.size)
+        chunk_at = self._out.tell()
+        head_record = struct.pack("<BQ", CHUNK, len(head) + chunk.size) + head
+        indexes, offsets = [], []
+        at = chunk_at + len(head_record) + chunk.size
+        ids, counts = np.unique(channels, return_counts=True)
+        for cid in ids.tolist():
+            entries = pairs[channels == cid].tobytes()
+            index = record(MESSAGE_INDEX, struct.pack("<HI", cid, len(entries)) + entries)
+            offsets.append(struct.pack("<HQ", cid, at))
+            indexes.append(index)
+            at += len(index)
+        self._out.write(b"".join([head_record, records, *indexes]))
+        for cid, count in zip(ids.tolist(), counts.tolist(), strict=True):
+            self._by_id[cid].count += count
+        self.durable += len(chunk.times)
+        self._start, self._end = min(self._start, start), max(self._end, end)
+        length = len(head_record) + chunk.size
+        body = struct.pack("<QQQQ", start, end, chunk_at, length)
+        body += pack_string(b"".join(offsets)) + struct.pack("<Q", at - chunk_at - length)
+        body += pack_string("") + struct.pack("<QQ", chunk.size, chunk.size)
+        self._chunk_indexes.append(record(CHUNK_INDEX, body))
+
+    def metadata(self) -> dict[str, Any]:
+        """metadata.yaml's `rosbag2_bagfile_information` of what was written so far."""
+        count = sum(ch.count for ch in self.channels.values())
+        start = self._start if count else 0
+        duration = max(0, self._end - start)
+        return {
+            "version": VERSION,
+            "storage_identifier": "mcap",
+            "relative_file_paths": [self.file.name],
+            "duration": {"nanoseconds": duration},
+            "starting_time": {"nanoseconds_since_epoch": start},
+            "message_count": count,
+            "topics_with_message_count": [
+                {
+                    "topic_metadata": {
+                        "name": ch.topic,
+                        "type": ch.msgtype,
+                        "serialization_format": "cdr",
+                        "offered_qos_profiles": ch.qos,
+                        "type_description_hash": TYPESTORE.hash_rihs01(ch.msgtype),
+                    },
+                    "message_count": ch.count,
+                }
+                for ch in self.channels.values()
+            ],
+            "compression_format": "",
+            "compression_mode": "",
+            "files": [
+                {
+                    "path": self.file.name,
+                    "starting_time": {"nanoseconds_since_epoch": start},
+                    "duration": {"nanoseconds": duration},
+                    "message_count": count,
+                }
+            ],
+            "custom_data": self.custom_data or None,
+            "ros_distro": "jazzy",
+        }
+
+    def close(self) -> None:
+        """Write the last chunk, the summary, the footer and metadata.yaml."""
+        self._close_chunk()
+        info = self.metadata()
+        out = self._out
+        metadata_at = out.tell()
+        entries = pack_string("serialized_metadata") + pack_string(_yaml_text(info).strip())
+        out.write(record(METADATA, pack_string("rosbag2") + pack_string(entries)))
+        metadata_end = out.tell()
+        out.write(record(DATA_END, struct.pack("<I", 0)))
+        sections = [
+            (SCHEMA, b"".join(self._schemas)),
+            (CHANNEL, b"".join(self._channels)),
+            (CHUNK_INDEX, b"".join(self._chunk_indexes)),
+            (
+                METADATA_INDEX,
+                record(METADATA_INDEX, self._metadata_index(metadata_at, metadata_end)),
+            ),
+            (STATISTICS, record(STATISTICS, self._statistics())),
+        ]
+        summary_at = out.tell()
+        offsets = []
+        at = summary_at
+        for op, data in sections:
+            if data:
+                offsets.append(record(SUMMARY_OFFSET, struct.pack("<BQQ", op, at, len(data))))
+                out.write(data)
+                at += len(data)
+        out.write(b"".join(offsets))
+        out.write(record(FOOTER, struct.pack("<QQI", summary_at, at, 0)) + MAGIC)
+        out.close()
+        meta = self.path / "metadata.yaml"
+        tmp = meta.with_suffix(".yaml.tmp")
+        tmp.write_text(_yaml_text({"rosbag2_bagfile_information": info}), "utf8")
+        tmp.replace(meta)
+
+    @staticmethod
+    def _metadata_index(start: int, end: int) -> bytes:
+        return struct.pack("<QQ", start, end - start) + pack_string("rosbag2")
+
+    def _statistics(self) -> bytes:
+        counts = b"".join(struct.pack("<HQ", ch.id, ch.count) for ch in self.channels.values())
+        total = sum(ch.count for ch in self.channels.values())
+        start = self._start if total else 0
+        head = struct.pack(
+            "<QHIIIIQQ",
+            total,
+            len(self._schemas),
+            len(self.channels),
+            0,
+            1,
+            len(self._chunk_indexes),
+            start,
+            self._end,
+        )
+        return head + pack_string(counts)
+
+    def abort(self) -> None:
+        """Close the file as it is: no summary, no metadata.yaml."""
+        self._out.close()
