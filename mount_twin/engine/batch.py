@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from itertools import repeat
 
 import numpy as np
 
@@ -54,7 +55,7 @@ class SampleBatch:
             if a.shape != (n, 3):
                 msg = f"SampleBatch.{name}: shape {a.shape}, expected ({n}, 3) for {n} stamps"
                 raise ValueError(msg)
-        if len(self.frame_ids) != n or not all(isinstance(f, str) for f in self.frame_ids):
+        if len(self.frame_ids) != n or not all(map(isinstance, self.frame_ids, repeat(str))):
             msg = f"SampleBatch.frame_ids: {len(self.frame_ids)} entries, expected {n} strings"
             raise ValueError(msg)
 

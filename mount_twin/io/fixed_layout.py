@@ -155,8 +155,8 @@ class FixedLayout:
     ) -> tuple[np.ndarray, list[np.ndarray]]:
         """Which messages have this layout (bool mask), and their columns of fields `want`."""
         size = self.size
-        idx = np.flatnonzero(np.fromiter((len(r) == size for r in raws), bool, len(raws)))
-        joined = b"".join(bytes(raws[i]) for i in idx.tolist())
+        idx = np.flatnonzero(np.fromiter(map(len, raws), np.int64, len(raws)) == size)
+        joined = b"".join(raws if len(idx) == len(raws) else [raws[i] for i in idx.tolist()])
         rows = np.frombuffer(joined, np.uint8).reshape(-1, size)
         same = (rows[:, self.fixed] == self.template[self.fixed]).all(axis=1)
         match = np.zeros(len(raws), dtype=bool)

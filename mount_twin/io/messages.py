@@ -12,6 +12,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from dataclasses import fields as dataclass_fields
 from functools import cached_property, lru_cache, partial
+from itertools import chain
 from operator import attrgetter
 from typing import Any
 
@@ -532,17 +533,18 @@ def encode_outputs(
         (st.topic, _pack(st.msgtype, st.frames, sec, nsec, st.values(out)))
         for st in output_streams(scene)
     ]
+    stamp_list = stamps.tolist()
+    n = len(stamp_list)
+    per_row = [zip([topic] * n, stamp_list, raws, strict=True) for topic, raws in rows]
+    row_major = list(chain.from_iterable(zip(*per_row, strict=True)))
     msgs: list[tuple[str, int, bytes]] = []
-    reports = iter(out.health)
-    report = next(reports, None)
-    for k, stamp in enumerate(stamps.tolist()):
-        while report is not None and report.rows <= k:
-            msgs.append(encode_report(scene, report, int(stamps_ns[report.sample])))
-            report = next(reports, None)
-        msgs.extend((topic, stamp, raws[k]) for topic, raws in rows)
-    while report is not None:
+    done = 0  # rows in msgs
+    for report in out.health:  # each before the first row at or after its `rows`
+        upto = max(done, min(report.rows, len(stamp_list)))
+        msgs += row_major[done * len(rows) : upto * len(rows)]
         msgs.append(encode_report(scene, report, int(stamps_ns[report.sample])))
-        report = next(reports, None)
+        done = upto
+    msgs += row_major[done * len(rows) :]
     return msgs
 
 
