@@ -25,7 +25,13 @@ from mount_twin.analysis.accuracy import measure, raw_gyro, reference_run, run_a
 from mount_twin.engine import driver as driver_module
 from mount_twin.engine.batch import WARN, SampleBatch
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.engine.estimator import new_estimator
+from mount_twin.engine.estimator import (
+    CHECK_RTOL_FLOOR,
+    FLOOR_DIVISOR,
+    TOLERANCE_DIVISOR,
+    check_divisor,
+    new_estimator,
+)
 from mount_twin.engine.health import INTEGRATION
 from mount_twin.io.input_samples import read_samples
 from mount_twin.model.assemble import assemble
@@ -135,7 +141,7 @@ def _pump() -> tuple[Scene, SampleBatch]:
 
 CASES = {
     "stiff_light": (_stiff_light, [1e-3, 1e-6]),
-    "stiff_light_rosenbrock": (partial(_stiff_light, "ros34pw2"), [1e-6]),
+    "stiff_light_rosenbrock": (partial(_stiff_light, "ros34pw2"), [1e-6, 1e-9]),
     "stiff_light_exponential": (partial(_stiff_light, "exprb32"), [1e-3]),
     "rubber_on_snubbers": (_rubber_on_snubbers, [1e-3, 1e-6]),
     "hysteresis_snubbers_real_shock": (_hysteresis_snubbers_real_shock, [1e-3, 1e-6]),
@@ -181,6 +187,17 @@ def test_measuring_every_interval_comes_within_ten_percent_where_sampling_over_c
         mp.setattr(driver_module, "new_estimator", every)
         acc = measure(scene, samples, rtol, 100_000, ref)
     assert 0.9 < acc.est_force_error / acc.force_error < 1.1, acc
+
+
+def test_the_check_is_tighter_than_the_twin_but_not_below_the_round_off_floor() -> None:
+    """32× tighter at the shipped tolerances; at tight ones the check stops at the floor
+    (the exponential method hunted at 3e-11: 85 steps an interval), yet stays 4× tighter."""
+    for rtol in (1e-3, 1e-6, 1e-8):
+        assert check_divisor(rtol) == TOLERANCE_DIVISOR
+    for rtol in (3e-9, 1e-9, 1e-10, 1e-12):
+        check = rtol / check_divisor(rtol)
+        assert check >= min(CHECK_RTOL_FLOOR, rtol / FLOOR_DIVISOR) * (1 - 1e-12)
+        assert check <= rtol / FLOOR_DIVISOR * (1 + 1e-12)
 
 
 def test_the_propagator_is_the_matrix_exponential() -> None:

@@ -15,7 +15,8 @@ fan"). The estimate follows that recursion with
   is engaged, and every LINEARISE_EVERY regular checks; its exponential by scaling and
   squaring (`src/core/linalg.hpp`); one matrix-vector product per interval;
 - ℓ measured, not modelled: from the twin's state at the interval's start, a checking stepper
-  (the twin's method at rtol and atol over TOLERANCE_DIVISOR, at least MIN_STEPS steps) runs
+  (the twin's method at rtol and atol over TOLERANCE_DIVISOR, less below rtol 1e-8:
+  `check_divisor`; at least MIN_STEPS steps) runs
   the same interval under the same held input; the twin's end state less the check's is the
   twin's local error (to within the check's own, TOLERANCE_DIVISOR or 2⁵ times smaller). An
   embedded pair's error estimate would not do: it is the error of the lower-order solution,
@@ -68,6 +69,23 @@ TOLERANCE_DIVISOR = 32.0
 """The checking stepper's rtol and atol are the twin's over this."""
 MIN_STEPS = 2
 """The checking stepper's fewest steps per input interval."""
+CHECK_RTOL_FLOOR = 3e-10
+"""The checking stepper's rtol is not taken below this (`check_divisor`): near 1e-11 a stepper
+hunts on round-off (the exponential method at 3e-11 took 85 steps per interval where it takes
+one at 1e-10), and a check costing a hundred intervals made the estimate 10× the engine."""
+FLOOR_DIVISOR = 4.0
+"""The smallest divisor the floor leaves: the check stays 4× tighter than the twin at least."""
+
+
+def check_divisor(rtol: float) -> float:
+    """The twin's rtol (and atol) over this is the checking stepper's: TOLERANCE_DIVISOR,
+    less where that would take the check below CHECK_RTOL_FLOOR, never below FLOOR_DIVISOR.
+    (With the MIN_STEPS halving, a check 4× tighter measures the twin's local error to within
+    a quarter where the twin's steps are bound by its tolerance, to within 2^-p where they are
+    bound by the input interval, as at these tolerances they mostly are.)"""
+    return min(TOLERANCE_DIVISOR, max(FLOOR_DIVISOR, rtol / CHECK_RTOL_FLOOR))
+
+
 DENSE_MAX = 64
 """The most states carried (the body's first, then the internal states that move)."""
 CHECK_EVERY = 32
@@ -154,7 +172,7 @@ def new_estimator(
     states); n_free: the body's free coordinates; check_every: see CHECK_EVERY (1 measures
     every interval: the reference the sampling is tested against)."""
     n = scratch.sink.shape[0]
-    own = tighter_arrays(method, n, rtol, atol, max_substeps, TOLERANCE_DIVISOR, MIN_STEPS)
+    own = tighter_arrays(method, n, rtol, atol, max_substeps, check_divisor(rtol), MIN_STEPS)
     n_body = 2 * n_free
     slots = max(min(n, DENSE_MAX), n_body)
     n_out = 3 * n_mounts + 3
