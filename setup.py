@@ -118,6 +118,7 @@ setup(
             "dask[distributed]>=2024.1",
             "pyyeti>=1.4.7",  # test_srs holds the SRS to pyyeti.srs.srs
             "mujoco>=4.0,<5",  # test_mujoco_peer: the peer poses the twin's problem
+            "mcap>=1.1,<2",  # test_mcap_io: the MCAP project's reader checks the bags we write
         ],
         "plot": ["matplotlib>=3.6"],
         "sweep": ["dask[distributed]>=2024.1"],

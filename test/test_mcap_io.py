@@ -8,12 +8,15 @@ leaves to rosbags what it does not read (chunks overlapping in time)."""
 from __future__ import annotations
 
 import itertools
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 from io_helpers import read_raw
+from mcap.reader import make_reader
+from mcap.stream_reader import StreamReader
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
 
@@ -106,6 +109,32 @@ def test_our_bag_reads_back_through_rosbags_as_rosbags_own(
     chunks = salvage(ours / "ours.mcap", "/deck/imu")  # record by record, no summary
     assert not chunks.damage and chunks.msgtype == IMU
     assert chunks.messages == [(t, r) for topic, t, r in messages if topic == "/deck/imu"]
+
+
+def test_our_bag_passes_the_mcap_projects_own_reader_crcs_and_indexes_checked(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The reference implementation (Foxglove's `mcap`): every record read in order with the
+    checksums validated, and the indexed reader (chunk and message indexes, summary) giving
+    the messages in log-time order with the statistics' counts."""
+    monkeypatch.setattr(mcap_writer, "CHUNK_BYTES", 8192)
+    messages = _mixed(2000)
+    topics = dict.fromkeys(dict.fromkeys(t for t, _, _ in messages), IMU)
+    with OutputBag(tmp_path / "ours", topics) as bag:
+        bag.write(messages)
+    file = tmp_path / "ours" / "ours.mcap"
+    with file.open("rb") as f:
+        kinds = Counter(type(r).__name__ for r in StreamReader(f, validate_crcs=True).records)
+    assert kinds["Message"] == len(messages) and kinds["Chunk"] == 0  # read into chunks
+    assert kinds["ChunkIndex"] > 10 and kinds["Footer"] == 1
+    with file.open("rb") as f:
+        reader = make_reader(f, validate_crcs=True)
+        stats = reader.get_summary().statistics
+        got = [(c.topic, m.log_time, m.data) for _, c, m in reader.iter_messages()]
+    assert got == messages and stats.message_count == len(messages)
+    assert stats.channel_message_counts == dict(
+        Counter(list(topics).index(t) + 1 for t, _, _ in messages)
+    )
 
 
 def test_a_partial_bag_says_why_in_its_metadata_and_an_empty_one_reads(tmp_path: Path) -> None:
