@@ -41,6 +41,8 @@ from mount_twin.io.messages import (
     IMU,
     TF,
     TF_STATIC_TOPIC,
+    Encoded,
+    RowBlock,
     encode_report,
     output_types,
     resolve,
@@ -335,7 +337,7 @@ def _open(
     bag = InputBag(input_path, scene.input.topic, scene.input.msg_type)
     try:
         check_new_bag(output_path)
-        stream = TwinStream(scene)
+        stream = TwinStream(scene, blocks=True)
         if checkpoint is not None:  # a signal while the twin was built: no output bag yet
             checkpoint()
     except BaseException:
@@ -424,6 +426,7 @@ def replay(
         for raws in chain(_until_damage(bag.chunks(chunk), damage), [None]):
             if checkpoint is not None:
                 checkpoint()
+            outputs: list[Encoded]
             if raws is None:  # the body IMU's rest, then the end
                 outputs = [m for b in body_chunks for m in stream.process_body(b)]
                 outputs += stream.finish()
@@ -432,9 +435,16 @@ def replay(
                 while stream.body_behind and (body := next(body_chunks, None)) is not None:
                     outputs += stream.process_body(body)
             if static_due and outputs:
-                out.write([static_transforms(scene, outputs[0][1])])
+                first = outputs[0]
+                stamp = int(first.stamps_ns[0]) if isinstance(first, RowBlock) else first[1]
+                out.write([static_transforms(scene, stamp)])
                 static_due = False
-            out.write([(resolved[topic], stamp, raw) for topic, stamp, raw in outputs])
+            out.write(
+                [
+                    m.renamed(resolved) if isinstance(m, RowBlock) else (resolved[m[0]], *m[1:])
+                    for m in outputs
+                ]
+            )
             if (batch := stream.last_outputs) is not None:
                 figures.add(batch)
                 for report in batch.health:

@@ -18,9 +18,11 @@ from mount_twin.errors import require
 from mount_twin.io.messages import (
     IMU,
     Decoded,
+    Encoded,
     TimeBase,
     decode_inputs,
     encode_body,
+    encode_output_blocks,
     encode_outputs,
     encode_report,
 )
@@ -42,9 +44,12 @@ class TwinStream:
             for summaries).
     """
 
-    def __init__(self, scene: Scene) -> None:
+    def __init__(self, scene: Scene, *, blocks: bool = False) -> None:
         require(scene, Scene, "TwinStream(scene)")
         self.scene = scene
+        self.blocks = blocks
+        """Per-row outputs come as `RowBlock`s (a bag writer's) rather than message by message
+        (a publisher's): the same bytes, in the same order (`messages_of`)."""
         self.engine = TwinEngine(assemble(scene))
         # rosbags generates a type's serializer at its first use and the output layouts are
         # probed then: ~40 ms that would otherwise delay the first live sample.
@@ -73,8 +78,9 @@ class TwinStream:
         self._ageing_jobs: list[WindowJob] = []
         self._ageing_last_ns = 0
 
-    def process(self, raws: list[bytes]) -> list[tuple[str, int, bytes]]:
-        """Outputs for raw input messages, as (unresolved topic, stamp ns, CDR bytes)."""
+    def process(self, raws: list[bytes]) -> list[Encoded]:
+        """Outputs for raw input messages, as (unresolved topic, stamp ns, CDR bytes), or blocks
+        of them (`blocks`)."""
         decoded = decode_inputs(raws, self.scene.input.msg_type)
         if decoded.undecodable:
             self.engine.count("received", decoded.undecodable)
@@ -197,18 +203,21 @@ class TwinStream:
         self.body_reports += reports
         return encode_body(self.scene, rows)
 
-    def _encode(self, out: OutputBatch, stamps_ns: np.ndarray) -> list[tuple[str, int, bytes]]:
-        """encode_outputs, keeping the last stamp answered."""
+    def _encode(self, out: OutputBatch, stamps_ns: np.ndarray) -> list[Encoded]:
+        """The outputs encoded (in blocks or one by one: `blocks`), keeping the last stamp
+        answered."""
         if len(out):
             self._last_ns = int(stamps_ns[out.sample[-1]])
-        return encode_outputs(self.scene, out, stamps_ns)
+        if self.blocks:
+            return encode_output_blocks(self.scene, out, stamps_ns)
+        return list(encode_outputs(self.scene, out, stamps_ns))
 
     def stalled(self, waited_s: float, stamp_ns: int) -> list[tuple[str, int, bytes]]:
         """A report now, after `waited_s` (s) of the node's clock without any (live only),
         stamped `stamp_ns` (the clock: there is no input stamp to answer)."""
         return [encode_report(self.scene, self.engine.report_stalled(waited_s), stamp_ns)]
 
-    def finish(self) -> list[tuple[str, int, bytes]]:
+    def finish(self) -> list[Encoded]:
         """The end of the stream (end of a bag, node shutdown): the outputs the gyro delay
         still holds, then the last, partial diagnostics period, stamped with the last input
         stamp answered (none answered: the last received; none with a stamp: 0); no report if

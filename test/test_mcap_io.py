@@ -25,7 +25,7 @@ from mount_twin.io import mcap_writer
 from mount_twin.io.bag import LATCHED_QOS, PARTIAL_KEY, InputBag, OutputBag
 from mount_twin.io.mcap_reader import plain_messages
 from mount_twin.io.mcap_salvage import salvage
-from mount_twin.io.messages import IMU, TYPESTORE, imu_messages
+from mount_twin.io.messages import IMU, TYPESTORE, RowBlock, imu_messages
 
 POSE, DIAG = "geometry_msgs/msg/PoseStamped", "diagnostic_msgs/msg/DiagnosticArray"
 T0 = 1_700_000_000_000_000_000
@@ -135,6 +135,42 @@ def test_our_bag_passes_the_mcap_projects_own_reader_crcs_and_indexes_checked(
     assert stats.channel_message_counts == dict(
         Counter(list(topics).index(t) + 1 for t, _, _ in messages)
     )
+
+
+@pytest.mark.parametrize("chunk_bytes", [1 << 20, 5000])
+def test_rows_written_as_a_block_make_the_same_file_as_one_by_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, chunk_bytes: int
+) -> None:
+    """A block of rows (a replay's outputs) and the same messages one by one, row by row:
+    byte-equal files, with chunks cut inside rows (5000 bytes) or not."""
+    monkeypatch.setattr(mcap_writer, "CHUNK_BYTES", chunk_bytes)
+    k = 500
+    deck, body = _imu(k, "deck_imu"), _imu(k, "body_frame_longer")
+    stamps = np.array([t for t, _ in deck], np.int64)
+    rows = tuple(
+        np.frombuffer(b"".join(r for _, r in m), np.uint8).reshape(k, -1) for m in (deck, body)
+    )
+    block = RowBlock(("/deck/imu", "/body/imu"), stamps, rows)
+    topics = {"/deck/imu": IMU, "/body/imu": IMU, "/diagnostics": IMU}
+    extra = ("/diagnostics", int(stamps[-1]), body[0][1])
+    one_by_one = [*block.messages(), extra]
+    assert one_by_one[:4] == [
+        ("/deck/imu", deck[0][0], deck[0][1]),
+        ("/body/imu", body[0][0], body[0][1]),
+        ("/deck/imu", deck[1][0], deck[1][1]),
+        ("/body/imu", body[1][0], body[1][1]),
+    ]
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    with OutputBag(tmp_path / "a" / "bag", topics) as a:
+        a.write([RowBlock(block.topics, stamps[:200], tuple(r[:200] for r in rows))])
+        a.write([RowBlock(block.topics, stamps[200:], tuple(r[200:] for r in rows)), extra])
+    with OutputBag(tmp_path / "b" / "bag", topics) as b:
+        b.write(one_by_one[:7])
+        b.write(one_by_one[7:])
+    one = (tmp_path / "a" / "bag" / "bag.mcap").read_bytes()
+    assert one == (tmp_path / "b" / "bag" / "bag.mcap").read_bytes()
+    assert _in_order(tmp_path / "a" / "bag") == one_by_one
 
 
 def test_a_partial_bag_says_why_in_its_metadata_and_an_empty_one_reads(tmp_path: Path) -> None:

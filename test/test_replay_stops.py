@@ -19,6 +19,7 @@ from rosbags.highlevel import AnyReader
 
 from mount_twin.cli import main
 from mount_twin.io.bag import PARTIAL_KEY
+from mount_twin.io.mcap_writer import CHUNK_BYTES
 from mount_twin.io.messages import TYPESTORE
 
 PUMP = str(CONFIG / "pump_8_mounts.scene.yaml")
@@ -55,10 +56,10 @@ def test_a_signal_leaves_a_readable_bag_marked_partial(
         env={**os.environ, "PYTHONUNBUFFERED": "1"},
     )
     deadline = time.monotonic() + 120.0
-    while not (out / "metadata.yaml").exists() and not any(out.glob("*.mcap")):
+    mcap = out / "out.mcap"
+    while not (mcap.exists() and mcap.stat().st_size > CHUNK_BYTES):  # well into the replay:
         assert time.monotonic() < deadline and proc.poll() is None, proc.communicate()
-        time.sleep(0.2)
-    time.sleep(2.0)  # well into the replay
+        time.sleep(0.01)  # its first chunk written, about 1 % of it (the whole takes seconds)
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == code, err

@@ -12,7 +12,6 @@ from collections import Counter
 from collections.abc import Generator, Iterator, Mapping, Sequence
 from contextlib import suppress
 from itertools import accumulate
-from operator import itemgetter
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -32,7 +31,7 @@ from mount_twin.errors import BagError, DamagedBagError
 from mount_twin.io.mcap_reader import plain_messages
 from mount_twin.io.mcap_salvage import Salvage, salvage
 from mount_twin.io.mcap_writer import McapBagWriter
-from mount_twin.io.messages import TYPESTORE
+from mount_twin.io.messages import TYPESTORE, Encoded, RowBlock
 
 _INFINITE = QosTime(9223372036, 854775807)
 """RMW_DURATION_INFINITE (sec, nsec), as a Jazzy recording stores a default deadline/lifespan."""
@@ -424,15 +423,27 @@ class OutputBag:
         """Why the bag is partial (then recorded in its metadata), or None: complete."""
         self._failed: OSError | None = None
 
-    def write(self, messages: Sequence[tuple[str, int, bytes | memoryview]]) -> None:
-        """Write serialized messages, each (topic, stamp ns, CDR bytes), in order. A stamp before
-        1970 is refused before any of them is written; a failed write (a full disk) names the
-        bag, which is then closed without its index (`close`)."""
-        if messages and min(map(itemgetter(1), messages)) < 0:
-            for topic, stamp_ns, _ in messages:
-                check_stamp(self.path, topic, stamp_ns)
+    def write(self, encoded: Sequence[Encoded]) -> None:
+        """Write serialized messages in order: each (topic, stamp ns, CDR bytes), or a block of
+        rows of them (`RowBlock`, its topics resolved). A stamp before 1970 is refused before
+        any of them is written; a failed write (a full disk) names the bag, which is then
+        closed without its index (`close`)."""
+        for item in encoded:
+            if isinstance(item, RowBlock):
+                if len(item.stamps_ns) and item.topics:
+                    check_stamp(self.path, item.topics[0], int(item.stamps_ns.min()))
+            else:
+                check_stamp(self.path, item[0], item[1])
         try:
-            self._writer.write(messages)
+            singles: list[tuple[str, int, bytes]] = []
+            for piece in encoded:
+                if isinstance(piece, tuple):
+                    singles.append(piece)
+                    continue
+                self._writer.write(singles)
+                singles = []
+                self._writer.write_rows(piece.topics, piece.stamps_ns, piece.rows)
+            self._writer.write(singles)
         except OSError as err:
             self._failed = err
             msg = (
@@ -440,9 +451,13 @@ class OutputBag:
                 f"messages; the bag is left unfinished (no index, no metadata.yaml)"
             )
             raise BagError(msg) from err
-        if messages:
-            self.written += len(messages)
-            self.last_stamp_ns = messages[-1][1]
+        for item in encoded:
+            if isinstance(item, RowBlock):
+                self.written += len(item.stamps_ns) * len(item.topics)
+                self.last_stamp_ns = int(item.stamps_ns[-1]) if len(item.stamps_ns) else None
+            else:
+                self.written += 1
+                self.last_stamp_ns = item[1]
 
     def mark_partial(self, reason: str) -> None:
         """Record in the bag's metadata (custom_data `mount_twin.partial`, which `ros2 bag

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import struct
 
+import numpy as np
+
 MAGIC = b"\x89MCAP0\r\n"
 HEADER, FOOTER, SCHEMA, CHANNEL, MESSAGE, CHUNK = 0x01, 0x02, 0x03, 0x04, 0x05, 0x06
 MESSAGE_INDEX, CHUNK_INDEX, STATISTICS, METADATA = 0x07, 0x08, 0x0B, 0x0C
@@ -23,6 +25,17 @@ METADATA_INDEX, SUMMARY_OFFSET, DATA_END = 0x0D, 0x0E, 0x0F
 
 MESSAGE_HEAD = struct.Struct("<BQHIQQ")
 """A message record's opcode, length, channel, sequence, log and publish time."""
+MESSAGE_HEAD_DTYPE = np.dtype(
+    [
+        ("op", "u1"),
+        ("length", "<u8"),
+        ("channel", "<u2"),
+        ("sequence", "<u4"),
+        ("log_time", "<u8"),
+        ("publish_time", "<u8"),
+    ]
+)
+"""MESSAGE_HEAD as a numpy record (packed: no padding; tested the same size)."""
 CHUNK_HEAD = 28
 """A chunk body's bytes before its compression string (start, end, size, crc)."""
 

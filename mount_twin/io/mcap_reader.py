@@ -29,22 +29,12 @@ from mount_twin.io.mcap_format import (
     MAGIC,
     MESSAGE,
     MESSAGE_HEAD,
+    MESSAGE_HEAD_DTYPE,
     decompress,
     read_string,
 )
 
 _FOOTER_BYTES = 9 + 20 + len(MAGIC)
-_HEAD_DTYPE = np.dtype(
-    [
-        ("op", "u1"),
-        ("length", "<u8"),
-        ("channel", "<u2"),
-        ("sequence", "<u4"),
-        ("log_time", "<u8"),
-        ("publish_time", "<u8"),
-    ]
-)
-"""MESSAGE_HEAD as a numpy record (packed: no padding)."""
 
 
 @dataclass(frozen=True)
@@ -175,7 +165,7 @@ def _uniform(records: bytes, wanted: set[int]) -> list[tuple[int, bytes]] | None
     if cid not in wanted or len(records) % stride:
         return None
     rows = np.frombuffer(records, np.uint8).reshape(-1, stride)
-    heads = rows[:, : MESSAGE_HEAD.size].copy().view(_HEAD_DTYPE)[:, 0]
+    heads = rows[:, : MESSAGE_HEAD.size].copy().view(MESSAGE_HEAD_DTYPE)[:, 0]
     same = (heads["op"] == MESSAGE) & (heads["length"] == length) & (heads["channel"] == cid)
     if not same.all():
         return None

@@ -17,10 +17,9 @@ from __future__ import annotations
 
 import struct
 import zlib
-from bisect import bisect_left
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from itertools import accumulate, chain, repeat
+from itertools import chain, repeat
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -39,6 +38,7 @@ from mount_twin.io.mcap_format import (
     MAGIC,
     MESSAGE,
     MESSAGE_HEAD,
+    MESSAGE_HEAD_DTYPE,
     MESSAGE_INDEX,
     METADATA,
     METADATA_INDEX,
@@ -72,14 +72,14 @@ class _Channel:
 
 @dataclass
 class _Chunk:
-    """The open chunk: its records and their bytes; each message's channel, log time and offset
-    in the records."""
+    """The open chunk: its records' bytes, in parts; each message's channel, log time and offset
+    in the records, in arrays per part."""
 
-    parts: list[bytes | memoryview] = field(default_factory=list)
+    parts: list[bytes] = field(default_factory=list)
     size: int = 0
-    channels: list[int] = field(default_factory=list)
-    times: list[int] = field(default_factory=list)
-    offsets: list[int] = field(default_factory=list)
+    channels: list[np.ndarray] = field(default_factory=list)
+    times: list[np.ndarray] = field(default_factory=list)
+    offsets: list[np.ndarray] = field(default_factory=list)
 
 
 def _yaml_text(data: object) -> str:
@@ -139,42 +139,88 @@ class McapBagWriter:
 
     def write(self, messages: Sequence[tuple[str, int, bytes | memoryview]]) -> None:
         """Add messages, each (topic, log time ns, CDR bytes): log time is also its publish
-        time. A chunk is closed where its records reach CHUNK_BYTES."""
-        while messages:
-            chunk = self._chunk
-            sizes = [MESSAGE_HEAD.size + len(data) for _, _, data in messages]
-            ends = list(accumulate(sizes, initial=chunk.size))  # the records' ends
-            full = bisect_left(ends, CHUNK_BYTES, 1)
-            part, messages = messages[:full], messages[full:]
-            channels = [self._ids[topic] for topic, _, _ in part]
-            times = [log_time for _, log_time, _ in part]
+        time."""
+        if not messages:
+            return
+        datas = [data for _, _, data in messages]
+        sizes = np.fromiter(map(len, datas), np.int64, len(datas)) + MESSAGE_HEAD.size
+        channels = np.array([self._ids[topic] for topic, _, _ in messages], np.int64)
+        times = np.array([log_time for _, log_time, _ in messages], np.uint64)
+
+        def records(a: int, b: int) -> bytes:
+            ts = times[a:b].tolist()
             heads = map(
                 MESSAGE_HEAD.pack,
                 repeat(MESSAGE),
-                [n - 9 for n in sizes],
-                channels,
+                (sizes[a:b] - 9).tolist(),
+                channels[a:b].tolist(),
                 repeat(0),
-                times,
-                times,
+                ts,
+                ts,
             )
-            chunk.parts += chain.from_iterable(
-                zip(heads, (data for _, _, data in part), strict=True)
-            )
-            chunk.channels += channels
-            chunk.times += times
-            chunk.offsets += ends[: len(part)]
-            chunk.size = ends[len(part)]
+            return b"".join(chain.from_iterable(zip(heads, datas[a:b], strict=True)))
+
+        self._append(sizes, channels, times, records)
+
+    def write_rows(
+        self, topics: Sequence[str], stamps_ns: np.ndarray, rows: Sequence[np.ndarray]
+    ) -> None:
+        """Add messages in rows, as `write` would take them row by row: row k holds, for each
+        topic j in order, the message logged at stamps_ns[k] whose bytes are rows[j][k] (each
+        (k, L_j) uint8). The records are built in one numpy pass."""
+        k, m = len(stamps_ns), len(topics)
+        if not k or not m:
+            return
+        heads = np.zeros((k, m), MESSAGE_HEAD_DTYPE)
+        heads["op"] = MESSAGE
+        heads["length"] = [MESSAGE_HEAD.size - 9 + r.shape[1] for r in rows]
+        heads["channel"] = [self._ids[t] for t in topics]
+        heads["log_time"] = heads["publish_time"] = np.asarray(stamps_ns)[:, None]
+        head_bytes = heads.view(np.uint8).reshape(k, m, MESSAGE_HEAD.size)
+        flat = np.concatenate(
+            [part for j in range(m) for part in (head_bytes[:, j], rows[j])], axis=1
+        ).tobytes()
+        sizes = np.tile(heads["length"][0].astype(np.int64) + 9, k)
+        starts = np.concatenate([[0], np.cumsum(sizes)])
+        self._append(
+            sizes,
+            np.tile(heads["channel"][0].astype(np.int64), k),
+            np.repeat(np.asarray(stamps_ns, np.uint64), m),
+            lambda a, b: flat[starts[a] : starts[b]],
+        )
+
+    def _append(
+        self,
+        sizes: np.ndarray,
+        channels: np.ndarray,
+        times: np.ndarray,
+        records: Callable[[int, int], bytes],
+    ) -> None:
+        """Add n messages of these record sizes, channels and log times, whose records
+        a..b are `records(a, b)`, closing a chunk right after the message that takes its
+        records to CHUNK_BYTES."""
+        n, a = len(sizes), 0
+        while a < n:
+            chunk = self._chunk
+            ends = chunk.size + np.cumsum(sizes[a:])
+            b = min(n, a + int(np.searchsorted(ends, CHUNK_BYTES)) + 1)
+            chunk.parts.append(records(a, b))
+            chunk.offsets.append(np.concatenate([[chunk.size], ends[: b - a - 1]]))
+            chunk.channels.append(channels[a:b])
+            chunk.times.append(times[a:b])
+            chunk.size = int(ends[b - a - 1])
             if chunk.size >= CHUNK_BYTES:
                 self._close_chunk()
+            a = b
 
     def _close_chunk(self) -> None:
         """Write the open chunk, its message indexes, and keep its chunk index."""
         chunk, self._chunk = self._chunk, _Chunk()
         if not chunk.times:
             return
-        channels = np.array(chunk.channels)
-        times = np.array(chunk.times, dtype="<u8")
-        pairs = np.column_stack((times, np.array(chunk.offsets, dtype="<u8")))
+        channels = np.concatenate(chunk.channels)
+        times = np.concatenate(chunk.times).astype("<u8")
+        pairs = np.column_stack((times, np.concatenate(chunk.offsets).astype("<u8")))
         start, end = int(times.min()), int(times.max())
         records = b"".join(chunk.parts)
         head = struct.pack("<QQQI", start, end, chunk.size, zlib.crc32(records))
@@ -193,7 +239,7 @@ class McapBagWriter:
         self._out.write(b"".join([head_record, records, *indexes]))
         for cid, count in zip(ids.tolist(), counts.tolist(), strict=True):
             self._by_id[cid].count += count
-        self.durable += len(chunk.times)
+        self.durable += len(times)
         self._start, self._end = min(self._start, start), max(self._end, end)
         length = len(head_record) + chunk.size
         body = struct.pack("<QQQQ", start, end, chunk_at, length)

@@ -512,12 +512,64 @@ def resolve(name: str, node_name: str, namespace: str = "/") -> str:
     return name if name.startswith("/") else f"{ns}/{name}"
 
 
+@dataclass(frozen=True)
+class RowBlock:
+    """Per-row output messages in columns: row k holds, for each topic j in order, the message
+    stamped stamps_ns[k] whose CDR bytes are rows[j][k] (`messages` lists them row by row, the
+    order they are published in). A bag writer takes the block whole (`io.mcap_writer`).
+
+    Attributes:
+        topics: (m,) topic of each column (unresolved from `encode_output_blocks`; `renamed`).
+        stamps_ns: (k,) int64 stamps, ns.
+        rows: m arrays (k, L_j) uint8, each message of topic j one row of L_j bytes.
+    """
+
+    topics: tuple[str, ...]
+    stamps_ns: np.ndarray
+    rows: tuple[np.ndarray, ...]
+
+    def messages(self) -> list[tuple[str, int, bytes]]:
+        """(topic, stamp ns, CDR bytes) row by row."""
+        k = len(self.stamps_ns)
+        stamps = self.stamps_ns.tolist()
+        columns = []
+        for topic, rows in zip(self.topics, self.rows, strict=True):
+            data, size = rows.tobytes(), rows.shape[1]
+            raws = [data[i * size : (i + 1) * size] for i in range(k)]
+            columns.append(zip([topic] * k, stamps, raws, strict=True))
+        return list(chain.from_iterable(zip(*columns, strict=True)))
+
+    def renamed(self, names: dict[str, str]) -> RowBlock:
+        """The block with each topic t as names[t]."""
+        return RowBlock(tuple(names[t] for t in self.topics), self.stamps_ns, self.rows)
+
+
+Encoded = tuple[str, int, bytes] | RowBlock
+"""An encoded output: one message (topic, stamp ns, CDR bytes), or a block of per-row ones."""
+
+
+def messages_of(encoded: Sequence[Encoded]) -> list[tuple[str, int, bytes]]:
+    """The messages of encoded outputs one by one, in order."""
+    out: list[tuple[str, int, bytes]] = []
+    for item in encoded:
+        if isinstance(item, RowBlock):
+            out += item.messages()
+        else:
+            out.append(item)
+    return out
+
+
 def encode_outputs(
     scene: Scene, out: OutputBatch, stamps_ns: np.ndarray
 ) -> list[tuple[str, int, bytes]]:
-    """CDR messages for an output batch as (unresolved topic, stamp ns, bytes), in the order the
-    samples were processed; each diagnostics report follows the rows published before it was
-    due (`HealthReport.rows`).
+    """`encode_output_blocks` message by message."""
+    return messages_of(encode_output_blocks(scene, out, stamps_ns))
+
+
+def encode_output_blocks(scene: Scene, out: OutputBatch, stamps_ns: np.ndarray) -> list[Encoded]:
+    """CDR messages for an output batch, in the order the samples were processed: blocks of
+    per-row messages (`RowBlock`), each diagnostics report (topic, stamp ns, bytes) after the
+    rows published before it was due (`HealthReport.rows`).
 
     Args:
         stamps_ns: (n,) header stamps of the pushed samples, integer ns; rows reuse them, so
@@ -529,23 +581,34 @@ def encode_outputs(
     """
     stamps = stamps_ns[out.sample]
     sec, nsec = np.divmod(stamps, 1_000_000_000)
-    rows = [
-        (st.topic, _pack(st.msgtype, st.frames, sec, nsec, st.values(out)))
-        for st in output_streams(scene)
-    ]
-    stamp_list = stamps.tolist()
-    n = len(stamp_list)
-    per_row = [zip([topic] * n, stamp_list, raws, strict=True) for topic, raws in rows]
-    row_major = list(chain.from_iterable(zip(*per_row, strict=True)))
-    msgs: list[tuple[str, int, bytes]] = []
-    done = 0  # rows in msgs
+    streams = output_streams(scene)
+    topics = tuple(st.topic for st in streams)
+    if len(stamps) == 1:  # a live sample: struct beats numpy's per-call overhead (~3 vs ~25 µs)
+        one: list[Encoded] = [
+            (st.topic, int(stamps[0]), _pack(st.msgtype, st.frames, sec, nsec, st.values(out))[0])
+            for st in streams
+        ]
+    else:
+        rows = tuple(
+            _layout(st.msgtype, *st.frames).pack_rows([sec, nsec, st.values(out)])
+            for st in streams
+        )
+
+    def block(a: int, b: int) -> list[Encoded]:
+        if b <= a or not topics:
+            return []
+        if len(stamps) == 1:
+            return one
+        return [RowBlock(topics, stamps[a:b], tuple(r[a:b] for r in rows))]
+
+    encoded: list[Encoded] = []
+    done = 0  # rows encoded
     for report in out.health:  # each before the first row at or after its `rows`
-        upto = max(done, min(report.rows, len(stamp_list)))
-        msgs += row_major[done * len(rows) : upto * len(rows)]
-        msgs.append(encode_report(scene, report, int(stamps_ns[report.sample])))
+        upto = max(done, min(report.rows, len(stamps)))
+        encoded += block(done, upto)
+        encoded.append(encode_report(scene, report, int(stamps_ns[report.sample])))
         done = upto
-    msgs += row_major[done * len(rows) :]
-    return msgs
+    return encoded + block(done, len(stamps))
 
 
 def encode_report(scene: Scene, report: HealthReport, stamp_ns: int) -> tuple[str, int, bytes]:

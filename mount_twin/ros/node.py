@@ -51,6 +51,7 @@ from mount_twin.io.messages import (
     TF,
     TF_STATIC_TOPIC,
     encode_report,
+    messages_of,
     output_types,
     static_transforms,
 )
@@ -244,7 +245,7 @@ class MountTwinNode(Node):
 
     def _process(self, raws: list[bytes]) -> None:
         """Input through the twin; its outputs published, its diagnostics reports counted."""
-        messages = self.stream.process(raws)
+        messages = messages_of(self.stream.process(raws))
         self._reports += sum(topic == DIAGNOSTICS_TOPIC for topic, _, _ in messages)
         self._publish(messages)
         self._submit_fits()
@@ -328,7 +329,7 @@ class MountTwinNode(Node):
         self._drain()
         if self._body_sub is not None:
             self._publish(self.stream.process_body(take_waiting(self._body_sub, TAKE_LIMIT)))
-        self._publish(self.stream.finish())
+        self._publish(messages_of(self.stream.finish()))
         self._submit_fits()
         self._publish_fits(wait=True)
         deadline = time.monotonic() + SHUTDOWN_ACK_S
