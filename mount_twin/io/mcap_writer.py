@@ -1,14 +1,14 @@
-"""A rosbag2 bag in mcap storage, written by us a message at a small, fixed cost: the bag's
-layout is the one rosbags writes (records, summary, metadata.yaml), each message's record packed
-by one `struct` call into the open chunk instead of rosbags' dozen small writes per message.
+"""A rosbag2 bag in mcap storage, written by us at a small cost per message: the layout rosbags
+writes (records, chunk and message indexes, summary, metadata.yaml), each message's record
+packed by one `struct` call (`write`), or a block of rows' records in one numpy pass
+(`write_rows`), where rosbags makes a dozen small writes per message.
 
 Why not rosbags' Writer: at a 1 kHz input and 11 output topics its per-message cost (about
-10 µs) made writing half of a replay's time; this writer takes about a tenth of that. The
-message bytes are CDR encoded as before (`io.messages`, layouts checked against rosbags'
-serializer); each type's definition and hash come from the Jazzy typestore, the QoS text from
-rosbags' own dumper, so rosbags and `ros2 bag` read the bag as one rosbags wrote (tested:
-test/test_mcap_writer.py reads it back with rosbags and compares it with rosbags' bag of the
-same messages).
+10 µs) made writing half of a replay's time. The message bytes are CDR encoded as before
+(`io.messages`, layouts checked against rosbags' serializer); each type's definition and hash
+come from the Jazzy typestore, the QoS text from rosbags' own dumper, so rosbags and `ros2 bag`
+read the bag as one rosbags wrote (test/test_mcap_io.py reads it back with rosbags against
+rosbags' bag of the same messages, and with the MCAP project's own reader, checksums checked).
 
 The record layout: `io.mcap_format`.
 """
@@ -56,7 +56,6 @@ CHUNK_BYTES = 1 << 20
 """A chunk is closed once its records reach this many bytes (rosbags' size)."""
 VERSION = 9
 """metadata.yaml's version (rosbag2 in Jazzy)."""
-_MESSAGE_FIELDS = MESSAGE_HEAD.size - 9  # the body's bytes before the data
 
 
 @dataclass
