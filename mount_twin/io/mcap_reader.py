@@ -1,6 +1,7 @@
 """One topic's messages of an intact, indexed mcap file, read a chunk at a time in log-time
 order: the order rosbags' reader yields them in, at a fraction of its per-message cost (it
-parses each record through a few small reads; here one `struct` call walks a record).
+parses each record through a few small reads; here one `struct` call walks a record, and a
+chunk of one IMU of one frame_id, its records all of one length, is read in one numpy pass).
 
 Only the plain case is read here, the case of every bag a recorder or rosbags writes in time
 order: a summary with chunk indexes whose chunks do not overlap in time. Within a chunk the
