@@ -58,14 +58,17 @@ def read_output_bag(path: str | Path) -> list[Table]:
                     tables_of[c.id] = ("diagnostics", None)
                 elif (found := output_table(c.topic, c.msgtype)) is not None:
                     tables_of[c.id] = found
+                else:
+                    continue
+                name, output = tables_of[c.id]
+                columns_of[name] = output
+                rank[name] = _rank(c.msgtype, c.topic)
             conns = [c for c in reader.connections if c.id in tables_of]
             # (no connection list would mean every connection to rosbags)
             for conn, _, raw in reader.messages(connections=conns) if conns else ():
                 msg: Any = reader.deserialize(raw, conn.msgtype)
                 stamp = int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec)
                 name, output = tables_of[conn.id]
-                columns_of[name] = output
-                rank[name] = _rank(conn.msgtype, conn.topic)
                 if output is None:  # diagnostics
                     for st in msg.status:
                         stamps.setdefault(name, []).append(stamp)
