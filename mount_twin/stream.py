@@ -210,7 +210,7 @@ class TwinStream:
             self._last_ns = int(stamps_ns[out.sample[-1]])
         if self.blocks:
             return encode_output_blocks(self.scene, out, stamps_ns)
-        return list(encode_outputs(self.scene, out, stamps_ns))
+        return [*encode_outputs(self.scene, out, stamps_ns)]
 
     def stalled(self, waited_s: float, stamp_ns: int) -> list[tuple[str, int, bytes]]:
         """A report now, after `waited_s` (s) of the node's clock without any (live only),

@@ -393,7 +393,8 @@ PARTIAL_KEY = "mount_twin.partial"
 
 
 class OutputBag:
-    """An mcap bag written message by message (`io.mcap_writer`); log time = the message's stamp.
+    """An mcap bag written by `io.mcap_writer`, message by message or in blocks of rows; log time
+    = the message's stamp.
 
     Args:
         path: new bag directory (must not exist: an output bag is never overwritten).
@@ -454,7 +455,8 @@ class OutputBag:
         for item in encoded:
             if isinstance(item, RowBlock):
                 self.written += len(item.stamps_ns) * len(item.topics)
-                self.last_stamp_ns = int(item.stamps_ns[-1]) if len(item.stamps_ns) else None
+                if len(item.stamps_ns):
+                    self.last_stamp_ns = int(item.stamps_ns[-1])
             else:
                 self.written += 1
                 self.last_stamp_ns = item[1]

@@ -34,6 +34,12 @@ def _sentinel(i: int, dtype: str) -> float | int:
     return struct.unpack(_FORMATS[dtype], bytes([0xA5, i, 0x5A, 0x3C]))[0]
 
 
+def split_rows(rows: np.ndarray) -> list[bytes]:
+    """Each row of a (k, L) uint8 array as its own bytes."""
+    data, size = rows.tobytes(), rows.shape[1]
+    return [data[i * size : (i + 1) * size] for i in range(rows.shape[0])]
+
+
 @dataclass(frozen=True)
 class FixedLayout:
     """Byte layout of one message shape.
@@ -102,8 +108,7 @@ class FixedLayout:
         """One message per row of the columns (`pack_rows`), each its own bytes."""
         if len(columns[0]) == 1:  # a live sample: struct beats numpy's per-call overhead
             return [self._pack_one([v for c in columns for v in c.reshape(-1).tolist()])]
-        data, size = self.pack_rows(columns).tobytes(), self.size
-        return [data[i * size : (i + 1) * size] for i in range(len(columns[0]))]
+        return split_rows(self.pack_rows(columns))
 
     def pack_rows(self, columns: Sequence[np.ndarray]) -> np.ndarray:
         """(k, size) uint8: one message per row of the columns: each (k,) column fills one

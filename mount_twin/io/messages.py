@@ -21,7 +21,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from mount_twin.engine.batch import HealthReport, OutputBatch, SampleBatch
 from mount_twin.engine.body_check import BodyComparison
-from mount_twin.io.fixed_layout import FixedLayout
+from mount_twin.io.fixed_layout import FixedLayout, split_rows
 from mount_twin.physics import pose_row
 from mount_twin.physics.rotations import quaternion_from_matrix, rpy_matrix
 from mount_twin.scene.description import Outputs, Scene
@@ -534,9 +534,7 @@ class RowBlock:
         stamps = self.stamps_ns.tolist()
         columns = []
         for topic, rows in zip(self.topics, self.rows, strict=True):
-            data, size = rows.tobytes(), rows.shape[1]
-            raws = [data[i * size : (i + 1) * size] for i in range(k)]
-            columns.append(zip([topic] * k, stamps, raws, strict=True))
+            columns.append(zip([topic] * k, stamps, split_rows(rows), strict=True))
         return list(chain.from_iterable(zip(*columns, strict=True)))
 
     def renamed(self, names: dict[str, str]) -> RowBlock:
