@@ -89,8 +89,9 @@ class Scratch(NamedTuple):
       quaternion quat, its rate phi_rate and the couple map where a mount reads them
       (`ModelArrays.rotation_read`; else phi, phi_rate and the map are NaN and quat is left,
       for `outputs` to take): read by the mount laws and the rest of `rhs` at that y.
-    - `mount_loads` (inside `rhs`) fills arm, force, couple, loc, total_force, total_moment,
-      sink: read by `rhs` itself.
+    - `mount_loads` (inside `rhs`) fills total_force, total_moment (the linear mounts' own
+      couples summed through one law: it is linear in their K_r, C_r), and for the non-linear
+      mounts arm, force, couple, loc and sink: read by `rhs` itself.
     - `rhs(t, y, u)` fills all of the above, then f_s, big_w, big_w_dot, rel, w_x_rel,
       kin_rate, moment_b, w_b, w_dot_b, acc, w_abs, h, i_w, rhs_rot and mass_rot (the
       Cholesky factor of Jᵀ I J). `outputs(y)` may follow only if that last `rhs` was at y
@@ -99,8 +100,8 @@ class Scratch(NamedTuple):
     - `run_samples` fills rate_step (the jump of Ω' at a sample): read by
       `rhs_after_rate_step`.
     - `mount_wrenches`, `mount_monitors`, `outputs` and `evaluate` (which calls `body_motion`
-      first) overwrite arm, force, couple, loc and sink; their results go to the caller's
-      arrays.
+      first) overwrite arm, force, couple, loc and sink where the model has non-linear
+      mounts; their results go to the caller's arrays.
     """
 
     q: np.ndarray  # (6,)

@@ -145,6 +145,12 @@ inline Model model(py::handle m) {
   out.lin_c_t = matsrc<3, 3>(field(m, "lin_c_t"), "ModelArrays.lin_c_t", n);
   out.lin_k_r = matsrc<3, 3>(field(m, "lin_k_r"), "ModelArrays.lin_k_r", n);
   out.lin_c_r = matsrc<3, 3>(field(m, "lin_c_r"), "ModelArrays.lin_c_r", n);
+  for (idx i = 0; i < n; ++i) {  // the linear mounts' couples sum through one law
+    for (int k = 0; k < 9; ++k) {
+      out.lin_k_r_sum[k] += out.lin_k_r.d[9 * i + k];
+      out.lin_c_r_sum[k] += out.lin_c_r.d[9 * i + k];
+    }
+  }
   out.lin_slot = ivec(field(m, "lin_slot"), "ModelArrays.lin_slot", n);
   out.lin_per_rating = matc<6>(field(m, "lin_per_rating"), "ModelArrays.lin_per_rating", n);
   auto nl = field(m, "nl");

@@ -1,6 +1,8 @@
 // Equations of motion on the free generalized coordinates, in the moving foundation frame F
 // (physics/dynamics.py holds the derivation, the state layout and which call fills which
-// scratch field; this is the compiled implementation, the same operations in the same order).
+// scratch field; this is the compiled implementation). The hot loops read the body motion from
+// a `Motion` of locals and solve the 3×3 system at a fixed size: the scratch's views may alias,
+// and through them the compiler reloads every operand after every store.
 #pragma once
 
 #include <cmath>
@@ -37,8 +39,9 @@ inline double body_motion(Vec y, const Model& m, Scratch& s) {
     qd[3 + m.free_rot[k]] = y[nf + nt + k];
   }
   for (int i = 0; i < 3; ++i) {
-    trig[i] = std::sin(q[3 + i]);
-    trig[3 + i] = std::cos(q[3 + i]);
+    const double angle = q[3 + i];  // one load: the compiler pairs sin and cos into sincos
+    trig[i] = std::sin(angle);
+    trig[3 + i] = std::cos(angle);
   }
   const double sa = trig[0], sg = trig[1], sd = trig[2], ca = trig[3], cg = trig[4],
                cd = trig[5];
@@ -96,15 +99,15 @@ inline void out_of_axes(const NonLinear& nl, idx i, const double* local, double*
 
 /// Deflection, rate, rotation vector and its rate of non-linear mount i in its axes into
 /// s.loc rows 0..3 (rows 2, 3 NaN for a kind without a rotational law); its arm into s.arm.
-inline void local_motion(idx i, const NonLinear& nl, Scratch& s) {
+inline void local_motion(idx i, const NonLinear& nl, const Motion& mo, Scratch& s) {
   double de[6];
-  point_motion(&nl.point(i, 0), s.rot, s.q, s.qd, s.omega_f, s.arm, de);
+  point_motion(&nl.point(i, 0), mo, s.arm.d, de);
   const M3 loc = s.loc;
   into_axes(nl, i, de[0], de[1], de[2], loc.row(0).d);
   into_axes(nl, i, de[3], de[4], de[5], loc.row(1).d);
   if (nl.rotational[i]) {
-    into_axes(nl, i, s.phi[0], s.phi[1], s.phi[2], loc.row(2).d);
-    into_axes(nl, i, s.phi_rate[0], s.phi_rate[1], s.phi_rate[2], loc.row(3).d);
+    into_axes(nl, i, mo.phi[0], mo.phi[1], mo.phi[2], loc.row(2).d);
+    into_axes(nl, i, mo.rate[0], mo.rate[1], mo.rate[2], loc.row(3).d);
   } else {
     for (int j = 0; j < 3; ++j) {
       loc(2, j) = NAN;
@@ -114,8 +117,9 @@ inline void local_motion(idx i, const NonLinear& nl, Scratch& s) {
 }
 
 /// Load of non-linear mount i in its axes into s.loc rows 4, 5; its state rates into dydt.
-inline void nl_load(idx i, Vec y, const NonLinear& nl, Scratch& s, Vec dydt) {
-  local_motion(i, nl, s);
+inline void nl_load(idx i, Vec y, const NonLinear& nl, const Motion& mo, Scratch& s,
+                    Vec dydt) {
+  local_motion(i, nl, mo, s);
   const M3 loc = s.loc;
   kinds::kind_load(nl.kind[i], &nl.par(i, 0), y, nl.state[i], loc.row(0).d, loc.row(1).d,
                    loc.row(2).d, loc.row(3).d, dydt, loc.row(4).d, loc.row(5).d);
@@ -129,7 +133,8 @@ inline void nl_couple(idx i, const NonLinear& nl, Scratch& s, Vec c) {
   for (int j = 0; j < 3; ++j) c[j] = cmap(j, 0) * c0 + cmap(j, 1) * c1 + cmap(j, 2) * c2;
 }
 
-inline void add_load(Vec arm, Vec f, Vec c, Vec total_f, Vec total_m) {
+inline void add_load(const double* arm, const double* f, const double* c, double* total_f,
+                     double* total_m) {
   total_f[0] += f[0];
   total_f[1] += f[1];
   total_f[2] += f[2];
@@ -141,37 +146,48 @@ inline void add_load(Vec arm, Vec f, Vec c, Vec total_f, Vec total_m) {
 /// Sum the mount loads on the body into s.total_force, s.total_moment (F, about the CG);
 /// the internal-state rates of the mounts that have them into dydt.
 inline void mount_loads(Vec y, const Model& m, Scratch& s, Vec dydt) {
-  const Vec total_f = s.total_force, total_m = s.total_moment, arm = s.arm, f = s.force,
-            c = s.couple;
-  for (int j = 0; j < 3; ++j) {
-    total_f[j] = 0.0;
-    total_m[j] = 0.0;
-  }
+  const Motion mo = Motion::of(s);
+  double total_f[3] = {0.0, 0.0, 0.0}, total_m[3] = {0.0, 0.0, 0.0};
+  const double none[3] = {0.0, 0.0, 0.0};
   for (idx i = 0; i < m.lin_point.rows; ++i) {
-    linear_mount_load(i, m, s, arm, f, c);
-    add_load(arm, f, c, total_f, total_m);
+    double arm[3], f[3];
+    linear_mount_force(i, m, mo, arm, f);
+    add_load(arm, f, none, total_f, total_m);
   }
-  if (!m.has_nl) return;
-  const NonLinear& nl = m.nl;
-  for (idx i = 0; i < nl.k; ++i) {
-    nl_load(i, y, nl, s, dydt);
-    out_of_axes(nl, i, s.loc.row(4).d, f.d);
-    if (nl.rotational[i]) {
-      nl_couple(i, nl, s, c);
-    } else {
-      c[0] = 0.0;
-      c[1] = 0.0;
-      c[2] = 0.0;
+  if (m.lin_point.rows > 0) {  // their own couples, through their summed K_r, C_r
+    double c[3];
+    linear_couple(m.lin_k_r_sum, m.lin_c_r_sum, mo, c);
+    for (int j = 0; j < 3; ++j) total_m[j] += c[j];
+  }
+  if (m.has_nl) {
+    const NonLinear& nl = m.nl;
+    const Vec f = s.force, c = s.couple;
+    for (idx i = 0; i < nl.k; ++i) {
+      nl_load(i, y, nl, mo, s, dydt);
+      out_of_axes(nl, i, s.loc.row(4).d, f.d);
+      if (nl.rotational[i]) {
+        nl_couple(i, nl, s, c);
+      } else {
+        c[0] = 0.0;
+        c[1] = 0.0;
+        c[2] = 0.0;
+      }
+      add_load(s.arm.d, f.d, c.d, total_f, total_m);
     }
-    add_load(arm, f, c, total_f, total_m);
+  }
+  for (int j = 0; j < 3; ++j) {
+    s.total_force[j] = total_f[j];
+    s.total_moment[j] = total_m[j];
   }
 }
 
 /// Each mount's force (N) and own couple (N·m) on the body, in its axes: wrenches row slot.
 inline void mount_wrenches(Vec y, const Model& m, Scratch& s, M6 wrenches) {
-  const Vec arm = s.arm, f = s.force, c = s.couple;
+  const Motion mo = Motion::of(s);
   for (idx i = 0; i < m.lin_point.rows; ++i) {
-    linear_mount_load(i, m, s, arm, f, c);
+    double arm[3], f[3], c[3];
+    linear_mount_force(i, m, mo, arm, f);
+    linear_couple(&m.lin_k_r(i, 0, 0), &m.lin_c_r(i, 0, 0), mo, c);
     const idx row = m.lin_slot[i];
     const M33s& axes = m.lin_axes;
     for (int j = 0; j < 3; ++j) {
@@ -182,8 +198,9 @@ inline void mount_wrenches(Vec y, const Model& m, Scratch& s, M6 wrenches) {
   if (!m.has_nl) return;
   const NonLinear& nl = m.nl;
   const M3 loc = s.loc;
+  const Vec c = s.couple;
   for (idx i = 0; i < nl.k; ++i) {
-    nl_load(i, y, nl, s, s.sink);
+    nl_load(i, y, nl, mo, s, s.sink);
     if (nl.rotational[i]) {
       nl_couple(i, nl, s, c);
       into_axes(nl, i, c[0], c[1], c[2], loc.row(5).d);
@@ -200,9 +217,10 @@ inline void mount_wrenches(Vec y, const Model& m, Scratch& s, M6 wrenches) {
 /// motion computed); then their discrete switches. Returns whether one switched (y jumped).
 inline bool mount_monitors(Vec y, Vec y0, const NonLinear& nl, Scratch& s, Mat g, Vec util) {
   const M3 loc = s.loc;
+  const Motion mo = Motion::of(s);
   bool switched = false;
   for (idx i = 0; i < nl.k; ++i) {
-    local_motion(i, nl, s);
+    local_motion(i, nl, mo, s);
     const idx code = nl.kind[i], o = nl.state[i];
     const double* p = &nl.par(i, 0);
     util[i] = kinds::kind_monitor(code, p, y, y0, o, loc.row(0).d, loc.row(1).d, g.row(i));
@@ -231,36 +249,79 @@ inline void translational(const Model& m, Scratch& s, Vec dydt, idx nf) {
   }
 }
 
-/// Solve L Lᵀ x = b[:n] in place, L the lower triangle of low.
-inline void cholesky_solve(M3 low, Vec b, idx n) {
-  for (idx i = 0; i < n; ++i) {
+/// Solve L Lᵀ x = b in place, L (N×N, lower) in l: forward, then back substitution.
+template <idx N>
+inline void substitute(const double (&l)[3][3], double (&b)[3]) {
+  for (idx i = 0; i < N; ++i) {
     double e = b[i];
-    for (idx k = 0; k < i; ++k) e -= low(i, k) * b[k];
-    b[i] = e / low(i, i);
+    for (idx k = 0; k < i; ++k) e -= l[i][k] * b[k];
+    b[i] = e / l[i][i];
   }
-  for (idx i = n - 1; i >= 0; --i) {
+  for (idx i = N - 1; i >= 0; --i) {
     double e = b[i];
-    for (idx k = i + 1; k < n; ++k) e -= low(k, i) * b[k];
-    b[i] = e / low(i, i);
+    for (idx k = i + 1; k < N; ++k) e -= l[k][i] * b[k];
+    b[i] = e / l[i][i];
   }
 }
 
-/// Solve a[:n, :n] x = b[:n] in place by Cholesky (a keeps its factor); false if a is not
-/// positive definite.
-inline bool solve_spd(M3 a, Vec b, idx n) {
-  for (idx j = 0; j < n; ++j) {
-    double d = a(j, j);
-    for (idx k = 0; k < j; ++k) d -= a(j, k) * a(j, k);
+/// `substitute` on views, copied into locals first (the views may alias: in locals the
+/// compiler keeps the triangle in registers; N fixed: the loops unroll).
+template <idx N>
+inline void cholesky_solve_n(M3 low, Vec b) {
+  double l[3][3], x[3];
+  for (idx i = 0; i < N; ++i) {
+    x[i] = b[i];
+    for (idx k = 0; k <= i; ++k) l[i][k] = low(i, k);
+  }
+  substitute<N>(l, x);
+  for (idx i = 0; i < N; ++i) b[i] = x[i];
+}
+
+/// Solve L Lᵀ x = b[:n] in place, L the lower triangle of low (n ≤ 3).
+inline void cholesky_solve(M3 low, Vec b, idx n) {
+  if (n == 3) {
+    cholesky_solve_n<3>(low, b);
+  } else if (n == 2) {
+    cholesky_solve_n<2>(low, b);
+  } else if (n == 1) {
+    cholesky_solve_n<1>(low, b);
+  }
+}
+
+/// `solve_spd` for a fixed N.
+template <idx N>
+inline bool solve_spd_n(M3 a, Vec b) {
+  double l[3][3], x[3];
+  for (idx i = 0; i < N; ++i) {
+    x[i] = b[i];
+    for (idx k = 0; k <= i; ++k) l[i][k] = a(i, k);
+  }
+  for (idx j = 0; j < N; ++j) {
+    double d = l[j][j];
+    for (idx k = 0; k < j; ++k) d -= l[j][k] * l[j][k];
     if (!(d > 0.0)) return false;
     d = std::sqrt(d);
-    a(j, j) = d;
-    for (idx i = j + 1; i < n; ++i) {
-      double e = a(i, j);
-      for (idx k = 0; k < j; ++k) e -= a(i, k) * a(j, k);
-      a(i, j) = e / d;
+    l[j][j] = d;
+    for (idx i = j + 1; i < N; ++i) {
+      double e = l[i][j];
+      for (idx k = 0; k < j; ++k) e -= l[i][k] * l[j][k];
+      l[i][j] = e / d;
     }
   }
-  cholesky_solve(a, b, n);
+  substitute<N>(l, x);
+  for (idx i = 0; i < N; ++i) {
+    b[i] = x[i];
+    for (idx k = 0; k <= i; ++k) a(i, k) = l[i][k];
+  }
+  return true;
+}
+
+/// Solve a[:n, :n] x = b[:n] in place by Cholesky (n ≤ 3; the lower triangle of a keeps its
+/// factor); false if a is not positive definite.
+inline bool solve_spd(M3 a, Vec b, idx n) {
+  if (n == 3) return solve_spd_n<3>(a, b);
+  if (n == 2) return solve_spd_n<2>(a, b);
+  if (n == 1) return solve_spd_n<1>(a, b);
   return true;
 }
 

@@ -18,41 +18,76 @@
 
 namespace mt::physics {
 
+/// The body motion at y that the mount laws read, copied out of the scratch once per call
+/// (`Motion::of`): plain local values the compiler keeps in registers, where the scratch's
+/// views, which may alias one another, make it reload every operand after every store.
+struct Motion {
+  double rot[3][3];   // R, B → F
+  double q[3];        // m, the CG's displacement from its reference, F
+  double qd[3];       // m/s, its rate
+  double w[3];        // rad/s, the body's angular velocity R·ω, F
+  double phi[3];      // rad, the rotation vector of R (NaN unless a mount reads it)
+  double rate[3];     // rad/s, its rate
+  double cmap[3][3];  // J(φ)⁻ᵀ
+
+  /// The motion body_motion left in s.
+  static Motion of(const Scratch& s) {
+    Motion mo;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        mo.rot[i][j] = s.rot(i, j);
+        mo.cmap[i][j] = s.couple_map(i, j);
+      }
+      mo.q[i] = s.q[i];
+      mo.qd[i] = s.qd[i];
+      mo.w[i] = s.omega_f[i];
+      mo.phi[i] = s.phi[i];
+      mo.rate[i] = s.phi_rate[i];
+    }
+    return mo;
+  }
+};
+
 /// Displacement d (m) and velocity ḋ (m/s) in F of body point `point` from its reference
 /// position into de[0..2], de[3..5]; the lever arm R·p (m, F) into `arm`.
-inline void point_motion(const double* point, M3 rot, Vec q, Vec qd, Vec omega_f, Vec arm,
-                         double* de) {
+inline void point_motion(const double* point, const Motion& mo, double* arm, double* de) {
   for (int j = 0; j < 3; ++j) {
-    arm[j] = rot(j, 0) * point[0] + rot(j, 1) * point[1] + rot(j, 2) * point[2];
+    arm[j] = mo.rot[j][0] * point[0] + mo.rot[j][1] * point[1] + mo.rot[j][2] * point[2];
   }
-  de[0] = q[0] + arm[0] - point[0];
-  de[1] = q[1] + arm[1] - point[1];
-  de[2] = q[2] + arm[2] - point[2];
-  de[3] = qd[0] + omega_f[1] * arm[2] - omega_f[2] * arm[1];
-  de[4] = qd[1] + omega_f[2] * arm[0] - omega_f[0] * arm[2];
-  de[5] = qd[2] + omega_f[0] * arm[1] - omega_f[1] * arm[0];
+  de[0] = mo.q[0] + arm[0] - point[0];
+  de[1] = mo.q[1] + arm[1] - point[1];
+  de[2] = mo.q[2] + arm[2] - point[2];
+  de[3] = mo.qd[0] + mo.w[1] * arm[2] - mo.w[2] * arm[1];
+  de[4] = mo.qd[1] + mo.w[2] * arm[0] - mo.w[0] * arm[2];
+  de[5] = mo.qd[2] + mo.w[0] * arm[1] - mo.w[1] * arm[0];
 }
 
-/// Load of linear mount i on the body, in F: force (N) at its point, lever arm `arm` (m),
-/// its own couple (N·m) through the couple map of the generalized force K_r·φ + C_r·φ′.
-inline void linear_mount_load(idx i, const Model& m, const Scratch& s, Vec arm, Vec force,
-                              Vec couple) {
+/// Force (N, F) of linear mount i on the body at its point, and its lever arm `arm` (m, F).
+inline void linear_mount_force(idx i, const Model& m, const Motion& mo, double* arm,
+                               double* force) {
   double de[6];
-  point_motion(&m.lin_point(i, 0), s.rot, s.q, s.qd, s.omega_f, arm, de);
-  const M33s &k_t = m.lin_k_t, &c_t = m.lin_c_t, &k_r = m.lin_k_r, &c_r = m.lin_c_r;
+  point_motion(&m.lin_point(i, 0), mo, arm, de);
+  const M33s &k_t = m.lin_k_t, &c_t = m.lin_c_t;
   for (int j = 0; j < 3; ++j) {
     force[j] = -(k_t(i, j, 0) * de[0] + k_t(i, j, 1) * de[1] + k_t(i, j, 2) * de[2] +
                  c_t(i, j, 0) * de[3] + c_t(i, j, 1) * de[4] + c_t(i, j, 2) * de[5]);
   }
+}
+
+/// The couple (N·m, F) of rotational springs k_r and dampers c_r (3×3, row-major, F) through
+/// the couple map of their generalized force K_r·φ + C_r·φ′. The law is linear in K_r and
+/// C_r, so the summed matrices give the linear mounts' total couple in one call.
+inline void linear_couple(const double* k_r, const double* c_r, const Motion& mo,
+                          double* couple) {
   double g[3];
-  const Vec phi = s.phi, rate = s.phi_rate;
   for (int j = 0; j < 3; ++j) {
-    g[j] = k_r(i, j, 0) * phi[0] + k_r(i, j, 1) * phi[1] + k_r(i, j, 2) * phi[2] +
-           c_r(i, j, 0) * rate[0] + c_r(i, j, 1) * rate[1] + c_r(i, j, 2) * rate[2];
+    const double* k = k_r + 3 * j;
+    const double* c = c_r + 3 * j;
+    g[j] = k[0] * mo.phi[0] + k[1] * mo.phi[1] + k[2] * mo.phi[2] + c[0] * mo.rate[0] +
+           c[1] * mo.rate[1] + c[2] * mo.rate[2];
   }
-  const M3 cmap = s.couple_map;
   for (int j = 0; j < 3; ++j) {
-    couple[j] = -(cmap(j, 0) * g[0] + cmap(j, 1) * g[1] + cmap(j, 2) * g[2]);
+    couple[j] = -(mo.cmap[j][0] * g[0] + mo.cmap[j][1] * g[1] + mo.cmap[j][2] * g[2]);
   }
 }
 
@@ -61,11 +96,11 @@ inline void linear_mount_load(idx i, const Model& m, const Scratch& s, Vec arm, 
 /// Qᵀ·d from the reference pose, the force from its wrench row in its axes; m.lin_per_rating
 /// holds the inverse ratings, 0 where unrated).
 inline void linear_utilisation(const Model& m, const Scratch& s, M6 wrenches, Vec peak) {
-  double arm_d[3], de[6];
-  const Vec arm{arm_d, 3};
+  double arm[3], de[6];
   const M33s& axes = m.lin_axes;
+  const Motion mo = Motion::of(s);
   for (idx i = 0; i < m.lin_point.rows; ++i) {
-    point_motion(&m.lin_point(i, 0), s.rot, s.q, s.qd, s.omega_f, arm, de);
+    point_motion(&m.lin_point(i, 0), mo, arm, de);
     const idx row = m.lin_slot[i];
     double u = peak[i];
     for (int j = 0; j < 3; ++j) {
