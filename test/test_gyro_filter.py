@@ -20,7 +20,7 @@ from io_helpers import DATA_DIR, batch, engine_for, scene_with, split
 from mount_twin.analysis.deck_motion import SHIP, DeckMotion, deck_samples, rolling
 from mount_twin.commands.common import share_dir
 from mount_twin.engine.batch import OutputBatch, SampleBatch
-from mount_twin.engine.gyro_filter import FLATNESS, design, fir_rows
+from mount_twin.engine.gyro_filter import FLATNESS, design, fir_rows, kaiser_window
 from mount_twin.errors import SceneError
 from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import load_scene_file, scene_from_dict
@@ -55,6 +55,12 @@ def test_gain_is_flat_in_the_passband_and_stops_in_the_stopband(rate_hz: float) 
         assert abs(_gain(rate_hz, f)) <= 2.0 * FLATNESS, f"{f} Hz"
     half = design(rate_hz, PASSBAND_HZ, STOPBAND_HZ).half
     assert half[0] + 2.0 * half[1:].sum() == pytest.approx(1.0, abs=1e-14), "DC passes exactly"
+
+
+@pytest.mark.parametrize(("m", "beta"), [(1, 5.0), (2, 5.0), (77, 9.4), (751, 9.4), (41, 0.0)])
+def test_the_window_is_numpys_kaiser(m: int, beta: float) -> None:
+    """The power-series window against numpy's Chebyshev-series I₀ (its independent code)."""
+    np.testing.assert_allclose(kaiser_window(m, beta), np.kaiser(m, beta), rtol=0, atol=1e-14)
 
 
 def test_latency_is_about_38_ms_at_any_rate_and_raw_below_four_times_the_stopband() -> None:
