@@ -36,10 +36,12 @@ fan"). The estimate follows that recursion with
   1.07–1.33 (test/test_error_estimate.py).
 
 The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities differenced with J).
-Cost per interval: a matrix-vector product of the carried states; per check, the check's steps;
-per linearisation, n + 1 right-hand sides and an exponential. Engine time with it over without:
-1.18–1.20× on the pump, 2.7–2.9× where the twin rejects steps every interval (docs/scene.md "Error
-estimate", bench/error_estimate.py). The engaged-mount and internal-state handling below works
+Cost per interval: two matrix-vector products (the propagator's over the carried states, the
+output sensitivities'); per check, the check's steps; per linearisation, n + 1 right-hand sides
+and an exponential. Engine time with it over without: 1.10–1.14× on the pump (of which the
+interval's products 0.03–0.07, the checks and the linearisations about 0.04 each; 2026-11-26),
+2.7–2.9× where the twin rejects steps every interval (docs/scene.md "Error estimate",
+bench/error_estimate.py). The engaged-mount and internal-state handling below works
 for any model (measured on the non-linear scenes above) though the engine gives those the
 companion. It never touches the twin's state: the
 published numbers are identical with it on or off (test/test_error_estimate.py).
