@@ -138,6 +138,40 @@ def test_one_step_is_exact_on_a_stiff_driven_oscillator() -> None:
     assert abs(got["dopri54"][0] - exact_z) > response
 
 
+def test_a_step_keeps_the_half_steps_phi_functions() -> None:
+    """The φ functions of half the step that an interval's single step keeps (for the error
+    estimate's check in two steps) are φ_k((h/2)·J) of the Jacobian it held: the same bits as
+    computing them at h/2, and the augmented exponential's values."""
+    model, y_eq, u = oscillator(2.0 * math.pi * 3100.0)
+    n, span = model.n_state, 1e-3
+    st = stepper.new_stepper("exprb32", n, 1e-2, 1.0, 1)
+    y = y_eq.copy()
+    status = stepper.advance(
+        EXPRB32,
+        y,
+        0.0,
+        span,
+        st.settings,
+        model.arrays,
+        model.new_scratch(),
+        u,
+        st.work2d,
+        st.work1d,
+        st.result,
+    )
+    assert status == methods.SUCCESS and st.result[1] == 1
+    k = st.work2d
+    assert k[exprb32.HALF, 0] == 0.5 * span
+    jac = k[exprb32.J0 : exprb32.J0 + n].copy()
+    first = exprb32.J0 + exprb32.HALF_P1 * n
+    kept = [k[first + i * n : first + (i + 1) * n] for i in range(3)]
+    ok, direct = phi_compiled(jac, 0.5 * span)
+    assert ok
+    for mine, theirs, ref in zip(kept, direct, phi_reference(0.5 * span * jac), strict=True):
+        np.testing.assert_array_equal(mine, theirs)
+        np.testing.assert_allclose(mine, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+
+
 INERTIA6 = [2.0, 3.0, 4.0, 0.15, -0.1, 0.2]
 OMEGA0 = np.array([0.9, -0.7, 2.5])  # rad/s in B: a non-linear tumble (test_physics_torque_free)
 

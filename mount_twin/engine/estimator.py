@@ -12,8 +12,9 @@ fan"). The estimate follows that recursion with
 - Φ ≈ exp(h·J): J = ∂f/∂y by forward differences at the twin's state over the carried states
   (the body's, and the mounts' internal states that move there: a Bouc–Wen z, a joint while it
   slips; not a stuck joint's), taken again after a mount's event, at every check while a mount
-  is engaged, and every LINEARISE_EVERY regular checks; its exponential by scaling and
-  squaring (`src/core/linalg.hpp`); one matrix-vector product per interval;
+  is engaged, and every LINEARISE_EVERY × CHECK_EVERY intervals of regular checks; its
+  exponential by scaling and squaring (`src/core/linalg.hpp`); one matrix-vector product per
+  interval;
 - ℓ measured, not modelled: from the twin's state at the interval's start, a checking stepper
   (the twin's method at rtol and atol over TOLERANCE_DIVISOR, less below rtol 1e-8:
   `check_divisor`; at least MIN_STEPS steps) runs
@@ -32,8 +33,19 @@ fan"). The estimate follows that recursion with
   to a later time, the local errors of a free oscillation arrive in phase (Φ(t, tₙ)·ℓₙ is
   constant in n), a forced one's drift at the beat of forcing and mode. Where they do not add
   up in phase (a lightly damped mode above the sample rate's Nyquist, contact chatter) it
-  over-counts, up to 13× measured; measuring every interval (`check_every=1`) is then within
-  1.07–1.33 (test/test_error_estimate.py).
+  over-counts, up to 6.8× measured (13× with checks 32 apart); measuring every interval
+  (`check_every=1`) is then within 1.07–1.33 (test/test_error_estimate.py);
+- under an exponential twin (exprb32, `auto`'s choice for stiff linear-mount scenes), a check's
+  own Jacobian and φ functions of half the interval (two steps) were most of its cost (the
+  φ functions' squarings), and the twin had just made the same. A regular check therefore comes
+  early, from CHECK_EVERY / 4 intervals pending, at the first interval whose Jacobian the twin
+  took at its start, and borrows it with the φ functions of half the step that the twin kept
+  (src/core/integrate/exprb32.hpp HALF): the same numbers the check would have made (but
+  where a check's step is rejected: the borrowed Jacobian is then renewed there). The
+  twin renews its Jacobian at least every JACOBIAN_MAX_AGE (20) intervals, so checks come
+  about that often (`BORROWED` counts them), and linearisations as often as before (they
+  count check periods, not checks). On the stiff scene the estimate's cost fell from 1.3–1.4×
+  to 1.14–1.15× the engine, its over-count from 13 to 6.8 (bench/error_estimate.py).
 
 The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities differenced with J).
 Cost per interval: two matrix-vector products (the propagator's over the carried states, the
@@ -98,7 +110,9 @@ SPIKE_RATIO = _core.SPIKE_RATIO
 """An interval whose twin's error norm is above this multiple of its running mean is measured
 on its own (the core's constant)."""
 LINEARISE_EVERY = 2
-"""Regular checks between linearisations (a mount's event linearises at once)."""
+"""Check periods (CHECK_EVERY intervals) of regular checks between linearisations: two checks
+32 apart, or the early ones that stand for as many intervals (a mount's event linearises at
+once)."""
 (
     CHECK_EVERY_SLOT,
     LINEARISE_EVERY_SLOT,
@@ -110,6 +124,7 @@ LINEARISE_EVERY = 2
     N_CARRIED,
     CHECKS,
     LINEARISATIONS,
+    BORROWED,
     N_SLOTS,
 ) = _core.ESTIMATOR_SLOTS
 """Slots of `Estimator.state` (src/core/engine/estimator.hpp says what each keeps)."""

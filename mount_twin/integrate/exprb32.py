@@ -26,7 +26,10 @@ After each accepted step the right-hand side is evaluated at the new state, so o
 scratch holds the body motion at (t1, y) as `outputs` requires; not first-same-as-last.
 
 Work arrays: `work_rows(n)` rows of n: f0, v, a scratch row, U, D, the balancing's diagonal,
-then J, φ1, φ2, φ3 and the φ functions' four work blocks (`phi.Blocks`).
+HALF, then J, φ1, φ2, φ3, the φ functions' four work blocks (`phi.Blocks`) and φ1, φ2, φ3 of
+half the step: the doubling's last iterate but one, kept so that the error estimate's check of
+an interval in two steps borrows them with the Jacobian (`engine.estimator`); HALF[0] is the
+step they are for (0: none).
 """
 
 from __future__ import annotations
@@ -47,13 +50,17 @@ TYPICAL = 1.0
 """The magnitude (m, rad, m/s, rad/s) below which a Jacobian column is differenced over
 JAC_STEP·TYPICAL: unlike a W-method, this one is only as exact as J, and a step scaled by
 atol/rtol (1e-11 m/s for a velocity at rest) leaves rounding of f/step in J, a fake damping."""
-F, FT, FTMP, U, DIFF, SCALE = range(6)
+F, FT, FTMP, U, DIFF, SCALE, HALF = range(7)
 """Rows of the work array: f0, v = ∂f/∂t, a right-hand side's scratch, the stage state U,
-the remainder's change D, the balancing's diagonal; then the blocks from J0."""
-ROWS = 6
+the remainder's change D, the balancing's diagonal, the half-step φ functions' step; then the
+blocks from J0."""
+ROWS = 7
 J0 = ROWS
-BLOCKS = 8
-"""J, φ1, φ2, φ3 and the φ functions' four work blocks, n rows each."""
+BLOCKS = 11
+"""J, φ1, φ2, φ3, the φ functions' four work blocks and φ1, φ2, φ3 of half the step, n rows
+each."""
+HALF_P1 = 8
+"""The first of the half step's φ blocks, counted in blocks from J0."""
 
 
 def work_rows(n: int) -> int:

@@ -53,7 +53,7 @@ class Method:
         order: order of the solution it propagates.
         stages: fixed rows of its work array (explicit: the stages, the FSAL one included).
         square_blocks: further rows per state (n×n blocks: the Rosenbrock's J and LU, the
-            exponential method's J, φ functions and their work).
+            exponential method's J, φ functions, their work and the half step's φ functions).
         family: EXPLICIT, ROSENBROCK or EXPONENTIAL (the last two hold a Jacobian, taken by
             finite differences, for stiff scenes).
         summary: one line for parameter descriptions.
@@ -104,9 +104,9 @@ METHODS: dict[str, Method] = {
             2,
             "mount_twin.integrate.exprb32",
             3,
-            6,
+            7,
             "exponential Rosenbrock 3(2), exact on linear mounts (stiff, smooth scenes)",
-            square_blocks=8,
+            square_blocks=11,
             family=EXPONENTIAL,
         ),
     )

@@ -21,15 +21,16 @@ namespace mt::engine {
 /// settings (CHECK_EVERY, LINEARISE_EVERY, set once), then what it keeps between intervals.
 enum EstimatorSlot : int {
   CHECK_EVERY = 0,    // a measured interval counts for at most this many
-  LINEARISE_EVERY,    // regular checks between linearisations
+  LINEARISE_EVERY,    // check periods (CHECK_EVERY intervals) between linearisations
   PENDING,            // intervals not measured since the last check
   PENDING_NORM,       // the twin's error norms of those intervals, summed
   PROPAGATOR_STEP,    // s, the interval the propagator is for (0: none held)
   ERROR_NORM_MEAN,    // running mean of the twin's error norm
-  SINCE_LINEARISED,   // regular checks since the last linearisation
+  SINCE_LINEARISED,   // check periods the regular checks since the last one stood for
   N_CARRIED,          // states carried (their indices: `carried`)
   CHECKS,             // intervals measured since the start
   LINEARISATIONS,     // linearisations since the start
+  BORROWED,           // checks that took the exponential twin's linearisation
   N_ESTIMATOR_SLOTS
 };
 
@@ -149,14 +150,49 @@ inline bool linearise_at(const Model& m, Estimator& est, Vec u, double t, double
   return propagator(est, h);
 }
 
+/// Whether the check of an interval of h can take the exponential twin's linearisation: the
+/// twin took the interval in one step, none rejected, from a Jacobian taken at its start (what
+/// the check's own would be: the same differences at the same state and input) and kept the
+/// φ functions of half the step, the check's two steps (exprb32.hpp HALF).
+inline bool twin_linearisation_fits(const Integrator& twin, const Estimator& est, double h) {
+  namespace x = integrate::exprb32;
+  return twin.method == EXPRB32 && est.integ.method == EXPRB32 && twin.result[1] == 1.0 &&
+         twin.result[2] == 0.0 && twin.settings[JACOBIAN_AGE] == 1.0 &&
+         twin.work2d(x::HALF, 0) == 0.5 * h && est.integ.settings[MIN_STEPS] == 2.0;
+}
+
+/// Give the check the twin's Jacobian and half-step φ functions (`twin_linearisation_fits`):
+/// the check then computes neither (most of its cost: the φ functions' squarings) and
+/// takes the same steps it would have taken with its own.
+inline void borrow_linearisation(const Integrator& twin, const Integrator& check, idx n,
+                                 double h) {
+  namespace x = integrate::exprb32;
+  for (idx r = 0; r < n; ++r) {
+    for (idx c = 0; c < n; ++c) {
+      check.work2d(x::J0 + r, c) = twin.work2d(x::J0 + r, c);
+      for (idx b = 0; b < 3; ++b) {
+        check.work2d(x::J0 + (1 + b) * n + r, c) = twin.work2d(x::J0 + (x::HALF_P1 + b) * n + r, c);
+      }
+    }
+  }
+  check.settings[JACOBIAN_AGE] = 1.0;  // held from this state: not renewed at the start
+  check.settings[PHI_STEP] = 0.5 * h;
+}
+
 /// The twin's local error over [t0, t1]: est.y_end less the checking stepper's solution from
-/// est.y_start under the same input u; false (nothing measured) if the check failed.
-inline bool local_error(const Model& m, Estimator& est, Vec u, double t0, double t1) {
+/// est.y_start under the same input u (with the twin's linearisation where it fits); false
+/// (nothing measured) if the check failed.
+inline bool local_error(const Model& m, Estimator& est, Vec u, double t0, double t1,
+                        const Integrator& twin) {
   const Integrator& c = est.integ;
   copy(est.y_start, est.y);
   c.settings[CHAINED] = 0.0;  // the state jumped: no last stage, no Jacobian held (the step
   c.settings[JACOBIAN_AGE] = 0.0;  // proposal is kept: it suits the next check)
   c.settings[PHI_STEP] = 0.0;
+  if (twin_linearisation_fits(twin, est, t1 - t0)) {
+    borrow_linearisation(twin, c, est.y.n, t1 - t0);
+    est.state[BORROWED] += 1.0;
+  }
   est.state[CHECKS] += 1.0;
   const int status = integrate::advance(c.method, est.y, t0, t1, c.settings, m, est.s, u,
                                         c.work2d, c.work1d, c.result);
@@ -188,11 +224,16 @@ inline void carry(Estimator& est) {
 /// twin rejected a step, or its error norm spiked) or where CHECK_EVERY intervals are pending
 /// (ENGAGED_CHECK_EVERY while a mount is engaged; it then counts for them); linearise again at
 /// the twin's state y after a mount's event, at every check while one is engaged, and every
-/// LINEARISE_EVERY regular checks; fold the estimated errors of the outputs into the figures.
-/// twin_result: the twin's stepper result [error norm, accepted, rejected]; wrenches: the
-/// twin's at t1.
+/// LINEARISE_EVERY check periods of regular checks (CHECK_EVERY intervals each: an early check
+/// counts for its share); fold the estimated errors of the outputs into the figures.
+/// A regular check may come early, from a quarter of CHECK_EVERY pending, where it can take the
+/// exponential twin's linearisation (`twin_linearisation_fits`: the twin renews its Jacobian
+/// every 20 intervals at most, so one such interval falls in every window of that length).
+/// twin: the twin's stepper after its step (result: [error norm, accepted, rejected]);
+/// wrenches: the twin's at t1.
 inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, double t1,
-                              int watched, Vec twin_result, M6 wrenches, Vec y) {
+                              int watched, const Integrator& twin, M6 wrenches, Vec y) {
+  const Vec twin_result = twin.result;
   const bool changed = (watched & CHANGED) != 0, engaged = (watched & ENGAGED) != 0;
   const Vec st = est.state, fig = est.figures, e = est.e;
   const idx nm = wrenches.rows, n_out = est.out1.n;
@@ -209,17 +250,18 @@ inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, 
   st[PENDING] += 1.0;
   if (!special) st[PENDING_NORM] += err;
   const double every = engaged ? py_min(st[CHECK_EVERY], ENGAGED_CHECK_EVERY) : st[CHECK_EVERY];
-  const bool regular = !special && st[PENDING] >= every;
+  const bool cheap = st[PENDING] >= 0.25 * every && twin_linearisation_fits(twin, est, h);
+  const bool regular = !special && (st[PENDING] >= every || cheap);
   if (special || regular || !linearised) {
-    if (local_error(m, est, u, t0, t1)) {
+    if (local_error(m, est, u, t0, t1, twin)) {
       const double weight = special ? 1.0 : stands_for(st[PENDING], st[PENDING_NORM], err);
       for (idx i = 0; i < y.n; ++i) e[i] += weight * (est.y_end[i] - est.y[i]);
     } else {
       fig[FAILURES] += 1.0;
     }
+    if (regular) st[SINCE_LINEARISED] += st[PENDING] / every;  // an early check, its share
     st[PENDING] = special ? st[PENDING] - 1.0 : 0.0;
     if (!special) st[PENDING_NORM] = 0.0;
-    if (regular) st[SINCE_LINEARISED] += 1.0;
     if (changed || engaged || !linearised || st[SINCE_LINEARISED] >= st[LINEARISE_EVERY]) {
       copy(y, est.y);
       if (!linearise_at(m, est, u, t1, h)) st[PROPAGATOR_STEP] = 0.0;

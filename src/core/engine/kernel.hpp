@@ -198,8 +198,8 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
       watched = watch_mounts(y, m.nl, s, watch, smp.t[j - 1], smp.t[j], wrenches_j, settings);
     }
     if (estimator != nullptr) {
-      estimate_interval(m, *estimator, u, smp.t[j - 1], smp.t[j], watched, integ.result,
-                        wrenches_j, y);
+      estimate_interval(m, *estimator, u, smp.t[j - 1], smp.t[j], watched, integ, wrenches_j,
+                        y);
     }
     if (companion != nullptr) {
       follow(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, d_wdot, out.pose.row(j),

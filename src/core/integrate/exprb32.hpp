@@ -32,12 +32,16 @@ constexpr double PHI_REUSE = 1e-9;
 /// JAC_STEP·TYPICAL.
 constexpr double TYPICAL = 1.0;
 /// Rows of the work array: f0, v = ∂f/∂t, a right-hand side's scratch, the stage state U, the
-/// remainder's change D, the balancing's diagonal; then the blocks from J0.
-constexpr idx F = 0, FT = 1, FTMP = 2, U = 3, DIFF = 4, SCALE = 5;
-constexpr idx ROWS = 6;
+/// remainder's change D, the balancing's diagonal, HALF (its first entry: the step, s, the
+/// half-step φ functions held are for; 0: none); then the blocks from J0.
+constexpr idx F = 0, FT = 1, FTMP = 2, U = 3, DIFF = 4, SCALE = 5, HALF = 6;
+constexpr idx ROWS = 7;
 constexpr idx J0 = ROWS;
-/// J, φ1, φ2, φ3 and the φ functions' four work blocks, n rows each.
-constexpr idx BLOCKS = 8;
+/// J, φ1, φ2, φ3, the φ functions' four work blocks, then φ1, φ2, φ3 of half the step (the
+/// doubling's last iterate but one: what a check of the interval in two steps takes,
+/// engine/estimator.hpp), n rows each.
+constexpr idx BLOCKS = 11;
+constexpr idx HALF_P1 = 8;  // the first half-step block, in blocks from J0
 
 /// Rows of n of the work array for n states.
 inline idx work_rows(idx n) { return ROWS + BLOCKS * n; }
@@ -81,8 +85,10 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
     const bool last = count == 1.0;
     bool ok = true;
     if (std::fabs(step - settings[PHI_STEP]) > PHI_REUSE * step) {
-      ok = phi::phi_functions(k, n, step, blocks);
+      bool halved = false;
+      ok = phi::phi_functions(k, n, step, blocks, J0 + HALF_P1 * n, &halved);
       settings[PHI_STEP] = ok ? step : 0.0;
+      k(HALF, 0) = ok && halved ? 0.5 * step : 0.0;
     }
     not_finite = !ok;
     if (ok) {

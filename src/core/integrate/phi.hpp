@@ -91,9 +91,20 @@ inline double int_power(double a, std::int64_t b) {
   return invert ? 1.0 / r : r;
 }
 
+/// Copy the three φ blocks from row `from` to row `to` (3n rows).
+inline void copy_phis(Mat k, idx from, idx to, idx n) {
+  for (idx r = 0; r < 3 * n; ++r) {
+    for (idx c = 0; c < n; ++c) k(to + r, c) = k(from + r, c);
+  }
+}
+
 /// φ_1, φ_2, φ_3 of h·J (h in s, J in 1/s) into the blocks from b.p1 (J at b.j); false if they
-/// are not finite (J with NaN or inf).
-inline bool phi_functions(Mat k, idx n, double h, Blocks b) {
+/// are not finite (J with NaN or inf). With `half` ≥ 0 and at least one doubling, also φ_1,
+/// φ_2, φ_3 of (h/2)·J into the three blocks from row `half`: the doubling's last iterate but
+/// one, what `phi_functions(k, n, h / 2, b)` computes (the same balancing, the same scaled
+/// matrix, one doubling fewer); *halved says whether it did.
+inline bool phi_functions(Mat k, idx n, double h, Blocks b, idx half = -1,
+                          bool* halved = nullptr) {
   const idx z = b.z, pw = b.z + n, tmp = b.z + 2 * n, e = b.z + 3 * n, sc = b.scale;
   const idx p1 = b.p1, p2 = b.p1 + n, p3 = b.p1 + 2 * n;
   for (idx r = 0; r < n; ++r) {
@@ -149,6 +160,9 @@ inline bool phi_functions(Mat k, idx n, double h, Blocks b) {
     }
   }
   // square back: each doubling uses the old φ_1, φ_2 in the higher ones, so φ_3 goes first
+  const bool keep_half = half >= 0 && squarings >= 1;
+  if (halved != nullptr) *halved = keep_half;
+  if (keep_half && squarings == 1) copy_phis(k, p1, half, n);
   for (std::int64_t q = 0; q < squarings; ++q) {
     matmul(k, e, p3, tmp, n);
     for (idx r = 0; r < n; ++r) {
@@ -168,6 +182,7 @@ inline bool phi_functions(Mat k, idx n, double h, Blocks b) {
     for (idx r = 0; r < n; ++r) {
       for (idx c = 0; c < n; ++c) k(e + r, c) = k(tmp + r, c);
     }
+    if (keep_half && q + 2 == squarings) copy_phis(k, p1, half, n);
   }
   bool finite = true;
   for (idx r = 0; r < n; ++r) {  // undo the balancing: φ(A) = D φ(D⁻¹AD) D⁻¹
@@ -177,6 +192,9 @@ inline bool phi_functions(Mat k, idx n, double h, Blocks b) {
       k(p2 + r, c) *= ratio;
       k(p3 + r, c) *= ratio;
       finite = finite && std::isfinite(k(p3 + r, c)) && std::isfinite(k(p1 + r, c));
+      if (keep_half) {
+        for (idx block = 0; block < 3; ++block) k(half + block * n + r, c) *= ratio;
+      }
     }
   }
   return finite;
