@@ -17,6 +17,7 @@ import zlib
 from collections.abc import Iterator
 from dataclasses import dataclass
 from itertools import pairwise
+from operator import itemgetter
 from pathlib import Path
 from typing import BinaryIO
 
@@ -117,7 +118,9 @@ def _messages(
                 msg = f"{file}: no chunk at byte {chunk.offset}, where the index puts one"
                 raise ValueError(msg)
             records = _records(raw, chunk.compression, file, chunk.offset)
-            if messages := sorted(_topic_messages(records, wanted), key=lambda m: m[0]):
+            messages = _topic_messages(records, wanted)
+            messages.sort(key=itemgetter(0))  # stable: equal log times keep file order
+            if messages:
                 yield messages
 
 
