@@ -6,7 +6,8 @@ ship-motion bag through the default scene at an output decimation of 10 (100 Hz 
 
 Generating the input takes longer than replaying it (about 40 s and 6 GB of memory for an
 hour: `generate` holds the record); `--keep DIR` keeps (or reuses) it there. Prints the
-replay's user + system CPU seconds, its wall time, its verdict and its input counts.
+replay's user + system CPU seconds, its wall time, its verdict and its input counts. Side by
+side with another tree: run that tree's copy of this script with `PYTHONPATH=<tree>`.
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ def main() -> None:
             subprocess.run(
                 [sys.executable, "-m", "mount_twin.cli", *gen, "--duration", f"{args.seconds:g}"],
                 check=True,
+                cwd=tmp,
             )
         scene["outputs"]["decimation"] = args.decimation
         scene_file = Path(tmp) / "scene.yaml"
@@ -56,7 +58,9 @@ def main() -> None:
         cmd = [sys.executable, "-m", "mount_twin.cli", "replay", str(bag), "--scene"]
         cmd += [str(scene_file), "-o", str(out), "--no-progress", "--json", str(work / "s.json")]
         cpu0, wall0 = _child_cpu(), time.perf_counter()
-        done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        # cwd: `python -m` puts the working directory first on sys.path, ahead of PYTHONPATH:
+        # run from a tree, the child would replay that tree's code, whatever the side by side
+        done = subprocess.run(cmd, capture_output=True, text=True, check=False, cwd=tmp)
         cpu, wall = _child_cpu() - cpu0, time.perf_counter() - wall0
         if done.returncode != 0:
             sys.exit(f"replay failed ({done.returncode}):\n{done.stderr[-2000:]}")

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import nullcontext
 from dataclasses import dataclass, field
 from itertools import chain
@@ -277,8 +277,8 @@ def _grouped(events: list[MountEvent]) -> dict[tuple[str, str], list[MountEvent]
 
 
 def _until_damage(
-    chunks: Iterator[list[bytes]], damage: list[DamagedBagError]
-) -> Iterator[list[bytes]]:
+    chunks: Iterator[Sequence[bytes]], damage: list[DamagedBagError]
+) -> Iterator[Sequence[bytes]]:
     """The chunks up to a damaged bag's damage, which is put in `damage` rather than raised."""
     try:
         yield from chunks

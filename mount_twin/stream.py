@@ -6,6 +6,7 @@ the bag replay hands it chunks of raw messages from a bag. Only the transport di
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -78,7 +79,7 @@ class TwinStream:
         self._ageing_jobs: list[WindowJob] = []
         self._ageing_last_ns = 0
 
-    def process(self, raws: list[bytes]) -> list[Encoded]:
+    def process(self, raws: Sequence[bytes]) -> list[Encoded]:
         """Outputs for raw input messages, as (unresolved topic, stamp ns, CDR bytes), or blocks
         of them (`blocks`)."""
         decoded = decode_inputs(raws, self.scene.input.msg_type)
@@ -164,7 +165,7 @@ class TwinStream:
             return np.zeros((decoded.stamps_ns.shape[0], 3))
         return rotated(decoded.gyro, self.engine.model.sensor_rotation)
 
-    def process_body(self, raws: list[bytes]) -> list[tuple[str, int, bytes]]:
+    def process_body(self, raws: Sequence[bytes]) -> list[tuple[str, int, bytes]]:
         """The body IMU's raw messages (sensor_msgs/Imu): the prediction and residual at each
         sample the twin has answered, and the windows judged (none without a body_sensor).
         A message that cannot be compared is counted (BodyCheck.counts) and skipped: not

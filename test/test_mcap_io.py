@@ -7,7 +7,6 @@ leaves to rosbags what it does not read (chunks overlapping in time)."""
 
 from __future__ import annotations
 
-import itertools
 from collections import Counter
 from pathlib import Path
 
@@ -26,6 +25,7 @@ from mount_twin.io.bag import LATCHED_QOS, PARTIAL_KEY, InputBag, OutputBag
 from mount_twin.io.mcap_reader import plain_messages
 from mount_twin.io.mcap_salvage import salvage
 from mount_twin.io.messages import IMU, TYPESTORE, RowBlock, imu_messages
+from mount_twin.io.raw_rows import RawRows, joined
 
 POSE, DIAG = "geometry_msgs/msg/PoseStamped", "diagnostic_msgs/msg/DiagnosticArray"
 T0 = 1_700_000_000_000_000_000
@@ -200,10 +200,26 @@ def test_the_plain_reader_yields_what_rosbags_yields(
     _rosbags_bag(tmp_path / "bag", messages, zstd=zstd)
     plain = plain_messages(tmp_path / "bag" / "bag.mcap", topic)
     assert plain is not None
-    got = list(itertools.chain.from_iterable(plain))
+    got = _flat(plain)
     assert got == read_raw(tmp_path / "bag")[topic]
     with InputBag(tmp_path / "bag", topic, IMU) as bag:
         assert [r for c in bag.chunks(1000) for r in c] == [r for _, r in got]
+
+
+def _flat(plain) -> list[tuple[int, bytes]]:
+    """(log time, raw) of each message of the reader's batches, in order."""
+    return [(int(t), r) for times, raws in plain for t, r in zip(times, raws, strict=True)]
+
+
+def test_raw_rows_are_their_messages_and_join_as_rows_where_lengths_agree() -> None:
+    raws = [bytes([k]) * 5 for k in range(7)]
+    rows = RawRows(np.frombuffer(b"".join(raws), np.uint8).reshape(7, 5))
+    assert len(rows) == 7 and rows[3] == raws[3] and list(rows) == raws
+    assert list(rows[2:5]) == raws[2:5] and isinstance(rows[2:5], RawRows)
+    both = joined([rows[:3], raws[3:5], rows[5:]])
+    assert isinstance(both, RawRows) and list(both) == raws
+    mixed = joined([rows[:3], [b"short"[:4]]])
+    assert isinstance(mixed, list) and mixed == [*raws[:3], b"shor"]
 
 
 def test_one_topic_of_one_frame_id_is_read_at_once_in_time_order(tmp_path: Path) -> None:
@@ -213,8 +229,14 @@ def test_one_topic_of_one_frame_id_is_read_at_once_in_time_order(tmp_path: Path)
     _rosbags_bag(tmp_path / "bag", [("/deck/imu", t, r) for t, r in msgs])
     plain = plain_messages(tmp_path / "bag" / "bag.mcap", "/deck/imu")
     assert plain is not None
-    got = list(itertools.chain.from_iterable(plain))
+    batches = list(plain)
+    assert all(isinstance(raws, RawRows) for _, raws in batches), "one length: rows"
+    got = _flat(batches)
     assert got == read_raw(tmp_path / "bag")["/deck/imu"] == sorted(msgs, key=lambda m: m[0])
+    with InputBag(tmp_path / "bag", "/deck/imu", IMU) as bag:
+        pieces = list(bag.chunks(1000))  # cut across the file's chunks, joined as rows
+    assert all(isinstance(p, RawRows) for p in pieces)
+    assert [r for p in pieces for r in p] == [r for _, r in got]
 
 
 def test_chunks_that_overlap_in_time_are_left_to_rosbags(tmp_path: Path) -> None:

@@ -28,10 +28,11 @@ from rosbags.interfaces import (
 from rosbags.rosbag2 import StoragePlugin, Writer
 
 from mount_twin.errors import BagError, DamagedBagError
-from mount_twin.io.mcap_reader import plain_messages
+from mount_twin.io.mcap_reader import Batch, plain_messages
 from mount_twin.io.mcap_salvage import Salvage, salvage
 from mount_twin.io.mcap_writer import McapBagWriter
 from mount_twin.io.messages import TYPESTORE, Encoded, RowBlock
+from mount_twin.io.raw_rows import joined, nbytes
 
 _INFINITE = QosTime(9223372036, 854775807)
 """RMW_DURATION_INFINITE (sec, nsec), as a Jazzy recording stores a default deadline/lifespan."""
@@ -127,24 +128,25 @@ class InputBag:
         self.count = len(self._salvage.messages)
         self.ros1 = False
 
-    def chunks(self, size: int) -> Iterator[list[bytes]]:
+    def chunks(self, size: int) -> Iterator[Sequence[bytes]]:
         """Raw messages of the topic in log-time order, `size` at a time, fewer where they
-        reach CHUNK_MAX_BYTES (1 MB frame ids: 2 GB a chunk). From a damaged bag,
+        reach CHUNK_MAX_BYTES (1 MB frame ids: 2 GB a chunk): lists of bytes, or `RawRows`
+        where a plain mcap chunk holds them as rows of one length. From a damaged bag,
         those before the damage, then DamagedBagError saying how many and up to which log
         time."""
         if self._salvage is not None:
             yield from self._salvaged_chunks(self._salvage, 0, size)
             return
-        pending: list[bytes] = []
-        read, last, held = 0, None, 0
+        parts: list[Sequence[bytes]] = []  # read, not yet yielded
+        read, last, held, count = 0, None, 0, 0
         batches = self._batches()
         while True:
             try:
-                batch = next(batches)
+                times, raws = next(batches)
             except StopIteration:
                 break
             except Exception as err:  # rosbags' readers raise their own types on damage
-                yield from _pieces(pending, size, everything=True)
+                yield from _pieces(joined(parts) if parts else [], size, everything=True)
                 rest = self._salvage_after(read)
                 if rest is not None:
                     yield from self._salvaged_chunks(rest, read, size)
@@ -153,13 +155,19 @@ class InputBag:
                     f"{self.topic}{_up_to(last)}: {err}"
                 )
                 raise DamagedBagError(msg) from err
-            raws = [self._ros1_to_cdr(raw) if self.ros1 else raw for _, raw in batch]
-            pending += raws
-            read, last, held = read + len(batch), batch[-1][0], held + sum(map(len, raws))
-            if len(pending) >= size or held >= CHUNK_MAX_BYTES:
-                pending = yield from _pieces(pending, size)
-                held = sum(map(len, pending))
-        yield from _pieces(pending, size, everything=True)
+            if self.ros1:
+                raws = [self._ros1_to_cdr(raw) for raw in raws]
+            parts.append(raws)
+            read, last, held, count = (
+                read + len(raws),
+                int(times[-1]),
+                held + nbytes(raws),
+                count + len(raws),
+            )
+            if count >= size or held >= CHUNK_MAX_BYTES:
+                left = yield from _pieces(joined(parts), size)
+                parts, held, count = [left] if len(left) else [], nbytes(left), len(left)
+        yield from _pieces(joined(parts) if parts else [], size, everything=True)
         if read < self.count:  # records lost without an error: zeroed or overwritten bytes
             msg = (
                 f"{self.path}: damaged: its index lists {self.count} messages of {self.topic}, "
@@ -167,16 +175,17 @@ class InputBag:
             )
             raise DamagedBagError(msg)
 
-    def _batches(self) -> Iterator[list[tuple[int, bytes]]]:
-        """The topic's (log time, raw) in log-time order, in batches: a chunk's from a bag of
-        one plain mcap file (`io.mcap_reader`), one at a time from rosbags otherwise."""
+    def _batches(self) -> Iterator[Batch]:
+        """The topic's log times and raw messages in log-time order, in batches: a chunk's from
+        a bag of one plain mcap file (`io.mcap_reader`), one at a time from rosbags
+        otherwise."""
         files = _storage_files(self.path)
         if not self.ros1 and len(files) == 1 and files[0].suffix == ".mcap":
             with suppress(ValueError, struct.error, UnicodeDecodeError, OSError):
                 plain = plain_messages(files[0], self.topic)
                 if plain is not None:
                     return plain
-        return ([(log_time, raw)] for _, log_time, raw in self._reader.messages(self._conns))
+        return (([log_time], [raw]) for _, log_time, raw in self._reader.messages(self._conns))
 
     def _salvage_after(self, read: int) -> Salvage | None:
         """After rosbags failed past `read` messages: the messages after those (in file order,
@@ -251,14 +260,14 @@ STORAGE_SUFFIXES = (".mcap", ".db3")
 
 
 def _pieces(
-    pending: list[bytes], size: int, *, everything: bool = False
-) -> Generator[list[bytes], None, list[bytes]]:
+    pending: Sequence[bytes], size: int, *, everything: bool = False
+) -> Generator[Sequence[bytes], None, Sequence[bytes]]:
     """Yield `size` messages at a time of `pending`, fewer where they reach CHUNK_MAX_BYTES;
     return what is left short of a piece (nothing with `everything`)."""
     at = 0
     while len(pending) - at >= size or (everything and at < len(pending)):
         piece = pending[at : at + size]
-        if sum(map(len, piece)) >= CHUNK_MAX_BYTES:
+        if nbytes(piece) >= CHUNK_MAX_BYTES:
             held = accumulate(map(len, piece))
             piece = piece[: next(k for k, h in enumerate(held) if h >= CHUNK_MAX_BYTES) + 1]
         yield piece

@@ -166,14 +166,24 @@ class FixedLayout:
         size = self.size
         idx = np.flatnonzero(np.fromiter(map(len, raws), np.int64, len(raws)) == size)
         joined = b"".join(raws if len(idx) == len(raws) else [raws[i] for i in idx.tolist()])
-        rows = np.frombuffer(joined, np.uint8).reshape(-1, size)
-        same = (rows[:, self.fixed] == self.template[self.fixed]).all(axis=1)
+        same, columns = self.unpack_rows(np.frombuffer(joined, np.uint8).reshape(-1, size), want)
         match = np.zeros(len(raws), dtype=bool)
         match[idx[same]] = True
-        rows = rows[same]
+        return match, columns
+
+    def unpack_rows(
+        self, rows: np.ndarray, want: Sequence[int]
+    ) -> tuple[np.ndarray, list[np.ndarray]]:
+        """`unpack` of messages already the rows of a (k, L) uint8 array (L the message length:
+        `io.raw_rows`): which have this layout, and their columns of fields `want`."""
+        if rows.shape[1] != self.size:
+            return np.zeros(rows.shape[0], dtype=bool), [np.zeros(0) for _ in want]
+        same = (rows[:, self.fixed] == self.template[self.fixed]).all(axis=1)
+        if not same.all():
+            rows = rows[same]
         columns = []
         for f in want:
             offset, dtype = self.fields[f]
             width = np.dtype(dtype).itemsize
             columns.append(rows[:, offset : offset + width].copy().view(dtype)[:, 0])
-        return match, columns
+        return same, columns

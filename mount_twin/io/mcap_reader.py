@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import struct
 import zlib
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from itertools import pairwise
 from operator import itemgetter
@@ -35,6 +35,7 @@ from mount_twin.io.mcap_format import (
     decompress,
     read_string,
 )
+from mount_twin.io.raw_rows import RawRows
 
 _FOOTER_BYTES = 9 + 20 + len(MAGIC)
 
@@ -91,10 +92,14 @@ def _in_order(chunks: list[_ChunkAt]) -> bool:
     return True
 
 
-def plain_messages(file: Path, topic: str) -> Iterator[list[tuple[int, bytes]]] | None:
-    """(log time ns, raw CDR) of `topic` in `file` in log-time order, a chunk's at a time (a
-    chunk without the topic gives none), or None where this reader does not apply (see the
-    module docstring)."""
+Batch = tuple[Sequence[int] | np.ndarray, Sequence[bytes]]
+"""A chunk's messages of the topic: their log times (ns) and raw CDR, in log-time order."""
+
+
+def plain_messages(file: Path, topic: str) -> Iterator[Batch] | None:
+    """The messages of `topic` in `file` in log-time order, a chunk's at a time (a chunk
+    without the topic gives none; a chunk of one length gives `RawRows`), or None where this
+    reader does not apply (see the module docstring)."""
     with file.open("rb") as f:
         found = _summary(f, file.stat().st_size)
     if found is None:
@@ -107,9 +112,7 @@ def plain_messages(file: Path, topic: str) -> Iterator[list[tuple[int, bytes]]] 
     return _messages(file, wanted, chunks)
 
 
-def _messages(
-    file: Path, wanted: set[int], chunks: list[_ChunkAt]
-) -> Iterator[list[tuple[int, bytes]]]:
+def _messages(file: Path, wanted: set[int], chunks: list[_ChunkAt]) -> Iterator[Batch]:
     with file.open("rb") as f:
         for chunk in chunks:
             f.seek(chunk.offset)
@@ -118,10 +121,14 @@ def _messages(
                 msg = f"{file}: no chunk at byte {chunk.offset}, where the index puts one"
                 raise ValueError(msg)
             records = _records(raw, chunk.compression, file, chunk.offset)
+            uniform = _uniform(records, wanted)
+            if uniform is not None:
+                yield uniform
+                continue
             messages = _topic_messages(records, wanted)
             messages.sort(key=itemgetter(0))  # stable: equal log times keep file order
             if messages:
-                yield messages
+                yield [t for t, _ in messages], [r for _, r in messages]
 
 
 def _records(raw: bytes, compression: str, file: Path, offset: int) -> bytes:
@@ -138,9 +145,6 @@ def _records(raw: bytes, compression: str, file: Path, offset: int) -> bytes:
 
 def _topic_messages(records: bytes, wanted: set[int]) -> list[tuple[int, bytes]]:
     """The (log time, data) of the message records of the `wanted` channels in `records`."""
-    uniform = _uniform(records, wanted)
-    if uniform is not None:
-        return uniform
     out = []
     at, end = 0, len(records)
     unpack = MESSAGE_HEAD.unpack_from
@@ -159,20 +163,26 @@ def _topic_messages(records: bytes, wanted: set[int]) -> list[tuple[int, bytes]]
     return out
 
 
-def _uniform(records: bytes, wanted: set[int]) -> list[tuple[int, bytes]] | None:
-    """The same, at once, where `records` are messages of one wanted channel all of one length
-    (a recording of one IMU: one frame id), else None."""
-    if len(records) < MESSAGE_HEAD.size or records[0] != MESSAGE:
+def _uniform(records: bytes, wanted: set[int]) -> Batch | None:
+    """The chunk's messages in log-time order (stably), at once, as `RawRows`, where `records`
+    are messages of one wanted channel all of one length (a recording of one IMU: one frame
+    id), after any other records before the first message, else None."""
+    first = 0  # past the schema and channel records a writer puts before its first message
+    while first + 9 <= len(records) and records[first] != MESSAGE:
+        first += 9 + struct.unpack_from("<Q", records, first + 1)[0]
+    if len(records) - first < MESSAGE_HEAD.size:
         return None
-    _, length, cid, _, _, _ = MESSAGE_HEAD.unpack_from(records, 0)
+    _, length, cid, _, _, _ = MESSAGE_HEAD.unpack_from(records, first)
     stride = 9 + length
-    if cid not in wanted or len(records) % stride:
+    if cid not in wanted or (len(records) - first) % stride:
         return None
-    rows = np.frombuffer(records, np.uint8).reshape(-1, stride)
+    rows = np.frombuffer(records, np.uint8, offset=first).reshape(-1, stride)
     heads = rows[:, : MESSAGE_HEAD.size].copy().view(MESSAGE_HEAD_DTYPE)[:, 0]
     same = (heads["op"] == MESSAGE) & (heads["length"] == length) & (heads["channel"] == cid)
     if not same.all():
         return None
-    starts = range(MESSAGE_HEAD.size, len(records), stride)
-    data = [records[k : k + stride - MESSAGE_HEAD.size] for k in starts]
-    return list(zip(heads["log_time"].tolist(), data, strict=True))
+    times, data = heads["log_time"].astype(np.int64), rows[:, MESSAGE_HEAD.size :]
+    if (np.diff(times) < 0).any():
+        order = np.argsort(times, kind="stable")
+        times, data = times[order], data[order]
+    return times, RawRows(data)
