@@ -6,7 +6,12 @@ mount-force error against a reference run (the same twin at rtol 1e-12 on the in
 8×), the twin's own estimate of it, their ratio, the attitude errors, substeps per sample, and
 the engine's wall time with the estimate over without it (one run, side by side).
 
-    python3 bench/error_estimate.py [--rtol 1e-3 1e-5 1e-7]
+    python3 bench/error_estimate.py [--rtol 1e-3 1e-5 1e-7] [--cases NAME ...] [--sampled]
+
+`--sampled` gives every scene the sampled estimator (`engine.estimator`), the non-linear ones
+included, which the engine gives the companion (`engine.companion`): how honest and how dear
+the cheaper method is where mounts slip, open and hit their stops. The case `genset` (the
+bundled bolted, keyed genset under its 10 kHz shock bag) is run only when named in `--cases`.
 """
 
 from __future__ import annotations
@@ -20,18 +25,38 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test"))
 from test_error_estimate import CASES
 
 from mount_twin.analysis.accuracy import measure, reference_run
+from mount_twin.commands.common import share_dir
+from mount_twin.engine import driver
+from mount_twin.io.input_samples import read_samples
+from mount_twin.scene.loader import load_scene_file
+
+
+def _genset():
+    root = share_dir()
+    scene = load_scene_file(root / "config" / "genset_bolted_keyed.scene.yaml")
+    return scene, read_samples(root / "bags" / "genset_shock_10khz", scene.input)
+
+
+def _sampled(model, n_watched):
+    """The engine's estimate choice with the sampled estimator on every model."""
+    return driver.sampled_estimator(model) if model.scene.integration.error_estimate else None
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rtol", type=float, nargs="+", default=[1e-3, 1e-4, 1e-5, 1e-6, 1e-7])
+    parser.add_argument("--cases", nargs="+", help="case names (default: the test's cases)")
+    parser.add_argument("--sampled", action="store_true", help="the sampled estimator on all")
     args = parser.parse_args()
+    builds = {**{name: build for name, (build, _) in CASES.items()}, "genset": _genset}
+    if args.sampled:
+        driver._new_estimator = _sampled  # a bench's what-if: the engine's choice replaced
     print(
         f"{'case':<20} {'rtol':>6} {'force err':>10} {'estimate':>10} {'ratio':>6} "
         f"{'attitude rad':>12} {'estimate':>10} {'substeps':>8} {'cost':>6}"
     )
-    for case, (build, _) in CASES.items():
-        scene, samples = build()
+    for case in args.cases or list(CASES):
+        scene, samples = builds[case]()
         ref = reference_run(scene, samples, 1_000_000)
         for rtol in args.rtol:
             a = measure(scene, samples, rtol, 100_000, ref)

@@ -109,6 +109,14 @@ def _new_estimator(model: Model, n_watched: tuple[int, int]) -> Estimator | Comp
             model.n_mounts,
             n_watched,
         )
+    return sampled_estimator(model)
+
+
+def sampled_estimator(model: Model) -> Estimator:
+    """The sampled estimate's arrays for `model` as its scene configures it (`engine.estimator`:
+    the one for linear mounts; on non-linear ones `bench/error_estimate.py --sampled` measures
+    it against the companion)."""
+    integ, arrays = model.scene.integration, model.arrays
     return new_estimator(
         integ.method,
         integ.rtol,
