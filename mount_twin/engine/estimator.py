@@ -50,7 +50,7 @@ fan"). The estimate follows that recursion with
 The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities differenced with J).
 Cost per interval: two matrix-vector products (the propagator's over the carried states, the
 output sensitivities'); per check, the check's steps; per linearisation, n + 1 right-hand sides
-and an exponential. Engine time with it over without: 1.10–1.14× on the pump (of which the
+and an exponential. Engine time with it over without: 1.10–1.20× on the pump (of which the
 interval's products 0.03–0.07, the checks and the linearisations about 0.04 each; 2026-11-26),
 2.7–2.9× where the twin rejects steps every interval (docs/scene.md "Error estimate",
 bench/error_estimate.py). The engaged-mount and internal-state handling below works
