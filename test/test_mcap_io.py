@@ -24,7 +24,7 @@ from mount_twin.io import mcap_writer
 from mount_twin.io.bag import LATCHED_QOS, PARTIAL_KEY, InputBag, OutputBag
 from mount_twin.io.mcap_reader import plain_messages
 from mount_twin.io.mcap_salvage import salvage
-from mount_twin.io.messages import IMU, TYPESTORE, RowBlock, imu_messages
+from mount_twin.io.messages import IMU, TYPESTORE, RowBlock, decode_inputs, imu_messages
 from mount_twin.io.raw_rows import RawRows, joined
 
 POSE, DIAG = "geometry_msgs/msg/PoseStamped", "diagnostic_msgs/msg/DiagnosticArray"
@@ -220,6 +220,20 @@ def test_raw_rows_are_their_messages_and_join_as_rows_where_lengths_agree() -> N
     assert isinstance(both, RawRows) and list(both) == raws
     mixed = joined([rows[:3], [b"short"[:4]]])
     assert isinstance(mixed, list) and mixed == [*raws[:3], b"shor"]
+
+
+def test_rows_decode_as_their_bytes_do_with_frame_ids_of_one_length_and_an_odd_message() -> None:
+    """decode_inputs on RawRows (read as they lie) equals it on the same messages as bytes:
+    two frame ids of one length interleaved, one message whose last covariance is not the
+    layout's zero (rosbags decodes it alone)."""
+    a, b = _imu(30, "imu_a"), _imu(30, "imu_b", start_ns=T0 + 500_000)
+    raws = [r for pair in zip(a, b, strict=True) for _, r in pair]
+    raws[7] = raws[7][:-8] + b"\xff" * 8
+    rows = RawRows(np.frombuffer(b"".join(raws), np.uint8).reshape(len(raws), -1))
+    got, want = decode_inputs(rows, IMU), decode_inputs(raws, IMU)
+    assert got.frame_ids == want.frame_ids and got.undecodable == want.undecodable
+    for field in ("stamps_ns", "accel", "gyro"):
+        np.testing.assert_array_equal(getattr(got, field), getattr(want, field))
 
 
 def test_one_topic_of_one_frame_id_is_read_at_once_in_time_order(tmp_path: Path) -> None:
