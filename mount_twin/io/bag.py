@@ -146,7 +146,7 @@ class InputBag:
             except StopIteration:
                 break
             except Exception as err:  # rosbags' readers raise their own types on damage
-                yield from _pieces(joined(parts) if parts else [], size, everything=True)
+                yield from _pieces(joined(parts), size, everything=True)
                 rest = self._salvage_after(read)
                 if rest is not None:
                     yield from self._salvaged_chunks(rest, read, size)
@@ -167,7 +167,7 @@ class InputBag:
             if count >= size or held >= CHUNK_MAX_BYTES:
                 left = yield from _pieces(joined(parts), size)
                 parts, held, count = [left] if len(left) else [], nbytes(left), len(left)
-        yield from _pieces(joined(parts) if parts else [], size, everything=True)
+        yield from _pieces(joined(parts), size, everything=True)
         if read < self.count:  # records lost without an error: zeroed or overwritten bytes
             msg = (
                 f"{self.path}: damaged: its index lists {self.count} messages of {self.topic}, "

@@ -42,10 +42,6 @@ class RawRows(Sequence[bytes]):
     def __iter__(self) -> Iterator[bytes]:
         return iter(split_rows(np.ascontiguousarray(self.rows)))
 
-    def take(self, index: np.ndarray) -> RawRows:
-        """The messages at `index` (positions), in its order."""
-        return RawRows(self.rows[index])
-
 
 def nbytes(raws: Sequence[bytes]) -> int:
     """The messages' total length, bytes."""
@@ -55,7 +51,7 @@ def nbytes(raws: Sequence[bytes]) -> int:
 def joined(parts: Sequence[Sequence[bytes]]) -> Sequence[bytes]:
     """The parts' messages in order, as one sequence: `RawRows` where every message has the
     length of the `RawRows` among them (a list part of that length is made rows too), else a
-    list of bytes."""
+    list of bytes (no parts: an empty list)."""
     if len(parts) == 1:
         return parts[0]
     widths = {p.rows.shape[1] for p in parts if isinstance(p, RawRows)}

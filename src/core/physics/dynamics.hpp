@@ -264,15 +264,21 @@ inline void substitute(const double (&l)[3][3], double (&b)[3]) {
   }
 }
 
-/// `substitute` on views, copied into locals first (the views may alias: in locals the
-/// compiler keeps the triangle in registers; N fixed: the loops unroll).
+/// The lower triangle of a and b[:N] into locals (the views may alias: in locals the compiler
+/// keeps them in registers; N fixed: the loops unroll).
+template <idx N>
+inline void load_lower(M3 a, Vec b, double (&l)[3][3], double (&x)[3]) {
+  for (idx i = 0; i < N; ++i) {
+    x[i] = b[i];
+    for (idx k = 0; k <= i; ++k) l[i][k] = a(i, k);
+  }
+}
+
+/// `substitute` on views (`load_lower` first).
 template <idx N>
 inline void cholesky_solve_n(M3 low, Vec b) {
   double l[3][3], x[3];
-  for (idx i = 0; i < N; ++i) {
-    x[i] = b[i];
-    for (idx k = 0; k <= i; ++k) l[i][k] = low(i, k);
-  }
+  load_lower<N>(low, b, l, x);
   substitute<N>(l, x);
   for (idx i = 0; i < N; ++i) b[i] = x[i];
 }
@@ -292,10 +298,7 @@ inline void cholesky_solve(M3 low, Vec b, idx n) {
 template <idx N>
 inline bool solve_spd_n(M3 a, Vec b) {
   double l[3][3], x[3];
-  for (idx i = 0; i < N; ++i) {
-    x[i] = b[i];
-    for (idx k = 0; k <= i; ++k) l[i][k] = a(i, k);
-  }
+  load_lower<N>(a, b, l, x);
   for (idx j = 0; j < N; ++j) {
     double d = l[j][j];
     for (idx k = 0; k < j; ++k) d -= l[j][k] * l[j][k];
