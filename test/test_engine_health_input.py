@@ -18,6 +18,7 @@ from io_helpers import batch, default_model, default_scene, scene_with, split
 
 from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus, SampleBatch
 from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.health import _median
 from mount_twin.model.assemble import assemble
 from mount_twin.scene import Scene
 
@@ -183,6 +184,16 @@ def test_jitter_without_holes_loses_nothing() -> None:
         assert (s.level, s.message, s.values["lost_in_period"]) == (OK, "ok", "0")
         assert float(s.values["nominal_interval_s"]) == pytest.approx(DT, rel=0.02)
     assert eng.counts["lost_estimated"] == 0
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 998, 1001])
+def test_the_window_median_is_numpys(n: int) -> None:
+    """The lost-sample estimate's median (one partition) is np.median's number, for odd and
+    even counts, with repeated values among them."""
+    rng = np.random.default_rng(n)
+    values = np.round(DT * (1.0 + rng.uniform(-0.1, 0.1, n)), 7)
+    assert _median(values) == float(np.median(values))
+    assert _median(values[::-1].copy()) == float(np.median(values))
 
 
 def test_late_samples_stamped_by_the_host_are_not_lost() -> None:
