@@ -9,6 +9,7 @@
 #include <string>
 
 #include "model.hpp"
+#include "physics/linear_mount.hpp"
 
 namespace mt::convert {
 
@@ -151,6 +152,7 @@ inline Model model(py::handle m) {
       out.lin_c_r_sum[k] += out.lin_c_r.d[9 * i + k];
     }
   }
+  physics::lay_out_lanes(out);
   out.lin_slot = ivec(field(m, "lin_slot"), "ModelArrays.lin_slot", n);
   out.lin_per_rating = matc<6>(field(m, "lin_per_rating"), "ModelArrays.lin_per_rating", n);
   auto nl = field(m, "nl");

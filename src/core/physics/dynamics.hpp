@@ -148,12 +148,7 @@ inline void add_load(const double* arm, const double* f, const double* c, double
 inline void mount_loads(Vec y, const Model& m, Scratch& s, Vec dydt) {
   const Motion mo = Motion::of(s);
   double total_f[3] = {0.0, 0.0, 0.0}, total_m[3] = {0.0, 0.0, 0.0};
-  const double none[3] = {0.0, 0.0, 0.0};
-  for (idx i = 0; i < m.lin_point.rows; ++i) {
-    double arm[3], f[3];
-    linear_mount_force(i, m, mo, arm, f);
-    add_load(arm, f, none, total_f, total_m);
-  }
+  linear_loads(m, mo, total_f, total_m);
   if (m.lin_point.rows > 0) {  // their own couples, through their summed K_r, C_r
     double c[3];
     linear_couple(m.lin_k_r_sum, m.lin_c_r_sum, mo, c);

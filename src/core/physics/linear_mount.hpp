@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
 
 #include "../model.hpp"
 #include "../numeric.hpp"
@@ -62,15 +63,77 @@ inline void point_motion(const double* point, const Motion& mo, double* arm, dou
   de[5] = mo.qd[2] + mo.w[0] * arm[1] - mo.w[1] * arm[0];
 }
 
+/// Kelvin–Voigt force (N, F) −(K·d + C·ḋ) of a mount of stiffness k (N/m) and damping c
+/// (N·s/m), 3×3 row-major in F, at displacement and velocity de = (d, ḋ) (m, m/s, F).
+inline void kelvin_voigt(const double* k, const double* c, const double* de, double* force) {
+  for (int j = 0; j < 3; ++j) {
+    const double* kj = k + 3 * j;
+    const double* cj = c + 3 * j;
+    force[j] = -(kj[0] * de[0] + kj[1] * de[1] + kj[2] * de[2] + cj[0] * de[3] +
+                 cj[1] * de[4] + cj[2] * de[5]);
+  }
+}
+
 /// Force (N, F) of linear mount i on the body at its point, and its lever arm `arm` (m, F).
 inline void linear_mount_force(idx i, const Model& m, const Motion& mo, double* arm,
                                double* force) {
   double de[6];
   point_motion(&m.lin_point(i, 0), mo, arm, de);
-  const M33s &k_t = m.lin_k_t, &c_t = m.lin_c_t;
-  for (int j = 0; j < 3; ++j) {
-    force[j] = -(k_t(i, j, 0) * de[0] + k_t(i, j, 1) * de[1] + k_t(i, j, 2) * de[2] +
-                 c_t(i, j, 0) * de[3] + c_t(i, j, 1) * de[4] + c_t(i, j, 2) * de[5]);
+  kelvin_voigt(&m.lin_k_t(i, 0, 0), &m.lin_c_t(i, 0, 0), de, force);
+}
+
+/// Model.lin_lanes holds blocks of LANES linear mounts (the last one padded with zeros), each
+/// LANE_ROWS rows of LANES: the points (m, B), then K_t and C_t (F, row-major), component by
+/// component, so that `linear_loads` reads each at a fixed offset from its block.
+constexpr idx LANES = 8;
+constexpr idx LANE_POINT = 0, LANE_K = 3, LANE_C = 12, LANE_ROWS = 21;
+
+/// Fill m.lin_lanes from m.lin_point, m.lin_k_t, m.lin_c_t.
+inline void lay_out_lanes(Model& m) {
+  const idx n = m.lin_point.rows, blocks = (n + LANES - 1) / LANES;
+  m.lin_lanes.assign(static_cast<std::size_t>(blocks * LANE_ROWS * LANES), 0.0);
+  double* lanes = m.lin_lanes.data();
+  for (idx i = 0; i < n; ++i) {
+    double* lane = lanes + (i / LANES) * LANE_ROWS * LANES + i % LANES;
+    for (idx c = 0; c < 3; ++c) lane[(LANE_POINT + c) * LANES] = m.lin_point(i, c);
+    for (idx k = 0; k < 9; ++k) {
+      lane[(LANE_K + k) * LANES] = m.lin_k_t.d[9 * i + k];
+      lane[(LANE_C + k) * LANES] = m.lin_c_t.d[9 * i + k];
+    }
+  }
+}
+
+/// Add the linear mounts' forces (N) and their moments about the CG (N·m), F, to total_f and
+/// total_m, mount by mount in scene order: the arithmetic of `linear_mount_force` and
+/// dynamics.hpp add_load, a block of LANES mounts at a time from m.lin_lanes, so that the
+/// compiler computes two or more mounts per instruction.
+inline void linear_loads(const Model& m, const Motion& mo, double* total_f, double* total_m) {
+  const idx n = m.lin_point.rows;
+  for (idx first = 0; first < n; first += LANES) {
+    const double(*block)[LANES] =
+        reinterpret_cast<const double(*)[LANES]>(m.lin_lanes.data() + first * LANE_ROWS);
+    double load[6][LANES];
+    for (idx l = 0; l < LANES; ++l) {  // the padding's lanes too: a fixed count, zero loads
+      double point[3], k[9], c[9], arm[3], de[6], f[3];
+      for (idx j = 0; j < 3; ++j) point[j] = block[LANE_POINT + j][l];
+      for (idx j = 0; j < 9; ++j) {
+        k[j] = block[LANE_K + j][l];
+        c[j] = block[LANE_C + j][l];
+      }
+      point_motion(point, mo, arm, de);
+      kelvin_voigt(k, c, de, f);
+      for (idx j = 0; j < 3; ++j) load[j][l] = f[j];
+      load[3][l] = arm[1] * f[2] - arm[2] * f[1] + 0.0;  // + 0.0: add_load's no own couple
+      load[4][l] = arm[2] * f[0] - arm[0] * f[2] + 0.0;
+      load[5][l] = arm[0] * f[1] - arm[1] * f[0] + 0.0;
+    }
+    const idx count = n - first < LANES ? n - first : LANES;
+    for (idx l = 0; l < count; ++l) {
+      for (idx j = 0; j < 3; ++j) {
+        total_f[j] += load[j][l];
+        total_m[j] += load[3 + j][l];
+      }
+    }
   }
 }
 
