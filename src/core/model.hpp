@@ -25,6 +25,7 @@ struct NonLinear {
 struct Model {
   double mass = 0.0;     // kg
   M3 inertia;            // (3, 3) kg·m², about the CG, in B
+  double inertia_inv[3][3] = {};  // its inverse, 1/(kg·m²) (convert fills it)
   Vec cg_ref;            // (3,) m, in F
   Vec sensor_position;   // (3,) m, in F
   IVec free_trans;       // (nt,) free indices among X, Y, Z

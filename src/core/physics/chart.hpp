@@ -41,6 +41,17 @@ inline void kinematic_matrix(double sa, double ca, double sg, double cg, double 
   out(2, 2) = ct;
 }
 
+/// x = B⁻¹·v (B of `kinematic_matrix`): the chart rates (α', γ', δ') of the angular velocity
+/// v (rad/s, body axes), or their accelerations of an angular acceleration. B's lower 2×2
+/// block has determinant −cos γ (cos²θ + sin²α = cos²γ), and its first column is (cos α /
+/// cos θ, 0, 0): both invertible on the chart (cos θ > 0 needs |sin α| < cos γ).
+inline void inverse_kinematic(double sa, double ca, double sg, double cg, double ct,
+                              const double* v, double* x) {
+  x[1] = -(ct * v[1] - sa * v[2]) / cg;
+  x[2] = (sa * v[1] + ct * v[2]) / (cg * cg);
+  x[0] = (v[0] - sa * sg / (cg * ct) * x[1] - sg * x[2]) * ct / ca;
+}
+
 /// dB/dt along the motion, 1/s.
 inline void kinematic_matrix_rate(double sa, double ca, double sg, double cg, double ct,
                                   double alpha_dot, double gamma_dot, M3 out) {

@@ -323,6 +323,19 @@ inline bool solve_spd(M3 a, Vec b, idx n) {
   return true;
 }
 
+/// With all three rotations free, the projected Euler equations Bᵀ·(I·(B·x + a) − m) = 0
+/// are I·(B·x + a) = m: the chart accelerations x = B⁻¹·I⁻¹·h for h (N·m, body axes, the
+/// moments less the known accelerations' share), into dydt[first:first + 3], directly (the
+/// reduced mass matrix BᵀIB squares B's condition and takes a factorisation).
+inline void chart_accelerations(const Model& m, const Scratch& s, double ct, const Vec h,
+                                Vec dydt, idx first) {
+  const double(&inv)[3][3] = m.inertia_inv;
+  double v[3], x[3];
+  for (int i = 0; i < 3; ++i) v[i] = inv[i][0] * h[0] + inv[i][1] * h[1] + inv[i][2] * h[2];
+  inverse_kinematic(s.trig[0], s.trig[3], s.trig[1], s.trig[4], ct, v, x);
+  for (idx a = 0; a < 3; ++a) dydt[first + a] = x[m.free_rot[a]];
+}
+
 /// Free rotational accelerations (projected Euler equations) into dydt[first:first + nr];
 /// false if the reduced mass matrix is numerically singular.
 inline bool rotational(const Model& m, Scratch& s, double ct, Vec dydt, idx first) {
@@ -351,6 +364,10 @@ inline bool rotational(const Model& m, Scratch& s, double ct, Vec dydt, idx firs
     h[i] = moment_b[i] - cross(w_abs, i_w, i) - i_acc;
   }
   const idx nr = m.free_rot.n;
+  if (nr == 3) {
+    chart_accelerations(m, s, ct, h, dydt, first);
+    return true;
+  }
   for (idx a = 0; a < nr; ++a) {
     const idx ca = m.free_rot[a];
     const double k0 = kin(0, ca), k1 = kin(1, ca), k2 = kin(2, ca);
@@ -418,6 +435,12 @@ inline void rhs_after_rate_step(const Model& m, Scratch& s, Vec d_wdot, Vec dydt
   }
   for (int i = 0; i < 3; ++i) {
     h[i] = -(inertia(i, 0) * dw_b[0] + inertia(i, 1) * dw_b[1] + inertia(i, 2) * dw_b[2]);
+  }
+  if (nr == 3) {  // as `rotational` solves it: the change of x = B⁻¹·I⁻¹·h
+    double x[3];
+    chart_accelerations(m, s, s.rot(2, 2), h, Vec{x, 3}, 0);
+    for (idx a = 0; a < 3; ++a) dydt[nf + nt + a] += x[a];
+    return;
   }
   for (idx a = 0; a < nr; ++a) {
     const idx ca = m.free_rot[a];
