@@ -9,6 +9,10 @@ linear in q'. Projecting Newton–Euler on q_f (Kane's method) gives, exactly fo
     translation:  q_t'' = F/m − f_s − [2Ω×r' + Ω'×(r − s) + Ω×(Ω×(r − s))]   (physics notes §6)
     rotation:     (Jᵀ I J) q_r'' = Jᵀ [M − ω_a × I ω_a − I(B' q_r' − ω×Ωᴮ + RᵀΩ')],  J = B[:, free]
 
+With all three rotations free J = B is square and invertible on the chart, and the rotation
+rows are q_r'' = B⁻¹·I⁻¹·[…]: the core solves them so (B⁻¹ in closed form), and factors the
+reduced mass matrix Jᵀ I J only for fewer free rotations.
+
 with f_s the specific force at sensor point s, Ω the foundation angular velocity (in F),
 Ωᴮ = RᵀΩ, ω_a = ω + Ωᴮ the absolute angular velocity and M the mount moment about the CG (in B).
 
@@ -93,10 +97,11 @@ class Scratch(NamedTuple):
       couples summed through one law: it is linear in their K_r, C_r), and for the non-linear
       mounts arm, force, couple, loc and sink: read by `rhs` itself.
     - `rhs(t, y, u)` fills all of the above, then f_s, big_w, big_w_dot, rel, w_x_rel,
-      kin_rate, moment_b, w_b, w_dot_b, acc, w_abs, h, i_w, rhs_rot and mass_rot (the
-      Cholesky factor of Jᵀ I J). `outputs(y)` may follow only if that last `rhs` was at y
-      (the stepper's last stage is: first same as last); `rhs_after_rate_step` moves that
-      last stage to a new Ω' through the factored mass_rot.
+      kin_rate, moment_b, w_b, w_dot_b, acc, w_abs, h, i_w, and with fewer than three free
+      rotations rhs_rot and mass_rot (the Cholesky factor of Jᵀ I J; with three, B⁻¹·I⁻¹
+      solves and they are left as they were). `outputs(y)` may follow only if that last `rhs`
+      was at y (the stepper's last stage is: first same as last); `rhs_after_rate_step` moves
+      that last stage to a new Ω' through the same solve (trig, rot, kin, mass_rot).
     - `run_samples` fills rate_step (the jump of Ω' at a sample): read by
       `rhs_after_rate_step`.
     - `mount_wrenches`, `mount_monitors`, `outputs` and `evaluate` (which calls `body_motion`
@@ -201,6 +206,6 @@ mount_monitors = _core.mount_monitors
 util[i] of each non-linear mount at y (its body motion just computed; y0 the state at the
 previous sample), then their discrete switches; returns whether one switched (y jumped)."""
 rhs_after_rate_step = _core.rhs_after_rate_step
-"""rhs_after_rate_step(m, s, d_wdot, dydt): move dydt, the last `rhs` result (whose kinematics
-and factored reduced mass matrix s holds), to an input whose Ω' changed by d_wdot (rad/s², F):
+"""rhs_after_rate_step(m, s, d_wdot, dydt): move dydt, the last `rhs` result (whose kinematics,
+and with fewer than three free rotations factored reduced mass matrix, s holds), to an input whose Ω' changed by d_wdot (rad/s², F):
 Ω' enters linearly, so this costs a few dozen flops instead of a right-hand side."""

@@ -422,8 +422,8 @@ inline double evaluate(Vec y, const Model& m, Scratch& s, Vec pose, M6 wrenches)
   return ct;
 }
 
-/// Move dydt, the last rhs's result (whose kinematics and factored reduced mass matrix s
-/// holds), to an input whose Ω' changed by d_wdot (rad/s², F).
+/// Move dydt, the last rhs's result (whose kinematics, and with fewer than three free rotations
+/// factored reduced mass matrix, s holds), to an input whose Ω' changed by d_wdot (rad/s², F).
 inline void rhs_after_rate_step(const Model& m, Scratch& s, Vec d_wdot, Vec dydt) {
   const idx nt = m.free_trans.n, nr = m.free_rot.n, nf = nt + nr;
   for (idx k = 0; k < nt; ++k) dydt[nf + k] -= cross(d_wdot, s.rel, m.free_trans[k]);
