@@ -49,14 +49,15 @@ fan"). The estimate follows that recursion with
 
 The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities differenced with J).
 Cost per interval: two matrix-vector products (the propagator's over the carried states, the
-output sensitivities'); per check, the check's steps; per linearisation, n + 1 right-hand sides
-and an exponential. Engine time with it over without: 1.10–1.20× on the pump (of which the
-interval's products 0.03–0.07, the checks and the linearisations about 0.04 each; 2026-11-26),
-2.7–2.9× where the twin rejects steps every interval (docs/scene.md "Error estimate",
-bench/error_estimate.py). The engaged-mount and internal-state handling below works
-for any model (measured on the non-linear scenes above) though the engine gives those the
-companion. It never touches the twin's state: the
-published numbers are identical with it on or off (test/test_error_estimate.py).
+output sensitivities'; both held transposed, so the rows' sums advance side by side); per
+check, the check's steps; per linearisation, n + 1 right-hand sides and an exponential.
+Engine time with it over without: 1.10–1.20× on the pump (of which the interval's products
+0.03–0.07, the checks and the linearisations about 0.04 each; 2026-11-26), 2.7–2.9× where
+the twin rejects steps every interval (docs/scene.md "Error estimate",
+bench/error_estimate.py). The engaged-mount and internal-state handling below works for any
+model (measured on the non-linear scenes above) though the engine gives those the companion.
+It never touches the twin's state: the published numbers are identical with it on or off
+(test/test_error_estimate.py).
 
 What it does not see: the state jump of a mount's discrete switch is carried as the identity
 (its derivative, that of a slip or a plastic set, is not differenced); internal states that do
@@ -141,10 +142,11 @@ class Estimator(NamedTuple):
     y: (n,) the check's state; s: its scratch; y_start, y_end: (n,) the twin's state at an
     interval's start and after its step; e: (n,) the estimated error of the twin's state.
     carried: (np,) indices of the carried states (float); n_body: the body's states, always
-    carried. jac, prop: (np²,) ∂f/∂y and exp(h·∂f/∂y) over them; work: (2np²,);
-    sens: ((3nm + 3)·np,) ∂(mount forces N, α γ δ rad)/∂y. f0, f1: (n,); out0, out1:
-    (3nm + 3,); ec, pc: (np,); wrenches: (nm, 6): work. state: (N_SLOTS,). figures:
-    (N_FIGURES,) running maxima, reset by the reader.
+    carried. jac, prop: (np²,) ∂f/∂y and exp(h·∂f/∂y) over them (prop transposed); work:
+    (2np²,); sens: (np·(3nm + 3),) ∂(mount forces N, α γ δ rad)/∂y, transposed (a carried
+    state's row of outputs). f0, f1: (n,); out0, out1: (3nm + 3,); ec, pc: (np,); wrenches:
+    (nm, 6): work. state: (N_SLOTS,). figures: (N_FIGURES,) running maxima, reset by the
+    reader.
     """
 
     method: int

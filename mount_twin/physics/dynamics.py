@@ -207,5 +207,6 @@ util[i] of each non-linear mount at y (its body motion just computed; y0 the sta
 previous sample), then their discrete switches; returns whether one switched (y jumped)."""
 rhs_after_rate_step = _core.rhs_after_rate_step
 """rhs_after_rate_step(m, s, d_wdot, dydt): move dydt, the last `rhs` result (whose kinematics,
-and with fewer than three free rotations factored reduced mass matrix, s holds), to an input whose Ω' changed by d_wdot (rad/s², F):
-Ω' enters linearly, so this costs a few dozen flops instead of a right-hand side."""
+and with fewer than three free rotations factored reduced mass matrix, s holds), to an input
+whose Ω' changed by d_wdot (rad/s², F): Ω' enters linearly, so this costs a few dozen flops
+instead of a right-hand side."""

@@ -62,9 +62,11 @@ struct Estimator {
   Vec e;             // (n,) the estimated global error of the twin's state
   Vec carried;       // (np_max,) indices into y of the carried states (first N_CARRIED)
   Vec jac;           // (np_max²,) ∂f/∂y over the carried states (row-major, N_CARRIED²)
-  Vec prop;          // (np_max²,) exp(h·jac): the error's propagator over an interval of h
+  Vec prop;          // (np_max²,) exp(h·jac), the error's propagator over an interval of h,
+                     // transposed (linalg::matvec_t)
   Vec work;          // (2·np_max²,)
-  Vec sens;          // ((3·nm + 3)·np_max,) ∂(mount forces, α γ δ)/∂(carried states)
+  Vec sens;          // (np_max·(3·nm + 3),) ∂(mount forces, α γ δ)/∂(carried states),
+                     // transposed: a carried state's row of outputs (linalg::matvec_t)
   Vec f0, f1;        // (n,)
   Vec out0, out1;    // (3·nm + 3,)
   Vec ec, pc;        // (np_max,) the carried error, gathered; its propagation
@@ -94,6 +96,7 @@ inline bool propagator(Estimator& est, double h) {
   const Mat w0{est.work.d, nc, nc}, w1{est.work.d + nc * nc, nc, nc};
   est.state[LINEARISATIONS] += 1.0;
   if (!linalg::expm(square(est.jac, nc), h, square(est.prop, nc), w0, w1)) return false;
+  linalg::transpose(square(est.prop, nc));
   est.state[PROPAGATOR_STEP] = h;
   return true;
 }
@@ -128,7 +131,7 @@ inline bool linearise_at(const Model& m, Estimator& est, Vec u, double t, double
   est.figures[UNCARRIED] = py_max(est.figures[UNCARRIED],
                                   static_cast<double>(choose_carried(est)));
   const idx nc = static_cast<idx>(est.state[N_CARRIED]);
-  const Mat jac = square(est.jac, nc), sens{est.sens.d, n_out, nc};
+  const Mat jac = square(est.jac, nc), sens_t{est.sens.d, nc, n_out};
   const Vec set = est.integ.settings;
   const double typical = py_min(py_max(set[ATOL] / set[RTOL], 1e-6), 1.0);
   for (idx c = 0; c < nc; ++c) {
@@ -144,7 +147,7 @@ inline bool linearise_at(const Model& m, Estimator& est, Vec u, double t, double
       const idx row = static_cast<idx>(est.carried[r]);
       jac(r, c) = (est.f1[row] - est.f0[row]) / d;
     }
-    for (idx r = 0; r < n_out; ++r) sens(r, c) = (est.out1[r] - est.out0[r]) / d;
+    for (idx r = 0; r < n_out; ++r) sens_t(c, r) = (est.out1[r] - est.out0[r]) / d;
   }
   est.state[SINCE_LINEARISED] = 0.0;
   return propagator(est, h);
@@ -215,7 +218,7 @@ inline double stands_for(double pending, double pending_norm, double norm) {
 inline void carry(Estimator& est) {
   const idx nc = static_cast<idx>(est.state[N_CARRIED]);
   for (idx c = 0; c < nc; ++c) est.ec[c] = est.e[static_cast<idx>(est.carried[c])];
-  linalg::matvec(square(est.prop, nc), est.ec.d, est.pc.d);
+  linalg::matvec_t(square(est.prop, nc), est.ec.d, est.pc.d);
   for (idx c = 0; c < nc; ++c) est.e[static_cast<idx>(est.carried[c])] = est.pc[c];
 }
 
@@ -269,7 +272,7 @@ inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, 
   }
   const idx nc = static_cast<idx>(st[N_CARRIED]);
   for (idx c = 0; c < nc; ++c) est.ec[c] = e[static_cast<idx>(est.carried[c])];
-  linalg::matvec(Mat{est.sens.d, n_out, nc}, est.ec.d, est.out1.d);
+  linalg::matvec_t(Mat{est.sens.d, nc, n_out}, est.ec.d, est.out1.d);
   double force = fig[FORCE_ERROR], scale = fig[FORCE_SCALE], attitude = fig[ATTITUDE_ERROR];
   for (idx a = 0; a < nm; ++a) {
     for (int b = 0; b < 3; ++b) {
