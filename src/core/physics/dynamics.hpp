@@ -179,17 +179,7 @@ inline void mount_loads(Vec y, const Model& m, Scratch& s, Vec dydt) {
 /// Each mount's force (N) and own couple (N·m) on the body, in its axes: wrenches row slot.
 inline void mount_wrenches(Vec y, const Model& m, Scratch& s, M6 wrenches) {
   const Motion mo = Motion::of(s);
-  for (idx i = 0; i < m.lin_point.rows; ++i) {
-    double arm[3], f[3], c[3];
-    linear_mount_force(i, m, mo, arm, f);
-    linear_couple(&m.lin_k_r(i, 0, 0), &m.lin_c_r(i, 0, 0), mo, c);
-    const idx row = m.lin_slot[i];
-    const M33s& axes = m.lin_axes;
-    for (int j = 0; j < 3; ++j) {
-      wrenches(row, j) = axes(i, 0, j) * f[0] + axes(i, 1, j) * f[1] + axes(i, 2, j) * f[2];
-      wrenches(row, 3 + j) = axes(i, 0, j) * c[0] + axes(i, 1, j) * c[1] + axes(i, 2, j) * c[2];
-    }
-  }
+  linear_wrenches(m, mo, wrenches);
   if (!m.has_nl) return;
   const NonLinear& nl = m.nl;
   const M3 loc = s.loc;

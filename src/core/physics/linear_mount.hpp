@@ -74,21 +74,34 @@ inline void kelvin_voigt(const double* k, const double* c, const double* de, dou
   }
 }
 
-/// Force (N, F) of linear mount i on the body at its point, and its lever arm `arm` (m, F).
-inline void linear_mount_force(idx i, const Model& m, const Motion& mo, double* arm,
-                               double* force) {
-  double de[6];
-  point_motion(&m.lin_point(i, 0), mo, arm, de);
-  kelvin_voigt(&m.lin_k_t(i, 0, 0), &m.lin_c_t(i, 0, 0), de, force);
+/// The couple (N·m, F) of rotational springs k_r and dampers c_r (3×3, row-major, F) through
+/// the couple map of their generalized force K_r·φ + C_r·φ′. The law is linear in K_r and
+/// C_r, so the summed matrices give the linear mounts' total couple in one call.
+inline void linear_couple(const double* k_r, const double* c_r, const Motion& mo,
+                          double* couple) {
+  double g[3];
+  for (int j = 0; j < 3; ++j) {
+    const double* k = k_r + 3 * j;
+    const double* c = c_r + 3 * j;
+    g[j] = k[0] * mo.phi[0] + k[1] * mo.phi[1] + k[2] * mo.phi[2] + c[0] * mo.rate[0] +
+           c[1] * mo.rate[1] + c[2] * mo.rate[2];
+  }
+  for (int j = 0; j < 3; ++j) {
+    couple[j] = -(mo.cmap[j][0] * g[0] + mo.cmap[j][1] * g[1] + mo.cmap[j][2] * g[2]);
+  }
 }
 
 /// Model.lin_lanes holds blocks of LANES linear mounts (the last one padded with zeros), each
-/// LANE_ROWS rows of LANES: the points (m, B), then K_t and C_t (F, row-major), component by
-/// component, so that `linear_loads` reads each at a fixed offset from its block.
+/// LANE_ROWS rows of LANES: the points (m, B), K_t, C_t, K_r, C_r (F, row-major) and the
+/// axes Q (F, row-major), component by component, so that the loops over a block's mounts
+/// read each at a fixed offset from the block and the compiler computes two mounts per
+/// instruction.
 constexpr idx LANES = 8;
-constexpr idx LANE_POINT = 0, LANE_K = 3, LANE_C = 12, LANE_ROWS = 21;
+constexpr idx LANE_POINT = 0, LANE_K = 3, LANE_C = 12, LANE_K_R = 21, LANE_C_R = 30,
+              LANE_AXES = 39, LANE_ROWS = 48;
+using Block = const double (*)[LANES];
 
-/// Fill m.lin_lanes from m.lin_point, m.lin_k_t, m.lin_c_t.
+/// Fill m.lin_lanes from m.lin_point, lin_k_t, lin_c_t, lin_k_r, lin_c_r and lin_axes.
 inline void lay_out_lanes(Model& m) {
   const idx n = m.lin_point.rows, blocks = (n + LANES - 1) / LANES;
   m.lin_lanes.assign(static_cast<std::size_t>(blocks * LANE_ROWS * LANES), 0.0);
@@ -99,29 +112,44 @@ inline void lay_out_lanes(Model& m) {
     for (idx k = 0; k < 9; ++k) {
       lane[(LANE_K + k) * LANES] = m.lin_k_t.d[9 * i + k];
       lane[(LANE_C + k) * LANES] = m.lin_c_t.d[9 * i + k];
+      lane[(LANE_K_R + k) * LANES] = m.lin_k_r.d[9 * i + k];
+      lane[(LANE_C_R + k) * LANES] = m.lin_c_r.d[9 * i + k];
+      lane[(LANE_AXES + k) * LANES] = m.lin_axes.d[9 * i + k];
     }
   }
 }
 
+/// The block of linear mounts from mount `first` (a multiple of LANES).
+inline Block block_of(const Model& m, idx first) {
+  return reinterpret_cast<Block>(m.lin_lanes.data() + first * LANE_ROWS);
+}
+
+/// row[0..count) of the block from lane row `row` (count ≤ 9) of lane l into out.
+inline void lane_rows(Block block, idx row, idx count, idx l, double* out) {
+  for (idx j = 0; j < count; ++j) out[j] = block[row + j][l];
+}
+
+/// Lane l of a block: the mount's lever arm R·p (m) and Kelvin–Voigt force (N) on the body, F.
+inline void lane_force(Block block, idx l, const Motion& mo, double* arm, double* force) {
+  double point[3], k[9], c[9], de[6];
+  lane_rows(block, LANE_POINT, 3, l, point);
+  lane_rows(block, LANE_K, 9, l, k);
+  lane_rows(block, LANE_C, 9, l, c);
+  point_motion(point, mo, arm, de);
+  kelvin_voigt(k, c, de, force);
+}
+
 /// Add the linear mounts' forces (N) and their moments about the CG (N·m), F, to total_f and
-/// total_m, mount by mount in scene order: the arithmetic of `linear_mount_force` and
-/// dynamics.hpp add_load, a block of LANES mounts at a time from m.lin_lanes, so that the
-/// compiler computes two or more mounts per instruction.
+/// total_m, mount by mount in scene order (`lane_force`, then dynamics.hpp add_load's sums), a
+/// block of LANES mounts at a time.
 inline void linear_loads(const Model& m, const Motion& mo, double* total_f, double* total_m) {
   const idx n = m.lin_point.rows;
   for (idx first = 0; first < n; first += LANES) {
-    const double(*block)[LANES] =
-        reinterpret_cast<const double(*)[LANES]>(m.lin_lanes.data() + first * LANE_ROWS);
+    const Block block = block_of(m, first);
     double load[6][LANES];
     for (idx l = 0; l < LANES; ++l) {  // the padding's lanes too: a fixed count, zero loads
-      double point[3], k[9], c[9], arm[3], de[6], f[3];
-      for (idx j = 0; j < 3; ++j) point[j] = block[LANE_POINT + j][l];
-      for (idx j = 0; j < 9; ++j) {
-        k[j] = block[LANE_K + j][l];
-        c[j] = block[LANE_C + j][l];
-      }
-      point_motion(point, mo, arm, de);
-      kelvin_voigt(k, c, de, f);
+      double arm[3], f[3];
+      lane_force(block, l, mo, arm, f);
       for (idx j = 0; j < 3; ++j) load[j][l] = f[j];
       load[3][l] = arm[1] * f[2] - arm[2] * f[1] + 0.0;  // + 0.0: add_load's no own couple
       load[4][l] = arm[2] * f[0] - arm[0] * f[2] + 0.0;
@@ -137,20 +165,30 @@ inline void linear_loads(const Model& m, const Motion& mo, double* total_f, doub
   }
 }
 
-/// The couple (N·m, F) of rotational springs k_r and dampers c_r (3×3, row-major, F) through
-/// the couple map of their generalized force K_r·φ + C_r·φ′. The law is linear in K_r and
-/// C_r, so the summed matrices give the linear mounts' total couple in one call.
-inline void linear_couple(const double* k_r, const double* c_r, const Motion& mo,
-                          double* couple) {
-  double g[3];
-  for (int j = 0; j < 3; ++j) {
-    const double* k = k_r + 3 * j;
-    const double* c = c_r + 3 * j;
-    g[j] = k[0] * mo.phi[0] + k[1] * mo.phi[1] + k[2] * mo.phi[2] + c[0] * mo.rate[0] +
-           c[1] * mo.rate[1] + c[2] * mo.rate[2];
-  }
-  for (int j = 0; j < 3; ++j) {
-    couple[j] = -(mo.cmap[j][0] * g[0] + mo.cmap[j][1] * g[1] + mo.cmap[j][2] * g[2]);
+/// Each linear mount's force (N) and own couple (N·m) on the body, in its axes, into its
+/// wrenches row (m.lin_slot), a block of LANES mounts at a time.
+inline void linear_wrenches(const Model& m, const Motion& mo, M6 wrenches) {
+  const idx n = m.lin_point.rows;
+  for (idx first = 0; first < n; first += LANES) {
+    const Block block = block_of(m, first);
+    double out[6][LANES];
+    for (idx l = 0; l < LANES; ++l) {
+      double arm[3], f[3], k_r[9], c_r[9], c[3], q[9];
+      lane_force(block, l, mo, arm, f);
+      lane_rows(block, LANE_K_R, 9, l, k_r);
+      lane_rows(block, LANE_C_R, 9, l, c_r);
+      lane_rows(block, LANE_AXES, 9, l, q);
+      linear_couple(k_r, c_r, mo, c);
+      for (idx j = 0; j < 3; ++j) {  // Qᵀ·f, Qᵀ·c
+        out[j][l] = q[j] * f[0] + q[3 + j] * f[1] + q[6 + j] * f[2];
+        out[3 + j][l] = q[j] * c[0] + q[3 + j] * c[1] + q[6 + j] * c[2];
+      }
+    }
+    const idx count = n - first < LANES ? n - first : LANES;
+    for (idx l = 0; l < count; ++l) {
+      const idx row = m.lin_slot[first + l];
+      for (idx j = 0; j < 6; ++j) wrenches(row, j) = out[j][l];
+    }
   }
 }
 
