@@ -173,8 +173,16 @@ class TwinEngine:
 
     def run(self, samples: SampleBatch) -> OutputBatch:
         """A whole record: `push` it, then `flush`; every row and report, positions in
-        `samples` (the final report last)."""
-        return self.push(samples).then(self.flush(), len(samples))
+        `samples` (the final report last). In one frame where nothing is held back from an
+        earlier push: the rows the gyro delay holds to the end then land beside the others,
+        and the record's rows are not copied into one batch (1 ms of the pump's 5 s)."""
+        require(samples, SampleBatch, "TwinEngine.run(samples)")
+        if not len(samples) or self._intake.held is not None:
+            return self.push(samples).then(self.flush(), len(samples))
+        samples.check()
+        first_id = self._pushed
+        self._pushed += len(samples)
+        return self._push(samples, first_id, end=True)
 
     @property
     def holding(self) -> bool:
@@ -199,10 +207,10 @@ class TwinEngine:
         """The gyro filter was designed, at the interval into `stamp` (s)."""
         self.health.gyro_designed(stamp, design)
 
-    def _push(self, batch: SampleBatch, first_id: int) -> OutputBatch:
+    def _push(self, batch: SampleBatch, first_id: int, *, end: bool = False) -> OutputBatch:
         """`push` of a batch that holds any held-back sample first (stream position
         `first_id`): its samples judged, then followed chunk by chunk, a chunk ending where a
-        report falls due."""
+        report falls due; with `end`, then the stream's end (`_end`) in the same frame."""
         judged = self._intake.judge(batch)
         frame = self._gyro.frame(batch.stamps, judged.f, judged.w, first_id)
         rows = BatchRows(len(frame.stamps), self.model.n_mounts)
@@ -215,6 +223,8 @@ class TwinEngine:
                 stamp = float(batch.stamps[stop - 1])
                 reports.append(self._reporting.report(stamp, stop - 1, parts))
             start = stop
+        if end:
+            reports.extend(self._end(frame, rows, parts, len(batch) - 1))
         self._gyro.close(frame)
         return self._reporting.batch(frame, rows, parts, reports)
 
@@ -315,23 +325,31 @@ class TwinEngine:
         samples were received but none ever accepted, the report (`stamp` NaN) says so at
         ERROR, and why (`health.ENDED`).
         """
-        if self._intake.held is not None:
-            self._intake.held = None
-            self.count("received")
-            self.count("rejected_unconfirmed_jump")
         empty = np.zeros((0, 3))
         frame = self._gyro.frame(np.zeros(0), empty, empty, self._pushed)
         rows = BatchRows(len(frame.stamps), self.model.n_mounts)
         parts: list[Rows] = []
+        reports = self._end(frame, rows, parts, -1)
+        return self._reporting.batch(frame, rows, parts, reports)
+
+    def _end(
+        self, frame: Frame, rows: BatchRows, parts: list[Rows], last: int
+    ) -> list[HealthReport]:
+        """The stream's end in `frame` (`flush`'s, or the last push's in `run`): a held-back
+        sample counted rejected, the gyro delay drained onto `parts`, and the final report
+        (after `parts`, at sample `last`), if one is due."""
+        if self._intake.held is not None:
+            self._intake.held = None
+            self.count("received")
+            self.count("rejected_unconfirmed_jump")
         self._follow(self._gyro.drain(frame), frame, rows, parts)
-        reports = []
         last_stamp = self._intake.last_stamp
         if last_stamp is not None:
             if self.health.pending:
-                reports.append(self._reporting.report(last_stamp, -1, parts))
+                return [self._reporting.report(last_stamp, last, parts)]
         elif self.counts["received"] and not self.counts["accepted"]:
-            reports.append(self._reporting.report(math.nan, -1, parts, stalled_s=ENDED))
-        return self._reporting.batch(frame, rows, parts, reports)
+            return [self._reporting.report(math.nan, last, parts, stalled_s=ENDED)]
+        return []
 
     def report_stalled(self, waited_s: float) -> HealthReport:
         """The report a live adapter publishes when `waited_s` (s, its clock) passed without
