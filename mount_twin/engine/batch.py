@@ -55,7 +55,7 @@ class SampleBatch:
             if a.shape != (n, 3):
                 msg = f"SampleBatch.{name}: shape {a.shape}, expected ({n}, 3) for {n} stamps"
                 raise ValueError(msg)
-        if len(self.frame_ids) != n or not all(map(isinstance, self.frame_ids, repeat(str))):
+        if len(self.frame_ids) != n or not _all_strings(self.frame_ids):
             msg = f"SampleBatch.frame_ids: {len(self.frame_ids)} entries, expected {n} strings"
             raise ValueError(msg)
 
@@ -74,6 +74,14 @@ class SampleBatch:
             np.concatenate([p.gyro for p in parts]).reshape(-1, 3),
             [fid for p in parts for fid in p.frame_ids],
         )
+
+
+def _all_strings(items: list[str]) -> bool:
+    """Whether every item is a str: at once where they all equal the first, a str (one IMU's
+    samples: list.count compares by identity first), else item by item."""
+    if items and type(items[0]) is str and items.count(items[0]) == len(items):
+        return True
+    return all(map(isinstance, items, repeat(str)))
 
 
 @dataclass
