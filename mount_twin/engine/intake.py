@@ -187,6 +187,8 @@ class Intake:
     def __init__(self, model: Model, health: HealthWindow, counts: Counter[str]) -> None:
         self.spec = model.scene.input
         self._rot = model.sensor_rotation
+        self._aligned = bool(np.array_equal(self._rot, np.eye(3)))
+        """The sensor's axes are F's: readings are taken as they are (as floats, copied)."""
         self._gravity_up = np.array([0.0, 0.0, self.spec.g])
         self._health = health
         self._counts = counts
@@ -237,12 +239,17 @@ class Intake:
             accel = np.where(readable[:, None], accel, 0.0)
             gyro = np.where(readable[:, None], gyro, 0.0)
             finite &= readable
-        f = rotated(accel, self._rot)
+        f = self._into_f(accel)
         if not self.spec.includes_gravity:
             f = f + self._gravity_up
         if self.spec.gyro_filter == "ignore":  # the foundation's rotation neglected
             return f, np.zeros_like(f), finite
-        return f, rotated(gyro, self._rot), finite
+        return f, self._into_f(gyro), finite
+
+    def _into_f(self, rows: np.ndarray) -> np.ndarray:
+        """(n, 3) sensor-frame readings in F: a new float array (the gyro's is filtered in
+        place later), rotated unless the sensor is aligned with F."""
+        return np.array(rows, dtype=np.float64) if self._aligned else rotated(rows, self._rot)
 
     def _suspect_readings(self, batch: SampleBatch) -> dict[str, np.ndarray]:
         """Per sample (bool, not held back): 'saturated', a reading at the sensor's full scale;
