@@ -51,9 +51,10 @@ The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities d
 Cost per interval: two matrix-vector products (the propagator's over the carried states, the
 output sensitivities'; both held transposed, so the rows' sums advance side by side); per
 check, the check's steps; per linearisation, n + 1 right-hand sides and an exponential.
-Engine time with it over without: 1.10–1.20× on the pump (of which the interval's products
-0.03–0.07, the checks and the linearisations about 0.04 each; 2026-11-26), 2.7–2.9× where
-the twin rejects steps every interval (docs/scene.md "Error estimate",
+Engine time with it over without: 1.16–1.24× on the pump (under perf the interval's
+bookkeeping and products 5 % of the samples, the linearisations' exponentials 3 %;
+2026-11-26 at 9124055, an engine 1.3× faster than when the estimate took 1.10–1.20×),
+2.1–2.8× where the twin rejects steps every interval (docs/scene.md "Error estimate",
 bench/error_estimate.py). The engaged-mount and internal-state handling below works for any
 model (measured on the non-linear scenes above) though the engine gives those the companion.
 It never touches the twin's state: the published numbers are identical with it on or off
