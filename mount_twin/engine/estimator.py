@@ -34,13 +34,7 @@ fan"). The estimate follows that recursion with
   constant in n), a forced one's drift at the beat of forcing and mode. Where they do not add
   up in phase (a lightly damped mode above the sample rate's Nyquist, contact chatter) it
   over-counts, up to 6.8× measured (13× with checks 32 apart); measuring every interval
-  (`check_every=1`) is then within 1.07–1.33 (test/test_error_estimate.py). Nor do they where
-  the twin's steps are set by its tolerance rather than by the interval (a running mean of
-  more than 1.5 accepted steps an interval: the step sizes, and the local errors with them,
-  follow the error controller): one interval in 8 is then measured (the pump at rtol 1e-9,
-  two steps an interval, read 3.3× its true error with checks 32 apart, 1.8× 16 apart, 0.97×
-  8 apart, 0.92× by this rule; the Rosenbrock at 1e-6, 4.9 steps, 1.49× before it, 0.96×
-  with it; the pump's case tested);
+  (`check_every=1`) is then within 1.07–1.33 (test/test_error_estimate.py);
 - under an exponential twin (exprb32, `auto`'s choice for stiff linear-mount scenes), a check's
   own Jacobian and φ functions of half the interval (two steps) were most of its cost (the
   φ functions' squarings), and the twin had just made the same. A regular check therefore comes
@@ -133,19 +127,10 @@ once)."""
     CHECKS,
     LINEARISATIONS,
     BORROWED,
-    STEPS_MEAN,
     N_SLOTS,
 ) = _core.ESTIMATOR_SLOTS
 """Slots of `Estimator.state` (src/core/engine/estimator.hpp says what each keeps)."""
-KEPT = [
-    PENDING,
-    PENDING_NORM,
-    PROPAGATOR_STEP,
-    ERROR_NORM_MEAN,
-    SINCE_LINEARISED,
-    N_CARRIED,
-    STEPS_MEAN,
-]
+KEPT = [PENDING, PENDING_NORM, PROPAGATOR_STEP, ERROR_NORM_MEAN, SINCE_LINEARISED, N_CARRIED]
 """The slots a restart clears."""
 
 

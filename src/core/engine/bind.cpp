@@ -120,7 +120,7 @@ void bind_engine(py::module_& mod) {
       int(engine::PENDING_NORM),
       int(engine::PROPAGATOR_STEP), int(engine::ERROR_NORM_MEAN), int(engine::SINCE_LINEARISED),
       int(engine::N_CARRIED), int(engine::CHECKS), int(engine::LINEARISATIONS),
-      int(engine::BORROWED), int(engine::STEPS_MEAN), int(engine::N_ESTIMATOR_SLOTS));
+      int(engine::BORROWED), int(engine::N_ESTIMATOR_SLOTS));
   mod.attr("ENGAGED_CHECK_EVERY") = engine::ENGAGED_CHECK_EVERY;
   mod.attr("SPIKE_RATIO") = engine::SPIKE_RATIO;
   mod.def(

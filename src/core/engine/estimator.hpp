@@ -31,7 +31,6 @@ enum EstimatorSlot : int {
   CHECKS,             // intervals measured since the start
   LINEARISATIONS,     // linearisations since the start
   BORROWED,           // checks that took the exponential twin's linearisation
-  STEPS_MEAN,         // running mean of the twin's accepted steps per interval
   N_ESTIMATOR_SLOTS
 };
 
@@ -43,15 +42,6 @@ enum Watched : int { CHANGED = 1, ENGAGED = 2 };
 /// While a mount is ENGAGED its stiffness moves with the state (a Hertzian contact, a slipping
 /// face): a regular check comes every ENGAGED_CHECK_EVERY intervals, and linearises again.
 constexpr double ENGAGED_CHECK_EVERY = 4.0;
-
-/// Where the twin's steps are set by its tolerance, not by the input interval (a running mean
-/// of more than TOLERANCE_BOUND_STEPS accepted steps an interval), the step sizes, and with
-/// them the local errors, follow the error controller rather than the motion, and do not add
-/// up in phase over CHECK_EVERY intervals: a regular check comes every
-/// TOLERANCE_BOUND_CHECK_EVERY intervals (the pump at rtol 1e-9, two steps an interval, read
-/// 3.3× its true error with checks 32 apart, 1.8× at 16, 0.97× at 8).
-constexpr double TOLERANCE_BOUND_STEPS = 1.5;
-constexpr double TOLERANCE_BOUND_CHECK_EVERY = 8.0;
 
 /// The twin's error norm of an interval is a spike (the interval is checked on its own) above
 /// this multiple of its running mean.
@@ -259,12 +249,10 @@ inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, 
   const double err = twin_result[0];
   const bool spike = err > SPIKE_RATIO * st[ERROR_NORM_MEAN];
   st[ERROR_NORM_MEAN] += MEAN_WEIGHT * (err - st[ERROR_NORM_MEAN]);
-  st[STEPS_MEAN] += MEAN_WEIGHT * (twin_result[1] - st[STEPS_MEAN]);
   const bool special = changed || twin_result[2] > 0.0 || spike;
   st[PENDING] += 1.0;
   if (!special) st[PENDING_NORM] += err;
-  double every = engaged ? py_min(st[CHECK_EVERY], ENGAGED_CHECK_EVERY) : st[CHECK_EVERY];
-  if (st[STEPS_MEAN] > TOLERANCE_BOUND_STEPS) every = py_min(every, TOLERANCE_BOUND_CHECK_EVERY);
+  const double every = engaged ? py_min(st[CHECK_EVERY], ENGAGED_CHECK_EVERY) : st[CHECK_EVERY];
   const bool cheap = st[PENDING] >= 0.25 * every && twin_linearisation_fits(twin, est, h);
   const bool regular = !special && (st[PENDING] >= every || cheap);
   if (special || regular || !linearised) {
