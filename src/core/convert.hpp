@@ -8,6 +8,7 @@
 
 #include <string>
 
+#include "linalg.hpp"
 #include "model.hpp"
 #include "physics/linear_mount.hpp"
 
@@ -129,27 +130,12 @@ inline NonLinear nonlinear(py::handle nl) {
   return v;
 }
 
-/// inv = a⁻¹ of a 3×3 matrix (the adjugate over the determinant; the inertia is positive
-/// definite, the scene loader says so).
-inline void invert_3x3(M3 a, double (&inv)[3][3]) {
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {  // cofactor of a(j, i): the adjugate's (i, j)
-      const int r0 = (j + 1) % 3, r1 = (j + 2) % 3, c0 = (i + 1) % 3, c1 = (i + 2) % 3;
-      inv[i][j] = a(r0, c0) * a(r1, c1) - a(r0, c1) * a(r1, c0);
-    }
-  }
-  const double det = a(0, 0) * inv[0][0] + a(0, 1) * inv[1][0] + a(0, 2) * inv[2][0];
-  for (auto& row : inv) {
-    for (double& x : row) x /= det;
-  }
-}
-
 /// physics.dynamics.ModelArrays → Model.
 inline Model model(py::handle m) {
   Model out;
   out.mass = field(m, "mass").cast<double>();
   out.inertia = matc<3>(field(m, "inertia"), "ModelArrays.inertia", 3);
-  invert_3x3(out.inertia, out.inertia_inv);
+  linalg::invert_3x3(out.inertia, out.inertia_inv);
   out.cg_ref = vec(field(m, "cg_ref"), "ModelArrays.cg_ref", 3);
   out.sensor_position = vec(field(m, "sensor_position"), "ModelArrays.sensor_position", 3);
   out.free_trans = ivec(field(m, "free_trans"), "ModelArrays.free_trans");

@@ -1,5 +1,6 @@
-// Small dense linear algebra on row-major square views: products and the matrix exponential
-// (the error estimate's propagator, engine/estimator.hpp). No allocation: callers pass work.
+// Small dense linear algebra on row-major square views: products, a 3×3 inverse (the model's
+// inertia) and the matrix exponential (the error estimate's propagator,
+// engine/estimator.hpp). No allocation: callers pass work.
 #pragma once
 
 #include <cmath>
@@ -46,6 +47,21 @@ inline void transpose(Mat a) {
       a(i, j) = a(j, i);
       a(j, i) = keep;
     }
+  }
+}
+
+/// inv = a⁻¹ of an invertible 3×3 matrix, the adjugate over the determinant (the model's
+/// inertia, which the scene loader holds positive definite).
+inline void invert_3x3(MatC<3> a, double (&inv)[3][3]) {
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {  // cofactor of a(j, i): the adjugate's (i, j)
+      const int r0 = (j + 1) % 3, r1 = (j + 2) % 3, c0 = (i + 1) % 3, c1 = (i + 2) % 3;
+      inv[i][j] = a(r0, c0) * a(r1, c1) - a(r0, c1) * a(r1, c0);
+    }
+  }
+  const double det = a(0, 0) * inv[0][0] + a(0, 1) * inv[1][0] + a(0, 2) * inv[2][0];
+  for (auto& row : inv) {
+    for (double& x : row) x /= det;
   }
 }
 

@@ -35,8 +35,8 @@ struct Model {
   M33s lin_axes;         // (n, 3, 3)
   M33s lin_k_t, lin_c_t, lin_k_r, lin_c_r;  // (n, 3, 3) in F
   double lin_k_r_sum[9] = {}, lin_c_r_sum[9] = {};  // Σ lin_k_r, Σ lin_c_r (row-major)
-  std::vector<double> lin_lanes;  // lin_point, lin_k_t, lin_c_t component by component, each
-                                  // over the n mounts (physics/linear_mount.hpp LANE_*)
+  std::vector<double> lin_lanes;  // the linear mounts' points and laws in blocks of LANES
+                                  // mounts side by side (physics/linear_mount.hpp)
   IVec lin_slot;         // (n,)
   M6 lin_per_rating;     // (n, 6) 1/m (travel x, y, z), then 1/N (load); 0: unrated
   bool has_nl = false;   // NonLinearMounts present (None on the Python side: false)

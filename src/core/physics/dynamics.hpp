@@ -268,11 +268,10 @@ inline void cholesky_solve_n(M3 low, Vec b) {
   for (idx i = 0; i < N; ++i) b[i] = x[i];
 }
 
-/// Solve L Lᵀ x = b[:n] in place, L the lower triangle of low (n ≤ 3).
+/// Solve L Lᵀ x = b[:n] in place, L the lower triangle of low (n ≤ 2: three free rotations
+/// take `chart_accelerations`).
 inline void cholesky_solve(M3 low, Vec b, idx n) {
-  if (n == 3) {
-    cholesky_solve_n<3>(low, b);
-  } else if (n == 2) {
+  if (n == 2) {
     cholesky_solve_n<2>(low, b);
   } else if (n == 1) {
     cholesky_solve_n<1>(low, b);
@@ -304,10 +303,9 @@ inline bool solve_spd_n(M3 a, Vec b) {
   return true;
 }
 
-/// Solve a[:n, :n] x = b[:n] in place by Cholesky (n ≤ 3; the lower triangle of a keeps its
-/// factor); false if a is not positive definite.
+/// Solve a[:n, :n] x = b[:n] in place by Cholesky (n ≤ 2, as `cholesky_solve`; the lower
+/// triangle of a keeps its factor); false if a is not positive definite.
 inline bool solve_spd(M3 a, Vec b, idx n) {
-  if (n == 3) return solve_spd_n<3>(a, b);
   if (n == 2) return solve_spd_n<2>(a, b);
   if (n == 1) return solve_spd_n<1>(a, b);
   return true;
@@ -327,7 +325,8 @@ inline void chart_accelerations(const Model& m, const Scratch& s, double ct, con
 }
 
 /// Free rotational accelerations (projected Euler equations) into dydt[first:first + nr];
-/// false if the reduced mass matrix is numerically singular.
+/// false if the reduced mass matrix (fewer than three free rotations) is numerically
+/// singular.
 inline bool rotational(const Model& m, Scratch& s, double ct, Vec dydt, idx first) {
   const M3 rot = s.rot, kin = s.kin, kin_rate = s.kin_rate, inertia = m.inertia,
             mass_rot = s.mass_rot;
