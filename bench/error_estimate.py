@@ -11,18 +11,25 @@ the engine's wall time with the estimate over without it (one run, side by side)
 `--sampled` gives every scene the sampled estimator (`engine.estimator`), the non-linear ones
 included, which the engine gives the companion (`engine.companion`): how honest and how dear
 the cheaper method is where mounts slip, open and hit their stops. The case `genset` (the
-bundled bolted, keyed genset under its 10 kHz shock bag) is run only when named in `--cases`.
+bundled bolted, keyed genset under its 10 kHz shock bag) and the cases `hysteretic_N` (N = 4,
+16, 64, 256 Bouc–Wen elastomers on a grid under the same 200 kg body, together as stiff as
+four, 2 s of the pump's ship motion: how the estimate's cost grows with the mounts) are run
+only when named in `--cases`.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
+from functools import partial
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test"))
 
-from test_error_estimate import CASES
+from kinds_helpers import kind_mount
+from physics_helpers import base_scene
+from test_error_estimate import CASES, _ship_motion, _with_pump_input
 
 from mount_twin.analysis.accuracy import measure, reference_run
 from mount_twin.commands.common import share_dir
@@ -37,6 +44,28 @@ def _genset():
     return scene, read_samples(root / "bags" / "genset_shock_10khz", scene.input)
 
 
+HYSTERETIC_COUNTS = (4, 16, 64, 256)
+
+
+def _hysteretic(n: int):
+    """n Bouc–Wen elastomers on a grid over 0.8 × 0.6 m, each 1/n of four's stiffness and
+    damping, under 200 kg; 2 s of the pump's ship motion."""
+    side = math.ceil(math.sqrt(n))
+    mounts = [
+        kind_mount(
+            "elastomer",
+            f"r{i}",
+            (0.8 * (i % side) / (side - 1) - 0.4, 0.6 * (i // side) / (side - 1) - 0.3, 0.0),
+            stiffness_linear=[4e5 / n, 4e5 / n, 8e5 / n],
+            damping=[1200.0 / n, 1200.0 / n, 2000.0 / n],
+            hysteresis={"ratio": 0.6, "beta": 120.0, "gamma": 80.0},
+        )
+        for i in range(n)
+    ]
+    body = base_scene(200.0, [0.0, 0.0, 0.3], [20.0, 30.0, 40.0, 0.0, 0.0, 0.0], mounts)
+    return _ship_motion(_with_pump_input(body), 2.0)
+
+
 def _sampled(model, n_watched):
     """The engine's estimate choice with the sampled estimator on every model."""
     return driver.sampled_estimator(model) if model.scene.integration.error_estimate else None
@@ -48,7 +77,10 @@ def main() -> None:
     parser.add_argument("--cases", nargs="+", help="case names (default: the test's cases)")
     parser.add_argument("--sampled", action="store_true", help="the sampled estimator on all")
     args = parser.parse_args()
-    builds = {**{name: build for name, (build, _) in CASES.items()}, "genset": _genset}
+    builds = {name: build for name, (build, _) in CASES.items()}
+    builds["genset"] = _genset
+    for n in HYSTERETIC_COUNTS:
+        builds[f"hysteretic_{n}"] = partial(_hysteretic, n)
     if args.sampled:
         driver._new_estimator = _sampled  # a bench's what-if: the engine's choice replaced
     print(

@@ -1,8 +1,7 @@
 """The live error estimate where the model has non-linear mounts: a companion solution of the
-twin at half the step (models of linear mounts take the cheaper `engine.estimator`, which
-measured 0.31–0.98 of the true error on the bolted genset against this one's 0.73–1.07, at
-2.4–3.1× the engine's cost against 2.2–2.5×: its sampled local errors miss what contact, slip
-and opening joints commit between its checks).
+twin at half the step (models of linear mounts take the cheaper `engine.estimator`, which is
+not cheaper here: on the bolted genset at rtol 1e-6 it read 0.92 of the true error at 2.9× the
+engine's time against this one's 0.95 at 2.1×; see there).
 
 Richardson's global error estimate (Hairer, Nørsett & Wanner, *Solving Ordinary Differential
 Equations I*, §II.4 and §II.12): integrate the same problem twice, the published solution y and
@@ -18,9 +17,14 @@ but cost 10× the integration on the bolted genset, where tight tolerances hunt 
 switches; 4 cost 3× there and gave 0.54. The companion reads the same held input, takes the
 same discrete mount switches between samples, and restarts with the twin.
 
-Cost: about 2× the engine's integration time on smooth scenes, 4× on the bolted genset at
-rtol 1e-6; `integration.error_estimate: false` turns it off. It never touches the twin's state:
-the published numbers are identical with it on or off (test/test_error_estimate.py).
+Cost: the engine takes 2.1× as long with it on the bolted genset at rtol 1e-6, 2.3–2.7× on 4 to
+256 Bouc–Wen elastomers (bench/error_estimate.py, docs/scene.md "Error estimate"): its two steps
+an interval are about the twin's work again, whatever the mounts. Followed on a second thread it
+would hide in wall time only up to its own loop, the slower one: measured on the genset, the
+run's wall time fell from 48–53 to 41 ms and its CPU time rose to 59–60 ms (not kept; a live
+node's runs of one sample would gain nothing). `integration.error_estimate: false` turns it
+off. It never touches the twin's state: the published numbers are identical with it on or off
+(test/test_error_estimate.py).
 
 Its figures, kept as `engine.estimate` lays them out, are running maxima since the engine last
 read them: the largest |ΔF| over mounts and force components (N, mount axes), the largest
