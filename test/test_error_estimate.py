@@ -30,6 +30,8 @@ from mount_twin.engine.estimator import (
     CHECK_RTOL_FLOOR,
     CHECKS,
     FLOOR_DIVISOR,
+    N_CARRIED,
+    PROPAGATOR_STEP,
     TOLERANCE_DIVISOR,
     Estimator,
     check_divisor,
@@ -144,19 +146,17 @@ def _pump() -> tuple[Scene, SampleBatch]:
 
 CASES = {
     "stiff_light": (_stiff_light, [1e-3, 1e-6]),
-    "stiff_light_rosenbrock": (partial(_stiff_light, "ros34pw2"), [1e-6, 1e-9]),
+    "stiff_light_rosenbrock": (partial(_stiff_light, "ros34pw2"), [1e-3, 1e-6, 1e-9]),
     "stiff_light_exponential": (partial(_stiff_light, "exprb32"), [1e-3]),
     "rubber_on_snubbers": (_rubber_on_snubbers, [1e-3, 1e-6]),
     "hysteresis_snubbers_real_shock": (_hysteresis_snubbers_real_shock, [1e-3, 1e-6]),
     "pump_ship_motion": (_pump, [1e-4]),
 }
-OVER = {("stiff_light_exponential", 1e-3): 8.0}
-"""Where the estimate is allowed above FACTOR (never below 1/FACTOR): local errors that do not
-add up in phase (a lightly damped 2–6 kHz mode sampled at 1 kHz), which one measured interval
-standing for the ~19 since the last over-counts (`engine.estimator`). Measured: 6.8 (13 while a
-check stood for 32); measuring every interval (`check_every=1`), 1.07. The true error there
-is 4e-9 of the largest force: the estimate reads tiny either way. (Scenes with non-linear
-mounts take the companion, `engine.companion`.)"""
+"""Each case's rtols are asserted within FACTOR. The Rosenbrock's at 1e-3 read 0.27 while its
+checks were Rosenbrock steps too (they damp the stiff modes as the twin does: 1.00 checked by
+the exponential method, `estimator.CHECKED_BY`); the exponential's 6.8 while a check's local
+error counted undamped for the ~19 intervals since the last (1.22 damped, `add_local_error`).
+(Scenes with non-linear mounts take the companion, `engine.companion`.)"""
 ATTITUDE_FLOOR_RAD = 1e-12
 """Attitude errors below this are rounding (the stiff scenes': 1e-13), not compared."""
 
@@ -169,20 +169,18 @@ def test_the_estimate_is_within_a_factor_two_of_the_true_error(case: str, rtol: 
     scene, samples = build()
     ref = reference_run(scene, samples, 1_000_000)
     acc = measure(scene, samples, rtol, 100_000, ref)
-    high = OVER.get((case, rtol), FACTOR)
     assert acc.failures == 0
     assert acc.force_error > 1e-12, "an error worth estimating, above rounding"
-    assert 1 / FACTOR < acc.est_force_error / acc.force_error < high, acc
+    assert 1 / FACTOR < acc.est_force_error / acc.force_error < FACTOR, acc
     if acc.attitude_error_rad > ATTITUDE_FLOOR_RAD:
-        assert 1 / FACTOR < acc.est_attitude_error_rad / acc.attitude_error_rad < high, acc
+        assert 1 / FACTOR < acc.est_attitude_error_rad / acc.attitude_error_rad < FACTOR, acc
 
 
 @pytest.mark.parametrize("case", ["stiff_light_exponential"])
-def test_measuring_every_interval_comes_within_ten_percent_where_sampling_over_counts(
-    case: str,
-) -> None:
-    """The carried error is right: what over-counts in OVER is the sampling, not the
-    linearised propagation or the local errors it carries."""
+def test_measuring_every_interval_comes_within_ten_percent_on_the_stiff_scene(case: str) -> None:
+    """The carried error is right where the modes lose most of their error an interval: what
+    the sampling adds (1.22 as configured) is the weighting of the intervals a check stands
+    for, not the linearised propagation or the local errors it carries."""
     scene, samples = CASES[case][0]()
     rtol = min(CASES[case][1])
     ref = reference_run(scene, samples, 1_000_000)
@@ -193,8 +191,8 @@ def test_measuring_every_interval_comes_within_ten_percent_where_sampling_over_c
     assert 0.9 < acc.est_force_error / acc.force_error < 1.1, acc
 
 
-def _checks_of(case: str) -> tuple[float, float]:
-    """(checks, checks that took the twin's linearisation) of the case's run as configured."""
+def _estimator_after(case: str) -> Estimator:
+    """The estimator's arrays after the case's run as configured."""
     scene, samples = CASES[case][0]()
     made: list[Estimator] = []
 
@@ -205,13 +203,19 @@ def _checks_of(case: str) -> tuple[float, float]:
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(driver_module, "new_estimator", keep)
         TwinEngine(assemble(scene)).run(samples)
-    return float(made[0].state[CHECKS]), float(made[0].state[BORROWED])
+    return made[0]
+
+
+def _checks_of(case: str) -> tuple[float, float]:
+    """(checks, checks that took the twin's linearisation) of the case's run as configured."""
+    est = _estimator_after(case)
+    return float(est.state[CHECKS]), float(est.state[BORROWED])
 
 
 def test_the_exponential_twins_checks_take_its_jacobian_and_half_step_phi_functions() -> None:
     """Where the twin is exponential, a regular check waits for an interval whose Jacobian the
     twin took at its start, and takes it with the half step's φ functions instead of making its
-    own (their squarings were most of a check's cost); the estimate stays within OVER there
+    own (their squarings were most of a check's cost); the estimate stays within FACTOR there
     (test above). Another twin's checks take nothing."""
     checks, borrowed = _checks_of("stiff_light_exponential")
     assert checks > 30 and borrowed >= 0.9 * checks, (checks, borrowed)
@@ -240,6 +244,23 @@ def test_the_propagator_is_the_matrix_exponential() -> None:
         want = scipy.linalg.expm(scale * a)
         got = _core.expm(a, scale)
         np.testing.assert_allclose(got, want, rtol=1e-6, atol=1e-9 * abs(want).max())
+
+
+@pytest.mark.parametrize("case", ["stiff_light_exponential", "pump_ship_motion"])
+def test_the_decay_an_interval_is_how_much_of_each_mode_the_propagator_keeps(case: str) -> None:
+    """`decay` is exp(h/2·J_vv) of the Jacobian held (scipy's exponential), and its eigenvalues
+    are the moduli of the propagator's: what an interval leaves of each mode's error (0.37–0.76
+    for the 2.6–5 kHz modes of the stiff scene at 1 kHz, 0.99 for the pump's), which a check
+    standing for many intervals sums instead of counting each at full size."""
+    est = _estimator_after(case)
+    h = float(est.state[PROPAGATOR_STEP])
+    nc, nf = int(est.state[N_CARRIED]), est.n_body // 2
+    jac = est.jac[: nc * nc].reshape(nc, nc)
+    decay = est.decay.reshape(nf, nf)
+    want = scipy.linalg.expm(0.5 * h * jac[nf : 2 * nf, nf : 2 * nf])
+    np.testing.assert_allclose(decay, want, rtol=1e-6, atol=1e-9)
+    kept = np.sort(np.abs(np.linalg.eigvals(scipy.linalg.expm(h * jac[: 2 * nf, : 2 * nf]))))
+    np.testing.assert_allclose(np.sort(np.linalg.eigvals(decay).real), kept[::2], rtol=0.02)
 
 
 @pytest.mark.parametrize("case", ["rubber_on_snubbers", "pump_ship_motion"])
@@ -294,7 +315,7 @@ def test_on_a_stiff_scene_the_linearising_methods_are_stable_where_explicit_ones
     by stability and is 9 % off; the L-stable ros34pw2 takes one step per sample and is within
     1e-3 (it damps the kHz ringing each input kink excites, see docs/scene.md); the exponential
     exprb32, exact on linear mounts, takes one step per sample and is within 1e-7. Every
-    estimate stays within 10× of its true error, the exponential's within OVER (see there)."""
+    estimate is within FACTOR of its true error."""
     scene, samples = _stiff_light("auto")
     ref = reference_run(scene, samples, 1_000_000)
     got = {}
@@ -307,9 +328,8 @@ def test_on_a_stiff_scene_the_linearising_methods_are_stable_where_explicit_ones
     assert explicit.substeps_per_sample > 10 and explicit.force_error > 1e-2
     assert rosenbrock.substeps_per_sample < 1.5 and rosenbrock.force_error < 1e-3
     assert exponential.substeps_per_sample == 1.0 and exponential.force_error < 1e-7
-    for method, acc in got.items():
-        high = OVER[("stiff_light_exponential", 1e-3)] if method == "exprb32" else 10.0
-        assert 0.1 < acc.est_force_error / acc.force_error < high, acc
+    for acc in got.values():
+        assert 1 / FACTOR < acc.est_force_error / acc.force_error < FACTOR, acc
 
 
 def _stiff_with_a_snubbed_mount() -> tuple[Scene, SampleBatch]:

@@ -76,6 +76,12 @@ engine::Estimator estimator(py::handle obj, idx n_state, idx n_mounts) {
   }
   c.jac = convert::vec(field(obj, "jac"), "Estimator.jac", np * np);
   c.prop = convert::vec(field(obj, "prop"), "Estimator.prop", np * np);
+  if (c.n_body % 2 != 0 || c.n_body > 2 * engine::MAX_FREE) {
+    throw py::value_error("Estimator.n_body: " + std::to_string(c.n_body) +
+                          " (twice the free coordinates, at most 6)");
+  }
+  const idx nf = c.n_body / 2;
+  c.decay = convert::vec(field(obj, "decay"), "Estimator.decay", nf * nf);
   c.work = convert::vec(field(obj, "work"), "Estimator.work", 2 * np * np);
   c.sens = convert::vec(field(obj, "sens"), "Estimator.sens", n_out * np);
   c.f0 = convert::vec(field(obj, "f0"), "Estimator.f0", n_state);
