@@ -57,7 +57,8 @@ fan"). The estimate follows that recursion with
 The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities differenced with J).
 Cost per interval: two matrix-vector products (the propagator's over the carried states, the
 output sensitivities'; both held transposed, so the rows' sums advance side by side); per
-check, the check's steps; per linearisation, n + 1 right-hand sides and an exponential.
+check, the check's steps and k products by the body's D (nf × nf); per linearisation, n + 1
+right-hand sides and two exponentials (the propagator's, D's).
 Engine time with it over without: 1.16–1.24× on the pump (under perf the interval's
 bookkeeping and products 5 % of the samples, the linearisations' exponentials 3 %;
 2026-11-26 at 9124055, an engine 1.3× faster than when the estimate took 1.10–1.20×),
