@@ -1,7 +1,7 @@
 """The live error estimate of a model of linear mounts: local errors measured on a sample of the
 intervals, carried forward by the linearised dynamics (a model with non-linear mounts takes
 `engine.companion`: measured on those at rtol 1e-6, this one read 0.92 of the true error on the
-bolted genset at 2.9× the engine's time against the companion's 2.1×, because an engaged mount
+bolted genset at 2.8–3.3× the engine's time against the companion's 2.1×, because an engaged mount
 has it check every ENGAGED_CHECK_EVERY intervals and linearise at each; checked every 8 or 32
 there without linearising again, it cost 1.7–1.9× and over-read rubber hitting snubbers
 17–260×; on 64 and 256 Bouc–Wen mounts, whose states pass DENSE_MAX, it read 0.27 and 0.62:
