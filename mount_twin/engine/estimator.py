@@ -68,7 +68,10 @@ model (measured on the non-linear scenes above) though the engine gives those th
 It never touches the twin's state: the published numbers are identical with it on or off
 (test/test_error_estimate.py).
 
-What it does not see: the state jump of a mount's discrete switch is carried as the identity
+What it does not see: an overdamped mode (ζ > 1, more damping than mounts have) keeps its
+error longer than D says (its slow root decays at ω/(2ζ), not ζω), so the intervals a check
+stands for count less there than they should; the state jump of a mount's discrete switch is
+carried as the identity
 (its derivative, that of a slip or a plastic set, is not differenced); internal states that do
 not move where it linearised hold their error; beyond DENSE_MAX carried states, moving internal
 states are measured into each check's local error but their error is held, not carried: the
