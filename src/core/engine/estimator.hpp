@@ -250,26 +250,38 @@ inline void add_local_error(Estimator& est, double weight, bool decayed) {
   for (idx i = 2 * nf; i < n; ++i) e[i] += weight * (est.y_end[i] - est.y[i]);
   if (nf == 0) return;
   const Mat d = square(est.decay, nf);
-  double term[2][MAX_FREE], next[MAX_FREE];
-  for (idx part = 0; part < 2; ++part) {
-    for (idx i = 0; i < nf; ++i) {
-      term[part][i] = est.y_end[part * nf + i] - est.y[part * nf + i];
+  double t[MAX_FREE][2], next[MAX_FREE][2], sum[MAX_FREE][2];  // (position, velocity) pairs
+  for (idx i = 0; i < nf; ++i) {
+    for (idx part = 0; part < 2; ++part) {
+      t[i][part] = est.y_end[part * nf + i] - est.y[part * nf + i];
+      sum[i][part] = 0.0;
     }
   }
-  const double whole = std::floor(weight);
+  const double whole = std::floor(weight), share = weight - whole;
   const idx count = static_cast<idx>(whole);
-  for (idx j = 0; j <= count; ++j) {
-    const double w = j < count ? 1.0 : weight - whole;
-    for (idx part = 0; part < 2; ++part) {
-      double* t = term[part];
-      for (idx i = 0; i < nf; ++i) e[part * nf + i] += w * t[i];
-      for (idx r = 0; r < nf; ++r) {
-        double acc = 0.0;
-        for (idx c = 0; c < nf; ++c) acc += d(r, c) * t[c];
-        next[r] = acc;
-      }
-      for (idx i = 0; i < nf; ++i) t[i] = next[i];
+  for (idx j = 0; j < count; ++j) {
+    for (idx i = 0; i < nf; ++i) {
+      sum[i][0] += t[i][0];
+      sum[i][1] += t[i][1];
     }
+    if (j + 1 == count && share == 0.0) break;
+    for (idx r = 0; r < nf; ++r) {
+      double a0 = 0.0, a1 = 0.0;
+      for (idx c = 0; c < nf; ++c) {
+        a0 += d(r, c) * t[c][0];
+        a1 += d(r, c) * t[c][1];
+      }
+      next[r][0] = a0;
+      next[r][1] = a1;
+    }
+    for (idx i = 0; i < nf; ++i) {
+      t[i][0] = next[i][0];
+      t[i][1] = next[i][1];
+    }
+  }
+  for (idx i = 0; i < nf; ++i) {
+    e[i] += sum[i][0] + share * t[i][0];
+    e[nf + i] += sum[i][1] + share * t[i][1];
   }
 }
 
