@@ -97,7 +97,7 @@ constexpr idx MAX_FREE = 6;
 
 /// est.decay = exp(h/2·J_vv), J_vv the body's velocity block of the Jacobian held (−M⁻¹C, the
 /// damping, and the gyroscopic terms): a lightly damped mode of rate ω and damping ratio ζ
-/// loses e^(−ζωh) of its amplitude, position and velocity alike, over an interval of h
+/// keeps e^(−ζωh) of its amplitude, position and velocity alike, over an interval of h
 /// (modally, where the damping is, J_vv/2 has the eigenvalues −ζω; `add_local_error`).
 /// False if it is not finite.
 inline bool decay_per_interval(Estimator& est, double h) {
