@@ -156,9 +156,7 @@ class TwinEngine:
         require(batch, SampleBatch, "TwinEngine.push(batch)")
         if len(batch) == 0:  # whatever its arrays' shapes (a decoder's empty result may be flat)
             return OutputBatch.empty(self.model.n_mounts)
-        batch.check()
-        first_id = self._pushed
-        self._pushed += len(batch)
+        first_id = self._accept(batch)
         held = self._intake.held
         if held is None:
             return self._push(batch, first_id)
@@ -179,10 +177,15 @@ class TwinEngine:
         require(samples, SampleBatch, "TwinEngine.run(samples)")
         if not len(samples) or self._intake.held is not None:
             return self.push(samples).then(self.flush(), len(samples))
-        samples.check()
+        return self._push(samples, self._accept(samples), end=True)
+
+    def _accept(self, batch: SampleBatch) -> int:
+        """Check a non-empty batch (`SampleBatch.check`: ValueError naming the field, nothing
+        changed) and give its samples their stream positions; returns the first one's."""
+        batch.check()
         first_id = self._pushed
-        self._pushed += len(samples)
-        return self._push(samples, first_id, end=True)
+        self._pushed += len(batch)
+        return first_id
 
     @property
     def holding(self) -> bool:
