@@ -18,10 +18,12 @@
 namespace mt::engine {
 
 /// Slots of the estimator's small state vector (engine/estimator.py: the same names): its
-/// settings (CHECK_EVERY, LINEARISE_EVERY, set once), then what it keeps between intervals.
+/// settings (CHECK_EVERY, LINEARISE_EVERY, JACOBIAN_KEEP, set once), then what it keeps
+/// between intervals.
 enum EstimatorSlot : int {
   CHECK_EVERY = 0,    // a measured interval counts for at most this many
   LINEARISE_EVERY,    // check periods (CHECK_EVERY intervals) between linearisations
+  JACOBIAN_KEEP,      // the propagator is kept while the Jacobian moves less than this share
   PENDING,            // intervals not measured since the last check
   PENDING_NORM,       // the twin's error norms of those intervals, summed
   PROPAGATOR_STEP,    // s, the interval the propagator is for (0: none held)
@@ -29,7 +31,8 @@ enum EstimatorSlot : int {
   SINCE_LINEARISED,   // check periods the regular checks since the last one stood for
   N_CARRIED,          // states carried (their indices: `carried`)
   CHECKS,             // intervals measured since the start
-  LINEARISATIONS,     // linearisations since the start
+  LINEARISATIONS,     // linearisations (Jacobians taken) since the start
+  EXPONENTIALS,       // propagators computed since the start
   BORROWED,           // checks that took the exponential twin's linearisation
   N_ESTIMATOR_SLOTS
 };
@@ -66,7 +69,7 @@ struct Estimator {
                      // transposed (linalg::matvec_t)
   Vec decay;         // ((n_body/2)²,) exp(h/2·∂v̇/∂v): how an interval damps the body's
                      // modes (`decay_per_interval`), held with the propagator
-  Vec work;          // (2·np_max²,)
+  Vec work;          // (2·np_max²,): a linearisation's fresh Jacobian, the exponentials' work
   Vec sens;          // (np_max·(3·nm + 3),) ∂(mount forces, α γ δ)/∂(carried states),
                      // transposed: a carried state's row of outputs (linalg::matvec_t)
   Vec f0, f1;        // (n,)
@@ -115,7 +118,7 @@ inline bool decay_per_interval(Estimator& est, double h) {
 inline bool propagator(Estimator& est, double h) {
   const idx nc = static_cast<idx>(est.state[N_CARRIED]);
   const Mat w0{est.work.d, nc, nc}, w1{est.work.d + nc * nc, nc, nc};
-  est.state[LINEARISATIONS] += 1.0;
+  est.state[EXPONENTIALS] += 1.0;
   if (!linalg::expm(square(est.jac, nc), h, square(est.prop, nc), w0, w1)) return false;
   linalg::transpose(square(est.prop, nc));
   if (!decay_per_interval(est, h)) return false;
@@ -125,35 +128,66 @@ inline bool propagator(Estimator& est, double h) {
 
 /// Choose the carried states at est.y (f0 = f there): the body's, then each internal state
 /// whose rate is not zero (a Bouc–Wen z under motion, a slip while slipping; not a stuck
-/// joint, a fracture flag), up to np_max; returns how many moving ones did not fit.
-inline idx choose_carried(Estimator& est) {
+/// joint, a fracture flag), up to np_max; returns how many moving ones did not fit, and in
+/// `same` whether they are the ones carried before.
+inline idx choose_carried(Estimator& est, bool& same) {
   const idx n = est.y.n, np_max = est.carried.n;
   idx nc = 0, left_out = 0;
+  same = true;
   for (idx i = 0; i < n; ++i) {
     if (i >= est.n_body && est.f0[i] == 0.0) continue;
     if (nc < np_max) {
-      est.carried[nc++] = static_cast<double>(i);
+      const double index = static_cast<double>(i);
+      same = same && nc < est.state[N_CARRIED] && est.carried[nc] == index;
+      est.carried[nc++] = index;
     } else {
       ++left_out;
     }
   }
+  same = same && static_cast<double>(nc) == est.state[N_CARRIED];
   est.state[N_CARRIED] = static_cast<double>(nc);
   return left_out;
 }
 
+/// Whether the propagator held serves a fresh Jacobian `fresh` (nc², over the same carried
+/// states) for an interval of h: it is for h (STEP_MATCH), and the Jacobian it came from
+/// (est.jac) is within JACOBIAN_KEEP of `fresh` (Frobenius norms). A relative change δ of the
+/// Jacobian moves a mode's frequency by about δ/2: with δ = 1e-3, and a lightly damped mode's
+/// error kept over 1/(ζωh) intervals, its phase by 5e-3 rad at ζ = 0.1, nothing an estimate
+/// within a factor 2 would feel; on the pump under ship motion the Jacobian moved 1.6e-5 to
+/// 1.0e-4 between linearisations.
+inline bool propagator_holds(const Estimator& est, const Mat fresh, double h) {
+  const double held_h = est.state[PROPAGATOR_STEP];
+  if (!(held_h > 0.0) || std::fabs(h - held_h) > STEP_MATCH * h) return false;
+  const idx nc = fresh.rows;
+  const Mat jac = square(est.jac, nc);
+  double change = 0.0, size = 0.0;
+  for (idx r = 0; r < nc; ++r) {
+    for (idx c = 0; c < nc; ++c) {
+      const double d = fresh(r, c) - jac(r, c);
+      change += d * d;
+      size += jac(r, c) * jac(r, c);
+    }
+  }
+  const double keep = est.state[JACOBIAN_KEEP];
+  return change <= keep * keep * size;
+}
+
 /// Jacobian and output sensitivities at (t, est.y) by forward differences (the steppers'
-/// JAC_STEP) over the carried states, chosen afresh, then the propagator over h. False if an
-/// evaluation failed (off the chart).
+/// JAC_STEP) over the carried states, chosen afresh, then the propagator over h, unless the
+/// one held serves (`propagator_holds`: the Jacobian, differenced into est.work, then stays
+/// the one the propagator came from). False if an evaluation failed (off the chart).
 inline bool linearise_at(const Model& m, Estimator& est, Vec u, double t, double h) {
   Scratch& s = est.s;
   const Vec y = est.y;
   const idx n_out = est.out0.n;
   if (physics::rhs(t, y, m, s, u, est.f0) != OK) return false;
   estimated_outputs(y, m, s, est.wrenches, est.out0);
+  bool same = false;
   est.figures[UNCARRIED] = py_max(est.figures[UNCARRIED],
-                                  static_cast<double>(choose_carried(est)));
+                                  static_cast<double>(choose_carried(est, same)));
   const idx nc = static_cast<idx>(est.state[N_CARRIED]);
-  const Mat jac = square(est.jac, nc), sens_t{est.sens.d, nc, n_out};
+  const Mat fresh = square(est.work, nc), sens_t{est.sens.d, nc, n_out};
   const Vec set = est.integ.settings;
   const double typical = py_min(py_max(set[ATOL] / set[RTOL], 1e-6), 1.0);
   for (idx c = 0; c < nc; ++c) {
@@ -167,11 +201,14 @@ inline bool linearise_at(const Model& m, Estimator& est, Vec u, double t, double
     if (bad) return false;
     for (idx r = 0; r < nc; ++r) {
       const idx row = static_cast<idx>(est.carried[r]);
-      jac(r, c) = (est.f1[row] - est.f0[row]) / d;
+      fresh(r, c) = (est.f1[row] - est.f0[row]) / d;
     }
     for (idx r = 0; r < n_out; ++r) sens_t(c, r) = (est.out1[r] - est.out0[r]) / d;
   }
   est.state[SINCE_LINEARISED] = 0.0;
+  est.state[LINEARISATIONS] += 1.0;
+  if (same && propagator_holds(est, fresh, h)) return true;
+  for (idx i = 0; i < nc * nc; ++i) est.jac[i] = est.work[i];
   return propagator(est, h);
 }
 
