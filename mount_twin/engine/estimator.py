@@ -59,9 +59,9 @@ Cost per interval: two matrix-vector products (the propagator's over the carried
 output sensitivities'; both held transposed, so the rows' sums advance side by side); per
 check, the check's steps and k products by the body's D (nf × nf); per linearisation, n + 1
 right-hand sides, and two exponentials (the propagator's, D's) where J moved.
-Engine time with it over without: 1.16–1.24× on the pump (under perf the interval's
-bookkeeping and products 5 % of the samples, the linearisations' exponentials 3 %;
-2026-11-26 at 9124055, an engine 1.3× faster than when the estimate took 1.10–1.20×),
+Engine time with it over without: 1.15–1.19× on the pump (1.16–1.24× before JACOBIAN_KEEP,
+when under perf the interval's bookkeeping and products were 5 % of the samples and the
+linearisations' exponentials 3 %; 2026-11-26),
 2.1–2.8× where the twin rejects steps every interval (docs/scene.md "Error estimate",
 bench/error_estimate.py). The engaged-mount and internal-state handling below works for any
 model (measured on the non-linear scenes above) though the engine gives those the companion.
