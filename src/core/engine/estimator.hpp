@@ -46,6 +46,12 @@ enum Watched : int { CHANGED = 1, ENGAGED = 2 };
 /// face): a regular check comes every ENGAGED_CHECK_EVERY intervals, and linearises again.
 constexpr double ENGAGED_CHECK_EVERY = 4.0;
 
+/// Where the twin's steps are bound by its tolerance (more than one step in the interval), a
+/// regular check comes every BOUND_CHECK_EVERY intervals at most: there the local errors keep
+/// their phase over fewer intervals than where one step an interval is all the input allows
+/// (engine/estimator.py says what was measured).
+constexpr double BOUND_CHECK_EVERY = 12.0;
+
 /// The twin's error norm of an interval is a spike (the interval is checked on its own) above
 /// this multiple of its running mean.
 constexpr double SPIKE_RATIO = 4.0;
@@ -333,7 +339,8 @@ inline void carry(Estimator& est) {
 /// One input interval [t0, t1] of the estimate, after the twin's step: carry the error over
 /// it; measure the twin's local error where the interval is special (`watched` CHANGED, or the
 /// twin rejected a step, or its error norm spiked) or where CHECK_EVERY intervals are pending
-/// (ENGAGED_CHECK_EVERY while a mount is engaged; it then counts for them); linearise again at
+/// (ENGAGED_CHECK_EVERY while a mount is engaged, BOUND_CHECK_EVERY where the twin took more
+/// than one step; it then counts for them); linearise again at
 /// the twin's state y after a mount's event, at every check while one is engaged, and every
 /// LINEARISE_EVERY check periods of regular checks (CHECK_EVERY intervals each: an early check
 /// counts for its share); fold the estimated errors of the outputs into the figures.
@@ -360,7 +367,8 @@ inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, 
   const bool special = changed || twin_result[2] > 0.0 || spike;
   st[PENDING] += 1.0;
   if (!special) st[PENDING_NORM] += err;
-  const double every = engaged ? py_min(st[CHECK_EVERY], ENGAGED_CHECK_EVERY) : st[CHECK_EVERY];
+  double every = engaged ? py_min(st[CHECK_EVERY], ENGAGED_CHECK_EVERY) : st[CHECK_EVERY];
+  if (twin_result[1] > 1.0) every = py_min(every, BOUND_CHECK_EVERY);
   const bool cheap = st[PENDING] >= 0.25 * every && twin_linearisation_fits(twin, est, h);
   const bool regular = !special && (st[PENDING] >= every || cheap);
   if (special || regular || !linearised) {
