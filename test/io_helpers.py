@@ -106,17 +106,10 @@ def split(b: SampleBatch, sizes: Iterable[int]) -> list[SampleBatch]:
     for size in sizes:
         if i >= len(b):
             break
-        out.append(
-            SampleBatch(
-                b.stamps[i : i + size],
-                b.accel[i : i + size],
-                b.gyro[i : i + size],
-                b.frame_ids[i : i + size],
-            )
-        )
+        out.append(b.part(slice(i, i + size)))
         i += size
     if i < len(b):
-        out.append(SampleBatch(b.stamps[i:], b.accel[i:], b.gyro[i:], b.frame_ids[i:]))
+        out.append(b.part(slice(i, None)))
     return out
 
 

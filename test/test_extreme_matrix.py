@@ -120,7 +120,7 @@ def _push_sample_by_sample(scene: Scene, samples: SampleBatch) -> tuple[OutputBa
     engine = TwinEngine(assemble(scene))
     outs, states = [], []
     for i in range(len(samples)):
-        outs.append(engine.push(_select(samples, slice(i, i + 1))))
+        outs.append(engine.push(samples.part(slice(i, i + 1))))
         states.append(engine.state)
     assert engine.running and engine.counts["integration_failures"] == 0
     joined = OutputBatch(
@@ -130,12 +130,6 @@ def _push_sample_by_sample(scene: Scene, samples: SampleBatch) -> tuple[OutputBa
         np.concatenate([o.wrenches for o in outs]),
     )
     return joined, np.array(states)
-
-
-def _select(samples: SampleBatch, rows: slice) -> SampleBatch:
-    return SampleBatch(
-        samples.stamps[rows], samples.accel[rows], samples.gyro[rows], samples.frame_ids[rows]
-    )
 
 
 def _assert_finite(out: OutputBatch) -> None:
@@ -251,7 +245,7 @@ def test_a_tumble_to_high_tilt_keeps_energy_and_momentum_and_estimates_honestly(
     """Torque-free: ½ωᵀIω and the angular momentum R·I·ω (in F, inertial here) stay put up to
     `tilt_deg` of tilt, where the α/γ/δ chart is far from its comfort."""
     scene, samples = _tumbler()
-    full, states = _push_sample_by_sample(scene, _select(samples, slice(0, 375)))  # to 86°
+    full, states = _push_sample_by_sample(scene, samples.part(slice(0, 375)))  # to 86°
     tilt = _tilt(full)
     assert tilt.max() > tilt_deg, "the tumble reaches the tilt under test"
     upto = int(np.argmax(tilt > tilt_deg)) + 1
@@ -264,7 +258,7 @@ def test_a_tumble_to_high_tilt_keeps_energy_and_momentum_and_estimates_honestly(
     assert np.abs(energy / energy[0] - 1).max() < 1e-9
     assert np.abs(momentum - momentum[0]).max() < 1e-9 * np.linalg.norm(momentum[0])
     _assert_finite(full)
-    _assert_honest(scene, _select(samples, slice(0, upto)), "attitude_error_rad")
+    _assert_honest(scene, samples.part(slice(0, upto)), "attitude_error_rad")
 
 
 def test_past_90_degrees_the_twin_stops_following_and_says_so() -> None:

@@ -59,10 +59,11 @@ class SampleBatch:
             msg = f"SampleBatch.frame_ids: {len(self.frame_ids)} entries, expected {n} strings"
             raise ValueError(msg)
 
-    def tail(self, start: int) -> SampleBatch:
-        """The samples from position `start` on."""
+    def part(self, keep: slice) -> SampleBatch:
+        """The samples at the positions `keep` takes (views of the arrays where numpy gives
+        them)."""
         return SampleBatch(
-            self.stamps[start:], self.accel[start:], self.gyro[start:], self.frame_ids[start:]
+            self.stamps[keep], self.accel[keep], self.gyro[keep], self.frame_ids[keep]
         )
 
     @classmethod

@@ -30,26 +30,31 @@ fan"). The estimate follows that recursion with
   twin rejected a step, or its error norm spiked above SPIKE_RATIO × its running mean — counts
   for itself; otherwise one interval in CHECK_EVERY (in ENGAGED_CHECK_EVERY while a mount is
   engaged: in contact, slipping, open, where its stiffness moves with the state and the
-  linearisation with it; in BOUND_CHECK_EVERY where the twin's steps are bound by its
-  tolerance, below) is measured and stands for those since the last, in proportion to the
-  twin's error norms (within 1 and their count: a shock's onset after quiet intervals is not
-  counted as many loud ones). The intervals it stands for are taken to have committed as much,
-  in phase (ℓₙ = hᵖ⁺¹·ψ(yₙ) follows the motion: carried to a later time, the local errors of a
-  free oscillation arrive in phase), each damped by the intervals since: on the body's states
-  it adds Σ_{j<k} Dʲ·ℓ for k intervals, D = exp(h/2·∂v̇/∂v) (what an interval leaves of each
-  lightly damped mode, e^(−ζωh); `add_local_error` in src/core/engine/estimator.hpp). Counted
-  undamped (k·ℓ), a mode that loses a third to two thirds of its error an interval (2.6–5 kHz
-  on stiff mounts at 1 kHz) over-counted 6.8× (13× with checks 32 apart), nearly k over the
-  1.6–4.2 intervals its error lasts; damped, 1.22. Where the twin takes more than one step an
-  interval, its steps bound by its tolerance and not by the input, the local errors do not add
-  up in phase over 32 intervals: on the pump at rtol 1e-9 (2 steps an interval) checks 32 apart
-  over-counted 3.05×, and 1, 4, 8, 16 apart read 0.86, 0.72, 0.95, 1.74. There a check stands
-  for BOUND_CHECK_EVERY = 12 intervals at most: the pump at rtol 1e-8, 3e-9, 1e-9, 1e-10 (1.2–2.8
-  steps an interval) reads 0.95, 0.81, 1.10, 0.82 (32 apart: 0.93, 1.39, 3.05, 1.94; 8 apart:
-  0.94, 0.62, 0.93, 0.70; 16 apart: 0.95, 0.81, 1.74, 1.18) at 1.16–1.27× the engine (1.03–1.39×
-  32 apart; `python3 bench/error_estimate.py --cases pump_ship_motion --rtol 1e-8 3e-9 1e-9
-  1e-10`). Twelve is measured on this one scene, in the middle of the spacings that keep it
-  within 0.5–2; the shipped rtol 1e-6 takes one step an interval and is not affected;
+  linearisation with it; a quarter of the fastest mode's period where the twin's steps are
+  bound by its tolerance, below) is measured and stands for those since the last, in proportion
+  to the twin's error norms (within 1 and their count: a shock's onset after quiet intervals is
+  not counted as many loud ones). The intervals it stands for are taken to have committed as
+  much, in phase (ℓₙ = hᵖ⁺¹·ψ(yₙ) follows the motion: carried to a later time, the local errors
+  of a free oscillation arrive in phase), each damped by the intervals since: on the body's
+  states it adds Σ_{j<k} Dʲ·ℓ for k intervals, D = exp(h/2·∂v̇/∂v) (what an interval leaves of
+  each lightly damped mode, e^(−ζωh); `add_local_error` in src/core/engine/estimator.hpp).
+  Counted undamped (k·ℓ), a mode that loses a third to two thirds of its error an interval
+  (2.6–5 kHz on stiff mounts at 1 kHz) over-counted 6.8× (13× with checks 32 apart), nearly k
+  over the 1.6–4.2 intervals its error lasts; damped, 1.22. Where the twin takes more than one
+  step an interval, its steps bound by its tolerance and not by the input, the local errors add
+  up in phase over a share of the fastest mode's period only. On the pump (fastest mode 122
+  rad/s) at rtol 1e-9 and 1 kHz (2 steps an interval, a period of 51 intervals) checks 32 apart
+  over-read 3.05×, and 1, 4, 8, 16 apart 0.86, 0.72, 0.95, 1.74; at 250 Hz (13 intervals a
+  period) and rtol 1e-6, 1e-8, 1, 2, 3, 4, 8 apart read 0.95–0.96, 1.08–1.13, 0.87–1.15,
+  1.42–1.57, 1.75–2.08; at 100 Hz (5 intervals) 0.96, 0.97–1.06, 0.92–1.31, 1.36–1.91,
+  2.04–2.96. There a check therefore stands for BOUND_PERIOD_SHARE (a quarter) of the period at
+  most, the rate bounded from the Jacobian held (`fastest_rate`: 157 rad/s on the pump, so 10,
+  2 and 1 intervals): the pump at 1 kHz and rtol 1e-8, 3e-9, 1e-9, 1e-10 reads 0.94, 0.62,
+  0.76, 0.68 at 1.16–1.31× the engine (`python3 bench/error_estimate.py --cases
+  pump_ship_motion --rtol 1e-8 3e-9 1e-9 1e-10`), at 250 Hz and rtol 1e-6, 1e-8, 1e-10 1.08,
+  1.13, 0.67, at 100 Hz 0.96, 0.96, 0.75 (checks 32 apart read 6.16, 5.71, 4.00 at 250 Hz,
+  1.72, 1.52, 1.15 at 100 Hz, 2.90 at 100 Hz and rtol 1e-4; tested at 250 Hz and rtol 1e-6, at
+  100 Hz and 1e-4). The shipped pump, one step an interval at rtol 1e-6, is not affected;
 - under an exponential twin (exprb32, `auto`'s choice for stiff linear-mount scenes), a check's
   own Jacobian and φ functions of half the interval (two steps) were most of its cost (the
   φ functions' squarings), and the twin had just made the same. A regular check therefore comes
@@ -139,8 +144,9 @@ CHECK_EVERY = 32
 """A measured interval counts for at most this many (one in CHECK_EVERY is measured)."""
 ENGAGED_CHECK_EVERY = _core.ENGAGED_CHECK_EVERY
 """The same while a mount is engaged (the core's constant)."""
-BOUND_CHECK_EVERY = _core.BOUND_CHECK_EVERY
-"""The same where the twin took more than one step in the interval (the core's constant)."""
+BOUND_PERIOD_SHARE = _core.BOUND_PERIOD_SHARE
+"""Where the twin took more than one step in the interval, a measured interval counts for at
+most this share of the fastest mode's period (the core's constant)."""
 SPIKE_RATIO = _core.SPIKE_RATIO
 """An interval whose twin's error norm is above this multiple of its running mean is measured
 on its own (the core's constant)."""
@@ -162,6 +168,7 @@ of the engine's samples under perf (src/core/engine/estimator.hpp `propagator_ho
     PENDING,
     PENDING_NORM,
     PROPAGATOR_STEP,
+    FASTEST_RATE,
     ERROR_NORM_MEAN,
     SINCE_LINEARISED,
     N_CARRIED,
@@ -172,7 +179,15 @@ of the engine's samples under perf (src/core/engine/estimator.hpp `propagator_ho
     N_SLOTS,
 ) = _core.ESTIMATOR_SLOTS
 """Slots of `Estimator.state` (src/core/engine/estimator.hpp says what each keeps)."""
-KEPT = [PENDING, PENDING_NORM, PROPAGATOR_STEP, ERROR_NORM_MEAN, SINCE_LINEARISED, N_CARRIED]
+KEPT = [
+    PENDING,
+    PENDING_NORM,
+    PROPAGATOR_STEP,
+    FASTEST_RATE,
+    ERROR_NORM_MEAN,
+    SINCE_LINEARISED,
+    N_CARRIED,
+]
 """The slots a restart clears."""
 
 

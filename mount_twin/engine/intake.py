@@ -358,7 +358,7 @@ class Intake:
             verdict = self._verdict(batch, finite, i, last_step)
             verdicts.append(verdict)
             if verdict == HOLD:
-                self.held = batch.tail(i)
+                self.held = batch.part(slice(i, None))
                 break
             if verdict not in _COUNTS:
                 self.skipped += 1

@@ -27,6 +27,7 @@ enum EstimatorSlot : int {
   PENDING,            // intervals not measured since the last check
   PENDING_NORM,       // the twin's error norms of those intervals, summed
   PROPAGATOR_STEP,    // s, the interval the propagator is for (0: none held)
+  FASTEST_RATE,       // rad/s, a bound on the fastest mode's rate where the propagator came from
   ERROR_NORM_MEAN,    // running mean of the twin's error norm
   SINCE_LINEARISED,   // check periods the regular checks since the last one stood for
   N_CARRIED,          // states carried (their indices: `carried`)
@@ -47,10 +48,10 @@ enum Watched : int { CHANGED = 1, ENGAGED = 2 };
 constexpr double ENGAGED_CHECK_EVERY = 4.0;
 
 /// Where the twin's steps are bound by its tolerance (more than one step in the interval), a
-/// regular check comes every BOUND_CHECK_EVERY intervals at most: there the local errors keep
-/// their phase over fewer intervals than where one step an interval is all the input allows
-/// (engine/estimator.py says what was measured).
-constexpr double BOUND_CHECK_EVERY = 12.0;
+/// regular check stands for this share of the fastest mode's period at most (`bound_spacing`):
+/// there the local errors keep their phase over fewer intervals than where one step an interval
+/// is all the input allows (engine/estimator.py says what was measured).
+constexpr double BOUND_PERIOD_SHARE = 0.25;
 
 /// The twin's error norm of an interval is a spike (the interval is checked on its own) above
 /// this multiple of its running mean.
@@ -119,6 +120,29 @@ inline bool decay_per_interval(Estimator& est, double h) {
   return linalg::expm(jvv, 0.5 * h, square(est.decay, nf), w0, w1);
 }
 
+/// A bound on the body's fastest mode's rate (rad/s) from the Jacobian held: the square root of
+/// the ∞-norm of ∂v̇/∂q, which bounds its spectral radius, ω² of the fastest mode (on the pump,
+/// 157 rad/s for its 122).
+inline double fastest_rate(const Estimator& est) {
+  const idx nc = static_cast<idx>(est.state[N_CARRIED]), nf = est.n_body / 2;
+  const Mat jac = square(est.jac, nc);
+  double norm = 0.0;
+  for (idx r = 0; r < nf; ++r) {
+    double row = 0.0;
+    for (idx c = 0; c < nf; ++c) row += std::fabs(jac(nf + r, c));
+    norm = py_max(norm, row);
+  }
+  return std::sqrt(norm);
+}
+
+/// The most intervals a regular check stands for where the twin's steps are bound by its
+/// tolerance: BOUND_PERIOD_SHARE of the fastest mode's period (FASTEST_RATE) in intervals of
+/// h, at least 1.
+inline double bound_spacing(const Vec st, double h) {
+  const double period = 2.0 * M_PI / (st[FASTEST_RATE] * h);
+  return py_max(1.0, std::floor(BOUND_PERIOD_SHARE * period));
+}
+
 /// The propagator over an interval of h from the Jacobian held, and the decay with it; false
 /// if either is not finite.
 inline bool propagator(Estimator& est, double h) {
@@ -128,6 +152,7 @@ inline bool propagator(Estimator& est, double h) {
   if (!linalg::expm(square(est.jac, nc), h, square(est.prop, nc), w0, w1)) return false;
   linalg::transpose(square(est.prop, nc));
   if (!decay_per_interval(est, h)) return false;
+  est.state[FASTEST_RATE] = fastest_rate(est);
   est.state[PROPAGATOR_STEP] = h;
   return true;
 }
@@ -339,7 +364,7 @@ inline void carry(Estimator& est) {
 /// One input interval [t0, t1] of the estimate, after the twin's step: carry the error over
 /// it; measure the twin's local error where the interval is special (`watched` CHANGED, or the
 /// twin rejected a step, or its error norm spiked) or where CHECK_EVERY intervals are pending
-/// (ENGAGED_CHECK_EVERY while a mount is engaged, BOUND_CHECK_EVERY where the twin took more
+/// (ENGAGED_CHECK_EVERY while a mount is engaged, `bound_spacing` where the twin took more
 /// than one step; it then counts for them); linearise again at
 /// the twin's state y after a mount's event, at every check while one is engaged, and every
 /// LINEARISE_EVERY check periods of regular checks (CHECK_EVERY intervals each: an early check
@@ -368,7 +393,7 @@ inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, 
   st[PENDING] += 1.0;
   if (!special) st[PENDING_NORM] += err;
   double every = engaged ? py_min(st[CHECK_EVERY], ENGAGED_CHECK_EVERY) : st[CHECK_EVERY];
-  if (twin_result[1] > 1.0) every = py_min(every, BOUND_CHECK_EVERY);
+  if (twin_result[1] > 1.0 && linearised) every = py_min(every, bound_spacing(st, h));
   const bool cheap = st[PENDING] >= 0.25 * every && twin_linearisation_fits(twin, est, h);
   const bool regular = !special && (st[PENDING] >= every || cheap);
   if (special || regular || !linearised) {
