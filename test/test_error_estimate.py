@@ -151,7 +151,7 @@ CASES = {
     "hysteresis_snubbers_real_shock": (_hysteresis_snubbers_real_shock, [1e-3, 1e-6]),
     "pump_ship_motion": (_pump, [1e-4, 1e-9]),
     "pump_250hz": (partial(_pump, 4), [1e-6]),
-    "pump_100hz": (partial(_pump, 10), [1e-4]),
+    "pump_100hz": (partial(_pump, 10), [1e-3]),
 }
 """Each case's rtols are asserted within FACTOR. The Rosenbrock's at 1e-3 read 0.27 while its
 checks were Rosenbrock steps too (they damp the stiff modes as the twin does: 1.00 checked by

@@ -128,6 +128,7 @@ void bind_engine(py::module_& mod) {
       int(engine::N_CARRIED), int(engine::CHECKS), int(engine::LINEARISATIONS),
       int(engine::EXPONENTIALS), int(engine::BORROWED), int(engine::N_ESTIMATOR_SLOTS));
   mod.attr("ENGAGED_CHECK_EVERY") = engine::ENGAGED_CHECK_EVERY;
+  mod.attr("PERIOD_SHARE") = engine::PERIOD_SHARE;
   mod.attr("BOUND_PERIOD_SHARE") = engine::BOUND_PERIOD_SHARE;
   mod.attr("SPIKE_RATIO") = engine::SPIKE_RATIO;
   mod.def(

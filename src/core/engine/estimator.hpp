@@ -47,10 +47,12 @@ enum Watched : int { CHANGED = 1, ENGAGED = 2 };
 /// face): a regular check comes every ENGAGED_CHECK_EVERY intervals, and linearises again.
 constexpr double ENGAGED_CHECK_EVERY = 4.0;
 
-/// Where the twin's steps are bound by its tolerance (more than one step in the interval), a
-/// regular check stands for this share of the fastest mode's period at most (`bound_spacing`):
-/// there the local errors keep their phase over fewer intervals than where one step an interval
-/// is all the input allows (engine/estimator.py says what was measured).
+/// A regular check stands for this share of the fastest mode's period at most
+/// (`period_spacing`): beyond it local errors no longer add up in phase (engine/estimator.py
+/// says what was measured) ...
+constexpr double PERIOD_SHARE = 1.0;
+/// ... and this share where the twin's steps are bound by its tolerance (more than one step in
+/// the interval): their local errors keep their phase over fewer intervals.
 constexpr double BOUND_PERIOD_SHARE = 0.25;
 
 /// The twin's error norm of an interval is a spike (the interval is checked on its own) above
@@ -135,12 +137,14 @@ inline double fastest_rate(const Estimator& est) {
   return std::sqrt(norm);
 }
 
-/// The most intervals a regular check stands for where the twin's steps are bound by its
-/// tolerance: BOUND_PERIOD_SHARE of the fastest mode's period (FASTEST_RATE) in intervals of
-/// h, at least 1.
-inline double bound_spacing(const Vec st, double h) {
+/// The most intervals a regular check stands for: `share` of the fastest mode's period
+/// (FASTEST_RATE) in intervals of h, at least 1; no limit where that period is shorter than an
+/// interval (ωh > 2π, as the stiff scene's 33): a mode the samples do not resolve loses most of
+/// its error within the few intervals the damped count gives it, in phase or not.
+inline double period_spacing(const Vec st, double h, double share) {
   const double period = 2.0 * M_PI / (st[FASTEST_RATE] * h);
-  return py_max(1.0, std::floor(BOUND_PERIOD_SHARE * period));
+  if (!(period >= 1.0)) return INFINITY;
+  return py_max(1.0, std::floor(share * period));
 }
 
 /// The propagator over an interval of h from the Jacobian held, and the decay with it; false
@@ -364,8 +368,8 @@ inline void carry(Estimator& est) {
 /// One input interval [t0, t1] of the estimate, after the twin's step: carry the error over
 /// it; measure the twin's local error where the interval is special (`watched` CHANGED, or the
 /// twin rejected a step, or its error norm spiked) or where CHECK_EVERY intervals are pending
-/// (ENGAGED_CHECK_EVERY while a mount is engaged, `bound_spacing` where the twin took more
-/// than one step; it then counts for them); linearise again at
+/// (ENGAGED_CHECK_EVERY while a mount is engaged, a share of the fastest mode's period:
+/// `period_spacing`; it then counts for them); linearise again at
 /// the twin's state y after a mount's event, at every check while one is engaged, and every
 /// LINEARISE_EVERY check periods of regular checks (CHECK_EVERY intervals each: an early check
 /// counts for its share); fold the estimated errors of the outputs into the figures.
@@ -393,7 +397,10 @@ inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, 
   st[PENDING] += 1.0;
   if (!special) st[PENDING_NORM] += err;
   double every = engaged ? py_min(st[CHECK_EVERY], ENGAGED_CHECK_EVERY) : st[CHECK_EVERY];
-  if (twin_result[1] > 1.0 && linearised) every = py_min(every, bound_spacing(st, h));
+  if (linearised) {
+    const double share = twin_result[1] > 1.0 ? BOUND_PERIOD_SHARE : PERIOD_SHARE;
+    every = py_min(every, period_spacing(st, h, share));
+  }
   const bool cheap = st[PENDING] >= 0.25 * every && twin_linearisation_fits(twin, est, h);
   const bool regular = !special && (st[PENDING] >= every || cheap);
   if (special || regular || !linearised) {
