@@ -13,6 +13,8 @@ POSE_ROW: tuple[int, int, int, int]
 FIGURE_SLOTS: tuple[int, ...]
 ESTIMATOR_SLOTS: tuple[int, ...]
 ENGAGED_CHECK_EVERY: float
+PERIOD_SHARE: float
+BOUND_PERIOD_SHARE: float
 SPIKE_RATIO: float
 AT_EVENT: int
 INPUT_SIZE: int
