@@ -9,6 +9,10 @@ the engine's wall time with the estimate over without it (side by side).
     python3 bench/error_estimate.py [--rtol 1e-3 1e-5 1e-7] [--cases NAME ...] [--sampled]
                                     [--repeats N]
 
+Each case's first line gives what its reference resolves (`analysis.accuracy.resolution`); a
+ratio marked * is of an error within RESOLVED times that: the reference's own error or
+round-off, not the twin's, so no measure of the estimate.
+
 The cost is one run each way; with `--repeats N`, the best of N runs each way, alternating
 (short records move by ±0.1 from run to run).
 
@@ -35,7 +39,7 @@ from kinds_helpers import kind_mount
 from physics_helpers import base_scene
 from test_error_estimate import CASES, _ship_motion, _with_pump_input
 
-from mount_twin.analysis.accuracy import measure, reference_run, run_at
+from mount_twin.analysis.accuracy import RESOLVED, measure, reference_run, resolution, run_at
 from mount_twin.commands.common import share_dir
 from mount_twin.engine import driver
 from mount_twin.io.input_samples import read_samples
@@ -105,14 +109,20 @@ def main() -> None:
     for case in args.cases or list(CASES):
         scene, samples = builds[case]()
         ref = reference_run(scene, samples, 1_000_000)
+        res = resolution(scene, samples, 1_000_000, ref)
+        print(
+            f"{case:<20} the reference resolves {res.force_error:.1e} of the force, "
+            f"{res.attitude_error_rad:.1e} rad"
+        )
         for rtol in args.rtol:
             a = measure(scene, samples, rtol, 100_000, ref)
+            mark = "*" if a.force_error <= RESOLVED * res.force_error else " "
             cost = a.estimate_cost
             if args.repeats > 1:
                 cost = _best_cost(scene, samples, rtol, args.repeats)
             print(
                 f"{case:<20} {rtol:>6.0e} {a.force_error:>10.2e} {a.est_force_error:>10.2e} "
-                f"{a.est_force_error / a.force_error:>6.2f} {a.attitude_error_rad:>12.2e} "
+                f"{a.est_force_error / a.force_error:>6.2f}{mark}{a.attitude_error_rad:>12.2e} "
                 f"{a.est_attitude_error_rad:>10.2e} {a.substeps_per_sample:>8.2f} "
                 f"{cost:>5.2f}×",
                 flush=True,

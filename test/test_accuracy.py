@@ -13,8 +13,9 @@ from io_helpers import CONFIG, ROOT
 from physics_helpers import base_scene, mount
 from scipy.integrate import solve_ivp
 
-from mount_twin.analysis.accuracy import compare, reference_run, run_at
+from mount_twin.analysis.accuracy import NAN, Accuracy, compare, reference_run, run_at
 from mount_twin.cli import main
+from mount_twin.commands.accuracy import _unresolved
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.scene.loader import scene_from_dict
 
@@ -95,9 +96,29 @@ def test_the_command_writes_a_table_a_csv_and_a_plot(
     assert main(args) == 0
     out = capsys.readouterr().out
     assert "reference: the same twin at rtol 1e-12" in out
+    assert "resolution: the reference differs from one on the input refined 9× by" in out
+    assert "not resolved" not in out  # the pump's errors are 1e-5, its resolution 1e-13
     rows = list(csv.DictReader(table.open(encoding="utf-8")))
     assert [float(r["rtol"]) for r in rows] == [1e-3, 1e-9]
     # the runs take the gyro as shipped (linear_phase), the reference raw: the figure is the
     # gyro conditioning's error on this deck (the integration's own is < 1e-6 at both rtols)
     assert all(1e-6 < float(r["force_error"]) < 1e-4 for r in rows)
     assert png.stat().st_size > 10_000
+
+
+def test_errors_within_the_references_resolution_are_named_not_resolved() -> None:
+    """The command names each rtol whose force or attitude error is within RESOLVED times what
+    the reference resolves, and nothing where every error is above it."""
+    resolved = _accuracy(1.0, force=1e-9, attitude=1e-12)
+    rows = [
+        _accuracy(1e-3, force=1e-5, attitude=1e-9),
+        _accuracy(1e-9, force=2e-9, attitude=1e-9),
+        _accuracy(1e-12, force=1e-5, attitude=3e-12),
+    ]
+    line = _unresolved(rows, resolved)
+    assert line.endswith("rtol 1e-09 (force), 1e-12 (attitude)"), line
+    assert _unresolved(rows[:1], resolved) == ""
+
+
+def _accuracy(rtol: float, force: float, attitude: float) -> Accuracy:
+    return Accuracy(rtol, force, 0.0, attitude, 0.0, 0.0, 1.0, 0, NAN, NAN, NAN)

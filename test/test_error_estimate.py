@@ -21,7 +21,14 @@ from kinds_helpers import kind_mount
 from physics_helpers import base_scene, mount
 
 from mount_twin import _core
-from mount_twin.analysis.accuracy import measure, raw_gyro, reference_run, run_at
+from mount_twin.analysis.accuracy import (
+    RESOLVED,
+    measure,
+    raw_gyro,
+    reference_run,
+    resolution,
+    run_at,
+)
 from mount_twin.engine import driver as driver_module
 from mount_twin.engine.batch import WARN, SampleBatch
 from mount_twin.engine.engine import TwinEngine
@@ -153,35 +160,59 @@ CASES = {
     "pump_250hz": (partial(_pump, 4), [1e-6]),
     "pump_100hz": (partial(_pump, 10), [1e-3]),
 }
-"""Each case's rtols are asserted within FACTOR. The Rosenbrock's at 1e-3 read 0.27 while its
-checks were Rosenbrock steps too (they damp the stiff modes as the twin does: 1.00 checked by
-the exponential method, `estimator.CHECKED_BY`); the exponential's 6.8 while a check's local
-error counted undamped for the ~19 intervals since the last (1.22 damped, `add_local_error`).
-(Scenes with non-linear mounts take the companion, `engine.companion`.)"""
+"""Each case's rtols are asserted within FACTOR, but UNRESOLVED's. The Rosenbrock's at 1e-3
+read 0.27 while its checks were Rosenbrock steps too (they damp the stiff modes as the twin
+does: 1.00 checked by the exponential method, `estimator.CHECKED_BY`). (Scenes with non-linear
+mounts take the companion, `engine.companion`.)"""
+UNRESOLVED = ("stiff_light_exponential",)
+"""Cases whose error is below what the reference resolves (`analysis.accuracy.resolution`):
+no truth to hold the estimate to (test below)."""
 ATTITUDE_FLOOR_RAD = 1e-12
-"""Attitude errors below this are rounding (the stiff scenes': 1e-13), not compared."""
+"""Attitude errors below this are the twin's own rounding (the stiff scenes' 1e-13 at every
+rtol), not compared."""
 
 
 @pytest.mark.parametrize(
-    ("case", "rtol"), [(c, r) for c, (_, rtols) in CASES.items() for r in rtols]
+    ("case", "rtol"),
+    [(c, r) for c, (_, rtols) in CASES.items() if c not in UNRESOLVED for r in rtols],
 )
 def test_the_estimate_is_within_a_factor_two_of_the_true_error(case: str, rtol: float) -> None:
+    """Where the reference resolves the error (`resolution`: a reference on another step grid
+    differs from it by RESOLVED times less than the error)."""
     build, _ = CASES[case]
     scene, samples = build()
     ref = reference_run(scene, samples, 1_000_000)
+    res = resolution(scene, samples, 1_000_000, ref)
     acc = measure(scene, samples, rtol, 100_000, ref)
     assert acc.failures == 0
-    assert acc.force_error > 1e-12, "an error worth estimating, above rounding"
+    assert acc.force_error > RESOLVED * res.force_error, ("not resolved", acc, res)
     assert 1 / FACTOR < acc.est_force_error / acc.force_error < FACTOR, acc
-    if acc.attitude_error_rad > ATTITUDE_FLOOR_RAD:
+    if acc.attitude_error_rad > max(ATTITUDE_FLOOR_RAD, RESOLVED * res.attitude_error_rad):
         assert 1 / FACTOR < acc.est_attitude_error_rad / acc.attitude_error_rad < FACTOR, acc
 
 
-@pytest.mark.parametrize("case", ["stiff_light_exponential"])
-def test_measuring_every_interval_comes_within_ten_percent_on_the_stiff_scene(case: str) -> None:
-    """The carried error is right where the modes lose most of their error an interval: what
-    the sampling adds (1.22 as configured) is the weighting of the intervals a check stands
-    for, not the linearised propagation or the local errors it carries."""
+def test_the_exponential_twins_stiff_error_is_below_what_a_reference_resolves() -> None:
+    """10 kg on 4 × 1e9 N/m integrated by exprb32, exact on the linear part: its error against
+    the reference, 4.2e-9 of the largest force at every rtol and at 1 kHz and 100 Hz alike, is
+    what a second reference on another step grid differs by (one by ros34pw2 as well, measured:
+    round-off of the position times 1e9 N/m). The true error is not known below that; the
+    estimate claims no more than FACTOR times it (it read 6.8 times it while a check's local
+    error counted undamped for the ~19 intervals since the last: `add_local_error`)."""
+    scene, samples = CASES["stiff_light_exponential"][0]()
+    ref = reference_run(scene, samples, 1_000_000)
+    res = resolution(scene, samples, 1_000_000, ref)
+    acc = measure(scene, samples, 1e-3, 100_000, ref)
+    assert 1e-9 < res.force_error < 1e-8
+    assert acc.force_error <= RESOLVED * res.force_error
+    assert acc.est_force_error < FACTOR * res.force_error, (acc, res)
+
+
+@pytest.mark.parametrize("case", ["pump_250hz"])
+def test_measuring_every_interval_comes_within_ten_percent(case: str) -> None:
+    """The carried error is right where a check stands for a few intervals of a period (the
+    pump at 250 Hz: 0.95 measured every interval, 1.08 as configured): what the sampling adds
+    is the weighting of the intervals a check stands for, not the linearised propagation or the
+    local errors it carries."""
     scene, samples = CASES[case][0]()
     rtol = min(CASES[case][1])
     ref = reference_run(scene, samples, 1_000_000)

@@ -37,6 +37,7 @@ def run(args: argparse.Namespace) -> int:
         REFINE,
         measure,
         reference_run,
+        resolution,
     )
     from mount_twin.commands.common import load_scene
     from mount_twin.io.input_samples import read_samples
@@ -53,6 +54,7 @@ def run(args: argparse.Namespace) -> int:
         file=sys.stderr,
     )
     ref = reference_run(scene, samples, args.max_substeps)
+    resolved = resolution(scene, samples, args.max_substeps, ref)
     rows = []
     for rtol in args.rtol or DEFAULT_RTOLS:
         print(f"  rtol {rtol:g} ...", file=sys.stderr, flush=True)
@@ -62,12 +64,20 @@ def run(args: argparse.Namespace) -> int:
         f"refined {REFINE}×, the gyro raw (the runs take it as the scene does: gyro_filter "
         f"{scene.input.gyro_filter})"
     )
+    print(
+        f"resolution: the reference differs from one on the input refined {REFINE + 1}× by "
+        f"{resolved.force_error:.2e} of the largest force, {resolved.attitude_error_rad:.2e} "
+        "rad of attitude"
+    )
     print(_table(rows))
+    unresolved = _unresolved(rows, resolved)
+    if unresolved:
+        print(unresolved)
     if args.csv:
         _write_csv(rows, args.csv)
         print(f"csv: {args.csv}")
     if args.plot:
-        _plot(rows, ref, args.plot, f"{scene.name} on {args.bag}")
+        _plot(rows, ref, resolved, args.plot, f"{scene.name} on {args.bag}")
         print(f"plot: {args.plot}")
     return 0
 
@@ -88,6 +98,29 @@ def _table(rows: list[Accuracy]) -> str:
             f"{r.estimate_cost:>7.2f}×"
         )
     return "\n".join(lines)
+
+
+def _unresolved(rows: list[Accuracy], resolved: Accuracy) -> str:
+    """A line naming the rtols whose force or attitude error is within RESOLVED times the
+    reference's resolution (not measured: at the reference's own error or round-off); ''
+    where none is."""
+    from mount_twin.analysis.accuracy import RESOLVED
+
+    named = [
+        f"{r.rtol:g} ({what})"
+        for r in rows
+        for what, err, floor in (
+            ("force", r.force_error, resolved.force_error),
+            ("attitude", r.attitude_error_rad, resolved.attitude_error_rad),
+        )
+        if err <= RESOLVED * floor
+    ]
+    if not named:
+        return ""
+    return (
+        f"not resolved (within {RESOLVED:g}× the reference's resolution: the error and its "
+        f"estimate are not compared there): rtol {', '.join(named)}"
+    )
 
 
 def _write_csv(rows: list[Accuracy], path: str) -> None:
@@ -118,7 +151,7 @@ def _label_levels(wall: list[float], close: float = 0.12) -> list[int]:
     return levels
 
 
-def _plot(rows: list[Accuracy], ref: Run, png: str, title: str) -> None:
+def _plot(rows: list[Accuracy], ref: Run, resolved: Accuracy, png: str, title: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -132,6 +165,8 @@ def _plot(rows: list[Accuracy], ref: Run, png: str, title: str) -> None:
         ax.loglog(wall, err, "o-", label=f"{label} error")
     est = [max(r.est_force_error, 1e-17) for r in rows]
     ax.loglog(wall, est, "x:", color="k", label="max mount force error, the twin's live estimate")
+    floor = max(resolved.force_error, 1e-17)
+    ax.axhline(floor, color="0.5", lw=1, ls="--", label="the reference's resolution (force)")
     for r, level in zip(rows, _label_levels(wall), strict=True):
         ax.annotate(
             f"rtol {r.rtol:.0e}" + (f", {r.failures} failures" if r.failures else ""),
@@ -144,7 +179,7 @@ def _plot(rows: list[Accuracy], ref: Run, png: str, title: str) -> None:
         max(getattr(r, n), 1e-17)
         for r in rows
         for n in ("force_error", "peak_force_error", "est_force_error")
-    ]
+    ] + [floor]
     ax.set_ylim(min(shown) / 3.0, max(shown) * 10.0)  # room for the labels inside the axes
     if max(wall) < 10.0 * min(wall):  # within a decade: plain labels, not 1.1×10⁻² crowding
         ax.xaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%.3g"))
