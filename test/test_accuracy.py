@@ -13,10 +13,12 @@ from io_helpers import CONFIG, ROOT
 from physics_helpers import base_scene, mount
 from scipy.integrate import solve_ivp
 
+from mount_twin.analysis import accuracy as accuracy_module
 from mount_twin.analysis.accuracy import NAN, Accuracy, compare, reference_run, run_at
 from mount_twin.cli import main
 from mount_twin.commands.accuracy import _unresolved
 from mount_twin.engine.batch import SampleBatch
+from mount_twin.errors import MountTwinError
 from mount_twin.scene.loader import scene_from_dict
 
 G = 9.80665
@@ -122,3 +124,24 @@ def test_errors_within_the_references_resolution_are_named_not_resolved() -> Non
 
 def _accuracy(rtol: float, force: float, attitude: float) -> Accuracy:
     return Accuracy(rtol, force, 0.0, attitude, 0.0, 0.0, 1.0, 0, NAN, NAN, NAN)
+
+
+def test_the_command_goes_on_where_the_second_reference_fails(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A reference on the other step grid that fails (a chattering law may fail on one grid and
+    not the other) leaves the resolution unmeasured, said so; the table is still the runs'."""
+
+    def fails(*args: object) -> None:
+        raise MountTwinError("no reference: the stepper failed at every reference tolerance")
+
+    monkeypatch.setattr(accuracy_module, "resolution", fails)
+    args = [
+        "accuracy",
+        str(CONFIG / "pump_8_mounts.scene.yaml"),
+        str(ROOT / "bags" / "ship_motion_1khz"),
+    ]
+    assert main([*args, "--rtol", "1e-3"]) == 0
+    out = capsys.readouterr().out
+    assert "resolution: not measured (the reference on the input refined 9×: no reference:" in out
+    assert "1e-03" in out

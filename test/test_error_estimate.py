@@ -151,7 +151,7 @@ def _pump(every: int = 1) -> tuple[Scene, SampleBatch]:
 
 
 CASES = {
-    "stiff_light": (_stiff_light, [1e-3, 1e-6]),
+    "stiff_light": (_stiff_light, [1e-3, 1e-6, 1e-7]),
     "stiff_light_rosenbrock": (partial(_stiff_light, "ros34pw2"), [1e-3, 1e-6, 1e-9]),
     "stiff_light_exponential": (partial(_stiff_light, "exprb32"), [1e-3]),
     "rubber_on_snubbers": (_rubber_on_snubbers, [1e-3, 1e-6]),
@@ -160,10 +160,12 @@ CASES = {
     "pump_250hz": (partial(_pump, 4), [1e-6]),
     "pump_100hz": (partial(_pump, 10), [1e-3]),
 }
-"""Each case's rtols are asserted within FACTOR, but UNRESOLVED's. The Rosenbrock's at 1e-3
-read 0.27 while its checks were Rosenbrock steps too (they damp the stiff modes as the twin
-does: 1.00 checked by the exponential method, `estimator.CHECKED_BY`). (Scenes with non-linear
-mounts take the companion, `engine.companion`.)"""
+"""Each case's rtols are asserted within FACTOR, but UNRESOLVED's. Dormand–Prince's at 1e-7 (17
+steps an interval, its modes unresolved at 1 kHz) read 2.84 under a fixed spacing for
+tolerance-bound steps (reverted at a2ce250); the period's share leaves it alone. The
+Rosenbrock's at 1e-3 read 0.27 while its checks were Rosenbrock steps too (they damp the stiff
+modes as the twin does: 1.00 checked by the exponential method, `estimator.CHECKED_BY`). (Scenes
+with non-linear mounts take the companion, `engine.companion`.)"""
 UNRESOLVED = ("stiff_light_exponential",)
 """Cases whose error is below what the reference resolves (`analysis.accuracy.resolution`):
 no truth to hold the estimate to (test below)."""

@@ -40,6 +40,7 @@ def run(args: argparse.Namespace) -> int:
         resolution,
     )
     from mount_twin.commands.common import load_scene
+    from mount_twin.errors import MountTwinError
     from mount_twin.io.input_samples import read_samples
 
     if args.plot:
@@ -54,7 +55,11 @@ def run(args: argparse.Namespace) -> int:
         file=sys.stderr,
     )
     ref = reference_run(scene, samples, args.max_substeps)
-    resolved = resolution(scene, samples, args.max_substeps, ref)
+    why = ""
+    try:
+        resolved: Accuracy | None = resolution(scene, samples, args.max_substeps, ref)
+    except MountTwinError as err:  # the second grid's reference failed where the first did not
+        resolved, why = None, str(err)
     rows = []
     for rtol in args.rtol or DEFAULT_RTOLS:
         print(f"  rtol {rtol:g} ...", file=sys.stderr, flush=True)
@@ -64,13 +69,18 @@ def run(args: argparse.Namespace) -> int:
         f"refined {REFINE}×, the gyro raw (the runs take it as the scene does: gyro_filter "
         f"{scene.input.gyro_filter})"
     )
-    print(
-        f"resolution: the reference differs from one on the input refined {REFINE + 1}× by "
-        f"{resolved.force_error:.2e} of the largest force, {resolved.attitude_error_rad:.2e} "
-        "rad of attitude"
-    )
+    if resolved is None:
+        print(
+            f"resolution: not measured (the reference on the input refined {REFINE + 1}×: {why})"
+        )
+    else:
+        print(
+            f"resolution: the reference differs from one on the input refined {REFINE + 1}× by "
+            f"{resolved.force_error:.2e} of the largest force, "
+            f"{resolved.attitude_error_rad:.2e} rad of attitude"
+        )
     print(_table(rows))
-    unresolved = _unresolved(rows, resolved)
+    unresolved = "" if resolved is None else _unresolved(rows, resolved)
     if unresolved:
         print(unresolved)
     if args.csv:
@@ -151,7 +161,7 @@ def _label_levels(wall: list[float], close: float = 0.12) -> list[int]:
     return levels
 
 
-def _plot(rows: list[Accuracy], ref: Run, resolved: Accuracy, png: str, title: str) -> None:
+def _plot(rows: list[Accuracy], ref: Run, resolved: Accuracy | None, png: str, title: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -165,8 +175,9 @@ def _plot(rows: list[Accuracy], ref: Run, resolved: Accuracy, png: str, title: s
         ax.loglog(wall, err, "o-", label=f"{label} error")
     est = [max(r.est_force_error, 1e-17) for r in rows]
     ax.loglog(wall, est, "x:", color="k", label="max mount force error, the twin's live estimate")
-    floor = max(resolved.force_error, 1e-17)
-    ax.axhline(floor, color="0.5", lw=1, ls="--", label="the reference's resolution (force)")
+    floors = [] if resolved is None else [max(resolved.force_error, 1e-17)]
+    for floor in floors:
+        ax.axhline(floor, color="0.5", lw=1, ls="--", label="the reference's resolution (force)")
     for r, level in zip(rows, _label_levels(wall), strict=True):
         ax.annotate(
             f"rtol {r.rtol:.0e}" + (f", {r.failures} failures" if r.failures else ""),
@@ -179,7 +190,7 @@ def _plot(rows: list[Accuracy], ref: Run, resolved: Accuracy, png: str, title: s
         max(getattr(r, n), 1e-17)
         for r in rows
         for n in ("force_error", "peak_force_error", "est_force_error")
-    ] + [floor]
+    ] + floors
     ax.set_ylim(min(shown) / 3.0, max(shown) * 10.0)  # room for the labels inside the axes
     if max(wall) < 10.0 * min(wall):  # within a decade: plain labels, not 1.1×10⁻² crowding
         ax.xaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%.3g"))
