@@ -303,12 +303,13 @@ inline bool solve_spd_n(M3 a, Vec b) {
   return true;
 }
 
-/// Solve a[:n, :n] x = b[:n] in place by Cholesky (n ≤ 2, as `cholesky_solve`; the lower
-/// triangle of a keeps its factor); false if a is not positive definite.
+/// Solve a[:n, :n] x = b[:n] in place by Cholesky (n of 1 or 2, as `cholesky_solve`; the lower
+/// triangle of a keeps its factor); false if a is not positive definite, or for any other n
+/// (three free rotations take `chart_accelerations`: a call with 3 is a mistake, and fails).
 inline bool solve_spd(M3 a, Vec b, idx n) {
   if (n == 2) return solve_spd_n<2>(a, b);
   if (n == 1) return solve_spd_n<1>(a, b);
-  return true;
+  return false;
 }
 
 /// With all three rotations free, the projected Euler equations Bᵀ·(I·(B·x + a) − m) = 0
