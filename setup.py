@@ -64,7 +64,7 @@ CORE = Extension(
     language="c++",
     # the sources' fingerprint: `mount_twin._core` refuses a build older than src/core
     define_macros=[("MT_SOURCE_SHA256", f'"{core_sources.fingerprint()}"')],
-    # -O2 without -ffast-math and without fused multiply-adds: IEEE arithmetic in the order
+    # -O3 without -ffast-math and without fused multiply-adds: IEEE arithmetic in the order
     # written, the same bits on every machine; no -march: the wheel runs on any x86-64/arm64.
     extra_compile_args=[
         "-std=c++17",
