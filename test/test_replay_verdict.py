@@ -176,3 +176,16 @@ def test_peak_force_and_displacement_are_one_definition_in_json_report_and_sweep
     assert row["max_cg_displacement_from_start_m"] == pytest.approx(moved, rel=1e-9)
     for mount, value in peak.items():
         assert row[f"peak_force_magnitude_N.{mount}"] == pytest.approx(value, rel=1e-9)
+
+
+def test_the_worst_mount_status_over_a_replay_reads_the_runs_peak_utilisation(
+    tmp_path: Path,
+) -> None:
+    """Of a mount's statuses at one level, the worst over the run is the period of its largest
+    utilisation: the summary's peak, not the first period's (the pump's front mounts peak
+    later in the record than its first period)."""
+    code, doc, _ = _replay(tmp_path, PUMP, ROOT / "bags" / "ship_motion_1khz")
+    assert code == 0
+    for mount, figures in doc["mounts"].items():
+        worst = doc["diagnostics_worst"][f"mount_twin: mount {mount}"]
+        assert worst == {"level": "OK", "message": f"utilisation {figures['utilisation_max']:.3g}"}

@@ -25,6 +25,8 @@ INTEGRATION = f"{PREFIX}: integration"
 
 PEAK_KEYS = tuple(f"peak_{axis}" for axis in ("fx_N", "fy_N", "fz_N", "tx_Nm", "ty_Nm", "tz_Nm"))
 """A mount status' keys of its peak wrench components in this period (N, N·m, mount axes)."""
+UTILISATION_KEY = "utilisation_max"
+"""A mount status' key of its largest utilisation in this period ("n/a": none rated)."""
 HOLE = 1.5
 """A stamp interval longer than HOLE nominal intervals is a hole: samples were lost."""
 LOST_ERROR = 0.01
@@ -401,7 +403,7 @@ class HealthWindow:
             else:
                 level = OK
             values = {key: f"{v:.6g}" for key, v in zip(PEAK_KEYS, peak, strict=True)}
-            values["utilisation_max"] = "n/a" if math.isnan(u) else f"{u:.4g}"
+            values[UTILISATION_KEY] = "n/a" if math.isnan(u) else f"{u:.4g}"
             values["now"] = ", ".join(name for name, _ in now) or "none"
             text = _events_text(mine, u, self.origin_s)
             if now:
