@@ -33,7 +33,13 @@ from mount_twin.engine.batch import (
     OutputBatch,
 )
 from mount_twin.engine.estimate import ErrorEstimate
-from mount_twin.engine.health import INTEGRATION, UTILISATION_KEY, tilt_from_quaternions
+from mount_twin.engine.health import (
+    EVENTS_KEY,
+    INTEGRATION,
+    NOW_KEY,
+    UTILISATION_KEY,
+    tilt_from_quaternions,
+)
 from mount_twin.errors import BagError, DamagedBagError
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import (
@@ -255,11 +261,11 @@ class ReplaySummary:
 
 
 def _keep_worst(worst: dict[str, HealthStatus], report: HealthReport) -> None:
-    """Keep, per status name, the status of the highest level seen: of a mount's, the one of
-    that level with the largest utilisation (so the worst over the run reads the summary's peak
-    utilisation), else the first; of the integration status the latest: its estimated error is
-    that of the run so far (`health.estimate_warning`), so the worst over the run is the
-    summary's `error_estimate`."""
+    """Keep, per status name, the first status of the highest level seen, except: of a mount's
+    periods at that level that report only their utilisation (no event, no condition), the one
+    of the largest (so it reads the summary's peak utilisation); of the integration status the
+    latest: its estimated error is that of the run so far (`health.estimate_warning`), so the
+    worst over the run is the summary's `error_estimate`."""
     for status in report.statuses:
         kept = worst.get(status.name)
         if kept is None or _outranks(status, kept):
@@ -267,15 +273,23 @@ def _keep_worst(worst: dict[str, HealthStatus], report: HealthReport) -> None:
 
 
 def _outranks(status: HealthStatus, kept: HealthStatus) -> bool:
-    """Whether `status` replaces `kept`, of the same name, as its worst: a higher level; at the
-    same level, the integration status's latest, a mount's of a larger utilisation."""
+    """Whether `status` replaces `kept`, of the same name, as its worst (`_keep_worst`)."""
     if status.level != kept.level:
         return status.level > kept.level
-    return status.name == INTEGRATION or _utilisation(status) > _utilisation(kept)
+    if status.name == INTEGRATION:
+        return True
+    quiet = _utilisation_only(status) and _utilisation_only(kept)
+    return quiet and _utilisation(status) > _utilisation(kept)
+
+
+def _utilisation_only(status: HealthStatus) -> bool:
+    """Whether a mount's status reports its utilisation alone: no event, no condition."""
+    values = status.values
+    return values.get(EVENTS_KEY) == "0" and values.get(NOW_KEY) == "none"
 
 
 def _utilisation(status: HealthStatus) -> float:
-    """A mount status' utilisation over its period; −inf for other statuses and unrated mounts."""
+    """A mount status' utilisation over its period; −inf where unrated."""
     value = status.values.get(UTILISATION_KEY, "n/a")
     return -np.inf if value == "n/a" else float(value)
 

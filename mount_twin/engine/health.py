@@ -27,6 +27,10 @@ PEAK_KEYS = tuple(f"peak_{axis}" for axis in ("fx_N", "fy_N", "fz_N", "tx_Nm", "
 """A mount status' keys of its peak wrench components in this period (N, N·m, mount axes)."""
 UTILISATION_KEY = "utilisation_max"
 """A mount status' key of its largest utilisation in this period ("n/a": none rated)."""
+EVENTS_KEY = "events"
+"""A mount status' key of the number of its events in this period."""
+NOW_KEY = "now"
+"""A mount status' key of the conditions holding at the report ("none": none)."""
 HOLE = 1.5
 """A stamp interval longer than HOLE nominal intervals is a hole: samples were lost."""
 LOST_ERROR = 0.01
@@ -404,10 +408,11 @@ class HealthWindow:
                 level = OK
             values = {key: f"{v:.6g}" for key, v in zip(PEAK_KEYS, peak, strict=True)}
             values[UTILISATION_KEY] = "n/a" if math.isnan(u) else f"{u:.4g}"
-            values["now"] = ", ".join(name for name, _ in now) or "none"
+            values[EVENTS_KEY] = str(len(mine))
+            values[NOW_KEY] = ", ".join(name for name, _ in now) or "none"
             text = _events_text(mine, u, self.origin_s)
             if now:
-                text = f"now: {values['now']}" + ("" if text == "ok" else f"; {text}")
+                text = f"now: {values[NOW_KEY]}" + ("" if text == "ok" else f"; {text}")
             out.append(HealthStatus(f"{PREFIX}: mount {mount.name}", level, text, values))
         return out
 
