@@ -2,7 +2,7 @@
 
     python3 bench/bench_engine.py [--repeats 7]
 
-For the pump under ship motion (1 kHz, 10 s) and the bolted, keyed genset under its shock
+For the pump under ship motion (1 kHz, 5 s) and the bolted, keyed genset under its shock
 (10 kHz, 0.25 s): the bag's samples decoded once, then pushed in one batch into fresh engines
 of the scene as it is configured (gyro filter, `auto`, rtol 1e-6), without and with the live
 error estimate, and without it with `gyro_filter: none` (the cost of the shipped gyro filter);
