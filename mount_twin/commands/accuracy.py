@@ -195,7 +195,7 @@ def _plot(rows: list[Accuracy], ref: Run, resolved: Accuracy | None, png: str, t
     if max(wall) < 10.0 * min(wall):  # within a decade: plain labels, not 1.1×10⁻² crowding
         ax.xaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%.3g"))
         ax.xaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%.3g"))
-        ax.tick_params(axis="x", which="minor", labelsize=7)
+        ax.tick_params(axis="x", which="both", labelsize=7)  # major and minor alike
     ax.set_xlabel("engine wall time per simulated second [s/s]")
     ax.set_ylabel(f"relative error against rtol {ref.rtol:.0e} [-]")
     ax.set_title(f"work-precision: {title}", fontsize=9)
