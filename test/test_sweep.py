@@ -14,6 +14,7 @@ from mount_twin.cli import main
 from mount_twin.errors import SceneError
 from mount_twin.scene.loader import read_scene_yaml
 from mount_twin.sweeps.cases import apply, check
+from mount_twin.sweeps.plot import plot_sweep, trade_off
 from mount_twin.sweeps.runner import FAILED, columns, read_results, run_case, run_sweep
 from mount_twin.sweeps.spec import load_sweep
 
@@ -191,3 +192,33 @@ def test_the_command_reports_and_exits_5_when_a_case_failed(
     out = capsys.readouterr().out
     assert "verdicts:" in out and "FAILED" in out and "highest peak mount force" in out
     assert rows() == before + 4  # the 4 failed cases rerun, their rows appended
+
+
+def test_the_plot_draws_each_inputs_largest_force_and_utilisation_in_the_sweeps_order(
+    swept, tmp_path: Path
+) -> None:
+    """One line per input in the sweep file's order (the bag, then `dhs`), its points by the
+    first varied value: the largest of the mounts' peak forces (kN) and utilisations in the
+    results table; the failed cases (negative mass) left out."""
+    pytest.importorskip("matplotlib")
+    spec, results, _ = swept
+    rows = read_results(results)
+    lines = trade_off(rows, spec)
+    assert list(lines) == ["half_sine_shock_10khz body.mass=1100.0", "dhs body.mass=1100.0"]
+    names = [m["name"] for m in spec.base["mounts"]]
+    for label, points in lines.items():
+        done = sorted(
+            (r for r in rows if label.startswith(r["input"] + " ") and r["verdict"] != FAILED),
+            key=lambda r: r["mounts[*].stiffness (scale)"],
+        )
+        assert (
+            [p[0] for p in points]
+            == [0.5, 2.0]
+            == [r["mounts[*].stiffness (scale)"] for r in done]
+        )
+        for p, r in zip(points, done, strict=True):
+            assert p[1] == max(r[f"peak_force_magnitude_N.{n}"] for n in names) * 1e-3
+            assert p[2] == max(r[f"utilisation.{n}"] for n in names) > 0.0
+            assert p[3] == r["verdict"]
+    png = plot_sweep(rows, spec, tmp_path / "sweep.png")
+    assert png.stat().st_size > 10_000

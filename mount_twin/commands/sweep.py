@@ -21,7 +21,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--plot",
         metavar="PNG",
-        help="largest peak mount force against the first varied value, one line per input",
+        help="largest peak mount force and largest utilisation against the first varied value, "
+        "one line per input",
     )
     parser.add_argument("--no-progress", action="store_true")
 

@@ -1,43 +1,88 @@
-"""The trade-off of a sweep: the largest peak mount force of each case against the first varied
-value, one line per input (and per value of the other variations)."""
+"""The trade-off of a sweep: the largest peak mount force and the largest utilisation of each
+case against the first varied value, one line per input (and per value of the other
+variations), in the sweep's order."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
-from mount_twin.sweeps.runner import FAILED, columns, largest_peak_force
+from mount_twin.sweeps.runner import FAILED, columns, largest_peak_force, largest_utilisation
 from mount_twin.sweeps.spec import SweepSpec
+
+MARKS = {"OK": "o", "WARN": "s", "ERROR": "v"}
+"""A case's marker by its verdict."""
+
+
+Point = tuple[float, float, float, str]
+"""A case on a line: the first varied value, its largest peak mount force (kN), its largest
+utilisation (NaN: no mount rated) and its verdict."""
+
+
+def trade_off(rows: list[dict[str, Any]], spec: SweepSpec) -> dict[str, list[Point]]:
+    """The plot's lines: per input (in the sweep file's order) and values of the other
+    variations (in their order), its cases by the first varied value; FAILED cases left out."""
+    varied = columns(spec)[2 : 2 + len(spec.variations)]
+    names = [m["name"] for m in spec.base["mounts"]]
+    order = {c.name: i for i, c in enumerate(spec.inputs)}
+
+    def line_key(r: dict[str, Any]) -> tuple:
+        others = tuple(_sortable(r[k]) for k in varied[1:])
+        return (order.get(r["input"], len(order)), str(r["input"]), *others)
+
+    lines: dict[str, list[Point]] = {}
+    for r in sorted(rows, key=line_key):
+        if r["verdict"] == FAILED or not varied:
+            continue
+        label = " ".join([r["input"], *(f"{k}={r[k]}" for k in varied[1:])])
+        lines.setdefault(label, []).append(
+            (
+                float(r[varied[0]]),
+                largest_peak_force(r, names) * 1e-3,
+                largest_utilisation(r, names),
+                r["verdict"],
+            )
+        )
+    for points in lines.values():
+        points.sort()
+    return lines
+
+
+def _sortable(value: Any) -> tuple[int, float, str]:
+    """A varied value as a sort key: numbers by value, before anything else by its text."""
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return (0, float(value), "")
+    return (1, 0.0, str(value))
 
 
 def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> Path:
-    """Write the plot; FAILED cases are left out."""
+    """Write the plot of `trade_off`: the force above, the utilisation below (its limit, 1,
+    dashed; that panel only where a mount is rated)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    lines = trade_off(rows, spec)
+    rated = any(not math.isnan(p[2]) for points in lines.values() for p in points)
+    fig, axes = plt.subplots(2 if rated else 1, 1, figsize=(8, 8 if rated else 5), sharex=True)
+    panels = list(axes) if rated else [axes]
+    for label, points in lines.items():
+        for ax, column in zip(panels, (1, 2), strict=False):
+            line = ax.plot([p[0] for p in points], [p[column] for p in points], label=label)[0]
+            for p in points:
+                ax.plot(p[0], p[column], MARKS.get(p[3], "x"), color=line.get_color())
+    if rated:
+        panels[1].axhline(1.0, color="0.4", lw=1, ls="--")
+    ylabels = ("largest peak mount force [kN]", "largest utilisation [-]")
+    for ax, ylabel in zip(panels, ylabels, strict=False):
+        ax.set_ylabel(ylabel)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7)
     varied = columns(spec)[2 : 2 + len(spec.variations)]
-    names = [m["name"] for m in spec.base["mounts"]]
-    lines: dict[str, list[tuple[float, float, str]]] = {}
-    for r in rows:
-        if r["verdict"] == FAILED or not varied:
-            continue
-        label = " ".join([r["input"], *(f"{k}={r[k]}" for k in varied[1:])])
-        peak = largest_peak_force(r, names)
-        lines.setdefault(label, []).append((float(r[varied[0]]), peak, r["verdict"]))
-    fig, ax = plt.subplots(figsize=(8, 5))
-    marks = {"OK": "o", "WARN": "s", "ERROR": "v"}
-    for label, points in sorted(lines.items()):
-        points.sort()
-        line = ax.plot([p[0] for p in points], [p[1] * 1e-3 for p in points], label=label)[0]
-        for x, y, verdict in points:
-            ax.plot(x, y * 1e-3, marks.get(verdict, "x"), color=line.get_color())
-    ax.set_xlabel(varied[0] if varied else "case")
-    ax.set_ylabel("largest peak mount force [kN]")
-    ax.set_title(f"{Path(spec.source).name}: markers o OK, s WARN, v ERROR", fontsize=9)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7)
+    panels[-1].set_xlabel(varied[0] if varied else "case")
+    panels[0].set_title(f"{Path(spec.source).name}: markers o OK, s WARN, v ERROR", fontsize=9)
     fig.tight_layout()
     out = Path(png)
     fig.savefig(out, dpi=110)

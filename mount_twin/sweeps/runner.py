@@ -38,6 +38,8 @@ from mount_twin.sweeps.cases import Case, apply, expand
 from mount_twin.sweeps.cluster import dask_client, results_as_completed
 from mount_twin.sweeps.spec import InputCase, SweepSpec
 
+UTILISATION = "utilisation"
+"""The result table's per-mount utilisation columns are UTILISATION.<mount> (NaN: unrated)."""
 BATCHES_PER_WORKER = 4
 """Tasks per worker a sweep is cut into: few enough to share the scheduling cost, enough to
 balance the load and to report progress."""
@@ -53,7 +55,7 @@ def columns(spec: SweepSpec) -> list[str]:
         "verdict",
         "error",
         *(f"{PEAK_FORCE}.{n}" for n in names),
-        *(f"utilisation.{n}" for n in names),
+        *(f"{UTILISATION}.{n}" for n in names),
         "events",
         "first_event",
         "first_event_s",
@@ -140,7 +142,7 @@ def _figures(scene: Scene, samples: SampleBatch) -> dict[str, Any]:
     }
     for i, m in enumerate(scene.mounts):
         row[f"{PEAK_FORCE}.{m.name}"] = float(force[i]) if force is not None else math.nan
-        row[f"utilisation.{m.name}"] = util.get(m.name, math.nan)
+        row[f"{UTILISATION}.{m.name}"] = util.get(m.name, math.nan)
     return row
 
 
@@ -255,6 +257,12 @@ def _column_type(cells: list[str]) -> Callable[[str], Any]:
 def largest_peak_force(row: dict[str, Any], mounts: list[str]) -> float:
     """The largest of a row's peak mount forces |F| (N)."""
     return max(float(row[f"{PEAK_FORCE}.{n}"]) for n in mounts)
+
+
+def largest_utilisation(row: dict[str, Any], mounts: list[str]) -> float:
+    """The largest of a row's mount utilisations (NaN where no mount is rated)."""
+    rated = [u for u in (float(row[f"{UTILISATION}.{n}"]) for n in mounts) if not math.isnan(u)]
+    return max(rated, default=math.nan)
 
 
 def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
