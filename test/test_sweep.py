@@ -191,6 +191,17 @@ def test_the_command_reports_and_exits_5_when_a_case_failed(
     assert code == 5
     out = capsys.readouterr().out
     assert "verdicts:" in out and "FAILED" in out and "highest peak mount force" in out
+    # per input, the case of the lowest largest utilisation, from the table's own columns
+    names = [m["name"] for m in spec.base["mounts"]]
+    done = [r for r in read_results(results) if r["verdict"] != FAILED]
+    assert "lowest largest utilisation, per input:" in out
+    for name in ("half_sine_shock_10khz", "dhs"):
+        best = min(
+            (r for r in done if r["input"] == name),
+            key=lambda r: max(r[f"utilisation.{n}"] for n in names),
+        )
+        value = max(best[f"utilisation.{n}"] for n in names)
+        assert f"  {name}: {value:.3g}, case {best['case']} (" in out, name
     assert rows() == before + 4  # the 4 failed cases rerun, their rows appended
 
 

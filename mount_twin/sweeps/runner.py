@@ -266,7 +266,8 @@ def largest_utilisation(row: dict[str, Any], mounts: list[str]) -> float:
 
 
 def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
-    """The verdict counts, and the cases of the lowest and highest peak mount force."""
+    """The verdict counts, the cases of the lowest and highest peak mount force, and per input
+    the case whose largest mount utilisation is lowest (the design that input favours)."""
     rows = list(rows)
     names = [m["name"] for m in spec.base["mounts"]]
     varied = columns(spec)[2 : 2 + len(spec.variations)]
@@ -286,6 +287,23 @@ def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
                 f"{label} peak mount force: {peak(r):.4g} N, case {r['case']} "
                 f"({r['input']}; {setting}) {r['verdict']}"
             )
+
+        def utilisation(r: dict[str, Any]) -> float:
+            return largest_utilisation(r, names)
+
+        best = []
+        for case in spec.inputs:
+            mine = [r for r in done if r["input"] == case.name]
+            rated = [r for r in mine if not math.isnan(utilisation(r))]
+            if rated:
+                r = min(rated, key=utilisation)
+                setting = ", ".join(f"{k} = {r[k]}" for k in varied)
+                best.append(
+                    f"  {case.name}: {utilisation(r):.3g}, case {r['case']} ({setting}) "
+                    f"{r['verdict']}"
+                )
+        if best:
+            lines += ["lowest largest utilisation, per input:", *best]
     return "\n".join(lines)
 
 
