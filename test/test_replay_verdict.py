@@ -91,7 +91,8 @@ def test_a_sweep_case_whose_integration_fails_is_a_failed_row_out_of_the_extreme
     assert good["verdict"] != FAILED and good["error"] == ""
     text = summary(rows, spec)
     assert f"{FAILED} 1" in text
-    assert text.count(good["case"]) == 2 and bad["case"] not in text
+    # the good case is the lowest and the highest force and its input's lowest utilisation
+    assert text.count(good["case"]) == 3 and bad["case"] not in text
 
 
 def test_a_replay_that_accepted_nothing_says_so_at_error_in_its_summary_and_bag(
