@@ -165,6 +165,11 @@ def test_peak_force_and_displacement_are_one_definition_in_json_report_and_sweep
     assert f"max_cg_displacement_from_start_m (CG): {moved:.6g}" in html
     for mount, value in peak.items():
         assert f"<td>{mount}</td><td></td><td>{value:.4g}</td>" in html
+        # its utilisation, from the bag's diagnostics, as the summary's to the digits shown
+        # (the genset's key_y, 0.51451, read back from four digits as 0.5145, showed 0.514)
+        u = doc["mounts"][mount]["utilisation_max"]
+        cells = rf"<td>{mount}</td>(<td>[^<]*</td>){{3}}<td>{u:.3g}</td>"
+        assert u is not None and re.search(cells, html), (mount, u)
 
     sweep = tmp_path / "sweep.yaml"
     sweep.write_text(

@@ -407,7 +407,7 @@ class HealthWindow:
             else:
                 level = OK
             values = {key: f"{v:.6g}" for key, v in zip(PEAK_KEYS, peak, strict=True)}
-            values[UTILISATION_KEY] = "n/a" if math.isnan(u) else f"{u:.4g}"
+            values[UTILISATION_KEY] = "n/a" if math.isnan(u) else f"{u:.6g}"
             values[EVENTS_KEY] = str(len(mine))
             values[NOW_KEY] = ", ".join(name for name, _ in now) or "none"
             text = _events_text(mine, u, self.origin_s)
