@@ -386,7 +386,7 @@ def _draw_utilisation(
             np.r_[0.0, t],
             np.r_[u[0], u],
             where="pre",
-            label=f"{name} ({kinds.get(name, '?')})",
+            label=f"{name} ({kinds[name]})" if name in kinds else name,  # kinds: with a scene
         )
     ax.axhline(1.0, color="red", linestyle="--", label="rated (1)")
     ax.set_ylabel("peak utilisation per diagnostics period [-]")
