@@ -145,3 +145,20 @@ def test_a_design_needs_the_input(genset_run, capsys: pytest.CaptureFixture[str]
     table = Path(__file__).parent / "data"  # any path: refused before it is read
     assert main(["report", str(out), "--design", str(table / "none.csv")]) == 2
     assert "--design judges the input's spectra: it needs --input" in capsys.readouterr().err
+
+
+def test_with_its_scene_the_report_lists_the_mounts_in_the_scenes_order(tmp_path: Path) -> None:
+    """The pump's scene names ml1, mr1, ml2, mr2 in that order (the replay's summary's); the
+    bag's topics sort ml1, ml2, mr1, mr2, the order without the scene."""
+    pump = CONFIG / "pump_8_mounts.scene.yaml"
+    out = tmp_path / "out"
+    replay(load_scene_file(pump), ROOT / "bags" / "ship_motion_1khz", out, progress=False)
+    order = {}
+    for label, extra in (("scene", ["--scene", str(pump)]), ("bag", [])):
+        page = tmp_path / f"{label}.html"
+        assert main(["report", str(out), *extra, "-o", str(page)]) == 0
+        table = page.read_text(encoding="utf-8").split("Peaks (largest")[1].split("</table>")[0]
+        order[label] = re.findall(r"<tr><td>([^<]+)</td>", table)
+    scene = [m.name for m in load_scene_file(pump).mounts]
+    assert order["scene"] == scene == ["fl", "fr", "ml1", "mr1", "ml2", "mr2", "rl", "rr"]
+    assert order["bag"] == sorted(scene)

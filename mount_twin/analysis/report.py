@@ -256,6 +256,8 @@ def write_report(
     events = events_of(diagnostics, origin) if diagnostics else []
     utilisation = utilisation_of(diagnostics) if diagnostics else {}
     kinds = {m.name: m.kind for m in scene.mounts} if scene else {}
+    if scene:  # the scene's order, as the replay's summary has them (else the bag's topics')
+        mounts = {m.name: mounts[m.name] for m in scene.mounts if m.name in mounts} | mounts
     title = f"{scene.name if scene else 'mount_twin'} — {Path(output_bag).name}"
     if input_name:
         title += f" (input {input_name})"
