@@ -41,6 +41,15 @@ inline int give_up(idx steps, double max_steps, bool too_small, bool not_finite,
 
 /// The step (s) to try from t toward the interval's end t1 (the proposal h, at most h_max),
 /// and whether it is the interval's last (then it ends exactly at t1).
+/// The step h from t as the time grid holds it, (t + h) − t (exact): the state then advances
+/// by the span the time does, and an interval's steps add up to it to the bit. Taken as h, a
+/// step whose end t + h rounds (by up to half an ulp of t: 1.1e-16 s at 1 s of stamps) moves
+/// the state a little more or less than the time; the estimator's checks, two or more such
+/// steps against the twin's one, measured that rounding times the state's rate as local error
+/// (the pump at 10 kHz under a half-sine shock: 34× its true error of 1e-13, checked at every
+/// interval; more with more check steps).
+inline double on_grid(double t, double h) { return (t + h) - t; }
+
 struct Trial {
   double step;
   bool last;
@@ -48,7 +57,7 @@ struct Trial {
 inline Trial trial_step(double t, double t1, double h, double h_max, double span) {
   const double step = py_min(h, h_max);
   const bool last = t + step >= t1 - 1e-12 * span;
-  return {last ? t1 - t : step, last};
+  return {last ? t1 - t : on_grid(t, step), last};
 }
 
 /// The proposal after an accepted step: from a full step, not from a last step clipped to the

@@ -81,8 +81,8 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
     const double count = py_max(
         1.0, static_cast<double>(static_cast<std::int64_t>(
                  std::ceil(rest / py_min(h, h_max) * (1.0 - 1e-12)))));
-    const double step = rest / count;
     const bool last = count == 1.0;
+    const double step = last ? rest : on_grid(t, rest / count);
     bool ok = true;
     if (std::fabs(step - settings[PHI_STEP]) > PHI_REUSE * step) {
       bool halved = false;
