@@ -114,6 +114,13 @@ def _record(scene: Scene, t: np.ndarray, accel: np.ndarray) -> tuple[Scene, Samp
     return raw_gyro(scene), SampleBatch(t, accel, np.zeros_like(accel), frames)
 
 
+def _half_sine_record(scene: Scene) -> tuple[Scene, SampleBatch]:
+    """`_record` of a 30 g, 5 ms vertical half-sine (30 % of it fore-aft) at 10 kHz, 0.2 s."""
+    t = 1.0 + np.arange(2001) / 10_000.0
+    pulse = np.where((t > 1.02) & (t < 1.025), 30 * G * np.sin(math.pi * (t - 1.02) / 0.005), 0.0)
+    return _record(scene, t, np.column_stack([0.3 * pulse, np.zeros_like(t), G + pulse]))
+
+
 def _rubber_on_snubbers() -> tuple[Scene, SampleBatch]:
     """200 kg on four hysteretic elastomers that hit their snubbers (3 mm gap, Hertzian
     contact) under a 30 g, 5 ms half-sine at 10 kHz: non-smooth in the state (|ẋ| of
@@ -123,9 +130,7 @@ def _rubber_on_snubbers() -> tuple[Scene, SampleBatch]:
         ([1e5, 1e5, 2e5], [300.0, 300.0, 500.0]),
         {"gap": 3e-3, "stiffness": 1e9, "exponent": 1.5, "axes": ["z"]},
     )
-    t = 1.0 + np.arange(2001) / 10_000.0
-    pulse = np.where((t > 1.02) & (t < 1.025), 30 * G * np.sin(math.pi * (t - 1.02) / 0.005), 0.0)
-    return _record(scene, t, np.column_stack([0.3 * pulse, np.zeros_like(t), G + pulse]))
+    return _half_sine_record(scene)
 
 
 def _hysteresis_snubbers_real_shock() -> tuple[Scene, SampleBatch]:
@@ -157,10 +162,7 @@ def _pump_half_sine() -> tuple[Scene, SampleBatch]:
     s an interval, read as local error made the estimate 28× the true error (34× checked at
     every interval, 155× with four steps a check) until steps were taken as the grid holds
     them (`control.hpp` on_grid)."""
-    t = 1.0 + np.arange(2001) / 10_000.0
-    pulse = np.where((t > 1.02) & (t < 1.025), 30 * G * np.sin(math.pi * (t - 1.02) / 0.005), 0.0)
-    accel = np.column_stack([0.3 * pulse, np.zeros_like(t), G + pulse])
-    return _record(default_scene(), t, accel)
+    return _half_sine_record(default_scene())
 
 
 CASES = {

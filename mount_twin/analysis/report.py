@@ -26,7 +26,7 @@ from mount_twin.analysis.figures import (
 from mount_twin.analysis.html_page import digest, page, png, produced_by, scene_section
 from mount_twin.analysis.html_page import table as html_table
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
-from mount_twin.engine.health import INTEGRATION
+from mount_twin.engine.health import INTEGRATION, UTILISATION_KEY
 from mount_twin.errors import ModelError
 from mount_twin.io.messages import WRENCHES_OUTPUT
 from mount_twin.io.output_tables import Event, Table, events_of, read_output_bag
@@ -44,7 +44,7 @@ def utilisation_of(diagnostics: Table) -> dict[str, tuple[np.ndarray, np.ndarray
     series: dict[str, tuple[list[float], list[float]]] = {}
     c = diagnostics.columns
     for t, status, values in zip(c["t_s"], c["status"], c["values"], strict=True):
-        u = json.loads(values).get("utilisation_max", "n/a")
+        u = json.loads(values).get(UTILISATION_KEY, "n/a")
         if status.startswith("mount_twin: mount ") and u != "n/a":
             times, utils = series.setdefault(status.removeprefix("mount_twin: mount "), ([], []))
             times.append(float(t))

@@ -281,11 +281,13 @@ def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
         def peak(r: dict[str, Any]) -> float:
             return largest_peak_force(r, names)
 
+        def setting(r: dict[str, Any]) -> str:
+            return ", ".join(f"{k} = {r[k]}" for k in varied)
+
         for label, r in (("lowest", min(done, key=peak)), ("highest", max(done, key=peak))):
-            setting = ", ".join(f"{k} = {r[k]}" for k in varied)
             lines.append(
                 f"{label} peak mount force: {peak(r):.4g} N, case {r['case']} "
-                f"({r['input']}; {setting}) {r['verdict']}"
+                f"({r['input']}; {setting(r)}) {r['verdict']}"
             )
 
         def utilisation(r: dict[str, Any]) -> float:
@@ -293,13 +295,11 @@ def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
 
         best = []
         for case in spec.inputs:
-            mine = [r for r in done if r["input"] == case.name]
-            rated = [r for r in mine if not math.isnan(utilisation(r))]
+            rated = [r for r in done if r["input"] == case.name and not math.isnan(utilisation(r))]
             if rated:
                 r = min(rated, key=utilisation)
-                setting = ", ".join(f"{k} = {r[k]}" for k in varied)
                 best.append(
-                    f"  {case.name}: {utilisation(r):.3g}, case {r['case']} ({setting}) "
+                    f"  {case.name}: {utilisation(r):.3g}, case {r['case']} ({setting(r)}) "
                     f"{r['verdict']}"
                 )
         if best:

@@ -124,7 +124,8 @@ void bind_engine(py::module_& mod) {
   mod.attr("ESTIMATOR_SLOTS") = py::make_tuple(
       int(engine::CHECK_EVERY), int(engine::LINEARISE_EVERY), int(engine::JACOBIAN_KEEP),
       int(engine::PENDING), int(engine::PENDING_NORM),
-      int(engine::PROPAGATOR_STEP), int(engine::FASTEST_RATE), int(engine::ERROR_NORM_MEAN), int(engine::SINCE_LINEARISED),
+      int(engine::PROPAGATOR_STEP), int(engine::FASTEST_RATE), int(engine::ERROR_NORM_MEAN),
+      int(engine::SINCE_LINEARISED),
       int(engine::N_CARRIED), int(engine::CHECKS), int(engine::LINEARISATIONS),
       int(engine::EXPONENTIALS), int(engine::BORROWED), int(engine::N_ESTIMATOR_SLOTS));
   mod.attr("ENGAGED_CHECK_EVERY") = engine::ENGAGED_CHECK_EVERY;

@@ -39,17 +39,17 @@ inline int give_up(idx steps, double max_steps, bool too_small, bool not_finite,
   return SUCCESS;
 }
 
-/// The step (s) to try from t toward the interval's end t1 (the proposal h, at most h_max),
-/// and whether it is the interval's last (then it ends exactly at t1).
 /// The step h from t as the time grid holds it, (t + h) − t (exact): the state then advances
 /// by the span the time does, and an interval's steps add up to it to the bit. Taken as h, a
-/// step whose end t + h rounds (by up to half an ulp of t: 1.1e-16 s at 1 s of stamps) moves
-/// the state a little more or less than the time; the estimator's checks, two or more such
-/// steps against the twin's one, measured that rounding times the state's rate as local error
-/// (the pump at 10 kHz under a half-sine shock: 34× its true error of 1e-13, checked at every
-/// interval; more with more check steps).
+/// step whose end t + h rounds (by up to half an ulp of t: 1.1e-16 s at 1 s of the engine's
+/// time) moves the state a little more or less than the time; the estimator's checks, two or
+/// more such steps against the twin's one, measured that rounding times the state's rate as
+/// local error (the pump at 10 kHz under a half-sine shock: 34× its true error of 1e-13,
+/// checked at every interval; more with more check steps).
 inline double on_grid(double t, double h) { return (t + h) - t; }
 
+/// The step (s) to try from t toward the interval's end t1 (the proposal h, at most h_max),
+/// and whether it is the interval's last (then it ends exactly at t1).
 struct Trial {
   double step;
   bool last;
