@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from io_helpers import DATA_DIR, SCENE_FILE, read_bag, stamp_ns
+from io_helpers import DATA_DIR, ROOT, SCENE_FILE, read_bag, stamp_ns
 from rosbags.highlevel import AnyReader
 
 from mount_twin.cli import main
@@ -154,6 +154,30 @@ def test_import_csv_with_a_wrong_header_exits_2_naming_the_file(
     err = capsys.readouterr().err
     assert f"{csv}: row 1: no column for ax, ay, az: the header has time, a1, a2, a3" in err
     assert not (tmp_path / "bag").exists()
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["generate", "ship-motion", "--duration", "0.01"],
+        ["import-csv", "config/sample_shock.csv"],
+    ],
+    ids=lambda c: c[0],
+)
+def test_a_bag_writer_refuses_an_existing_output_with_exit_2_and_leaves_it(
+    tmp_path: Path, command: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """generate and import-csv, like replay: a clear error, not rosbags' traceback
+    (exit 1), and the existing bag as it was."""
+    out = tmp_path / "bag"
+    assert main(["generate", "ship-motion", "-o", str(out), "--duration", "0.01"]) == 0
+    before = {f.name: f.read_bytes() for f in out.iterdir()}
+    capsys.readouterr()
+    args = [a if not a.startswith("config/") else str(ROOT / a) for a in command]
+    assert main([*args, "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("mount-twin: error: ") and f"{out}" in err and "exists" in err
+    assert {f.name: f.read_bytes() for f in out.iterdir()} == before
 
 
 def test_import_csv_of_a_missing_file_exits_2(

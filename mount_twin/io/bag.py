@@ -531,8 +531,9 @@ def write_bag(
     messages: Iterator[tuple[int, bytes]],
     storage: str = "mcap",
 ) -> int:
-    """Write one topic's (stamp ns, CDR bytes) messages into a new bag; return the count. A
-    failed write (a full disk) names the bag."""
+    """Write one topic's (stamp ns, CDR bytes) messages into a new bag; return the count. An
+    existing `path` (`check_new_bag`) and a failed write (a full disk) name the bag."""
+    check_new_bag(path)
     plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
     n = 0
     try:
