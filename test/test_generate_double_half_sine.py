@@ -51,9 +51,19 @@ def test_without_the_new_options_the_half_sine_is_unchanged() -> None:
     assert (plain.accel[:, :2] == 0.0).all() and plain.accel[:, 2].min() == G
 
 
-def test_a_negative_rebound_is_refused() -> None:
-    with pytest.raises(ValueError, match="rebound must be ≥ 0"):
-        half_sine_shock(rebound=-1.0)
+@pytest.mark.parametrize(
+    ("shape", "refused"),
+    [
+        ({"rebound": -1.0}, "rebound must be ≥ 0"),
+        ({"duration": 0.0}, "pulse duration must be > 0 s"),  # NaN samples, written
+        ({"duration": -0.005}, "pulse duration must be > 0 s"),
+        ({"peak": math.nan}, "peak must be finite"),
+        ({"peak": -100.0, "rebound": 50.0}, "> 0 with a rebound"),  # the rebound fell away
+    ],
+)
+def test_a_pulse_that_is_no_pulse_is_refused(shape: dict[str, float], refused: str) -> None:
+    with pytest.raises(ValueError, match=refused):
+        half_sine_shock(**shape)
 
 
 def test_generate_writes_the_double_half_sine_and_rejects_a_negative_rebound(
@@ -71,6 +81,18 @@ def test_generate_writes_the_double_half_sine_and_rejects_a_negative_rebound(
     capsys.readouterr()
     assert main([*args, "--rebound", "-5", "-o", str(tmp_path / "bad")]) == 2
     assert "rebound must be ≥ 0" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("kind", ["half-sine", "ship-motion"])
+@pytest.mark.parametrize("option", ["--rate", "--duration"])
+def test_generate_refuses_a_zero_rate_or_duration_rather_than_taking_the_default(
+    tmp_path: Path, kind: str, option: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--rate 0` wrote 4000 samples at 10 kHz: 0 read as not given."""
+    out = tmp_path / "bag"
+    assert main(["generate", kind, "-o", str(out), option, "0"]) == 2
+    assert "mount-twin: error: " in capsys.readouterr().err
+    assert not out.exists()
 
 
 def test_the_bundled_genset_bag_is_what_the_documented_command_writes(tmp_path: Path) -> None:

@@ -50,6 +50,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def _given(value: float | None, default: float) -> float:
+    """The option's value where given (0 too: refused by the signal, not replaced), else the
+    kind's default."""
+    return default if value is None else value
+
+
 def run(args: argparse.Namespace) -> int:
     from mount_twin.commands.common import write_signal
     from mount_twin.io.signals import half_sine_shock, ship_motion
@@ -58,13 +64,13 @@ def run(args: argparse.Namespace) -> int:
         sig = half_sine_shock(
             peak=args.peak,
             duration=args.pulse,
-            rate_hz=args.rate or 10000.0,
-            total=args.duration or 0.4,
+            rate_hz=_given(args.rate, 10000.0),
+            total=_given(args.duration, 0.4),
             lateral=args.lateral,
             rebound=args.rebound,
         )
     else:
-        sig = ship_motion(rate_hz=args.rate or 1000.0, total=args.duration or 5.0)
+        sig = ship_motion(rate_hz=_given(args.rate, 1000.0), total=_given(args.duration, 5.0))
     n = write_signal(sig, args.output, args.topic, args.frame_id, args.start, args.storage)
     print(f"wrote {n} sensor_msgs/msg/Imu messages on {args.topic} to {args.output}")
     return 0

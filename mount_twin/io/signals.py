@@ -65,7 +65,15 @@ def half_sine_shock(
         lateral: share of a(t) along +y of F, −; rebound: peak of the downward half-sine, m/s²
             (0: none).
     """
-    if rebound < 0.0:
+    if not 0.0 < duration < math.inf:
+        msg = f"pulse duration must be > 0 s and finite, got {duration!r}"
+        raise ValueError(msg)
+    if not math.isfinite(peak) or (rebound > 0.0 and not peak > 0.0):
+        msg = (
+            f"peak must be finite, and > 0 with a rebound (it undoes an upward kick), got {peak!r}"
+        )
+        raise ValueError(msg)
+    if not 0.0 <= rebound < math.inf:
         msg = f"rebound must be ≥ 0 (the peak of a downward pulse), got {rebound!r} m/s²"
         raise ValueError(msg)
     t = _sample_times(rate_hz, total)
