@@ -145,3 +145,22 @@ def test_the_command_goes_on_where_the_second_reference_fails(
     out = capsys.readouterr().out
     assert "resolution: not measured (the reference on the input refined 9×: no reference:" in out
     assert "1e-03" in out
+
+
+@pytest.mark.parametrize(
+    ("option", "named"),
+    [
+        (
+            ["--rtol", "0"],
+            "--rtol: 0.0 is outside [1e-13, 0.1]",
+        ),  # the core's "bad stepper settings"
+        (["--rtol", "1e-3", "0.5"], "--rtol: 0.5 is outside"),
+        (["--max-substeps", "0"], "--max-substeps: must be ≥ 1, got 0"),
+    ],
+)
+def test_the_command_refuses_a_setting_no_run_takes_naming_the_option(
+    option: list[str], named: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag = str(ROOT / "bags" / "ship_motion_1khz")
+    assert main(["accuracy", str(CONFIG / "pump_8_mounts.scene.yaml"), bag, *option]) == 2
+    assert f"mount-twin: error: {named}" in capsys.readouterr().err

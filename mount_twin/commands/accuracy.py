@@ -42,7 +42,16 @@ def run(args: argparse.Namespace) -> int:
     from mount_twin.commands.common import load_scene
     from mount_twin.errors import MountTwinError
     from mount_twin.io.input_samples import read_samples
+    from mount_twin.scene.description import RTOL_RANGE
 
+    lo, hi = RTOL_RANGE
+    for rtol in args.rtol or ():
+        if not lo <= rtol <= hi:
+            msg = f"--rtol: {rtol!r} is outside [{lo:g}, {hi:g}] (integration.rtol's range)"
+            raise ValueError(msg)
+    if args.max_substeps < 1:
+        msg = f"--max-substeps: must be ≥ 1, got {args.max_substeps}"
+        raise ValueError(msg)
     if args.plot:
         from mount_twin.commands.extras import require
 

@@ -160,6 +160,11 @@ class InitialState:
     tilt_tolerance_rad: float = 0.35
 
 
+RTOL_RANGE = (1.0e-13, 0.1)
+"""The relative tolerances a stepper is given (integration.rtol, `accuracy --rtol`): tighter
+is round-off, looser no error control."""
+
+
 @dataclass(frozen=True)
 class Integration:
     """Stepper settings: method name (or "auto", see `integrate.methods.choose`), relative and

@@ -17,6 +17,7 @@ from mount_twin.scene.checks import check_scene
 from mount_twin.scene.description import (
     DOF_NAMES,
     GYRO_FILTERS,
+    RTOL_RANGE,
     SENSOR_AXES,
     Ageing,
     Body,
@@ -362,7 +363,7 @@ def _integration(r: Reader) -> Integration:
     d = Integration()
     spec = Integration(
         method=r.choice("method", STEPPERS, d.method),
-        rtol=r.number("rtol", d.rtol, lo=1.0e-13, hi=0.1),
+        rtol=r.number("rtol", d.rtol, lo=RTOL_RANGE[0], hi=RTOL_RANGE[1]),
         atol=r.positive("atol", d.atol),
         max_substeps=r.integer("max_substeps", d.max_substeps, lo=1),
         error_estimate=r.boolean("error_estimate", d.error_estimate),
