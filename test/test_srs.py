@@ -7,7 +7,6 @@ import csv
 import json
 import math
 import re
-import time
 from pathlib import Path
 
 import numpy as np
@@ -176,13 +175,6 @@ def test_octave_spacing() -> None:
     np.testing.assert_allclose(f, 10.0 * 2.0 ** (np.arange(10) / 3), rtol=1e-15)
     with pytest.raises(ValueError, match="f_min ≤ f_max"):
         octave_frequencies(100.0, 10.0)
-
-
-def test_ten_seconds_at_10_khz_and_a_hundred_frequencies_take_well_under_a_second() -> None:
-    a = np.random.default_rng(0).normal(size=100_000)
-    start = time.perf_counter()
-    srs(a, 10_000.0, np.geomspace(10.0, 1000.0, 100))
-    assert time.perf_counter() - start < 1.0  # 0.05 s measured
 
 
 def _rows(path: Path) -> list[dict[str, str]]:
