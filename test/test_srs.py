@@ -286,6 +286,16 @@ def test_a_bag_with_several_imu_topics_needs_topic(
     assert "no Imu/AccelStamped topic /nope" in capsys.readouterr().err
 
 
+def test_an_fmax_of_0_is_refused_not_read_as_the_default(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--fmax 0` gave the spectrum up to the default (0.1 of the rate) with exit 0."""
+    out = tmp_path / "s.csv"
+    assert main(["srs", str(GENSET), "--fmax", "0", "--csv", str(out)]) == 2
+    assert "0 < f_min ≤ f_max" in capsys.readouterr().err
+    assert not out.exists()
+
+
 def test_a_recorder_csv_in_g_is_read_and_what_is_no_sampled_signal_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -210,7 +210,8 @@ def _frequencies(args: argparse.Namespace, rate_hz: float) -> np.ndarray:
 
     if args.freqs:
         return np.array(args.freqs)
-    return octave_frequencies(args.fmin, args.fmax or ACCURATE_SHARE * rate_hz, args.octave)
+    fmax = ACCURATE_SHARE * rate_hz if args.fmax is None else args.fmax  # 0 is refused
+    return octave_frequencies(args.fmin, fmax, args.octave)
 
 
 def _spectrum_columns(spectra: dict[str, Spectrum], unit: str) -> list[Column]:
