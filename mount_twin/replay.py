@@ -422,8 +422,12 @@ def replay(
 
     With a body_sensor, its IMU (body_sensor.topic of `body_path`, else of the input bag if it
     has it) is compared with the twin as the node compares it live (`TwinStream.process_body`):
-    it is fed after each input chunk up to that chunk's last stamp.
+    it is fed after each input chunk up to that chunk's last stamp. A `chunk` below 1 message
+    is a ValueError, before anything is opened (0 had looped for ever on empty chunks).
     """
+    if chunk < 1:
+        msg = f"chunk: must be ≥ 1 message, got {chunk}"
+        raise ValueError(msg)
     bag, stream = _open(scene, input_path, output_path, checkpoint)
     try:
         body_bag = _body_bag(scene, input_path, body_path)

@@ -41,6 +41,12 @@ def test_help_answers_without_importing_numerics(args: tuple[str, ...]) -> None:
         (("bogus",), "invalid choice: 'bogus'"),
         (("replay", "in_bag"), "the following arguments are required: --scene, -o/--output"),
         (("generate", "half-sine", "-o", "x", "--rate", "fast"), "invalid float value: 'fast'"),
+        # counts below 1: `replay --chunk 0` looped for ever, `qualify --workers -1` hung
+        (("replay", "b", "--scene", "s", "-o", "o", "--chunk", "0"), "--chunk: must be ≥ 1"),
+        (("qualify", "s", "--plan", "p", "-o", "o", "--workers", "-1"), "--workers: must be ≥ 1"),
+        (("sweep", "s", "-o", "o", "--workers", "0"), "--workers: must be ≥ 1, got 0"),
+        (("accuracy", "s", "b", "--max-substeps", "0"), "--max-substeps: must be ≥ 1, got 0"),
+        (("build-tf2-msgs", "--jobs", "x"), "--jobs/-j: 'x' is not an integer"),
     ],
 )
 def test_an_argument_error_exits_2_without_importing_numerics(

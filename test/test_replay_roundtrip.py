@@ -324,3 +324,12 @@ def test_replay_plot_of_a_run_without_mount_events_is_drawn(
     args = ["replay", str(bags["in_mcap"]), "--scene", str(scene), "-o", str(tmp_path / "out")]
     assert main([*args, "--no-progress", "--plot", str(png)]) == 0
     assert png.stat().st_size > 10_000
+
+
+def test_a_chunk_below_one_message_is_refused_before_anything_is_opened(
+    bags: dict[str, Path], tmp_path: Path
+) -> None:
+    """0 had looped for ever on empty chunks (the command line refuses it at parse)."""
+    with pytest.raises(ValueError, match="chunk: must be ≥ 1 message, got 0"):
+        replay(_scene(), bags["in_mcap"], tmp_path / "out", chunk=0, progress=False)
+    assert not (tmp_path / "out").exists()

@@ -14,6 +14,7 @@ from mount_twin.cli import main
 from mount_twin.errors import SceneError
 from mount_twin.scene.loader import read_scene_yaml
 from mount_twin.sweeps.cases import apply, check
+from mount_twin.sweeps.cluster import dask_client
 from mount_twin.sweeps.plot import plot_sweep, trade_off
 from mount_twin.sweeps.runner import FAILED, columns, read_results, run_case, run_sweep
 from mount_twin.sweeps.spec import load_sweep
@@ -233,3 +234,13 @@ def test_the_plot_draws_each_inputs_largest_force_and_utilisation_in_the_sweeps_
             assert p[3] == r["verdict"]
     png = plot_sweep(rows, spec, tmp_path / "sweep.png")
     assert png.stat().st_size > 10_000
+
+
+def test_a_cluster_of_fewer_than_one_worker_is_refused_at_once() -> None:
+    """A LocalCluster of −1 workers waited for ever (`qualify --workers -1` hung)."""
+    for workers in (0, -1):
+        with (
+            pytest.raises(ValueError, match=f"workers: must be ≥ 1, got {workers}"),
+            dask_client(workers=workers),
+        ):
+            pytest.fail("a cluster came up")

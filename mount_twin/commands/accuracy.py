@@ -8,6 +8,8 @@ import sys
 from itertools import pairwise
 from typing import TYPE_CHECKING
 
+from mount_twin.commands.common import positive_int
+
 if TYPE_CHECKING:
     from mount_twin.analysis.accuracy import Accuracy, Run
 
@@ -25,7 +27,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="relative tolerances to measure (default: 1e-3 to 1e-8; atol = rtol·1e-3)",
     )
     parser.add_argument(
-        "--max-substeps", type=int, default=100_000, help="per input interval (default: 100000)"
+        "--max-substeps",
+        type=positive_int,
+        default=100_000,
+        help="per input interval (default: 100000)",
     )
     parser.add_argument("--csv", metavar="FILE", help="write the table as CSV")
     parser.add_argument("--plot", metavar="PNG", help="work-precision diagram (the plot extra)")
@@ -49,9 +54,6 @@ def run(args: argparse.Namespace) -> int:
         if not lo <= rtol <= hi:
             msg = f"--rtol: {rtol!r} is outside [{lo:g}, {hi:g}] (integration.rtol's range)"
             raise ValueError(msg)
-    if args.max_substeps < 1:
-        msg = f"--max-substeps: must be ≥ 1, got {args.max_substeps}"
-        raise ValueError(msg)
     if args.plot:
         from mount_twin.commands.extras import require
 

@@ -12,6 +12,8 @@ import argparse
 import time
 from pathlib import Path
 
+from mount_twin.commands.common import positive_int
+
 NAME = "build-tf2-msgs"
 HELP = "build tf2_msgs from registry wheels so the pip-installed node publishes /tf (ROS has it)"
 
@@ -23,7 +25,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="where to build and install (default: share/mount_twin/tf2_msgs in this Python "
         "environment: the build is tied to its Python and geometry_msgs)",
     )
-    parser.add_argument("--jobs", "-j", type=int, help="parallel compile jobs (default: cores)")
+    parser.add_argument(
+        "--jobs", "-j", type=positive_int, help="parallel compile jobs (default: cores)"
+    )
     parser.add_argument("--force", action="store_true", help="rebuild even if up to date")
 
 

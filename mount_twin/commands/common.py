@@ -3,6 +3,7 @@ what is implausible in it, writing a signal as a bag."""
 
 from __future__ import annotations
 
+import argparse
 import sys
 from collections.abc import Mapping
 from itertools import pairwise
@@ -17,6 +18,21 @@ if TYPE_CHECKING:
 
 DEFAULT_SCENE = "pump_8_mounts.scene.yaml"
 DEFAULT_BAG = "ship_motion_1khz"
+
+
+def positive_int(text: str) -> int:
+    """argparse type of a count (workers, jobs, messages, substeps): an integer ≥ 1. A 0 or a
+    negative one is refused at parse, naming the option (exit 2): `replay --chunk 0` had looped
+    for ever, `qualify --workers -1` hung, `sweep --workers 0` meant one per core."""
+    try:
+        value = int(text)
+    except ValueError:
+        msg = f"{text!r} is not an integer"
+        raise argparse.ArgumentTypeError(msg) from None
+    if value < 1:
+        msg = f"must be ≥ 1, got {value}"
+        raise argparse.ArgumentTypeError(msg)
+    return value
 
 
 def share_dir() -> Path:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING
 
+from mount_twin.commands.common import positive_int
 from mount_twin.commands.synthesize import add_synthesis_arguments
 
 if TYPE_CHECKING:
@@ -43,7 +44,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--report", metavar="HTML", help="a report to hand over, one file")
     parser.add_argument(
         "--workers",
-        type=int,
+        type=positive_int,
         help="local Dask workers (default: one per core, at most one per input; 1: no cluster)",
     )
     parser.add_argument("--scheduler", help="a Dask scheduler's address (bags on shared disk)")

@@ -8,6 +8,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from mount_twin.commands.common import positive_int
+
 if TYPE_CHECKING:
     from mount_twin.replay import ReplaySummary
 
@@ -49,7 +51,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--frame-id",
         help="expected header.frame_id, '' for any (default: the scene's input.frame_id)",
     )
-    parser.add_argument("--chunk", type=int, default=2000, help="messages per engine batch")
+    parser.add_argument(
+        "--chunk", type=positive_int, default=2000, help="messages per engine batch"
+    )
     parser.add_argument("--no-progress", action="store_true")
     add_plot_argument(parser)
     parser.add_argument("--json", metavar="FILE", help="also write the summary as JSON")

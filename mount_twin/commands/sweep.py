@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from mount_twin.commands.common import positive_int
+
 NAME = "sweep"
 HELP = "run a design sweep (scene variants × inputs) on a local or remote Dask cluster"
 
@@ -15,7 +17,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--scheduler", help="Dask scheduler address (default: a local cluster)")
     parser.add_argument(
-        "--workers", type=int, help="local cluster worker processes (default: one per core)"
+        "--workers",
+        type=positive_int,
+        help="local cluster worker processes (default: one per core)",
     )
     parser.add_argument("--parquet", metavar="FILE", help="also write the table as Parquet")
     parser.add_argument(

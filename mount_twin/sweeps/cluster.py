@@ -11,12 +11,16 @@ from typing import Any
 @contextmanager
 def dask_client(scheduler: str | None = None, workers: int | None = None) -> Iterator[Any]:
     """A `dask.distributed.Client` of the scheduler at `scheduler`, or of a local cluster of
-    `workers` processes, one thread each (default one per core), closed afterwards."""
+    `workers` processes, one thread each (default one per core), closed afterwards. Fewer
+    than one worker is a ValueError (a LocalCluster of −1 workers waits for ever)."""
+    if workers is not None and workers < 1:
+        msg = f"workers: must be ≥ 1, got {workers}"
+        raise ValueError(msg)
     from dask.distributed import Client, LocalCluster
 
     cluster = None
     if scheduler is None:
-        n = workers or os.cpu_count() or 1
+        n = (os.cpu_count() or 1) if workers is None else workers
         cluster = LocalCluster(
             n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
         )
