@@ -249,6 +249,17 @@ def test_a_resting_imu_has_a_null_spectrum_once_gravity_is_taken_out(tmp_path: P
         assert max(float(v) for r in rows for k, v in r.items() if k != "frequency_hz") < 1e-12
 
 
+def test_a_head_as_long_as_the_record_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Its mean would be the shock's own: `--head 100` on 1 s took out the whole record's mean,
+    exit 0, titled "the mean of the first 2000 samples"."""
+    bag = _resting_bag(tmp_path / "rest", np.array([0.0, 0.0, G]))
+    assert main(["srs", str(bag), "--head", "100", "--freqs", "10"]) == 2
+    assert "--head 100 s: the whole record (0.9995 s)" in capsys.readouterr().err
+    assert main(["srs", str(bag), "--head", "0.5", "--freqs", "10"]) == 0
+
+
 def test_gravity_left_in_is_a_step_at_the_start(tmp_path: Path) -> None:
     """--gravity none: 1 g from rest is a step, whose absolute acceleration response is
     1 − e^(−ζωt)(cos ω_d t − ζω/ω_d sin ω_d t) (in g); its peak, 1.85 at ζ = 0.05."""
