@@ -10,7 +10,7 @@ import pytest
 from scipy.integrate import cumulative_trapezoid
 
 from mount_twin.analysis.srs import octave_frequencies, srs
-from mount_twin.analysis.synthesis import G, synthesize, wavelets
+from mount_twin.analysis.synthesis import G, imu_record, synthesize, wavelets
 from mount_twin.cli import main
 
 DESIGN = ([10.0, 100.0, 300.0, 1000.0], [2.0, 20.0, 60.0, 60.0])
@@ -56,6 +56,14 @@ def test_seeds_give_different_histories_of_one_spectrum() -> None:
 def test_a_design_past_a_tenth_of_the_rate_is_refused() -> None:
     with pytest.raises(ValueError, match="a rate of at least 10000 Hz is needed"):
         synthesize(*DESIGN, 5000.0)
+
+
+def test_a_record_past_max_samples_is_refused_before_it_is_allocated() -> None:
+    """`synthesize --head 1e9` died in numpy's MemoryError (437 TiB), exit 1."""
+    shock = synthesize(*DESIGN, 20_000.0, seed=0)
+    with pytest.raises(ValueError, match=r"more than a generated signal may have \(MAX_SAMPLES"):
+        imu_record(shock, 20_000.0, "z", 1e9)
+    assert imu_record(shock, 20_000.0, "z", 0.05).t.shape[0] == 1000 + shock.t.shape[0]
 
 
 def test_synthesized_bags_pass_srs_against_the_design(

@@ -24,7 +24,7 @@ import numpy as np
 
 from mount_twin.analysis.design_margin import TOLERANCE_DB, DesignCheck, check_design
 from mount_twin.analysis.srs import octave_frequencies, srs
-from mount_twin.io.signals import Signal
+from mount_twin.io.signals import MAX_SAMPLES, Signal
 from mount_twin.scene.description import STANDARD_GRAVITY as G
 
 CLOSE_DB = 0.5
@@ -129,9 +129,16 @@ def synthesize(
 
 def imu_record(shock: Synthesis, rate_hz: float, axis: str, head_s: float) -> Signal:
     """The shock as an Imu at rest reads it: +g on z throughout, `head_s` of rest first (the
-    start checks, the SRS's gravity head), then the shock along the sensor's `axis`."""
+    start checks, the SRS's gravity head), then the shock along the sensor's `axis`. At most
+    MAX_SAMPLES samples, as any generated signal (ValueError)."""
     head = round(head_s * rate_hz)
     n = head + shock.t.shape[0]
+    if n > MAX_SAMPLES:
+        msg = (
+            f"{head_s:g} s of rest and {shock.t[-1]:.3g} s of shock at {rate_hz:g} Hz: {n:.4g} "
+            f"samples, more than a generated signal may have (MAX_SAMPLES, {MAX_SAMPLES})"
+        )
+        raise ValueError(msg)
     accel = np.zeros((n, 3))
     accel[:, 2] = G
     accel[head:, "xyz".index(axis)] += shock.accel
