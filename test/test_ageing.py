@@ -4,6 +4,7 @@ not before."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -15,8 +16,9 @@ from scipy.signal import butter, sosfiltfilt
 from mount_twin import load_scene_file
 from mount_twin.analysis import calibration as cal_mod
 from mount_twin.cli import main
+from mount_twin.errors import SceneError
 from mount_twin.io.signals import Signal, ship_motion
-from mount_twin.scene.loader import read_scene_yaml
+from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
 
 RATE, TOTAL, CHANGE = 200.0, 92.5, 45.0
 
@@ -92,3 +94,43 @@ def test_groups_of_mounts_are_tracked_apart(
     for group in groups:
         value = float(after.split(f"{group} ×")[1].split()[0])
         assert value == pytest.approx(0.7, rel=0.02), group
+
+
+@pytest.mark.parametrize(
+    ("options", "says"),
+    [
+        # 92.5 s of records: no 100 s window after the lead (an empty table, exit 0, before)
+        (["--window", "100"], "the records hold 90.5 s after the 2 s lead: less than one window"),
+        (["--window", "0"], "window 0 s: give more than 4 s"),  # 0 read as not given, before
+        (["--warn", "1.2", "0.8"], "warn band [1.2, 0.8]: expected 0 ≤ low < high"),
+        (["--warn", "0.9", "1.1", "--error", "0.95", "1.05"], "must hold the warn band"),
+    ],
+)
+def test_a_window_or_band_no_judgement_can_take_is_refused(
+    ageing_pair: tuple[Path, Signal, Signal],
+    options: list[str],
+    says: str,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    d, _, _ = ageing_pair
+    files = ["--foundation", str(d / "foundation.csv"), "--body", str(d / "body.csv")]
+    assert main(["track", str(d / "pump.scene.yaml"), *files, *options]) == 2
+    assert says in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("bands", "says"),
+    [
+        ({"warn": [0.9, 1.1], "error": [0.95, 1.05]}, "ageing.error: [0.95, 1.05] must hold"),
+        ({"warn": [1.2, 0.8]}, "ageing.warn: [1.2, 0.8]: expected low < high"),
+    ],
+)
+def test_a_scenes_ageing_bands_are_refused_at_load_naming_the_key(
+    bands: dict[str, list[float]], says: str
+) -> None:
+    """The same rule as the command's (`ageing_bands_problem`), with the key path."""
+    data = read_scene_yaml(ROOT / "config/pump_8_mounts.scene.yaml")
+    data["body_sensor"] = {"position": [0.8, 0.3, 1.0]}
+    data["ageing"] = bands
+    with pytest.raises(SceneError, match=re.escape(says)):
+        scene_from_dict(data, "pump")

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 from mount_twin.analysis.calibration import calibrate, is_scale
 from mount_twin.io.signals import Signal
-from mount_twin.scene.description import Scene
+from mount_twin.scene.description import Scene, ageing_bands_problem
 
 LEAD_S = 2.0
 """Each window's records start this much earlier: the twin's start transient settles there,
@@ -29,6 +29,12 @@ class Band:
 
     warn: tuple[float, float] = (0.85, 1.15)
     error: tuple[float, float] = (0.75, 1.25)
+
+    def __post_init__(self) -> None:
+        """ValueError for bands no judgement can take (`ageing_bands_problem`: the scene
+        loader refuses the same in a scene's ageing section, naming the key)."""
+        if problem := ageing_bands_problem(self.warn, self.error):
+            raise ValueError(problem)
 
 
 @dataclass(frozen=True)
@@ -97,6 +103,12 @@ def track(
         records = (_window(foundation, start - LEAD_S, end), _window(body, start, end))
         fits.append(fit_window(scene, records, (start, end), fit, band))
         start = end
+    if not fits:
+        msg = (
+            f"the records hold {max(stop - start, 0.0):.4g} s after the {LEAD_S:g} s lead: less "
+            f"than one window of {window_s:g} s (give a shorter one)"
+        )
+        raise ValueError(msg)
     return fits
 
 

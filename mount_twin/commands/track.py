@@ -51,7 +51,8 @@ def run(args: argparse.Namespace) -> int:
     ageing = scene.ageing or Ageing(window_s=30.0)
     band = Band(tuple(args.warn or ageing.warn), tuple(args.error or ageing.error))
     fit = tuple(args.fit or ageing.fit)
-    fits = track(scene, foundation, body, args.window or ageing.window_s, fit, band)
+    window = ageing.window_s if args.window is None else args.window  # 0 is refused
+    fits = track(scene, foundation, body, window, fit, band)
     print(f"{'window s':<19} level fit")
     print("\n".join(window_table(fits)))
     levels = {f.level for f in fits}

@@ -262,6 +262,17 @@ class BodySensor:
     axes: tuple[str, ...] = SENSOR_AXES
 
 
+def ageing_bands_problem(warn: tuple[float, float], error: tuple[float, float]) -> str | None:
+    """What is wrong with an ageing judgement's bands of scale factors (low, high), or None:
+    each must have 0 ≤ low < high, and `error` must hold `warn`."""
+    for name, (low, high) in (("warn", warn), ("error", error)):
+        if not 0.0 <= low < high:
+            return f"{name} band [{low:g}, {high:g}]: expected 0 ≤ low < high"
+    if not (error[0] <= warn[0] and warn[1] <= error[1]):
+        return f"{list(error)} must hold the warn band {list(warn)}"
+    return None
+
+
 @dataclass(frozen=True)
 class Ageing:
     """Live tracking of mounts that age: the calibration re-fitted window by window on the

@@ -32,6 +32,7 @@ from mount_twin.scene.description import (
     Scene,
     Vec3,
     Vec6,
+    ageing_bands_problem,
 )
 from mount_twin.scene.reader import Reader, Used, shown
 from mount_twin.scene.yaml_reading import SceneYamlError, load_yaml
@@ -445,8 +446,8 @@ def _ageing(r: Reader, mounts: tuple[Mount, ...]) -> Ageing:
                 or f"{shown(name)}: expected stiffness or damping (of all linear mounts), "
                 "or stiffness:A+B (damping:A+B) for a group",
             )
-    if not (ageing.error[0] <= ageing.warn[0] and ageing.warn[1] <= ageing.error[1]):
-        raise r.error("error", f"{list(ageing.error)} must hold the warn band {list(ageing.warn)}")
+    if problem := ageing_bands_problem(ageing.warn, ageing.error):
+        raise r.error("error", problem)
     r.finish()
     return ageing
 
