@@ -174,6 +174,15 @@ def test_a_group_naming_a_mount_the_scene_lacks_is_refused() -> None:
         )
 
 
+def test_records_that_do_not_overlap_on_one_clock_are_refused_saying_so() -> None:
+    """A body record from another run: scipy had said "`x_scale` must be 'jac' or array_like
+    with positive numbers", after numpy's warnings of a mean of nothing."""
+    foundation, body = _pair(_pump(), ship_motion(rate_hz=RATE, total=5.0), {})
+    later = Signal(body.t + 100.0, body.accel, body.gyro)
+    with pytest.raises(ValueError, match=r"has 0 samples within the foundation's .* one clock"):
+        cal_mod.calibrate(_pump(), foundation, later, ("stiffness",))
+
+
 def test_what_the_record_cannot_identify_is_refused_by_name() -> None:
     """Slow roll and heave alone (no vibration near the mounts' modes): the body follows the
     deck, and what moves the mounts' stiffness and damping in the fit is the foundation

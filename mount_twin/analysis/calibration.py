@@ -62,6 +62,9 @@ MAX_YAW_SIGMA_RAD = math.radians(2.0)
 EDGE_S = 0.25
 """Body samples this close to either end of the foundation record are left out of the fit."""
 
+MIN_OVERLAP = 10
+"""Body samples the fit needs within the foundation record (`EDGE_S` off each end) at least."""
+
 
 @dataclass(frozen=True)
 class Calibration:
@@ -220,6 +223,14 @@ class _Problem:
     def __init__(self, scene: Scene, foundation: Signal, body: Signal, free: list[str]) -> None:
         self.scene, self.foundation, self.free = scene, foundation, free
         keep = (body.t > foundation.t[0] + EDGE_S) & (body.t < foundation.t[-1] - EDGE_S)
+        if np.count_nonzero(keep) < MIN_OVERLAP:
+            msg = (
+                f"the body record ({body.t[0]:.6g} to {body.t[-1]:.6g} s) has "
+                f"{np.count_nonzero(keep)} samples within the foundation's ({foundation.t[0]:.6g} "
+                f"to {foundation.t[-1]:.6g} s, {EDGE_S:g} s off each end), fewer than "
+                f"{MIN_OVERLAP}: the two records must overlap on one clock"
+            )
+            raise ValueError(msg)
         self.t, self.measured = body.t[keep], body.accel[keep]
         self.scale = self.measured.std(axis=0) + 1e-12
 
