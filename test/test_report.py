@@ -162,3 +162,18 @@ def test_with_its_scene_the_report_lists_the_mounts_in_the_scenes_order(tmp_path
     scene = [m.name for m in load_scene_file(pump).mounts]
     assert order["scene"] == scene == ["fl", "fr", "ml1", "mr1", "ml2", "mr2", "rl", "rr"]
     assert order["bag"] == sorted(scene)
+
+
+def test_another_scenes_mounts_are_refused_naming_both(
+    genset_run, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The pump's scene on the genset's bag: its name, kinds, modes and scene table headed the
+    genset's numbers, exit 0."""
+    out, _ = genset_run
+    page = tmp_path / "wrong.html"
+    pump = CONFIG / "pump_8_mounts.scene.yaml"
+    assert main(["report", str(out), "--scene", str(pump), "-o", str(page)]) == 2
+    err = capsys.readouterr().err
+    assert "--scene pump_8_mounts: its mounts (fl, fr, ml1, mr1, ml2, mr2, rl, rr)" in err
+    assert "(foot_fl, foot_fr, foot_ml, foot_mr, foot_rl, foot_rr, key_x, key_y)" in err
+    assert not page.exists()

@@ -256,7 +256,9 @@ def write_report(
     events = events_of(diagnostics, origin) if diagnostics else []
     utilisation = utilisation_of(diagnostics) if diagnostics else {}
     kinds = {m.name: m.kind for m in scene.mounts} if scene else {}
-    if scene:  # the scene's order, as the replay's summary has them (else the bag's topics')
+    if scene:
+        _check_scene_is_the_bags(scene, set(mounts) or set(utilisation), output_bag)
+        # the scene's order, as the replay's summary has them (else the bag's topics')
         mounts = {m.name: mounts[m.name] for m in scene.mounts if m.name in mounts} | mounts
     title = f"{scene.name if scene else 'mount_twin'} — {Path(output_bag).name}"
     if input_name:
@@ -294,6 +296,18 @@ def write_report(
     out = Path(html_path)
     out.write_text(page(title, sections), encoding="utf-8")
     return out
+
+
+def _check_scene_is_the_bags(scene: Scene, in_bag: set[str], output_bag: str | Path) -> None:
+    """ValueError unless the bag's mounts (those it holds wrenches or statuses of) are the
+    scene's: another scene's name, kinds, modes and scene table would head the bag's numbers."""
+    names = [m.name for m in scene.mounts]
+    if in_bag and in_bag != set(names):
+        msg = (
+            f"--scene {scene.name}: its mounts ({', '.join(names)}) are not those of "
+            f"{output_bag} ({', '.join(sorted(in_bag))}): give the replay's own scene"
+        )
+        raise ValueError(msg)
 
 
 def _draw_response(
