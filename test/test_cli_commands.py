@@ -331,3 +331,32 @@ def test_water_entry_csv_imports_and_replays(
     assert pos.shape == (5000, 3) and np.isfinite(pos).all()
     disp = np.linalg.norm(pos - np.array(data["body"]["cg"]), axis=1).max()
     assert disp < 0.2, f"a 47 g, ms-long shock moved the CG by {disp} m"
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        "replay bags/ship_motion_1khz --scene config/pump_8_mounts.scene.yaml -o OUT --json X",
+        "demo -o OUT --plot X",
+        "accuracy config/pump_8_mounts.scene.yaml bags/ship_motion_1khz --csv X",
+        "sweep config/sweep_pump.yaml -o OUT --plot X",
+        "qualify config/genset_bolted_keyed.scene.yaml --plan config/qualify_genset.yaml -o OUT "
+        "--report X",
+    ],
+    ids=lambda c: c.split()[0],
+)
+def test_a_target_no_file_can_be_written_at_is_refused_before_the_work(
+    tmp_path: Path, command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A --json in a missing directory: the replay ran to its end, then exit 2 (its verdict's
+    exit status lost)."""
+    target = tmp_path / "missing" / "x"
+    out = tmp_path / "out"
+    args = [
+        {"X": str(target), "OUT": str(out)}.get(a, str(ROOT / a) if "/" in a else a)
+        for a in command.split()
+    ]
+    assert main(args) == 2
+    flag = command.split()[command.split().index("X") - 1]
+    assert f"mount-twin: error: {flag} {target}: there is no directory" in capsys.readouterr().err
+    assert not out.exists()

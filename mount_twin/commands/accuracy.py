@@ -44,7 +44,7 @@ def run(args: argparse.Namespace) -> int:
         reference_run,
         resolution,
     )
-    from mount_twin.commands.common import load_scene
+    from mount_twin.commands.common import check_targets, load_scene
     from mount_twin.errors import MountTwinError
     from mount_twin.io.input_samples import read_samples
     from mount_twin.scene.description import RTOL_RANGE
@@ -54,6 +54,7 @@ def run(args: argparse.Namespace) -> int:
         if not lo <= rtol <= hi:
             msg = f"--rtol: {rtol!r} is outside [{lo:g}, {hi:g}] (integration.rtol's range)"
             raise ValueError(msg)
+    check_targets(csv=args.csv, plot=args.plot)
     if args.plot:
         from mount_twin.commands.extras import require
 

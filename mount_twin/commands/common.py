@@ -47,6 +47,22 @@ def share_dir() -> Path:
     raise MountTwinError(msg)
 
 
+def check_targets(**targets: str | None) -> None:
+    """ValueError naming the option (`--json` for json=...) of the first given path a file
+    cannot be written at (its directory missing, or a directory there): checked before long
+    work, which had run to its end to fail there with exit 2, its own exit status lost."""
+    for option, path in targets.items():
+        if path is None:
+            continue
+        flag, target = "--" + option.replace("_", "-"), Path(path)
+        if target.is_dir():
+            msg = f"{flag} {path}: is a directory"
+            raise ValueError(msg)
+        if not target.parent.is_dir():
+            msg = f"{flag} {path}: there is no directory {target.parent}"
+            raise ValueError(msg)
+
+
 def load_scene(path: str | Path, input_overrides: Mapping[str, str] | None = None) -> Scene:
     """The scene file at `path`, with `input` fields replaced by `input_overrides` (checked like
     the file's own); each of its warnings (units? a message type's convention?) is printed on

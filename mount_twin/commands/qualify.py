@@ -167,8 +167,9 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from mount_twin.analysis.qualification import judge, verdict_text
-    from mount_twin.commands.common import load_scene
+    from mount_twin.commands.common import check_targets, load_scene
 
+    check_targets(json=args.json, report=args.report)
     plan = plan_of(args)
     load_scene(args.scene)  # a bad scene fails here, before anything is synthesised
     out = Path(args.output)

@@ -109,9 +109,10 @@ def replay_and_report(
     """Replay, print the summary (and plot), and return the exit status (see `verdict`).
     `input_overrides`: scene `input` fields replaced (topic, frame_id), checked like the
     scene's own."""
-    from mount_twin.commands.common import load_scene
+    from mount_twin.commands.common import check_targets, load_scene
     from mount_twin.replay import replay
 
+    check_targets(json=options.json_path, plot=options.plot)
     scene = load_scene(scene_path, input_overrides)
     from mount_twin.commands.stopping import checkpoint
 

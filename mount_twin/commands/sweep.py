@@ -32,8 +32,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from mount_twin.commands.common import check_targets
     from mount_twin.commands.extras import require
 
+    check_targets(plot=args.plot, parquet=args.parquet)
     require("dask.distributed", "mount-twin sweep")
     if args.plot:
         require("matplotlib", "--plot")
