@@ -223,10 +223,10 @@ class _Problem:
     def __init__(self, scene: Scene, foundation: Signal, body: Signal, free: list[str]) -> None:
         self.scene, self.foundation, self.free = scene, foundation, free
         keep = (body.t > foundation.t[0] + EDGE_S) & (body.t < foundation.t[-1] - EDGE_S)
-        if np.count_nonzero(keep) < MIN_OVERLAP:
+        if (overlap := int(np.count_nonzero(keep))) < MIN_OVERLAP:
             msg = (
                 f"the body record ({body.t[0]:.6g} to {body.t[-1]:.6g} s) has "
-                f"{np.count_nonzero(keep)} samples within the foundation's ({foundation.t[0]:.6g} "
+                f"{overlap} samples within the foundation's ({foundation.t[0]:.6g} "
                 f"to {foundation.t[-1]:.6g} s, {EDGE_S:g} s off each end), fewer than "
                 f"{MIN_OVERLAP}: the two records must overlap on one clock"
             )
