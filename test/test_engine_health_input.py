@@ -163,6 +163,21 @@ def test_holes_in_the_stamps_are_counted_as_lost() -> None:
     assert second.values["lost_in_period"] == "0" and second.values["lost_estimated"] == "8"
 
 
+def test_the_input_rate_is_the_inputs_own_over_its_stamps() -> None:
+    """rate_hz: the samples the window's stamp intervals lead into (rejected ones too: see the
+    stall test) over the intervals' sum. It read the accepted count over
+    the outputs' span, which the gyro delay shifts and which holds one interval fewer than
+    samples: 1040.5, 1001.0, ..., 964.3 Hz for the bundled 1 kHz bag."""
+    whole = [status(r).values["rate_hz"] for r in engine().push(batch(ramp(3500))).health]
+    assert whole == ["1000.0"] * 3  # 1000 intervals of 1 ms in each window (none into the start)
+    holes = [100, 300, 500, *range(700, 705)]  # 8 lost: 992 intervals over the same 1.000 s
+    cut = [
+        status(r).values["rate_hz"]
+        for r in engine().push(batch(without(ramp(2500), holes))).health
+    ]
+    assert cut == ["992.0", "1000.0"]
+
+
 def test_more_than_one_percent_lost_is_an_error() -> None:
     holes = [i for start in (100, 300, 500, 700) for i in range(start, start + 5)]  # 20 lost
     eng = engine()

@@ -202,6 +202,18 @@ class HealthWindow:
         beyond_span = np.rint(steps.sum() / nominal) - steps.shape[0] - skipped.sum()
         return int(min(missing, max(beyond_span, 0.0))), nominal
 
+    def _input_rate(self) -> float:
+        """Samples per second of input stamps in this window, as `ros2 topic hz` counts them:
+        the samples its stamp intervals lead into (those rejected within an interval too) over
+        the intervals' sum, a hole's included; NaN without intervals. Not the accepted count
+        over the outputs' span, which the gyro delay shifts and which holds one interval fewer
+        than samples: 1040.5, 1001.0 and 964.3 Hz for a 1 kHz input."""
+        if not self.steps:
+            return math.nan
+        total = float(np.concatenate(self.steps).sum())  # one array: any batching, one sum
+        samples = self.n_steps + sum(n for _, n in self.skipped)
+        return samples / total if total > 0.0 else math.nan
+
     def restart_cadence(self) -> None:
         """Make the next accepted sample start the report cadence afresh (after a stall)."""
         self._next_due = None
@@ -288,7 +300,7 @@ class HealthWindow:
         self._last_counts = counts.copy()
         span = self.t_last - self.t_first
         inp = self._input_status(
-            new, counts, span, lost_from_stamps, nominal_interval_s, stalled_s
+            new, counts, self._input_rate(), lost_from_stamps, nominal_interval_s, stalled_s
         )
         step = self._integration_status(counts, span)
         att = self._attitude_status()
@@ -420,7 +432,7 @@ class HealthWindow:
         self,
         new: Counter[str],
         counts: Counter[str],
-        span: float,
+        rate_hz: float,
         lost_from_stamps: int,
         nominal_s: float,
         stalled_s: float | None,
@@ -466,7 +478,7 @@ class HealthWindow:
             share = lost / (new["accepted"] + lost)
             level = max(level, ERROR if share > LOST_ERROR else WARN)
             parts.append(_lost_text(lost, share, lost_from_stamps, nominal_s, reported))
-        values = self._input_values(new, counts, span, lost, nominal_s, stalled_s)
+        values = self._input_values(counts, rate_hz, lost, nominal_s, stalled_s)
         return HealthStatus(f"{PREFIX}: input", level, "; ".join(parts) or "ok", values)
 
     def _stall_text(
@@ -512,20 +524,19 @@ class HealthWindow:
 
     def _input_values(
         self,
-        new: Counter[str],
         counts: Counter[str],
-        span: float,
+        rate_hz: float,
         lost: int,
         nominal_s: float,
         stalled_s: float | None,
     ) -> dict[str, str]:
-        """The input status' values: the topic, the rate of this window (`span`, s), the
+        """The input status' values: the topic, the rate of this window (`_input_rate`), the
         cumulative counts, the samples `lost` in this window at the nominal interval
         `nominal_s` (s), the time since the last report (`stalled_s`, s) and the last start's
         specific force (m/s²) and tilt (rad)."""
         values = {
             "topic": self.scene.input.topic,
-            "rate_hz": f"{new['accepted'] / span:.1f}" if span > 0 else "n/a",
+            "rate_hz": "n/a" if math.isnan(rate_hz) else f"{rate_hz:.1f}",
             **{k: str(counts[k]) for k in ("received", "accepted", "gaps", "restarts")},
             **{k: str(v) for k, v in sorted(counts.items()) if k.startswith("rejected_")},
             "reset_stamp_jumped_back": str(counts["reset_stamp_jumped_back"]),
