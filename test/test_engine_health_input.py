@@ -468,3 +468,16 @@ def test_stall_of_a_running_twin_then_reports_continue() -> None:
         starts=1,
     )
     assert first.stamp == 1.0
+
+
+def test_the_real_time_factor_is_the_input_time_over_the_wall_time() -> None:
+    """real_time_factor: the stamp time the window's input intervals cover over the wall time
+    spent on its samples. It took the outputs' span, which the gyro delay shifts and which
+    holds one interval fewer than samples."""
+    calls = iter(range(10**6))
+    eng = TwinEngine(default_model(), clock=lambda: 1e-5 * next(calls))
+    # one sample a push: the clock read twice around each, 10 µs of wall a sample
+    reports = [r for t in ramp(3001) for r in eng.push(batch(np.array([t]))).health]
+    figures = [status(r, "integration").values["real_time_factor"] for r in reports]
+    # 1000 intervals of 1 ms a window; the first holds the start's sample too (1001 samples)
+    assert figures == [f"{1.0 / 1001e-5:.1f}", "100.0", "100.0"]

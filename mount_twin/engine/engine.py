@@ -221,7 +221,8 @@ class TwinEngine:
         reports = []
         start = 0
         for stop, report_due in [*((i + 1, True) for i in judged.due), (len(batch), False)]:
-            self._chunk(batch, judged, (start, stop), frame, rows, parts)
+            if stop > start:  # none after a report due at the batch's last sample
+                self._chunk(batch, judged, (start, stop), frame, rows, parts)
             if report_due:
                 stamp = float(batch.stamps[stop - 1])
                 reports.append(self._reporting.report(stamp, stop - 1, parts))

@@ -82,8 +82,8 @@ class HealthWindow:
         """Samples and seconds by which outputs follow their input (the gyro delay)."""
 
     def _reset(self) -> None:
-        self.t_first = math.nan
-        self.t_last = math.nan
+        self.published = False
+        """Whether rows were published in this window."""
         self.wall = 0.0
         self.err_max = 0.0
         self.estimate = np.zeros(N_FIGURES)
@@ -106,13 +106,7 @@ class HealthWindow:
     @property
     def pending(self) -> bool:
         """Whether anything was recorded since the last report."""
-        return bool(
-            self.samples
-            or self.events
-            or self.failures
-            or self.starts
-            or not math.isnan(self.t_last)
-        )
+        return bool(self.samples or self.events or self.failures or self.starts or self.published)
 
     def gyro_designed(self, stamp: float, design: Design) -> None:
         """The gyro filter designed at the interval into `stamp` (s): its latency from now on;
@@ -138,23 +132,19 @@ class HealthWindow:
         if stamps.shape[0] == 0:
             return
         tilt = float(tilt_from_quaternions(pose[:, pose_row.QUATERNION_COLS]).max())
-        self._add_peaks(stamps[0], stamps[-1], np.abs(wrenches).max(axis=0), tilt)
+        self._add_peaks(np.abs(wrenches).max(axis=0), tilt)
 
-    def add_output_peaks(
-        self, t_first: float, t_last: float, wrench_abs_max: np.ndarray, cos_tilt_min: float
-    ) -> None:
+    def add_output_peaks(self, wrench_abs_max: np.ndarray, cos_tilt_min: float) -> None:
         """`add_outputs` from the figures of published rows that the compiled loop folds in
-        (`kernel.Published`): their first and last stamps (s), the largest |wrench component|
-        per mount (n, 6; N, N·m) and the smallest cos θ (R₃₃)."""
-        self._add_peaks(t_first, t_last, wrench_abs_max, float(tilt_from_cos(cos_tilt_min)))
+        (`kernel.Published`): the largest |wrench component| per mount (n, 6; N, N·m) and the
+        smallest cos θ (R₃₃)."""
+        self._add_peaks(wrench_abs_max, float(tilt_from_cos(cos_tilt_min)))
 
-    def _add_peaks(
-        self, t_first: float, t_last: float, wrench_abs_max: np.ndarray, tilt_max_rad: float
-    ) -> None:
+    def _add_peaks(self, wrench_abs_max: np.ndarray, tilt_max_rad: float) -> None:
+        """Published rows' largest |wrench component| per mount (n, 6; N, N·m) and largest
+        tilt (rad)."""
         np.maximum(self.wrench_peak, wrench_abs_max, out=self.wrench_peak)
-        if math.isnan(self.t_first):
-            self.t_first = float(t_first)
-        self.t_last = float(t_last)
+        self.published = True
         self.tilt_max = max(self.tilt_max, tilt_max_rad)
 
     def add_intervals(self, steps: np.ndarray, skipped: dict[int, int]) -> None:
@@ -208,11 +198,16 @@ class HealthWindow:
         the intervals' sum, a hole's included; NaN without intervals. Not the accepted count
         over the outputs' span, which the gyro delay shifts and which holds one interval fewer
         than samples: 1040.5, 1001.0 and 964.3 Hz for a 1 kHz input."""
-        if not self.steps:
-            return math.nan
-        total = float(np.concatenate(self.steps).sum())  # one array: any batching, one sum
+        total = self._stamp_seconds()
         samples = self.n_steps + sum(n for _, n in self.skipped)
         return samples / total if total > 0.0 else math.nan
+
+    def _stamp_seconds(self) -> float:
+        """The input's stamp time this window's intervals cover, s (0 without intervals): the
+        time the twin advanced over them, a hole's included."""
+        if not self.steps:
+            return 0.0
+        return float(np.concatenate(self.steps).sum())  # one array: any batching, one sum
 
     def restart_cadence(self) -> None:
         """Make the next accepted sample start the report cadence afresh (after a stall)."""
@@ -298,18 +293,18 @@ class HealthWindow:
         """
         new = counts - self._last_counts
         self._last_counts = counts.copy()
-        span = self.t_last - self.t_first
         inp = self._input_status(
             new, counts, self._input_rate(), lost_from_stamps, nominal_interval_s, stalled_s
         )
-        step = self._integration_status(counts, span)
+        step = self._integration_status(counts, self._stamp_seconds())
         att = self._attitude_status()
         mounts = self._mount_statuses(utilisation, active)
         self._reset()
         return HealthReport(stamp, sample, [inp, step, att, *mounts])
 
     def _integration_status(self, counts: Counter[str], span: float) -> HealthStatus:
-        """The integration status of this window (`span`: its stamps, s): stepper failures and
+        """The integration status of this window (`span`: the stamp time its input intervals
+        cover, s; over its wall time, the real-time factor): stepper failures and
         a stop (ERROR), notes on how the input is taken and an estimated error past
         WARN_FORCE_ERROR_REL (WARN); the solver's settings and figures as values."""
         integ = self.scene.integration

@@ -39,11 +39,7 @@ class Reporting:
                     frame.stamps[published.sample], published.pose, published.wrenches
                 )
             elif published.sample.shape[0]:
-                self._health.add_output_peaks(
-                    frame.stamps[published.sample[0]],
-                    frame.stamps[published.sample[-1]],
-                    *published.peaks,
-                )
+                self._health.add_output_peaks(*published.peaks)
 
     def batch(
         self, frame: Frame, rows: BatchRows, parts: list[Rows], reports: list[HealthReport]
