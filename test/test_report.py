@@ -174,6 +174,9 @@ def test_another_scenes_mounts_are_refused_naming_both(
     pump = CONFIG / "pump_8_mounts.scene.yaml"
     assert main(["report", str(out), "--scene", str(pump), "-o", str(page)]) == 2
     err = capsys.readouterr().err
-    assert "--scene pump_8_mounts: its mounts (fl, fr, ml1, mr1, ml2, mr2, rl, rr)" in err
+    assert (
+        "scene pump_8_mounts (report --scene): its mounts (fl, fr, ml1, mr1, ml2, mr2, rl, rr)"
+        in err
+    )
     assert "(foot_fl, foot_fr, foot_ml, foot_mr, foot_rl, foot_rr, key_x, key_y)" in err
     assert not page.exists()

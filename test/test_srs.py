@@ -256,7 +256,7 @@ def test_a_head_as_long_as_the_record_is_refused(
     exit 0, titled "the mean of the first 2000 samples"."""
     bag = _resting_bag(tmp_path / "rest", np.array([0.0, 0.0, G]))
     assert main(["srs", str(bag), "--head", "100", "--freqs", "10"]) == 2
-    assert "--head 100 s: the whole record (0.9995 s)" in capsys.readouterr().err
+    assert "head_s (srs --head) 100 s: the whole record (0.9995 s)" in capsys.readouterr().err
     assert main(["srs", str(bag), "--head", "0.5", "--freqs", "10"]) == 0
 
 

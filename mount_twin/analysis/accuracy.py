@@ -177,10 +177,11 @@ def reference_run(
             return dataclasses.replace(ref, out=ref.out.select(at_samples))
     msg = (
         f"no reference: the stepper failed at every reference tolerance {REFERENCE_RTOLS} "
-        f"with at most {max_substeps} substeps per input interval (--max-substeps). The explicit "
-        "stepper steps across the mounts' switches (joints opening, slip, contact): a scene "
-        "that switches at every step (a chattering law) makes tight tolerances hunt; raise "
-        "--max-substeps, or look for the mount whose law chatters."
+        f"with at most {max_substeps} substeps per input interval (max_substeps, accuracy "
+        "--max-substeps). The explicit stepper steps across the mounts' switches (joints "
+        "opening, slip, contact): a scene that switches at every step (a chattering law) "
+        "makes tight tolerances hunt; raise max_substeps, or look for the mount whose law "
+        "chatters."
     )
     raise MountTwinError(msg)
 

@@ -304,8 +304,8 @@ def _check_scene_is_the_bags(scene: Scene, in_bag: set[str], output_bag: str | P
     names = [m.name for m in scene.mounts]
     if in_bag and in_bag != set(names):
         msg = (
-            f"--scene {scene.name}: its mounts ({', '.join(names)}) are not those of "
-            f"{output_bag} ({', '.join(sorted(in_bag))}): give the replay's own scene"
+            f"scene {scene.name} (report --scene): its mounts ({', '.join(names)}) are not "
+            f"those of {output_bag} ({', '.join(sorted(in_bag))}): give the replay's own scene"
         )
         raise ValueError(msg)
 

@@ -56,7 +56,10 @@ def check_response(text: str, scene: Scene) -> str | None:
     names = [m.name for m in scene.mounts]
     name = text.removeprefix(MOUNT_PREFIX)
     if not text.startswith(MOUNT_PREFIX) or name not in names:
-        msg = f"--response {text!r}: give cg or mount:NAME, NAME one of {', '.join(names)}"
+        msg = (
+            f"response {text!r} (srs --response): give cg or mount:NAME, NAME one of "
+            f"{', '.join(names)}"
+        )
         raise ValueError(msg)
     return name
 

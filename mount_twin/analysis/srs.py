@@ -170,13 +170,13 @@ def gravity_offset(
         msg = f"gravity mode {mode!r}: choose from {', '.join(GRAVITY_MODES)}"
         raise ValueError(msg)
     if not head_s > 0.0:
-        msg = f"--head {head_s} s: the quiet head must be longer than 0"
+        msg = f"head_s (srs --head) {head_s} s: the quiet head must be longer than 0"
         raise ValueError(msg)
     count = int(np.count_nonzero(t - t[0] < head_s))
     if count == len(t):
         msg = (
-            f"--head {head_s:g} s: the whole record ({t[-1] - t[0]:.4g} s); the head is the quiet "
-            "part before the shock, its mean gravity and bias"
+            f"head_s (srs --head) {head_s:g} s: the whole record ({t[-1] - t[0]:.4g} s); the "
+            "head is the quiet part before the shock, its mean gravity and bias"
         )
         raise ValueError(msg)
     return accel[:count].mean(axis=0), f"the mean of the first {count} samples"
