@@ -16,7 +16,14 @@ from mount_twin.scene.loader import read_scene_yaml
 from mount_twin.sweeps.cases import apply, check
 from mount_twin.sweeps.cluster import dask_client
 from mount_twin.sweeps.plot import plot_sweep, trade_off
-from mount_twin.sweeps.runner import FAILED, columns, read_results, run_case, run_sweep
+from mount_twin.sweeps.runner import (
+    FAILED,
+    NAMED_FAILURES,
+    columns,
+    read_results,
+    run_case,
+    run_sweep,
+)
 from mount_twin.sweeps.spec import load_sweep
 
 PUMP = CONFIG / "pump_8_mounts.scene.yaml"
@@ -192,6 +199,11 @@ def test_the_command_reports_and_exits_5_when_a_case_failed(
     assert code == 5
     out = capsys.readouterr().out
     assert "verdicts:" in out and "FAILED" in out and "highest peak mount force" in out
+    # the failed cases named with their errors: a script's exit 5 says which and why
+    named = [line for line in out.splitlines() if line.startswith("  FAILED case ")]
+    assert len(named) == NAMED_FAILURES
+    assert all("body.mass = -5.0): SceneError: " in line for line in named)
+    assert "more FAILED (the table's error column)" in out
     # per input, the case of the lowest largest utilisation, from the table's own columns
     names = [m["name"] for m in spec.base["mounts"]]
     done = [r for r in read_results(results) if r["verdict"] != FAILED]

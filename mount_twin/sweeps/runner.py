@@ -265,24 +265,39 @@ def largest_utilisation(row: dict[str, Any], mounts: list[str]) -> float:
     return max(rated, default=math.nan)
 
 
+NAMED_FAILURES = 3
+"""Failed cases the summary names with their errors (the rest it counts)."""
+
+
 def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
-    """The verdict counts, the cases of the lowest and highest peak mount force, and per input
-    the case whose largest mount utilisation is lowest (the design that input favours)."""
+    """The verdict counts, the first NAMED_FAILURES failed cases with their errors, the cases
+    of the lowest and highest peak mount force, and per input the case whose largest mount
+    utilisation is lowest (the design that input favours)."""
     rows = list(rows)
     names = [m["name"] for m in spec.base["mounts"]]
     varied = columns(spec)[2 : 2 + len(spec.variations)]
+
+    def setting(r: dict[str, Any]) -> str:
+        return ", ".join(f"{k} = {r[k]}" for k in varied)
+
     counts: dict[str, int] = {}
     for r in rows:
         counts[r["verdict"]] = counts.get(r["verdict"], 0) + 1
     lines = ["verdicts: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))]
+    failed = [r for r in rows if r["verdict"] == FAILED]
+    lines += [
+        f"  FAILED case {r['case']} ({r['input']}; {setting(r)}): {r['error']}"
+        for r in failed[:NAMED_FAILURES]
+    ]
+    if len(failed) > NAMED_FAILURES:
+        lines.append(
+            f"  and {len(failed) - NAMED_FAILURES} more FAILED (the table's error column)"
+        )
     done = [r for r in rows if r["verdict"] != FAILED]
     if done:
 
         def peak(r: dict[str, Any]) -> float:
             return largest_peak_force(r, names)
-
-        def setting(r: dict[str, Any]) -> str:
-            return ", ".join(f"{k} = {r[k]}" for k in varied)
 
         for label, r in (("lowest", min(done, key=peak)), ("highest", max(done, key=peak))):
             lines.append(
