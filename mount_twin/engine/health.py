@@ -175,9 +175,9 @@ class HealthWindow:
         there, so the estimate is at most what the span holds beyond the window's samples.
         Windows of the same samples give the same figures however the samples were pushed.
         """
-        if not self.steps:
+        steps = self._intervals()
+        if not steps.shape[0]:
             return 0, math.nan
-        steps = np.concatenate(self.steps)
         median = _median(steps)
         regular = (steps > (2.0 - HOLE) * median) & (steps < HOLE * median)
         n_regular = int(np.count_nonzero(regular))
@@ -205,9 +205,13 @@ class HealthWindow:
     def _stamp_seconds(self) -> float:
         """The input's stamp time this window's intervals cover, s (0 without intervals): the
         time the twin advanced over them, a hole's included."""
-        if not self.steps:
-            return 0.0
-        return float(np.concatenate(self.steps).sum())  # one array: any batching, one sum
+        return float(self._intervals().sum())  # one array: any batching, one sum
+
+    def _intervals(self) -> np.ndarray:
+        """This window's stamp intervals (`add_intervals`), s, as one array (kept so)."""
+        if len(self.steps) != 1:
+            self.steps = [np.concatenate([np.zeros(0), *self.steps])]
+        return self.steps[0]
 
     def restart_cadence(self) -> None:
         """Make the next accepted sample start the report cadence afresh (after a stall)."""
