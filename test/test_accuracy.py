@@ -5,21 +5,35 @@ from __future__ import annotations
 
 import csv
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
-from io_helpers import CONFIG, ROOT
+from io_helpers import CONFIG, ROOT, read_raw, scene_with
 from physics_helpers import base_scene, mount
 from scipy.integrate import solve_ivp
 
 from mount_twin.analysis import accuracy as accuracy_module
-from mount_twin.analysis.accuracy import NAN, Accuracy, compare, reference_run, run_at
+from mount_twin.analysis.accuracy import (
+    NAN,
+    REPRODUCED,
+    Accuracy,
+    compare,
+    raw_gyro,
+    reference_input,
+    reference_run,
+    run_at,
+)
 from mount_twin.cli import main
 from mount_twin.commands.accuracy import _unresolved
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.errors import MountTwinError
-from mount_twin.scene.loader import scene_from_dict
+from mount_twin.io.bag import write_bag
+from mount_twin.io.input_samples import read_samples
+from mount_twin.io.messages import IMU
+from mount_twin.scene import Scene
+from mount_twin.scene.loader import load_scene_file, scene_from_dict
 
 G = 9.80665
 MASS, F_N, ZETA = 10.0, 200.0, 0.05  # kg, Hz, −: a stiff bounce against a 1 kHz record
@@ -98,14 +112,63 @@ def test_the_command_writes_a_table_a_csv_and_a_plot(
     assert main(args) == 0
     out = capsys.readouterr().out
     assert "reference: the same twin at rtol 1e-12" in out
+    assert "gives its run bit for bit): the errors are the integration's" in out
     assert "resolution: the reference differs from one on the input refined 9× by" in out
-    assert "not resolved" not in out  # the pump's errors are 1e-5, its resolution 1e-13
+    assert "not resolved" not in out  # the pump's errors are 1e-10–1e-9, its resolution 1e-13
     rows = list(csv.DictReader(table.open(encoding="utf-8")))
     assert [float(r["rtol"]) for r in rows] == [1e-3, 1e-9]
-    # the runs take the gyro as shipped (linear_phase), the reference raw: the figure is the
-    # gyro conditioning's error on this deck (the integration's own is < 1e-6 at both rtols)
-    assert all(1e-6 < float(r["force_error"]) < 1e-4 for r in rows)
+    # the runs take the gyro as shipped (linear_phase), and so does the reference: the figures
+    # are the integration's error (1e-9 and 2e-10), which the live estimate estimates; they
+    # read 1.03e-5 at every rtol, the gyro filter's effect, when the reference took it raw
+    for r in rows:
+        assert 1e-11 < float(r["force_error"]) < 1e-8
+        assert 0.5 < float(r["est_force_error"]) / float(r["force_error"]) < 2.0
+    (effect,) = re.findall(r"gyro conditioning \(linear_phase\): .* differs by (\S+) of", out)
+    assert 1e-6 < float(effect) < 1e-4  # ship motion's roll and pitch, filtered at 20-100 Hz
     assert png.stat().st_size > 10_000
+
+
+def _ship_motion_with_a_gap(bag: Path) -> tuple[Scene, SampleBatch]:
+    """The pump under 3 s of ship motion, 0.6 s of it missing (past max_gap_s 0.5: the twin
+    restarts after it), written to `bag` and read back."""
+    scene = load_scene_file(CONFIG / "pump_8_mounts.scene.yaml")
+    (msgs,) = read_raw(ROOT / "bags" / "ship_motion_1khz", [scene.input.topic]).values()
+    write_bag(bag, scene.input.topic, IMU, iter(msgs[:1000] + msgs[1600:3000]))
+    return scene, read_samples(bag, scene.input)
+
+
+def test_the_reference_takes_the_record_as_the_twin_takes_it() -> None:
+    """The twin of the raw gyro on the record conditioned beforehand gives the scene's twin's
+    run bit for bit (the sensor's axes are F's); with the gyro ignored, its rate zero."""
+    scene = load_scene_file(CONFIG / "pump_8_mounts.scene.yaml")
+    samples = read_samples(ROOT / "bags" / "ship_motion_1khz", scene.input).part(slice(3000))
+    for gyro_filter in ("linear_phase", "ignore"):
+        variant = scene_with(scene, input={"gyro_filter": gyro_filter})
+        record = reference_input(variant, samples, 100_000)
+        assert record.conditioned and record.reproduction == 0.0
+        assert not np.array_equal(record.samples.gyro, samples.gyro)  # it was conditioned
+        twin = run_at(variant, samples, 1e-4, 100_000, estimate=False)
+        again = run_at(raw_gyro(variant), record.samples, 1e-4, 100_000, estimate=False)
+        np.testing.assert_array_equal(again.out.wrenches, twin.out.wrenches)
+        np.testing.assert_array_equal(again.out.angles, twin.out.angles)
+
+
+def test_a_record_the_twin_restarts_in_is_referenced_as_recorded_and_said_so(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """A restart after a gap starts the delay line afresh, which the record conditioned in one
+    run does not: the reference then takes the gyro as recorded, and the command says that its
+    errors include the conditioning's."""
+    bag = tmp_path / "gap"
+    scene, samples = _ship_motion_with_a_gap(bag)
+    record = reference_input(scene, samples, 100_000)
+    assert not record.conditioned and record.samples is samples
+    assert record.reproduction > REPRODUCED
+    args = ["accuracy", str(CONFIG / "pump_8_mounts.scene.yaml"), str(bag), "--rtol", "1e-6"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "so the errors include the gyro conditioning's (gyro_filter linear_phase)" in out
+    assert "gyro conditioning (linear_phase): " not in out
 
 
 def test_errors_within_the_references_resolution_are_named_not_resolved() -> None:

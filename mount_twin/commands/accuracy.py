@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from mount_twin.commands.common import positive_int
 
 if TYPE_CHECKING:
-    from mount_twin.analysis.accuracy import Accuracy, Run
+    from mount_twin.analysis.accuracy import Accuracy, ReferenceInput, Run
 
 NAME = "accuracy"
 HELP = "error against run time of the twin on a scene and bag, per tolerance (work-precision)"
@@ -40,7 +40,9 @@ def run(args: argparse.Namespace) -> int:
     from mount_twin.analysis.accuracy import (
         DEFAULT_RTOLS,
         REFINE,
+        compare,
         measure,
+        reference_input,
         reference_run,
         resolution,
     )
@@ -66,21 +68,21 @@ def run(args: argparse.Namespace) -> int:
         f"{scene.name}: {len(samples)} samples over {duration:.3f} s from {args.bag}",
         file=sys.stderr,
     )
-    ref = reference_run(scene, samples, args.max_substeps)
+    record = reference_input(scene, samples, args.max_substeps)
+    ref = reference_run(scene, record.samples, args.max_substeps)
     why = ""
     try:
-        resolved: Accuracy | None = resolution(scene, samples, args.max_substeps, ref)
+        resolved: Accuracy | None = resolution(scene, record.samples, args.max_substeps, ref)
     except MountTwinError as err:  # the second grid's reference failed where the first did not
         resolved, why = None, str(err)
+    effect: Accuracy | None = None  # the conditioning's, where the reference took it
+    if record.conditioned and scene.input.gyro_filter != "none":
+        effect = compare(reference_run(scene, samples, args.max_substeps), ref, duration)
     rows = []
     for rtol in args.rtol or DEFAULT_RTOLS:
         print(f"  rtol {rtol:g} ...", file=sys.stderr, flush=True)
         rows.append(measure(scene, samples, rtol, args.max_substeps, ref))
-    print(
-        f"reference: the same twin at rtol {ref.rtol:g}, atol {ref.atol:g}, on the input "
-        f"refined {REFINE}×, the gyro raw (the runs take it as the scene does: gyro_filter "
-        f"{scene.input.gyro_filter})"
-    )
+    print(_reference_text(ref, record, scene.input.gyro_filter, effect))
     if resolved is None:
         print(
             f"resolution: not measured (the reference on the input refined {REFINE + 1}×: {why})"
@@ -99,9 +101,45 @@ def run(args: argparse.Namespace) -> int:
         _write_csv(rows, args.csv)
         print(f"csv: {args.csv}")
     if args.plot:
-        _plot(rows, ref, resolved, args.plot, f"{scene.name} on {args.bag}")
+        _plot(rows, ref, resolved, effect, args.plot, f"{scene.name} on {args.bag}")
         print(f"plot: {args.plot}")
     return 0
+
+
+def _reference_text(
+    ref: Run, record: ReferenceInput, gyro_filter: str, effect: Accuracy | None
+) -> str:
+    """What the reference is, what its input's rate is, and the gyro conditioning's effect."""
+    from mount_twin.analysis.accuracy import REFINE
+
+    head = f"reference: the same twin at rtol {ref.rtol:g}, atol {ref.atol:g}, on the input "
+    head += f"refined {REFINE}×"
+    if gyro_filter == "none":
+        return f"{head} (gyro_filter none)"
+    if not record.conditioned:
+        return (
+            f"{head}, the gyro as recorded: the record conditioned beforehand does not give "
+            f"the twin's run ({record.reproduction:.2g} off: samples rejected, or a restart "
+            f"splitting it), so the errors include the gyro conditioning's (gyro_filter "
+            f"{gyro_filter})"
+        )
+    same = (
+        "bit for bit"
+        if record.reproduction == 0.0
+        else f"to {record.reproduction:.2g} (the rounding of the sensor's rotation)"
+    )
+    lines = [
+        f"{head}, the gyro as the twin takes it (gyro_filter {gyro_filter}, applied to the "
+        f"record beforehand; the twin on that record gives its run {same}): the errors are "
+        "the integration's"
+    ]
+    if effect is not None:
+        lines.append(
+            f"gyro conditioning ({gyro_filter}): the reference on the gyro as recorded differs "
+            f"by {effect.force_error:.2e} of the largest force, {effect.attitude_error_rad:.2e} "
+            "rad of attitude (the conditioning's effect, not an integration error)"
+        )
+    return "\n".join(lines)
 
 
 def _table(rows: list[Accuracy]) -> str:
@@ -173,7 +211,14 @@ def _label_levels(wall: list[float], close: float = 0.12) -> list[int]:
     return levels
 
 
-def _plot(rows: list[Accuracy], ref: Run, resolved: Accuracy | None, png: str, title: str) -> None:
+def _plot(
+    rows: list[Accuracy],
+    ref: Run,
+    resolved: Accuracy | None,
+    effect: Accuracy | None,
+    png: str,
+    title: str,
+) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -190,6 +235,15 @@ def _plot(rows: list[Accuracy], ref: Run, resolved: Accuracy | None, png: str, t
     floors = [] if resolved is None else [max(resolved.force_error, 1e-17)]
     for floor in floors:
         ax.axhline(floor, color="0.5", lw=1, ls="--", label="the reference's resolution (force)")
+    if effect is not None:
+        floors.append(max(effect.force_error, 1e-17))
+        ax.axhline(
+            floors[-1],
+            color="tab:green",
+            lw=1,
+            ls="-.",
+            label="the gyro conditioning's effect (force), not an integration error",
+        )
     for r, level in zip(rows, _label_levels(wall), strict=True):
         ax.annotate(
             f"rtol {r.rtol:.0e}" + (f", {r.failures} failures" if r.failures else ""),

@@ -52,6 +52,19 @@ def delay_samples(spec: InputSpec, rate_hz: float) -> int:
     return 0 if bands is None else design(rate_hz, *bands).delay
 
 
+def conditioned_rates(bands: tuple[float, float], stamps: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Ω of a whole record (rad/s, (n, 3), in any fixed axes) as the delay line hands it to the
+    twin where every sample is accepted in one run: filtered by the design `bands`
+    (`filter_bands`) makes for its stamps, its edges held (`GyroDelay`: the same code); w is
+    not changed."""
+    delay = GyroDelay(bands, lambda stamp, design: None)
+    out = np.array(w, dtype=np.float64)
+    frame = delay.frame(stamps, np.zeros_like(out), out, 0)
+    delay.feed(Run(np.arange(out.shape[0]), restart=True), frame)
+    delay.drain(frame)
+    return out
+
+
 @dataclass
 class Run:
     """Accepted samples to integrate in one go (rows of a Frame); `restart`: the first one
