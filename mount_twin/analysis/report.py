@@ -25,6 +25,7 @@ from mount_twin.analysis.figures import (
 )
 from mount_twin.analysis.html_page import digest, page, png, produced_by, scene_section
 from mount_twin.analysis.html_page import table as html_table
+from mount_twin.analysis.log_labels import plain_log_labels
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
 from mount_twin.engine.health import INTEGRATION, UTILISATION_KEY
 from mount_twin.errors import ModelError
@@ -172,6 +173,7 @@ def _draw_srs(
         ax.loglog(*design, "k--", label="design")
     ax.set_xlabel("natural frequency [Hz]")
     ax.set_ylabel("peak absolute acceleration [g]")
+    plain_log_labels(ax, "y")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
 

@@ -223,7 +223,8 @@ def _plot(
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import matplotlib.ticker
+
+    from mount_twin.analysis.log_labels import plain_log_labels
 
     fig, ax = plt.subplots(figsize=(7, 5))
     wall = [r.wall_s_per_sim_s for r in rows]
@@ -258,10 +259,7 @@ def _plot(
         for n in ("force_error", "peak_force_error", "est_force_error")
     ] + floors
     ax.set_ylim(min(shown) / 3.0, max(shown) * 10.0)  # room for the labels inside the axes
-    if max(wall) < 10.0 * min(wall):  # within a decade: plain labels, not 1.1×10⁻² crowding
-        ax.xaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%.3g"))
-        ax.xaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%.3g"))
-        ax.tick_params(axis="x", which="both", labelsize=7)  # major and minor alike
+    plain_log_labels(ax, "x")  # within a decade or so: plain labels, not 1.1×10⁻² crowding
     ax.set_xlabel("engine wall time per simulated second [s/s]")
     ax.set_ylabel(f"relative error against rtol {ref.rtol:.0e} [-]")
     ax.set_title(f"work-precision: {title}", fontsize=9)
