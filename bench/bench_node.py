@@ -10,13 +10,15 @@ every /mount_twin/pose. Printed per run: the rate actually sent,
 the share of inputs the node accepted (its final /diagnostics), the latency from input stamp to
 the pose's arrival here (p50, p99, max) of the poses that came while the node ran (the gyro
 filter's delay holds the last samples' outputs until the node shuts down: those are counted
-apart, "at stop"), the worst input status level and the losses the node itself reported (from
-stamp gaps and from the middleware).
+apart, "at stop"), the worst input status level, the losses the node itself reported (from
+stamp gaps and from the middleware), and the node's CPU time (user + system, from
+/proc/PID/stat) per second of wall time while the input was sent: the share of a core it takes.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import subprocess
 import sys
@@ -77,6 +79,7 @@ def run(rate_hz: float, seconds: float, options: list[str]) -> dict[str, float]:
         node.stop()
         raise RuntimeError(f"the node did not start: {node.stderr}")
     time.sleep(0.5)
+    cpu0, wall0 = _cpu_s(node.proc.pid), time.monotonic()
     publisher = subprocess.Popen(
         [sys.executable, __file__, "--publish", str(domain), str(rate_hz), str(seconds)],
         stdout=subprocess.PIPE,
@@ -84,6 +87,7 @@ def run(rate_hz: float, seconds: float, options: list[str]) -> dict[str, float]:
     )
     try:
         peer.take_until(lambda: publisher.poll() is not None or not node.alive, seconds + 120.0)
+        cpu_share = (_cpu_s(node.proc.pid) - cpu0) / (time.monotonic() - wall0)
         n = int(rate_hz * seconds)
         decimation = int(options[-1].split(":=")[1]) if "decimation" in options[-1] else 1
         held = delay_samples(INPUT, rate_hz)  # answered at shutdown
@@ -122,8 +126,15 @@ def run(rate_hz: float, seconds: float, options: list[str]) -> dict[str, float]:
         "missing": n - lost["accepted"],
         "level": ("OK", "WARN", "ERROR")[level],
         "worst": worst,
+        "cpu": cpu_share,
         **lost,
     }
+
+
+def _cpu_s(pid: int) -> float:
+    """User + system CPU time (s) of process `pid` so far (Linux: /proc/PID/stat)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def _stamp_s(raw: bytes, msgtype: str) -> float:
@@ -151,7 +162,7 @@ def main() -> None:
     args = parser.parse_args()
     print(
         f"{'mode':<14} {'rate Hz':>8} {'sent Hz':>8} {'answered':>9} {'missing':>8} "
-        f"{'p50 ms':>7} {'p99 ms':>7} {'max ms':>7} {'at stop':>7}  input status, "
+        f"{'p50 ms':>7} {'p99 ms':>7} {'max ms':>7} {'at stop':>7} {'CPU':>5}  input status, "
         "node-reported lost "
         "(stamps, DDS)"
     )
@@ -164,7 +175,7 @@ def main() -> None:
             print(
                 f"{mode:<14} {rate:8.0f} {r['published_hz']:8.0f} {r['answered']:9.2%} "
                 f"{r['missing']:8d} {r['p50_ms']:7.2f} {r['p99_ms']:7.2f} {r['max_ms']:7.2f} "
-                f"{r['at_stop']:7d}  "
+                f"{r['at_stop']:7d} {r['cpu']:5.0%}  "
                 f"{r['level']}, {r['lost_estimated']}, {r['lost_middleware']}"
                 + ("" if r["level"] == "OK" else f" ({r['worst']})"),
                 flush=True,
