@@ -678,3 +678,54 @@ def test_a_slow_subscriber_loses_outputs_and_no_event_says_so() -> None:
         executor.remove_node(peer.node)
         peer.close()
     assert got == list(range(990, 1000)) and lost == []
+
+
+def test_the_node_wakes_its_executor_only_for_work() -> None:
+    """rclpy's executor builds its wait set anew at every wake-up (about a millisecond of CPU
+    here): the outputs' publishers add no event handlers to it (rclpy's defaults, two a
+    publisher, were 26 of the pump's 31 waitables), and the batch timer runs only while input
+    comes (it woke an idle node every 5 ms: 35 % of a core). In this process, the node on an
+    executor of its own context, a peer publishing."""
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+
+    from mount_twin.ros.node import MountTwinNode
+
+    domain = fresh_domain()
+    context = Context()
+    args = ["mount_twin_node", "--ros-args", "--params-file", str(PARAMS_FILE)]
+    args += ["-p", "batch_period_s:=0.005"]
+    rclpy.init(args=args, context=context, domain_id=domain)
+    node = MountTwinNode(args, context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    peer = Peer(domain)
+    try:
+        outputs = [*node._pubs.values(), getattr(node, "_static", None)]  # /tf_static: tf2_msgs
+        outputs = [p for p in outputs if p is not None]
+        assert len(outputs) >= 11 and all(not p.event_handlers for p in outputs)  # 8 mounts
+        timer = node._batch_timer
+        assert timer is not None and timer.is_canceled()  # no input yet: not running
+        pub = peer.publisher(IMU, "/deck/imu")
+        assert wait_for(lambda: pub.get_subscription_count() > 0, 30.0)
+        for raw in _imu(*_at_rest(50)):
+            pub.publish(raw)
+        counts = node.stream.engine.counts
+        deadline = time.monotonic() + 30.0
+        while counts["accepted"] < 50 and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.01)
+        assert counts["accepted"] == 50
+        for _ in range(10):  # input has stopped: the next period finds nothing and stops it
+            executor.spin_once(timeout_sec=0.01)
+        assert timer.is_canceled() and not node._pending
+        for raw in _imu(*_at_rest(5, STAMP0 + 50_000_000)):  # input again: running again
+            pub.publish(raw)
+        while not node._pending and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.01)
+        assert node._pending and not timer.is_canceled()
+    finally:
+        peer.close()
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
