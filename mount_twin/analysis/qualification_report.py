@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from mount_twin.analysis.html_page import digest, page, png, produced_by, scene_section, table
+from mount_twin.analysis.log_labels import plain_log_labels
 from mount_twin.analysis.qualification import InputRun, Plan
 from mount_twin.scene.description import Scene
 
@@ -97,6 +98,7 @@ def _spectra_section(plan: Plan, runs: list[InputRun]) -> list[str]:
             ax.set_title(f"axis {axis}: maximax of the inputs (ζ = {plan.damping:g})", fontsize=9)
             ax.set_xlabel("natural frequency [Hz]")
             ax.set_ylabel("peak absolute acceleration [g]")
+            plain_log_labels(ax, "y")
             ax.grid(True, which="both", alpha=0.3)
             ax.legend(fontsize=8)
 
