@@ -5,8 +5,9 @@ instead of silently dropping input or parameters:
 
 - `take_waiting`: every message waiting in a subscription's queue, through the subscription
   handle the executor itself takes from. One executor wake-up then answers all the messages
-  that arrived meanwhile instead of paying the executor once per message (~50–100 µs), which
-  is what lets a Python node follow a 10 kHz sensor.
+  that arrived meanwhile instead of paying the executor once per message (measured
+  2026-11-26, rclpy 7.1.6 on 2 shared cores: 0.86 ms of CPU a wake-up of a node holding one
+  timer, 1.0 ms of this node's), which is what lets a Python node follow a 10 kHz sensor.
 - `given_parameters`: the parameter overrides the node was started with (params files, `-p`,
   `parameter_overrides=`), before any is declared. rclpy keeps them in a private attribute; a
   node needs them to refuse unknown keys by name and to take an integer written for a double,
