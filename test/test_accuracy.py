@@ -31,8 +31,7 @@ from mount_twin.engine.batch import SampleBatch
 from mount_twin.errors import MountTwinError
 from mount_twin.io.bag import write_bag
 from mount_twin.io.input_samples import read_samples
-from mount_twin.io.messages import IMU
-from mount_twin.scene import Scene
+from mount_twin.io.messages import IMU, TYPESTORE
 from mount_twin.scene.loader import load_scene_file, scene_from_dict
 
 G = 9.80665
@@ -128,39 +127,49 @@ def test_the_command_writes_a_table_a_csv_and_a_plot(
     assert png.stat().st_size > 10_000
 
 
-def _ship_motion_with_a_gap(bag: Path) -> tuple[Scene, SampleBatch]:
-    """The pump under 3 s of ship motion, 0.6 s of it missing (past max_gap_s 0.5: the twin
-    restarts after it), written to `bag` and read back."""
-    scene = load_scene_file(CONFIG / "pump_8_mounts.scene.yaml")
-    (msgs,) = read_raw(ROOT / "bags" / "ship_motion_1khz", [scene.input.topic]).values()
-    write_bag(bag, scene.input.topic, IMU, iter(msgs[:1000] + msgs[1600:3000]))
-    return scene, read_samples(bag, scene.input)
+def _ship_motion_bag(bag: Path, keep: slice | np.ndarray, nan_gyro_at: int | None = None) -> Path:
+    """The bundled ship-motion bag's messages `keep` written to `bag`, one of them (position
+    among those kept) with a NaN gyro reading if `nan_gyro_at` is given."""
+    (msgs,) = read_raw(ROOT / "bags" / "ship_motion_1khz", ["/deck/imu"]).values()
+    kept = [msgs[i] for i in np.arange(len(msgs))[keep]]
+    if nan_gyro_at is not None:
+        t, raw = kept[nan_gyro_at]
+        msg = TYPESTORE.deserialize_cdr(raw, IMU)
+        msg.angular_velocity.x = math.nan
+        kept[nan_gyro_at] = (t, bytes(TYPESTORE.serialize_cdr(msg, IMU)))
+    write_bag(bag, "/deck/imu", IMU, iter(kept))
+    return bag
 
 
-def test_the_reference_takes_the_record_as_the_twin_takes_it() -> None:
+def test_the_reference_takes_the_record_as_the_twin_takes_it(tmp_path: Path) -> None:
     """The twin of the raw gyro on the record conditioned beforehand gives the scene's twin's
-    run bit for bit (the sensor's axes are F's); with the gyro ignored, its rate zero."""
+    run bit for bit (the sensor's axes are F's): with the shipped filter, also across a gap
+    past max_gap_s (0.5 s), after which the twin restarts and its delay line with it; with the
+    gyro ignored, its rate zero."""
     scene = load_scene_file(CONFIG / "pump_8_mounts.scene.yaml")
-    samples = read_samples(ROOT / "bags" / "ship_motion_1khz", scene.input).part(slice(3000))
-    for gyro_filter in ("linear_phase", "ignore"):
+    gap = _ship_motion_bag(tmp_path / "gap", np.r_[0:1000, 1600:3000])
+    for gyro_filter, bag in (("linear_phase", gap), ("ignore", gap)):
         variant = scene_with(scene, input={"gyro_filter": gyro_filter})
+        samples = read_samples(bag, variant.input)
         record = reference_input(variant, samples, 100_000)
         assert record.conditioned and record.reproduction == 0.0
         assert not np.array_equal(record.samples.gyro, samples.gyro)  # it was conditioned
         twin = run_at(variant, samples, 1e-4, 100_000, estimate=False)
+        assert twin.out.stamps.shape[0] == 2400  # every sample answered, the restart's too
         again = run_at(raw_gyro(variant), record.samples, 1e-4, 100_000, estimate=False)
         np.testing.assert_array_equal(again.out.wrenches, twin.out.wrenches)
         np.testing.assert_array_equal(again.out.angles, twin.out.angles)
 
 
-def test_a_record_the_twin_restarts_in_is_referenced_as_recorded_and_said_so(
+def test_a_record_the_twin_rejects_samples_of_is_referenced_as_recorded_and_said_so(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
-    """A restart after a gap starts the delay line afresh, which the record conditioned in one
-    run does not: the reference then takes the gyro as recorded, and the command says that its
-    errors include the conditioning's."""
-    bag = tmp_path / "gap"
-    scene, samples = _ship_motion_with_a_gap(bag)
+    """A sample the twin rejects (a NaN reading) never reaches its delay line; the record
+    conditioned beforehand filters it in: the reference then takes the gyro as recorded, and
+    the command says that its errors include the conditioning's."""
+    bag = _ship_motion_bag(tmp_path / "nan", slice(0, 2000), nan_gyro_at=700)
+    scene = load_scene_file(CONFIG / "pump_8_mounts.scene.yaml")
+    samples = read_samples(bag, scene.input)
     record = reference_input(scene, samples, 100_000)
     assert not record.conditioned and record.samples is samples
     assert record.reproduction > REPRODUCED

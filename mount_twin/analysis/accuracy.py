@@ -131,14 +131,18 @@ def raw_gyro(scene: Scene) -> Scene:
 
 
 def conditioned(scene: Scene, samples: SampleBatch) -> SampleBatch:
-    """The record with its rate as the twin takes it where it accepts every sample in one
-    run (`input.gyro_filter`): filtered by the delay line (`delay_line.conditioned_rates`, in
-    the sensor's axes), zero for `ignore`, as recorded for `none`. The twin of `raw_gyro(scene)`
-    on it integrates the scene's twin's own input (`reference_input` checks)."""
+    """The record with its rate as the twin takes it where it accepts every sample
+    (`input.gyro_filter`): filtered by the delay line (`delay_line.conditioned_rates`, in the
+    sensor's axes), a run ending where the twin restarts after a gap (`input.max_gap_s`,
+    `gap_policy: reset`); zero for `ignore`; as recorded for `none`. The
+    twin of `raw_gyro(scene)` on it integrates the scene's twin's own input (`reference_input`
+    checks)."""
     spec = scene.input
     bands = filter_bands(spec)
     if bands is not None:
-        gyro = conditioned_rates(bands, samples.stamps, samples.gyro)
+        gaps = np.diff(samples.stamps) > spec.max_gap_s
+        restarts = (np.flatnonzero(gaps) + 1).tolist() if spec.gap_policy == "reset" else []
+        gyro = conditioned_rates(bands, samples.stamps, samples.gyro, restarts)
     elif spec.gyro_filter == "ignore":
         gyro = np.zeros_like(samples.gyro)
     else:

@@ -19,7 +19,7 @@ pushed ones.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,15 +52,19 @@ def delay_samples(spec: InputSpec, rate_hz: float) -> int:
     return 0 if bands is None else design(rate_hz, *bands).delay
 
 
-def conditioned_rates(bands: tuple[float, float], stamps: np.ndarray, w: np.ndarray) -> np.ndarray:
+def conditioned_rates(
+    bands: tuple[float, float], stamps: np.ndarray, w: np.ndarray, restarts: Sequence[int] = ()
+) -> np.ndarray:
     """Ω of a whole record (rad/s, (n, 3), in any fixed axes) as the delay line hands it to the
-    twin where every sample is accepted in one run: filtered by the design `bands`
-    (`filter_bands`) makes for its stamps, its edges held (`GyroDelay`: the same code); w is
-    not changed."""
+    twin where every sample is accepted and the twin restarts at the samples `restarts`
+    (positions, increasing): filtered by the design `bands` (`filter_bands`) makes from the
+    record's first intervals, each run's edges held (`GyroDelay`: the same code); w is not
+    changed."""
     delay = GyroDelay(bands, lambda stamp, design: None)
     out = np.array(w, dtype=np.float64)
     frame = delay.frame(stamps, np.zeros_like(out), out, 0)
-    delay.feed(Run(np.arange(out.shape[0]), restart=True), frame)
+    for run in np.split(np.arange(out.shape[0]), list(restarts)):
+        delay.feed(Run(run, restart=True), frame)
     delay.drain(frame)
     return out
 
