@@ -465,7 +465,7 @@ def test_the_command_line_outranks_a_params_file_section_for_the_node(tmp_path: 
 
     params = tmp_path / "p.yaml"
     params.write_text(
-        "/**:\n  ros__parameters:\n    body: {mass: 1200.0}\n    name: a\n"
+        "/**:\n  ros__parameters:\n    body: {mass: 1200.0, cg: [0.0, 0.0, 0.4]}\n    name: a\n"
         "/ship/twin:\n  ros__parameters:\n    outputs: {decimation: 4}\n"
         "other_node:\n  ros__parameters:\n    input: {g: 9.0}\n"
     )
@@ -475,13 +475,14 @@ def test_the_command_line_outranks_a_params_file_section_for_the_node(tmp_path: 
         "-p", "body.mass:=heavy",
         "--params-file", str(params),
         "-p", "twin:outputs.decimation:=2",
+        "-p", "body.cg:=[0.05, 0.0, 5e-1]",  # rcl reads 5e-1 as a double: so must the node
         "-p", "input.g:=9.5",  # only another node's section sets it: rcl keeps this -p
         "-p", "other_node:name:=b",  # for another node
         "--",
         "-p", "name:=c",  # not a ROS argument
     ]  # fmt: skip
     got = shadowed_command_line(args, {"twin", "ship/twin"})
-    assert got == {"body.mass": "heavy", "outputs.decimation": 2}
+    assert got == {"body.mass": "heavy", "outputs.decimation": 2, "body.cg": [0.05, 0.0, 0.5]}
 
 
 def test_a_renamed_namespaced_node_takes_the_bundled_params_file() -> None:

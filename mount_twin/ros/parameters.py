@@ -25,6 +25,7 @@ from mount_twin.errors import SceneError
 from mount_twin.ros.rclpy_private import given_parameters
 from mount_twin.scene.description import Scene
 from mount_twin.scene.params import effective_parameters, flatten, parameter_description
+from mount_twin.scene.yaml_reading import load_yaml
 
 
 @dataclass(frozen=True)
@@ -130,7 +131,7 @@ def shadowed_command_line(args: Sequence[str], names: set[str]) -> dict[str, Any
             name, _, text = value.partition(":=")
             target, _, name = name.rpartition(":")
             if not target or target.lstrip("/") in names:
-                given[name] = yaml.safe_load(text)
+                given[name] = load_yaml(text)  # 1.5e3 a float, as rcl reads it
         elif flag == "--params-file":
             with open(value, encoding="utf-8") as f:  # rcl has read it: it exists and parses
                 sections = yaml.safe_load(f) or {}
