@@ -145,7 +145,7 @@ setup(
     tests_require=["pytest"],
     entry_points={
         "console_scripts": [
-            "mount_twin_node = mount_twin.ros.node:main",
+            "mount_twin_node = mount_twin.ros.start:main",
             "mount-twin = mount_twin.cli:main",
         ],
     },

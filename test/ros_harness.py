@@ -1,7 +1,7 @@
 """The real node over real DDS, for tests and the node benchmark.
 
 Each run gets a DDS domain of its own (`ROS_DOMAIN_ID`) on localhost only, the node runs as its
-own process (`python -m mount_twin.ros.node`, what the console script runs), and the test side
+own process (`python -m mount_twin.ros.start`, what the console script runs), and the test side
 is one rclpy node in a context of its own that publishes raw input and takes raw outputs from
 its subscriptions without an executor (`take_waiting`), so the recorder keeps up with a node
 publishing a dozen topics at kHz rates.
@@ -68,7 +68,7 @@ class NodeProcess:
 
     def __init__(self, domain: int, ros_args: Iterable[str]) -> None:
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", "mount_twin.ros.node", "--ros-args", *ros_args],
+            [sys.executable, "-m", "mount_twin.ros.start", "--ros-args", *ros_args],
             env=ros_env(domain),
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,

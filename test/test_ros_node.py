@@ -730,3 +730,26 @@ def test_the_node_wakes_its_executor_only_for_work() -> None:
         executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown(context=context)
+
+
+def _catches_sigterm(pid: int) -> bool:
+    """Whether process `pid` has a handler for SIGTERM (Linux: SigCgt of /proc/PID/status;
+    Python catches SIGINT from its start, SIGTERM only where a program asks)."""
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("SigCgt:"):
+            return bool(int(line.split()[1], 16) >> (signal.SIGTERM - 1) & 1)
+    return False
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_stop_while_the_node_starts_exits_0_without_a_traceback(sig: int) -> None:
+    """SIGINT or SIGTERM while the process still imports rclpy, numpy and the core (about a
+    second): exit 0, nothing on stderr. They ended it with a KeyboardInterrupt traceback (exit
+    130) or without a word (143). The signal goes once the process catches SIGTERM (its entry
+    point does so first thing) or 0.3 s after its start, whichever comes first."""
+    node = NodeProcess(fresh_domain(), ["--params-file", str(PARAMS_FILE)])
+    started = time.monotonic()
+    while not _catches_sigterm(node.proc.pid) and time.monotonic() < started + 0.3:
+        time.sleep(0.002)
+    code = node.stop(sig)
+    assert (code, node.stderr) == (0, "")

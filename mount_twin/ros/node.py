@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import importlib
 import math
-import signal
 import sys
 import threading
 import time
@@ -366,17 +365,17 @@ class MountTwinNode(Node):
             )
 
 
-def main(args: list[str] | None = None) -> int:
-    """Console entry point `mount_twin_node`: spin until SIGINT or SIGTERM, then publish the
-    last diagnostics period and exit 0; a configuration error exits 2 with one line."""
-    stop = threading.Event()
+def run(stop: threading.Event, args: list[str] | None = None) -> int:
+    """The node's process (`mount_twin.ros.start`, which sets `stop` on SIGINT or SIGTERM):
+    spin until `stop`, then publish the last diagnostics period and exit 0; a configuration
+    error exits 2 with one line. A stop before the node is made exits 0 at once."""
+    if stop.is_set():
+        return 0
     try:
         rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     except Exception as err:  # rcl's argument and params-file errors (RCLError)
         print(f"mount_twin_node: {str(err).splitlines()[0]}", file=sys.stderr)
         return 2
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: stop.set())
     node = None
     try:
         node = MountTwinNode(sys.argv if args is None else args)
@@ -396,7 +395,3 @@ def main(args: list[str] | None = None) -> int:
             node.destroy_node()
         rclpy.try_shutdown()
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
