@@ -7,6 +7,7 @@ the bag replay hands it chunks of raw messages from a bag. Only the transport di
 from __future__ import annotations
 
 from collections.abc import Sequence
+from itertools import pairwise
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -83,21 +84,40 @@ class TwinStream:
         """Outputs for raw input messages, as (unresolved topic, stamp ns, CDR bytes), or blocks
         of them (`blocks`)."""
         decoded = decode_inputs(raws, self.scene.input.msg_type)
-        if decoded.undecodable:
-            self.engine.count("received", decoded.undecodable)
-            self.engine.count("rejected_undecodable", decoded.undecodable)
-        # An unset header.stamp has no time to place the sample at; one before 1970 (sec < 0,
-        # which builtin_interfaces/Time allows) cannot be written to a bag or answered.
-        # Both masks are taken before either selects: each is of the messages as decoded.
-        for reason, bad in (
-            ("zero_stamp", decoded.stamps_ns == 0),
-            ("negative_stamp", decoded.stamps_ns < 0),
-        ):
-            if bad.any():
-                self.engine.count("received", int(bad.sum()))
-                self.engine.count(f"rejected_{reason}", int(bad.sum()))
-        if (decoded.stamps_ns <= 0).any():
-            decoded = decoded.select(decoded.stamps_ns > 0)
+        good = decoded.stamps_ns > 0
+        if not decoded.undecodable and good.all():
+            return self._follow(decoded)
+        # Messages the engine cannot take: not valid CDR; an unset header.stamp, which has no
+        # time to place the sample at; one before 1970 (sec < 0, which builtin_interfaces/Time
+        # allows), which cannot be written to a bag or answered. Each is counted where it
+        # came, between the pushes of the samples around it, as a rejected sample is, so the
+        # diagnostics period and the stamp interval it falls in do not depend on how the
+        # messages were batched (counted before a batch's push, all were credited to its first
+        # interval and its first period: a hole later read as samples lost).
+        reason = np.full(len(raws), "undecodable", dtype=object)
+        reason[decoded.places()] = np.where(
+            good, "", np.where(decoded.stamps_ns == 0, "zero_stamp", "negative_stamp")
+        )
+        outputs: list[Encoded] = []
+        merged: OutputBatch | None = None
+        pushed = 0
+        for start, stop in _runs(reason):
+            if reason[start]:  # a run of messages rejected for the same reason
+                self.engine.count("received", stop - start)
+                self.engine.count(f"rejected_{reason[start]}", stop - start)
+                continue
+            part = decoded.select((decoded.places() >= start) & (decoded.places() < stop))
+            self.last_outputs = None
+            outputs += self._follow(part)
+            if self.last_outputs is not None:
+                got = self.last_outputs
+                merged = got if merged is None else merged.then(got, pushed)
+            pushed += stop - start
+        self.last_outputs = merged
+        return outputs
+
+    def _follow(self, decoded: Decoded) -> list[Encoded]:
+        """`process` of messages the engine takes (decoded, stamps > 0), pushed in one call."""
         if decoded.stamps_ns.shape[0]:
             self._received_ns = int(decoded.stamps_ns[-1])
         if self.base is None:
@@ -239,3 +259,10 @@ class TwinStream:
         self.final_report = reports[0] if reports else None
         stamp_ns = self._last_ns or self._received_ns
         return msgs + [encode_report(self.scene, r, stamp_ns) for r in reports]
+
+
+def _runs(values: np.ndarray) -> list[tuple[int, int]]:
+    """[start, stop) of each run of equal neighbours in `values`, in order."""
+    cuts = np.flatnonzero(values[1:] != values[:-1]) + 1
+    edges = [0, *cuts.tolist(), values.shape[0]]
+    return list(pairwise(edges))

@@ -74,7 +74,9 @@ def stamp_ns(header: Any) -> int:
 class Decoded:
     """Raw input messages decoded: stamps (ns), sensor-frame vectors and frame ids.
 
-    `undecodable` counts messages that were not valid CDR of the expected type.
+    `undecodable` counts messages that were not valid CDR of the expected type; `position`
+    gives each decoded message's place among the raw messages (int64; None: they are all of
+    them, in order).
     """
 
     stamps_ns: np.ndarray
@@ -82,13 +84,26 @@ class Decoded:
     gyro: np.ndarray
     frame_ids: list[str]
     undecodable: int = 0
+    position: np.ndarray | None = None
 
     def select(self, keep: np.ndarray) -> Decoded:
         """The messages where `keep` (bool, per decoded message) is True."""
         frames = [f for f, k in zip(self.frame_ids, keep.tolist(), strict=True) if k]
+        places = self.places()[keep]
         return Decoded(
-            self.stamps_ns[keep], self.accel[keep], self.gyro[keep], frames, self.undecodable
+            self.stamps_ns[keep],
+            self.accel[keep],
+            self.gyro[keep],
+            frames,
+            self.undecodable,
+            places,
         )
+
+    def places(self) -> np.ndarray:
+        """Each decoded message's place among the raw messages (int64)."""
+        if self.position is None:
+            return np.arange(self.stamps_ns.shape[0])
+        return self.position
 
     def batch(self, base: TimeBase) -> SampleBatch:
         """Engine samples with stamps in seconds from `base`."""
@@ -158,7 +173,15 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
         accel[got] = np.column_stack(cols[2:5])[1:]
         if msgtype == IMU:
             gyro[got] = np.column_stack(cols[5:8])[1:]
-    return Decoded(stamps[ok], accel[ok], gyro[ok], frames[ok].tolist(), int(n - ok.sum()))
+    bad = n - int(ok.sum())
+    return Decoded(
+        stamps[ok],
+        accel[ok],
+        gyro[ok],
+        frames[ok].tolist(),
+        bad,
+        np.flatnonzero(ok) if bad else None,
+    )
 
 
 def _input_values(msg: Any, msgtype: str) -> tuple[int, tuple, tuple]:
