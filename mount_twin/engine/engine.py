@@ -356,10 +356,10 @@ class TwinEngine:
         return []
 
     def report_stalled(self, waited_s: float) -> HealthReport:
-        """The report a live adapter publishes when `waited_s` (s, its clock) passed without
-        the stamps of accepted samples making a report due: the window so far, as `flush`
-        gives it, with the input status an ERROR that says why (nothing received, everything
-        rejected, or too few samples accepted). Works before any sample was accepted.
+        """The report a live adapter publishes when `waited_s` (s, its clock) passed without a
+        sample accepted nor a report due: the window so far, as `flush` gives it, with the
+        input status an ERROR that says why (nothing received, everything rejected, or the
+        samples accepted came before). Works before any sample was accepted.
 
         Its `stamp` is the last accepted stamp (engine seconds, NaN if none), its `sample` −1.
         The window starts anew, and the stamp cadence restarts at the next accepted sample.

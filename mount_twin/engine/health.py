@@ -495,8 +495,11 @@ class HealthWindow:
                 f"all rejected ({why})" if all_rejected else "none accepted"
             )
             return text, all_rejected
-        waited = _seconds(stalled_s)
-        return f"input stalled: only {new['accepted']} samples accepted in {waited}", False
+        # a stall report comes after a stall period without an accepted sample (the adapter's
+        # condition): these came before it; the input stopped or paused (it read "input
+        # stalled: only 499 samples accepted in 1.0 s" after the tail of a stream at full rate)
+        n = new["accepted"]
+        return f"no sample accepted {waited} ({n} before it in this period)", False
 
     def _sensor_findings(self, new: Counter[str]) -> list[str]:
         """Warnings on the readings of this window: samples at the sensor's range (clipped)
