@@ -112,7 +112,9 @@ def run(rate_hz: float, seconds: float, options: list[str]) -> dict[str, float]:
                 values = {kv.key: kv.value for kv in status.values}
                 lost = {k: int(values.get(k, 0)) for k in lost}
                 # the clock's reports before the first sample and after the last one
-                quiet = status.message.startswith(("no input received", "input stalled"))
+                quiet = status.message.startswith("no input received") or status.message.endswith(
+                    "before it in this period)"
+                )
                 if not quiet and int(status.level) > level:
                     level, worst = int(status.level), status.message
 
