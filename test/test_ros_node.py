@@ -420,6 +420,7 @@ def test_parameters_are_all_set_described_and_read_only(tmp_path: Path) -> None:
         (["-p", "scene_file:=/nonexistent.yaml"], "/nonexistent.yaml: <file>: cannot read"),
         (["-p", "input.topic:=/deck//imu"], "input.topic: '/deck//imu' is not a ROS topic name"),
         (["-p", "batch_period_s:=-1.0"], "batch_period_s: must be in [0.0, 1.0]"),
+        (["-p", "input_queue_depth:=10.5"], "input_queue_depth: expected an integer, got 10.5"),
         (
             ["-p", f"scene_file:={GENSET}", "-p", "body.mass:=heavy"],
             "body.mass: expected a number, got 'heavy'",
@@ -440,6 +441,7 @@ def test_parameters_are_all_set_described_and_read_only(tmp_path: Path) -> None:
         "bad_scene_file",
         "bad_topic",
         "out_of_range",
+        "option_not_an_integer",
         "bad_type",
         "bad_type_over_params_file",
         "bad_qos_override",

@@ -176,7 +176,8 @@ def _declare_options(node: Node, given: dict[str, Any], source: str) -> dict[str
         if wanted is float and isinstance(value, int) and not isinstance(value, bool):
             value = float(value)
         if isinstance(value, bool) or not isinstance(value, wanted):
-            raise SceneError(source, name, f"expected a {wanted.__name__}, got {value!r}")
+            kind = "a number" if wanted is float else "an integer"
+            raise SceneError(source, name, f"expected {kind}, got {value!r}")
         try:
             values[name] = node.declare_parameter(
                 name, value, descriptor, ignore_override=True
