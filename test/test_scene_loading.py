@@ -266,9 +266,9 @@ BAD_SCENES = [
         "negative_mass",
         _set("body/mass", -5.0),
         "body.mass",
-        r"must be in \(0\.0, inf\], got -5\.0",
+        r"must be in \(0\.0, inf\), got -5\.0",
     ),
-    ("zero_mass", _set("body/mass", 0.0), "body.mass", r"must be in \(0\.0, inf\], got 0\.0"),
+    ("zero_mass", _set("body/mass", 0.0), "body.mass", r"must be in \(0\.0, inf\), got 0\.0"),
     (
         "inertia_not_positive_definite",
         _set("body/inertia", [250.0, 450.0, 500.0, 400.0, 0.0, 0.0]),

@@ -234,6 +234,6 @@ class Reader:
             )
         value = float(value)
         if value < lo or value > hi or (lo_open and value == lo):
-            low = "(" if lo_open else "["
-            raise self.error(key, f"must be in {low}{lo}, {hi}], got {value!r}")
+            low, high = "(" if lo_open else "[", ")" if math.isinf(hi) else "]"  # inf: not taken
+            raise self.error(key, f"must be in {low}{lo}, {hi}{high}, got {value!r}")
         return value
