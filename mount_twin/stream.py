@@ -106,7 +106,7 @@ class TwinStream:
                 self.engine.count("received", stop - start)
                 self.engine.count(f"rejected_{reason[start]}", stop - start)
                 continue
-            part = decoded.select((decoded.places() >= start) & (decoded.places() < stop))
+            part = decoded.select(_within(decoded, start, stop))
             self.last_outputs = None
             outputs += self._follow(part)
             if self.last_outputs is not None:
@@ -195,15 +195,20 @@ class TwinStream:
             return []
         decoded = decode_inputs(raws, IMU)
         self.body.counts["received"] += len(raws)
-        self.body.counts["rejected_undecodable"] += decoded.undecodable
         measured = np.hstack([decoded.accel, decoded.gyro])
-        decoded = decoded.select(self.body.screen(decoded.stamps_ns, measured, decoded.frame_ids))
-        if not decoded.stamps_ns.shape[0]:
-            return []
-        if self.base is None:  # no foundation sample yet: the time base waits for it
-            self._body_waiting.append(decoded)
-            return []
-        return self._body_in(decoded)
+        reason = np.full(len(raws), "undecodable", dtype=object)
+        reason[decoded.places()] = self.body.screen(decoded.stamps_ns, measured, decoded.frame_ids)
+        out: list[tuple[str, int, bytes]] = []
+        # the rejected counted at their place, between the samples around them: the window
+        # they are reported in does not depend on how the messages were batched
+        for start, stop in _runs(reason):
+            if reason[start]:
+                self.body.reject(reason[start], stop - start)
+            elif self.base is None:  # no foundation sample yet: the time base waits for it
+                self._body_waiting.append(decoded.select(_within(decoded, start, stop)))
+            else:
+                out += self._body_in(decoded.select(_within(decoded, start, stop)))
+        return out
 
     def _body_in(self, decoded: Decoded) -> list[tuple[str, int, bytes]]:
         """Accepted body samples into the comparison, on the twin's time base."""
@@ -263,6 +268,13 @@ class TwinStream:
 
 def _runs(values: np.ndarray) -> list[tuple[int, int]]:
     """[start, stop) of each run of equal neighbours in `values`, in order."""
+    if not values.shape[0]:
+        return []
     cuts = np.flatnonzero(values[1:] != values[:-1]) + 1
-    edges = [0, *cuts.tolist(), values.shape[0]]
-    return list(pairwise(edges))
+    return list(pairwise([0, *cuts.tolist(), values.shape[0]]))
+
+
+def _within(decoded: Decoded, start: int, stop: int) -> np.ndarray:
+    """Which decoded messages came at places [start, stop) of the raw messages (bool)."""
+    places = decoded.places()
+    return (places >= start) & (places < stop)

@@ -259,3 +259,26 @@ def test_a_body_sensor_needs_every_samples_wrenches() -> None:
     data["outputs"]["decimation"] = 5
     with pytest.raises(SceneError, match=r"outputs\.decimation: 5 with a body_sensor"):
         scene_from_dict(data, "pump")
+
+
+def test_bad_body_messages_are_reported_in_the_same_window_in_any_batching() -> None:
+    """Rejected body messages are counted at their place in the stream: windows read the same
+    however the body messages come batched. Counted at a batch's start, ten garbage messages
+    among the second window's samples (5–10 s, 200 Hz) were reported in the first window by one
+    batch, in the second by batches of 1 or 7."""
+    scene, deck = _pump(frame_id="pump_imu"), _deck(12.0)
+    _, whole = _whole_record(scene, deck)
+    good = _body_raws(_stamps(deck), whole, "pump_imu")
+    garbage = set(range(1100, 2000, 90))
+    body = [b"\x00\x01garbage" if i in garbage else raw for i, raw in enumerate(good)]
+    windows = {}
+    for chunk in (1, 7, len(body)):
+        stream = TwinStream(scene)
+        out = stream.process(_deck_raws(scene, deck))
+        for k in range(0, len(body), chunk):
+            out += stream.process_body(body[k : k + chunk])
+        out += stream.finish()
+        windows[chunk] = _windows(out)
+    assert windows[1] == windows[7] == windows[len(body)]
+    counted = [int(values["body_rejected_undecodable"]) for _, _, values in windows[1]]
+    assert counted == [0, len(garbage)]

@@ -38,6 +38,9 @@ come (once body samples flow, only from the last one compared on): a body stream
 the foundation's by more loses those samples (counted `late`)."""
 PENDING_LIMIT = 100_000
 """Most body samples held waiting for the twin (a twin that stopped): the oldest go first."""
+REJECTED = ("undecodable", "nonpositive_stamp", "nonfinite", "wrong_frame_id", "stamp_back")
+"""Why a body message was not taken (`BodyCheck.screen`, and undecodable): reported as
+body_rejected_<reason> in every window, zero included."""
 PROBLEMS = ("before_twin", "late", "in_gap", "unanswered", "dropped_waiting", "lost_middleware")
 """Why a body sample accepted was not compared: before the twin's first row, behind the kept
 predictions, inside a gap of the twin's rows, after its last row, or held too long."""
@@ -301,7 +304,7 @@ class BodyCheck:
 
     def __init__(self, scene: Scene, sensor: BodySensor) -> None:
         self.sensor = sensor
-        self.counts: Counter[str] = Counter()
+        self.counts: Counter[str] = Counter({f"rejected_{r}": 0 for r in REJECTED})
         self.last_ns = 0
         """The last accepted body stamp, ns (0: none yet)."""
 
@@ -319,10 +322,10 @@ class BodyCheck:
     def screen(
         self, stamps_ns: np.ndarray, measured: np.ndarray, frame_ids: list[str]
     ) -> np.ndarray:
-        """Which body messages (stamps ns, (k, 6) readings, header.frame_ids) can be compared
-        (bool mask); the others counted as rejected_<reason>: an unset or pre-1970 stamp, a
-        value not finite, a frame_id other than body_sensor.frame_id ("": any), a stamp not
-        after every one accepted before it."""
+        """Why each body message (stamps ns, (k, 6) readings, header.frame_ids) cannot be
+        compared ('' where it can; the caller counts the others with `reject`, at their place
+        in the stream): an unset or pre-1970 stamp, a value not finite, a frame_id other than
+        body_sensor.frame_id ("": any), a stamp not after every one accepted before it."""
         expected = self.sensor.frame_id
         reasons = {
             "nonpositive_stamp": stamps_ns <= 0,
@@ -331,16 +334,21 @@ class BodyCheck:
                 [bool(expected) and f != expected for f in frame_ids], bool
             ),
         }
-        keep = np.ones(stamps_ns.shape[0], bool)
+        why = np.full(stamps_ns.shape[0], "", dtype=object)
         for reason, bad in reasons.items():
-            self.counts[f"rejected_{reason}"] += int((bad & keep).sum())
-            keep &= ~bad
-        back = keep & ~rising(stamps_ns, keep, self.last_ns)
-        self.counts["rejected_stamp_back"] += int(back.sum())
-        keep &= ~back
+            why[bad & (why == "")] = reason
+        keep = why == ""
+        why[keep & ~rising(stamps_ns, keep, self.last_ns)] = "stamp_back"
+        keep = why == ""
         if keep.any():
             self.last_ns = int(stamps_ns[keep][-1])
-        return keep
+        return why
+
+    def reject(self, reason: str, n: int) -> None:
+        """Count n body messages not compared, because `reason` (one of REJECTED)."""
+        if reason not in REJECTED:
+            raise ValueError(f"body messages rejected for {reason!r}, not one of {REJECTED}")
+        self.counts[f"rejected_{reason}"] += n
 
     def add_rows(
         self, t: np.ndarray, pose: np.ndarray, wrenches: np.ndarray, rate: np.ndarray
