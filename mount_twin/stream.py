@@ -40,7 +40,9 @@ class TwinStream:
 
     Attributes:
         engine: the streaming engine (counts, state, health).
-        last_outputs: the engine's last OutputBatch (for summaries and plots).
+        last_outputs: the engine's outputs of the last `process` or `finish` call, one
+            OutputBatch however many pushes it took (for summaries and plots; None before
+            any, or where the call pushed nothing).
         body: the body IMU's comparison with the twin (None: the scene has no body_sensor).
         body_reports: the body comparison's window reports not yet taken (`take_body_reports`;
             for summaries).
