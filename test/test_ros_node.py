@@ -416,6 +416,10 @@ def test_parameters_are_all_set_described_and_read_only(tmp_path: Path) -> None:
     ("args", "names"),
     [
         (["-p", "outputs.decimaton:=2"], "outputs.decimaton: unknown key"),
+        (  # the list names the node's own options too, not only the scene's
+            ["-p", "batch_perod_s:=0.01"],
+            "batch_perod_s: unknown parameter (known: ageing, batch_period_s, body,",
+        ),
         ([], "mount_names: required parameter is missing"),
         (["-p", "scene_file:=/nonexistent.yaml"], "/nonexistent.yaml: <file>: cannot read"),
         (["-p", "input.topic:=/deck//imu"], "input.topic: '/deck//imu' is not a ROS topic name"),
@@ -437,6 +441,7 @@ def test_parameters_are_all_set_described_and_read_only(tmp_path: Path) -> None:
     ],
     ids=[
         "unknown_key",
+        "unknown_option",
         "no_parameters",
         "bad_scene_file",
         "bad_topic",

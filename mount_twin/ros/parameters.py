@@ -24,7 +24,12 @@ from rclpy.node import Node
 from mount_twin.errors import SceneError
 from mount_twin.ros.rclpy_private import given_parameters
 from mount_twin.scene.description import Scene
-from mount_twin.scene.params import effective_parameters, flatten, parameter_description
+from mount_twin.scene.params import (
+    PARAMETERS,
+    effective_parameters,
+    flatten,
+    parameter_description,
+)
 from mount_twin.scene.yaml_reading import load_yaml
 
 
@@ -156,6 +161,7 @@ def configure(node: Node, args: Sequence[str] = ()) -> tuple[NodeOptions, Scene]
         for k, v in {**given_parameters(node), **shadowed_command_line(args, names)}.items()
         if k not in BUILT_IN and not k.startswith(QOS_OVERRIDES)
     }
+    _refuse_unknown_names(given, source)
     options = {k: given.pop(k) for k in list(given) if k in _OPTIONS}
     scene, effective, bounds = effective_parameters(given, source)
     values = _declare_options(node, options, source)
@@ -165,6 +171,25 @@ def configure(node: Node, args: Sequence[str] = ()) -> tuple[NodeOptions, Scene]
         descriptor = _described(meaning, bounds.get(name), integer=integer)
         node.declare_parameter(name, value, descriptor, ignore_override=True)
     return NodeOptions(**values), scene
+
+
+KNOWN_NAMES = frozenset({name.split(".")[0] for name in PARAMETERS} | {"mounts", *_OPTIONS})
+"""The first part of every parameter name the node takes: the scene's sections and scene
+keys (`mount_names`, `scene_file`, ...), `mounts`, and the node's own options."""
+
+
+def _refuse_unknown_names(given: dict[str, Any], source: str) -> None:
+    """A given parameter no scene section or node option starts: an error listing all of them
+    (the scene loader's own list knows only the scene's sections, and a misspelt
+    batch_period_s would read as a scene key).
+
+    Raises:
+        SceneError: naming the first unknown parameter.
+    """
+    unknown = sorted(name for name in given if name.split(".")[0] not in KNOWN_NAMES)
+    if unknown:
+        known = ", ".join(sorted(KNOWN_NAMES))
+        raise SceneError(source, unknown[0], f"unknown parameter (known: {known})")
 
 
 def _declare_options(node: Node, given: dict[str, Any], source: str) -> dict[str, Any]:
