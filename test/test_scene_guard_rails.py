@@ -376,6 +376,22 @@ def test_positions_in_millimetres_are_warned_of() -> None:
     )
 
 
+@pytest.mark.parametrize(
+    ("section", "key", "says"),
+    [
+        ("input", "sensor_position", "the twin takes the deck as rigid between them"),
+        ("body_sensor", "position", "outside the body"),
+    ],
+)
+def test_sensor_positions_in_millimetres_are_warned_of(section: str, key: str, says: str) -> None:
+    """A deck IMU 500 mm above F's origin written as 500 gave 3.4× the mount forces, and a body
+    IMU's position the same way, without a word."""
+    data = _pump()
+    data.setdefault(section, {"topic": "/pump/imu"})[key] = [0.05, 0.0, 500.5]  # CG + 500 m
+    warned = _warnings(scene_from_dict(data, "pump"))
+    assert re.search(rf"^500 m from the CG, .*{says}.* millimetres\?$", warned[f"{section}.{key}"])
+
+
 def test_a_warning_names_the_parameter_of_a_params_scene() -> None:
     flat = as_params(_pump())
     flat["mounts.fl.position"] = [900.0, 400.0, 0.0]

@@ -212,6 +212,8 @@ def test_every_declared_parameter_is_accepted_by_the_loader(name: str) -> None:
         flat[name] = EXTRA_VALUES[name]
     if name.startswith("ageing."):  # the ageing is tracked from the body IMU
         flat.setdefault("body_sensor.position", EXTRA_VALUES["body_sensor.position"])
+    if name in ("initial_state.pose", "initial_state.velocity"):  # read with a given start
+        flat["initial_state.mode"] = "given"
     scene = scene_from_params(flat, "params")
     section, _, field = name.partition(".")
     if name in EXTRA_VALUES:
@@ -352,6 +354,48 @@ BAD_SCENES = [
         r"chart degenerates",
     ),
     ("mounts_not_a_list", _set("mounts", {"fl": {}}), "mounts", r"non-empty list"),
+    (  # 20° meant: it made the wrong-sensor_rpy check (3 × 20 rad) never fire
+        "tilt_tolerance_in_degrees",
+        _set("initial_state", {"tilt_tolerance_rad": 20.0}),
+        "initial_state.tilt_tolerance_rad",
+        r"must be in \(0\.0, 1\.5707963267948966\], got 20\.0",
+    ),
+    (  # 10 % meant
+        "gravity_tolerance_in_percent",
+        _set("initial_state", {"gravity_tolerance": 10.0}),
+        "initial_state.gravity_tolerance",
+        r"must be in \(0\.0, 1\.0\], got 10\.0",
+    ),
+    (  # an equilibrium start is at rest: the velocity was ignored without a word
+        "velocity_at_an_equilibrium_start",
+        _set("initial_state", {"velocity": [0.0, 0.0, 0.1, 0.0, 0.0, 0.0]}),
+        "initial_state.velocity",
+        r"\[0\.0, 0\.0, 0\.1, 0\.0, 0\.0, 0\.0\]: read only with mode: given",
+    ),
+    (  # the free DOFs start at the equilibrium: their pose entries were ignored
+        "free_pose_at_an_equilibrium_start",
+        _set("initial_state", {"pose": [0.0, 0.0, 0.01, 0.0, 0.0, 0.0]}),
+        "initial_state.pose",
+        r"z = 0\.01 of a free DOF: read only with mode: given .*frozen DOFs",
+    ),
+    (
+        "body_frame_is_the_foundation_frame",
+        _set("frames/body", "deck"),
+        "frames.body",
+        r"'deck' is also frames\.foundation",
+    ),
+    (  # its /tf_static deck → pump beside the body's moving deck → pump on /tf
+        "mount_frame_is_the_body_frame",
+        _set("mounts/0/name", "pump"),
+        "mounts[0].name",
+        r"its frame 'pump' \(frames\.mount_prefix \+ name\) is also frames\.body",
+    ),
+    (
+        "body_sensor_on_the_input_topic",
+        _set("body_sensor", {"topic": "/deck/imu", "position": [0.0, 0.0, 0.5]}),
+        "body_sensor.topic",
+        r"'/deck/imu' is also input\.topic",
+    ),
 ]
 
 

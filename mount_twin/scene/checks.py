@@ -21,8 +21,9 @@ Warnings (SceneWarning, kept on `Scene.warnings`): values that load but are like
 - a DOF the weight overturns (negative stiffness: a CG high above soft mounts);
 - a static sag of the CG or of a mount's attachment point beyond SAG_WARN_M (stiffness in N/mm
   sags a thousand times more), and a mount's static load or deflection beyond its rated values;
-- a mount farther from the CG than FAR_FACTOR times the body's largest radius of gyration, and
-  a radius of gyration beyond GYRATION_WARN_M (positions in mm, inertia in kg·mm²);
+- a mount, the body IMU or the deck IMU farther from the CG than FAR_FACTOR times the body's
+  largest radius of gyration, and a radius of gyration beyond GYRATION_WARN_M (positions in
+  mm, inertia in kg·mm²);
 - an Imu input declared without gravity: sensor_msgs/Imu linear_acceleration is specific force.
 
 Angles beyond 2π are refused when read (`loader.ANGLE_LIMIT_RAD`), not warned of: no
@@ -39,7 +40,7 @@ import numpy as np
 
 from mount_twin.errors import SceneError
 from mount_twin.kinds.elastomer import Elastomer
-from mount_twin.scene.description import LinearMount, Scene, SceneWarning
+from mount_twin.scene.description import LinearMount, Scene, SceneWarning, Vec3
 from mount_twin.scene.statics import AXES, Statics, loose_dofs, statics
 
 STIFFNESS_LIMIT = 1.0e13
@@ -71,6 +72,7 @@ def check_scene(
     """
     _check_compactness(scene)
     _check_body_sensor(scene)
+    _check_frames(scene, mount_paths)
     st = statics(scene)
     _check_stiffness_limits(scene, st, mount_paths)
     if not st.finite:
@@ -94,6 +96,13 @@ def _check_body_sensor(scene: Scene) -> None:
         raise SceneError(
             scene.source, "ageing", "tracks mounts from the body IMU: give the body_sensor"
         )
+    if scene.body_sensor is not None and scene.body_sensor.topic == scene.input.topic:
+        raise SceneError(
+            scene.source,
+            "body_sensor.topic",
+            f"{scene.body_sensor.topic!r} is also input.topic: the body IMU is another sensor, "
+            "on the machine, on its own topic",
+        )
     if scene.body_sensor is not None and scene.outputs.decimation > 1:
         raise SceneError(
             scene.source,
@@ -101,6 +110,30 @@ def _check_body_sensor(scene: Scene) -> None:
             f"{scene.outputs.decimation} with a body_sensor: its prediction needs every "
             "sample's mount forces (decimated rows hold each component's peak), so 1",
         )
+
+
+def _check_frames(scene: Scene, mount_paths: Sequence[str]) -> None:
+    """Every frame the twin publishes on /tf and /tf_static is its own: a body frame that is
+    the foundation's is a transform to itself, and a mount frame that is the foundation's or
+    the body's gets two parents."""
+    frames = scene.frames
+    if frames.body == frames.foundation:
+        raise SceneError(
+            scene.source,
+            "frames.body",
+            f"{frames.body!r} is also frames.foundation: /tf would hold a transform from the "
+            "frame to itself",
+        )
+    taken = {frames.foundation: "frames.foundation", frames.body: "frames.body"}
+    for mount, path in zip(scene.mounts, mount_paths, strict=True):
+        frame = frames.mount_frame(mount.name)
+        if frame in taken:
+            raise SceneError(
+                scene.source,
+                f"{path}.name",
+                f"its frame {frame!r} (frames.mount_prefix + name) is also {taken[frame]}: "
+                "one frame id would be two frames on /tf and /tf_static",
+            )
 
 
 def _check_compactness(scene: Scene) -> None:
@@ -243,21 +276,37 @@ def _geometry(scene: Scene, mount_paths: Sequence[str]) -> list[SceneWarning]:
                 "machine on mounts; inertia in kg·mm², or mass in t?",
             )
         )
-    arms = np.linalg.norm(np.array([m.position for m in scene.mounts]) - body.cg, axis=1)
+    mounts = [
+        (f"{path}.position", m.position) for path, m in zip(mount_paths, scene.mounts, strict=True)
+    ]
+    found += _farthest(scene, gyration, mounts, "outside the body")
+    if scene.body_sensor is not None:
+        on_body = [("body_sensor.position", scene.body_sensor.position)]
+        found += _farthest(scene, gyration, on_body, "outside the body")
+    deck = [("input.sensor_position", scene.input.sensor_position)]
+    rigid = "the twin takes the deck as rigid between them"
+    return found + _farthest(scene, gyration, deck, rigid)
+
+
+def _farthest(
+    scene: Scene, gyration: float, points: Sequence[tuple[str, Vec3]], meaning: str
+) -> list[SceneWarning]:
+    """A warning for the farthest of `points` (key path, position m in F) that lies more than
+    FAR_FACTOR radii of gyration (m) from the CG, counting the others that do too."""
+    arms = np.linalg.norm(np.array([p for _, p in points]) - scene.body.cg, axis=1)
     far = np.flatnonzero(arms > FAR_FACTOR * gyration)
-    if far.size:
-        i = int(far[np.argmax(arms[far])])
-        found.append(
-            SceneWarning(
-                scene.source,
-                f"{mount_paths[i]}.position",
-                f"{arms[i]:.4g} m from the CG{_others(far.size - 1)}, {arms[i] / gyration:.3g} "
-                f"times the body's largest radius of gyration ({gyration:.3g} m): outside the "
-                "body; "
-                "positions in millimetres?",
-            )
+    if not far.size:
+        return []
+    i = int(far[np.argmax(arms[far])])
+    return [
+        SceneWarning(
+            scene.source,
+            points[i][0],
+            f"{arms[i]:.4g} m from the CG{_others(far.size - 1)}, {arms[i] / gyration:.3g} "
+            f"times the body's largest radius of gyration ({gyration:.3g} m): {meaning}; "
+            "positions in millimetres?",
         )
-    return found
+    ]
 
 
 def _gravity_convention(scene: Scene) -> list[SceneWarning]:

@@ -129,7 +129,7 @@ def scene_from_dict(
         mounts=mounts,
         dofs=dofs,
         input=_input(top.sub("input")),
-        initial=_initial(top.sub("initial_state")),
+        initial=_initial(top.sub("initial_state"), dofs),
         integration=_integration(top.sub("integration")),
         outputs=_outputs(top.sub("outputs")),
         frames=_frames(top.sub("frames")),
@@ -337,7 +337,25 @@ def _pose(r: Reader, key: str, default: Vec6) -> Vec6:
     return pose
 
 
-def _initial(r: Reader) -> InitialState:
+def _refuse_unread_start(r: Reader, state: InitialState, dofs: tuple[str, ...]) -> None:
+    """An equilibrium start is at rest and finds the free DOFs itself: a velocity, or a pose
+    entry of a free DOF, given with it would be ignored without a word."""
+    if any(state.velocity):
+        raise r.error(
+            "velocity",
+            f"{list(state.velocity)}: read only with mode: given (an equilibrium start is at "
+            "rest)",
+        )
+    for name, value in zip(DOF_NAMES, state.pose, strict=True):
+        if name in dofs and value:
+            raise r.error(
+                "pose",
+                f"{name} = {value!r} of a free DOF: read only with mode: given (an "
+                "equilibrium start finds the free DOFs; pose holds the frozen DOFs' values)",
+            )
+
+
+def _initial(r: Reader, dofs: tuple[str, ...]) -> InitialState:
     d = InitialState()
     state = InitialState(
         mode=r.choice("mode", ("equilibrium", "given"), d.mode),
@@ -345,9 +363,15 @@ def _initial(r: Reader) -> InitialState:
         pose=_pose(r, "pose", d.pose),
         velocity=r.vector("velocity", 6, d.velocity),
         gravity_samples=r.integer("gravity_samples", d.gravity_samples, lo=1),
-        gravity_tolerance=r.positive("gravity_tolerance", d.gravity_tolerance),
-        tilt_tolerance_rad=r.positive("tilt_tolerance_rad", d.tilt_tolerance_rad),
+        gravity_tolerance=r.number(
+            "gravity_tolerance", d.gravity_tolerance, lo=0.0, hi=1.0, lo_open=True
+        ),
+        tilt_tolerance_rad=r.number(
+            "tilt_tolerance_rad", d.tilt_tolerance_rad, lo=0.0, hi=math.pi / 2, lo_open=True
+        ),
     )
+    if state.mode == "equilibrium":
+        _refuse_unread_start(r, state, dofs)
     alpha, gamma = state.pose[3], state.pose[4]
     cos_tilt = math.sqrt(max(math.cos(gamma) ** 2 - math.sin(alpha) ** 2, 0.0))
     if not (math.cos(gamma) > 0.0 and cos_tilt > math.cos(START_TILT_MAX_RAD)):
