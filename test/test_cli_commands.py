@@ -216,6 +216,20 @@ def test_replay_with_a_bad_scene_value_exits_2_naming_key_and_value(
     )
 
 
+@pytest.mark.parametrize("text", ["", "[1, 2]\n", "input:\n"], ids=["empty", "list", "null"])
+def test_a_scene_that_is_no_mapping_exits_2_with_input_flags_too(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str
+) -> None:
+    """--topic (and --frame-id) are merged into the file's input: on an empty file, a list or
+    a null input that was an AttributeError's traceback and exit 1."""
+    scene = tmp_path / "s.scene.yaml"
+    scene.write_text(text, encoding="utf-8")
+    out = str(tmp_path / "out")
+    rc = main(["replay", "whatever", "--scene", str(scene), "--topic", "/deck/imu", "-o", out])
+    assert rc == 2
+    assert capsys.readouterr().err.startswith(f"mount-twin: error: {scene}")
+
+
 def test_replay_of_a_bag_without_the_input_topic_exits_2(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

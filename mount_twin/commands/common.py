@@ -71,8 +71,8 @@ def load_scene(path: str | Path, input_overrides: Mapping[str, str] | None = Non
 
     data = read_scene_yaml(path)
     source = str(path)
-    if input_overrides:
-        data.setdefault("input", {}).update(input_overrides)
+    if input_overrides and isinstance(data, dict) and isinstance(data.get("input", {}), dict):
+        data["input"] = {**data.get("input", {}), **input_overrides}
         source += f" (with input {', '.join(sorted(input_overrides))} from the command line)"
     scene = scene_from_dict(data, source, refuse_unheld=True)
     for warning in scene.warnings:
