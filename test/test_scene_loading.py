@@ -477,6 +477,19 @@ BAD_PARAMS = [
         "mount_names",
         r"expected a list of strings, got 'fl'",
     ),
+    (  # these three were a TypeError's traceback out of the node
+        "mount_names_an_integer",
+        {"mount_names": 5},
+        "mount_names",
+        r"expected a list of strings, got 5",
+    ),
+    ("scene_file_an_integer", {"scene_file": 5}, "scene_file", r"expected a string, got 5"),
+    (
+        "mount_listed_twice",  # it was "mounts.fr: namespace not listed in mount_names"
+        {"mount_names": ["fl", "fl", "ml1", "mr1", "ml2", "mr2", "rl", "rr"]},
+        "mount_names",
+        r"'fl' listed twice",
+    ),
 ]
 
 
@@ -489,6 +502,14 @@ def test_bad_parameter_set_fails_naming_parameter_and_value(
     flat = {**flat_params(), **change}
     with pytest.raises(SceneError, match=re.escape(f"params.yaml: {key}: ") + ".*" + rest):
         scene_from_params(flat, "params.yaml")
+
+
+def test_a_mount_namespace_that_is_a_value_fails_naming_it() -> None:
+    """`mounts: {fl: 5}` in a params file (a TypeError's traceback out of the node)."""
+    flat = {k: v for k, v in flat_params().items() if not k.startswith("mounts.fl.")}
+    flat["mounts.fl"] = 5
+    with pytest.raises(SceneError, match=re.escape("P: mounts.fl: expected its parameters")):
+        scene_from_params(flat, "P")
 
 
 def test_missing_mount_names_parameter_fails() -> None:

@@ -193,6 +193,8 @@ def effective_parameters(flat: Mapping[str, Any], source: str) -> Effective:
     paths), then the other parameters override its values (errors name the parameter).
     """
     scene_file = flat.get("scene_file", "")
+    if not isinstance(scene_file, str):
+        raise SceneError(source, "scene_file", f"expected a string, got {scene_file!r}")
     given = {k: v for k, v in flat.items() if k != "scene_file"}
     if scene_file:
         from_file = load_scene_file(scene_file)
@@ -257,9 +259,14 @@ def _mounts_as_list(tree: dict[str, Any], source: str) -> dict[str, Any]:
             "required parameter is missing (or give scene_file: a scene YAML, see "
             "config/params.yaml)",
         )
-    if isinstance(names, str) or not all(isinstance(n, str) for n in names):
+    if not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names):
         raise SceneError(source, "mount_names", f"expected a list of strings, got {names!r}")
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise SceneError(source, "mount_names", f"{twice[0]!r} listed twice")
     per_mount = tree.pop("mounts", {})
+    if not isinstance(per_mount, dict):
+        raise SceneError(source, "mounts", f"expected a namespace per mount, got {per_mount!r}")
     unknown = sorted(set(per_mount) - set(names))
     if unknown:
         raise SceneError(source, f"mounts.{unknown[0]}", "namespace not listed in mount_names")
@@ -268,6 +275,10 @@ def _mounts_as_list(tree: dict[str, Any], source: str) -> dict[str, Any]:
         if name not in per_mount:
             raise SceneError(
                 source, f"mounts.{name}", "mount listed in mount_names has no namespace"
+            )
+        if not isinstance(per_mount[name], dict):
+            raise SceneError(
+                source, f"mounts.{name}", f"expected its parameters, got {per_mount[name]!r}"
             )
         mounts.append({**per_mount[name], "name": name})
     tree["mounts"] = mounts
