@@ -157,6 +157,15 @@ def test_a_plan_runs_every_axis_and_its_criteria_judge(
         ("spectra:\n  z: z.csv\ncriteria:\n  fail_on: never\n", r"criteria\.fail_on"),
         ("spectra:\n  z: z.csv\nseed: 3\n", r"plan\.yaml: seed"),
         ("spectra:\n  z: z.csv\ntolerance_db: [1, 3]\n", r"tolerance_db: expected \[LOW, HIGH\]"),
+        (  # a TypeError's traceback
+            "spectra:\n  z: z.csv\ntolerance_db: ['-1.5', 3.0]\n",
+            r"plan\.yaml: tolerance_db\[0\]: expected a number, got '-1\.5'",
+        ),
+        (  # named neither the file nor the key
+            "spectra:\n  z: z.csv\ndamping: 5\n",
+            r"plan\.yaml: damping: ζ = 5\.0: an SRS oscillator is underdamped",
+        ),
+        ("spectra:\n  z: z.csv\nq: 0.2\n", r"plan\.yaml: q: Q = 0\.2: an SRS oscillator"),
     ],
 )
 def test_a_bad_plan_fails_at_load_naming_the_key(

@@ -88,10 +88,16 @@ def load_plan(path: str | Path) -> Plan:
     spectra.finish()
     if top.has("damping") and top.has("q"):
         raise top.error("q", "give the damping as damping (ζ) or as q, not both")
-    zeta = damping_ratio(top.number("damping", 0.05) if not top.has("q") else None, _q(top))
-    band = top.raw("tolerance_db", list(TOLERANCE_DB))
-    if not (isinstance(band, list) and len(band) == 2 and band[0] < 0.0 < band[1]):
-        raise top.error("tolerance_db", f"expected [LOW, HIGH] dB, LOW < 0 < HIGH, got {band}")
+    given = "q" if top.has("q") else "damping"
+    try:
+        zeta = damping_ratio(top.number("damping", 0.05) if given == "damping" else None, _q(top))
+    except ValueError as err:
+        raise top.error(given, str(err)) from err
+    low_db, high_db = top.vector("tolerance_db", 2, TOLERANCE_DB)
+    if not low_db < 0.0 < high_db:
+        raise top.error(
+            "tolerance_db", f"expected [LOW, HIGH] dB, LOW < 0 < HIGH, got {[low_db, high_db]}"
+        )
     criteria = top.sub("criteria")
     plan = Plan(
         files,
@@ -99,7 +105,7 @@ def load_plan(path: str | Path) -> Plan:
         top.integer("seeds", 3, lo=1, hi=1000),
         top.integer("first_seed", 0),
         top.positive("rate_hz", 20000.0),
-        (float(band[0]), float(band[1])),
+        (low_db, high_db),
         top.number("head_s", 0.05, lo=0.0),
         criteria.positive("max_utilisation", 1.0),
         criteria.choice("fail_on", FAIL_ON, "error"),
