@@ -22,6 +22,7 @@ from mount_twin.analysis.figures import (
     mount_travel,
     peak_magnitudes,
 )
+from mount_twin.engine import intake
 from mount_twin.engine.agreement import NAME as BODY_STATUS
 from mount_twin.engine.batch import (
     FAILED,
@@ -120,18 +121,13 @@ class ReplaySummary:
     def nothing_accepted(self) -> str:
         """Why no input sample was accepted ('' if some were): the rejection counts, and the
         bag's header.frame_id when it is the wrong one."""
-        if self.counts.get("accepted", 0):
-            return ""
-        why = f"{self.counts.get('received', 0)} received, rejected: {self._rejected()}"
+        detail = ""
         if self.wrong_frame_id is not None:
             from mount_twin.scene.reader import shown  # a 1 MB frame id, shortened
 
             frame = shown(self.wrong_frame_id)
-            why += f"; the bag's header.frame_id is {frame}: see input.frame_id"
-        return f"no input sample was accepted ({why})"
-
-    def _rejected(self) -> dict[str, int]:
-        return {k: v for k, v in self.counts.items() if k.startswith("rejected_") and v}
+            detail = f"; the bag's header.frame_id is {frame}: see input.frame_id"
+        return intake.nothing_accepted(self.counts, detail)
 
     @property
     def real_time_factor(self) -> float:
@@ -146,7 +142,7 @@ class ReplaySummary:
             *([f"  {nothing}"] if (nothing := self.nothing_accepted()) else []),
             *([f"  {FAILED}: {self.failure}"] if self.failure else []),
             f"  input samples: {c.get('received', 0)} received, {c.get('accepted', 0)} accepted, "
-            f"rejected: {self._rejected() or 'none'}, gaps: {c.get('gaps', 0)}, "
+            f"rejected: {intake.rejected(c) or 'none'}, gaps: {c.get('gaps', 0)}, "
             f"restarts: {c.get('restarts', 0)}, integration failures: "
             f"{c.get('integration_failures', 0)}",
             *(
@@ -160,21 +156,14 @@ class ReplaySummary:
             ),
             f"  {self.written} messages written over {self.stamp_span_s:.3f} s of stamps in "
             f"{self.wall_s:.2f} s wall: real-time factor {self.real_time_factor:.1f}",
-            f"  max CG displacement from the first published position "
-            f"{self.displacement_max_m * 1e3:.3f} mm, max tilt "
-            f"{np.degrees(self.tilt_max_rad):.4f} deg",
             f"  {_estimate_text(self.error_estimate)}",
             f"  latency: outputs {self.latency[0]} samples ({self.latency[1] * 1e3:.1f} ms) "
             "after their input, at its stamps (input.gyro_filter; none: no latency)",
-            "  peak mount loads (largest magnitude at one instant): |F| [N]  |M| [N·m]",
         ]
-        for name, peak in self.peaks.items():
-            lines.append(f"    {name:>12}: " + " ".join(f"{v:10.1f}" for v in peak))
-        if self.utilisation_max:
-            lines.append(
-                "  peak utilisation (bolt F/F_y, rubber deflection/rated, key F/allowable):"
-            )
-            lines += [f"    {n:>12}: {u:.3f}" for n, u in self.utilisation_max.items()]
+        if nothing:
+            lines.append("  motion and mount loads: none, no input sample was accepted")
+        else:
+            lines += self._figure_lines()
         lines.append(f"  mount events: {len(self.events) or 'none'}")
         for (mount, event), same in _grouped(self.events).items():
             lines.append(
@@ -189,6 +178,23 @@ class ReplaySummary:
         ]
         lines.append(f"  verdict: {self.verdict}")
         return "\n".join(lines)
+
+    def _figure_lines(self) -> list[str]:
+        """The run's motion, peak mount loads and utilisations (a run that accepted samples)."""
+        lines = [
+            f"  max CG displacement from the first published position "
+            f"{self.displacement_max_m * 1e3:.3f} mm, max tilt "
+            f"{np.degrees(self.tilt_max_rad):.4f} deg",
+            "  peak mount loads (largest magnitude at one instant): |F| [N]  |M| [N·m]",
+        ]
+        for name, peak in self.peaks.items():
+            lines.append(f"    {name:>12}: " + " ".join(f"{v:10.1f}" for v in peak))
+        if self.utilisation_max:
+            lines.append(
+                "  peak utilisation (bolt F/F_y, rubber deflection/rated, key F/allowable):"
+            )
+            lines += [f"    {n:>12}: {u:.3f}" for n, u in self.utilisation_max.items()]
+        return lines
 
     def _body_lines(self) -> list[str]:
         """What became of the body IMU's messages (none without a body_sensor)."""
@@ -210,6 +216,7 @@ class ReplaySummary:
         """The summary as JSON-ready data, units in the key names; event times `t_s` count
         from the first output, `stamp_s` are header stamps."""
         util = self.utilisation_max
+        known = not self.nothing_accepted()  # else no figures: null, not a machine at rest
         return {
             "input_bag": self.input_bag,
             "output_bag": self.output_bag,
@@ -221,8 +228,8 @@ class ReplaySummary:
             "stamp_span_s": self.stamp_span_s,
             "wall_s": self.wall_s,
             "real_time_factor": self.real_time_factor,
-            DISPLACEMENT: self.displacement_max_m,
-            "max_tilt_rad": self.tilt_max_rad,
+            DISPLACEMENT: self.displacement_max_m if known else None,
+            "max_tilt_rad": self.tilt_max_rad if known else None,
             "latency_samples": self.latency[0],
             "latency_s": self.latency[1],
             "error_estimate": self.error_estimate.as_dict() if self.error_estimate else None,
@@ -231,10 +238,10 @@ class ReplaySummary:
             else {"topic": self.body_topic, "counts": dict(self.body_counts)},
             "mounts": {
                 name: {
-                    PEAK_FORCE: float(peak[0]),
-                    PEAK_COUPLE: float(peak[1]),
-                    TRAVEL: self.travel_max_m.get(name),
-                    "utilisation_max": util.get(name),
+                    PEAK_FORCE: float(peak[0]) if known else None,
+                    PEAK_COUPLE: float(peak[1]) if known else None,
+                    TRAVEL: self.travel_max_m.get(name) if known else None,
+                    "utilisation_max": util.get(name) if known else None,
                 }
                 for name, peak in self.peaks.items()
             },

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
@@ -263,11 +264,18 @@ def test_replay_where_no_sample_is_accepted_exits_3_naming_the_frames(
     gen = ["generate", "ship-motion", "-o", str(bag), "--duration", "0.05", "--topic"]
     assert main([*gen, "/deck/imu", "--frame-id", "imu_link"]) == 0
     scene = _scene_file(tmp_path)
-    out = ["-o", str(tmp_path / "out"), "--no-progress"]
+    out = ["-o", str(tmp_path / "out"), "--no-progress", "--json", str(tmp_path / "s.json")]
     assert main(["replay", str(bag), "--scene", str(scene), *out]) == 3
-    err = capsys.readouterr().err
-    assert "no input sample was accepted (50 received" in err
-    assert "'rejected_wrong_frame': 50" in err and "frame_id is 'imu_link'" in err
+    printed = capsys.readouterr()
+    assert "no input sample was accepted (50 received" in printed.err
+    assert "'rejected_wrong_frame': 50" in printed.err and "frame_id is 'imu_link'" in printed.err
+    # no figures: peaks of 0 N and a utilisation of 0 read as a machine at rest
+    assert "motion and mount loads: none, no input sample was accepted" in printed.out
+    assert "peak mount loads" not in printed.out and "peak utilisation" not in printed.out
+    summary = json.loads((tmp_path / "s.json").read_text(encoding="utf-8"))
+    assert summary["max_cg_displacement_from_start_m"] is None
+    assert summary["max_tilt_rad"] is None
+    assert {v for m in summary["mounts"].values() for v in m.values()} == {None}
 
 
 @pytest.mark.parametrize(("fail_on", "code"), [("never", 0), ("warn", 4), ("error", 4)])

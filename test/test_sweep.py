@@ -115,6 +115,20 @@ def test_a_generated_input_of_no_or_too_many_samples_is_a_failed_case(
     assert row["verdict"] == FAILED and says in row["error"]
 
 
+def test_a_case_where_no_input_sample_is_accepted_is_a_failed_row(tmp_path: Path) -> None:
+    """Every sample of the bag refused (another frame_id): the row read ERROR with utilisation
+    0.0 and a NaN peak force, which the summary took for both the lowest and the highest."""
+    varied = "input.frame_id\n    values: [x]"
+    text = SWEEP.replace("body.mass\n    values: [1100.0, -5.0]", varied)
+    spec = load_sweep(_sweep_file(tmp_path, text))
+    case = next(c for c in check(spec) if not c.input.generate)
+    row = run_case(spec.base, spec.source, case)
+    assert row["verdict"] == FAILED
+    assert row["error"].startswith("no input sample was accepted (")
+    assert "rejected_wrong_frame" in row["error"]
+    assert not [k for k in row if k.startswith(("peak_force", "utilisation"))]  # none made
+
+
 def test_results_that_are_no_regular_file_are_an_error_before_any_case_runs(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
+from collections.abc import Mapping
 from typing import NamedTuple
 
 import numpy as np
@@ -101,6 +102,21 @@ class Judged(NamedTuple):
     due: list[int]
     intervals: Intervals
     suspect: dict[str, np.ndarray]
+
+
+def rejected(counts: Mapping[str, int]) -> dict[str, int]:
+    """The non-zero rejection counts of an engine's `counts` (rejected_<reason>)."""
+    return {k: v for k, v in counts.items() if k.startswith("rejected_") and v}
+
+
+def nothing_accepted(counts: Mapping[str, int], detail: str = "") -> str:
+    """Why no input sample was accepted, from an engine's `counts` ('' if some were): how many
+    were received and why each was rejected, then `detail`. A run like that has no figures:
+    a peak of 0 N would read as a machine at rest."""
+    if counts.get("accepted", 0):
+        return ""
+    why = f"{counts.get('received', 0)} received, rejected: {rejected(counts)}{detail}"
+    return f"no input sample was accepted ({why})"
 
 
 def rotated(rows: np.ndarray, rot: np.ndarray) -> np.ndarray:
