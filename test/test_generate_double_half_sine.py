@@ -59,6 +59,14 @@ def test_without_the_new_options_the_half_sine_is_unchanged() -> None:
         ({"duration": -0.005}, "pulse duration must be > 0 s"),
         ({"peak": math.nan}, "peak must be finite"),
         ({"peak": -100.0, "rebound": 50.0}, "> 0 with a rebound"),  # the rebound fell away
+        # these three wrote a record without the shock asked for, and exited 0
+        ({"total": 0.03}, r"the pulse ends at 0\.058 s, after the record's end at 0\.03 s"),
+        (
+            {"rebound": 50.0, "total": 0.07},  # the rebound lasts 24 ms
+            r"the pulse and its rebound end at 0\.082 s, after the record's end at 0\.07 s",
+        ),
+        ({"rate_hz": 10.0}, r"0\.008 s at 10 Hz is 0\.08 samples: give ≥ 4 \(rate ≥ 500 Hz\)"),
+        ({"lateral": math.nan}, "lateral share must be finite"),  # NaN samples, written
     ],
 )
 def test_a_pulse_that_is_no_pulse_is_refused(shape: dict[str, float], refused: str) -> None:
@@ -110,3 +118,13 @@ def test_the_bundled_genset_bag_is_what_the_documented_command_writes(tmp_path: 
         assert m0.header.frame_id == m1.header.frame_id == "deck_imu"
         a0, a1 = m0.linear_acceleration, m1.linear_acceleration
         assert (a0.x, a0.y, a0.z) == (a1.x, a1.y, a1.z)
+
+
+def test_generate_refuses_a_first_stamp_of_zero(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--start 0` wrote a bag whose first sample every replay rejected as unset (WARN)."""
+    out = tmp_path / "bag"
+    assert main(["generate", "half-sine", "-o", str(out), "--start", "0"]) == 2
+    assert "stamped 0 ns, which ROS reads as unset" in capsys.readouterr().err
+    assert not out.exists()

@@ -84,14 +84,20 @@ def write_signal(
     sig: Signal, out: str, topic: str, frame_id: str, start_ns: int, storage: str
 ) -> int:
     """Write `sig` as sensor_msgs/Imu messages stamped start_ns + t into a new bag; stamps a
-    bag cannot hold are refused before it is created."""
+    bag cannot hold, and a stamp of 0 (unset in ROS), are refused before it is created."""
     import numpy as np
 
     from mount_twin.io.bag import check_stamp, write_bag
     from mount_twin.io.messages import IMU, imu_messages
 
-    check_stamp(out, topic, start_ns)  # sig.t counts from 0
     stamps = start_ns + np.rint(sig.t * 1e9).astype(np.int64)
+    check_stamp(out, topic, int(stamps.min()))
+    if (stamps == 0).any():
+        msg = (
+            f"{out}: {topic}: a sample would be stamped 0 ns, which ROS reads as unset (the twin "
+            "rejects it): start the stamps later (--start, --offset)"
+        )
+        raise ValueError(msg)
     return write_bag(
         out, topic, IMU, iter(imu_messages(stamps, sig.accel, sig.gyro, frame_id)), storage
     )

@@ -39,6 +39,30 @@ class Signal:
     gyro: np.ndarray
 
 
+MIN_PULSE_SAMPLES = 4
+"""Fewest samples of a half-sine (and of its rebound): at 4 the sampled peak is at least
+cos(π/8) = 0.92 of it; at fewer the pulse may fall between two samples and vanish."""
+
+
+def _check_pulse_fits(
+    duration: float, rebound_s: float, rate_hz: float, pre: float, total: float
+) -> None:
+    """ValueError unless the pulse (duration, s) and its rebound (rebound_s, s; 0: none) are
+    sampled at least MIN_PULSE_SAMPLES times each at rate_hz and end by the record's end."""
+    for what, span in (("pulse", duration), ("rebound", rebound_s)):
+        if span and span * rate_hz < MIN_PULSE_SAMPLES:
+            msg = (
+                f"the {what}'s {span:.3g} s at {rate_hz:g} Hz is {span * rate_hz:.3g} samples: "
+                f"give ≥ {MIN_PULSE_SAMPLES} (rate ≥ {MIN_PULSE_SAMPLES / span:.4g} Hz)"
+            )
+            raise ValueError(msg)
+    end = pre + duration + rebound_s
+    if end > total:
+        what = "the pulse and its rebound end" if rebound_s else "the pulse ends"
+        msg = f"{what} at {end:.4g} s, after the record's end at {total:.4g} s"
+        raise ValueError(msg)
+
+
 def half_sine_shock(
     peak: float = 150.0,
     duration: float = 0.008,
@@ -76,11 +100,15 @@ def half_sine_shock(
     if not 0.0 <= rebound < math.inf:
         msg = f"rebound must be ≥ 0 (the peak of a downward pulse), got {rebound!r} m/s²"
         raise ValueError(msg)
+    if not math.isfinite(lateral):
+        msg = f"the lateral share must be finite, got {lateral!r}"
+        raise ValueError(msg)
+    length = peak * duration / rebound if rebound > 0.0 else 0.0
+    _check_pulse_fits(duration, length, rate_hz, pre, total)
     t = _sample_times(rate_hz, total)
     tau = t - pre
     a = np.where((tau >= 0.0) & (tau <= duration), peak * np.sin(math.pi * tau / duration), 0.0)
     if rebound > 0.0:
-        length = peak * duration / rebound
         tau2 = tau - duration
         inside = (tau2 > 0.0) & (tau2 <= length)
         a = a - np.where(inside, rebound * np.sin(math.pi * tau2 / length), 0.0)
