@@ -1,5 +1,7 @@
 """Errors raised by mount_twin; each message names the file, key path or message at fault."""
 
+from typing import Any
+
 
 class MountTwinError(Exception):
     """Base class of every error mount_twin raises on purpose."""
@@ -23,7 +25,14 @@ class BagError(MountTwinError):
 
 
 class DamagedBagError(BagError):
-    """An input bag is damaged part-way: what came before the damage was processed."""
+    """An input bag is damaged part-way: what came before the damage was processed.
+
+    Attributes:
+        summary: where a replay raised it, its `replay.ReplaySummary` up to the damage (its
+            `damaged` says this error); else None.
+    """
+
+    summary: Any = None
 
 
 class Terminated(BaseException):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import nullcontext
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import chain
 from pathlib import Path
 
@@ -105,6 +105,7 @@ class ReplaySummary:
     travel_max_m: dict[str, float] = field(default_factory=dict)  # per mount (`figures.TRAVEL`)
     body_counts: dict[str, int] | None = None  # the body IMU's (None: no body_sensor)
     body_topic: str = ""
+    damaged: str = ""  # the input's damage, where the replay stopped at it ('' if none)
 
     @property
     def worst_level(self) -> int:
@@ -139,6 +140,7 @@ class ReplaySummary:
         c = self.counts
         lines = [
             f"replayed {self.input_bag} -> {self.output_bag}",
+            *([f"  input damaged, replayed up to the damage: {d}"] if (d := self.damaged) else []),
             *([f"  {nothing}"] if (nothing := self.nothing_accepted()) else []),
             *([f"  {FAILED}: {self.failure}"] if self.failure else []),
             f"  input samples: {c.get('received', 0)} received, {c.get('accepted', 0)} accepted, "
@@ -222,6 +224,7 @@ class ReplaySummary:
             "output_bag": self.output_bag,
             "verdict": self.verdict,
             "failure": self.failure or None,
+            "input_damaged": self.damaged or None,
             "nothing_accepted": self.nothing_accepted() or None,
             "diagnostics_worst_level": LEVEL_NAMES[self.worst_level],
             "counts": dict(self.counts),
@@ -497,9 +500,12 @@ def replay(
             bar.update(len(raws or ()))
         if stream.final_report is not None:
             _keep_worst(worst, stream.final_report)
-        if damage:
-            raise damage[0]
         written = out.written
+        if damage:  # raised with the replay up to it (the bag is then marked partial)
+            wall = time.perf_counter() - wall0
+            up_to = _summary(scene, input_path, output_path, stream, figures, worst, written, wall)
+            damage[0].summary = replace(up_to, damaged=str(damage[0]))
+            raise damage[0]
     wall = time.perf_counter() - wall0
     return _summary(scene, input_path, output_path, stream, figures, worst, written, wall)
 

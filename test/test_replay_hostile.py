@@ -7,6 +7,7 @@ the --topic/--frame-id overrides in test_replay_inputs.py.
 
 from __future__ import annotations
 
+import json
 import shutil
 import struct
 from collections.abc import Callable
@@ -172,14 +173,22 @@ def test_bytes_zeroed_inside_an_mcap_chunk_are_no_silent_loss(
     rosbags wrote them); our reader of plain bags walks every record of the chunk, stops at
     them, and the messages before them are replayed."""
     bag = _zeroed_at_message_1000(ship["mcap"], tmp_path / "zeroed")
-    out = tmp_path / "out"
-    assert _replay(bag, out) == 5
-    err = capsys.readouterr().err
+    out, summary = tmp_path / "out", tmp_path / "s.json"
+    args = ["replay", str(bag), "--scene", str(SCENE_FILE), "-o", str(out), "--no-progress"]
+    assert main([*args, "--json", str(summary)]) == 5
+    printed = capsys.readouterr()
+    err = printed.err
     assert f"{bag}: damaged (chunk at byte " in err and "Traceback" not in err
     assert _damaged_count(err) == 1000
     _, got = read_bag(out)
     assert len(got[POSES]) == 1000
     assert _partial(out).startswith("stopped by DamagedBagError")
+    # the replay up to the damage is summarised, saying so (nothing was printed or written)
+    assert "  input damaged, replayed up to the damage: " in printed.out
+    assert "1000 accepted" in printed.out and "verdict: " in printed.out
+    data = json.loads(summary.read_text(encoding="utf-8"))
+    assert data["counts"]["accepted"] == 1000
+    assert data["input_damaged"].startswith(f"{bag}: damaged (chunk at byte ")
 
 
 def test_bytes_zeroed_where_rosbags_reads_are_caught_by_the_index_count(

@@ -110,21 +110,35 @@ def replay_and_report(
     `input_overrides`: scene `input` fields replaced (topic, frame_id), checked like the
     scene's own."""
     from mount_twin.commands.common import check_targets, load_scene
+    from mount_twin.errors import DamagedBagError
     from mount_twin.replay import replay
 
     check_targets(json=options.json_path, plot=options.plot)
     scene = load_scene(scene_path, input_overrides)
     from mount_twin.commands.stopping import checkpoint
 
-    summary = replay(
-        scene,
-        bag,
-        output,
-        chunk=options.chunk,
-        progress=options.progress,
-        checkpoint=checkpoint,
-        body_path=options.body,
-    )
+    try:
+        summary = replay(
+            scene,
+            bag,
+            output,
+            chunk=options.chunk,
+            progress=options.progress,
+            checkpoint=checkpoint,
+            body_path=options.body,
+        )
+    except DamagedBagError as err:  # exit 5, after the summary of what came before it
+        if err.summary is not None:
+            _report(err.summary, scene_path, output, options)
+        raise
+    _report(summary, scene_path, output, options)
+    return verdict(summary, options.fail_on)
+
+
+def _report(
+    summary: ReplaySummary, scene_path: str | Path, output: str, options: ReplayOptions
+) -> None:
+    """Print the summary, write it as JSON and plot the outputs, as `options` ask."""
     print(summary.text())
     if options.json_path:
         import json
@@ -139,7 +153,6 @@ def replay_and_report(
             output, options.plot, Path(scene_path).name, summary.events, summary.origin_s
         )
         print(f"plot: {png}")
-    return verdict(summary, options.fail_on)
 
 
 EXIT_NOTHING_ACCEPTED, EXIT_FAIL_ON, EXIT_FAILED = 3, 4, 6
