@@ -7,6 +7,7 @@ the --topic/--frame-id overrides in test_replay_inputs.py.
 
 from __future__ import annotations
 
+import html
 import json
 import shutil
 import struct
@@ -189,6 +190,28 @@ def test_bytes_zeroed_inside_an_mcap_chunk_are_no_silent_loss(
     data = json.loads(summary.read_text(encoding="utf-8"))
     assert data["counts"]["accepted"] == 1000
     assert data["input_damaged"].startswith(f"{bag}: damaged (chunk at byte ")
+
+
+def test_what_reads_a_partial_output_bag_says_it_is_partial(
+    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """report, export and srs --response read the output of a replay stopped at damage as if
+    it were the whole run: the page to hand over said nothing of it."""
+    out = tmp_path / "out"
+    assert _replay(_zeroed_at_message_1000(ship["mcap"], tmp_path / "zeroed"), out) == 5
+    capsys.readouterr()
+    marker = _partial(out)
+    page = tmp_path / "r.html"
+    scene = ["--scene", str(SCENE_FILE)]
+    assert main(["report", str(out), *scene, "-o", str(page)]) == 0
+    text = page.read_text(encoding="utf-8")
+    assert "(partial run)</h2>" in text and html.escape(marker) in text
+    warning = f"mount-twin: warning: {out} is partial: {marker}"
+    assert warning in capsys.readouterr().err
+    assert main(["export", str(out), "--csv", str(tmp_path / "csv")]) == 0
+    assert warning in capsys.readouterr().err
+    assert main(["srs", str(out), "--response", "cg", *scene]) == 0
+    assert warning in capsys.readouterr().err
 
 
 def test_bytes_zeroed_where_rosbags_reads_are_caught_by_the_index_count(

@@ -29,6 +29,7 @@ from mount_twin.analysis.log_labels import plain_log_labels
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
 from mount_twin.engine.health import INTEGRATION, UTILISATION_KEY
 from mount_twin.errors import ModelError
+from mount_twin.io.bag import partial_marker
 from mount_twin.io.messages import WRENCHES_OUTPUT
 from mount_twin.io.output_tables import Event, Table, events_of, read_output_bag
 from mount_twin.scene.description import STANDARD_GRAVITY, Scene
@@ -82,8 +83,10 @@ def _provenance_section(
     """The verdict, what produced the page from what, the solver's settings and estimated
     error, and the scene as loaded."""
     verdict, integration = _verdict(diagnostics)
+    partial = partial_marker(output_bag)
     rows = [
         ["verdict (worst over the run)", verdict],
+        *([["partial run", f"the bag stops early: {partial}"]] if partial else []),
         ["produced by", produced_by()],
         ["output bag", f"{output_bag} (sha256 {digest(Path(output_bag))})"],
     ]
@@ -113,7 +116,8 @@ def _provenance_section(
                 f"attitude {integration.get('est_attitude_error_rad_run', '?')} rad",
             ]
         )
-    out = [f"<h2>Verdict: {html.escape(verdict)}</h2>", html_table(["", ""], rows)]
+    heading = f"Verdict: {verdict}" + (" (partial run)" if partial else "")
+    out = [f"<h2>{html.escape(heading)}</h2>", html_table(["", ""], rows)]
     if scene is not None:
         out += scene_section(scene)
     return out

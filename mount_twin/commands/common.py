@@ -80,6 +80,17 @@ def load_scene(path: str | Path, input_overrides: Mapping[str, str] | None = Non
     return scene
 
 
+def warn_if_partial(bag: str | Path) -> str:
+    """Say on stderr that an output bag stops early (a replay stopped by a signal or at damage
+    in its input), and why: its figures are then not the whole run's. Returns the marker ('' if
+    the bag is whole)."""
+    from mount_twin.io.bag import partial_marker
+
+    if marker := partial_marker(bag):
+        print(f"mount-twin: warning: {bag} is partial: {marker}", file=sys.stderr)
+    return marker
+
+
 def write_signal(
     sig: Signal, out: str, topic: str, frame_id: str, start_ns: int, storage: str
 ) -> int:

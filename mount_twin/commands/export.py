@@ -20,6 +20,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from mount_twin.commands.common import warn_if_partial
     from mount_twin.io.output_tables import read_output_bag, write_tables
 
     fmt, directory = ("parquet", args.parquet) if args.parquet else ("csv", args.csv)
@@ -28,6 +29,7 @@ def run(args: argparse.Namespace) -> int:
 
         require("pyarrow", "--parquet")
     tables = read_output_bag(args.bag)
+    warn_if_partial(args.bag)
     for path, table in zip(write_tables(tables, directory, fmt), tables, strict=True):
         print(f"{path}: {len(table)} rows, columns {', '.join(table.columns)}")
     return 0

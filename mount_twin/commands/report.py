@@ -31,7 +31,7 @@ def run(args: argparse.Namespace) -> int:
 
     require("matplotlib", "mount-twin report")
     from mount_twin.analysis.report import write_report
-    from mount_twin.commands.common import load_scene, read_design_table
+    from mount_twin.commands.common import load_scene, read_design_table, warn_if_partial
 
     tolerance = tolerance_of(args)
     if args.design and not args.input:
@@ -53,6 +53,7 @@ def run(args: argparse.Namespace) -> int:
             f[:, 2] += scene.input.g
         samples = (decoded.stamps_ns, f)
     name = Path(args.input).name if args.input else ""
+    warn_if_partial(args.bag)
     out = write_report(
         args.bag,
         args.output,

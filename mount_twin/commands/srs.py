@@ -391,7 +391,7 @@ def _response(args: argparse.Namespace, path: Path) -> tuple[np.ndarray, np.ndar
     from the scene's input topic of `path` replayed in memory. A run whose integration failed
     is refused: its figures are not the machine's."""
     from mount_twin.analysis.response import check_response, response_of, wrenches_of
-    from mount_twin.commands.common import load_scene
+    from mount_twin.commands.common import load_scene, warn_if_partial
     from mount_twin.io.bag_info import bag_info
     from mount_twin.io.messages import output_table
 
@@ -405,7 +405,8 @@ def _response(args: argparse.Namespace, path: Path) -> tuple[np.ndarray, np.ndar
         from mount_twin.io.output_tables import read_output_bag
 
         stamps, wrenches = wrenches_of(read_output_bag(path), scene, str(path))
-        source = f"{path.name} (output bag)"
+        partial = " (partial)" if warn_if_partial(path) else ""
+        source = f"{path.name} (output bag{partial})"
     else:
         stamps, wrenches = _replayed(scene, path)
         source = f"{path.name} replayed on {scene.name}"

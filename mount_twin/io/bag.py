@@ -16,6 +16,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
+import yaml
 from rosbags.highlevel import AnyReader
 from rosbags.interfaces import (
     Qos,
@@ -399,6 +400,20 @@ def _as_ros2(value: Any) -> Any:
 
 PARTIAL_KEY = "mount_twin.partial"
 """custom_data key in an output bag's metadata.yaml present when the bag stops early."""
+
+
+def partial_marker(path: str | Path) -> str:
+    """Why an output bag stops early, from its metadata.yaml (`PARTIAL_KEY`): '' if it does
+    not, or has no metadata.yaml to say so (a storage file given alone)."""
+    meta = Path(path) / "metadata.yaml"
+    if not meta.is_file():
+        return ""
+    try:
+        info = yaml.safe_load(meta.read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
+    except (OSError, UnicodeDecodeError, yaml.YAMLError, TypeError, KeyError) as err:
+        msg = f"{meta}: cannot read the bag's metadata: {err}"
+        raise BagError(msg) from err
+    return str((info.get("custom_data") or {}).get(PARTIAL_KEY, ""))
 
 
 class OutputBag:
