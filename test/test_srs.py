@@ -471,5 +471,26 @@ def test_a_half_sine_record_meets_its_closed_form_spectrum_and_not_twice_it(
     assert max(abs(m + 20 * math.log10(2.0)) for m in result["spectra"]["margin_db"]) < 0.01
 
 
+def _strict(text: str) -> object:
+    """JSON as the standard has it: NaN and ±Infinity are no numbers."""
+
+    def refuse(constant: str) -> None:
+        raise AssertionError(f"{constant} is not JSON")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_an_axis_without_motion_is_null_in_the_json_not_minus_infinity(tmp_path: Path) -> None:
+    """Its spectrum is 0, its margin −inf dB: json wrote -Infinity, which parsers refuse."""
+    design = _design_file(tmp_path / "d.csv", [100.0, 1000.0], [10.0, 10.0])
+    doc = tmp_path / "s.json"
+    args = ["srs", str(GENSET), "--axis", "all", "--design", str(design), "--json", str(doc)]
+    assert main(args) == EXIT_OUT_OF_TOLERANCE
+    result = _strict(doc.read_text(encoding="utf-8"))
+    assert isinstance(result, dict)
+    assert set(result["spectra"]["margin_db_x"]) == {None}
+    assert [b["worst_db"] for b in result["axes"]["x"]["out_of_band"]] == [None]
+
+
 def test_the_tolerance_defaults_agree() -> None:
     assert TOLERANCE_DB == DEFAULT_BAND

@@ -20,6 +20,25 @@ DEFAULT_SCENE = "pump_8_mounts.scene.yaml"
 DEFAULT_BAG = "ship_motion_1khz"
 
 
+def json_text(doc: object, indent: int = 1) -> str:
+    """`doc` as standard JSON, every NaN or ±inf float as null: JSON has no such numbers, and
+    json.dumps would write NaN or -Infinity, which strict parsers (JavaScript's, jq) refuse
+    (an axis without motion has a margin of −inf dB)."""
+    import json
+    import math
+
+    def finite(value: object) -> object:
+        if isinstance(value, float):
+            return value if math.isfinite(value) else None
+        if isinstance(value, dict):
+            return {k: finite(v) for k, v in value.items()}
+        if isinstance(value, (list, tuple)):
+            return [finite(v) for v in value]
+        return value
+
+    return json.dumps(finite(doc), indent=indent, allow_nan=False)
+
+
 def positive_int(text: str) -> int:
     """argparse type of a count (workers, jobs, messages, substeps): an integer ≥ 1. A 0 or a
     negative one is refused at parse, naming the option (exit 2): `replay --chunk 0` had looped

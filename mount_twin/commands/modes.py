@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -40,11 +39,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from mount_twin.analysis.modes import modes
-    from mount_twin.commands.common import load_scene
+    from mount_twin.commands.common import json_text, load_scene
 
     scene = load_scene(args.scene)
     result = modes(scene, geometric=not args.no_geometric)
-    print(json.dumps(document(scene, result), indent=2) if args.json else table(scene, result))
+    print(json_text(document(scene, result), indent=2) if args.json else table(scene, result))
     return 0
 
 

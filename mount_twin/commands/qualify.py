@@ -163,11 +163,10 @@ def _said(r: InputRun, done: int, total: int) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import json
     from pathlib import Path
 
     from mount_twin.analysis.qualification import judge, verdict_text
-    from mount_twin.commands.common import check_targets, load_scene
+    from mount_twin.commands.common import check_targets, json_text, load_scene
 
     check_targets(json=args.json, report=args.report)
     plan = plan_of(args)
@@ -183,7 +182,7 @@ def run(args: argparse.Namespace) -> int:
     doc = judge(runs, plan)
     print(verdict_text(doc))
     if args.json:
-        Path(args.json).write_text(json.dumps(doc, indent=1), encoding="utf-8")
+        Path(args.json).write_text(json_text(doc), encoding="utf-8")
         print(f"json: {args.json}")
     if args.report:
         from mount_twin.analysis.qualification_report import write_qualification_report

@@ -141,9 +141,9 @@ def _report(
     """Print the summary, write it as JSON and plot the outputs, as `options` ask."""
     print(summary.text())
     if options.json_path:
-        import json
+        from mount_twin.commands.common import json_text
 
-        text = json.dumps(summary.to_dict(), indent=2)
+        text = json_text(summary.to_dict(), indent=2)
         Path(options.json_path).write_text(text, encoding="utf-8")
         print(f"json: {options.json_path}")
     if options.plot:

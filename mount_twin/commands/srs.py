@@ -298,11 +298,9 @@ def _write_json(
     zeta: float,
 ) -> None:
     """The spectra (as --csv has them), and with a design the verdict and its bands."""
-    import json
-    import math
+    from pathlib import Path
 
-    def number(v: float) -> float | None:
-        return None if math.isnan(v) else float(v)
+    from mount_twin.commands.common import json_text
 
     doc = {
         "input": args.input,
@@ -310,7 +308,7 @@ def _write_json(
         "rate_hz": rate_hz,
         "damping": zeta,
         "frequency_hz": [float(f) for f in freqs],
-        "spectra": {c.name: [number(v) for v in c.values] for c in columns},
+        "spectra": {c.name: [float(v) for v in c.values] for c in columns},
         "units": {c.name: c.unit for c in columns},
         "design": args.design,
         "tolerance_db": list(args.tolerance_db) if checks else None,
@@ -331,8 +329,7 @@ def _write_json(
             for axis, c in checks.items()
         },
     }
-    with open(args.json, "w", encoding="utf-8") as fh:
-        json.dump(doc, fh, indent=1)
+    Path(args.json).write_text(json_text(doc), encoding="utf-8")
 
 
 class Column(NamedTuple):
