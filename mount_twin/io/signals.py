@@ -103,9 +103,9 @@ def half_sine_shock(
     if not math.isfinite(lateral):
         msg = f"the lateral share must be finite, got {lateral!r}"
         raise ValueError(msg)
+    t = _sample_times(rate_hz, total)
     length = peak * duration / rebound if rebound > 0.0 else 0.0
     _check_pulse_fits(duration, length, rate_hz, pre, total)
-    t = _sample_times(rate_hz, total)
     tau = t - pre
     a = np.where((tau >= 0.0) & (tau <= duration), peak * np.sin(math.pi * tau / duration), 0.0)
     if rebound > 0.0:
