@@ -382,3 +382,50 @@ def test_a_target_no_file_can_be_written_at_is_refused_before_the_work(
     flag = command.split()[command.split().index("X") - 1]
     assert f"mount-twin: error: {flag} {target}: there is no directory" in capsys.readouterr().err
     assert not out.exists()
+
+
+CALIBRATE = (
+    "calibrate test/data/shake_table_1story/block.scene.yaml --foundation "
+    "test/data/shake_table_1story/sine_2hz_trial1_ground_excerpt.csv --body "
+    "test/data/shake_table_1story/sine_2hz_trial1_top_excerpt.csv -o OUT --plot X"
+)
+
+
+@pytest.mark.parametrize("name", ["figure.txt", "figure"])
+@pytest.mark.parametrize(
+    "command",
+    [
+        "replay bags/ship_motion_1khz --scene config/pump_8_mounts.scene.yaml -o OUT --plot X",
+        "srs bags/genset_shock_10khz --plot X",
+        "show config/pump_8_mounts.scene.yaml -o X",
+        "accuracy config/pump_8_mounts.scene.yaml bags/ship_motion_1khz --plot X",
+        "sweep config/sweep_pump.yaml -o OUT --plot X",
+        CALIBRATE,
+    ],
+    ids=lambda c: c.split()[0],
+)
+def test_a_figure_without_a_format_matplotlib_writes_is_refused_before_the_work(
+    tmp_path: Path, command: str, name: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`replay --plot x.txt` ran the replay, wrote its bag and JSON, then exited 2 with
+    matplotlib's error naming neither the option nor the file; `show -o lay` wrote lay.png and
+    printed `layout: lay`."""
+    target = tmp_path / name
+    out = tmp_path / "out"
+    args = [
+        {"X": str(target), "OUT": str(out)}.get(a, str(ROOT / a) if "/" in a else a)
+        for a in command.split()
+    ]
+    assert main(args) == 2
+    flag = {"-o": "--output"}.get(f := command.split()[command.split().index("X") - 1], f)
+    err = capsys.readouterr().err
+    assert f"mount-twin: error: {flag} {target}: a figure's file name ends in its format" in err
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
+def test_matplotlib_writes_every_figure_format_taken() -> None:
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    from mount_twin.commands.common import FIGURE_FORMATS
+
+    assert set(FIGURE_FORMATS) <= set(FigureCanvasBase.get_supported_filetypes())

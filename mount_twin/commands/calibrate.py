@@ -97,7 +97,9 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from mount_twin.analysis.calibration import calibrate
+    from mount_twin.commands.common import check_targets
 
+    check_targets(plot=args.plot)
     out = Path(args.output)
     if out.exists():
         msg = f"{out}: exists; calibrate writes a new scene file"

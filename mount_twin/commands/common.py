@@ -66,10 +66,15 @@ def share_dir() -> Path:
     raise MountTwinError(msg)
 
 
-def check_targets(**targets: str | None) -> None:
+FIGURE_FORMATS = ("png", "svg", "pdf", "svgz", "eps", "ps", "jpg", "jpeg", "tif", "tiff", "webp")
+"""The file name endings a figure may have: formats matplotlib writes (tested)."""
+
+
+def check_targets(*, figures: tuple[str, ...] = ("plot",), **targets: str | None) -> None:
     """ValueError naming the option (`--json` for json=...) of the first given path a file
-    cannot be written at (its directory missing, or a directory there): checked before long
-    work, which had run to its end to fail there with exit 2, its own exit status lost."""
+    cannot be written at (its directory missing, or a directory there; for the options named
+    in `figures`, a name not ending in one of FIGURE_FORMATS): checked before long work, which
+    had run to its end to fail there with exit 2, its own exit status lost."""
     for option, path in targets.items():
         if path is None:
             continue
@@ -79,6 +84,12 @@ def check_targets(**targets: str | None) -> None:
             raise ValueError(msg)
         if not target.parent.is_dir():
             msg = f"{flag} {path}: there is no directory {target.parent}"
+            raise ValueError(msg)
+        if option in figures and target.suffix.lower().lstrip(".") not in FIGURE_FORMATS:
+            msg = (
+                f"{flag} {path}: a figure's file name ends in its format: "
+                f"{', '.join('.' + f for f in FIGURE_FORMATS)}"
+            )
             raise ValueError(msg)
 
 

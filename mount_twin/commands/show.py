@@ -20,7 +20,8 @@ def run(args: argparse.Namespace) -> int:
 
     require("matplotlib", "mount-twin show")
     from mount_twin.analysis.layout_view import draw_layout
-    from mount_twin.commands.common import load_scene
+    from mount_twin.commands.common import check_targets, load_scene
 
+    check_targets(output=args.output, figures=("output",))
     print(f"layout: {draw_layout(load_scene(args.scene), args.output)}")
     return 0

@@ -152,8 +152,9 @@ def tolerance_of(args: argparse.Namespace) -> tuple[float, float]:
 def run(args: argparse.Namespace) -> int:
     from mount_twin.analysis.sampling import uniform
     from mount_twin.analysis.srs import ACCURATE_SHARE, damping_ratio, gravity_offset, srs
-    from mount_twin.commands.common import read_design_table
+    from mount_twin.commands.common import check_targets, read_design_table
 
+    check_targets(plot=args.plot, json=args.json, csv=args.csv)
     if args.plot:
         from mount_twin.commands.extras import require
 
