@@ -180,6 +180,19 @@ def test_a_record_the_twin_rejects_samples_of_is_referenced_as_recorded_and_said
     assert "gyro conditioning (linear_phase): " not in out
 
 
+def test_a_record_whose_every_sample_the_twin_rejects_is_refused_saying_why(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """It was numpy's "zero-size array to reduction operation maximum which has no identity"."""
+    text = (CONFIG / "pump_8_mounts.scene.yaml").read_text(encoding="utf-8")
+    scene = tmp_path / "s.scene.yaml"
+    scene.write_text(text.replace("frame_id: deck_imu", "frame_id: elsewhere"), encoding="utf-8")
+    bag = _ship_motion_bag(tmp_path / "few", slice(0, 200))
+    assert main(["accuracy", str(scene), str(bag), "--rtol", "1e-4"]) == 2
+    err = capsys.readouterr().err
+    assert "mount-twin: error: " in err and "no input sample was accepted (200 received" in err
+
+
 def test_errors_within_the_references_resolution_are_named_not_resolved() -> None:
     """The command names each rtol whose force or attitude error is within RESOLVED times what
     the reference resolves, and nothing where every error is above it."""

@@ -44,6 +44,7 @@ from mount_twin.engine.batch import OutputBatch, SampleBatch
 from mount_twin.engine.delay_line import conditioned_rates, filter_bands
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.estimate import ErrorEstimate
+from mount_twin.engine.intake import nothing_accepted
 from mount_twin.errors import MountTwinError
 from mount_twin.model.assemble import assemble
 from mount_twin.scene.description import Scene
@@ -206,7 +207,8 @@ def run_at(
 ) -> Run:
     """The twin over `samples` at `rtol` (atol = rtol·ATOL_PER_RTOL), every sample published
     (`TwinEngine.run`), with its live error estimate if `estimate` (the wall time then
-    includes the estimate's checks and propagation)."""
+    includes the estimate's checks and propagation). MountTwinError if it accepted no sample,
+    saying why."""
     atol = rtol * ATOL_PER_RTOL
     integ = dataclasses.replace(
         scene.integration,
@@ -221,6 +223,8 @@ def run_at(
     out = engine.run(samples)
     wall = time.perf_counter() - t0
     counts = engine.counts
+    if nothing := nothing_accepted(counts):  # no run to measure
+        raise MountTwinError(nothing)
     intervals = max(counts["accepted"] - counts["starts"], 1)
     return Run(
         rtol,
