@@ -63,10 +63,27 @@ def test_key_paths_set_and_scale_what_they_name() -> None:
 
 def test_a_key_path_the_scene_lacks_fails_at_load_naming_it(tmp_path: Path) -> None:
     spec = load_sweep(_sweep_file(tmp_path, SWEEP.replace("body.mass", "body.mas")))
-    with pytest.raises(SceneError, match=r"vary\[1\]\.key: body\.mas: no 'mas' here"):
+    with pytest.raises(SceneError, match=r"vary\[1\]\.key: body\.mas: unknown key \(known"):
         check(spec)
     with pytest.raises(SceneError, match=r"sweep.yaml: inputs: required key is missing"):
         load_sweep(_sweep_file(tmp_path, SWEEP.split("inputs:", maxsplit=1)[0]))
+
+
+def test_a_key_the_base_leaves_at_its_default_can_be_set(tmp_path: Path) -> None:
+    """spec.py's own example, input.gyro_stopband_hz, was refused as "no 'gyro_stopband_hz'
+    here" against the bundled base, which leaves it at its default; a misspelt one is still
+    refused at load."""
+    varied = "input.gyro_stopband_hz\n    values: [90.0, 110.0]"
+    spec = load_sweep(
+        _sweep_file(tmp_path, SWEEP.replace("body.mass\n    values: [1100.0, -5.0]", varied))
+    )
+    stopbands = {c.settings[1][2] for c in check(spec)}
+    assert stopbands == {90.0, 110.0}
+    data = apply(spec.base, (("input.gyro_stopband_hz", "set", 90.0),))
+    assert data["input"]["gyro_stopband_hz"] == 90.0
+    typo = load_sweep(_sweep_file(tmp_path, SWEEP.replace("body.mass", "input.gyro_stopbnd_hz")))
+    with pytest.raises(SceneError, match=r"vary\[1\]\.key: input\.gyro_stopbnd_hz: unknown key"):
+        check(typo)
 
 
 @pytest.mark.parametrize(

@@ -56,9 +56,12 @@ def apply(base: dict[str, Any], settings: tuple[tuple[str, str, Any], ...]) -> d
 
 
 def _targets(node: Any, segments: list[str], key: str) -> list[tuple[dict[str, Any], str]]:
-    """The (mapping, key) pairs a key path designates."""
+    """The (mapping, key) pairs a key path designates; its last key may be missing from its
+    mapping (a value the scene leaves at its default: set, it is added; whether the scene
+    knows the key is its loader's to say)."""
     match = SEGMENT.match(segments[0])
-    if not match or not isinstance(node, dict) or match.group(1) not in node:
+    last_plain = len(segments) == 1 and match is not None and match.group(2) is None
+    if not match or not isinstance(node, dict) or (match.group(1) not in node and not last_plain):
         raise KeyError(f"{key}: no {segments[0]!r} here")
     name, selector = match.groups()
     if selector is None:
@@ -94,12 +97,29 @@ def _apply_one(data: dict[str, Any], key: str, op: str, value: Any) -> None:
 
 
 def check(spec: SweepSpec) -> list[Case]:
-    """The cases, after checking that every variation's key path exists in the base scene (an
-    error names the sweep file and the variation); scene values are checked per case, where a
-    bad one is that case's failure, not the sweep's."""
+    """The cases, after checking that every variation's key path names a key of the scene (in
+    the base, or one its loader knows and the base leaves at its default; an error names the
+    sweep file and the variation); scene values are checked per case, where a bad one is that
+    case's failure, not the sweep's."""
+    in_base = _unknown_key(spec.base)  # the base's own: every case's to fail on
     for i, v in enumerate(spec.variations):
         try:
-            apply(spec.base, ((v.key, v.op, v.values[0]),))
+            data = apply(spec.base, ((v.key, v.op, v.values[0]),))
         except KeyError as err:
             raise SceneError(spec.source, f"vary[{i}].key", str(err.args[0])) from err
+        if (unknown := _unknown_key(data)) is not None and unknown != in_base:
+            raise SceneError(spec.source, f"vary[{i}].key", f"{v.key}: {unknown[1]}")
     return expand(spec)
+
+
+def _unknown_key(data: dict[str, Any]) -> tuple[str, str] | None:
+    """The scene loader's complaint about an unknown key in `data` (key path, message), or
+    None (any other complaint is about a value: the case's to fail on)."""
+    from mount_twin.scene.loader import scene_from_dict
+
+    try:
+        scene_from_dict(data, "sweep case")
+    except SceneError as err:
+        message = str(err).removeprefix(f"{err.source}: {err.path}: ")
+        return (err.path, message) if message.startswith("unknown key") else None
+    return None
