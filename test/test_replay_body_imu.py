@@ -94,6 +94,25 @@ def test_without_the_body_topic_the_summary_says_so(
     assert summary["body_sensor"]["counts"].get("received", 0) == 0
 
 
+def test_a_body_imu_never_compared_is_a_warning_not_silence(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every body message of another frame_id: no window was ever judged, so no status said
+    anything, and the run read OK."""
+    _bags(tmp_path)
+    sensor = {"topic": BODY_TOPIC, "frame_id": "machine_imu", "position": [0.8, 0.3, 1.0]}
+    scene = pump_scene_file(tmp_path, body_sensor=sensor)
+    out, doc = tmp_path / "out", tmp_path / "s.json"
+    args = ["replay", str(tmp_path / "in_both"), "--scene", str(scene), "-o", str(out)]
+    assert main([*args, "--no-progress", "--json", str(doc)]) == 0
+    summary = json.loads(doc.read_text(encoding="utf-8"))
+    status = summary["diagnostics_worst"][NAME]
+    assert summary["verdict"] == status["level"] == "WARN"
+    assert status["message"].startswith("no window of the body IMU was judged over the run: ")
+    assert "0 of 1200 messages compared" in status["message"]
+    assert "rejected_wrong_frame_id 1200" in status["message"]
+
+
 def test_a_body_bag_for_a_scene_without_a_body_sensor_is_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

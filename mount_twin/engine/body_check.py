@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mount_twin.engine.agreement import MIN_SAMPLES, agreement, window_status
-from mount_twin.engine.batch import HealthStatus
+from mount_twin.engine.agreement import MIN_SAMPLES, NAME, agreement, window_status
+from mount_twin.engine.batch import WARN, HealthStatus
 from mount_twin.engine.intake import rising
 from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.physics import pose_row
@@ -215,6 +215,11 @@ class _Matcher:
         self._pred.drop_before(min(cut, pt.shape[0] - 1))
 
 
+def _not_compared(counts: Counter[str]) -> dict[str, int]:
+    """The counts of body messages not compared, by reason (`PROBLEMS`, rejected_<reason>)."""
+    return {k: v for k, v in counts.items() if k in PROBLEMS or k.startswith("rejected_")}
+
+
 @dataclass
 class _Window:
     """Compared samples of the window being filled: chunks of (stamps ns, seconds,
@@ -251,9 +256,21 @@ class _Windows:
             self._window.chunks.append((ns[part], t[part], measured[part], residual[part]))
         return reports
 
-    def finish(self) -> list[tuple[int, HealthStatus]]:
-        """The last, partial window's report, if it spans half a window."""
-        return self._close(final=True)
+    def finish(self, counts: Counter[str], stamp_ns: int) -> list[tuple[int, HealthStatus]]:
+        """The last, partial window's report, if it spans half a window; if no window was
+        judged over the run although body messages came (`counts`), a WARN saying why,
+        stamped `stamp_ns`: silence would read as a check passed."""
+        reports = self._close(final=True)
+        if reports or self._reported or not counts["received"]:
+            return reports
+        missed = ", ".join(f"{k} {v}" for k, v in _not_compared(counts).items() if v)
+        message = (
+            f"no window of the body IMU was judged over the run: {counts['compared']} of "
+            f"{counts['received']} messages compared (a window needs {MIN_SAMPLES} over half "
+            f"its {self._sensor.window_s:g} s)" + (f"; not compared: {missed}" if missed else "")
+        )
+        values = {f"body_{k}": str(v) for k, v in counts.items()}
+        return [(stamp_ns, HealthStatus(NAME, WARN, message, values))]
 
     def _close(self, final: bool = False) -> list[tuple[int, HealthStatus]]:
         window, self._window = self._window, None
@@ -262,11 +279,7 @@ class _Windows:
         ns, t, measured, residual = (np.concatenate(a) for a in zip(*window.chunks, strict=True))
         if t.shape[0] < MIN_SAMPLES or (final and t[-1] - t[0] < 0.5 * self._sensor.window_s):
             return []  # too short to judge (the last: its band barely resolved)
-        problems = {
-            k: self._problems[k] - self._reported[k]
-            for k in self._problems
-            if k in PROBLEMS or k.startswith("rejected_")
-        }
+        problems = {k: v - self._reported[k] for k, v in _not_compared(self._problems).items()}
         self._reported = Counter(self._problems)
         figures = agreement(t, measured, residual, self._sensor)
         span = (float(t[-1] - t[0]), int(t.shape[0]))
@@ -307,6 +320,8 @@ class BodyCheck:
         self.counts: Counter[str] = Counter({f"rejected_{r}": 0 for r in REJECTED})
         self.last_ns = 0
         """The last accepted body stamp, ns (0: none yet)."""
+        self.seen_ns = 0
+        """The latest stamp of any body message screened, ns (0: none with a stamp)."""
 
         geometry = SensorGeometry.of(scene, sensor)
 
@@ -342,6 +357,7 @@ class BodyCheck:
         keep = why == ""
         if keep.any():
             self.last_ns = int(stamps_ns[keep][-1])
+        self.seen_ns = max(self.seen_ns, int(stamps_ns.max(initial=0)))
         return why
 
     def reject(self, reason: str, n: int) -> None:
@@ -369,7 +385,7 @@ class BodyCheck:
         counted, the last window judged."""
         self._matcher.add_predictions(*self._lead.finish())
         out = self._compared(final=True)
-        out.reports += self._windows.finish()
+        out.reports += self._windows.finish(self.counts, self.seen_ns)
         return out
 
     def _compared(self, final: bool = False) -> BodyComparison:
