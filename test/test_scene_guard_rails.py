@@ -65,6 +65,22 @@ def test_a_key_given_twice_is_an_error_naming_the_lines(tmp_path: Path) -> None:
         load_scene_file(_file(tmp_path, text))
 
 
+@pytest.mark.parametrize(
+    ("value", "says"),
+    [("010", "octal: 8"), ("-0010", "octal: -8"), ("1:30", "base 60: 90")],
+)
+def test_an_integer_yaml_1_1_reads_otherwise_is_an_error(
+    tmp_path: Path, value: str, says: str
+) -> None:
+    """`decimation: 010` loaded as 8, `max_substeps: 010000` as 4096, without a word."""
+    text = _pump_text().replace("  decimation: 1\n", f"  decimation: {value}\n")
+    line = text.splitlines().index(f"  decimation: {value}") + 1
+    with pytest.raises(
+        SceneError, match=rf"<file>: line {line}: {value} is read by YAML 1\.1 as {says}; write"
+    ):
+        load_scene_file(_file(tmp_path, text))
+
+
 def test_a_key_given_twice_inside_a_mount_is_an_error_too(tmp_path: Path) -> None:
     text = _pump_text().replace(
         "    kind: linear\n    position: [0.9, 0.4, 0.0]\n",

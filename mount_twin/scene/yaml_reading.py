@@ -6,6 +6,8 @@
   and a sign as a string).
 - Aliases (`*name`) are refused: nested aliases expand exponentially ("billion laughs") and a
   scene is small enough to write out.
+- An integer with a leading zero (`010`, octal 8 in YAML 1.1) or colons (`1:30`, base 60: 90)
+  is refused: the value read is not the one written.
 - Nesting deeper than MAX_DEPTH is refused instead of exhausting the recursion.
 - A text longer than MAX_CHARS is refused before it is parsed (PyYAML reads ~0.3 MB/s: a 20 000
   mount file took 8 s only to be refused for its mount count), and an integer written with more
@@ -30,6 +32,9 @@ MAX_CHARS = 1_000_000
 0.4 MB; PyYAML parses 1 MB in ~4 s)."""
 MAX_INT_CHARS = 30
 """Longest integer scalar accepted, characters."""
+READ_OTHERWISE = re.compile(r"^[-+]?(?:0[0-9_]+|[0-9][0-9_]*(?::[0-5]?[0-9])+)$")
+"""Integers YAML 1.1 does not read in base 10: a leading zero (010 is octal 8) and colons
+(1:30 is base 60, 90)."""
 FLOAT_WITH_EXPONENT = re.compile(
     r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9][0-9_]*)[eE][-+]?[0-9]+$"
 )
@@ -79,7 +84,14 @@ class SceneLoader(yaml.SafeLoader):
                 f"line {node.start_mark.line + 1}: an integer of {len(node.value)} characters "
                 f"(at most {MAX_INT_CHARS} are accepted)"
             )
-        return super().construct_yaml_int(node)  # type: ignore[no-any-return]
+        value: int = super().construct_yaml_int(node)  # type: ignore[no-untyped-call]
+        if READ_OTHERWISE.match(node.value):
+            base = "base 60" if ":" in node.value else "octal"
+            raise SceneYamlError(
+                f"line {node.start_mark.line + 1}: {node.value} is read by YAML 1.1 as "
+                f"{base}: {value}; write the number you mean without a leading zero or ':'"
+            )
+        return value
 
 
 def _hashable(key: Any) -> bool:
