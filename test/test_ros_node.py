@@ -465,6 +465,22 @@ def test_configuration_errors_end_the_node_with_one_line_naming_the_parameter(
     assert "Traceback" not in node.stderr
 
 
+def test_a_params_file_key_given_twice_ends_the_node_naming_the_file_and_lines(
+    tmp_path: Path,
+) -> None:
+    """rcl keeps the last of `mass: -1.0` and `mass: 1200.0`, and the node ran; a scene file
+    refuses a key given twice, and a params file is read by the same rules now."""
+    text = PARAMS_FILE.read_text(encoding="utf-8")
+    params = tmp_path / "p.yaml"
+    params.write_text(text.replace("mass: ", "mass: -1.0\n      mass: ", 1), encoding="utf-8")
+    node = NodeProcess(fresh_domain(), ["--params-file", str(params)])
+    code = node.wait(60.0)
+    lines = [ln for ln in node.stderr.splitlines() if not ln.startswith("[")]
+    assert code == 2, node.stderr
+    assert len(lines) == 1 and f"{params}: <file>: line " in lines[0], node.stderr
+    assert "key 'mass' given twice in one mapping" in lines[0]
+
+
 def test_the_command_line_outranks_a_params_file_section_for_the_node(tmp_path: Path) -> None:
     """rcl reads params files after every -p: the node takes back the -p values that a file's
     section for it (its name, its full name, or /**) also sets, and only those."""

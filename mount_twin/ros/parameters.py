@@ -16,7 +16,6 @@ from dataclasses import dataclass
 from itertools import pairwise
 from typing import Any
 
-import yaml
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.exceptions import InvalidParameterValueException
 from rclpy.node import Node
@@ -24,6 +23,7 @@ from rclpy.node import Node
 from mount_twin.errors import SceneError
 from mount_twin.ros.rclpy_private import given_parameters
 from mount_twin.scene.description import Scene
+from mount_twin.scene.loader import read_scene_yaml
 from mount_twin.scene.params import (
     PARAMETERS,
     effective_parameters,
@@ -127,6 +127,10 @@ def shadowed_command_line(args: Sequence[str], names: set[str]) -> dict[str, Any
     rcl reads the params files after every `-p`, so a file outranks the command line whatever
     their order: `--params-file params.yaml -p body.mass:=heavy` ran on the file's 1200 kg
     without a word. The node takes the command line's values back, as a user means them.
+
+    Raises:
+        SceneError: a params file breaks the scene files' YAML rules (a key given twice in
+            one mapping, which rcl reads as its last value), naming the file and lines.
     """
     tokens = _ros_arguments(args)
     given: dict[str, Any] = {}
@@ -137,9 +141,8 @@ def shadowed_command_line(args: Sequence[str], names: set[str]) -> dict[str, Any
             target, _, name = name.rpartition(":")
             if not target or target.lstrip("/") in names:
                 given[name] = load_yaml(text)  # 1.5e3 a float, as rcl reads it
-        elif flag == "--params-file":
-            with open(value, encoding="utf-8") as f:  # rcl has read it: it exists and parses
-                sections = yaml.safe_load(f) or {}
+        elif flag == "--params-file":  # rcl has read it; read by the scene files' rules
+            sections = read_scene_yaml(value) or {}  # (a key given twice: rcl keeps the last)
             for section, body in sections.items():
                 if str(section).lstrip("/") in {*names, "**"} and isinstance(body, dict):
                     in_files |= {n for n, _ in flatten(body.get("ros__parameters") or {})}
