@@ -296,6 +296,12 @@ BAD_SCENES = [
         r"got -1\.0",
     ),
     ("typo_in_body_key", _set("body/mas", 3.0), "body.mas", r"unknown key"),
+    (  # it said only that mass was missing
+        "misspelt_required_key",
+        lambda d: d["body"].update(mas=d["body"].pop("mass")),
+        "body.mass",
+        r"required key is missing \(given: 'mas', misspelt\?\)",
+    ),
     ("typo_in_top_level_key", _set("intergration", {}), "intergration", r"unknown key"),
     (
         "typo_in_mount_key",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import difflib
 import math
 import reprlib
 from collections.abc import Mapping, Sequence
@@ -94,7 +95,10 @@ class Reader:
         if key in self.data:
             value = self.data[key]
         elif default is None:
-            raise self.error(key, "required key is missing")
+            unread = [str(k) for k in self.data if k not in self._used]
+            close = difflib.get_close_matches(key, unread, n=1, cutoff=0.6)
+            hint = f" (given: {close[0]!r}, misspelt?)" if close else ""
+            raise self.error(key, f"required key is missing{hint}")
         else:
             value = default
         if self.record is not None and not isinstance(value, Mapping):
