@@ -12,6 +12,7 @@ import pytest
 from io_helpers import CONFIG, ROOT, read_bag
 
 from mount_twin.cli import main
+from mount_twin.io.output_tables import Table, events_of
 from mount_twin.replay import replay
 from mount_twin.scene import load_scene_file
 
@@ -111,8 +112,35 @@ def test_the_events_table_holds_every_mount_event_of_the_run(tmp_path: Path) -> 
     for e in summary.events:
         want[(e.mount, e.event)] = want.get((e.mount, e.event), 0) + 1
     assert counts == want
+    # to the nanosecond and the bit (they were the message's µs and 4 digits: 135500.0 N)
+    for key in want:
+        mine = [e for e in summary.events if (e.mount, e.event) == key]
+        assert first[key] == summary.origin_s * 10**9 + round(mine[0].stamp * 1e9)
+        forces = [float(r["force_max_N"]) for r in rows if (r["mount"], r["event"]) == key]
+        assert max(forces) == max(e.force for e in mine)
     pose = _csv(tmp_path / "t" / "pose.csv")
     stamps = [int(r["stamp_ns"]) for r in rows]
     assert stamps == sorted(stamps)
     assert int(pose[0]["stamp_ns"]) - 1000 <= min(first.values())
     assert max(stamps) <= int(pose[-1]["stamp_ns"]) + 1000
+
+
+def test_events_of_a_bag_recorded_before_the_full_values_are_read_from_the_message() -> None:
+    """Mount statuses without `<event>.first_stamp_ns` (a node before them): the message's
+    µs and four digits."""
+    diagnostics = Table(
+        "diagnostics",
+        {
+            "stamp_ns": np.array([2_000_000_000]),
+            "t_s": np.array([0.0]),
+            "status": np.array(["mount_twin: mount fl"], dtype=object),
+            "level": np.array(["ERROR"], dtype=object),
+            "message": np.array(
+                ["joint_opened ×3 (first 1.234567 s, |F| max 4.5e+04 N)"], dtype=object
+            ),
+            "values": np.array(['{"events": "3"}'], dtype=object),
+        },
+    )
+    (event,) = events_of(diagnostics, 1_000_000_000)
+    assert (event.mount, event.event, event.count) == ("fl", "joint_opened", 3)
+    assert event.t_s == pytest.approx(0.234567, abs=1e-12) and event.force_n == 45000.0

@@ -420,6 +420,7 @@ class HealthWindow:
             values = {key: f"{v:.6g}" for key, v in zip(PEAK_KEYS, peak, strict=True)}
             values[UTILISATION_KEY] = "n/a" if math.isnan(u) else f"{u:.6g}"
             values[EVENTS_KEY] = str(len(mine))
+            values.update(_event_values(mine, self.origin_s))
             values[NOW_KEY] = ", ".join(name for name, _ in now) or "none"
             text = _events_text(mine, u, self.origin_s)
             if now:
@@ -614,6 +615,18 @@ def _lost_text(
     if reported:
         sources.append("reported " + ", ".join(f"{k} {v}" for k, v in reported.items()))
     return f"~{lost} samples lost in this period ({100.0 * share:.1f} %, {'; '.join(sources)})"
+
+
+def _event_values(events: list[MountEvent], origin_s: int) -> dict[str, str]:
+    """Per event kind of the period, in full: `<event>.count`, `<event>.first_stamp_ns` (the
+    header stamp of its first, ns) and `<event>.force_max_N` (the largest |F|, N, repr)."""
+    values = {}
+    for name in dict.fromkeys(e.event for e in events):
+        same = [e for e in events if e.event == name]
+        values[f"{name}.count"] = str(len(same))
+        values[f"{name}.first_stamp_ns"] = str(origin_s * 10**9 + round(same[0].stamp * 1e9))
+        values[f"{name}.force_max_N"] = repr(max(e.force for e in same))
+    return values
 
 
 def _events_text(events: list[MountEvent], utilisation: float, origin_s: int) -> str:

@@ -123,22 +123,29 @@ class Event:
 
 
 def events_of(diagnostics: Table, origin_ns: int) -> list[Event]:
-    """Mount event groups named in the diagnostics messages, in time order; each at its own
-    kind's level (the mount status' level is that of its worst event in the period)."""
+    """Mount event groups of the diagnostics' mount statuses, in time order; each at its own
+    kind's level (the mount status' level is that of its worst event in the period). Read in
+    full from the status's values (`<event>.count`, `.first_stamp_ns`, `.force_max_N`), or
+    where a bag recorded before those has none, from its message (µs, 4 digits)."""
     out = []
     c = diagnostics.columns
-    for status, message in zip(c["status"], c["message"], strict=True):
+    for status, message, pairs in zip(c["status"], c["message"], c["values"], strict=True):
         if not status.startswith("mount_twin: mount "):
             continue
-        for name, count, first, force in EVENT.findall(message):
-            t = float(first) - origin_ns * 1e-9
+        values = json.loads(pairs)
+        for name, count, first, force_text in EVENT.findall(message):
+            if f"{name}.first_stamp_ns" in values:
+                t = (int(values[f"{name}.first_stamp_ns"]) - origin_ns) * 1e-9
+                force = float(values[f"{name}.force_max_N"])
+            else:
+                t, force = float(first) - origin_ns * 1e-9, float(force_text)
             out.append(
                 Event(
                     status.removeprefix("mount_twin: mount "),
                     name,
                     int(count),
                     t,
-                    float(force),
+                    force,
                     event_level(EVENT_IS_ERROR[name]),
                 )
             )
