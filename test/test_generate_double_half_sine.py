@@ -128,3 +128,20 @@ def test_generate_refuses_a_first_stamp_of_zero(
     assert main(["generate", "half-sine", "-o", str(out), "--start", "0"]) == 2
     assert "stamped 0 ns, which ROS reads as unset" in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "says"),
+    [
+        ("--topic", "bad topic", "--topic 'bad topic': not a ROS topic name"),
+        ("--frame-id", "deck imu", "--frame-id 'deck imu': not a frame id (it has whitespace)"),
+    ],
+)
+def test_generate_refuses_a_topic_or_frame_id_no_scene_could_take(
+    tmp_path: Path, option: str, value: str, says: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """It wrote the bag and exited 0; no scene can name that topic or frame id."""
+    out = tmp_path / "bag"
+    assert main(["generate", "half-sine", "-o", str(out), option, value]) == 2
+    assert says in capsys.readouterr().err
+    assert not out.exists()
