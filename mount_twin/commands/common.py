@@ -124,8 +124,9 @@ def warn_if_partial(bag: str | Path) -> str:
 def write_signal(
     sig: Signal, out: str, topic: str, frame_id: str, start_ns: int, storage: str
 ) -> int:
-    """Write `sig` as sensor_msgs/Imu messages stamped start_ns + t into a new bag; stamps a
-    bag cannot hold, and a stamp of 0 (unset in ROS), are refused before it is created."""
+    """Write `sig` as sensor_msgs/Imu messages stamped start_ns + t into a new bag; a topic
+    that is no ROS topic name, a frame id with whitespace, stamps a bag cannot hold and a
+    stamp of 0 (unset in ROS) are refused before it is created."""
     import numpy as np
 
     from mount_twin.io.bag import check_stamp, write_bag
