@@ -145,3 +145,12 @@ def test_generate_refuses_a_topic_or_frame_id_no_scene_could_take(
     assert main(["generate", "half-sine", "-o", str(out), option, value]) == 2
     assert says in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-0.1"])
+def test_generate_refuses_a_duration_that_is_no_length_naming_it(
+    tmp_path: Path, value: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--duration nan` said "cannot convert float NaN to integer"."""
+    assert main(["generate", "ship-motion", "-o", str(tmp_path / "b"), "--duration", value]) == 2
+    assert f"duration must be > 0 s and finite, got {float(value)!r}" in capsys.readouterr().err

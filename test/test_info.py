@@ -9,6 +9,9 @@ import pytest
 from io_helpers import CONFIG, ROOT
 
 from mount_twin.cli import main
+from mount_twin.io.bag import OutputBag
+from mount_twin.io.bag_info import bag_info
+from mount_twin.io.messages import IMU
 
 
 def test_a_bag_lists_its_topics_types_and_counts(capsys: pytest.CaptureFixture[str]) -> None:
@@ -38,5 +41,32 @@ def test_a_scene_lists_its_mounts_input_and_resolved_outputs(
 def test_an_unreadable_bag_is_an_error_naming_it(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["info", str(tmp_path / "nothing")]) == 2
-    assert f"{tmp_path / 'nothing'}: cannot read the bag" in capsys.readouterr().err
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(b"not a bag")
+    assert main(["info", str(junk)]) == 2
+    assert f"{junk}: cannot read the bag" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", ["info", "export", "report"])
+def test_a_missing_bag_is_named_plainly(
+    tmp_path: Path, command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """It read "The following paths are missing: [PosixPath('...')]" (rosbags' own text)."""
+    missing = tmp_path / "nonexist"
+    extra = {
+        "export": ["--csv", str(tmp_path / "csv")],
+        "report": ["-o", str(tmp_path / "r.html")],
+    }
+    assert main([command, str(missing), *extra.get(command, [])]) == 2
+    err = capsys.readouterr().err
+    assert f"mount-twin: error: {missing}: no such file or directory" in err
+    assert "PosixPath" not in err
+
+
+def test_a_bag_without_messages_has_no_start(tmp_path: Path) -> None:
+    """Its start read 9223372036.854776382 s (rosbags' empty minimum)."""
+    empty = tmp_path / "empty"
+    with OutputBag(empty, {"/deck/imu": IMU}):
+        pass
+    text = bag_info(empty).text()
+    assert "start:     none (no message)" in text and "922337" not in text

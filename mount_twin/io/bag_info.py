@@ -12,6 +12,14 @@ from mount_twin.errors import BagError
 from mount_twin.io.messages import TYPESTORE
 
 
+def require_existing(path: str | Path) -> None:
+    """BagError naming `path` if nothing is there (rosbags says "The following paths are
+    missing: [PosixPath(...)]")."""
+    if not Path(path).exists():
+        msg = f"{path}: no such file or directory"
+        raise BagError(msg)
+
+
 @dataclass(frozen=True)
 class TopicInfo:
     """One topic: name, message type, message count."""
@@ -37,7 +45,9 @@ class BagInfo:
         lines = [
             f"bag:       {self.path}",
             f"duration:  {span:.6f} s",
-            f"start:     {self.start_ns * 1e-9:.9f} s (log time)",
+            f"start:     {self.start_ns * 1e-9:.9f} s (log time)"
+            if self.messages
+            else "start:     none (no message)",
             f"messages:  {self.messages}",
             "topics:",
         ]
@@ -48,6 +58,7 @@ class BagInfo:
 
 def bag_info(path: str | Path) -> BagInfo:
     """Read a bag's metadata (mcap, sqlite3 or ROS 1, as rosbags reads them); errors name it."""
+    require_existing(path)
     try:
         with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
             topics = sorted(

@@ -22,6 +22,7 @@ from rosbags.highlevel import AnyReader
 
 from mount_twin.engine.batch import event_level
 from mount_twin.errors import BagError
+from mount_twin.io.bag_info import require_existing
 from mount_twin.io.messages import DIAGNOSTICS, OUTPUTS, TYPESTORE, Readback, output_table
 from mount_twin.kinds.events import EVENT_IS_ERROR
 
@@ -50,6 +51,7 @@ def read_output_bag(path: str | Path) -> list[Table]:
     rows: dict[str, list[tuple[Any, ...]]] = {}
     columns_of: dict[str, Readback | None] = {}
     rank: dict[str, int] = {}
+    require_existing(path)
     try:
         with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
             tables_of: dict[int, tuple[str, Readback | None]] = {}

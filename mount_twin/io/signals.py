@@ -20,6 +20,9 @@ def _sample_times(rate_hz: float, total: float) -> np.ndarray:
     if not 0.0 < rate_hz < math.inf:
         msg = f"rate must be > 0 Hz and finite, got {rate_hz!r}"
         raise ValueError(msg)
+    if not 0.0 < total < math.inf:
+        msg = f"duration must be > 0 s and finite, got {total!r}"
+        raise ValueError(msg)
     n = total * rate_hz
     if not 1.0 <= round(n) <= MAX_SAMPLES:
         msg = (
