@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 import threading
 from collections.abc import Sequence
@@ -73,10 +74,11 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, Command]]:
     return parser, modules
 
 
-EXIT_DAMAGED, EXIT_SIGINT, EXIT_SIGTERM = 5, 130, 143
+EXIT_DAMAGED, EXIT_SIGINT, EXIT_SIGPIPE, EXIT_SIGTERM = 5, 130, 141, 143
 """Exit statuses besides 0 and the commands' own: 2 bad input or configuration (named), 5 an
 input damaged part-way (what came before it was processed), 128 + the signal's number when
-stopped by SIGINT (Ctrl-C) or SIGTERM (output bags are finished and marked partial)."""
+stopped by SIGINT (Ctrl-C) or SIGTERM (output bags are finished and marked partial), or when
+the reader of the output closed it (SIGPIPE: `| head`), silently, as a Unix tool is."""
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -89,7 +91,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         polls = getattr(modules[args.cmd], "STOPS_AT_CHECKPOINTS", False)
         stopping.install(polls)
     try:
-        return modules[args.cmd].run(args)
+        code = modules[args.cmd].run(args)
+        sys.stdout.flush()  # here, not at exit: a reader gone (`| head`) is seen below
+        return code
+    except BrokenPipeError:  # the reader closed the pipe: it took what it wanted, as `head`
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing left to flush
+        return EXIT_SIGPIPE
     except DamagedBagError as err:
         print(f"mount-twin: error: {err}{_partial(args)}", file=sys.stderr)
         return EXIT_DAMAGED

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import re
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -120,3 +121,19 @@ def test_a_missing_optional_dependency_is_named_with_its_extra() -> None:
     finally:
         del EXTRAS["no_such_module_for_this_test"]
     require("numpy", "anything")  # installed: no error
+
+
+def test_a_reader_that_closes_the_pipe_ends_the_command_quietly_with_141() -> None:
+    """`mount-twin srs BAG | head -1` printed "mount-twin: error: [Errno 32] Broken pipe" and
+    exited 2, as for bad input."""
+    child = subprocess.Popen(
+        [sys.executable, "-m", "mount_twin.cli", "info", str(ROOT / "bags" / "ship_motion_1khz")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        cwd=ROOT,
+    )
+    assert child.stdout is not None and child.stderr is not None
+    child.stdout.close()  # gone before anything is written
+    err = child.stderr.read().decode()
+    assert child.wait(timeout=60) == 141
+    assert err == ""
