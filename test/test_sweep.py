@@ -89,6 +89,24 @@ def test_a_key_the_base_leaves_at_its_default_can_be_set(tmp_path: Path) -> None
 @pytest.mark.parametrize(
     ("edit", "says"),
     [
+        (  # every case ran and FAILED, exit 5, none naming the key
+            ("half_sine_shock_10khz", "no_such_bag"),
+            r"inputs\[0\]\.bag: no such file or directory: .*no_such_bag",
+        ),
+        (("scale: [0.5, 2.0]", "scale: [true, 2.0]"), r"vary\[0\]\.scale: expected numbers"),
+    ],
+    ids=["missing-bag", "boolean-scale"],
+)
+def test_a_bad_input_or_scale_fails_at_load_naming_it(
+    tmp_path: Path, edit: tuple[str, str], says: str
+) -> None:
+    with pytest.raises(SceneError, match=says):
+        load_sweep(_sweep_file(tmp_path, SWEEP.replace(*edit)))
+
+
+@pytest.mark.parametrize(
+    ("edit", "says"),
+    [
         ((f"base: {PUMP}", "base: /dev/zero"), "/dev/zero: <file>: cannot read: larger than"),
         (
             ("values: [1100.0, -5.0]", "range: {start: 1.0, stop: 2.0, num: 1000000000}"),

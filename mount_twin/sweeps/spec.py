@@ -119,7 +119,8 @@ def _variation(r: Reader) -> Variation:
         if not isinstance(raw, list) or not raw:
             raise r.error(ops[0], f"expected a non-empty list, got {raw!r}")
         values, op = tuple(raw), "scale" if ops[0] == "scale" else "set"
-        if op == "scale" and not all(isinstance(v, (int, float)) for v in values):
+        numbers = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
+        if op == "scale" and not numbers:  # (a bool is an int: true scaled by 1)
             raise r.error("scale", f"expected numbers, got {raw!r}")
     r.finish()
     return Variation(key, op, values)
@@ -128,6 +129,8 @@ def _variation(r: Reader) -> Variation:
 def _input(r: Reader, folder: Path) -> InputCase:
     if "bag" in r.data:
         bag = str((folder / r.string("bag")).resolve())
+        if not Path(bag).exists():
+            raise r.error("bag", f"no such file or directory: {bag}")
         case = InputCase(r.string("name", Path(bag).name), bag=bag)
     else:
         g = r.sub("generate", optional=False)
