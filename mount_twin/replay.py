@@ -20,6 +20,7 @@ from mount_twin.analysis.figures import (
     TRAVEL,
     displacement_from_start,
     mount_travel,
+    peak_label,
     peak_magnitudes,
 )
 from mount_twin.engine import intake
@@ -106,6 +107,7 @@ class ReplaySummary:
     body_counts: dict[str, int] | None = None  # the body IMU's (None: no body_sensor)
     body_topic: str = ""
     damaged: str = ""  # the input's damage, where the replay stopped at it ('' if none)
+    decimation: int = 1  # outputs.decimation: what the peaks are (`figures.peak_label`)
 
     @property
     def worst_level(self) -> int:
@@ -187,7 +189,7 @@ class ReplaySummary:
             f"  max CG displacement from the first published position "
             f"{self.displacement_max_m * 1e3:.3f} mm, max tilt "
             f"{np.degrees(self.tilt_max_rad):.4f} deg",
-            "  peak mount loads (largest magnitude at one instant): |F| [N]  |M| [N·m]",
+            f"  peak mount loads ({peak_label(self.decimation)}): |F| [N]  |M| [N·m]",
         ]
         for name, peak in self.peaks.items():
             lines.append(f"    {name:>12}: " + " ".join(f"{v:10.1f}" for v in peak))
@@ -544,4 +546,5 @@ def _summary(
         {m.name: float(figures.travel[i]) for i, m in enumerate(scene.mounts)},
         None if stream.body is None else dict(stream.body.counts),
         scene.body_sensor.topic if scene.body_sensor else "",
+        decimation=scene.outputs.decimation,
     )

@@ -24,6 +24,18 @@ DISPLACEMENT = "max_cg_displacement_from_start_m"
 TRAVEL = "travel_max_m"
 
 
+def peak_label(decimation: int) -> str:
+    """What the peak |F|, |M| of rows published every `decimation` samples are: at
+    decimation 1, the largest at one instant; above, each row holds each component's peak
+    since the previous one (`OutputBatch.wrenches`), so theirs is an upper bound of it."""
+    if decimation == 1:
+        return "largest magnitude at one instant"
+    return (
+        f"decimated: from each component's peak over {decimation} samples, an upper bound of "
+        "the largest magnitude at one instant"
+    )
+
+
 def peak_magnitudes(wrenches: np.ndarray) -> np.ndarray:
     """Per mount, the largest |F| (N) and |M| (N·m) of the (k, n, 6) wrenches (force, couple
     in mount axes) over their k rows: (n, 2); zeros for k = 0."""

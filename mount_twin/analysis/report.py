@@ -21,6 +21,7 @@ from mount_twin.analysis.figures import (
     PEAK_COUPLE,
     PEAK_FORCE,
     displacement_from_start,
+    peak_label,
     peak_magnitudes,
 )
 from mount_twin.analysis.html_page import digest, page, png, produced_by, scene_section
@@ -291,7 +292,7 @@ def write_report(
     if "pose" in tables:
         sections.append(_displacement_line(tables["pose"]))
     sections += [
-        "<h2>Peaks (largest magnitude at one instant)</h2>",
+        f"<h2>Peaks ({peak_label(scene.outputs.decimation if scene else 1)})</h2>",
         html_table(
             ["mount", "kind", PEAK_FORCE, PEAK_COUPLE, "utilisation max"],
             _peak_rows(mounts, kinds, utilisation),
