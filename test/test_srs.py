@@ -249,6 +249,15 @@ def test_a_resting_imu_has_a_null_spectrum_once_gravity_is_taken_out(tmp_path: P
         assert max(float(v) for r in rows for k, v in r.items() if k != "frequency_hz") < 1e-12
 
 
+def test_a_head_over_the_shock_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
+    """`--head 0.06` on the genset bag (50 ms at rest, then a 5 ms, 400 m/s² pulse) took
+    (0, 5.4, 28.0) m/s² out as gravity and printed spectra 4 % low, exit 0."""
+    assert main(["srs", str(GENSET), "--head", "0.06", "--freqs", "100"]) == 2
+    err = capsys.readouterr().err
+    assert "head_s (srs --head) 0.06 s: not quiet: its samples stray " in err
+    assert main(["srs", str(GENSET), "--head", "0.045", "--freqs", "100"]) == 0
+
+
 def test_a_head_as_long_as_the_record_is_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

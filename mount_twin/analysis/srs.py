@@ -155,6 +155,15 @@ HEAD_S = 0.01
 """Default quiet head of a record for `mean-head`, s."""
 
 
+QUIET_SHARE = 0.1
+"""A quiet head strays from its mean by at most this share of what the whole record does: the
+shock itself in it would be taken out of the record as gravity (a 60 ms head over the bundled
+genset's 50 ms rest and 5 ms pulse took 28 m/s² for gravity)."""
+QUIET_FLOOR_M_S2 = 5.0
+"""Straying this far (m/s², about half a g) is quiet whatever the record: a MEMS IMU's noise
+peaks (2.1 m/s² in test/data/water_entry_rest_20khz_excerpt.csv) on a record at rest."""
+
+
 def gravity_offset(
     t: np.ndarray, accel: np.ndarray, mode: str = "mean-head", head_s: float = HEAD_S
 ) -> tuple[np.ndarray, str]:
@@ -179,4 +188,15 @@ def gravity_offset(
             "head is the quiet part before the shock, its mean gravity and bias"
         )
         raise ValueError(msg)
-    return accel[:count].mean(axis=0), f"the mean of the first {count} samples"
+    mean = accel[:count].mean(axis=0)
+    head_spread = float(np.linalg.norm(accel[:count] - mean, axis=1).max())
+    spread = float(np.linalg.norm(accel - mean, axis=1).max())
+    if head_spread > max(QUIET_SHARE * spread, QUIET_FLOOR_M_S2):
+        msg = (
+            f"head_s (srs --head) {head_s:g} s: not quiet: its samples stray {head_spread:.4g} "
+            f"m/s² from their mean, {head_spread / spread:.2g} of the whole record's "
+            f"{spread:.4g} (at most {QUIET_SHARE:g}, or {QUIET_FLOOR_M_S2:g} m/s²): a shorter "
+            "head, before the shock, or --gravity first or none"
+        )
+        raise ValueError(msg)
+    return mean, f"the mean of the first {count} samples"
