@@ -169,7 +169,8 @@ def gravity_offset(
 ) -> tuple[np.ndarray, str]:
     """The per-axis constant (m/s²) to take out of a record (t s, accel (n, 3) m/s²) before its
     spectra, and how it was found: `mean-head`, the mean over the first head_s s (which must be
-    quiet: gravity and bias, the noise averaged down); `first`, the first sample; `none`, zero
+    quiet, QUIET_SHARE and QUIET_FLOOR_M_S2, else ValueError: gravity and bias, the noise
+    averaged down); `first`, the first sample; `none`, zero
     (a constant is then a step)."""
     if mode == "none":
         return np.zeros(3), "nothing"
