@@ -13,6 +13,7 @@ class SceneError(MountTwinError):
     def __init__(self, source: str, path: str, msg: str) -> None:
         self.source = source
         self.path = path
+        self.message = msg
         super().__init__(f"{source}: {path}: {msg}")
 
 

@@ -408,6 +408,18 @@ def test_sensor_positions_in_millimetres_are_warned_of(section: str, key: str, s
     assert re.search(rf"^500 m from the CG, .*{says}.* millimetres\?$", warned[f"{section}.{key}"])
 
 
+def test_a_cg_in_millimetres_is_named_beside_the_restraint_it_breaks() -> None:
+    """cg: [0.05, 0.0, 500.0] said only "mounts: no mount holds y, x"."""
+    data = _pump()
+    data["body"]["cg"] = [0.05, 0.0, 500.0]
+    with pytest.raises(
+        SceneError,
+        match=r"pump: mounts: no mount holds .*; likely why: mounts\[\d\]\.position: "
+        r"\d+\.?\d* m from the CG.* millimetres\?",
+    ):
+        scene_from_dict(data, "pump", refuse_unheld=True)
+
+
 def test_a_warning_names_the_parameter_of_a_params_scene() -> None:
     flat = as_params(_pump())
     flat["mounts.fl.position"] = [900.0, 400.0, 0.0]

@@ -82,11 +82,19 @@ def check_scene(
             "the mounts are too soft to carry the weight: its static sag overflows (a "
             "stiffness near 1e-300?)",
         )
+    geometry = _geometry(scene, mount_paths)
+    try:
+        restraint = _restraint(scene, st, refuse_unheld)
+    except SceneError as err:  # a unit mistake breaks the restraint first: name it
+        if not geometry:
+            raise
+        why = "; ".join(f"{w.path}: {w.message}" for w in geometry)
+        raise SceneError(err.source, err.path, f"{err.message}; likely why: {why}") from err
     return (
-        *_restraint(scene, st, refuse_unheld),
+        *restraint,
         *_sag(scene, st, mount_paths),
         *_ratings(scene, st, mount_paths),
-        *_geometry(scene, mount_paths),
+        *geometry,
         *_gravity_convention(scene),
     )
 

@@ -120,6 +120,5 @@ def _unknown_key(data: dict[str, Any]) -> tuple[str, str] | None:
     try:
         scene_from_dict(data, "sweep case")
     except SceneError as err:
-        message = str(err).removeprefix(f"{err.source}: {err.path}: ")
-        return (err.path, message) if message.startswith("unknown key") else None
+        return (err.path, err.message) if err.message.startswith("unknown key") else None
     return None
