@@ -4,6 +4,7 @@ package ships py.typed, and the usage example of its docstring (the README's) ru
 from __future__ import annotations
 
 import textwrap
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -123,6 +124,15 @@ def test_the_usage_example_runs_and_the_mounts_carry_the_body(
         ("stamps", np.zeros((5, 1)), r"SampleBatch\.stamps: shape \(5, 1\), expected \(n,\)"),
         ("accel", np.full((5, 3), "a"), r"SampleBatch\.accel: dtype <U1, expected real"),
         ("frame_ids", ["deck_imu"] * 4, r"SampleBatch\.frame_ids: 4 entries, expected 5"),
+        # these three were an IndexError, numpy's "truth value ... ambiguous", and "5 entries,
+        # expected 5 strings"
+        ("stamps", np.float64(0.0), r"SampleBatch\.stamps: shape \(\), expected \(n,\)"),
+        (
+            "frame_ids",
+            np.array([b"deck_imu"] * 5),
+            r"SampleBatch\.frame_ids: expected 5 strings, \[0\] is a bytes_",
+        ),
+        ("frame_ids", [b"deck_imu"] * 5, r"SampleBatch\.frame_ids: .* \[0\] is a bytes"),
     ],
 )
 def test_a_malformed_batch_is_refused_naming_the_field_and_changes_nothing(
@@ -145,6 +155,32 @@ def test_a_malformed_batch_is_refused_naming_the_field_and_changes_nothing(
     assert engine.counts["received"] == 0
     out = engine.run(mount_twin.SampleBatch(**good))
     assert len(out) == 5
+
+
+def test_lists_and_float32_are_taken_as_the_float64_arrays_they_hold() -> None:
+    """A list for accel passed the checks and was kept as the last reading: every later push
+    raised a TypeError from inside the intake; float32 input warned of an overflow (the
+    reading limit, 1e150, cast to float32). Each gives the float64 run's outputs, bit for bit."""
+    scene = mount_twin.load_scene_file(ROOT / "config/pump_8_mounts.scene.yaml")
+    t = 1.0 + np.arange(400) * 1e-3
+    accel = np.tile([0.0, 0.0, 9.80665], (400, 1)) + 0.5 * np.sin(40.0 * t)[:, None]
+    gyro = np.zeros((400, 3))
+    ids = ["deck_imu"] * 400
+
+    def run(a: object, g: object, stamps: object) -> mount_twin.OutputBatch:
+        engine = mount_twin.TwinEngine(mount_twin.assemble(scene))
+        first = engine.push(mount_twin.SampleBatch(stamps[:10], a[:10], g[:10], ids[:10]))
+        rest = engine.push(mount_twin.SampleBatch(stamps[10:], a[10:], g[10:], ids[10:]))
+        return first.then(rest, 10).then(engine.flush(), 400)
+
+    want = run(accel, gyro, t)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        got = run(accel.tolist(), gyro.tolist(), t.tolist())
+        np.testing.assert_array_equal(got.wrenches, want.wrenches)
+        f32 = run(accel.astype(np.float32), gyro.astype(np.float32), t)
+    exact = run(accel.astype(np.float32).astype(np.float64), gyro, t)
+    np.testing.assert_array_equal(f32.wrenches, exact.wrenches)
 
 
 def test_the_entry_points_refuse_a_wrong_object_naming_the_argument() -> None:

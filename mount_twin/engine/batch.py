@@ -35,8 +35,22 @@ class SampleBatch:
     gyro: np.ndarray
     frame_ids: list[str]
 
+    def __post_init__(self) -> None:
+        """Arrays of float64 whatever holds the numbers (lists, float32, integers; no copy of
+        float64 arrays) and a list of frame ids: what the engine reads (a list kept as the
+        last reading broke every later push; float32 cast the reading limit to inf). What
+        holds no numbers is left for `check` to name."""
+        for name in ("stamps", "accel", "gyro"):
+            value = np.asarray(getattr(self, name))
+            if value.dtype.kind in "fiu" and value.dtype != np.float64:
+                value = value.astype(np.float64)
+            setattr(self, name, value)
+        if not isinstance(self.frame_ids, list):
+            self.frame_ids = list(self.frame_ids)
+
     def __len__(self) -> int:
-        return int(self.stamps.shape[0])
+        """n (stamps of another shape count 1: not empty, so `push` checks and names them)."""
+        return int(self.stamps.shape[0]) if self.stamps.ndim == 1 else 1
 
     def check(self) -> None:
         """Raise ValueError naming the field unless this is a batch of n samples: stamps (n,),
@@ -55,8 +69,12 @@ class SampleBatch:
             if a.shape != (n, 3):
                 msg = f"SampleBatch.{name}: shape {a.shape}, expected ({n}, 3) for {n} stamps"
                 raise ValueError(msg)
-        if len(self.frame_ids) != n or not _all_strings(self.frame_ids):
+        if len(self.frame_ids) != n:
             msg = f"SampleBatch.frame_ids: {len(self.frame_ids)} entries, expected {n} strings"
+            raise ValueError(msg)
+        if not _all_strings(self.frame_ids):
+            i, bad = next((i, f) for i, f in enumerate(self.frame_ids) if not isinstance(f, str))
+            msg = f"SampleBatch.frame_ids: expected {n} strings, [{i}] is a {type(bad).__name__}"
             raise ValueError(msg)
 
     def part(self, keep: slice) -> SampleBatch:
