@@ -316,6 +316,7 @@ class CoreDriver:
         for t, slot, e, force in watch.events[: min(n, cap)].tolist():
             name, kind = self._event_meta[int(slot)]
             new.append(MountEvent(t, name, kind.EVENTS[int(e)], force, kind.EVENT_ERROR[int(e)]))
+        new.sort(key=lambda event: event.stamp)  # the log is by substep, then mount: in time
         watch.n_events[0] = 0
         self._counts["mount_events"] += len(new)
         room = MAX_EVENTS - len(self.events)

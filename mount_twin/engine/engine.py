@@ -95,8 +95,8 @@ class TwinEngine:
     @property
     def events(self) -> list[MountEvent]:
         """Every mount event so far, in time order (the first `driver.MAX_EVENTS`; the rest
-        counted)."""
-        return self._driver.events
+        counted): a copy, as `state` is."""
+        return list(self._driver.events)
 
     @property
     def error_estimate(self) -> ErrorEstimate | None:
