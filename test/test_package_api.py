@@ -219,3 +219,19 @@ def test_the_events_are_in_time_order_and_the_engines_own() -> None:
     assert len(stamps) > 10 and stamps == sorted(stamps)
     engine.events.clear()
     assert len(engine.events) == len(stamps)
+
+
+def test_then_changes_neither_batch() -> None:
+    """`a.then(b, n)` shifted b's reports in place: b then disagreed with itself, and a second
+    call shifted them twice."""
+    scene = mount_twin.load_scene_file(ROOT / "config/pump_8_mounts.scene.yaml")
+    t = 1.0 + np.arange(3000) * 1e-3
+    accel, gyro = np.tile([0.0, 0.0, 9.80665], (3000, 1)), np.zeros((3000, 3))
+    batch = mount_twin.SampleBatch(t, accel, gyro, ["deck_imu"] * 3000)
+    engine = mount_twin.TwinEngine(mount_twin.assemble(scene))
+    a, b = engine.push(batch.part(slice(0, 1500))), engine.push(batch.part(slice(1500, None)))
+    before = [(r.sample, r.rows) for r in b.health]
+    once, twice = a.then(b, 1500), a.then(b, 1500)
+    assert before and [(r.sample, r.rows) for r in b.health] == before
+    assert [(r.sample, r.rows) for r in once.health] == [(r.sample, r.rows) for r in twice.health]
+    assert [r.sample for r in once.health][-len(before) :] == [s + 1500 for s, _ in before]

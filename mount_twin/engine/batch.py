@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import repeat
 
 import numpy as np
@@ -183,16 +183,15 @@ class OutputBatch:
 
     def then(self, later: OutputBatch, n: int) -> OutputBatch:
         """These rows and reports, then `later`'s, which count their samples (and rows) from
-        the end of a batch of n samples (`TwinEngine.flush` after a push of n)."""
-        for report in later.health:
-            report.sample += n
-            report.rows += len(self)
+        the end of a batch of n samples (`TwinEngine.flush` after a push of n). Neither batch
+        changes: `later`'s reports are moved in copies."""
+        moved = [replace(r, sample=r.sample + n, rows=r.rows + len(self)) for r in later.health]
         return OutputBatch(
             np.concatenate([self.stamps, later.stamps]),
             np.concatenate([self.sample, later.sample + n]),
             np.concatenate([self.pose, later.pose]),
             np.concatenate([self.wrenches, later.wrenches]),
-            [*self.health, *later.health],
+            [*self.health, *moved],
         )
 
     def select(self, keep: np.ndarray) -> OutputBatch:
