@@ -42,7 +42,7 @@ from mount_twin.engine.health import (
     UTILISATION_KEY,
     tilt_from_quaternions,
 )
-from mount_twin.errors import BagError, DamagedBagError
+from mount_twin.errors import BagError, DamagedBagError, require
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import (
     DIAGNOSTICS_TOPIC,
@@ -437,8 +437,9 @@ def replay(
     it is fed after each input chunk up to that chunk's last stamp. A `chunk` below 1 message
     is a ValueError, before anything is opened (0 had looped for ever on empty chunks).
     """
-    if chunk < 1:
-        msg = f"chunk: must be ≥ 1 message, got {chunk}"
+    require(scene, Scene, "replay(scene)")
+    if isinstance(chunk, bool) or not isinstance(chunk, int) or chunk < 1:
+        msg = f"chunk: must be an integer ≥ 1 message, got {chunk!r}"
         raise ValueError(msg)
     bag, stream = _open(scene, input_path, output_path, checkpoint)
     try:

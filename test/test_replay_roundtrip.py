@@ -329,7 +329,13 @@ def test_replay_plot_of_a_run_without_mount_events_is_drawn(
 def test_a_chunk_below_one_message_is_refused_before_anything_is_opened(
     bags: dict[str, Path], tmp_path: Path
 ) -> None:
-    """0 had looped for ever on empty chunks (the command line refuses it at parse)."""
-    with pytest.raises(ValueError, match="chunk: must be ≥ 1 message, got 0"):
-        replay(_scene(), bags["in_mcap"], tmp_path / "out", chunk=0, progress=False)
-    assert not (tmp_path / "out").exists()
+    """0 had looped for ever on empty chunks (the command line refuses it at parse); 2.5 made
+    the output bag, then failed in a slice, leaving it behind marked partial."""
+    for chunk in (0, 2.5):
+        with pytest.raises(
+            ValueError, match=f"chunk: must be an integer ≥ 1 message, got {chunk}"
+        ):
+            replay(_scene(), bags["in_mcap"], tmp_path / "out", chunk=chunk, progress=False)
+        assert not (tmp_path / "out").exists()
+    with pytest.raises(TypeError, match=r"replay\(scene\): got a str, expected a Scene"):
+        replay("pump.scene.yaml", bags["in_mcap"], tmp_path / "out", progress=False)
