@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from io_helpers import CONFIG
 
 from mount_twin import SampleBatch, TwinEngine, assemble, load_scene_file
@@ -176,3 +177,20 @@ def test_a_bad_plan_fails_at_load_naming_the_key(
     assert main([*args, "-o", str(tmp_path / "q")]) == 2
     assert re.search(says, capsys.readouterr().err)
     assert not (tmp_path / "q").exists()
+
+
+def test_a_shock_along_a_dof_the_scene_freezes_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A pump with only z, alpha, gamma free passed a 15 g shock along x: the mounts carried
+    their static load, the constraint the rest, unpublished."""
+    data = yaml.safe_load((CONFIG / "pump_8_mounts.scene.yaml").read_text(encoding="utf-8"))
+    data["dofs"] = ["z", "alpha", "gamma"]
+    scene = tmp_path / "pump_3dof.scene.yaml"
+    scene.write_text(yaml.safe_dump(data), encoding="utf-8")
+    spectrum = str(CONFIG / "shock_spectrum_vertical.csv")
+    out = tmp_path / "q"
+    args = ["qualify", str(scene), "--spectrum", spectrum, "--axis", "x", "-o", str(out)]
+    assert main([*args, "--seeds", "1", "--workers", "1"]) == 2
+    assert "--axis x: the scene freezes x (dofs z, alpha, gamma)" in capsys.readouterr().err
+    assert not out.exists()

@@ -170,7 +170,15 @@ def run(args: argparse.Namespace) -> int:
 
     check_targets(json=args.json, report=args.report)
     plan = plan_of(args)
-    load_scene(args.scene)  # a bad scene fails here, before anything is synthesised
+    scene = load_scene(args.scene)  # a bad scene fails here, before anything is synthesised
+    for axis in plan.spectra:
+        if axis not in scene.dofs:  # the mounts would carry their static load, and pass
+            where = f"--axis {axis}" if args.plan is None else f"{plan.source}: spectra.{axis}"
+            msg = (
+                f"{where}: the scene freezes {axis} (dofs {', '.join(scene.dofs)}): a "
+                "shock along it goes into a constraint whose force is not published; free it"
+            )
+            raise ValueError(msg)
     out = Path(args.output)
     if out.exists():
         msg = f"{out}: exists; qualify writes a new directory"
