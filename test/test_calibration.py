@@ -225,3 +225,17 @@ def test_the_real_shake_table_pair_is_calibrated_on_one_run_and_predicts_the_oth
         after = cal_mod.prediction_error(calibrated, held_out, slice(0, 1), below)
         assert after < 0.6 * before, (below, before, after)
     assert (tmp_path / "c.png").stat().st_size > 10_000
+
+
+def test_an_offset_the_motion_cannot_show_is_refused_not_fitted_to_zero_plus_or_minus_zero(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The block moves along x alone: the body IMU's y offset changes nothing it reads. The
+    pseudo-inverse gave it 1σ = 0 and the command accepted "sensor_y: 0 mm ± 0"."""
+    ground, top = (str(SHAKE / f"sine_2hz_trial1_{s}_excerpt.csv") for s in ("ground", "top"))
+    args = ["calibrate", str(SHAKE / "block.scene.yaml"), "-o", str(tmp_path / "c.yaml")]
+    assert (
+        main([*args, "--foundation", ground, "--body", top, "--fit", "stiffness", "sensor_y"]) == 0
+    )
+    said = capsys.readouterr().out
+    assert re.search(r"sensor_y.*refused.*does not move it at all", said), said

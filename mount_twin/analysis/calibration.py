@@ -257,6 +257,8 @@ class _Problem:
 
 def _too_uncertain(name: str, sigma: float, value: float, step_s: float) -> str | None:
     """Why a fitted parameter is not identified (None: it is)."""
+    if not math.isfinite(sigma):
+        return "the record does not move it at all (its 1σ is unbounded)"
     if is_scale(name) and sigma > MAX_REL_SIGMA * value:
         return f"1σ is {sigma / value:.0%} of its value (the record barely moves it)"
     if name in ANGLES and sigma > MAX_YAW_SIGMA_RAD:
@@ -276,9 +278,18 @@ def _fit(problem: _Problem, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     scales = [0.1 if n != "lag" else step for n in problem.free]
     sol = least_squares(problem.residual, x0, x_scale=scales, diff_step=1e-4, method="trf")
     dof = max(sol.fun.size - sol.x.size, 1)
-    s2 = 2.0 * sol.cost / dof
-    cov = np.linalg.pinv(sol.jac.T @ sol.jac) * s2
-    return sol.x, np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    return sol.x, _sigma(sol.jac, 2.0 * sol.cost / dof)
+
+
+def _sigma(jac: np.ndarray, s2: float) -> np.ndarray:
+    """Each parameter's 1σ from the residuals' Jacobian and variance s2: √diag((JᵀJ)⁻¹·s2),
+    infinite for a parameter with a share in a direction the residuals do not move along (a
+    pseudo-inverse gives it 0, and a sensor offset the motion cannot show passed as ± 0)."""
+    _, sv, vt = np.linalg.svd(jac, full_matrices=False)
+    seen = sv > sv.max(initial=0.0) * max(jac.shape) * np.finfo(float).eps
+    variance = ((vt[seen] / sv[seen, None]) ** 2).sum(axis=0) * s2
+    blind = (np.abs(vt[~seen]) > 1e-8).any(axis=0)
+    return np.where(blind, np.inf, np.sqrt(variance))
 
 
 def calibrate(
