@@ -355,6 +355,13 @@ def test_water_entry_csv_imports_and_replays(
     assert disp < 0.2, f"a 47 g, ms-long shock moved the CG by {disp} m"
 
 
+CALIBRATE = (
+    "calibrate test/data/shake_table_1story/block.scene.yaml --foundation "
+    "test/data/shake_table_1story/sine_2hz_trial1_ground_excerpt.csv --body "
+    "test/data/shake_table_1story/sine_2hz_trial1_top_excerpt.csv -o OUT --plot X"
+)
+
+
 @pytest.mark.parametrize(
     "command",
     [
@@ -362,6 +369,7 @@ def test_water_entry_csv_imports_and_replays(
         "demo -o OUT --plot X",
         "accuracy config/pump_8_mounts.scene.yaml bags/ship_motion_1khz --csv X",
         "sweep config/sweep_pump.yaml -o OUT --plot X",
+        CALIBRATE.replace("-o OUT --plot X", "-o X"),
         "qualify config/genset_bolted_keyed.scene.yaml --plan config/qualify_genset.yaml -o OUT "
         "--report X",
     ],
@@ -379,16 +387,9 @@ def test_a_target_no_file_can_be_written_at_is_refused_before_the_work(
         for a in command.split()
     ]
     assert main(args) == 2
-    flag = command.split()[command.split().index("X") - 1]
+    flag = {"-o": "--output"}.get(f := command.split()[command.split().index("X") - 1], f)
     assert f"mount-twin: error: {flag} {target}: there is no directory" in capsys.readouterr().err
     assert not out.exists()
-
-
-CALIBRATE = (
-    "calibrate test/data/shake_table_1story/block.scene.yaml --foundation "
-    "test/data/shake_table_1story/sine_2hz_trial1_ground_excerpt.csv --body "
-    "test/data/shake_table_1story/sine_2hz_trial1_top_excerpt.csv -o OUT --plot X"
-)
 
 
 @pytest.mark.parametrize("name", ["figure.txt", "figure"])
