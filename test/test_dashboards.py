@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import dataclasses
 import json
+from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import pytest
 from io_helpers import CONFIG
 
 from mount_twin.analysis.dashboards import foxglove_layout, plotjuggler_layout
+from mount_twin.cli import main
 from mount_twin.io.messages import IMU, TYPESTORE, output_streams, output_types, resolve
 from mount_twin.replay import NODE_NAME
 from mount_twin.scene.description import BodySensor
@@ -92,3 +94,15 @@ def test_a_body_imu_adds_its_prediction_and_residual_on_their_topics() -> None:
             assert f"{topic}.linear_acceleration.{a}" in paths
             assert _field_exists(IMU, ["linear_acceleration", a])
     assert len(names) == len(paths) == 2 * 3 + 3 * len(scene.mounts) + 2 * 3
+
+
+def test_both_layouts_into_one_file_are_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The PlotJuggler XML was overwritten by the Foxglove JSON, and 'layout: same' printed
+    twice, exit 0."""
+    same = str(tmp_path / "same.out")
+    scene = str(CONFIG / "pump_8_mounts.scene.yaml")
+    assert main(["dashboard", scene, "--plotjuggler", same, "--foxglove", same]) == 2
+    assert "--plotjuggler and --foxglove name one file" in capsys.readouterr().err
+    assert not Path(same).exists()

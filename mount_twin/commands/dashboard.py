@@ -18,11 +18,15 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from mount_twin.analysis.dashboards import foxglove_layout, plotjuggler_layout
-    from mount_twin.commands.common import load_scene
+    from mount_twin.commands.common import check_targets, load_scene
 
     if not (args.plotjuggler or args.foxglove):
         msg = "give --plotjuggler XML and/or --foxglove JSON"
         raise ValueError(msg)
+    if args.plotjuggler and args.foxglove and Path(args.plotjuggler) == Path(args.foxglove):
+        msg = f"--plotjuggler and --foxglove name one file, {args.foxglove}: one would overwrite"
+        raise ValueError(msg)
+    check_targets(plotjuggler=args.plotjuggler, foxglove=args.foxglove)
     scene = load_scene(args.scene)
     for path, text in ((args.plotjuggler, plotjuggler_layout), (args.foxglove, foxglove_layout)):
         if path:
