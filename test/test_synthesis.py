@@ -85,3 +85,16 @@ def test_synthesized_bags_pass_srs_against_the_design(
         assert "40 of 40 frequencies within -1.5/+3 dB: PASS" in capsys.readouterr().out
     assert main(args) == 2  # the directory exists now
     assert "exists" in capsys.readouterr().err
+
+
+def test_a_synthesis_that_fails_before_writing_leaves_no_directory(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--start 0` is refused at the first bag: the empty directory it left refused the
+    rerun ("exists; synthesize writes a new directory")."""
+    spectrum = Path(__file__).resolve().parents[1] / "config" / "shock_spectrum_vertical.csv"
+    out = tmp_path / "synth"
+    args = ["synthesize", "--spectrum", str(spectrum), "-o", str(out), "--seeds", "1"]
+    assert main([*args, "--start", "0"]) == 2
+    assert "stamped 0 ns" in capsys.readouterr().err
+    assert not out.exists()

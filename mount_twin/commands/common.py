@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from itertools import pairwise
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -119,6 +120,23 @@ def warn_if_partial(bag: str | Path) -> str:
     if marker := partial_marker(bag):
         print(f"mount-twin: warning: {bag} is partial: {marker}", file=sys.stderr)
     return marker
+
+
+@contextmanager
+def new_directory(path: str | Path, command: str) -> Iterator[Path]:
+    """A directory `command` creates for its outputs (ValueError if it exists), removed again
+    if the command fails before putting anything in it: an empty one blocked the rerun."""
+    out = Path(path)
+    if out.exists():
+        msg = f"{out}: exists; {command} writes a new directory"
+        raise ValueError(msg)
+    out.mkdir(parents=True)
+    try:
+        yield out
+    except BaseException:
+        if not any(out.iterdir()):
+            out.rmdir()
+        raise
 
 
 def write_signal(

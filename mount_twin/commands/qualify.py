@@ -166,7 +166,7 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from mount_twin.analysis.qualification import judge, verdict_text
-    from mount_twin.commands.common import check_targets, json_text, load_scene
+    from mount_twin.commands.common import check_targets, json_text, load_scene, new_directory
 
     check_targets(json=args.json, report=args.report)
     plan = plan_of(args)
@@ -179,14 +179,10 @@ def run(args: argparse.Namespace) -> int:
                 "shock along it goes into a constraint whose force is not published; free it"
             )
             raise ValueError(msg)
-    out = Path(args.output)
-    if out.exists():
-        msg = f"{out}: exists; qualify writes a new directory"
-        raise ValueError(msg)
-    out.mkdir(parents=True)
     axes = ", ".join(plan.spectra)
-    print(f"plan {plan.source}: {len(plan.inputs)} inputs ({axes}), ζ = {plan.damping:g}")
-    runs = _runs(args, plan, out)
+    with new_directory(args.output, "qualify") as out:
+        print(f"plan {plan.source}: {len(plan.inputs)} inputs ({axes}), ζ = {plan.damping:g}")
+        runs = _runs(args, plan, out)
     doc = judge(runs, plan)
     print(verdict_text(doc))
     if args.json:

@@ -93,17 +93,14 @@ def describe(shock: Synthesis, args: argparse.Namespace) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from pathlib import Path
 
-    from mount_twin.commands.common import write_signal
+    from mount_twin.commands.common import new_directory, write_signal
 
-    out = Path(args.output)
-    if out.exists():
-        msg = f"{out}: exists; synthesize writes a new directory"
-        raise ValueError(msg)
-    for seed, shock, sig in synthesized(args):
-        out.mkdir(parents=True, exist_ok=True)
-        bag = out / f"seed_{seed}"
-        written = write_signal(sig, str(bag), args.topic, args.frame_id, args.start, args.storage)
-        print(f"{bag}: {written} messages, {describe(shock, args)}")
+    with new_directory(args.output, "synthesize") as out:
+        for seed, shock, sig in synthesized(args):
+            bag = out / f"seed_{seed}"
+            written = write_signal(
+                sig, str(bag), args.topic, args.frame_id, args.start, args.storage
+            )
+            print(f"{bag}: {written} messages, {describe(shock, args)}")
     return 0
