@@ -104,6 +104,9 @@ def test_groups_of_mounts_are_tracked_apart(
         (["--window", "0"], "window 0 s: give more than 4 s"),  # 0 read as not given, before
         (["--warn", "1.2", "0.8"], "warn band [1.2, 0.8]: expected 0 ≤ low < high"),
         (["--warn", "0.9", "1.1", "--error", "0.95", "1.05"], "must hold the warn band"),
+        # printed as "lag ×-0.001 ± 0.00032" and "stiffness:: 0.9307 ×", never judged
+        (["--fit", "lag"], "--fit lag: track re-fits mount scales: stiffness, damping"),
+        (["--fit", "stiffness:"], "--fit stiffness:: track re-fits mount scales"),
     ],
 )
 def test_a_window_or_band_no_judgement_can_take_is_refused(
