@@ -92,7 +92,8 @@ def track(
     fit: tuple[str, ...] = ("stiffness", "damping"),
     band: Band = Band(),
 ) -> list[WindowFit]:
-    """The fit of each `window_s` window of the pair, in order (module docstring)."""
+    """The fit of each `window_s` window of the pair, in order (module docstring); ValueError
+    for a `fit` that is no mount scale (`calibration.is_mount_scale`) or a group of none."""
     for name in fit:
         _, colon, group = name.partition(":")
         if not is_mount_scale(name) or (colon and not all(group.split("+"))):
