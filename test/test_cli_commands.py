@@ -355,6 +355,18 @@ def test_water_entry_csv_imports_and_replays(
     assert disp < 0.2, f"a 47 g, ms-long shock moved the CG by {disp} m"
 
 
+def _refused(command: str, target: Path, out: Path) -> str:
+    """Run `command` (bundled paths from the repository root) with X for `target` and OUT for
+    `out`, check that it exits 2, and return the long name of the option that took X."""
+    words = command.split()
+    args = [
+        {"X": str(target), "OUT": str(out)}.get(a, str(ROOT / a) if "/" in a else a) for a in words
+    ]
+    assert main(args) == 2
+    flag = words[words.index("X") - 1]
+    return {"-o": "--output"}.get(flag, flag)
+
+
 CALIBRATE = (
     "calibrate test/data/shake_table_1story/block.scene.yaml --foundation "
     "test/data/shake_table_1story/sine_2hz_trial1_ground_excerpt.csv --body "
@@ -381,15 +393,9 @@ def test_a_target_no_file_can_be_written_at_is_refused_before_the_work(
     """A --json in a missing directory: the replay ran to its end, then exit 2 (its verdict's
     exit status lost)."""
     target = tmp_path / "missing" / "x"
-    out = tmp_path / "out"
-    args = [
-        {"X": str(target), "OUT": str(out)}.get(a, str(ROOT / a) if "/" in a else a)
-        for a in command.split()
-    ]
-    assert main(args) == 2
-    flag = {"-o": "--output"}.get(f := command.split()[command.split().index("X") - 1], f)
+    flag = _refused(command, target, tmp_path / "out")
     assert f"mount-twin: error: {flag} {target}: there is no directory" in capsys.readouterr().err
-    assert not out.exists()
+    assert not (tmp_path / "out").exists()
 
 
 @pytest.mark.parametrize("name", ["figure.txt", "figure"])
@@ -412,16 +418,10 @@ def test_a_figure_without_a_format_matplotlib_writes_is_refused_before_the_work(
     matplotlib's error naming neither the option nor the file; `show -o lay` wrote lay.png and
     printed `layout: lay`."""
     target = tmp_path / name
-    out = tmp_path / "out"
-    args = [
-        {"X": str(target), "OUT": str(out)}.get(a, str(ROOT / a) if "/" in a else a)
-        for a in command.split()
-    ]
-    assert main(args) == 2
-    flag = {"-o": "--output"}.get(f := command.split()[command.split().index("X") - 1], f)
+    flag = _refused(command, target, tmp_path / "out")
     err = capsys.readouterr().err
     assert f"mount-twin: error: {flag} {target}: a figure's file name ends in its format" in err
-    assert not out.exists() and not list(tmp_path.iterdir())
+    assert not list(tmp_path.iterdir())  # neither the output nor the figure
 
 
 def test_matplotlib_writes_every_figure_format_taken() -> None:

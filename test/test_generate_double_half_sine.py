@@ -134,7 +134,7 @@ def test_generate_refuses_a_first_stamp_of_zero(
     ("option", "value", "says"),
     [
         ("--topic", "bad topic", "--topic 'bad topic': not a ROS topic name"),
-        ("--frame-id", "deck imu", "--frame-id 'deck imu': not a frame id (it has whitespace)"),
+        ("--frame-id", "deck imu", "--frame-id 'deck imu' is not a frame id (it has whitespace)"),
     ],
 )
 def test_generate_refuses_a_topic_or_frame_id_no_scene_could_take(

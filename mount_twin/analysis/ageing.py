@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from mount_twin.analysis.calibration import calibrate, is_mount_scale, is_scale
+from mount_twin.analysis.calibration import calibrate, is_mount_scale, is_scale, scaled_mounts
 from mount_twin.io.signals import Signal
 from mount_twin.scene.description import Scene, ageing_bands_problem
 
@@ -93,15 +93,15 @@ def track(
     band: Band = Band(),
 ) -> list[WindowFit]:
     """The fit of each `window_s` window of the pair, in order (module docstring); ValueError
-    for a `fit` that is no mount scale (`calibration.is_mount_scale`) or a group of none."""
+    for a `fit` that is no mount scale (`calibration.is_mount_scale`, `scaled_mounts`)."""
     for name in fit:
-        _, colon, group = name.partition(":")
-        if not is_mount_scale(name) or (colon and not all(group.split("+"))):
+        if not is_mount_scale(name):
             msg = (
                 f"--fit {name}: track re-fits mount scales: stiffness, damping, or "
                 "stiffness:A+B (damping:A+B) for a group of mounts"
             )
             raise ValueError(msg)
+        scaled_mounts(name, scene)
     if window_s <= 2.0 * LEAD_S:
         msg = f"window {window_s:g} s: give more than {2.0 * LEAD_S:g} s (the lead settles)"
         raise ValueError(msg)

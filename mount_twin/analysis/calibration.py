@@ -106,10 +106,14 @@ def is_scale(name: str) -> bool:
 def scaled_mounts(name: str, scene: Scene) -> list[str]:
     """The linear mounts a scale parameter applies to: all of them, or those `name` lists
     after its colon, joined by `+`. Raises ValueError naming a mount the scene lacks, or one
-    whose kind has no stiffness and damping scales (a bolt, a key, rubber with its own law)."""
+    whose kind has no stiffness and damping scales (a bolt, a key, rubber with its own law),
+    or an empty name in the group."""
     linear = [m.name for m in scene.mounts if isinstance(m, LinearMount)]
-    _, _, group = name.partition(":")
-    listed = group.split("+") if group else linear
+    _, colon, group = name.partition(":")
+    listed = group.split("+") if colon else linear
+    if colon and not all(listed):
+        msg = f"{name}: a group names its mounts, stiffness:A+B (damping:A+B)"
+        raise ValueError(msg)
     wrong = [m for m in listed if m not in linear]
     if not listed:
         msg = f"{name}: the scene has no linear mount to scale"

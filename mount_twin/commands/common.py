@@ -149,13 +149,13 @@ def write_signal(
 
     from mount_twin.io.bag import check_stamp, write_bag
     from mount_twin.io.messages import IMU, imu_messages
-    from mount_twin.scene.loader import topic_name_problem
+    from mount_twin.scene.loader import header_frame_id_problem, topic_name_problem
 
     if problem := topic_name_problem(topic):
         msg = f"--topic {topic!r}: not a ROS topic name: {problem}"
         raise ValueError(msg)
-    if any(c.isspace() for c in frame_id):
-        msg = f"--frame-id {frame_id!r}: not a frame id (it has whitespace)"
+    if problem := header_frame_id_problem(frame_id):
+        msg = f"--frame-id {frame_id!r} {problem}"
         raise ValueError(msg)
 
     stamps = start_ns + np.rint(sig.t * 1e9).astype(np.int64)

@@ -617,12 +617,19 @@ def _lost_text(
     return f"~{lost} samples lost in this period ({100.0 * share:.1f} %, {'; '.join(sources)})"
 
 
+def _by_kind(events: list[MountEvent]) -> dict[str, list[MountEvent]]:
+    """The events by kind, kinds in the order of their first event."""
+    kinds: dict[str, list[MountEvent]] = {}
+    for event in events:
+        kinds.setdefault(event.event, []).append(event)
+    return kinds
+
+
 def _event_values(events: list[MountEvent], origin_s: int) -> dict[str, str]:
     """Per event kind of the period, in full: `<event>.count`, `<event>.first_stamp_ns` (the
     header stamp of its first, ns) and `<event>.force_max_N` (the largest |F|, N, repr)."""
     values = {}
-    for name in dict.fromkeys(e.event for e in events):
-        same = [e for e in events if e.event == name]
+    for name, same in _by_kind(events).items():
         values[f"{name}.count"] = str(len(same))
         values[f"{name}.first_stamp_ns"] = str(origin_s * 10**9 + round(same[0].stamp * 1e9))
         values[f"{name}.force_max_N"] = repr(max(e.force for e in same))
@@ -634,8 +641,7 @@ def _events_text(events: list[MountEvent], utilisation: float, origin_s: int) ->
     if not events:
         return "ok" if not utilisation > 0.0 else f"utilisation {utilisation:.3g}"
     parts = []
-    for name in dict.fromkeys(e.event for e in events):
-        same = [e for e in events if e.event == name]
+    for name, same in _by_kind(events).items():
         parts.append(
             f"{name} ×{len(same)} (first {origin_s + same[0].stamp:.6f} s, "
             f"|F| max {max(e.force for e in same):.4g} N)"

@@ -278,9 +278,14 @@ def _header_frame_id(r: Reader, key: str, default: str) -> str:
     """A frame id the input's header.frame_id is compared with, as its sensor writes it: no
     whitespace; empty for any; a leading '/' is ROS 1's (a bag from there says '/imu')."""
     frame = r.string(key, default)
-    if any(c.isspace() for c in frame):
-        raise r.error(key, f"{shown(frame)} is not a frame id (it has whitespace)")
+    if problem := header_frame_id_problem(frame):
+        raise r.error(key, f"{shown(frame)} {problem}")
     return frame
+
+
+def header_frame_id_problem(frame: str) -> str:
+    """What makes `frame` no header.frame_id a sensor writes ('' if nothing)."""
+    return "is not a frame id (it has whitespace)" if any(c.isspace() for c in frame) else ""
 
 
 def _input(r: Reader) -> InputSpec:
