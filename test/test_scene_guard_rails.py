@@ -322,6 +322,38 @@ def test_a_bolted_joint_beyond_the_stiffness_limit_names_its_keys() -> None:
         scene_from_dict(data, "genset")
 
 
+@pytest.mark.parametrize("index, kind", [(0, "bolted_joint"), (6, "shear_key")])
+def test_a_mount_whose_kind_line_was_lost_is_told_its_kind(index: int, kind: str) -> None:
+    """It was read as linear, and the message named linear's missing `stiffness`."""
+    data = yaml.safe_load((CONFIG / "genset_bolted_keyed.scene.yaml").read_text())
+    assert data["mounts"][index].pop("kind") == kind
+    with pytest.raises(SceneError, match=f"read as a {kind}: give kind: {kind}") as err:
+        scene_from_dict(data, "genset")
+    assert f"genset: mounts[{index}].kind: missing, so the mount was read as linear" in str(
+        err.value
+    )
+
+
+def test_a_linear_mount_without_kind_still_names_its_own_missing_key() -> None:
+    data = _pump()
+    del data["mounts"][2]["stiffness"]
+    with pytest.raises(SceneError, match=r"pump: mounts\[2\]\.stiffness: required key is"):
+        scene_from_dict(data, "pump")
+
+
+def test_an_elastomer_given_stiffness_for_stiffness_linear_is_told_the_unknown_key() -> None:
+    """It failed the check across keys instead: "each axis needs k1 > 0 or a force_table"."""
+    data = _pump()
+    data["mounts"][0] = {
+        "name": "fl",
+        "kind": "elastomer",
+        "position": [0.5, 0.4, 0.0],
+        "stiffness": [2e5, 2e5, 5e5],
+    }
+    with pytest.raises(SceneError, match=r"pump: mounts\[0\]\.stiffness: unknown key"):
+        scene_from_dict(data, "pump")
+
+
 def _laughs(levels: int) -> str:
     lines = ['l0: &l0 ["lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol"]']
     for i in range(1, levels):

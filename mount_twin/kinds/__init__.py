@@ -1,9 +1,11 @@
 """Mount kinds besides the linear one: each module is one place for a kind's scene keys and
-checks (`read`), its parameter row (`pack`), internal states (and which of them a restart
-resets: `RESTUCK`), force law (`load`), event functions (`monitor`), discrete switches
-between samples (`update`, which says whether it switched: the state then jumped, and a stepper
-must not start from a stage it took before) and its stiffness at the unstressed pose
-(`nominal_tangent`: statics, modes and `auto`'s first choice read it). A module's `load`,
+checks (`read`: every key read, then `Reader.finish`, then the checks across keys, so that a
+misspelt key is named rather than the check it makes fail), its parameter row (`pack`),
+internal states (and which of them a restart resets: `RESTUCK`), force law (`load`), event
+functions (`monitor`), discrete switches between samples (`update`, which says whether it
+switched: the state then jumped, and a stepper must not start from a stage it took before) and
+its stiffness at the unstressed pose (`nominal_tangent`: statics, modes and `auto`'s first
+choice read it). A module's `load`,
 `monitor` and `update` are plain Python: the reference the compiled core's port of the kind
 (src/core/kinds/<kind>.hpp) is held to.
 

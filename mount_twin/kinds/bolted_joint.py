@@ -137,6 +137,7 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> BoltedJoint:
         axial_damping=r.number("axial_damping", 0.0, lo=0.0),
         shear_damping=r.number("shear_damping", 0.0, lo=0.0),
     )
+    r.finish()
     if not joint.preload < joint.yield_force < joint.ultimate_force:
         raise r.error(
             "yield_force",

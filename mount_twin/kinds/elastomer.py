@@ -141,16 +141,11 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> Elastomer:
     tr.finish()
     hyst = _hysteresis(r.sub("hysteresis")) if r.has("hysteresis") else None
     snub = _snubber(r.sub("snubber")) if r.has("snubber") else None
-    table_axes = {t[0] for t in tables}
-    k1 = r.vector("stiffness_linear", 3, (0.0, 0.0, 0.0), lo=0.0)
-    for j, axis in enumerate(AXES):
-        if axis not in table_axes and not k1[j] > 0.0:
-            raise r.error(f"stiffness_linear[{j}]", "each axis needs k1 > 0 or a force_table")
-    return Elastomer(
+    mount = Elastomer(
         name=name,
         position=position,
         orientation_rpy=rpy,
-        stiffness_linear=k1,
+        stiffness_linear=r.vector("stiffness_linear", 3, (0.0, 0.0, 0.0), lo=0.0),
         stiffness_cubic=r.vector("stiffness_cubic", 3, (0.0, 0.0, 0.0), lo=0.0),
         force_table=tuple(tables),
         damping=r.vector("damping", 3, (0.0, 0.0, 0.0), lo=0.0),
@@ -160,6 +155,12 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> Elastomer:
         hysteresis=hyst,
         snubber=snub,
     )
+    r.finish()  # a misspelt key (`stiffness:`) before the check it makes fail
+    table_axes = {t[0] for t in tables}
+    for j, axis in enumerate(AXES):
+        if axis not in table_axes and not mount.stiffness_linear[j] > 0.0:
+            raise r.error(f"stiffness_linear[{j}]", "each axis needs k1 > 0 or a force_table")
+    return mount
 
 
 def _force_table(t: Reader) -> tuple[tuple[float, ...], tuple[float, ...]]:

@@ -70,6 +70,7 @@ def read(r: Reader, name: str, position: tuple, rpy: tuple) -> ShearKey:
         allowable_force=r.number("allowable_force", 0.0, lo=0.0),
         engagement_height=r.number("engagement_height", 0.0, lo=0.0),
     )
+    r.finish()
     if not any(k > 0.0 for k in key.stiffness):
         raise r.error("stiffness", f"a key needs at least one stiff axis, got {key.stiffness!r}")
     return key

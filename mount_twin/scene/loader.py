@@ -193,8 +193,10 @@ def _mount(r: Reader) -> Mount:
         )
     position = _position(r, "position")
     rpy = _angles(r, "orientation_rpy", (0.0, 0.0, 0.0))
-    if kind == "linear":
-        mount: Mount = LinearMount(
+    if kind != "linear":
+        return KINDS[kind].read(r, name, position, rpy)
+    try:
+        mount = LinearMount(
             name=name,
             position=position,
             orientation_rpy=rpy,
@@ -204,10 +206,33 @@ def _mount(r: Reader) -> Mount:
             rated_travel=r.vector("rated_travel", 3, (0.0,) * 3, lo=0.0),
             rated_load=r.vector("rated_load", 3, (0.0,) * 3, lo=0.0),
         )
-    else:
-        mount = KINDS[kind].read(r, name, position, rpy)
-    r.finish()
+        r.finish()
+    except SceneError as err:
+        guess = None if r.has("kind") else _kind_reading(r, name, position, rpy)
+        if guess is None:
+            raise
+        raise r.error(
+            "kind",
+            f"missing, so the mount was read as linear ({err.path}: {err.message}); its keys "
+            f"read as a {guess}: give kind: {guess}",
+        ) from err
     return mount
+
+
+def _kind_reading(r: Reader, name: str, position: Vec3, rpy: Vec3) -> str | None:
+    """The one kind of KINDS whose `read` takes the mount mapping of `r` whole, if one does:
+    what a mount whose `kind:` line was lost most likely is."""
+    fits = []
+    for kind, module in KINDS.items():
+        probe = Reader(r.data, r.source, r.path)
+        for key in ("name", "position", "orientation_rpy"):
+            probe.raw(key, ())
+        try:
+            module.read(probe, name, position, rpy)
+        except SceneError:
+            continue
+        fits.append(kind)
+    return fits[0] if len(fits) == 1 else None
 
 
 def _position(r: Reader, key: str, default: Vec3 | None = None) -> Vec3:
