@@ -179,6 +179,25 @@ def test_a_bad_plan_fails_at_load_naming_the_key(
     assert not (tmp_path / "q").exists()
 
 
+@pytest.mark.parametrize(
+    ("flags", "says"),
+    [
+        (["--rate", "5000"], "--rate: "),
+        (["--seeds", "3", "--damping", "0.1"], "--seeds, --damping: "),
+        (["--tolerance-db", "-1", "2", "--axis", "z"], "--axis, --tolerance-db: "),
+    ],
+)
+def test_synthesis_options_beside_a_plan_are_refused_not_ignored(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], flags: list[str], says: str
+) -> None:
+    """They were ignored without a word: the plan's synthesis ran, at its own rate and seeds."""
+    plan = _plan(tmp_path, "spectra:\n  z: z.csv\n")
+    args = ["qualify", str(CONFIG / "pump_8_mounts.scene.yaml"), "--plan", str(plan)]
+    assert main([*args, *flags, "-o", str(tmp_path / "q")]) == 2
+    assert f"{says}the plan sets the synthesis" in capsys.readouterr().err
+    assert not (tmp_path / "q").exists()
+
+
 def test_a_shock_along_a_dof_the_scene_freezes_is_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
