@@ -3,6 +3,7 @@ machine judged per mount on the worst over the inputs; the exit status says the 
 
 from __future__ import annotations
 
+import hashlib
 import json
 import re
 from pathlib import Path
@@ -144,6 +145,8 @@ def test_a_plan_runs_every_axis_and_its_criteria_judge(
     assert len(re.findall(r'src="data:image/png;base64,', text)) == 1
     assert 'src="http' not in text and "<script" not in text
     assert "<td>body.mass</td><td>1200.0</td>" in text
+    scene_sum = hashlib.sha256((CONFIG / "pump_8_mounts.scene.yaml").read_bytes()).hexdigest()
+    assert f"pump_8_mounts.scene.yaml (sha256 {scene_sum})" in text
     strict = _plan(tmp_path, PLAN.format(limit=0.01))
     assert main([*args[:-1], str(strict), "-o", str(tmp_path / "b"), "--workers", "1"]) == 4
     said = capsys.readouterr().out

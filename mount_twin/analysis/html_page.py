@@ -44,16 +44,16 @@ def table(head: list[str], rows: list[list[str]]) -> str:
     return f"<table><tr>{cells}</tr>{body}</table>"
 
 
-def digest(path: Path) -> str:
-    """sha256 over a bag's files' names and sha256s (one file, or a directory's in name order),
-    first 16 hex digits."""
-    h = hashlib.sha256()
-    for f in sorted(path.rglob("*")) if path.is_dir() else [path]:
-        if f.is_file():
-            h.update(f.name.encode())
-            with f.open("rb") as fh:  # in blocks: a bag may be larger than memory
-                h.update(hashlib.file_digest(fh, "sha256").digest())
-    return h.hexdigest()[:16]
+def fingerprint(path: Path) -> str:
+    """`sha256 <hex>` of a file as `sha256sum` prints it, or of each file of a directory (a
+    bag's), by its path inside, in name order."""
+    files = sorted(f for f in path.rglob("*") if f.is_file()) if path.is_dir() else [path]
+    sums = []
+    for f in files:
+        with f.open("rb") as fh:  # in blocks: a bag may be larger than memory
+            hexdigest = hashlib.file_digest(fh, "sha256").hexdigest()
+        sums.append(hexdigest if f is path else f"{f.relative_to(path)} {hexdigest}")
+    return "sha256 " + ", ".join(sums)
 
 
 def page(title: str, sections: list[str]) -> str:

@@ -1,5 +1,5 @@
 """The page a qualification hands over: one self-contained HTML file that opens with the
-verdict, then the plan and its criteria, what produced it (software, date, file digests), the
+verdict, then the plan and its criteria, what produced it (software, date, file fingerprints), the
 inputs' spectra against the design, each input's run, per mount the worst figures with their
 margins, and the scene as loaded."""
 
@@ -10,7 +10,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from mount_twin.analysis.html_page import digest, page, png, produced_by, scene_section, table
+from mount_twin.analysis.html_page import fingerprint, page, png, produced_by, scene_section, table
 from mount_twin.analysis.log_labels import plain_log_labels
 from mount_twin.analysis.qualification import InputRun, Plan
 from mount_twin.scene.description import Scene
@@ -47,9 +47,9 @@ def _verdict_section(scene: Scene, plan: Plan, doc: dict[str, Any]) -> list[str]
         ["verdict", doc["verdict"]],
         ["why", "; ".join(why) or "every criterion met in every input"],
         ["produced by", produced_by()],
-        ["scene", f"{scene.name} from {scene.source} (sha256 {digest(Path(scene.source))})"],
+        ["scene", f"{scene.name} from {scene.source} ({fingerprint(Path(scene.source))})"],
         *(
-            [f"design spectrum, axis {axis}", f"{file} (sha256 {digest(Path(file))})"]
+            [f"design spectrum, axis {axis}", f"{file} ({fingerprint(Path(file))})"]
             for axis, file in plan.spectra.items()
         ),
         [

@@ -24,7 +24,7 @@ from mount_twin.analysis.figures import (
     peak_label,
     peak_magnitudes,
 )
-from mount_twin.analysis.html_page import digest, page, png, produced_by, scene_section
+from mount_twin.analysis.html_page import fingerprint, page, png, produced_by, scene_section
 from mount_twin.analysis.html_page import table as html_table
 from mount_twin.analysis.log_labels import plain_log_labels
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
@@ -89,10 +89,10 @@ def _provenance_section(
         ["verdict (worst over the run)", verdict],
         *([["partial run", f"the bag stops early: {partial}"]] if partial else []),
         ["produced by", produced_by()],
-        ["output bag", f"{output_bag} (sha256 {digest(Path(output_bag))})"],
+        ["output bag", f"{output_bag} ({fingerprint(Path(output_bag))})"],
     ]
     if input_path is not None:
-        rows.append(["input bag", f"{input_path} (sha256 {digest(Path(input_path))})"])
+        rows.append(["input bag", f"{input_path} ({fingerprint(Path(input_path))})"])
     if scene is not None:
         spec, integ = scene.input, scene.integration
         rows += [
