@@ -109,6 +109,26 @@ def test_the_response_spectra_of_an_output_bag_and_of_its_replay_in_memory_agree
     assert max(force["maximax_z"]) > 1e4  # N: the bolt's dynamic load, far above noise
 
 
+def test_the_output_bag_of_a_failed_run_is_refused_as_failed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """It was refused for "a hole of 0.0002 s", the samples the failed steps did not publish,
+    as if the bag had lost them; the input bag replayed in memory said why."""
+    data = yaml.safe_load(GENSET.read_text(encoding="utf-8"))
+    data["integration"] = {"method": "dopri54", "rtol": 1e-13, "atol": 1e-15, "max_substeps": 1}
+    scene = tmp_path / "failing.scene.yaml"
+    scene.write_text(yaml.safe_dump(data), encoding="utf-8")
+    out_bag = tmp_path / "out"
+    replay = ["replay", str(SHOCK), "--scene", str(scene), "-o", str(out_bag), "--no-progress"]
+    assert main(replay) == 6
+    capsys.readouterr()
+    for src in (out_bag, SHOCK):
+        assert main(["srs", str(src), "--response", "cg", "--scene", str(scene)]) == 2
+        err = capsys.readouterr().err
+        assert f"{src}: the twin's run failed, its response is not the machine's: " in err
+        assert "integration failed" in err
+
+
 @pytest.mark.parametrize(
     ("extra", "says"),
     [

@@ -28,11 +28,17 @@ from mount_twin.analysis.html_page import fingerprint, page, png, produced_by, s
 from mount_twin.analysis.html_page import table as html_table
 from mount_twin.analysis.log_labels import plain_log_labels
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
-from mount_twin.engine.health import INTEGRATION, UTILISATION_KEY
+from mount_twin.engine.health import UTILISATION_KEY
 from mount_twin.errors import ModelError
 from mount_twin.io.bag import partial_marker
 from mount_twin.io.messages import WRENCHES_OUTPUT
-from mount_twin.io.output_tables import Event, Table, events_of, read_output_bag
+from mount_twin.io.output_tables import (
+    Event,
+    Table,
+    events_of,
+    integration_values,
+    read_output_bag,
+)
 from mount_twin.scene.description import STANDARD_GRAVITY, Scene
 
 if TYPE_CHECKING:
@@ -62,14 +68,11 @@ def _verdict(diagnostics: Table | None) -> tuple[str, dict[str, str]]:
     if diagnostics is None or not len(diagnostics):
         return "no diagnostics in the bag", {}
     c = diagnostics.columns
-    worst, integration = OK, {}
-    for status, level, values in zip(c["status"], c["level"], c["values"], strict=True):
-        if status == "mount_twin: ros":
-            continue
-        if level in LEVEL_NAMES:
+    worst = OK
+    for status, level in zip(c["status"], c["level"], strict=True):
+        if status != "mount_twin: ros" and level in LEVEL_NAMES:
             worst = max(worst, LEVEL_NAMES.index(level))
-        if status == INTEGRATION:
-            integration = json.loads(values)
+    integration = integration_values(diagnostics)
     if int(integration.get("failures_total", "0")):
         return f"{FAILED} ({integration['failures_total']} integration failures)", integration
     return LEVEL_NAMES[worst], integration

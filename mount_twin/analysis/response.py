@@ -21,7 +21,7 @@ from mount_twin.engine.batch import OutputBatch, SampleBatch
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.sensor_reading import cg_specific_force
 from mount_twin.io.messages import WRENCHES_OUTPUT
-from mount_twin.io.output_tables import Table
+from mount_twin.io.output_tables import Table, integration_values
 from mount_twin.model.assemble import Model, assemble
 from mount_twin.scene.description import Scene
 
@@ -96,7 +96,8 @@ def response_of(scene: Scene, stamps_s: np.ndarray, wrenches: np.ndarray, text: 
 
 def wrenches_of(tables: list[Table], scene: Scene, source: str) -> tuple[np.ndarray, np.ndarray]:
     """(stamps s, (k, n, 6) wrenches) from an output bag's tables (`io.output_tables`): every
-    mount of the scene, on the same rows. Raises ValueError naming `source` otherwise."""
+    mount of the scene, on the same rows, of a run whose integration never failed. Raises
+    ValueError naming `source` otherwise."""
     if scene.outputs.decimation > 1:
         msg = (
             f"{source}: written at outputs.decimation {scene.outputs.decimation}, its wrenches "
@@ -105,6 +106,13 @@ def wrenches_of(tables: list[Table], scene: Scene, source: str) -> tuple[np.ndar
         )
         raise ValueError(msg)
     by_name = {t.name: t for t in tables}
+    failures = integration_values(by_name.get("diagnostics")).get("failures_total", "0")
+    if int(failures):  # its wrenches have holes where it failed, and a restart after each
+        msg = (
+            f"{source}: the twin's run failed, its response is not the machine's: integration "
+            f"failed {failures} times"
+        )
+        raise ValueError(msg)
     names = [str(WRENCHES_OUTPUT.table).format(mount=m.name) for m in scene.mounts]
     missing = [n for n in names if n not in by_name]
     if missing:

@@ -21,6 +21,7 @@ import numpy as np
 from rosbags.highlevel import AnyReader
 
 from mount_twin.engine.batch import event_level
+from mount_twin.engine.health import INTEGRATION
 from mount_twin.errors import BagError
 from mount_twin.io.bag_info import require_existing
 from mount_twin.io.messages import DIAGNOSTICS, OUTPUTS, TYPESTORE, Readback, output_table
@@ -152,6 +153,16 @@ def events_of(diagnostics: Table, origin_ns: int) -> list[Event]:
                 )
             )
     return sorted(out, key=lambda e: e.t_s)
+
+
+def integration_values(diagnostics: Table | None) -> dict[str, str]:
+    """The key-values of the run's last integration status (`failures_total`, the error
+    estimate, …); empty where the bag holds none."""
+    if diagnostics is None:
+        return {}
+    c = diagnostics.columns
+    rows = [v for s, v in zip(c["status"], c["values"], strict=True) if s == INTEGRATION]
+    return json.loads(rows[-1]) if rows else {}
 
 
 def events_table(diagnostics: Table, origin_ns: int) -> Table:
