@@ -15,6 +15,7 @@ from scipy.signal import butter, sosfiltfilt
 
 from mount_twin import load_scene_file
 from mount_twin.analysis import calibration as cal_mod
+from mount_twin.analysis.ageing import track
 from mount_twin.cli import main
 from mount_twin.errors import SceneError
 from mount_twin.io.signals import Signal, ship_motion
@@ -119,6 +120,18 @@ def test_a_window_or_band_no_judgement_can_take_is_refused(
     files = ["--foundation", str(d / "foundation.csv"), "--body", str(d / "body.csv")]
     assert main(["track", str(d / "pump.scene.yaml"), *files, *options]) == 2
     assert says in capsys.readouterr().err
+
+
+def test_records_that_do_not_overlap_are_refused_for_it(
+    ageing_pair: tuple[Path, Signal, Signal],
+) -> None:
+    """A body record from another day was told "less than one window of 30 s (give a shorter
+    one)"."""
+    d, foundation, body = ageing_pair
+    later = Signal(body.t + 1000.0, body.accel, body.gyro)
+    scene = load_scene_file(d / "pump.scene.yaml")
+    with pytest.raises(ValueError, match="the records do not overlap on one clock: the found"):
+        track(scene, foundation, later)
 
 
 @pytest.mark.parametrize(

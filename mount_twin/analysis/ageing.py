@@ -105,7 +105,15 @@ def track(
     if window_s <= 2.0 * LEAD_S:
         msg = f"window {window_s:g} s: give more than {2.0 * LEAD_S:g} s (the lead settles)"
         raise ValueError(msg)
-    start, stop = float(body.t[0]) + LEAD_S, float(min(foundation.t[-1], body.t[-1]))
+    first, stop = float(max(foundation.t[0], body.t[0])), float(min(foundation.t[-1], body.t[-1]))
+    if stop <= first:
+        msg = (
+            "the records do not overlap on one clock: the foundation's runs "
+            f"{foundation.t[0]:.6g} to {foundation.t[-1]:.6g} s, the body's {body.t[0]:.6g} "
+            f"to {body.t[-1]:.6g} s"
+        )
+        raise ValueError(msg)
+    start = first + LEAD_S  # the twin settles on the foundation over the lead
     fits = []
     while start + window_s <= stop + 1e-9:
         end = start + window_s
