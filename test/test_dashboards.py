@@ -9,6 +9,7 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import pytest
+import yaml
 from io_helpers import CONFIG
 
 from mount_twin.analysis.dashboards import foxglove_layout, plotjuggler_layout
@@ -72,6 +73,37 @@ def test_the_bundled_layouts_are_what_the_command_writes(scene_name: str) -> Non
     assert (CONFIG / f"{scene_name}.foxglove.json").read_text(encoding="utf-8") == (
         foxglove_layout(scene)
     )
+
+
+@pytest.mark.parametrize("off", ["pose", "angles", "wrenches"])
+def test_an_output_the_scene_turns_off_is_not_plotted(off: str) -> None:
+    """Its panels were laid out on topics the node never publishes."""
+    pump = load_scene_file(CONFIG / "pump_8_mounts.scene.yaml")
+    scene = dataclasses.replace(pump, outputs=dataclasses.replace(pump.outputs, **{off: False}))
+    published = {resolve(s.topic, NODE_NAME) for s in output_streams(scene)}
+    curves = {c.get("name", "") for c in ET.fromstring(plotjuggler_layout(scene)).iter("curve")}
+    paths = {
+        p["value"]
+        for panel in json.loads(foxglove_layout(scene))["configById"].values()
+        for p in panel["paths"]
+    }
+    assert len(curves) == len(paths) == {"pose": 27, "angles": 27, "wrenches": 6}[off]
+    assert all(any(c.startswith(f"{t}/") for t in published) for c in curves)
+    assert {p.split(".")[0] for p in paths} <= published
+
+
+def test_a_scene_that_publishes_nothing_to_plot_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    data = yaml.safe_load((CONFIG / "pump_8_mounts.scene.yaml").read_text(encoding="utf-8"))
+    data["outputs"] = {**data["outputs"], "pose": False, "angles": False, "wrenches": False}
+    scene = tmp_path / "tf_only.scene.yaml"
+    scene.write_text(yaml.safe_dump(data), encoding="utf-8")
+    args = ["dashboard", str(scene), "--plotjuggler", str(tmp_path / "l.xml")]
+    assert main(args) == 2
+    said = capsys.readouterr().err
+    assert "wrenches are off and there is no body_sensor: nothing to plot" in said
+    assert not (tmp_path / "l.xml").exists()
 
 
 def test_a_body_imu_adds_its_prediction_and_residual_on_their_topics() -> None:

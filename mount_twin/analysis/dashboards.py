@@ -28,23 +28,25 @@ COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e
 
 
 def panels(scene: Scene) -> list[tuple[str, list[tuple[str, tuple[str, ...]]]]]:
-    """(panel title, [(topic, field path)]) of each plot: pose, angles, force x, y, z, and with
-    a body_sensor the body IMU's predicted and residual specific force."""
+    """(panel title, [(topic, field path)]) of each plot of what the scene publishes: pose,
+    angles, force x, y, z, and with a body_sensor the body IMU's predicted and residual
+    specific force. ValueError where it publishes none of them."""
+    published = scene.outputs
     pose = resolve(POSE_OUTPUT.topic, NODE_NAME)
     angles = resolve(ANGLES_OUTPUT.topic, NODE_NAME)
     Series = list[tuple[str, tuple[str, ...]]]
-    out: list[tuple[str, Series]] = [
-        ("CG position in F [m]", [(pose, _path(POSE_OUTPUT, k)) for k in range(3)]),
-        ("α (x), γ (y), δ (z) [rad]", [(angles, _path(ANGLES_OUTPUT, k)) for k in range(3)]),
-    ]
-    wrenches = WRENCHES_OUTPUT.streams(scene)
-    for k, axis in enumerate("xyz"):
+    out: list[tuple[str, Series]] = []
+    if published.pose:
+        out.append(("CG position in F [m]", [(pose, _path(POSE_OUTPUT, k)) for k in range(3)]))
+    if published.angles:
         out.append(
-            (
-                f"mount force along mount {axis} [N]",
-                [(resolve(st.topic, NODE_NAME), _path(WRENCHES_OUTPUT, k)) for st in wrenches],
-            )
+            ("α (x), γ (y), δ (z) [rad]", [(angles, _path(ANGLES_OUTPUT, k)) for k in range(3)])
         )
+    if published.wrenches:
+        topics = [resolve(st.topic, NODE_NAME) for st in WRENCHES_OUTPUT.streams(scene)]
+        for k, axis in enumerate("xyz"):
+            force = _path(WRENCHES_OUTPUT, k)
+            out.append((f"mount force along mount {axis} [N]", [(t, force) for t in topics]))
     if scene.body_sensor is not None:  # the body IMU against the twin (its axes)
         for topic, what in (
             (BODY_PREDICTED_TOPIC, "predicted"),
@@ -54,6 +56,12 @@ def panels(scene: Scene) -> list[tuple[str, list[tuple[str, tuple[str, ...]]]]]:
                 (resolve(topic, NODE_NAME), ("linear_acceleration", a)) for a in "xyz"
             ]
             out.append((f"body IMU specific force, {what} [m/s²]", series))
+    if not out:
+        msg = (
+            f"{scene.source}: outputs.pose, outputs.angles and outputs.wrenches are off and "
+            "there is no body_sensor: nothing to plot"
+        )
+        raise ValueError(msg)
     return out
 
 
