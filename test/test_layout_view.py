@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 from io_helpers import CONFIG, default_scene
 
-from mount_twin.analysis.layout_view import layout_size
+from mount_twin.analysis.layout_view import layout_size, sensors
 from mount_twin.cli import main
 from mount_twin.physics.rotations import rpy_matrix
+from mount_twin.scene.description import BodySensor
 
 
 def test_the_command_writes_the_picture(
@@ -35,6 +36,16 @@ def test_the_layout_scale_is_the_scene_extent() -> None:
         ),
     )
     assert layout_size(in_mm) == pytest.approx(1800.0)
+
+
+def test_the_body_imu_is_drawn_where_the_scene_puts_it() -> None:
+    """It was not drawn: a body IMU given in mm, or on the wrong side, did not show."""
+    scene = default_scene()
+    assert [label for label, _, _ in sensors(scene)] == ["foundation IMU"]
+    far = BodySensor(position=(0.8, 0.3, 3.0), orientation_rpy=(0.0, 0.0, 1.5))
+    with_body = dataclasses.replace(scene, body_sensor=far)
+    assert sensors(with_body)[1] == ("body IMU", far.position, far.orientation_rpy)
+    assert layout_size(with_body) == pytest.approx(3.0)  # z from 0 (origin) to 3 m
 
 
 def test_the_pump_end_mounts_lean_outward_and_their_lines_cross_below() -> None:

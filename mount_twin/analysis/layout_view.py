@@ -5,7 +5,8 @@ the foundation frame F at its origin; the CG; each mount at its position, colour
 with its own axes (x red, y green, z blue, as RViz draws frames) and the line of action of its
 local z (dashed, through the mount, both ways), so an inclined mount pointing the wrong way,
 lines of action meeting below the mounts, or positions in millimetres show at a glance; the
-sensor with its axes. matplotlib is imported here only (the `plot` extra).
+IMUs (the foundation's, the body's) with their axes. matplotlib is imported here only (the
+`plot` extra).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from mount_twin.physics.rotations import rpy_matrix
-from mount_twin.scene.description import Scene
+from mount_twin.scene.description import Scene, Vec3
 
 KIND_COLOURS = {
     "linear": "tab:blue",
@@ -25,18 +26,30 @@ KIND_COLOURS = {
     "shear_key": "tab:brown",
 }
 AXIS_COLOURS = ("red", "green", "blue")
+SENSOR_COLOURS = ("teal", "magenta")
+"""The foundation IMU's and the body IMU's markers."""
 VIEWS = (("side view (x–z of F)", 0, 2), ("end view (y–z of F)", 1, 2))
 """2-D panels: title, horizontal and vertical axis of F."""
 
 
+def sensors(scene: Scene) -> list[tuple[str, Vec3, Vec3]]:
+    """(label, position m in F, axes' roll, pitch, yaw rad) of each IMU of the scene: the
+    foundation's (the input) and the body's, if any (its axes relative to B, which is F's at
+    the reference pose drawn)."""
+    out = [("foundation IMU", scene.input.sensor_position, scene.input.sensor_rpy)]
+    if (body := scene.body_sensor) is not None:
+        out.append(("body IMU", body.position, body.orientation_rpy))
+    return out
+
+
 def layout_size(scene: Scene) -> float:
-    """The layout's extent, m: the largest distance between the CG, the origin, the sensor
-    and the mounts (at least 0.1 m), the scale of the arrows and lines drawn."""
+    """The layout's extent, m: the largest distance between the CG, the origin, the IMUs and
+    the mounts (at least 0.1 m), the scale of the arrows and lines drawn."""
     points = np.array(
         [
             scene.body.cg,
             (0.0, 0.0, 0.0),
-            scene.input.sensor_position,
+            *(position for _, position, _ in sensors(scene)),
             *(m.position for m in scene.mounts),
         ]
     )
@@ -111,8 +124,8 @@ class _Views:
 
 
 def _draw_scene(views: _Views, scene: Scene) -> None:
-    """F's axes at its origin; each mount's line of action, axes and name; the sensor and the
-    CG (arrows and lines scaled to `layout_size`)."""
+    """F's axes at its origin; each mount's line of action, axes and name; the IMUs with their
+    axes and the CG (arrows and lines scaled to `layout_size`)."""
     size = layout_size(scene)
     arrow, reach = 0.12 * size, 0.9 * size
     views.frame(np.zeros(3), np.eye(3), 2.0 * arrow, 2.0)
@@ -129,9 +142,9 @@ def _draw_scene(views: _Views, scene: Scene) -> None:
         )
         views.frame(p, rot, arrow, 1.2)
         views.point(p, m.name, color=colour, s=30)
-    sensor = np.array(scene.input.sensor_position)
-    views.frame(sensor, rpy_matrix(*scene.input.sensor_rpy), 0.7 * arrow, 1.0)
-    views.point(sensor, "sensor", color="teal", marker="^", s=40)
+    for (label, position, rpy), colour in zip(sensors(scene), SENSOR_COLOURS, strict=False):
+        views.frame(np.array(position), rpy_matrix(*rpy), 0.7 * arrow, 1.0)
+        views.point(np.array(position), label, color=colour, marker="^", s=40)
     cg = np.array(scene.body.cg)
     views.point(cg, f"CG ({scene.frames.body})", color="black", marker="o", s=70)
 
