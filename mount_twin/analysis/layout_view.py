@@ -118,8 +118,14 @@ class _Views:
         """The 2-D views' point labels, one per position."""
         for ax, named in zip(self.flat, self.labels, strict=True):
             for (u, v), names in named.items():
-                ax.annotate(
-                    ", ".join(names), (u, v), fontsize=7, xytext=(3, 3), textcoords="offset points"
+                ax.annotate(  # slanted: labels of points side by side do not run together
+                    ", ".join(names),
+                    (u, v),
+                    fontsize=7,
+                    xytext=(3, 3),
+                    textcoords="offset points",
+                    rotation=40,
+                    rotation_mode="anchor",
                 )
 
 
