@@ -200,7 +200,9 @@ class TwinStream:
         measured = np.hstack([decoded.accel, decoded.gyro])
         reason = np.full(len(raws), "undecodable", dtype=object)
         reason[decoded.places()] = self.body.screen(decoded.stamps_ns, measured, decoded.frame_ids)
-        out: list[tuple[str, int, bytes]] = []
+        stamps_ns = np.zeros(len(raws), np.int64)
+        stamps_ns[decoded.places()] = decoded.stamps_ns
+        out = self._encode_body(self.body.screened(stamps_ns, reason))
         # the rejected counted at their place, between the samples around them: the window
         # they are reported in does not depend on how the messages were batched
         for start, stop in _runs(reason):

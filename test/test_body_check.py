@@ -251,6 +251,40 @@ def test_bad_body_messages_are_counted_skipped_and_reported() -> None:
     assert first[0] == WARN and "rejected_wrong_frame_id 2" in first[1]
 
 
+def test_a_body_imu_whose_every_message_is_rejected_is_reported_window_by_window() -> None:
+    """Live, it was reported only at the node's shutdown: windows close on compared samples.
+    Now each window of the body's own stamps in which none was taken is a WARN when the next
+    begins, the same in any batching; a window where one was taken is not."""
+    scene, deck = _pump(frame_id="pump_imu"), _deck(12.0)
+    _, whole = _whole_record(scene, deck)
+    ns = _stamps(deck)
+    wrong = _body_raws(ns, whole, "other_imu")
+    body = [
+        *wrong[:1000],
+        b"\x00\x01garbage",
+        *wrong[1000:1100],
+        *_body_raws(ns, whole, "pump_imu")[1100:1101],
+        *wrong[1101:],
+    ]
+    deck_raws, runs = _deck_raws(scene, deck), {}
+    for chunk in (1, 7, len(body)):
+        stream = TwinStream(scene)
+        out = []
+        for k in range(0, len(body), chunk):
+            out += stream.process(deck_raws[k : k + chunk])
+            out += stream.process_body(body[k : k + chunk])
+        runs[chunk] = (_windows(out), stream.take_body_reports())
+    assert runs[1] == runs[7] == runs[len(body)]
+    ((level, message, values),) = runs[1][0]  # 5–10 s has the one taken, 10–12 s is open
+    assert level == WARN
+    assert message == (
+        "none of the 1001 body IMU messages over 5 s of their stamps was taken: "
+        "rejected_undecodable 1, rejected_wrong_frame_id 1000 (body_sensor.frame_id is "
+        "'pump_imu')"
+    )
+    assert values["body_rejected_wrong_frame_id"] == "1000"
+
+
 def test_a_body_sensor_needs_every_samples_wrenches() -> None:
     """Decimated rows hold each wrench component's peak: a scene with a body sensor and
     outputs.decimation past 1 fails at load, naming the key."""

@@ -15,6 +15,11 @@ batched, and whichever of the two streams comes first (live = replay), within `R
 3. `_Windows` judges the compared samples in windows of body_sensor.window_s of stamps
    (`agreement`), on a grid from the first compared sample; the last, partial window at the
    end of the stream if it spans half a window (and holds `agreement.MIN_SAMPLES`).
+
+Beside them, `_Refusals` watches the body messages themselves, in windows of the same length
+on their own stamps: a window in which every message was rejected (another frame_id, …) is a
+WARN when the next begins, so that a body IMU the twin never takes shows live, not only at
+the end of the stream. It depends on the body stream alone.
 """
 
 from __future__ import annotations
@@ -289,6 +294,61 @@ class _Windows:
         return [(int(ns[-1]), status)]
 
 
+class _Refusals:
+    """Windows of body_sensor.window_s of the body messages' own stamps (a grid from the first
+    message with one; a message without, or stamped behind, counts in the window the stream
+    is in): each in which messages came and none was accepted is reported, when the next
+    begins."""
+
+    def __init__(self, sensor: BodySensor) -> None:
+        self._sensor = sensor
+        self._window_ns = sensor.window_s * 1e9
+        self._origin: int | None = None
+        self._index = 0
+        self._accepted = 0
+        self._rejected: Counter[str] = Counter()
+        self._last_ns = 0
+
+    def add(self, stamps_ns: np.ndarray, why: np.ndarray) -> list[tuple[int, HealthStatus]]:
+        """Reports (stamp ns, status) of the windows these screened messages (stamps, and
+        why each was rejected, '' where not) close."""
+        stamped = stamps_ns > 0
+        if self._origin is None and stamped.any():
+            self._origin = int(stamps_ns[stamped][0])
+        if self._origin is None:
+            index = np.zeros(stamps_ns.shape[0], np.int64)
+        else:
+            raw = np.floor((stamps_ns - self._origin) / self._window_ns).astype(np.int64)
+            index = np.maximum.accumulate(np.where(stamped, raw, self._index))
+        reports = []
+        for i, reason, ns in zip(index.tolist(), why, stamps_ns.tolist(), strict=True):
+            if i > self._index:
+                reports += self._close(self._last_ns)  # the latest stamp in the window
+                self._index = i
+            if reason:
+                self._rejected[reason] += 1
+            else:
+                self._accepted += 1
+            self._last_ns = max(self._last_ns, ns)
+        return reports
+
+    def _close(self, stamp_ns: int) -> list[tuple[int, HealthStatus]]:
+        rejected, accepted = self._rejected, self._accepted
+        self._rejected, self._accepted = Counter(), 0
+        if accepted or not rejected:
+            return []
+        n = sum(rejected.values())
+        why = ", ".join(f"rejected_{r} {v}" for r, v in sorted(rejected.items()))
+        message = (
+            f"none of the {n} body IMU messages over {self._sensor.window_s:g} s of their "
+            f"stamps was taken: {why}"
+        )
+        if "wrong_frame_id" in rejected:
+            message += f" (body_sensor.frame_id is {self._sensor.frame_id!r})"
+        values = {f"body_rejected_{r}": str(rejected[r]) for r in REJECTED}
+        return [(stamp_ns, HealthStatus(NAME, WARN, message, values))]
+
+
 @dataclass
 class BodyComparison:
     """The body IMU's samples compared, and the windows judged.
@@ -333,6 +393,7 @@ class BodyCheck:
         self._lead = _Lead(predict)
         self._matcher = _Matcher(sensor.lag_s, scene.input.max_gap_s, self.counts)
         self._windows = _Windows(sensor, self.counts)
+        self._refusals = _Refusals(sensor)
 
     def screen(
         self, stamps_ns: np.ndarray, measured: np.ndarray, frame_ids: list[str]
@@ -359,6 +420,15 @@ class BodyCheck:
             self.last_ns = int(stamps_ns[keep][-1])
         self.seen_ns = max(self.seen_ns, int(stamps_ns.max(initial=0)))
         return why
+
+    def screened(self, stamps_ns: np.ndarray, why: np.ndarray) -> BodyComparison:
+        """Every body message as it came (stamps ns, 0 where unknown; why each was rejected,
+        '' where not): the windows of stamps in which none was taken, reported (nothing
+        compared)."""
+        empty = np.zeros((0, 6))
+        return BodyComparison(
+            np.zeros(0, np.int64), empty, empty, self._refusals.add(stamps_ns, why)
+        )
 
     def reject(self, reason: str, n: int) -> None:
         """Count n body messages not compared, because `reason` (one of REJECTED)."""
