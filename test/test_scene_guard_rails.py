@@ -17,6 +17,7 @@ from io_helpers import CONFIG, G
 from physics_helpers import base_scene, mount
 
 from mount_twin.errors import SceneError
+from mount_twin.model.assemble import assemble
 from mount_twin.scene import (
     Scene,
     SceneWarning,
@@ -352,6 +353,39 @@ def test_an_elastomer_given_stiffness_for_stiffness_linear_is_told_the_unknown_k
     }
     with pytest.raises(SceneError, match=r"pump: mounts\[0\]\.stiffness: unknown key"):
         scene_from_dict(data, "pump")
+
+
+def _replaced(scene: Scene, path: str, value: Any) -> Scene:
+    """`scene` with the attribute at `path` ("body.mass", "mounts[2].stiffness") replaced."""
+    head, _, rest = path.partition(".")
+    name, _, index = head.partition("[")
+    if index:
+        items = list(getattr(scene, name))
+        items[int(index[:-1])] = _replaced(items[int(index[:-1])], rest, value)
+        return dataclasses.replace(scene, **{name: tuple(items)})
+    if rest:
+        return dataclasses.replace(scene, **{name: _replaced(getattr(scene, name), rest, value)})
+    return dataclasses.replace(scene, **{name: value})
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "says"),
+    [  # each assembled before: a negative mass ran and failed at every sample; the rest ran
+        ("body.mass", -1200.0, "body.mass: must be > 0 kg, got -1200.0"),
+        ("body.inertia", (100.0, 100.0, 100.0, 150.0, 0.0, 0.0), "body.inertia: not positive"),
+        ("mounts[2].orientation_rpy", (0.0, 30.0, 0.0), "mounts[2].orientation_rpy: [0.0, 30.0"),
+        ("input.sensor_rpy", (0.0, 0.0, 90.0), "input.sensor_rpy: [0.0, 0.0, 90.0]: beyond a"),
+        ("mounts[1].stiffness", (1e5, 1e5, -1e5, 0.0, 0.0, 0.0), "mounts[1].stiffness[2]: must"),
+        ("body.cg", (0.0, 0.0, float("nan")), "body.cg[2]: must be finite, got nan"),
+        ("mounts[0].kind", "elastomer", "mounts[0].kind: 'elastomer' is not the kind of a Linear"),
+        ("dofs", ("x", "roll"), "dofs: expected distinct names of x, y, z, alpha"),
+    ],
+)
+def test_a_scene_built_in_code_is_checked_at_assembly(path: str, value: Any, says: str) -> None:
+    pump = load_scene_file(PUMP)
+    with pytest.raises(SceneError) as err:
+        assemble(_replaced(pump, path, value))
+    assert str(err.value).startswith(f"{PUMP}: {says}")
 
 
 def _laughs(levels: int) -> str:

@@ -21,6 +21,7 @@ from mount_twin.physics.dynamics import (
 )
 from mount_twin.physics.jacobian import central_columns
 from mount_twin.physics.rotations import rpy_matrices, rpy_matrix
+from mount_twin.scene.built import check_built
 from mount_twin.scene.description import DOF_NAMES, LinearMount, Scene
 
 
@@ -73,8 +74,10 @@ def _inverse(rated: tuple[float, ...]) -> list[float]:
 
 def assemble(scene: Scene) -> Model:
     """Build the core's arrays of `scene` and solve its nominal start state (done once, at
-    load; raises ModelError where the mounts cannot hold the body)."""
+    load; raises ModelError where the mounts cannot hold the body, SceneError for a value of
+    a scene built in code that no loader would have taken: `scene.built`)."""
     require(scene, Scene, "assemble(scene)")
+    check_built(scene)
     body = scene.body
     inertia = np.array(body.inertia_tensor())
     cg = np.array(body.cg)
