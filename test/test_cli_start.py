@@ -48,6 +48,8 @@ def test_help_answers_without_importing_numerics(args: tuple[str, ...]) -> None:
         (("sweep", "s", "-o", "o", "--workers", "0"), "--workers: must be ≥ 1, got 0"),
         (("accuracy", "s", "b", "--max-substeps", "0"), "--max-substeps: must be ≥ 1, got 0"),
         (("build-tf2-msgs", "--jobs", "x"), "--jobs/-j: 'x' is not an integer"),
+        # numpy's "expected non-negative integer", naming no option
+        (("synthesize", "--spectrum", "s", "-o", "o", "--first-seed", "-5"), "--first-seed: must"),
     ],
 )
 def test_an_argument_error_exits_2_without_importing_numerics(

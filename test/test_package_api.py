@@ -183,6 +183,14 @@ def test_lists_and_float32_are_taken_as_the_float64_arrays_they_hold() -> None:
     np.testing.assert_array_equal(f32.wrenches, exact.wrenches)
 
 
+def test_the_concatenation_of_no_batch_is_an_empty_batch_an_engine_takes() -> None:
+    """It was numpy's "need at least one array to concatenate"."""
+    empty = mount_twin.SampleBatch.concat([])
+    assert len(empty) == 0 and empty.accel.shape == (0, 3) and empty.frame_ids == []
+    scene = mount_twin.load_scene_file(ROOT / "config/pump_8_mounts.scene.yaml")
+    assert len(mount_twin.TwinEngine(mount_twin.assemble(scene)).push(empty)) == 0
+
+
 def test_the_entry_points_refuse_a_wrong_object_naming_the_argument() -> None:
     """A scene where a model goes (or a dict where a batch goes) is refused at the door, with
     what was given and what is taken, not with an AttributeError from deep inside."""

@@ -518,6 +518,12 @@ def test_a_mount_namespace_that_is_a_value_fails_naming_it() -> None:
         scene_from_params(flat, "P")
 
 
+def test_a_parameter_set_that_is_no_mapping_fails_naming_it() -> None:
+    """An AttributeError's traceback: 'list' object has no attribute 'get'."""
+    with pytest.raises(SceneError, match=re.escape("P: <top>: expected a mapping of parameter")):
+        scene_from_params([1], "P")  # type: ignore[arg-type]
+
+
 def test_missing_mount_names_parameter_fails() -> None:
     flat = flat_params()
     del flat["mount_names"]

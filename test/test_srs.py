@@ -168,6 +168,10 @@ def test_frequencies_from_half_the_sampling_rate_up_are_refused() -> None:
     with pytest.raises(ValueError, match="finite"):
         srs(np.array([0.0, np.nan]), 1000.0, np.array([10.0]))
     assert srs(np.ones(10), 1000.0, np.array([100.0, 101.0])).accurate.tolist() == [True, False]
+    # a 2-D grid was told its range; an empty one met numpy's "zero-size array"
+    for grid in (np.array([[10.0, 20.0]]), np.array([])):
+        with pytest.raises(ValueError, match=r"natural frequencies must be a non-empty 1-D arr"):
+            srs(np.ones(10), 1000.0, grid)
 
 
 def test_octave_spacing() -> None:

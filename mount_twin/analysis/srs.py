@@ -120,7 +120,10 @@ def srs(
     if not rate_hz > 0.0:
         msg = f"the sampling rate must be positive ({rate_hz} Hz)"
         raise ValueError(msg)
-    if f.ndim != 1 or f.size == 0 or not np.all(f > 0.0) or not np.all(f < 0.5 * rate_hz):
+    if f.ndim != 1 or f.size == 0:
+        msg = f"natural frequencies must be a non-empty 1-D array (shape {f.shape})"
+        raise ValueError(msg)
+    if not np.all(f > 0.0) or not np.all(f < 0.5 * rate_hz):
         msg = (
             f"natural frequencies must lie between 0 and half the sampling rate "
             f"({0.5 * rate_hz:g} Hz); got {f.min():g} to {f.max():g} Hz"

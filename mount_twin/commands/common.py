@@ -44,13 +44,24 @@ def positive_int(text: str) -> int:
     """argparse type of a count (workers, jobs, messages, substeps): an integer ≥ 1. A 0 or a
     negative one is refused at parse, naming the option (exit 2): `replay --chunk 0` had looped
     for ever, `qualify --workers -1` hung, `sweep --workers 0` meant one per core."""
+    return _integer_from(text, 1)
+
+
+def non_negative_int(text: str) -> int:
+    """argparse type of an index (a first seed): an integer ≥ 0 (a negative seed reached
+    numpy's generator, whose error named no option)."""
+    return _integer_from(text, 0)
+
+
+def _integer_from(text: str, low: int) -> int:
+    """`text` as an integer ≥ low, else argparse's error (it names the option)."""
     try:
         value = int(text)
     except ValueError:
         msg = f"{text!r} is not an integer"
         raise argparse.ArgumentTypeError(msg) from None
-    if value < 1:
-        msg = f"must be ≥ 1, got {value}"
+    if value < low:
+        msg = f"must be ≥ {low}, got {value}"
         raise argparse.ArgumentTypeError(msg)
     return value
 

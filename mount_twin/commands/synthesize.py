@@ -7,6 +7,7 @@ import argparse
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
+from mount_twin.commands.common import non_negative_int
 from mount_twin.commands.srs import add_tolerance_argument, tolerance_of
 from mount_twin.io.epoch import DEFAULT_START_NS
 
@@ -40,7 +41,7 @@ def add_synthesis_arguments(parser: argparse.ArgumentParser, *, required: bool =
         help="the design spectrum (frequency_hz,accel_g), maximax, interpolated log-log",
     )
     parser.add_argument("--seeds", type=int, default=3, help="time histories, one per seed")
-    parser.add_argument("--first-seed", type=int, default=0, help="the first seed")
+    parser.add_argument("--first-seed", type=non_negative_int, default=0, help="the first seed")
     parser.add_argument("--rate", type=float, default=20000.0, help="sampling rate, Hz")
     parser.add_argument(
         "--axis", choices=["x", "y", "z"], default="z", help="sensor axis of the shock"

@@ -86,7 +86,9 @@ class SampleBatch:
 
     @classmethod
     def concat(cls, parts: list[SampleBatch]) -> SampleBatch:
-        """One batch of several, in order."""
+        """One batch of several, in order (of none, an empty one)."""
+        if not parts:
+            return cls(np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)), [])
         return cls(
             np.concatenate([p.stamps for p in parts]),
             np.concatenate([p.accel for p in parts]).reshape(-1, 3),

@@ -16,7 +16,7 @@ from mount_twin.integrate.methods import METHODS
 from mount_twin.kinds import KINDS
 from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import load_scene_file, read_scene_yaml, scene_from_dict
-from mount_twin.scene.reader import Used
+from mount_twin.scene.reader import Used, shown
 
 PARAMETERS: dict[str, tuple[str, str]] = {
     "scene_file": (
@@ -192,6 +192,10 @@ def effective_parameters(flat: Mapping[str, Any], source: str) -> Effective:
     With `scene_file` set, the file is validated on its own first (errors name the file's key
     paths), then the other parameters override its values (errors name the parameter).
     """
+    if not isinstance(flat, Mapping):
+        raise SceneError(
+            source, "<top>", f"expected a mapping of parameter names to values, got {shown(flat)}"
+        )
     scene_file = flat.get("scene_file", "")
     if not isinstance(scene_file, str):
         raise SceneError(source, "scene_file", f"expected a string, got {scene_file!r}")
