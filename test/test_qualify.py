@@ -153,6 +153,25 @@ def test_a_plan_runs_every_axis_and_its_criteria_judge(
     assert "qualification: FAIL" in said and "utilisation over 0.01: fl " in said
 
 
+def test_a_fail_on_warn_verdict_names_the_status_that_warned(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A WARN that no mount event explains (here the attitude's, past a tilt of 1e-6 rad) read
+    "diagnostics reached WARN (see its diagnostics)"."""
+    data = yaml.safe_load((CONFIG / "pump_8_mounts.scene.yaml").read_text(encoding="utf-8"))
+    data["outputs"]["tilt_warn_rad"] = 1e-6
+    scene = tmp_path / "pump.scene.yaml"
+    scene.write_text(yaml.safe_dump(data), encoding="utf-8")
+    text = "spectra:\n  z: z.csv\nseeds: 1\ncriteria:\n  max_utilisation: 100\n  fail_on: warn\n"
+    plan = _plan(tmp_path, text)
+    args = ["qualify", str(scene), "--plan", str(plan), "-o", str(tmp_path / "q"), "--json"]
+    assert main([*args, str(tmp_path / "q.json")]) == 4
+    why = json.loads((tmp_path / "q.json").read_text(encoding="utf-8"))["why"]["broken"]
+    assert list(why) == ["z/0"] and len(why["z/0"]) == 1, why
+    assert why["z/0"][0].startswith("diagnostics reached WARN (mount_twin: attitude: tilt ")
+    assert "see its diagnostics" not in capsys.readouterr().out
+
+
 @pytest.mark.parametrize(
     ("text", "says"),
     [

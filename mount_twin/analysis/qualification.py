@@ -149,6 +149,9 @@ class InputRun:
     travel_m: dict[str, float]
     events: list[tuple[str, str, str]] = field(default_factory=list)
     estimate: float = math.nan
+    statuses: list[tuple[str, str, str]] = field(default_factory=list)
+    """(name, level, message) of each diagnostics status that reached WARN or ERROR, at its
+    worst over the run."""
 
 
 def _broken(run: InputRun, plan: Plan) -> list[str]:
@@ -157,7 +160,9 @@ def _broken(run: InputRun, plan: Plan) -> list[str]:
     levels = ("ERROR",) if plan.fail_on == "error" else ("ERROR", "WARN")
     if run.verdict in levels:
         seen = Counter(f"{m} {e}" for m, e, level in run.events if level in levels)
-        said = ", ".join(f"{k} ×{n}" for k, n in seen.items()) or "see its diagnostics"
+        said = ", ".join(f"{k} ×{n}" for k, n in seen.items()) or "; ".join(
+            f"{name}: {message}" for name, level, message in run.statuses if level in levels
+        )
         out.append(f"diagnostics reached {run.verdict} ({said})")
     over = [f"{m} {u:.3f}" for m, u in run.utilisation.items() if u > plan.max_utilisation]
     if over:

@@ -106,6 +106,7 @@ def run_input(scene_path: str, plan: Plan, axis: str, seed: int, out: str) -> In
     from mount_twin.analysis.qualification import InputRun
     from mount_twin.analysis.synthesis import imu_record, synthesize
     from mount_twin.commands.common import load_scene, read_design_table, write_signal
+    from mount_twin.engine.batch import LEVEL_NAMES
     from mount_twin.io.epoch import DEFAULT_START_NS
     from mount_twin.replay import replay
 
@@ -136,6 +137,7 @@ def run_input(scene_path: str, plan: Plan, axis: str, seed: int, out: str) -> In
         dict(s.travel_max_m),
         [(e.mount, e.event, e.level) for e in s.events],
         s.error_estimate.force_error_rel if s.error_estimate else float("nan"),
+        [(st.name, LEVEL_NAMES[st.level], st.message) for st in s.worst.values() if st.level],
     )
 
 
