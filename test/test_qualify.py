@@ -169,6 +169,7 @@ def test_a_fail_on_warn_verdict_names_the_status_that_warned(
     why = json.loads((tmp_path / "q.json").read_text(encoding="utf-8"))["why"]["broken"]
     assert list(why) == ["z/0"] and len(why["z/0"]) == 1, why
     assert why["z/0"][0].startswith("diagnostics reached WARN (mount_twin: attitude: tilt ")
+    assert "past outputs.tilt_warn_rad 1e-06" in why["z/0"][0]  # it read "0.0° past 0.0°"
     assert "see its diagnostics" not in capsys.readouterr().out
 
 

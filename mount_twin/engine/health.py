@@ -365,8 +365,8 @@ class HealthWindow:
         return HealthStatus(
             f"{PREFIX}: attitude",
             WARN if self.tilt_max > warn else OK,
-            f"tilt {math.degrees(self.tilt_max):.1f}° past {math.degrees(warn):.1f}°: the α/γ/δ "
-            "chart degrades toward 90°"
+            f"tilt {self.tilt_max:.4g} rad ({math.degrees(self.tilt_max):.3g}°) past "
+            f"outputs.tilt_warn_rad {warn:.4g}: the α/γ/δ chart degrades toward 90°"
             if self.tilt_max > warn
             else "ok",
             {"tilt_max_rad": f"{self.tilt_max:.6g}"},
