@@ -109,6 +109,26 @@ def test_the_response_spectra_of_an_output_bag_and_of_its_replay_in_memory_agree
     assert max(force["maximax_z"]) > 1e4  # N: the bolt's dynamic load, far above noise
 
 
+def test_an_axis_the_scene_freezes_has_no_spectrum_and_is_said(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Its CG specific force is NaN (the constraint's force is not published): `--axis all`
+    failed whole with "the record must be a non-empty 1-D array of finite values"."""
+    data = yaml.safe_load(GENSET.read_text(encoding="utf-8"))
+    data["dofs"] = ["x", "z", "alpha", "gamma", "delta"]
+    scene = tmp_path / "no_sway.scene.yaml"
+    scene.write_text(yaml.safe_dump(data), encoding="utf-8")
+    table = tmp_path / "cg.csv"
+    args = ["srs", str(SHOCK), "--response", "cg", "--scene", str(scene), "--axis"]
+    assert main([*args, "all", "--csv", str(table)]) == 0
+    assert "--axis all: the scene freezes y: a constraint holds" in capsys.readouterr().out
+    columns = _spectra(table)
+    assert "maximax_x" in columns and "maximax_z" in columns and "maximax_y" not in columns
+    assert all(math.isfinite(v) for v in columns["maximax_z"])
+    assert main([*args, "y"]) == 2
+    assert "--axis y: the scene freezes y: a constraint" in capsys.readouterr().err
+
+
 def test_the_output_bag_of_a_failed_run_is_refused_as_failed(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -150,6 +150,8 @@ def tolerance_of(args: argparse.Namespace) -> tuple[float, float]:
 
 
 def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from mount_twin.analysis.sampling import uniform
     from mount_twin.analysis.srs import ACCURATE_SHARE, damping_ratio, gravity_offset, srs
     from mount_twin.commands.common import check_targets, read_design_table
@@ -171,6 +173,16 @@ def run(args: argparse.Namespace) -> int:
     offset, removed = gravity_offset(t, accel, args.gravity, args.head)
     freqs = _frequencies(args, rate)
     axes = AXES if args.axis == "all" else (args.axis,)
+    frozen = [a for a in axes if np.isnan(accel[:, AXES.index(a)]).all()]  # --response cg
+    if frozen:
+        said = (
+            f"the scene freezes {', '.join(frozen)}: a constraint holds the body there and "
+            "publishes no force, so no spectrum"
+        )
+        if len(frozen) == len(axes):
+            raise ValueError(f"--axis {args.axis}: {said}")
+        print(f"--axis {args.axis}: {said}")
+        axes = tuple(a for a in axes if a not in frozen)
     spectra = {
         axis: srs(accel[:, AXES.index(axis)] - offset[AXES.index(axis)], rate, freqs, zeta)
         for axis in axes
