@@ -320,6 +320,29 @@ def test_an_fmax_of_0_is_refused_not_read_as_the_default(
     assert not out.exists()
 
 
+def test_an_xsens_export_is_read_as_its_bag_is(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`srs` refused a Movella/Xsens DOT export (which import-csv, calibrate and track read),
+    pointing at a --columns option it does not have."""
+    export = ROOT / "test/data/shake_table_1story/sine_2hz_trial1_ground_excerpt.csv"
+    bag = tmp_path / "ground"
+    assert main(["import-csv", str(export), "-o", str(bag)]) == 0
+    tables = []
+    for source in (export, bag):
+        table = tmp_path / f"{source.stem}.csv"
+        assert main(["srs", str(source), "--axis", "x", "--csv", str(table)]) == 0
+        tables.append(_rows(table))
+    assert len(tables[0]) == len(tables[1]) > 5
+    for direct, via_bag in zip(*tables, strict=True):  # the bag's stamps are whole ns
+        for key, value in direct.items():
+            assert float(value) == pytest.approx(float(via_bag[key]), rel=1e-9), key
+    odd = tmp_path / "odd.csv"
+    odd.write_text("time,a1,a2,a3\n0,0,0,9.8\n0.001,0,0,9.8\n", encoding="utf-8")
+    assert main(["srs", str(odd)]) == 2
+    assert "map them with `mount-twin import-csv --columns t=" in capsys.readouterr().err
+
+
 def test_a_recorder_csv_in_g_is_read_and_what_is_no_sampled_signal_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

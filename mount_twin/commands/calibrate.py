@@ -61,14 +61,10 @@ def _read_record(
 
     from mount_twin.io.messages import TimeBase
     from mount_twin.io.signals import Signal
-    from mount_twin.io.xsens_csv import is_xsens_csv, read_xsens_csv
+    from mount_twin.io.xsens_csv import read_csv_record
 
     if Path(path).suffix.lower() == ".csv":
-        if is_xsens_csv(path):
-            return read_xsens_csv(path)[0], base
-        from mount_twin.io.csv_import import read_recorder_csv
-
-        return read_recorder_csv(path).signal, base
+        return read_csv_record(path), base
     from mount_twin.io.input_samples import read_input
     from mount_twin.scene.description import InputSpec
 

@@ -373,9 +373,9 @@ def _record(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, str, str]
     if args.response or args.scene:
         return _response(args, path)
     if path.suffix.lower() == ".csv":
-        from mount_twin.io.csv_import import read_recorder_csv
+        from mount_twin.io.xsens_csv import read_csv_record
 
-        sig = read_recorder_csv(path).signal
+        sig = read_csv_record(path)
         return sig.t, sig.accel, path.name, "m/s²"
     from mount_twin.io.bag_info import bag_info
     from mount_twin.io.input_samples import read_input

@@ -255,7 +255,8 @@ def _single_axis_roles(path: Path, row: int, names: list[str], fmt: CsvFormat) -
                 path,
                 f"row {row}",
                 f"a single-axis record needs one acceleration column besides time; the header "
-                f"has {', '.join(names)}: name it with --columns {role}=NAME",
+                f"has {', '.join(names)}: name it with `mount-twin import-csv --columns "
+                f"{role}=NAME`",
             )
         (col,) = rest
     return {"t": t, role: col}
@@ -287,7 +288,8 @@ def _roles(
             path,
             f"row {row}",
             f"no column for {', '.join(missing)}: the header has {', '.join(names)}; name "
-            "them t, ax, ay, az (wx, wy, wz) or map them with --columns t=Time,ax=...",
+            "them t, ax, ay, az (wx, wy, wz), or map them with `mount-twin import-csv "
+            "--columns t=Time,ax=...`",
         )
     gyro = [r for r in ROLES[4:] if r in roles]
     if gyro and len(gyro) != 3:

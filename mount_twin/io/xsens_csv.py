@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mount_twin.io.csv_import import CSV_MAX_BYTES
+from mount_twin.io.csv_import import CSV_MAX_BYTES, read_recorder_csv
 from mount_twin.io.signals import Signal
 from mount_twin.textfiles import FileTooLargeError, read_limited
 
@@ -60,3 +60,9 @@ def read_xsens_csv(path: str | Path) -> tuple[Signal, str]:
         msg = f"{path}: SampleTimeFine does not increase, or a value is not a number"
         raise ValueError(msg)
     return Signal(t, accel, gyro), tag
+
+
+def read_csv_record(path: str | Path) -> Signal:
+    """A CSV record, whichever of the two it is: an Xsens DOT export (stamps on its device
+    clock) or a recorder CSV (`csv_import`: its stamps as written, units from its header)."""
+    return read_xsens_csv(path)[0] if is_xsens_csv(path) else read_recorder_csv(path).signal
