@@ -38,6 +38,27 @@ def test_a_scene_lists_its_mounts_input_and_resolved_outputs(
     assert "error estimate on" in out
 
 
+def test_a_scene_lists_every_topic_its_replay_writes_and_its_body_imu(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """/diagnostics, /tf_static and, with a body_sensor, its input topic and the prediction and
+    residual topics were not listed."""
+    out_bag = tmp_path / "out"
+    genset = str(CONFIG / "genset_bolted_keyed.scene.yaml")
+    bag = str(ROOT / "bags" / "genset_shock_10khz")
+    assert main(["replay", bag, "--scene", genset, "-o", str(out_bag), "--no-progress"]) == 0
+    capsys.readouterr()
+    assert main(["info", genset]) == 0
+    listed = capsys.readouterr().out.split("outputs (node named mount_twin):\n")[1]
+    topics = {line.split()[0]: line.split()[1] for line in listed.splitlines()}
+    assert topics == {t.name: t.msgtype for t in bag_info(out_bag).topics}
+    assert main(["info", str(ROOT / "test/data/shake_table_1story/block.scene.yaml")]) == 0
+    out = capsys.readouterr().out
+    assert f"body IMU: /machine/imu ({IMU}), frame_id block_imu, at [0.0, 0.0, 0.15] m" in out
+    for topic in ("/mount_twin/body_imu/predicted", "/mount_twin/body_imu/residual"):
+        assert re.search(f"^  {topic} +{IMU}$", out, re.MULTILINE)
+
+
 def test_an_unreadable_bag_is_an_error_naming_it(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -31,9 +31,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def scene_text(scene: Scene) -> str:
-    """A scene in a few lines: body, DOFs, each mount, input, integration, outputs and their
-    topics."""
-    from mount_twin.io.messages import output_streams, resolve
+    """A scene in a few lines: body, DOFs, each mount, input (and the body IMU), integration,
+    and every topic the node publishes with its type."""
+    from mount_twin.io.messages import IMU, TF, TF_STATIC_TOPIC, output_types, resolve
     from mount_twin.replay import NODE_NAME
 
     b, i, g = scene.body, scene.input, scene.integration
@@ -57,6 +57,14 @@ def scene_text(scene: Scene) -> str:
             if i.gyro_filter == "linear_phase"
             else ""
         ),
+        *(
+            [
+                f"body IMU: {bs.topic} ({IMU}), frame_id {bs.frame_id or '(any)'}, at "
+                f"{list(bs.position)} m, rpy {list(bs.orientation_rpy)} rad"
+            ]
+            if (bs := scene.body_sensor) is not None
+            else []
+        ),
         f"integration: {g.method}"
         + (
             " (by stiffness: at the first sample interval, again after a contact)"
@@ -66,6 +74,7 @@ def scene_text(scene: Scene) -> str:
         + f", rtol {g.rtol:g}, atol {g.atol:g}, error estimate "
         + ("on" if g.error_estimate else "off"),
         f"outputs (node named {NODE_NAME}):",
-        *(f"  {resolve(s.topic, NODE_NAME):<40} {s.msgtype}" for s in output_streams(scene)),
+        *(f"  {resolve(t, NODE_NAME):<40} {m}" for t, m in output_types(scene).items()),
+        f"  {TF_STATIC_TOPIC:<40} {TF} (latched: the mount frames)",
     ]
     return "\n".join(lines)
