@@ -135,7 +135,7 @@ def test_a_design_spectrum_judges_the_inputs_spectra(genset_run, tmp_path: Path)
         pages.append(page.read_text(encoding="utf-8"))
     one, two, tiny = pages
     for axis in "xyz":
-        assert f"<b>design</b>, axis {axis}: " in one
+        assert f"<b>design d1.csv</b>, axis {axis}: " in one  # it named no file
     m1, m2 = _margins(one), _margins(two)
     assert len(m1) >= 5 and len(m1) == len(m2)
     assert np.allclose(np.subtract(m1, m2), 20.0 * np.log10(2.0), atol=0.011)  # 2-decimal cells

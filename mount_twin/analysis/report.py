@@ -132,6 +132,7 @@ def _srs_section(
     f: np.ndarray,
     design: tuple[list[float], list[float]] | None = None,
     tolerance_db: tuple[float, float] = TOLERANCE_DB,
+    design_name: str = "",
 ) -> list[str]:
     """The input's shock response spectra (5 % damping; gravity and bias taken out as
     `mount-twin srs` does by default, the mean of a quiet head), per axis of F; with a design
@@ -158,7 +159,8 @@ def _srs_section(
     if checks:
         head += ["margin x dB", "margin y dB", "margin z dB"]
     verdicts = [
-        f"<p><b>design</b>, axis {a}: {html.escape(c.summary())}</p>" for a, c in checks.items()
+        f"<p><b>design {html.escape(design_name)}</b>, axis {a}: {html.escape(c.summary())}</p>"
+        for a, c in checks.items()
     ]
     return [
         f"<h2>Shock response spectra of the input (ζ = 5 %, {html.escape(removed)} removed)</h2>",
@@ -253,12 +255,14 @@ def write_report(
     input_path: str | Path | None = None,
     design: tuple[list[float], list[float]] | None = None,
     tolerance_db: tuple[float, float] = TOLERANCE_DB,
+    design_name: str = "",
 ) -> Path:
     """Write the report page. `input_samples`: (stamps ns, specific force (n, 3) m/s² in F) of
     the record, to plot beside the response; `input_path`: the record's bag, hashed for its
     provenance; `design` (Hz, g): a design spectrum the input's spectra are judged against
-    (within `tolerance_db`). The page opens with the verdict, what produced it and with what
-    settings, and the scene as loaded (every value with its meaning and unit)."""
+    (within `tolerance_db`), named `design_name` (its file). The page opens with the verdict,
+    what produced it and with what settings, and the scene as loaded (every value with its
+    meaning and unit)."""
     tables = {t.name: t for t in read_output_bag(output_bag)}
     mounts = {k.removeprefix("mount_"): t for k, t in tables.items() if k.startswith("mount_")}
     origin = min(int(t.columns["stamp_ns"][0]) for t in tables.values() if len(t))
@@ -289,7 +293,7 @@ def write_report(
             png(lambda fig: _draw_utilisation(fig, utilisation, kinds), (10, 4)),
         ]
     if input_samples is not None:
-        sections += _srs_section(*input_samples, design, tolerance_db)
+        sections += _srs_section(*input_samples, design, tolerance_db, design_name)
     if scene is not None:
         sections += _modes_section(scene)
     if "pose" in tables:

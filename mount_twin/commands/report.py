@@ -63,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
         input_path=args.input,
         design=design,
         tolerance_db=tolerance,
+        design_name=Path(args.design).name if args.design else "",
     )
     print(f"report: {out}")
     return 0
