@@ -505,6 +505,17 @@ def test_the_command_on_the_bundled_scenes(scene: str, capsys: pytest.CaptureFix
     assert elastic["modes"][0]["frequency_hz"] > freqs[0]
 
 
+def test_the_mounts_load_line_says_a_frozen_z_holds_the_weight(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """The shake-table block (x free alone): its mounts carry none of the weight, and the line
+    said "0.0, 0.0, 0.0 N (the weight, up)"."""
+    block = CONFIG.parent / "test/data/shake_table_1story/block.scene.yaml"
+    assert main(["modes", str(block)]) == 0
+    said = capsys.readouterr().out
+    assert "0.0 N (z is frozen: its constraint holds the weight, less what the mounts" in said
+
+
 def test_modes_help_imports_no_numerics() -> None:
     """`--help` must answer at once: the command module imports only the standard library."""
     code = (

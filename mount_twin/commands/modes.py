@@ -152,9 +152,12 @@ def _mounts(result: Modes) -> list[str]:
         travel = "".join(f"{_fixed(1e3 * v, 4):>9}" for v in ml.deflection_m)
         lines.append(f"{ml.name:<{width}}  {ml.kind:<13}{forces}{travel}")
     total = [sum(ml.force_in_f_n[k] for ml in result.mounts) for k in range(3)]
-    lines.append(
-        f"sum of the forces in F: {', '.join(_fixed(v, 1) for v in total)} N (the weight, up)"
+    carried = (
+        "the weight, up"
+        if "z" in result.dofs
+        else "z is frozen: its constraint holds the weight, less what the mounts carry"
     )
+    lines.append(f"sum of the forces in F: {', '.join(_fixed(v, 1) for v in total)} N ({carried})")
     return lines
 
 
