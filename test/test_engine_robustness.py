@@ -230,6 +230,51 @@ def test_gap_with_reset_policy_restarts_at_equilibrium_and_reports_the_input_los
     _gap_reported(reports[2][0])
 
 
+@pytest.mark.parametrize("gyro_filter", ["none", "linear_phase"])
+@pytest.mark.parametrize("pieces", [None, [1] * 400, [7] * 58])
+def test_a_restart_gathering_several_samples_is_not_lost_at_a_push_or_a_held_sample(
+    gyro_filter: str, pieces: list[int] | None
+) -> None:
+    """With initial_state.gravity_samples 5 a restart cut short (by a push, or by the engine's
+    own hold of the sample after a stamp jump: every batching under gyro_filter none) was
+    dropped: the twin integrated across the 0.7 s gap from the state before it, moving, and
+    counted no restart. It restarts at rest in equilibrium on the fifth sample after the gap."""
+    scene = scene_with(
+        input={"gap_policy": "reset", "gyro_filter": gyro_filter},
+        initial={"gravity_samples": 5},
+    )
+    full = SampleBatch.concat([ship_batch(0.2), batch(stamps(200, t0=0.2 + 0.7))])
+    engine = engine_for(scene)
+    out, _ = push_all(engine, [full] if pieces is None else split(full, pieces))
+    assert engine.counts["gaps"] == 1 and engine.counts["restarts"] == 1
+    after = np.flatnonzero(out.stamps > 0.5)
+    np.testing.assert_array_equal(out.stamps[after], full.stamps[204:])  # 4 gathered first
+    np.testing.assert_allclose(out.pose[after[0]], equilibrium_pose(), rtol=0, atol=POSE_TOL)
+
+
+def test_restarts_after_failures_answer_the_same_samples_in_any_batching() -> None:
+    """With gravity_samples 3, a failure within a push restarted at the next sample, one on a
+    push's last sample gathered three afresh in the next: 198 rows pushed whole, 109 pushed
+    one sample at a time. A restart after a failure takes the next sample alone, wherever
+    the push ends."""
+    scene = scene_with(
+        integration={"method": "dopri54", "rtol": 1e-13, "atol": 1e-15, "max_substeps": 1},
+        initial={"gravity_samples": 3},
+    )
+    full = ship_batch(0.4)
+    runs = []
+    for pieces in (None, [1] * 400, [7] * 58):
+        engine = engine_for(scene)
+        out, _ = push_all(engine, [full] if pieces is None else split(full, pieces))
+        runs.append((out, engine.counts))
+    (want, counts), *others = runs
+    assert counts["integration_failures"] > 100 and counts["restarts"] > 100
+    for out, got in others:
+        np.testing.assert_array_equal(out.stamps, want.stamps)
+        np.testing.assert_array_equal(out.pose, want.pose)
+        assert got == counts
+
+
 def test_gap_with_bridge_policy_integrates_across_it_without_restart() -> None:
     engine, full, out, reports = _gap_run("bridge")
     assert engine.counts["gaps"] == 1 and engine.counts["restarts"] == 0

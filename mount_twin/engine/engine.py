@@ -269,7 +269,9 @@ class TwinEngine:
                 self.counts["samples_not_followed"] += len(index)
                 return out
             self.health.stopped_at = None
-        if run.restart or driver.last is None:
+        if run.restart:  # gathered afresh, maybe over pushes: nothing goes on from before
+            driver.last = None
+        if driver.last is None:
             index, gathered = starts.gather(run, frame.f)
             if not len(index) or not starts.started(out, index, samples, gathered, rows):
                 return out
@@ -310,6 +312,7 @@ class TwinEngine:
         self.failure_causes[cause] += 1
         self.health.failure(stamp, cause)
         self._driver.last = None
+        self._starts.after_failure()
         if self.scene.initial.mode != "given":
             return True
         # A restart would launch the given initial motion again: a motion the body is not

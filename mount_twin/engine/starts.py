@@ -105,6 +105,15 @@ class Starts:
         )
         self._gathered: list[np.ndarray] = []
         """Specific forces (m/s², F) of the samples taken so far toward the next start."""
+        self._failed = False
+        """The last run ended in a stepper failure: its restart takes the next sample alone,
+        in this push or the next (a restart within a push does)."""
+
+    def after_failure(self) -> None:
+        """The stepper failed: the restart takes the next sample alone, wherever the push
+        ends (gathering `gravity_samples` only at a push's end answered fewer samples the
+        smaller the pushes)."""
+        self._failed, self._gathered = True, []
 
     def gather(self, run: Run, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Take a run's samples toward a start (`initial.gravity_samples` of them).
@@ -112,12 +121,12 @@ class Starts:
         Returns the run's samples from the start sample on (none while still gathering) and
         the specific forces (m/s², F) gathered for the start, the start sample's last.
         """
-        if run.restart:
-            self._gathered = []
-        need = self._start_samples - len(self._gathered)
+        if run.restart:  # a gap or a stamp jump: gravity is gathered again
+            self._gathered, self._failed = [], False
+        need = (1 if self._failed else self._start_samples) - len(self._gathered)
         taken = run.index[:need]
         self._gathered.extend(f[taken])
-        if len(self._gathered) < self._start_samples:
+        if need > len(taken):
             return run.index[:0], np.empty((0, 3))
         gathered, self._gathered = np.array(self._gathered), []
         return run.index[len(taken) - 1 :], gathered
@@ -135,6 +144,7 @@ class Starts:
         restart finds one."""
         stamps, f, w = frame
         driver, counts = self._driver, self._counts
+        self._failed = False
         internal = driver.y[2 * len(self.model.scene.dofs) :].copy()
         damage = internal if counts["starts"] and np.isfinite(internal).all() else None
         if driver.last is not None or counts["starts"]:
