@@ -172,7 +172,7 @@ def run(args: argparse.Namespace) -> int:
     t, accel, rate = record.t, record.values, record.rate_hz
     offset, removed = gravity_offset(t, accel, args.gravity, args.head)
     freqs = _frequencies(args, rate)
-    axes = AXES if args.axis == "all" else (args.axis,)
+    axes: tuple[str, ...] = AXES if args.axis == "all" else (args.axis,)
     frozen = [a for a in axes if np.isnan(accel[:, AXES.index(a)]).all()]  # --response cg
     if frozen:
         said = (
