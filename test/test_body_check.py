@@ -285,6 +285,49 @@ def test_a_body_imu_whose_every_message_is_rejected_is_reported_window_by_window
     assert values["body_rejected_wrong_frame_id"] == "1000"
 
 
+def test_messages_not_compared_are_counted_in_their_own_window_however_interleaved() -> None:
+    """Samples inside a gap of the twin's rows (the deck silent 6–7 s: a restart) and rejected
+    messages (an unset stamp and garbage after the sample at 5.1 s) were counted in the window
+    open when they were counted: the first or the second, by how the two streams were fed
+    (0 or 2 rejected in 0–5 s, in_gap moving with them). A sample counts where its stamp
+    falls, a rejected message where the accepted sample after it does."""
+    scene, deck = _pump(), _deck(12.0)
+    _, whole = _whole_record(scene, deck)
+    ns = _stamps(deck)
+    silent = (deck.t >= 6.0) & (deck.t < 7.0)
+    deck_raws = [r for r, s in zip(_deck_raws(scene, deck), silent, strict=True) if not s]
+    body = _body_raws(ns, whole)
+    body[1020:1020] = [_body_raws(np.array([0]), whole[:1])[0], b"\x00\x01garbage"]
+    runs = [
+        _interleaved(scene, deck_raws, ns[~silent], (body, np.insert(ns, 1020, [ns[1020]] * 2))),
+        _chunked(scene, deck_raws, body, 333, body_first=False),
+    ]
+    deck_first = TwinStream(scene)
+    runs.append(
+        deck_first.process(deck_raws) + deck_first.process_body(body) + deck_first.finish()
+    )
+    first_body = TwinStream(scene)
+    runs.append(
+        first_body.process_body(body) + first_body.process(deck_raws) + first_body.finish()
+    )
+    windows = [sorted(_windows(run), key=lambda w: w[1]) for run in runs]
+    assert all(w == windows[0] for w in windows[1:])
+    # and the samples at the rows either side of the gap are compared in every feeding (the
+    # one at its last row was in_gap once the row after it was published, the one at its
+    # first row in_gap until the row after that was)
+    topics = (BODY_PREDICTED_TOPIC, BODY_RESIDUAL_TOPIC)
+    body_msgs = [[m for m in run if m[0] in topics] for run in runs]
+    assert all(b == body_msgs[0] for b in body_msgs[1:])
+    compared = _imu_values(runs[0], BODY_PREDICTED_TOPIC)[0]
+    assert {ns[~silent][1199], ns[~silent][1200]} <= set(compared.tolist())  # 5.995, 7.0 s
+    second = next(v for _, _, v in windows[0] if int(v["body_in_gap"]))
+    assert second["body_rejected_nonpositive_stamp"] == "1"
+    assert second["body_rejected_undecodable"] == "1"
+    assert int(second["body_in_gap"]) >= 190  # 6–7 s at 200 Hz, the rows around it aside
+    firsts = [v for _, _, v in windows[0] if v is not second]
+    assert all(v["body_rejected_undecodable"] == "0" for v in firsts)
+
+
 def test_a_body_sensor_needs_every_samples_wrenches() -> None:
     """Decimated rows hold each wrench component's peak: a scene with a body sensor and
     outputs.decimation past 1 fails at load, naming the key."""

@@ -9,12 +9,14 @@ batched, and whichever of the two streams comes first (live = replay), within `R
    two rows after it are published (the run's first and last rows by one-sided differences):
    the prediction trails the twin by two rows.
 2. `_Matcher`: a body sample stamped s measured the motion at s − lag_s; the prediction there
-   is interpolated linearly between the rows around it, once a row at or past it exists. A
+   is that row's where a row is at it, else interpolated linearly between the rows around it,
+   once a row at or past it exists. A
    sample before the twin's first row, more than `RETAIN_S` behind the prediction, or between
    rows farther apart than input.max_gap_s (a gap, a restart) is counted and not compared.
 3. `_Windows` judges the compared samples in windows of body_sensor.window_s of stamps
    (`agreement`), on a grid from the first compared sample; the last, partial window at the
-   end of the stream if it spans half a window (and holds `agreement.MIN_SAMPLES`).
+   end of the stream if it spans half a window (and holds `agreement.MIN_SAMPLES`). Each
+   counts the body messages not compared in it by their place in the body stream.
 
 Beside them, `_Refusals` watches the body messages themselves, in windows of the same length
 on their own stamps: a window in which every message was rejected (another frame_id, …) is a
@@ -149,6 +151,39 @@ class _Series:
         self._start += i
 
 
+@dataclass
+class _Taken:
+    """Accepted body samples out of the matcher, in order: stamps (ns, s), measured (k, 6),
+    the prediction at each (where compared), why each was not compared ('' where it was:
+    `PROBLEMS`), and each one's place among the accepted samples."""
+
+    ns: np.ndarray
+    t: np.ndarray
+    measured: np.ndarray
+    predicted: np.ndarray
+    why: np.ndarray
+    place: np.ndarray
+
+    @classmethod
+    def none(cls) -> _Taken:
+        empty = np.zeros((0, 6))
+        return cls(
+            np.zeros(0, np.int64),
+            np.zeros(0),
+            empty,
+            empty,
+            np.zeros(0, object),
+            np.zeros(0, np.int64),
+        )
+
+    def compared(self) -> _Taken:
+        """Those compared."""
+        k = self.why == ""
+        return _Taken(
+            *(a[k] for a in (self.ns, self.t, self.measured, self.predicted, self.why, self.place))
+        )
+
+
 class _Matcher:
     """Body samples matched to the prediction at the motion they measured."""
 
@@ -158,6 +193,9 @@ class _Matcher:
         self._first: float | None = None
         self._body: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         """Waiting body samples: (stamps ns, stamps s, measured (k, 6)) chunks."""
+        self.taken = 0
+        """Accepted body samples taken out so far (compared, or counted not compared): the
+        place among them of the first one waiting."""
 
     def add_predictions(self, t: np.ndarray, v: np.ndarray) -> None:
         if t.shape[0]:
@@ -171,42 +209,53 @@ class _Matcher:
             ns, t, v = (np.concatenate(a) for a in zip(*self._body, strict=True))
             cut = waiting - PENDING_LIMIT
             self._problems["dropped_waiting"] += cut
+            self.taken += cut
             self._body = [(ns[cut:], t[cut:], v[cut:])]
 
-    def take(self, final: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(stamps ns, stamps s, measured, predicted) of the body samples the prediction now
-        covers (`final`: the end of the stream, the rest are counted unanswered)."""
+    def take(self, final: bool = False) -> _Taken:
+        """The body samples the prediction now covers, in order (`final`: the end of the
+        stream, the rest are counted unanswered)."""
         pt, pv = self._pred.t, self._pred.v
         if not self._body or self._first is None:
             if final:
-                self._problems["unanswered"] += sum(c[0].shape[0] for c in self._body)
+                left = sum(c[0].shape[0] for c in self._body)
+                self._problems["unanswered"] += left
+                self.taken += left
                 self._body = []
             self._trim(None)
-            return np.zeros(0, np.int64), np.zeros(0), np.zeros((0, 6)), np.zeros((0, 6))
+            return _Taken.none()
         ns, t, v = (np.concatenate(a) for a in zip(*self._body, strict=True))
-        ready = t - self._lag <= pt[-1]
+        ready = t - self._lag <= pt[-1]  # a prefix: accepted stamps rise
         self._body = [] if final else [(ns[~ready], t[~ready], v[~ready])]
-        self._problems["unanswered"] += int((~ready).sum()) if final else 0
+        first = self.taken
+        self.taken += int(ready.sum())
+        if final:
+            self._problems["unanswered"] += int((~ready).sum())
+            self.taken += int((~ready).sum())
         ns, t, v = ns[ready], t[ready], v[ready]
         tau = t - self._lag
-        before = tau < self._first
-        late = ~before & (tau < pt[0])
-        self._problems["before_twin"] += int(before.sum())
-        self._problems["late"] += int(late.sum())
-        keep = ~(before | late)
-        ns, t, tau, v = ns[keep], t[keep], tau[keep], v[keep]
-        j = np.clip(np.searchsorted(pt, tau, side="right"), 1, max(pt.shape[0] - 1, 1))
-        if pt.shape[0] == 1:  # one prediction: only a sample exactly at it
-            pred = np.repeat(pv, tau.shape[0], axis=0)
-            gap = np.zeros(tau.shape[0], bool)
-        else:
+        why = np.full(t.shape[0], "", dtype=object)
+        why[tau < self._first] = "before_twin"
+        why[(why == "") & (tau < pt[0])] = "late"
+        kept = np.flatnonzero(why == "")
+        after = np.searchsorted(pt, tau[kept], side="right")
+        at_row = pt[after - 1] == tau[kept]  # (after ≥ 1: tau ≥ the first row)
+        pred = np.zeros((t.shape[0], 6))
+        # A sample at a row takes that row's prediction whichever rows come after it (were it
+        # interpolated toward the next row, the row after a gap would make it in_gap or not by
+        # whether that row was already published: by how the two streams came interleaved).
+        pred[kept[at_row]] = pv[after[at_row] - 1]
+        between = kept[~at_row]  # tau < the last row: rows on both sides
+        j = after[~at_row]
+        if between.shape[0]:
             t0, t1 = pt[j - 1], pt[j]
-            w = ((tau - t0) / (t1 - t0))[:, None]
-            pred = (1.0 - w) * pv[j - 1] + w * pv[j]  # at a row exactly its value, either side
-            gap = (t1 - t0) > self._max_gap
-        self._problems["in_gap"] += int(gap.sum())
-        self._trim(float(tau[-1]) if tau.shape[0] else None)
-        return ns[~gap], t[~gap], v[~gap], pred[~gap]
+            w = ((tau[between] - t0) / (t1 - t0))[:, None]
+            pred[between] = (1.0 - w) * pv[j - 1] + w * pv[j]
+            why[between[(t1 - t0) > self._max_gap]] = "in_gap"
+        for reason in ("before_twin", "late", "in_gap"):
+            self._problems[reason] += int((why == reason).sum())
+        self._trim(float(tau[kept][-1]) if kept.shape[0] else None)
+        return _Taken(ns, t, v, pred, why, first + np.arange(t.shape[0]))
 
     def _trim(self, last_tau: float | None) -> None:
         """Drop the predictions no future body sample needs: those before the one at or
@@ -227,46 +276,99 @@ def _not_compared(counts: Counter[str]) -> dict[str, int]:
 
 @dataclass
 class _Window:
-    """Compared samples of the window being filled: chunks of (stamps ns, seconds,
-    measured, residual)."""
+    """The window being filled: chunks of its compared samples (stamps ns, seconds, measured,
+    residual), and the body messages not compared in it, by reason."""
 
     index: int
     chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
+    problems: Counter[str]
+
+
+LOOSE = ("dropped_waiting", "unanswered")
+"""Not compared for the stream's sake, not at a place in it (held too long, or left at its
+end): reported in the window judged next."""
 
 
 class _Windows:
-    """The agreement of compared samples, window by window of body stamps."""
+    """The agreement of compared samples, window by window of body stamps, and the body
+    messages not compared in each: a sample where its stamp falls, a rejected message where the
+    accepted sample after it does (its place in the body stream), so that neither depends on
+    how the two streams come interleaved; before the first window, in the first; in a window
+    too short to judge, in the next."""
 
-    def __init__(self, sensor: BodySensor, problems: Counter[str]) -> None:
-        self._sensor, self._problems = sensor, problems
+    def __init__(self, sensor: BodySensor, totals: Counter[str]) -> None:
+        self._sensor, self._totals = sensor, totals
         self._origin: float | None = None
         self._window: _Window | None = None
-        self._reported: Counter[str] = Counter()
+        self._carried: Counter[str] = Counter()
+        self._marks: list[tuple[int, str]] = []
+        """(place among the accepted samples of the one after it, rejected_<reason>) of each
+        rejected message not yet in a window."""
+        self._loose_reported: Counter[str] = Counter()
+        self._judged = False
 
-    def add(
-        self, ns: np.ndarray, t: np.ndarray, measured: np.ndarray, residual: np.ndarray
-    ) -> list[tuple[int, HealthStatus]]:
-        """Reports (stamp ns, status) of the windows these samples close."""
-        if not t.shape[0]:
+    def mark(self, places: np.ndarray, reasons: np.ndarray) -> None:
+        """Rejected messages (reasons of REJECTED), each before the accepted sample at its
+        place."""
+        self._marks += [
+            (p, f"rejected_{r}") for p, r in zip(places.tolist(), reasons, strict=True)
+        ]
+
+    def add(self, taken: _Taken, residual: np.ndarray) -> list[tuple[int, HealthStatus]]:
+        """Reports (stamp ns, status) of the windows these samples (all taken out of the
+        matcher, the compared ones' `residual` beside them) close."""
+        if not taken.t.shape[0]:
             return []
-        self._origin = float(t[0]) if self._origin is None else self._origin
-        index = np.floor((t - self._origin) / self._sensor.window_s).astype(np.int64)
+        compared = taken.why == ""
+        if self._origin is None:
+            if not compared.any():
+                self._carried.update(taken.why.tolist())
+                self._attribute(int(taken.place[-1]), self._carried)
+                return []
+            self._origin = float(taken.t[compared][0])
+        index = np.floor((taken.t - self._origin) / self._sensor.window_s).astype(np.int64)
+        index = np.maximum(index, 0)  # not compared before the first window: in it
         reports = []
+        k = 0  # into the compared ones
         for i in np.unique(index).tolist():
             part = index == i
             if self._window is not None and self._window.index != i:
                 reports += self._close()
             if self._window is None:
-                self._window = _Window(i, [])
-            self._window.chunks.append((ns[part], t[part], measured[part], residual[part]))
+                self._window, self._carried = _Window(i, [], self._carried), Counter()
+            window = self._window
+            window.problems.update(taken.why[part & ~compared].tolist())
+            self._attribute(int(taken.place[part][-1]), window.problems)
+            n = int((part & compared).sum())
+            if n:
+                window.chunks.append(
+                    (
+                        taken.ns[part & compared],
+                        taken.t[part & compared],
+                        taken.measured[part & compared],
+                        residual[k : k + n],
+                    )
+                )
+                k += n
         return reports
 
+    def _attribute(self, place: int, into: Counter[str]) -> None:
+        """The rejected messages before the accepted sample at `place` (and it), into `into`."""
+        n = 0
+        while n < len(self._marks) and self._marks[n][0] <= place:
+            into[self._marks[n][1]] += 1
+            n += 1
+        del self._marks[:n]
+
     def finish(self, counts: Counter[str], stamp_ns: int) -> list[tuple[int, HealthStatus]]:
-        """The last, partial window's report, if it spans half a window; if no window was
-        judged over the run although body messages came (`counts`), a WARN saying why,
-        stamped `stamp_ns`: silence would read as a check passed."""
+        """The last, partial window's report, if it spans half a window (with the rejected
+        messages after its last sample); if no window was judged over the run although body
+        messages came (`counts`), a WARN saying why, stamped `stamp_ns`: silence would read
+        as a check passed."""
+        if self._window is not None:
+            self._attribute(np.iinfo(np.int64).max, self._window.problems)
         reports = self._close(final=True)
-        if reports or self._reported or not counts["received"]:
+        if reports or self._judged or not counts["received"]:
             return reports
         missed = ", ".join(f"{k} {v}" for k, v in _not_compared(counts).items() if v)
         message = (
@@ -281,16 +383,24 @@ class _Windows:
         window, self._window = self._window, None
         if window is None:
             return []
+        if not window.chunks:
+            self._carried.update(window.problems)
+            return []
         ns, t, measured, residual = (np.concatenate(a) for a in zip(*window.chunks, strict=True))
         if t.shape[0] < MIN_SAMPLES or (final and t[-1] - t[0] < 0.5 * self._sensor.window_s):
-            return []  # too short to judge (the last: its band barely resolved)
-        problems = {k: v - self._reported[k] for k, v in _not_compared(self._problems).items()}
-        self._reported = Counter(self._problems)
+            self._carried.update(window.problems)  # too short to judge: said with the next
+            return []
+        for key in LOOSE:
+            window.problems[key] += self._totals[key] - self._loose_reported[key]
+            self._loose_reported[key] = self._totals[key]
+        keys = (*(f"rejected_{r}" for r in REJECTED), *PROBLEMS)
+        problems = {key: window.problems[key] for key in keys}
         figures = agreement(t, measured, residual, self._sensor)
         span = (float(t[-1] - t[0]), int(t.shape[0]))
         status = window_status(figures, self._sensor, span, problems)
         if final:
             status.message += " (the last window, closed by the end of the stream)"
+        self._judged = True
         return [(int(ns[-1]), status)]
 
 
@@ -382,6 +492,8 @@ class BodyCheck:
         """The last accepted body stamp, ns (0: none yet)."""
         self.seen_ns = 0
         """The latest stamp of any body message screened, ns (0: none with a stamp)."""
+        self._accepted_screened = 0
+        """Body messages screened and accepted so far, in the body stream's order."""
 
         geometry = SensorGeometry.of(scene, sensor)
 
@@ -423,8 +535,12 @@ class BodyCheck:
 
     def screened(self, stamps_ns: np.ndarray, why: np.ndarray) -> BodyComparison:
         """Every body message as it came (stamps ns, 0 where unknown; why each was rejected,
-        '' where not): the windows of stamps in which none was taken, reported (nothing
-        compared)."""
+        '' where not): each rejected one marked at its place in the body stream, and the
+        windows of stamps in which none was taken, reported (nothing compared)."""
+        accepted = why == ""
+        before = self._accepted_screened + np.cumsum(accepted) - accepted
+        self._windows.mark(before[~accepted], why[~accepted])
+        self._accepted_screened += int(accepted.sum())
         empty = np.zeros((0, 6))
         return BodyComparison(
             np.zeros(0, np.int64), empty, empty, self._refusals.add(stamps_ns, why)
@@ -459,8 +575,9 @@ class BodyCheck:
         return out
 
     def _compared(self, final: bool = False) -> BodyComparison:
-        ns, t, measured, predicted = self._matcher.take(final)
-        self.counts["compared"] += int(ns.shape[0])
-        residual = measured - predicted
-        reports = self._windows.add(ns, t, measured, residual)
-        return BodyComparison(ns, predicted, residual, reports)
+        taken = self._matcher.take(final)
+        compared = taken.compared()
+        self.counts["compared"] += int(compared.ns.shape[0])
+        residual = compared.measured - compared.predicted
+        reports = self._windows.add(taken, residual)
+        return BodyComparison(compared.ns, compared.predicted, residual, reports)
