@@ -185,7 +185,8 @@ class TwinStream:
         zeros where the scene ignores it (input.gyro_filter: ignore)."""
         if self.scene.input.gyro_filter == "ignore":
             return np.zeros((decoded.stamps_ns.shape[0], 3))
-        return rotated(decoded.gyro, self.engine.model.sensor_rotation)
+        with np.errstate(invalid="ignore", over="ignore"):  # a rejected sample's inf: unused
+            return rotated(decoded.gyro, self.engine.model.sensor_rotation)
 
     def process_body(self, raws: Sequence[bytes]) -> list[tuple[str, int, bytes]]:
         """The body IMU's raw messages (sensor_msgs/Imu): the prediction and residual at each

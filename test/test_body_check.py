@@ -8,6 +8,7 @@ skipped."""
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from collections.abc import Callable
 
 import numpy as np
@@ -326,6 +327,20 @@ def test_messages_not_compared_are_counted_in_their_own_window_however_interleav
     assert int(second["body_in_gap"]) >= 190  # 6–7 s at 200 Hz, the rows around it aside
     firsts = [v for _, _, v in windows[0] if v is not second]
     assert all(v["body_rejected_undecodable"] == "0" for v in firsts)
+
+
+def test_a_deck_sample_rejected_for_inf_warns_nothing_with_a_body_sensor() -> None:
+    """Its gyro's inf times the sensor rotation's zeros printed numpy's RuntimeWarning
+    ("invalid value encountered in multiply") on every replay of such a record."""
+    scene, deck = _pump(), _deck(1.0)
+    gyro = deck.gyro.copy()
+    gyro[50] = np.inf
+    raws = [r for _, r in imu_messages(_stamps(deck), deck.accel, gyro, "deck_imu")]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        stream = TwinStream(scene)
+        stream.process(raws)
+    assert stream.engine.counts["rejected_non_finite"] == 1
 
 
 def test_a_body_sensor_needs_every_samples_wrenches() -> None:
