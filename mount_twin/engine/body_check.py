@@ -10,9 +10,9 @@ batched, and whichever of the two streams comes first (live = replay), within `R
    the prediction trails the twin by two rows.
 2. `_Matcher`: a body sample stamped s measured the motion at s − lag_s; the prediction there
    is that row's where a row is at it, else interpolated linearly between the rows around it,
-   once a row at or past it exists. A
-   sample before the twin's first row, more than `RETAIN_S` behind the prediction, or between
-   rows farther apart than input.max_gap_s (a gap, a restart) is counted and not compared.
+   once a row at or past it exists. A sample before the twin's first row, more than
+   `RETAIN_S` behind the prediction, or between rows farther apart than input.max_gap_s (a
+   gap, a restart) is counted and not compared.
 3. `_Windows` judges the compared samples in windows of body_sensor.window_s of stamps
    (`agreement`), on a grid from the first compared sample; the last, partial window at the
    end of the stream if it spans half a window (and holds `agreement.MIN_SAMPLES`). Each
