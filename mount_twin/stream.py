@@ -62,6 +62,8 @@ class TwinStream:
         self.last_outputs: OutputBatch | None = None
         self._last_ns = 0
         self._received_ns = 0
+        self._stalled_ns = 0
+        """The stamp of the last stall report (ns, the node's clock; 0: none)."""
         """Stamp (ns) of the last sample received with a stamp (> 0), accepted or not."""
         self._tail_ns = np.zeros(0, np.int64)
         """Stamps (ns) of the last samples pushed that later outputs may answer
@@ -246,13 +248,15 @@ class TwinStream:
     def stalled(self, waited_s: float, stamp_ns: int) -> list[tuple[str, int, bytes]]:
         """A report now, after `waited_s` (s) of the node's clock without any (live only),
         stamped `stamp_ns` (the clock: there is no input stamp to answer)."""
+        self._stalled_ns = max(self._stalled_ns, stamp_ns)
         return [encode_report(self.scene, self.engine.report_stalled(waited_s), stamp_ns)]
 
     def finish(self) -> list[Encoded]:
         """The end of the stream (end of a bag, node shutdown): the outputs the gyro delay
         still holds, then the last, partial diagnostics period, stamped with the last input
-        stamp answered (none answered: the last received; none with a stamp: 0); no report if
-        that period is empty."""
+        stamp answered (none answered: the last received; none with a stamp: 0), or the last
+        stall report's if later (input not stamped by the clock: /diagnostics never goes
+        back); no report if that period is empty."""
         out = self.engine.flush()
         reports, out.health = out.health, []
         msgs = self._encode(out, self._tail_ns)
@@ -267,7 +271,7 @@ class TwinStream:
         self._tail_ns = self._tail_ns[:0]
         self.last_outputs = out
         self.final_report = reports[0] if reports else None
-        stamp_ns = self._last_ns or self._received_ns
+        stamp_ns = max(self._last_ns or self._received_ns, self._stalled_ns)
         return msgs + [encode_report(self.scene, r, stamp_ns) for r in reports]
 
 

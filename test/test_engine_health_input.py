@@ -19,8 +19,10 @@ from io_helpers import batch, default_model, default_scene, scene_with, split
 from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus, SampleBatch
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.health import _median
+from mount_twin.io.messages import DIAGNOSTICS_TOPIC, imu_messages
 from mount_twin.model.assemble import assemble
 from mount_twin.scene import Scene
+from mount_twin.stream import TwinStream
 
 RATE = 1000.0  # Hz
 DT = 1.0 / RATE  # s
@@ -388,6 +390,22 @@ def test_several_wrong_frames_are_all_named() -> None:
 
 def _names(report: HealthReport) -> list[str]:
     return [s.name for s in report.statuses]
+
+
+def test_the_shutdown_report_after_a_stall_report_is_not_stamped_before_it() -> None:
+    """An input stamped by another clock (a synthetic stream, a bag played without sim time)
+    stalls: the stall report takes the node's clock, later than any input stamp. The final
+    report took the last input stamp: /diagnostics went back in time at shutdown."""
+    stream = TwinStream(default_scene())
+    ns = 1_600_000_000 * 10**9 + np.arange(300) * 10**6
+    rest = np.tile([0.0, 0.0, 9.80665], (300, 1))
+    stream.process([raw for _, raw in imu_messages(ns, rest, np.zeros((300, 3)), "deck_imu")])
+    clock_ns = 1_800_000_000 * 10**9
+    stall = [
+        stamp for topic, stamp, _ in stream.stalled(1.0, clock_ns) if topic == DIAGNOSTICS_TOPIC
+    ]
+    final = [stamp for topic, stamp, _ in stream.finish() if topic == DIAGNOSTICS_TOPIC]
+    assert stall == [clock_ns] and final and min(final) >= clock_ns
 
 
 def test_stall_before_any_input_says_nothing_was_received() -> None:
