@@ -92,14 +92,20 @@ def _best_cost(scene, samples, rtol: float, repeats: int) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rtol", type=float, nargs="+", default=[1e-3, 1e-4, 1e-5, 1e-6, 1e-7])
-    parser.add_argument("--cases", nargs="+", help="case names (default: the test's cases)")
-    parser.add_argument("--sampled", action="store_true", help="the sampled estimator on all")
-    parser.add_argument("--repeats", type=int, default=1, help="runs per cost figure (best)")
-    args = parser.parse_args()
     builds = {name: build for name, (build, _) in CASES.items()}
     builds["genset"] = _genset
     for n in HYSTERETIC_COUNTS:
         builds[f"hysteretic_{n}"] = partial(_hysteretic, n)
+    parser.add_argument(
+        "--cases",
+        nargs="+",
+        choices=list(builds),
+        metavar="NAME",
+        help=f"case names (default: the test's cases): {', '.join(builds)}",
+    )
+    parser.add_argument("--sampled", action="store_true", help="the sampled estimator on all")
+    parser.add_argument("--repeats", type=int, default=1, help="runs per cost figure (best)")
+    args = parser.parse_args()
     if args.sampled:
         driver._new_estimator = _sampled  # a bench's what-if: the engine's choice replaced
     print(
