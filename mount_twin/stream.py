@@ -62,9 +62,9 @@ class TwinStream:
         self.last_outputs: OutputBatch | None = None
         self._last_ns = 0
         self._received_ns = 0
+        """Stamp (ns) of the last sample received with a stamp (> 0), accepted or not."""
         self._stalled_ns = 0
         """The stamp of the last stall report (ns, the node's clock; 0: none)."""
-        """Stamp (ns) of the last sample received with a stamp (> 0), accepted or not."""
         self._tail_ns = np.zeros(0, np.int64)
         """Stamps (ns) of the last samples pushed that later outputs may answer
         (`TwinEngine.lookback`: the gyro delay, a sample held back), oldest first."""
@@ -206,8 +206,8 @@ class TwinStream:
         stamps_ns = np.zeros(len(raws), np.int64)
         stamps_ns[decoded.places()] = decoded.stamps_ns
         out = self._encode_body(self.body.screened(stamps_ns, reason))
-        # the rejected counted at their place, between the samples around them: the window
-        # they are reported in does not depend on how the messages were batched
+        # the rejected counted (their window: `screened`, by their place in the body stream),
+        # the accepted compared once the time base exists
         for start, stop in _runs(reason):
             if reason[start]:
                 self.body.reject(reason[start], stop - start)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import math
 import re
 from collections.abc import Callable
 from pathlib import Path
@@ -386,6 +387,19 @@ def test_a_scene_built_in_code_is_checked_at_assembly(path: str, value: Any, say
     with pytest.raises(SceneError) as err:
         assemble(_replaced(pump, path, value))
     assert str(err.value).startswith(f"{PUMP}: {says}")
+
+
+@pytest.mark.parametrize(
+    ("path", "value"),
+    [("clamp_stiffness", -3.5e9), ("axial_damping", -5e4), ("preload", float("inf"))],
+)
+def test_a_kinds_values_built_in_code_are_checked_too(path: str, value: float) -> None:
+    """A bolt's coefficients are named otherwise than a linear mount's (`clamp_stiffness`):
+    a negative one, given as a float or an int, must not reach the core either."""
+    genset = load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml")
+    for given in (value, int(value) if math.isfinite(value) else value):
+        with pytest.raises(SceneError, match=re.escape(f"mounts[0].{path}: must be")):
+            assemble(_replaced(genset, f"mounts[0].{path}", given))
 
 
 def _laughs(levels: int) -> str:

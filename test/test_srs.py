@@ -19,7 +19,7 @@ from scipy.integrate import solve_ivp
 from mount_twin.analysis.design_margin import TOLERANCE_DB as DEFAULT_BAND
 from mount_twin.analysis.design_margin import check_design
 from mount_twin.analysis.sampling import uniform
-from mount_twin.analysis.srs import damping_ratio, octave_frequencies, srs
+from mount_twin.analysis.srs import damping_ratio, gravity_offset, octave_frequencies, srs
 from mount_twin.cli import main
 from mount_twin.commands.common import write_signal
 from mount_twin.commands.srs import EXIT_OUT_OF_TOLERANCE, TOLERANCE_DB
@@ -260,6 +260,19 @@ def test_a_head_over_the_shock_is_refused(capsys: pytest.CaptureFixture[str]) ->
     err = capsys.readouterr().err
     assert "head_s (srs --head) 0.06 s: not quiet: its samples stray " in err
     assert main(["srs", str(GENSET), "--head", "0.045", "--freqs", "100"]) == 0
+
+
+def test_a_head_over_the_shock_is_refused_beside_an_axis_of_nan() -> None:
+    """A frozen DOF's CG response is NaN: its spread made the whole head's NaN, and a head
+    over the shock passed as quiet."""
+    t = np.arange(2000) * 1e-3
+    accel = np.zeros((2000, 3))
+    accel[:, 1], accel[:, 2], accel[5:40, 0] = np.nan, 9.8, 50.0  # 35 ms of shock in the head
+    with pytest.raises(ValueError, match=r"0\.05 s: not quiet: its samples stray 35 m/s²"):
+        gravity_offset(t, accel, "mean-head", 0.05)
+    accel[5:40, 0] = 0.0
+    offset, _ = gravity_offset(t, accel, "mean-head", 0.05)
+    assert offset[0] == 0.0 and math.isnan(offset[1]) and offset[2] == pytest.approx(9.8)
 
 
 def test_a_head_as_long_as_the_record_is_refused(

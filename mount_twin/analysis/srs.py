@@ -193,8 +193,10 @@ def gravity_offset(
         )
         raise ValueError(msg)
     mean = accel[:count].mean(axis=0)
-    head_spread = float(np.linalg.norm(accel[:count] - mean, axis=1).max())
-    spread = float(np.linalg.norm(accel - mean, axis=1).max())
+    axes = np.isfinite(mean)  # an axis of NaN (a frozen DOF's response) has no spectrum
+    off = accel[:, axes] - mean[axes]
+    head_spread = float(np.linalg.norm(off[:count], axis=1).max())
+    spread = float(np.linalg.norm(off, axis=1).max())
     if head_spread > max(QUIET_SHARE * spread, QUIET_FLOOR_M_S2):
         msg = (
             f"head_s (srs --head) {head_s:g} s: not quiet: its samples stray {head_spread:.4g} "

@@ -27,9 +27,6 @@ if TYPE_CHECKING:
 NAME = "qualify"
 HELP = "qualify the scene's machine against a shock spectrum: synthesise, run, judge each mount"
 EXIT_FAIL, EXIT_FAILED = 4, 6
-SYNTHESIS_OPTIONS = ("seeds", "first_seed", "rate", "axis", "damping", "q", "tolerance_db", "head")
-"""The synthesis options beside --spectrum, which a --plan sets instead: parsed to None here
-(their defaults kept aside), so that one given beside --plan is seen, not silently ignored."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -38,10 +35,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "-o", "--output", required=True, help="directory (new) of the input and output bags"
     )
     add_synthesis_arguments(parser, required=False)
-    parser.set_defaults(
-        synthesis_defaults={o: parser.get_default(o) for o in SYNTHESIS_OPTIONS},
-        **dict.fromkeys(SYNTHESIS_OPTIONS),
-    )
+    # The synthesis options beside --spectrum, which a --plan sets instead, parse to None here
+    # (their defaults kept aside), so that one given beside --plan is seen, not ignored.
+    alone = argparse.ArgumentParser(add_help=False)
+    add_synthesis_arguments(alone, required=False)
+    defaults = {k: v for k, v in vars(alone.parse_args([])).items() if k != "spectrum"}
+    parser.set_defaults(synthesis_defaults=defaults, **dict.fromkeys(defaults))
     parser.add_argument(
         "--plan",
         metavar="YAML",
@@ -70,7 +69,7 @@ def plan_of(args: argparse.Namespace) -> Plan:
     if (args.plan is None) == (args.spectrum is None):
         msg = "give either --spectrum (one axis, options on the command line) or --plan"
         raise ValueError(msg)
-    given = [o for o in SYNTHESIS_OPTIONS if getattr(args, o) is not None]
+    given = [o for o in args.synthesis_defaults if getattr(args, o) is not None]
     if args.plan is not None:
         if given:
             flags = ", ".join("--" + o.replace("_", "-") for o in given)
@@ -80,7 +79,7 @@ def plan_of(args: argparse.Namespace) -> Plan:
     args = argparse.Namespace(
         **{
             **vars(args),
-            **{o: args.synthesis_defaults[o] for o in SYNTHESIS_OPTIONS if o not in given},
+            **{o: v for o, v in args.synthesis_defaults.items() if o not in given},
         }
     )
     if args.seeds < 1 or args.head < 0.0 or not args.rate > 0.0:

@@ -94,7 +94,6 @@ def describe(shock: Synthesis, args: argparse.Namespace) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-
     from mount_twin.commands.common import new_directory, write_signal
 
     with new_directory(args.output, "synthesize") as out:

@@ -5,9 +5,8 @@ internal states (and which of them a restart resets: `RESTUCK`), force law (`loa
 functions (`monitor`), discrete switches between samples (`update`, which says whether it
 switched: the state then jumped, and a stepper must not start from a stage it took before) and
 its stiffness at the unstressed pose (`nominal_tangent`: statics, modes and `auto`'s first
-choice read it). A module's `load`,
-`monitor` and `update` are plain Python: the reference the compiled core's port of the kind
-(src/core/kinds/<kind>.hpp) is held to.
+choice read it). A module's `load`, `monitor` and `update` are plain Python: the reference the
+compiled core's port of the kind (src/core/kinds/<kind>.hpp) is held to.
 
 The core's dispatchers (`kind_load`, `kind_monitor`, `kind_update` below) select a kind by its
 code; adding a kind is a new module here, a line in KINDS, its header in src/core/kinds/ with

@@ -22,8 +22,9 @@ from mount_twin.errors import SceneError
 from mount_twin.scene.description import DOF_NAMES, LinearMount, Scene
 from mount_twin.scene.loader import ANGLE_LIMIT_RAD, MOUNT_KINDS
 
-LAW_PREFIXES = ("stiffness", "damping", "rotational_stiffness", "rotational_damping")
-"""Fields of a mount that are a law's coefficients: not negative."""
+LAW_WORDS = ("stiffness", "damping")
+"""A number whose field's name holds one of these is a law's coefficient: not negative (a
+linear mount's `stiffness`, a bolt's `clamp_stiffness`, a snubber's `damping`, …)."""
 
 
 def check_built(scene: Scene) -> None:
@@ -36,6 +37,9 @@ def check_built(scene: Scene) -> None:
     for path, value in _numbers(scene, ""):
         if not math.isfinite(value):
             raise error(path, f"must be finite, got {value!r}")
+        field_name = path.rsplit(".", 1)[-1].partition("[")[0]
+        if value < 0.0 and any(word in field_name for word in LAW_WORDS):
+            raise error(path, f"must be ≥ 0, got {value!r}")
     if not scene.body.mass > 0.0:
         raise error("body.mass", f"must be > 0 kg, got {scene.body.mass!r}")
     if not np.linalg.eigvalsh(np.array(scene.body.inertia_tensor())).min() > 0.0:
@@ -54,18 +58,13 @@ def check_built(scene: Scene) -> None:
                 f"{path}.kind", f"{mount.kind!r} is not the kind of a {type(mount).__name__}"
             )
         angles[f"{path}.orientation_rpy"] = mount.orientation_rpy
-        for field in dataclasses.fields(mount):
-            if field.name.startswith(LAW_PREFIXES):
-                for k, v in enumerate(getattr(mount, field.name)):
-                    if v < 0.0:
-                        raise error(f"{path}.{field.name}[{k}]", f"must be ≥ 0, got {v!r}")
     for path, rpy in angles.items():
         if max(abs(a) for a in rpy) > ANGLE_LIMIT_RAD:
             raise error(path, f"{list(rpy)!r}: beyond a turn: radians, not degrees")
 
 
 def _numbers(value: object, path: str) -> Iterator[tuple[str, float]]:
-    """(attribute path, number) of every float in `value`'s dataclasses and tuples."""
+    """(attribute path, number) of every number in `value`'s dataclasses and tuples."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         for field in dataclasses.fields(value):
             sub = f"{path}.{field.name}" if path else field.name
@@ -73,5 +72,5 @@ def _numbers(value: object, path: str) -> Iterator[tuple[str, float]]:
     elif isinstance(value, tuple):
         for k, item in enumerate(value):
             yield from _numbers(item, f"{path}[{k}]")
-    elif isinstance(value, float):
-        yield path, value
+    elif isinstance(value, (int, float)) and not isinstance(value, bool):
+        yield path, float(value)

@@ -194,7 +194,9 @@ def _mount(r: Reader) -> Mount:
     position = _position(r, "position")
     rpy = _angles(r, "orientation_rpy", (0.0, 0.0, 0.0))
     if kind != "linear":
-        return KINDS[kind].read(r, name, position, rpy)
+        mount: Mount = KINDS[kind].read(r, name, position, rpy)
+        r.finish()  # the kind's read finishes before its checks across keys; this is the net
+        return mount
     try:
         mount = LinearMount(
             name=name,
