@@ -7,6 +7,7 @@ the bag replay hands it chunks of raw messages from a bag. Only the transport di
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
 from itertools import pairwise
 from typing import TYPE_CHECKING
 
@@ -33,6 +34,82 @@ from mount_twin.scene.description import Scene
 
 if TYPE_CHECKING:
     from mount_twin.analysis.ageing_live import AgeingTracker, WindowJob
+
+
+@dataclass
+class _Kept:
+    """What the stream keeps of the samples pushed whose outputs may still come
+    (`TwinEngine.pending_ids`): their stream positions (increasing), integer header stamps
+    (ns) and, with a body IMU, foundation rates (rad/s, F). A few samples, however long ago
+    the oldest came (a run's last one, before a long stretch of rejected samples)."""
+
+    ids: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    ns: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    rate: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+
+    def then(
+        self, first_id: int, stamps_ns: np.ndarray, rate: np.ndarray | None, wanted: np.ndarray
+    ) -> _Kept:
+        """These and a push's samples (positions from `first_id`, stamps ns, rates rad/s
+        where there is a body IMU, else None), as far as `wanted` (increasing positions, each
+        of these or of the push: the engine's `pending_ids` after it)."""
+        n, k, m = stamps_ns.shape[0], self.ids.shape[0], wanted.shape[0]
+        ns = np.concatenate([self.ns, stamps_ns])
+        rates = self.rate if rate is None else np.concatenate([self.rate, rate])
+        contiguous = not k or int(self.ids[-1]) - int(self.ids[0]) == k - 1 == first_id - 1 - int(
+            self.ids[0]
+        )
+        if m and contiguous and int(wanted[-1]) - int(wanted[0]) == m - 1:
+            # the common case: kept, pushed and wanted samples each consecutive
+            lo = int(wanted[0]) - (first_id - k)
+            if lo >= 0 and lo + m <= k + n:
+                return _Kept(
+                    wanted, ns[lo : lo + m], rates if rate is None else rates[lo : lo + m]
+                )
+        ids = np.concatenate([self.ids, np.arange(first_id, first_id + n, dtype=np.int64)])
+        at = np.searchsorted(ids, wanted)
+        if at.shape[0] and (at[-1] >= ids.shape[0] or (ids[at] != wanted).any()):
+            msg = f"the engine may still answer samples {wanted.tolist()}, not all kept"
+            raise RuntimeError(msg)
+        return _Kept(ids[at], ns[at], rates if rate is None else rates[at])
+
+    def renumbered(self, out: OutputBatch, first_id: int) -> OutputBatch:
+        """`out` (positions relative to a push whose first sample is at `first_id`; negative:
+        earlier samples) with its rows' and reports' earlier samples numbered into these kept
+        ones, appended after the push's: −1 the last kept. As they are where these are the
+        samples just before the push (no rejected samples since the oldest). Raises
+        RuntimeError for an earlier sample not kept (its stamp is lost: a mistake, never a
+        guess)."""
+        k = self.ids.shape[0]
+        reported = [r.sample for r in out.health]
+        oldest = min(int(out.sample.min()) if len(out) else 0, *reported, 0)
+        if not k or (int(self.ids[0]) == first_id - k and int(self.ids[-1]) == first_id - 1):
+            if oldest < -k:
+                msg = f"outputs answer sample {first_id + oldest}, whose stamp was not kept"
+                raise RuntimeError(msg)
+            return out
+        return replace(
+            out,
+            sample=self._index(out.sample, first_id),
+            health=[
+                replace(r, sample=int(self._index(np.array([r.sample]), first_id)[0]))
+                for r in out.health
+            ],
+        )
+
+    def _index(self, positions: np.ndarray, first_id: int) -> np.ndarray:
+        """`renumbered`'s positions."""
+        early = positions < 0
+        if not early.any():
+            return positions
+        ids = first_id + positions[early]
+        at = np.minimum(np.searchsorted(self.ids, ids), self.ids.shape[0] - 1)
+        if (self.ids[at] != ids).any():
+            msg = f"outputs answer samples {ids.tolist()} whose stamps were not kept"
+            raise RuntimeError(msg)
+        index = positions.copy()
+        index[early] = at - self.ids.shape[0]
+        return index
 
 
 class TwinStream:
@@ -65,11 +142,7 @@ class TwinStream:
         """Stamp (ns) of the last sample received with a stamp (> 0), accepted or not."""
         self._stalled_ns = 0
         """The stamp of the last stall report (ns, the node's clock; 0: none)."""
-        self._tail_ns = np.zeros(0, np.int64)
-        """Stamps (ns) of the last samples pushed that later outputs may answer
-        (`TwinEngine.lookback`: the gyro delay, a sample held back), oldest first."""
-        self._tail_rate = np.zeros((0, 3))
-        """The foundation's rate (rad/s, F) of those samples."""
+        self._kept = _Kept()
         self.final_report: HealthReport | None = None
         sensor = scene.body_sensor
         self.body = None if sensor is None else BodyCheck(scene, sensor)
@@ -129,23 +202,22 @@ class TwinStream:
                 return []
             self.base = TimeBase.at(int(decoded.stamps_ns[0]))
             self.engine.health.origin_s = self.base.origin_ns // 1_000_000_000
+        first_id = self.engine.pushed
         out = self.engine.push(decoded.batch(self.base))
         self.last_outputs = out
-        # Rows of samples of earlier pushes (the gyro delay, a sample held back) come as
-        # negative samples: the earlier stamps appended find them (−1: the last one).
-        stamps_ns = np.concatenate([decoded.stamps_ns, self._tail_ns])
-        tail = np.concatenate([self._tail_ns, decoded.stamps_ns])
-        keep = tail.shape[0] - self.engine.lookback
-        self._tail_ns = tail[keep:]
-        msgs = self._encode(out, stamps_ns)
+        # Rows of samples of earlier pushes (the gyro delay, a sample held back, a run's last
+        # sample) come as negative samples: the stamps kept of them find them.
+        rate = None if self.body is None else self._foundation_rate(decoded)
+        kept = self._kept
+        self._kept = kept.then(first_id, decoded.stamps_ns, rate, self.engine.pending_ids)
+        numbered = kept.renumbered(out, first_id)
+        msgs = self._encode(numbered, np.concatenate([decoded.stamps_ns, kept.ns]))
         if self.ageing is not None:
             self._track_foundation(decoded)
-        if self.body is None:
+        if rate is None or self.body is None:
             return msgs
-        rate = self._foundation_rate(decoded)
-        rates = np.concatenate([rate, self._tail_rate])
-        self._tail_rate = np.concatenate([self._tail_rate, rate])[keep:]
-        rows = self.body.add_rows(out.stamps, out.pose, out.wrenches, rates[out.sample])
+        rates = np.concatenate([rate, kept.rate])
+        rows = self.body.add_rows(out.stamps, out.pose, out.wrenches, rates[numbered.sample])
         waiting, self._body_waiting = self._body_waiting, []
         return msgs + self._encode_body(rows) + [m for d in waiting for m in self._body_in(d)]
 
@@ -259,16 +331,17 @@ class TwinStream:
         back); no report if that period is empty."""
         out = self.engine.flush()
         reports, out.health = out.health, []
-        msgs = self._encode(out, self._tail_ns)
+        kept, self._kept = self._kept, _Kept()
+        numbered = kept.renumbered(out, self.engine.pushed)
+        msgs = self._encode(numbered, kept.ns)
         if self.body is not None:
-            rates = self._tail_rate[out.sample] if len(out) else np.zeros((0, 3))
+            rates = kept.rate[numbered.sample] if len(out) else np.zeros((0, 3))
             msgs += self._encode_body(
                 self.body.add_rows(out.stamps, out.pose, out.wrenches, rates)
             )
             self.body.counts["unanswered"] += sum(len(d.stamps_ns) for d in self._body_waiting)
             self._body_waiting = []
             msgs += self._encode_body(self.body.finish())
-        self._tail_ns = self._tail_ns[:0]
         self.last_outputs = out
         self.final_report = reports[0] if reports else None
         stamp_ns = max(self._last_ns or self._received_ns, self._stalled_ns)

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_helpers import ROOT, comparable_messages, push_all, read_raw, split
+from io_helpers import ROOT, comparable_messages, push_all, read_raw, scene_with, split, stamp_ns
 
 from mount_twin.engine.batch import OutputBatch, SampleBatch
 from mount_twin.engine.engine import TwinEngine
@@ -191,3 +191,36 @@ def test_messages_the_engine_cannot_take_count_where_they_came_in_any_chunking(
     assert int(inputs[-1]["rejected_undecodable"]) == len(garbage)
     assert int(inputs[-1]["rejected_zero_stamp"]) == 1
     assert all(int(v["lost_estimated"]) == 0 for v in inputs)
+
+
+def test_a_decimated_replay_publishes_each_runs_last_sample_at_its_stamp_in_any_chunking(
+    tmp_path: Path,
+) -> None:
+    """With outputs.decimation 7, a run's last sample is published at its end (a restart
+    after a gap of rejected samples, the end of the bag) with the peaks since the row before:
+    at its own input stamp, in the same bytes whether it was pushed 600 messages before the
+    restart (chunks of 1) or in the same push."""
+    scene = load_scene_file(ROOT / "config" / "pump_8_mounts.scene.yaml")
+    scene = scene_with(scene, outputs={"decimation": 7})
+    (msgs,) = read_raw(ROOT / "bags" / "ship_motion_1khz", ["/deck/imu"]).values()
+    msgs = msgs[:2500]
+    for i in range(1200, 1800):  # another sensor's frame: rejected, then a gap resets
+        msg = TYPESTORE.deserialize_cdr(msgs[i][1], IMU)
+        msg.header.frame_id = "another_imu"
+        msgs[i] = (msgs[i][0], bytes(TYPESTORE.serialize_cdr(msg, IMU)))
+    bag = tmp_path / "rejected_stretch"
+    write_bag(bag, "/deck/imu", IMU, iter(msgs))
+    stamps = [stamp_ns(TYPESTORE.deserialize_cdr(raw, IMU)) for _, raw in msgs]
+    bags = {}
+    for chunk in (1, 7, 100_000):
+        out = tmp_path / f"out_{chunk}"
+        replay(scene, bag, out, chunk=chunk, progress=False)
+        bags[chunk] = comparable_messages(out)
+    for chunk in (1, 7):
+        assert bags[chunk] == bags[100_000], f"chunks of {chunk} differ from one of 100000"
+    (pose_topic,) = [t for t in bags[1] if t.endswith("/pose")]
+    published = [stamp for stamp, _ in bags[1][pose_topic]]
+    # each run: its start, every 7th sample after it, and its last (1199 before the
+    # restart at 1800, 2499 at the end; neither is a 7th)
+    rows = [*range(0, 1200, 7), 1199, *range(1800, 2500, 7), 2499]
+    assert published == [stamps[i] for i in rows]

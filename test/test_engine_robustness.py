@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable
+from itertools import pairwise
 
 import numpy as np
 import pytest
@@ -315,19 +316,24 @@ def test_outputs_do_not_depend_on_how_the_samples_are_batched(pieces: list[int])
 # --------------------------------------------------------------------------- decimation
 
 
-@pytest.mark.parametrize("n", [2, 5, 8])
+@pytest.mark.parametrize("n", [2, 5, 8, 7])
 def test_decimation_publishes_every_nth_sample_with_peak_hold_wrenches(n: int) -> None:
     full = ship_batch(0.5)
     every = engine_for().run(full)  # decimation 1: the independent reference
     engine = engine_for(scene_with(outputs={"decimation": n}))
     out, _ = push_all(engine, split(full, [7] * 100))  # windows straddle batch boundaries
 
-    rows = np.arange(0, len(full), n)  # the start sample, then every nth
+    # the start sample, then every nth, then the last (its window partial where n does not
+    # divide the record: its peaks are not lost at the stream's end)
+    rows = np.unique([*range(0, len(full), n), len(full) - 1])
     np.testing.assert_array_equal(out.stamps, full.stamps[rows])
     np.testing.assert_allclose(out.pose, every.pose[rows], rtol=0, atol=POSE_TOL)
     np.testing.assert_allclose(out.wrenches[0], every.wrenches[0], rtol=0, atol=1e-9)
-    for k, row in enumerate(rows[1:], start=1):
-        window = every.wrenches[row - n + 1 : row + 1]  # (n, mounts, 6)
+    np.testing.assert_allclose(
+        np.abs(out.wrenches).max(axis=0), np.abs(every.wrenches).max(axis=0), rtol=1e-12
+    )
+    for k, (before, row) in enumerate(pairwise(rows), start=1):
+        window = every.wrenches[before + 1 : row + 1]  # (≤ n, mounts, 6)
         pick = np.abs(window).argmax(axis=0)
         peak = np.take_along_axis(window, pick[None], axis=0)[0]
         np.testing.assert_allclose(
@@ -347,8 +353,30 @@ def test_decimation_counts_again_from_a_restart() -> None:
     engine = engine_for(scene_with(outputs={"decimation": n}))
     out = engine.run(SampleBatch.concat([first, after_gap]))
     assert engine.counts["restarts"] == 1
-    expected = np.concatenate([first.stamps[[0, 4, 8]], after_gap.stamps[[0, 4, 8]]])
+    # each run's last sample too, its window partial: before the restart and at the end
+    expected = np.concatenate([first.stamps[[0, 4, 8, 9]], after_gap.stamps[[0, 4, 8, 9]]])
     np.testing.assert_array_equal(out.stamps, expected)
+
+
+def test_a_runs_last_sample_stays_answerable_however_many_rejected_samples_follow() -> None:
+    """The stream keeps the stamps of `pending_ids` only: the run's last sample, which the
+    flush publishes after 3000 rejected samples pushed one by one, and the gyro delay's."""
+    n = 4
+    good = ship_batch(0.2)
+    engine = engine_for(scene_with(outputs={"decimation": n}))
+    for piece in split(good, [1] * len(good)):
+        engine.push(piece)
+    bad = ship_batch(3.0, frame_id="another_imu")
+    bad.stamps[:] += good.stamps[-1] + 1e-3
+    for piece in split(bad, [1] * len(bad)):
+        engine.push(piece)
+        assert len(engine.pending_ids) <= engine.latency + 2
+    out = engine.flush()
+    last = len(good) - 1
+    assert last % n, "the last good sample is not a decimation row"
+    assert engine.pushed - len(good) == len(bad)
+    np.testing.assert_array_equal(out.stamps[-1:], good.stamps[-1:])
+    assert out.sample[-1] == last - engine.pushed, "counted back from the end of the stream"
 
 
 # --------------------------------------------------------------------------- input hold

@@ -131,9 +131,9 @@ class GyroDelay:
         return 0 if self.design is None else self.design.delay
 
     @property
-    def oldest_id(self) -> int | None:
-        """The stream position of the oldest pending sample (None: none pending)."""
-        return None if self._stored is None else int(self._stored.stored_ids[0])
+    def pending_ids(self) -> np.ndarray:
+        """The stream positions of the pending samples, in order (int64)."""
+        return np.zeros(0, np.int64) if self._stored is None else self._stored.stored_ids
 
     def frame(self, stamps: np.ndarray, f: np.ndarray, w: np.ndarray, first_id: int) -> Frame:
         """The frame of a push: pending samples, then these (w: raw Ω, rad/s, filtered in

@@ -153,6 +153,8 @@ class CoreDriver:
         """The state vector (names in `model.state_names`)."""
         self._peak = np.zeros((model.n_mounts, 6))
         self._counter = np.zeros(1, dtype=np.int64)
+        self._tail_pose = np.zeros(pose_row.WIDTH)
+        """The pose row of the last sample done, where decimation left it unpublished."""
         self.last: tuple[float, np.ndarray, np.ndarray] | None = None
         """(stamp s, f m/s², Ω rad/s in F) of the last sample done; None: not started."""
         self._event_meta = {
@@ -201,10 +203,12 @@ class CoreDriver:
         """Put the twin at state y at sample `stamp` (s) under specific force f (m/s², F) and
         Ω w (rad/s, F): the stepper's history, the decimation and the error estimate start
         anew. Returns the start's outputs: its pose row and (n_mounts, 6) wrenches."""
+        if self._counter[0]:
+            msg = "a run ends with its last sample published: close_run before begin"
+            raise RuntimeError(msg)
         self.y = y
         self.stepper.reset()
         self._peak[:] = 0.0
-        self._counter[0] = 0
         self.last = (stamp, f.copy(), w.copy())
         outputs = self._start_outputs()
         if isinstance(self.estimator, Estimator):
@@ -262,6 +266,8 @@ class CoreDriver:
         self._counts["substeps"] += int(buf.step_log[1 : done + 1, 1:3].sum())
         if done > 0:
             self.last = (float(segment.t[done]), segment.f[done], segment.w[done])
+            if self._counter[0]:
+                self._tail_pose[:] = buf.pose[done]
         peaks = buf.wrench_abs_max, float(buf.cos_tilt_min[0])
         keep = np.flatnonzero(buf.publish[: done + 1])  # never row 0: the previous sample
         if keep.shape[0] == done:  # every sample published: views of this run's buffers
@@ -270,6 +276,23 @@ class CoreDriver:
         else:
             published = Rows(index[keep - 1], buf.pose[keep], buf.wrenches[keep], peaks)
         return Stepped(done, status, published, events)
+
+    @property
+    def tail_pending(self) -> bool:
+        """Whether the last sample done is unpublished (decimation): `close_run` gives it."""
+        return bool(self._counter[0])
+
+    def close_run(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """End the run (a restart follows, or the stream ends): the outputs of its last sample
+        done where decimation left it unpublished, its pose row (1, WIDTH) and as wrenches
+        (1, n_mounts, 6) each component's largest magnitude since the row before; None where
+        that sample was published. Decimation then counts afresh."""
+        if not self._counter[0]:
+            return None
+        pose, wrenches = self._tail_pose[None].copy(), self._peak[None].copy()
+        self._peak[:] = 0.0
+        self._counter[0] = 0
+        return pose, wrenches
 
     def look_again(self, segment: Samples, j: int, events: list[MountEvent]) -> None:
         """`auto` at sample j of the segment just ended, which logged `events`, one of which

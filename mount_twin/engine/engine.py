@@ -30,7 +30,7 @@ from mount_twin.engine.health import ENDED, HealthWindow
 from mount_twin.engine.intake import Intake, Judged, runs
 from mount_twin.engine.kernel import AT_EVENT, Samples
 from mount_twin.engine.reporting import Reporting
-from mount_twin.engine.rows import BatchRows, Rows
+from mount_twin.engine.rows import BatchRows, Part, Tail
 from mount_twin.engine.starts import Starts
 from mount_twin.errors import require
 from mount_twin.integrate.stepper import STATUS_TEXT
@@ -86,6 +86,8 @@ class TwinEngine:
         self._gyro = GyroDelay(filter_bands(self.scene.input), self._designed)
         self._pushed = 0
         """Samples pushed so far (a held one once)."""
+        self._done_at = (0, math.nan)
+        """(position among the samples pushed, stamp s) of the last sample the twin did."""
 
     @property
     def state(self) -> np.ndarray:
@@ -194,12 +196,24 @@ class TwinEngine:
         return self._intake.held is not None
 
     @property
-    def lookback(self) -> int:
-        """How many of the samples pushed so far, counted back from the last, later outputs
-        may still answer (as negative `OutputBatch.sample`): the gyro delay's pending samples
-        (`delay_line`) and a sample held back (a stamp jump to confirm)."""
-        oldest = self._gyro.oldest_id
-        return max(0 if oldest is None else self._pushed - oldest, int(self.holding))
+    def pushed(self) -> int:
+        """Samples pushed so far (a held one once): the next one's position in the stream."""
+        return self._pushed
+
+    @property
+    def pending_ids(self) -> np.ndarray:
+        """The positions in the stream (from 0, among all samples pushed; increasing, int64)
+        of the samples whose outputs later pushes or the flush may still give (as negative
+        `OutputBatch.sample`, −1 the last sample pushed): the gyro delay's pending samples
+        (`delay_line`), a sample held back (a stamp jump to confirm), and the last sample
+        done where decimation left it unpublished (at its run's end, `Tail`)."""
+        # in stream order: the last sample done, those released after it, the held one
+        ids = [self._gyro.pending_ids]
+        if self._driver.tail_pending:
+            ids.insert(0, np.array([self._done_at[0]], np.int64))
+        if self.holding:
+            ids.append(np.array([self._pushed - 1], np.int64))
+        return ids[0] if len(ids) == 1 else np.concatenate(ids)
 
     @property
     def latency(self) -> int:
@@ -217,7 +231,7 @@ class TwinEngine:
         judged = self._intake.judge(batch)
         frame = self._gyro.frame(batch.stamps, judged.f, judged.w, first_id)
         rows = BatchRows(len(frame.stamps), self.model.n_mounts)
-        parts: list[Rows] = []
+        parts: list[Part] = []
         reports = []
         start = 0
         for stop, report_due in [*((i + 1, True) for i in judged.due), (len(batch), False)]:
@@ -239,7 +253,7 @@ class TwinEngine:
         span: tuple[int, int],
         frame: Frame,
         rows: BatchRows,
-        parts: list[Rows],
+        parts: list[Part],
     ) -> None:
         """Tally and follow the batch's samples [start, stop) = `span`, their outputs onto
         `parts`; the wall time it took into the health window."""
@@ -249,7 +263,7 @@ class TwinEngine:
             self._follow(self._gyro.feed(run, frame), frame, rows, parts)
         self.health.add_wall(self._clock() - wall0)
 
-    def _follow(self, runs: list[Run], frame: Frame, rows: BatchRows, parts: list[Rows]) -> None:
+    def _follow(self, runs: list[Run], frame: Frame, rows: BatchRows, parts: list[Part]) -> None:
         """Integrate runs of frame rows (`_integrate`), their outputs onto `parts` and into the
         health window."""
         first = len(parts)
@@ -257,10 +271,10 @@ class TwinEngine:
             parts.extend(self._integrate(run, frame, rows))
         self._reporting.add(parts[first:], frame)
 
-    def _integrate(self, run: Run, frame: Frame, rows: BatchRows) -> list[Rows]:
+    def _integrate(self, run: Run, frame: Frame, rows: BatchRows) -> list[Part]:
         """Integrate one run, its outputs into `rows` where it can; on a stepper failure
-        restart at the next sample."""
-        out: list[Rows] = []
+        restart at the next sample (the run before ends: `_close_run`)."""
+        out: list[Part] = []
         index = run.index
         driver, starts = self._driver, self._starts
         samples = frame.stamps, frame.f, frame.w
@@ -270,6 +284,7 @@ class TwinEngine:
                 return out
             self.health.stopped_at = None
         if run.restart:  # gathered afresh, maybe over pushes: nothing goes on from before
+            self._close_run(out)
             driver.last = None
         if driver.last is None:
             index, gathered = starts.gather(run, frame.f)
@@ -287,6 +302,11 @@ class TwinEngine:
             step = driver.advance(segment, index, rows)
             out.append(step.rows)
             done = step.done
+            if done:
+                self._done_at = (
+                    frame.first_id + int(frame.relative(index[done - 1 : done])[0]),
+                    float(frame.stamps[index[done - 1]]),
+                )
             if step.status == 0:
                 break
             if step.status == AT_EVENT:
@@ -296,12 +316,20 @@ class TwinEngine:
                 continue
             segment = None  # a restart takes the rows after it afresh
             rest = index[done + 1 :]
+            self._close_run(out)
             if not self._failed(step.status, float(frame.stamps[index[done]]), len(rest)):
                 break
             if not len(rest) or not starts.started(out, rest, samples, frame.f[rest[:1]], rows):
                 break
             index = rest[1:]
         return out
+
+    def _close_run(self, out: list[Part]) -> None:
+        """The twin's run ends (a restart follows, or the stream ends): its last sample onto
+        `out` where decimation left it unpublished (`Tail`), so that no peak is lost."""
+        closed = self._driver.close_run()
+        if closed is not None:
+            out.append(Tail(*self._done_at, *closed))
 
     def _failed(self, status: int, stamp: float, n_rest: int) -> bool:
         """The stepper failed (`status`) into the sample at `stamp` (s), with `n_rest` samples
@@ -324,8 +352,10 @@ class TwinEngine:
     def flush(self) -> OutputBatch:
         """The end of the stream (end of a bag, shutdown): the outputs of the samples the gyro
         delay still holds (the rate after the last held at its value; `sample` negative, −1
-        the last sample pushed), and in `health` the report of what happened since the last
-        one, due or not (none if nothing was processed since; its `sample` is −1).
+        the last sample pushed), then the last sample's where decimation left it unpublished
+        (with the peaks since the row before), and in `health` the report of what happened
+        since the last one, due or not (none if nothing was processed since; its `sample` is
+        −1).
 
         A sample still held back (a stamp jump that no later sample confirmed) is counted as
         rejected_unconfirmed_jump: the record ends before it can be told from a glitch. Where
@@ -335,21 +365,26 @@ class TwinEngine:
         empty = np.zeros((0, 3))
         frame = self._gyro.frame(np.zeros(0), empty, empty, self._pushed)
         rows = BatchRows(len(frame.stamps), self.model.n_mounts)
-        parts: list[Rows] = []
+        parts: list[Part] = []
         reports = self._end(frame, rows, parts, -1)
         return self._reporting.batch(frame, rows, parts, reports)
 
     def _end(
-        self, frame: Frame, rows: BatchRows, parts: list[Rows], last: int
+        self, frame: Frame, rows: BatchRows, parts: list[Part], last: int
     ) -> list[HealthReport]:
         """The stream's end in `frame` (`flush`'s, or the last push's in `run`): a held-back
-        sample counted rejected, the gyro delay drained onto `parts`, and the final report
-        (after `parts`, at sample `last`), if one is due."""
+        sample counted rejected, the gyro delay drained onto `parts`, the run's last sample
+        where decimation left it unpublished, and the final report (after `parts`, at sample
+        `last`), if one is due."""
         if self._intake.held is not None:
             self._intake.held = None
             self.count("received")
             self.count("rejected_unconfirmed_jump")
         self._follow(self._gyro.drain(frame), frame, rows, parts)
+        tail: list[Part] = []
+        self._close_run(tail)
+        parts += tail
+        self._reporting.add(tail, frame)
         last_stamp = self._intake.last_stamp
         if last_stamp is not None:
             if self.health.pending:

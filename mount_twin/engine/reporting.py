@@ -12,7 +12,7 @@ from mount_twin.engine.batch import HealthReport, OutputBatch
 from mount_twin.engine.delay_line import Frame
 from mount_twin.engine.driver import CoreDriver
 from mount_twin.engine.health import HealthWindow
-from mount_twin.engine.rows import BatchRows, Rows
+from mount_twin.engine.rows import BatchRows, Part, Rows, Tail
 
 
 class Reporting:
@@ -30,11 +30,15 @@ class Reporting:
         self._counts = counts
         self._n_mounts = driver.model.n_mounts
 
-    def add(self, parts: list[Rows], frame: Frame) -> None:
+    def add(self, parts: list[Part], frame: Frame) -> None:
         """Hand published rows (of `frame`'s samples) to the health window: their peaks where
         the compiled loop gave them, else the rows."""
         for published in parts:
-            if published.peaks is None:
+            if isinstance(published, Tail):
+                self._health.add_outputs(
+                    np.array([published.stamp]), published.pose, published.wrenches
+                )
+            elif published.peaks is None:
                 self._health.add_outputs(
                     frame.stamps[published.sample], published.pose, published.wrenches
                 )
@@ -42,21 +46,29 @@ class Reporting:
                 self._health.add_output_peaks(*published.peaks)
 
     def batch(
-        self, frame: Frame, rows: BatchRows, parts: list[Rows], reports: list[HealthReport]
+        self, frame: Frame, rows: BatchRows, parts: list[Part], reports: list[HealthReport]
     ) -> OutputBatch:
         """The OutputBatch of a push's (or a flush's) published parts and reports."""
         if not parts:
             empty = OutputBatch.empty(self._n_mounts)
             empty.health = reports
             return empty
-        sample, pose, wrenches = rows.gather(parts)
-        return OutputBatch(frame.stamps[sample], frame.relative(sample), pose, wrenches, reports)
+        whole = [p for p in parts if isinstance(p, Rows)]
+        if len(whole) == len(parts):
+            sample, pose, wrenches = rows.gather(whole)
+            stamps, positions = frame.stamps[sample], frame.relative(sample)
+        else:  # a run's last sample (`Tail`), maybe of an earlier push
+            located = [_located(p, frame) for p in parts]
+            stamps, positions = (np.concatenate([x[i] for x in located]) for i in (0, 1))
+            pose = np.concatenate([p.pose for p in parts])
+            wrenches = np.concatenate([p.wrenches for p in parts])
+        return OutputBatch(stamps, positions, pose, wrenches, reports)
 
     def report(
         self,
         stamp: float,
         sample: int,
-        parts: list[Rows] | None = None,
+        parts: list[Part] | None = None,
         stalled_s: float | None = None,
     ) -> HealthReport:
         """The report due at `stamp` (s), after sample `sample` and the output rows of `parts`
@@ -77,6 +89,14 @@ class Reporting:
             nominal_interval_s=nominal,
             stalled_s=stalled_s,
         )
-        report.rows = sum(p.sample.shape[0] for p in parts or ())
+        report.rows = sum(p.pose.shape[0] for p in parts or ())
         self._driver.end_window()
         return report
+
+
+def _located(part: Part, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
+    """A part's stamps (s) and positions relative to the push's first sample (`Frame.relative`;
+    a `Tail` knows its own, whichever push its sample came in)."""
+    if isinstance(part, Tail):
+        return np.array([part.stamp]), np.array([part.stream_id - frame.first_id])
+    return frame.stamps[part.sample], frame.relative(part.sample)

@@ -20,6 +20,22 @@ class Rows(NamedTuple):
     peaks: tuple[np.ndarray, float] | None = None
 
 
+class Tail(NamedTuple):
+    """A run's last sample, which decimation had not published, published at the run's end
+    (a restart, the stream's end) so that its peaks are not lost: its position among all the
+    samples pushed (`TwinEngine.pending_ids`), stamp (s), pose row (1, WIDTH) and wrenches
+    (1, n_mounts, 6), each component's largest magnitude since the row before."""
+
+    stream_id: int
+    stamp: float
+    pose: np.ndarray
+    wrenches: np.ndarray
+
+
+Part = Rows | Tail
+"""What a push publishes comes in parts, in the order the twin gave them."""
+
+
 class BatchRows:
     """Output rows for a pushed batch, one per sample (row r + 1 holds sample r's; row 0 is
     before the batch): a start and a run over consecutive samples write theirs in place, so a

@@ -20,7 +20,7 @@ from mount_twin.engine.delay_line import Run
 from mount_twin.engine.driver import CoreDriver
 from mount_twin.engine.health import HealthWindow
 from mount_twin.engine.restart import start_state
-from mount_twin.engine.rows import BatchRows, Rows
+from mount_twin.engine.rows import BatchRows, Part
 from mount_twin.model.assemble import Model
 from mount_twin.scene.description import STANDARD_GRAVITY, InitialState, InputSpec
 
@@ -169,7 +169,7 @@ class Starts:
 
     def started(
         self,
-        out: list[Rows],
+        out: list[Part],
         index: np.ndarray,
         frame: tuple[np.ndarray, np.ndarray, np.ndarray],
         gathered: np.ndarray,

@@ -187,7 +187,8 @@ class Outputs:
         tf: publish the body pose on /tf (tf2_msgs/TFMessage: frames.foundation → frames.body,
             the CG position in m and the body attitude, the numbers of the PoseStamped).
         decimation: publish every Nth accepted input sample; wrench components hold their peak
-            (largest magnitude, with sign) over the interval.
+            (largest magnitude, with sign) over the interval. A run's last sample is published
+            at its end (a restart, the stream's end) with the peaks since the row before.
         diagnostics_period_s: stamp-time period of DiagnosticArray messages, s.
         tilt_warn_rad: tilt of body z from vertical past which diagnostics warn.
         alarm_margin: a mount warns once its utilisation passes 1 − alarm_margin.
