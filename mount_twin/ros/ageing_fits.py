@@ -40,15 +40,20 @@ class AgeingFits:
         then the worker stops), as /diagnostics messages; a fit that raised or did not finish
         in time is an ERROR saying so."""
         msgs = []
+        hung = False
         while self._pending and (wait or self._pending[0][1].done()):
             stamp_ns, future = self._pending.popleft()
             try:
                 report = future.result(timeout=FIT_WAIT_S)
             except Exception as err:  # the worker died, the fit raised or hung: said, not lost
+                hung = hung or not future.done()
                 status = HealthStatus(NAME, ERROR, f"the ageing fit failed: {err!r}", {})
                 report = HealthReport(stamp_ns * 1e-9, -1, [status])
             msgs.append(encode_report(self.scene, report, stamp_ns))
         if wait and self._pool is not None:
-            self._pool.shutdown(wait=False, cancel_futures=True)
+            # Joined where every fit is done: left running (wait=False), the pool's thread
+            # closed its wake-up pipe under the interpreter's exit hook, which then printed
+            # "OSError: Bad file descriptor" after a clean shutdown (CPython gh-83279).
+            self._pool.shutdown(wait=not hung, cancel_futures=True)
             self._pool = None
         return msgs
