@@ -543,3 +543,26 @@ def test_an_axis_without_motion_is_null_in_the_json_not_minus_infinity(tmp_path:
 
 def test_the_tolerance_defaults_agree() -> None:
     assert TOLERANCE_DB == DEFAULT_BAND
+
+
+def test_a_dead_channel_is_refused_not_left_out_of_the_verdict(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An x channel all NaN was taken for a frozen scene DOF: `--axis all --design` judged y
+    and z alone, PASS, exit 0. A channel asked for that is not finite is refused, named; the
+    other axes alone still give their spectra."""
+    design = tmp_path / "design.csv"
+    design.write_text("frequency_hz,accel_g\n10,1\n100,1\n")
+    t = np.arange(2000) * 1e-3
+    for bad, count, first in ((slice(None), 2000, 0), (slice(300, 301), 1, 300)):
+        accel = np.tile([0.0, 0.0, G], (t.size, 1))
+        accel[bad, 0] = np.nan
+        bag = tmp_path / f"x_nan_{count}"
+        write_signal(
+            Signal(t, accel, np.zeros_like(accel)), str(bag), "/imu", "imu", 10**18, "mcap"
+        )
+        assert main(["srs", str(bag), "--axis", "all", "--design", str(design)]) == 2
+        err = capsys.readouterr().err
+        assert f"axis x has {count} of 2000 values not finite, the first at sample {first} " in err
+        assert f"(t = {t[first]:.6g} s)" in err
+        assert main(["srs", str(bag), "--axis", "z", "--freqs", "10"]) == 0

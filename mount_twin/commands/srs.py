@@ -168,11 +168,13 @@ def run(args: argparse.Namespace) -> int:
     if design is not None and unit != "m/s²":
         msg = f"--design is a spectrum in g: {name} is a force (N)"
         raise ValueError(msg)
+    axes: tuple[str, ...] = AXES if args.axis == "all" else (args.axis,)
+    if not args.response:
+        _check_channels(accel, axes, t, name)
     record = uniform(t, accel, args.input)
     t, accel, rate = record.t, record.values, record.rate_hz
     offset, removed = gravity_offset(t, accel, args.gravity, args.head)
     freqs = _frequencies(args, rate)
-    axes: tuple[str, ...] = AXES if args.axis == "all" else (args.axis,)
     frozen = [a for a in axes if np.isnan(accel[:, AXES.index(a)]).all()]  # --response cg
     if frozen:
         said = (
@@ -212,6 +214,24 @@ def run(args: argparse.Namespace) -> int:
         _plot(args.plot, spectra, design, band, title, ACCURATE_SHARE * rate, unit)
         print(f"plot: {args.plot}")
     return EXIT_OUT_OF_TOLERANCE if any(not c.passed for c in checks.values()) else 0
+
+
+def _check_channels(values: np.ndarray, axes: tuple[str, ...], t: np.ndarray, name: str) -> None:
+    """Refuse a record whose channel of an axis asked for holds a value not finite (a dead or
+    damaged channel has no spectrum, and a design judged without it would pass on the other
+    axes), naming the axis, how many and the first (sample, t s from the record's start)."""
+    import numpy as np
+
+    for axis in axes:
+        bad = np.flatnonzero(~np.isfinite(values[:, AXES.index(axis)]))
+        if bad.shape[0]:
+            first = int(bad[0])
+            msg = (
+                f"{name}: axis {axis} has {bad.shape[0]} of {values.shape[0]} values not "
+                f"finite, the first at sample {first} (t = {t[first]:.6g} s): a damaged or "
+                "dead channel has no spectrum"
+            )
+            raise ValueError(msg)
 
 
 def _frequencies(args: argparse.Namespace, rate_hz: float) -> np.ndarray:
