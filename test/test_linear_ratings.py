@@ -61,6 +61,23 @@ def test_static_sag_and_load_give_the_closed_form_utilisation() -> None:
     assert "m1" not in engine.utilisation_max  # unrated mounts have no utilisation
 
 
+@pytest.mark.parametrize("n", [1, 2])
+def test_a_record_of_one_sample_is_judged_at_its_start(n: int) -> None:
+    """A start is published: its closed-form load and sag count. With one sample (nothing
+    integrated) the utilisation read 0 and the mount status "ok", which a sweep then ranked
+    as its best case."""
+    sag, load = MASS * G / (4 * K), MASS * G / 4
+    for travel, rated, expected in (
+        ([0.0, 0.0, 2.0 * sag], [0.0, 0.0, 0.0], 0.5),
+        ([0.0, 0.0, 0.0], [0.0, 0.0, 0.8 * load], 1.25),
+    ):
+        engine = _engine(travel, rated)
+        _, status = _run(engine, n=n)
+        assert engine.utilisation_max["m0"] == pytest.approx(expected, rel=1e-9)
+        assert status.values["utilisation_max"] == f"{expected:.4g}"
+        assert status.level == (OK if expected < 1.0 else ERROR)
+
+
 def test_travel_along_inclined_mount_axes() -> None:
     """Mounts in a V: the body sinks by s, so mount m0 (at x > 0, pitched −30°: its z axis is
     (−sin 30°, 0, cos 30°) in F, its x axis (cos 30°, 0, sin 30°)) moves −s·cos 30° along its z

@@ -43,7 +43,12 @@ from mount_twin.kinds import KINDS, N_EVENTS
 from mount_twin.model.assemble import Model
 from mount_twin.model.stiffness import spectral_radius
 from mount_twin.physics import pose_row
-from mount_twin.physics.dynamics import INPUT_SIZE, evaluate, mount_monitors
+from mount_twin.physics.dynamics import (
+    INPUT_SIZE,
+    evaluate,
+    linear_utilisation,
+    mount_monitors,
+)
 
 MAX_EVENTS = 100_000
 """Mount events kept in CoreDriver.events (later ones are counted only)."""
@@ -218,17 +223,22 @@ class CoreDriver:
         return outputs
 
     def _start_outputs(self) -> tuple[np.ndarray, np.ndarray]:
-        """Outputs (pose row, wrenches) of the state; arms the mount monitors there."""
+        """Outputs (pose row, wrenches) of the state; arms the mount monitors there and folds
+        its utilisation into the window's (a start is published: a run that fails at its
+        first interval still shows the load it started under)."""
         model, y = self.model, self.y
         pose, wrenches = np.zeros(pose_row.WIDTH), np.zeros((model.n_mounts, 6))
         ct = evaluate(y, model.arrays, self._scratch, pose, wrenches)
         if not math.isfinite(ct):
             msg = f"{model.scene.source}: initial_state.pose is off the α/γ/δ chart"
             raise ValueError(msg)
+        linear_utilisation(y, model.arrays, self._scratch, wrenches, self._linear_util)
         nl = model.arrays.nl
         if nl is not None:
-            self._watch.y_prev[:] = y
-            mount_monitors(y, y, nl, self._scratch, self._watch.g_prev, self._watch.util)
+            watch = self._watch
+            watch.y_prev[:] = y
+            mount_monitors(y, y, nl, self._scratch, watch.g_prev, watch.util)
+            np.maximum(watch.util_peak, watch.util, out=watch.util_peak)
         return pose, wrenches
 
     def choose_at_start(self, stamp: float) -> None:

@@ -201,6 +201,10 @@ outputs = _core.outputs
 """`evaluate` when s already holds the body motion at y (the last `rhs` was at y)."""
 mount_wrenches = _core.mount_wrenches
 """mount_wrenches(y, m, s, wrenches): each mount's force (N) and couple (N·m), in its axes."""
+linear_utilisation = _core.linear_utilisation
+"""linear_utilisation(y, m, s, wrenches, peak): fold each linear mount's utilisation at the
+body motion of y that s holds (the largest over its axes of |travel| / rated travel and
+|force| / rated load, `ModelArrays.lin_per_rating`) into peak, its running maxima."""
 mount_monitors = _core.mount_monitors
 """mount_monitors(y, y0, nl, s, g, util) -> switched: event functions g[i] and utilisation
 util[i] of each non-linear mount at y (its body motion just computed; y0 the state at the

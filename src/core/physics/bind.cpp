@@ -84,6 +84,16 @@ void bind_physics(py::module_& mod) {
       "Each mount's force (N) and couple (N·m) on the body, in its axes.", py::arg("y"),
       py::arg("m"), py::arg("s"), py::arg("wrenches"));
   mod.def(
+      "linear_utilisation",
+      [](py::handle y_, py::handle m_, py::handle s_, py::handle w_, py::handle peak_) {
+        auto [m, s, y] = call(m_, s_, y_);
+        physics::linear_utilisation(m, s, wrench_rows(m, w_),
+                                    convert::vec(peak_, "peak", m.lin_point.rows));
+      },
+      "Fold each linear mount's utilisation at the body motion of y (the scratch holds it; "
+      "its wrenches in their axes) into peak, its running maxima.",
+      py::arg("y"), py::arg("m"), py::arg("s"), py::arg("wrenches"), py::arg("peak"));
+  mod.def(
       "mount_monitors",
       [](py::handle y_, py::handle y0_, py::handle nl_, py::handle s_, py::handle g_,
          py::handle util_) {
