@@ -81,11 +81,15 @@ class Law:
         d: Sequence[float],
         v: Sequence[float] = (0.0, 0.0, 0.0),
         y: np.ndarray | None = None,
+        y0: np.ndarray | None = None,
     ) -> tuple[float, np.ndarray]:
-        """(utilisation, event functions in the order of the module's EVENTS)."""
+        """(utilisation, event functions in the order of the module's EVENTS); y0: the
+        previous sample's states, on which trial functions are judged (default: y, no trial
+        state)."""
         y = self.states() if y is None else np.asarray(y, dtype=float)
+        y0 = y if y0 is None else np.asarray(y0, dtype=float)
         g = np.full(len(self.module.EVENTS), np.nan)
-        util = self.module.monitor(self.p, y, y, 0, _vec(d), _vec(v), g)  # no trial state
+        util = self.module.monitor(self.p, y, y0, 0, _vec(d), _vec(v), g)
         return float(util), g
 
     def update(self, y: np.ndarray, d: Sequence[float]) -> None:

@@ -209,7 +209,32 @@ def test_the_joint_face_sticks_then_slides_at_mu_times_the_clamp_force(axis, u_a
     )
     stuck = np.abs(x - slip) < half * (1 - 1e-9)
     assert np.all(g[stuck] < 0.0)
-    assert np.max(np.abs(g[~stuck])) <= 1e-9 * MU * F_V
+    if f_k > 0.0:
+        assert np.max(np.abs(g[~stuck])) <= 1e-9 * MU * F_V
+        return
+    # open: the face carries no shear once it has slid; the engine judges the trial state
+    # (slip frozen at the previous sample), on which every move slides
+    trial = np.array(
+        [
+            law.monitor(d, y=y, y0=y0)[1][EVENT["joint_slipped"]]
+            for d, y, y0 in zip(path[1:], states[1:], states[:-1], strict=True)
+        ]
+    )
+    assert np.all(trial[np.diff(x) != 0.0] > 0.0)
+
+
+def test_an_open_face_with_no_shear_on_it_does_not_slip() -> None:
+    """Opened, the face's friction bound is 0: with no shear on it the slip function was
+    0 − 0 = 0, and every joint_opened came with a joint_slipped (a WARN, stamped at the
+    sample, not at a crossing). Any shear on an open face slips."""
+    law = joint()
+    for u in (U_OPEN, 2.0 * U_OPEN):
+        g = law.monitor([0.0, 0.0, u], y=law.states())[1]
+        assert g[EVENT["joint_opened"]] >= 0.0 and g[EVENT["joint_slipped"]] < 0.0
+        g = law.monitor([1e-12, 0.0, u], y=law.states())[1]
+        assert g[EVENT["joint_slipped"]] == pytest.approx(K_T * 1e-12, rel=1e-9)
+    closed = law.monitor([0.0, 0.0, 0.5 * U_OPEN], y=law.states())[1]
+    assert closed[EVENT["joint_slipped"]] == pytest.approx(-MU * 0.5 * F_V, rel=1e-12)
 
 
 def play_operator(x: np.ndarray, half_width: np.ndarray) -> np.ndarray:

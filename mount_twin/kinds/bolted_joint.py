@@ -272,7 +272,8 @@ def monitor(p, y, y0, o, d, v, g) -> float:
     g[0] = bolt_force(p, u, e_t, broken) - yield_limit(p, e_t) if broken < 0.5 else -1.0
     g[1] = p[KP] * u - p[FV]
     tx, ty = p[KT] * (d[0] - sx), p[KT] * (d[1] - sy)
-    g[2] = math.sqrt(tx * tx + ty * ty) - p[MU] * max(p[FV] - p[KP] * u, 0.0)
+    shear, bound = math.sqrt(tx * tx + ty * ty), p[MU] * max(p[FV] - p[KP] * u, 0.0)
+    g[2] = shear - bound if shear > 0.0 or bound > 0.0 else -1.0  # open, unsheared: no slip
     f_s = bolt_force(p, u, e_p, broken)
     g[3] = 1.0 if broken > 0.5 else max(f_s / p[FU] - 1.0, e_p / p[EPU] - 1.0)
     return f_s / p[FY]

@@ -96,7 +96,8 @@ inline double monitor(const double* p, Vec y, Vec y0, idx o, const double* d,
   g[0] = broken < 0.5 ? bolt_force(p, u, e_t, broken) - yield_limit(p, e_t) : -1.0;
   g[1] = p[KP] * u - p[FV];
   const double tx = p[KT] * (d[0] - sx), ty = p[KT] * (d[1] - sy);
-  g[2] = std::sqrt(tx * tx + ty * ty) - p[MU] * py_max(p[FV] - p[KP] * u, 0.0);
+  const double shear = std::sqrt(tx * tx + ty * ty), bound = p[MU] * py_max(p[FV] - p[KP] * u, 0.0);
+  g[2] = shear > 0.0 || bound > 0.0 ? shear - bound : -1.0;  // open, unsheared: no slip
   const double f_s = bolt_force(p, u, e_p, broken);
   g[3] = broken > 0.5 ? 1.0 : py_max(f_s / p[FU] - 1.0, e_p / p[EPU] - 1.0);
   return f_s / p[FY];
