@@ -125,3 +125,25 @@ def test_a_gap_reset_while_gathering_starts_the_gathering_again() -> None:
     stamps = np.concatenate([1.0 + np.arange(3) * 1e-3, 3.0 + np.arange(6) * 1e-3])
     out = engine.run(batch(stamps))
     assert out.stamps[0] == pytest.approx(3.0 + 4e-3)  # 5th sample after the gap
+
+
+def test_a_start_without_equilibrium_under_the_input_is_not_called_a_stepper_failure() -> None:
+    """The genset's joints hold no equilibrium under 400 m/s² downward: it starts from rest
+    under nominal gravity, an ERROR. The integration status said "stepper failed and the twin
+    restarted" where no stepper had failed (integration failures: 0, restarts: 0)."""
+    from pathlib import Path
+
+    from mount_twin.engine.engine import TwinEngine
+    from mount_twin.scene.loader import load_scene_file
+
+    root = Path(__file__).resolve().parent.parent
+    scene = load_scene_file(root / "config" / "genset_bolted_keyed.scene.yaml")
+    engine = TwinEngine(assemble(scene))
+    stamps = np.arange(200) * 1e-4
+    out = engine.run(batch(stamps, np.tile([0.0, 0.0, -400.0], (200, 1))))
+    assert engine.counts["starts_at_nominal_gravity"] == 1
+    assert engine.counts["integration_failures"] == 0 and engine.counts["restarts"] == 0
+    (status,) = [s for s in out.health[0].statuses if s.name == "mount_twin: integration"]
+    assert status.level == ERROR
+    assert status.message.startswith("started away from equilibrium: 0.000000 s: no static ")
+    assert "stepper failed" not in status.message

@@ -91,6 +91,9 @@ class HealthWindow:
         self.samples = 0
         self.tilt_max = 0.0
         self.failures: list[tuple[float, str]] = []
+        """(stamp s, cause) of each stepper failure."""
+        self.forced: list[tuple[float, str]] = []
+        """(stamp s, why) of each start forced away from equilibrium under the input."""
         self.wrench_peak = np.zeros((len(self.scene.mounts), 6))
         self.events: list[MountEvent] = []
         self.steps: list[np.ndarray] = []
@@ -237,8 +240,12 @@ class HealthWindow:
         self.stopped_at, self.stopped_why = stamp, why
 
     def failure(self, stamp: float, text: str) -> None:
-        """A stepper failure (or a forced start) at `stamp` (s)."""
+        """A stepper failure at `stamp` (s), its cause."""
         self.failures.append((stamp, text))
+
+    def forced_start(self, stamp: float, text: str) -> None:
+        """A start at `stamp` (s) away from equilibrium under the input (none found), why."""
+        self.forced.append((stamp, text))
 
     def tick(self, stamp: float) -> bool:
         """An accepted sample at `stamp` (s): is a report due once it is processed?
@@ -342,21 +349,27 @@ class HealthWindow:
         )
 
     def _stepper_status(self) -> tuple[int, str]:
-        """Level and text of the stepper in this window: ERROR with its failures (stamps in s)
-        or a stop, else OK."""
-        fail_text = "; ".join(f"{self.origin_s + t:.6f} s: {m}" for t, m in self.failures)
+        """Level and text of the stepper in this window: ERROR with its failures and forced
+        starts (stamps in s) or a stop, else OK."""
+
+        def listed(what: list[tuple[float, str]]) -> str:
+            return "; ".join(f"{self.origin_s + t:.6f} s: {m}" for t, m in what)
+
+        said = []
+        if self.failures:
+            said.append(f"stepper failed and the twin restarted: {listed(self.failures)}")
+        if self.forced:
+            said.append(f"started away from equilibrium: {listed(self.forced)}")
         if self.stopped_at is not None:
             step_text = (
                 f"not following since {self.origin_s + self.stopped_at:.6f} s: "
                 f"{self.stopped_why}; no pose, angles or wrenches until a restart (a gap or "
                 "the stamps jumping back) finds a state to start from"
-                + (f" ({fail_text})" if self.failures else "")
+                + (f" ({'; '.join(said)})" if said else "")
             )
-        elif self.failures:
-            step_text = f"stepper failed and the twin restarted: {fail_text}"
         else:
-            step_text = "ok"
-        return (ERROR if self.failures or self.stopped_at is not None else OK), step_text
+            step_text = "; ".join(said) or "ok"
+        return (ERROR if said or self.stopped_at is not None else OK), step_text
 
     def _attitude_status(self) -> HealthStatus:
         """The attitude status of this window: WARN past `outputs.tilt_warn_rad` of tilt, where

@@ -164,7 +164,7 @@ class Starts:
             return None
         if start.note is not None:
             counts["starts_at_nominal_gravity"] += 1
-            self._health.failure(stamp, start.note)
+            self._health.forced_start(stamp, start.note)
         return driver.begin(start.state, stamp, f[i], w0)
 
     def started(
