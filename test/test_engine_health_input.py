@@ -372,6 +372,30 @@ def test_wrong_frame_rejections_name_the_expected_and_the_seen_frame() -> None:
     assert after.values["last_wrong_frame_id"] == "imu_link"
 
 
+@pytest.mark.parametrize(("every", "level"), [(20, WARN), (5, ERROR), (1, ERROR)])
+def test_a_sensor_whose_readings_are_unusable_is_an_error(every: int, level: int) -> None:
+    """Past a tenth of a period's readings rejected (not a stamp repeated, nor another
+    sensor's on the topic) the input is an ERROR: a record 90 % NaN read WARN, and its replay
+    exited 0 under --fail-on error. One in 20 stays a WARN."""
+    b = batch(ramp(2500))
+    bad = np.arange(1100, 2500)[::every]  # from the second period on
+    b.accel[bad, 2] = np.nan
+    reports = engine().run(b).health
+    assert status(reports[0]).level == OK
+    ends = [r.stamp for r in reports[:-1]] + [b.stamps[-1]]  # each window's last stamp
+    for before, end, report in zip(ends[:-1], ends[1:], reports[1:], strict=True):
+        window = (b.stamps > before) & (b.stamps <= end)
+        n = int(np.isnan(b.accel[window, 2]).sum())
+        share = n / int(window.sum())
+        st = status(report)
+        assert st.level == (ERROR if share > 0.1 else WARN)
+        said = f"{n} samples rejected, " + (
+            f"{share:.3g} of the readings, " if share > 0.1 else ""
+        )
+        assert st.message.startswith(said)
+    assert max(status(r).level for r in reports) == level
+
+
 def test_several_wrong_frames_are_all_named() -> None:
     b = batch(ramp(1500))
     b.frame_ids[10] = "a"

@@ -35,6 +35,12 @@ HOLE = 1.5
 """A stamp interval longer than HOLE nominal intervals is a hole: samples were lost."""
 LOST_ERROR = 0.01
 """Fraction of (accepted + lost) samples lost in a period past which the input is an ERROR."""
+NOT_UNUSABLE = ("duplicate_stamp", "wrong_frame")
+"""Rejection reasons that are not the sensor's readings unusable: a repeat, another sensor's."""
+REJECTED_ERROR = 0.1
+"""Fraction of the readings received in a period (`NOT_UNUSABLE` aside) rejected past which
+the input is an ERROR: a sensor a tenth of whose readings are unusable is broken (a record 90 %
+NaN read WARN, and its replay exited 0 under --fail-on error)."""
 SATURATION_SHARE = 0.999
 """A reading at this share of `input.accel_range_m_s2` (or `gyro_range_rad_s`) is saturated."""
 PLATEAU_G = 2.0
@@ -450,8 +456,9 @@ class HealthWindow:
         nominal_s: float,
         stalled_s: float | None,
     ) -> HealthStatus:
-        """The input status of this window: rejections and gaps (WARN), lost samples (WARN,
-        ERROR past LOST_ERROR of the samples due), a stall (ERROR)."""
+        """The input status of this window: rejections and gaps (WARN; ERROR where the
+        readings rejected, duplicates aside, pass REJECTED_ERROR of those received), lost samples
+        (WARN, ERROR past LOST_ERROR of the samples due), a stall (ERROR)."""
         new_rejected = {
             k.removeprefix("rejected_"): v
             for k, v in sorted(new.items())
@@ -477,10 +484,16 @@ class HealthWindow:
                 level = max(level, note_level)
                 parts.append(f"start at {self.origin_s + stamp:.6f} s: {text}")
         if (n_rejected and not all_rejected) or new["gaps"]:
-            level = max(level, WARN)
+            # readings of the sensor the twin could not use (a duplicate stamp loses none,
+            # another sensor's on the topic are not this one's)
+            unseen = n_rejected - sum(new_rejected.get(r, 0) for r in NOT_UNUSABLE)
+            share = unseen / (new["accepted"] + unseen) if unseen else 0.0
+            level = max(level, ERROR if share > REJECTED_ERROR else WARN)
             detail = ""
             if "wrong_frame" in new_rejected:
                 detail = f" ({self._reason('wrong_frame', new_rejected['wrong_frame'])})"
+            if share > REJECTED_ERROR:
+                detail += f", {share:.3g} of the readings"
             parts.append(
                 f"{n_rejected} samples rejected{detail}, {new['gaps']} gaps in this period"
             )
