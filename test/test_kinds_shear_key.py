@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 from kinds_helpers import kind_mount, law_of
-from physics_helpers import base_scene, build
+from physics_helpers import base_scene, build, mount
 
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.engine.engine import TwinEngine
@@ -167,3 +167,26 @@ def test_a_foot_lifted_past_the_engagement_height_has_cleared_the_key() -> None:
     assert util == 0.0 and np.all(g < 0.0), "no contact and no overload once cleared"
     util_held, _ = law.monitor([d_side, 0.0, 0.019])
     assert util_held == 0.0  # no allowable given: not monitored
+
+
+@pytest.mark.parametrize("tilt", [0.0, 0.05, -0.3, 1.0])
+def test_a_dof_a_key_holds_within_its_clearance_starts_at_rest_where_it_bears(
+    tilt: float,
+) -> None:
+    """x held only by a key with a clearance (a spring holds z): the loader takes the scene, and
+    the start at equilibrium rests in the clearance on a level deck, or bears on the key on a
+    deck tilted by `tilt` (rad about y): x = −sign·(c + m·g·sin θ/k), z = −m·g·cos θ/k_z. It was
+    refused ("DOF x is not held by any mount"), its stiffness singular inside the clearance."""
+    k_x, k_z, c = 1e7, 1e6, 5e-4
+    spring = mount("spring", (0.0, 0.0, 0.0), (0.0, 0.0, k_z, 0.0, 0.0, 0.0))
+    stop = kind_mount("shear_key", "stop", stiffness=[k_x, 0.0, 0.0], clearance=c)
+    inertia = [5.0, 6.0, 7.0, 0.0, 0.0, 0.0]
+    scene = base_scene(MASS, [0.0, 0.0, 0.3], inertia, [spring, stop], ["x", "z"])
+    f = 9.80665 * np.array([math.sin(tilt), 0.0, math.cos(tilt)])
+    t = np.arange(101) / 1000.0
+    engine = TwinEngine(build(scene))
+    out = engine.run(SampleBatch(t, np.tile(f, (t.size, 1)), np.zeros((t.size, 3)), [""] * 101))
+    assert engine.counts["starts_at_nominal_gravity"] == 0
+    x = -math.copysign(c + MASS * abs(f[0]) / k_x, f[0]) if tilt else 0.0
+    expected = np.tile([x, 0.0, 0.3 - MASS * f[2] / k_z], (t.size, 1))
+    np.testing.assert_allclose(out.pose[:, :3], expected, rtol=0, atol=1e-12)

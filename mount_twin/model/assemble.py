@@ -23,6 +23,7 @@ from mount_twin.physics.jacobian import central_columns
 from mount_twin.physics.rotations import rpy_matrices, rpy_matrix
 from mount_twin.scene.built import check_built
 from mount_twin.scene.description import DOF_NAMES, LinearMount, Scene
+from mount_twin.scene.statics import loose_dofs, statics
 
 
 @dataclass(frozen=True)
@@ -226,6 +227,8 @@ def static_equilibrium(
 
     allowed_at = _allowed_residual(model, specific_force)
     found = newton.solve(accelerations, stiffness, q_guess, allowed_at)
+    if found is None:  # a singular stiffness at the guess: within a clearance?
+        found = newton.anchored(accelerations, stiffness, q_guess, allowed_at)
     if found is None:  # Newton did not get there: the robust solver says why
         from scipy.optimize import least_squares  # 0.2 s to import: only where Newton fails
 
@@ -270,7 +273,10 @@ def _allowed_residual(
 def _check_restrained(model: Model, jac: np.ndarray) -> None:
     """Refuse a free DOF that no mount holds: the equilibrium's stiffness, ∂(generalized
     accelerations)/∂q, is then singular, and the body would drift under any input along it.
-    The message names the DOF that dominates the unrestrained direction."""
+    The message names the DOF that dominates the unrestrained direction. A singular stiffness
+    where the mounts' nominal tangents hold every DOF (`scene.statics`: a shear key counts
+    with its clearance) is a rest within a clearance, which the body leaves at contact: taken,
+    as the loader takes the scene."""
     nf = jac.shape[0]
     scale = np.abs(jac).max()
     if not np.isfinite(scale) or scale == 0.0:
@@ -278,7 +284,9 @@ def _check_restrained(model: Model, jac: np.ndarray) -> None:
         msg = f"{model.scene.source}: no mount holds the body: DOFs {free} are free"
         raise ModelError(msg)
     _, sigma, vt = np.linalg.svd(jac / scale)
-    if sigma[-1] < 1e-9 * sigma[0] * max(nf, 1):
+    if sigma[-1] < newton.SINGULAR * sigma[0] * max(nf, 1):
+        if not any(loose_dofs(statics(model.scene), model.scene.dofs)):
+            return  # at rest within a clearance (a key's): free there, but not far
         dof = model.scene.dofs[int(np.argmax(np.abs(vt[-1])))]
         msg = (
             f"{model.scene.source}: DOF {dof} is not held by any mount (the mounts' stiffness "
