@@ -268,3 +268,51 @@ def test_an_offset_the_motion_cannot_show_is_refused_not_fitted_to_zero_plus_or_
     )
     said = capsys.readouterr().out
     assert re.search(r"sensor_y.*refused.*does not move it at all", said), said
+
+
+def _dead_top(tmp_path: Path) -> Path:
+    """The shake table's block record (trial 1) as a sensor that died before it began: every
+    data row's Acc and Gyr cells a constant 0, 0, 9.81 m/s² and 0 deg/s (the stamps kept)."""
+    lines = (SHAKE / "sine_2hz_trial1_top_excerpt.csv").read_text().splitlines()
+    start = next(i for i, ln in enumerate(lines) if ln.startswith("PacketCounter,")) + 1
+    for i in range(start + 1, len(lines)):  # the export's first data row is all zeros
+        cells = lines[i].split(",")
+        cells[5:11] = ["0", "0", "9.81", "0", "0", "0"]
+        lines[i] = ",".join(cells)
+    dead = tmp_path / "top_dead.csv"
+    dead.write_text("\n".join(lines) + "\n")
+    return dead
+
+
+@pytest.mark.parametrize("command", ["calibrate", "track"])
+def test_a_body_record_that_does_not_move_is_refused_at_load_naming_it(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A dead body IMU (a constant reading) against the moving shake table: calibrate had
+    kept yaw and lag "± 0.77°", printed an NRMS of 1e14 and written the scene; track had read
+    the window OK with every scale refused; both exited 0. Refused, exit 2, naming the file."""
+    dead = _dead_top(tmp_path)
+    out = tmp_path / "c.scene.yaml"
+    ground = str(SHAKE / "sine_2hz_trial1_ground_excerpt.csv")
+    files = ["--foundation", ground, "--body", str(dead)]
+    tail = ["-o", str(out)] if command == "calibrate" else ["--window", "10"]
+    assert main([command, str(SHAKE / "block.scene.yaml"), *files, *tail]) == 2
+    err = capsys.readouterr().err
+    assert f"{dead}: the body record does not move" in err, err
+    assert not out.exists()
+
+
+def test_a_still_body_refuses_every_parameter_and_has_no_nrms() -> None:
+    """Through the API (a window of track's, a body sensor that died mid-record): the pump
+    on ship motion with vibration, its body record a constant. Nothing is fitted (the dead
+    sensor had yaw and lag "fitted"), every parameter is refused saying the body does not
+    move, and the normalised error, a ratio to no motion, is nan rather than ~1e14."""
+    foundation = _vibrating_deck()
+    constant = np.tile([0.0, 0.0, 9.81], (foundation.t.size, 1))
+    still = Signal(foundation.t, constant, np.zeros_like(constant))
+    cal = cal_mod.calibrate(_pump(), foundation, still)
+    assert set(cal.refused) == set(FITTED) and not cal.sigma
+    assert all("the body record does not move" in why for why in cal.refused.values())
+    assert cal.values == {"stiffness": 1.0, "damping": 1.0, "yaw": 0.0, "lag": 0.0}
+    assert math.isnan(cal.nrms_before) and math.isnan(cal.nrms_after)
+    assert math.isnan(cal_mod.nrms(np.ones((50, 3)), np.tile([0.0, 0.0, 9.81], (50, 1))))

@@ -28,6 +28,8 @@ fit's Jacobian and residual (`(JᵀJ)⁻¹ s²`; the residual's own correlation 
 bound). A parameter the record cannot identify (relative 1σ past `MAX_REL_SIGMA`, an angle
 past 2°, a lag past a sample) is refused by name and held at its nominal value, and the rest is
 fitted again; a fit that predicts the body no better than the nominal scene is refused whole.
+A body record that does not move (`still_body`: a dead or disconnected sensor, another
+machine's record) leaves nothing to fit: every parameter is refused, saying so.
 """
 
 from __future__ import annotations
@@ -69,6 +71,16 @@ EDGE_S = 0.25
 
 MIN_OVERLAP = 10
 """Body samples the fit needs within the foundation record (`EDGE_S` off each end) at least."""
+STILL_SHARE = 0.01
+"""A body record whose dynamic RMS (its specific force about its mean, all three axes: gravity
+and bias out) is at most this share of the foundation's over the compared span does not move
+(`still_body`). Below its mounts' modes a body follows its foundation (a share near 1 or
+more: 2.1 on the shake table), and no mount isolates 40 dB over the whole of a record that
+moves at all; a sensor that reads a constant, or only its own noise (a MEMS IMU's 0.01 m/s²
+is this share of a 1 m/s² foundation), does."""
+NRMS_RESOLUTION = 1e-9
+"""`nrms` of a measured signal whose spread about its mean is at most this share of its size
+is undefined (nan): what is left after the mean is out is rounding, not motion."""
 
 
 @dataclass(frozen=True)
@@ -81,7 +93,8 @@ class Calibration:
         sigma: parameter → 1σ of the fitted ones, in the value's unit.
         refused: parameter → why the record cannot identify it.
         nrms_before, nrms_after: the body sensor's normalised RMS error (‖pred − meas‖ /
-            ‖meas‖, means out, all axes) with the nominal scene and the calibrated one.
+            ‖meas‖, means out, all axes) with the nominal scene and the calibrated one; nan
+            where the body record does not move (`still_body`).
         scene: the calibrated scene.
     """
 
@@ -197,10 +210,52 @@ def _at(stamps: np.ndarray, values: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 
 def nrms(predicted: np.ndarray, measured: np.ndarray) -> float:
-    """‖p − m‖ / ‖m‖ with each axis' mean taken out of both."""
+    """‖p − m‖ / ‖m‖ with each axis' mean taken out of both; nan where the measured signal
+    does not vary (‖m‖ at most `NRMS_RESOLUTION` of its size: a ratio to rounding)."""
     p = predicted - predicted.mean(axis=0)
     m = measured - measured.mean(axis=0)
-    return float(np.linalg.norm(p - m) / np.linalg.norm(m))
+    spread = float(np.linalg.norm(m))
+    if not spread > NRMS_RESOLUTION * float(np.linalg.norm(measured)):
+        return math.nan
+    return float(np.linalg.norm(p - m) / spread)
+
+
+def _compared(foundation: Signal, body: Signal) -> np.ndarray:
+    """Which body samples the fit compares: those within the foundation record, `EDGE_S` off
+    each end (a mask over body.t)."""
+    return (body.t > foundation.t[0] + EDGE_S) & (body.t < foundation.t[-1] - EDGE_S)
+
+
+def _dynamic_rms(accel: np.ndarray) -> float:
+    """The RMS of (k, 3) specific force about its mean, all axes, m/s² (0 for no sample)."""
+    if not accel.shape[0]:
+        return 0.0
+    return float(np.sqrt(((accel - accel.mean(axis=0)) ** 2).sum(axis=1).mean()))
+
+
+def still_body(foundation: Signal, body: Signal) -> str | None:
+    """Why the body record shows no motion to fit the twin to, or None where it moves (or
+    too few of its samples overlap the foundation's to say: the fit tells that itself). Over
+    the compared span (`_compared`), the body's dynamic RMS at most `STILL_SHARE` of the
+    foundation's there (both m/s²)."""
+    keep = _compared(foundation, body)
+    if np.count_nonzero(keep) < MIN_OVERLAP:
+        return None
+    t = body.t[keep]
+    during = (foundation.t >= t[0]) & (foundation.t <= t[-1])
+    moved, shaken = _dynamic_rms(body.accel[keep]), _dynamic_rms(foundation.accel[during])
+    if moved > STILL_SHARE * shaken:
+        return None
+    share = (
+        f"{moved / shaken:.2g} of the foundation's ({shaken:.3g} m/s²), at most {STILL_SHARE:g}"
+        if shaken > 0.0
+        else "and the foundation's not at all"
+    )
+    return (
+        f"the body record does not move: its specific force varies by {moved:.3g} m/s² RMS "
+        f"about its mean from {t[0]:.6g} to {t[-1]:.6g} s, {share}: a dead or disconnected "
+        "sensor, or not this machine's record"
+    )
 
 
 def prediction_error(
@@ -231,7 +286,7 @@ class _Problem:
 
     def __init__(self, scene: Scene, foundation: Signal, body: Signal, free: list[str]) -> None:
         self.scene, self.foundation, self.free = scene, foundation, free
-        keep = (body.t > foundation.t[0] + EDGE_S) & (body.t < foundation.t[-1] - EDGE_S)
+        keep = _compared(foundation, body)
         if (overlap := int(np.count_nonzero(keep))) < MIN_OVERLAP:
             msg = (
                 f"the body record ({body.t[0]:.6g} to {body.t[-1]:.6g} s) has "
@@ -329,7 +384,8 @@ def calibrate(
     scene: Scene, foundation: Signal, body: Signal, fit: tuple[str, ...] = PARAMETERS
 ) -> Calibration:
     """Fit `fit` (of PARAMETERS) so that the twin on `foundation` predicts `body` (module
-    docstring); refuse, by name, what the record cannot identify."""
+    docstring); refuse, by name, what the record cannot identify (all of it where the body
+    record does not move: `still_body`)."""
     known = (*PARAMETERS, *ON_REQUEST)
     unknown = [
         n for n in fit if n.partition(":")[0] not in known or (":" in n and not is_mount_scale(n))
@@ -350,8 +406,12 @@ def calibrate(
     for name in fit:
         if is_mount_scale(name):
             scaled_mounts(name, scene)
+    nominal = {n: 1.0 if is_scale(n) else 0.0 for n in (*fit, "yaw", "lag")}
+    if still := still_body(foundation, body):
+        refused = dict.fromkeys(fit, still)
+        return Calibration(nominal, {}, refused, math.nan, math.nan, calibrated_scene(scene, {}))
     free = list(fit)
-    refused: dict[str, str] = {}
+    refused = {}
     step = float(np.median(np.diff(body.t)))
     fitted: dict[str, float] = {}  # the last fit, in its coordinates: where a refit starts
     while True:
@@ -381,6 +441,5 @@ def calibrate(
         said = f"the fit predicts the body no better (NRMS {before:.3g} → {after:.3g})"
         refused.update(dict.fromkeys(values, said))
         values, sigma, after = {}, {}, before
-    nominal = {n: 1.0 if is_scale(n) else 0.0 for n in (*fit, "yaw", "lag")}
     full = {**nominal, **values}
     return Calibration(full, sigma, refused, before, after, calibrated_scene(scene, full))

@@ -75,7 +75,9 @@ def _read_record(
 
 def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
     """The scene (it must have a body_sensor) and its (foundation, body) records, on one
-    clock, from `args.scene`, `args.foundation` and `args.body`."""
+    clock, from `args.scene`, `args.foundation` and `args.body`; a body record that does not
+    move (`calibration.still_body`) is refused, naming its file."""
+    from mount_twin.analysis.calibration import still_body
     from mount_twin.commands.common import load_scene
     from mount_twin.io.messages import IMU
 
@@ -86,6 +88,9 @@ def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
     spec = scene.input
     foundation, base = _read_record(args.foundation, spec.topic, spec.msg_type, None)
     body, _ = _read_record(args.body, scene.body_sensor.topic, IMU, base)
+    if still := still_body(foundation, body):
+        msg = f"{args.body}: {still}"
+        raise ValueError(msg)
     return scene, foundation, body
 
 
