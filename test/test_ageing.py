@@ -150,3 +150,22 @@ def test_a_scenes_ageing_bands_are_refused_at_load_naming_the_key(
     data["ageing"] = bands
     with pytest.raises(SceneError, match=re.escape(says)):
         scene_from_dict(data, "pump")
+
+
+def test_a_window_in_which_every_scale_is_refused_is_not_judged_ok(
+    ageing_pair: tuple[Path, Signal, Signal],
+) -> None:
+    """The body IMU dies at 32 s (it reads its last sample from then on): the window before is
+    OK; the one after had its scales "fitted" to a sensor reading nothing, an ERROR (and, had
+    they been refused, read OK). Every scale is refused, and the window is a WARN (as one the
+    live tracker cannot fit), saying it is not judged."""
+    d, foundation, body = ageing_pair
+    dead = body.t >= 32.0
+    accel = np.where(dead[:, None], body.accel[np.argmax(dead)], body.accel)
+    died = Signal(body.t, accel, body.gyro)
+    keep = foundation.t < 63.0  # two windows: 2–32 s, 32–62 s
+    short = Signal(foundation.t[keep], foundation.accel[keep], foundation.gyro[keep])
+    fits = track(load_scene_file(d / "pump.scene.yaml"), short, died, 30.0)
+    assert [(f.start_s, f.level) for f in fits] == [(2.0, "OK"), (32.0, "WARN")]
+    assert not fits[1].values and set(fits[1].refused) == {"stiffness", "damping"}
+    assert "not judged" in fits[1].why

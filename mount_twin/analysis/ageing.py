@@ -5,7 +5,10 @@ a stiffness or damping scale that leaves 1. `track` fits `fit` (`analysis.calibr
 consecutive windows of the records, each after a settling lead (the twin starts at rest at the
 window's first sample, so the first `LEAD_S` are fitted out), and gives each window a level:
 WARN where a scale's 3σ interval lies wholly outside `Band.warn`, ERROR where it lies outside
-`Band.error`. A window whose fit refuses a parameter says so and is not judged on it.
+`Band.error`. A window whose fit refuses a parameter says so and is not judged on it; one whose
+fit refuses every scale (a body record that does not move, a fit no better than the scene) is
+not judged at all, and that is a WARN: it cannot say the mounts are OK (as a window the live
+tracker cannot fit, `ageing_live.run_job`).
 """
 
 from __future__ import annotations
@@ -78,7 +81,9 @@ def fit_window(
     cal = calibrate(scene, *records, fit)
     scales = [n for n in cal.sigma if is_scale(n)]
     verdicts = [judged(n, cal.values[n], cal.sigma[n], band) for n in scales]
-    level = max((v for v, _ in verdicts), default=0)
+    if not scales:
+        verdicts = [(1, "not judged: the window identified none of the scales")]
+    level = max(v for v, _ in verdicts)
     why = "; ".join(w for _, w in verdicts if w)
     fitted = {n: cal.values[n] for n in cal.sigma}
     return WindowFit(*span, fitted, dict(cal.sigma), dict(cal.refused), LEVELS[level], why)
