@@ -8,10 +8,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_helpers import CONFIG, read_bag, stamp_ns
+from io_helpers import CONFIG, DATA_DIR, read_bag, stamp_ns
 
 from mount_twin.cli import main
 from mount_twin.io.csv_import import CsvFormat, read_recorder_csv
+from mount_twin.io.xsens_csv import read_xsens_csv
 
 G = 9.80665
 
@@ -144,3 +145,55 @@ def test_a_file_beyond_the_size_limit_is_an_error_naming_it_read_no_further(
     err = capsys.readouterr().err
     assert f"{path}: <file>: cannot read: larger than 256 MiB" in err and "CSV_MAX_BYTES" in err
     assert not (tmp_path / "bag").exists()
+
+
+XSENS_COLUMNS = ["PacketCounter", "SampleTimeFine", "Euler_X", "Euler_Y", "Euler_Z"]
+XSENS_COLUMNS += ["Acc_X", "Acc_Y", "Acc_Z", "Gyr_X", "Gyr_Y", "Gyr_Z"]
+
+
+@pytest.mark.parametrize(
+    ("line", "column", "cell", "says"),
+    [
+        (501, "Acc_Z", "nan", "'nan' is not finite"),
+        (1200, "Gyr_X", "inf", "'inf' is not finite"),
+        (20, "Acc_X", "abc", "'abc' is not a number"),
+        (700, "Gyr_Z", "", "'' is not a number"),
+        (900, "SampleTimeFine", "2528767462", "time does not increase"),
+    ],
+)
+def test_an_xsens_exports_bad_cell_is_named_by_its_row_and_column(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    line: int,
+    column: str,
+    cell: str,
+    says: str,
+) -> None:
+    """The shake table's block record (a Movella/Xsens DOT export) with one cell spoilt, at a
+    line of the file and a column: import-csv said only "SampleTimeFine does not increase, or
+    a value is not a number" (and a cell that was no number, Python's "could not convert
+    string to float"). It names the line and the column, as a recorder CSV's error does."""
+    lines = (DATA_DIR / "shake_table_1story/sine_2hz_trial1_top_excerpt.csv").read_text()
+    rows = lines.splitlines()
+    cells = rows[line - 1].split(",")
+    cells[XSENS_COLUMNS.index(column)] = cell
+    rows[line - 1] = ",".join(cells)
+    path = _write(tmp_path, "\n".join(rows) + "\n", "top_bad.csv")
+    assert main(["import-csv", str(path), "-o", str(tmp_path / "bag")]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}: row {line}, column {column}: {says}" in err, err
+    assert not (tmp_path / "bag").exists()
+
+
+def test_an_xsens_row_with_a_cell_too_many_is_refused_naming_it(tmp_path: Path) -> None:
+    """A decimal comma in line 20's Acc_X (1,5) splits it in two: every later cell of the row
+    had been read one column off (Acc_Y as 5, …), silently."""
+    rows = (DATA_DIR / "shake_table_1story/sine_2hz_trial1_top_excerpt.csv").read_text()
+    rows = rows.splitlines()
+    cells = rows[19].split(",")
+    cells[XSENS_COLUMNS.index("Acc_X")] = "1,5"
+    rows[19] = ",".join(cells)
+    path = _write(tmp_path, "\n".join(rows) + "\n", "top_comma.csv")
+    with pytest.raises(ValueError, match=None) as err:
+        read_xsens_csv(path)
+    assert str(err.value) == f"{path}: row 20: 12 cells where the header has 11"

@@ -117,10 +117,7 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     columns = [(col, scale[role]) for role, col in roles.items()]
     values = _values(path, data, names, delimiter, decimal, columns)
     t = values[:, 0]
-    back = np.flatnonzero(np.diff(t) <= 0.0)
-    if back.size:
-        row = data[int(back[0]) + 1][0]
-        raise _fail(path, f"row {row}, column {names[roles['t']]}", "time does not increase")
+    check_increasing(path, t, [row for row, _ in data], names[roles["t"]])
     accel_role = f"a{fmt.axis or 'x'}"
     accel, gyro, found = _motion(values, fmt.axis, names[roles[accel_role]])
     notes += found
@@ -129,6 +126,44 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     if decimal == ",":
         notes.append("decimal comma")
     return Imported(Signal(t, accel, gyro), notes)
+
+
+def check_width(path: Path, row: int, cells: list[str], header: list[str]) -> None:
+    """ValueError naming the file and the row (its line number) where the row's `cells` are
+    not as many as the `header`'s (a cell split by a stray delimiter shifts the rest)."""
+    if len(cells) != len(header):
+        raise _fail(path, f"row {row}", f"{len(cells)} cells where the header has {len(header)}")
+
+
+def cell_value(
+    path: Path, row: int, column: str, cell: str, factor: float = 1.0, decimal: str = "."
+) -> float:
+    """A data cell's number times `factor` (to SI units), with a decimal comma where `decimal`
+    is ','; ValueError naming the file, the row (its line number), the column and the cell
+    where it is not a number, not finite, or not finite once in SI units."""
+    text = cell.strip()
+    try:
+        v = float(text.replace(decimal, ".") if decimal == "," else text)
+    except ValueError:
+        raise _cell_fail(path, row, column, f"{text!r} is not a number") from None
+    if not math.isfinite(v):
+        raise _cell_fail(path, row, column, f"{text!r} is not finite")
+    if not math.isfinite(v * factor):  # 1e308 g: finite, but not in m/s²
+        what = f"{text!r} is beyond a float in SI units (×{factor:g})"
+        raise _cell_fail(path, row, column, what)
+    return v * factor
+
+
+def _cell_fail(path: Path, row: int, column: str, what: str) -> ValueError:
+    return _fail(path, f"row {row}, column {column}", what)
+
+
+def check_increasing(path: Path, t: np.ndarray, rows: list[int], column: str) -> None:
+    """ValueError naming the file, the first row (of `rows`, the line numbers of t's samples)
+    whose time `t` (s) is not after the one before, and the time's column."""
+    back = np.flatnonzero(np.diff(t) <= 0.0)
+    if back.size:
+        raise _cell_fail(path, rows[int(back[0]) + 1], column, "time does not increase")
 
 
 def _read_text(path: Path) -> str:
@@ -186,24 +221,9 @@ def _values(
     values = np.empty((len(data), len(columns)))
     for i, (row, line) in enumerate(data):
         cells = line.split(delimiter) if delimiter else line.split()
-        if len(cells) != len(names):
-            raise _fail(
-                path, f"row {row}", f"{len(cells)} cells where the header has {len(names)}"
-            )
+        check_width(path, row, cells, names)
         for j, (col, factor) in enumerate(columns):
-            cell = cells[col].strip()
-            try:
-                v = float(cell.replace(decimal, ".") if decimal == "," else cell)
-            except ValueError:
-                raise _fail(
-                    path, f"row {row}, column {names[col]}", f"{cell!r} is not a number"
-                ) from None
-            if not math.isfinite(v):
-                raise _fail(path, f"row {row}, column {names[col]}", f"{cell!r} is not finite")
-            values[i, j] = v * factor
-            if not math.isfinite(values[i, j]):  # 1e308 g: finite, but not in m/s²
-                what = f"{cell!r} is beyond a float in SI units (×{factor:g})"
-                raise _fail(path, f"row {row}, column {names[col]}", what)
+            values[i, j] = cell_value(path, row, names[col], cells[col], factor, decimal)
     return values
 
 

@@ -14,7 +14,13 @@ from pathlib import Path
 
 import numpy as np
 
-from mount_twin.io.csv_import import CSV_MAX_BYTES, read_recorder_csv
+from mount_twin.io.csv_import import (
+    CSV_MAX_BYTES,
+    cell_value,
+    check_increasing,
+    check_width,
+    read_recorder_csv,
+)
 from mount_twin.io.signals import Signal
 from mount_twin.textfiles import FileTooLargeError, read_limited
 
@@ -34,7 +40,8 @@ def is_xsens_csv(path: str | Path) -> bool:
 def read_xsens_csv(path: str | Path) -> tuple[Signal, str]:
     """The record (stamps s on the device clock, SampleTimeFine: two synchronised sensors'
     records share it; specific force m/s², rate rad/s, sensor frame) and its device tag;
-    errors name the file and what is missing."""
+    errors name the file, the row (its line number) and the column, as a recorder CSV's do
+    (`csv_import.cell_value`, `check_width`, `check_increasing`)."""
     path = Path(path)
     try:
         lines = read_limited(path, CSV_MAX_BYTES, "CSV_MAX_BYTES", "utf-8-sig").splitlines()
@@ -46,20 +53,32 @@ def read_xsens_csv(path: str | Path) -> tuple[Signal, str]:
     if start is None:
         msg = f"{path}: no header row PacketCounter,SampleTimeFine,...: not an Xsens DOT export"
         raise ValueError(msg)
-    rows = list(csv.DictReader(lines[start:]))
-    missing = [c for c in ("SampleTimeFine", *ACCEL, *GYRO) if rows and c not in rows[0]]
-    if not rows or missing:
-        msg = f"{path}: no data rows, or no column {', '.join(missing)}"
+    reader = csv.reader(lines[start:])
+    header = next(reader)
+    columns = ("SampleTimeFine", *ACCEL, *GYRO)
+    factors = (1.0, 1.0, 1.0, 1.0, *(math.pi / 180.0,) * 3)  # the gyro's deg/s to rad/s
+    missing = [c for c in columns if c not in header]
+    if missing:
+        msg = f"{path}: row {start + 1}: no column {', '.join(missing)}"
         raise ValueError(msg)
-    rows = [r for r in rows if any(float(r[c]) != 0.0 for c in (*ACCEL, *GYRO))]
-    clock = np.unwrap(np.array([float(r["SampleTimeFine"]) for r in rows]), period=CLOCK_WRAP_US)
-    t = clock * 1e-6
-    accel = np.array([[float(r[c]) for c in ACCEL] for r in rows])
-    gyro = np.radians(np.array([[float(r[c]) for c in GYRO] for r in rows]))
-    if not (np.diff(t) > 0.0).all() or not math.isfinite(float(accel.sum() + gyro.sum())):
-        msg = f"{path}: SampleTimeFine does not increase, or a value is not a number"
+    read = [(c, header.index(c), f) for c, f in zip(columns, factors, strict=True)]
+    rows, values = [], []
+    for cells in reader:
+        row = start + reader.line_num  # the file's line number (the reader's are from 1)
+        if not cells:
+            continue  # a blank line
+        check_width(path, row, cells, header)
+        parsed = [cell_value(path, row, c, cells[i], f) for c, i, f in read]
+        if any(v != 0.0 for v in parsed[1:]):  # the export's first row is all zeros
+            rows.append(row)
+            values.append(parsed)
+    if not values:
+        msg = f"{path}: no data rows after the header (row {start + 1})"
         raise ValueError(msg)
-    return Signal(t, accel, gyro), tag
+    data = np.array(values)
+    t = np.unwrap(data[:, 0], period=CLOCK_WRAP_US) * 1e-6
+    check_increasing(path, t, rows, "SampleTimeFine")
+    return Signal(t, data[:, 1:4].copy(), data[:, 4:7].copy()), tag
 
 
 def read_csv_record(path: str | Path) -> Signal:
