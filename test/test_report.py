@@ -186,3 +186,76 @@ def test_another_scenes_mounts_are_refused_naming_both(
     )
     assert "(foot_fl, foot_fr, foot_ml, foot_mr, foot_rl, foot_rr, key_x, key_y)" in err
     assert not page.exists()
+
+
+def _pump_input(path: Path, n: int = 10_000, bad: slice = slice(0)) -> Path:
+    """A pump input bag (/deck/imu, frame deck_imu) of `n` samples at 1 kHz: a 5 g, 11 ms
+    vertical half-sine in its first second, then at rest; the samples `bad` with every accel
+    reading NaN."""
+    from mount_twin.io.bag import write_bag
+    from mount_twin.io.messages import IMU, imu_messages
+    from mount_twin.io.signals import half_sine_shock
+
+    shock = half_sine_shock(peak=50.0, duration=0.011, rate_hz=1000.0, total=1.0)
+    accel = np.tile([0.0, 0.0, 9.80665], (n, 1))
+    accel[:1000] = shock.accel[:n]
+    accel[bad] = np.nan
+    stamps = 1_700_000_000_000_000_000 + np.arange(n, dtype=np.int64) * 1_000_000
+    messages = imu_messages(stamps, accel, np.zeros_like(accel), "deck_imu")
+    write_bag(path, "/deck/imu", IMU, iter(messages))
+    return path
+
+
+def _spectra_table(page: str) -> str:
+    """The input's spectra table of a report page."""
+    part = page[page.index("<h2>Shock response spectra") :]
+    return part[part.index("<table") : part.index("</table>")]
+
+
+def test_an_inputs_samples_not_finite_after_the_others_are_skipped_as_the_replay_does(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The input's last 9000 samples NaN: the replay skips them, and the report had refused
+    the input with srs's "the record must be a non-empty 1-D array of finite values (shape
+    (10000,))", naming no bag nor axis. It skips them too, saying how many and where in its
+    output and on the page; its spectra are those of a bag of the first 1000 samples alone."""
+    pump = str(CONFIG / "pump_8_mounts.scene.yaml")
+    tail = _pump_input(tmp_path / "tail_nan", bad=slice(1000, None))
+    first = _pump_input(tmp_path / "first_second", n=1000)
+    out = tmp_path / "out"
+    assert main(["replay", str(tail), "--scene", pump, "-o", str(out), "--no-progress"]) == 0
+    assert "'rejected_non_finite': 9000" in capsys.readouterr().out
+    pages = {}
+    for bag in (tail, first):
+        page = tmp_path / f"{bag.name}.html"
+        args = ["report", str(out), "--scene", pump, "--input", str(bag), "-o", str(page)]
+        assert main(args) == 0
+        pages[bag.name] = page.read_text(encoding="utf-8")
+    said = f"{tail}: /deck/imu: 9000 of 10000 samples not finite, before or after the others"
+    assert said in capsys.readouterr().out
+    assert "sample 1000 (t = 1 s from the first) has accel x nan" in pages["tail_nan"]
+    assert "samples not finite" not in pages["first_second"]
+    assert _spectra_table(pages["tail_nan"]) == _spectra_table(pages["first_second"])
+    assert re.search(r"<td>[1-9][\d.]*</td>", _spectra_table(pages["tail_nan"]))  # the shock
+
+
+def test_an_inputs_sample_not_finite_between_finite_ones_is_refused_naming_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One NaN sample inside the record: the spectra take the samples as evenly spaced, and
+    dropping it would join its neighbours. Refused, naming the bag, the topic, the sample and
+    its axis (it was srs's "the record must be … finite values (shape (10000,))")."""
+    pump = str(CONFIG / "pump_8_mounts.scene.yaml")
+    holed = _pump_input(tmp_path / "holed", bad=slice(500, 501))
+    out = tmp_path / "out"
+    assert main(["replay", str(holed), "--scene", pump, "-o", str(out), "--no-progress"]) == 0
+    capsys.readouterr()
+    page = tmp_path / "r.html"
+    args = ["report", str(out), "--scene", pump, "--input", str(holed), "-o", str(page)]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert (
+        f"{holed}: /deck/imu: 1 of 10000 samples not finite; sample 500 (t = 0.5 s from the "
+        "first) has accel x nan, between finite samples" in err
+    ), err
+    assert not page.exists()

@@ -83,9 +83,11 @@ def _provenance_section(
     output_bag: str | Path,
     input_path: str | Path | None,
     scene: Scene | None,
+    input_note: str = "",
 ) -> list[str]:
-    """The verdict, what produced the page from what, the solver's settings and estimated
-    error, and the scene as loaded."""
+    """The verdict, what produced the page from what (with `input_note` on the input bag:
+    what of it was left out), the solver's settings and estimated error, and the scene as
+    loaded."""
     verdict, integration = _verdict(diagnostics)
     partial = partial_marker(output_bag)
     rows = [
@@ -96,6 +98,8 @@ def _provenance_section(
     ]
     if input_path is not None:
         rows.append(["input bag", f"{input_path} ({fingerprint(Path(input_path))})"])
+        if input_note:
+            rows.append(["input samples left out", input_note])
     if scene is not None:
         spec, integ = scene.input, scene.integration
         rows += [
@@ -253,16 +257,18 @@ def write_report(
     scene: Scene | None = None,
     input_name: str = "",
     input_path: str | Path | None = None,
+    input_note: str = "",
     design: tuple[list[float], list[float]] | None = None,
     tolerance_db: tuple[float, float] = TOLERANCE_DB,
     design_name: str = "",
 ) -> Path:
     """Write the report page. `input_samples`: (stamps ns, specific force (n, 3) m/s² in F) of
-    the record, to plot beside the response; `input_path`: the record's bag, hashed for its
-    provenance; `design` (Hz, g): a design spectrum the input's spectra are judged against
-    (within `tolerance_db`), named `design_name` (its file). The page opens with the verdict,
-    what produced it and with what settings, and the scene as loaded (every value with its
-    meaning and unit)."""
+    the record, to plot beside the response, every value finite; `input_path`: the record's
+    bag, hashed for its provenance; `input_note`: what of it was left out (its samples not
+    finite), said beside it; `design` (Hz, g): a design spectrum the input's spectra are
+    judged against (within `tolerance_db`), named `design_name` (its file). The page opens
+    with the verdict, what produced it and with what settings, and the scene as loaded (every
+    value with its meaning and unit)."""
     tables = {t.name: t for t in read_output_bag(output_bag)}
     mounts = {k.removeprefix("mount_"): t for k, t in tables.items() if k.startswith("mount_")}
     origin = min(int(t.columns["stamp_ns"][0]) for t in tables.values() if len(t))
@@ -278,7 +284,7 @@ def write_report(
     if input_name:
         title += f" (input {input_name})"
     sections = [f"<h1>{html.escape(title)}</h1>"]
-    sections += _provenance_section(diagnostics, output_bag, input_path, scene)
+    sections += _provenance_section(diagnostics, output_bag, input_path, scene, input_note)
     if "pose" in tables and "angles" in tables:
         sections += [
             "<h2>Input and response</h2>",

@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from mount_twin.commands.srs import add_design_arguments, tolerance_of
+
+if TYPE_CHECKING:
+    from mount_twin.io.messages import Decoded
 
 NAME = "report"
 HELP = "one HTML page of a replay: input and response, signed mount forces, utilisation, events"
@@ -39,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(msg)
     design = read_design_table(args.design) if args.design else None
     scene = load_scene(args.scene) if args.scene else None
-    samples = None
+    samples, note = None, ""
     if args.input:
         if scene is None:
             msg = "--input needs --scene (its input topic, sensor frame and gravity convention)"
@@ -48,6 +52,9 @@ def run(args: argparse.Namespace) -> int:
         from mount_twin.physics.rotations import rpy_matrix
 
         decoded = read_input(args.input, scene.input)
+        decoded, note = finite_input(args.input, scene.input.topic, decoded)
+        if note:
+            print(note)
         f = decoded.accel @ rpy_matrix(*scene.input.sensor_rpy).T
         if not scene.input.includes_gravity:
             f[:, 2] += scene.input.g
@@ -61,9 +68,48 @@ def run(args: argparse.Namespace) -> int:
         scene=scene,
         input_name=name,
         input_path=args.input,
+        input_note=note,
         design=design,
         tolerance_db=tolerance,
         design_name=Path(args.design).name if args.design else "",
     )
     print(f"report: {out}")
     return 0
+
+
+def finite_input(path: str, topic: str, decoded: Decoded) -> tuple[Decoded, str]:
+    """The input's samples the replay takes as finite (`intake.readable`), and what was skipped
+    ('' if nothing). Samples not finite before or after the finite ones are skipped, as the
+    replay skips them; one between finite samples is refused (ValueError naming the bag, the
+    topic, the sample and its axis): the input's spectra take the samples as evenly spaced,
+    and would join those around the hole. So is a record with no finite sample."""
+    import numpy as np
+
+    from mount_twin.engine.intake import READING_LIMIT, readable
+
+    ok = readable(decoded.accel, decoded.gyro)
+    if ok.all():
+        return decoded, ""
+    bad, finite = np.flatnonzero(~ok), np.flatnonzero(ok)
+    inside = bad[(bad > finite[0]) & (bad < finite[-1])] if finite.size else bad
+    first = int((inside if inside.size else bad)[0])
+    readings = np.concatenate([decoded.accel[first], decoded.gyro[first]]).tolist()
+    k = next(i for i, v in enumerate(readings) if not abs(v) <= READING_LIMIT)
+    t = (int(decoded.stamps_ns[first]) - int(decoded.stamps_ns[0])) * 1e-9
+    axis = f"{('accel', 'gyro')[k // 3]} {'xyz'[k % 3]}"
+    said = f"sample {first} (t = {t:.6g} s from the first) has {axis} {readings[k]!r}"
+    where = f"{path}: {topic}: {bad.size} of {ok.size} samples not finite"
+    if not finite.size:
+        msg = f"{where}, none finite: {said}"
+        raise ValueError(msg)
+    if inside.size:
+        msg = (
+            f"{where}; {said}, between finite samples: the input's spectra take its samples "
+            "as evenly spaced"
+        )
+        raise ValueError(msg)
+    note = (
+        f"{where}, before or after the others (the first: {said}): skipped, as the replay "
+        f"skips them; the input's plot and spectra are of the other {finite.size}"
+    )
+    return decoded.select(ok), note

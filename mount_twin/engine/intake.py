@@ -137,6 +137,12 @@ def _all_axes(mask: np.ndarray) -> np.ndarray:
     return mask[:, 0] & mask[:, 1] & mask[:, 2]
 
 
+def readable(accel: np.ndarray, gyro: np.ndarray) -> np.ndarray:
+    """(n,) which samples' (n, 3) readings (m/s², rad/s) are all within ±READING_LIMIT (NaN
+    and ±inf are not): the others the intake rejects as non_finite."""
+    return _all_axes(np.abs(accel) <= READING_LIMIT) & _all_axes(np.abs(gyro) <= READING_LIMIT)
+
+
 def rising(stamps: np.ndarray, keep: np.ndarray, last: int) -> np.ndarray:
     """Of the samples `keep` marks, those (bool mask) whose integer stamp is after `last` and
     after every kept stamp before it (one going back is not after the others either, so the
@@ -249,12 +255,10 @@ class Intake:
         finite = np.isfinite(batch.stamps)
         # NaN compares false: one test for NaN, ±inf and the absurdly large.
         if not (np.abs(accel).max() <= READING_LIMIT and np.abs(gyro).max() <= READING_LIMIT):
-            readable = _all_axes(np.abs(accel) <= READING_LIMIT) & _all_axes(
-                np.abs(gyro) <= READING_LIMIT
-            )
-            accel = np.where(readable[:, None], accel, 0.0)
-            gyro = np.where(readable[:, None], gyro, 0.0)
-            finite &= readable
+            ok = readable(accel, gyro)
+            accel = np.where(ok[:, None], accel, 0.0)
+            gyro = np.where(ok[:, None], gyro, 0.0)
+            finite &= ok
         f = self._into_f(accel)
         if not self.spec.includes_gravity:
             f = f + self._gravity_up
