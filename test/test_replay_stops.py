@@ -102,3 +102,25 @@ def test_an_mcap_cut_before_any_message_is_an_error_naming_it(
     bag = _cut_copy(tmp_path / "stub", lambda n: 43)
     assert main(["replay", str(bag), "--scene", PUMP, "-o", str(tmp_path / "o")]) == 2
     assert f"{bag}: cannot open bag" in capsys.readouterr().err
+
+
+def test_a_damaged_bag_whose_run_failed_says_both(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Exit 5 names the damage; the integration failures before it were said only in the
+    summary's verdict (FAILED), not on stderr with the damage."""
+    bag = _cut_copy(tmp_path / "cut", lambda n: int(n * 0.6))
+    text = (CONFIG / "pump_8_mounts.scene.yaml").read_text(encoding="utf-8")
+    failing = (
+        text.replace("  method: auto ", "  method: dopri54 #")
+        .replace("  max_substeps: 10000", "  max_substeps: 1")
+        .replace("  rtol: 1.0e-6", "  rtol: 1.0e-13")
+        .replace("  atol: 1.0e-9", "  atol: 1.0e-15")
+    )
+    scene = tmp_path / "failing.scene.yaml"
+    scene.write_text(failing, encoding="utf-8")
+    out = tmp_path / "out"
+    assert main(["replay", str(bag), "--scene", str(scene), "-o", str(out), "--no-progress"]) == 5
+    captured = capsys.readouterr()
+    assert f"{bag}: damaged (" in captured.err and "integration failed " in captured.err
+    assert "verdict: FAILED" in captured.out

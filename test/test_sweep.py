@@ -234,7 +234,7 @@ def test_a_rerun_skips_finished_cases_and_reruns_failed_ones(swept) -> None:
     assert len(again) == 4 and all(r["verdict"] == FAILED for r in again)
 
 
-def test_the_command_reports_and_exits_5_when_a_case_failed(
+def test_the_command_reports_and_exits_6_when_a_case_failed(
     swept, capsys: pytest.CaptureFixture[str]
 ) -> None:
     spec, results, _ = swept
@@ -245,10 +245,10 @@ def test_the_command_reports_and_exits_5_when_a_case_failed(
 
     before = rows()  # 8 + 4, or 8 + 4 + 4 after the rerun test on this worker
     code = main(["sweep", spec.source, "-o", str(results), "--workers", "1", "--no-progress"])
-    assert code == 5
+    assert code == 6  # FAILED, as replay's (5 is replay's damaged bag)
     out = capsys.readouterr().out
     assert "verdicts:" in out and "FAILED" in out and "highest peak mount force" in out
-    # the failed cases named with their errors: a script's exit 5 says which and why
+    # the failed cases named with their errors: a script's exit 6 says which and why
     named = [line for line in out.splitlines() if line.startswith("  FAILED case ")]
     assert len(named) == NAMED_FAILURES
     assert all("body.mass = -5.0): SceneError: " in line for line in named)

@@ -25,7 +25,8 @@ EXIT_STATUS = (
     "integration failed at least once (the summary says how often and why), whatever "
     "--fail-on says: after a failure the twin restarts at an equilibrium or stops following, "
     "so its figures are no longer the motion the record drove; 5 input bag "
-    "damaged part-way (the messages before the damage are replayed); 130 SIGINT (Ctrl-C), 143 "
+    "damaged part-way (the messages before the damage are replayed; a failure before it is "
+    "said on stderr too); 130 SIGINT (Ctrl-C), 143 "
     "SIGTERM. On 5, 130 and 143 the output bag is finished and marked partial in its metadata "
     "(custom_data mount_twin.partial: why, and up to which stamp)."
 )
@@ -130,6 +131,8 @@ def replay_and_report(
     except DamagedBagError as err:  # exit 5, after the summary of what came before it
         if err.summary is not None:
             _report(err.summary, scene_path, output, options)
+            if err.summary.failure:  # said too: the exit status names the damage alone
+                print(f"mount-twin: error: {err.summary.failure}", file=sys.stderr)
         raise
     _report(summary, scene_path, output, options)
     return verdict(summary, options.fail_on)

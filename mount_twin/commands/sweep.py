@@ -8,9 +8,14 @@ from mount_twin.commands.common import positive_int
 
 NAME = "sweep"
 HELP = "run a design sweep (scene variants × inputs) on a local or remote Dask cluster"
+EXIT_STATUS = (
+    "exit status: 0 every case ran (whatever its verdict); 6 a case FAILED (its row and the "
+    "summary say why); 2 bad input or configuration"
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.epilog = EXIT_STATUS
     parser.add_argument("sweep", help="sweep YAML (see mount_twin.sweeps.spec)")
     parser.add_argument(
         "-o", "--output", required=True, help="results CSV (appended; a rerun skips done cases)"
@@ -34,6 +39,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from mount_twin.commands.common import check_targets
     from mount_twin.commands.extras import require
+    from mount_twin.commands.replay import EXIT_FAILED
 
     check_targets(plot=args.plot, parquet=args.parquet)
     require("dask.distributed", "mount-twin sweep")
@@ -70,4 +76,4 @@ def run(args: argparse.Namespace) -> int:
         from mount_twin.sweeps.plot import plot_sweep
 
         print(f"plot: {plot_sweep(rows, spec, args.plot)}")
-    return 0 if all(r["verdict"] != FAILED for r in rows) else 5
+    return 0 if all(r["verdict"] != FAILED for r in rows) else EXIT_FAILED
