@@ -101,7 +101,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"mount-twin: error: {err}{_partial(args)}", file=sys.stderr)
         return EXIT_DAMAGED
     except (MountTwinError, ValueError, OSError) as err:
-        print(f"mount-twin: error: {err}", file=sys.stderr)
+        print(f"mount-twin: error: {_error_text(err)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"mount-twin: interrupted (SIGINT){_partial(args)}", file=sys.stderr)
@@ -109,6 +109,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Terminated:
         print(f"mount-twin: terminated (SIGTERM){_partial(args)}", file=sys.stderr)
         return EXIT_SIGTERM
+
+
+def _error_text(err: Exception) -> str:
+    """An error's message; an OSError's as "FILE: what" when it names its file (it had read
+    "[Errno 28] No space left on device", naming none, for an output on a full disk)."""
+    if isinstance(err, OSError) and err.filename is not None and err.strerror:
+        files = " -> ".join(str(f) for f in (err.filename, err.filename2) if f is not None)
+        return f"{files}: {err.strerror}"
+    return str(err)
 
 
 def _partial(args: argparse.Namespace) -> str:

@@ -1,9 +1,16 @@
 """Text files read whole, up to a size limit: /dev/zero, a sparse file or a wrong path given
-as a scene or a CSV fails at the limit, naming it, instead of exhausting memory."""
+as a scene or a CSV fails at the limit, naming it, instead of exhausting memory. Output files
+written whole or not at all: a full disk fails naming the file and leaves no part of it."""
 
 from __future__ import annotations
 
+import os
+import secrets
+import stat
+from collections.abc import Iterator
+from contextlib import contextmanager, suppress
 from pathlib import Path
+from typing import TextIO
 
 MIB = 1 << 20
 
@@ -21,3 +28,67 @@ def read_limited(path: Path, limit: int, limit_name: str, encoding: str = "utf-8
         msg = f"larger than {limit // MIB} MiB, the most {limit_name} allows"
         raise FileTooLargeError(msg)
     return data.decode(encoding)
+
+
+@contextmanager
+def replacing(path: str | Path) -> Iterator[Path]:
+    """A path to write the new content of `path` at, put in its place when the block ends:
+    a new file in the same directory, renamed over `path` (through a symlink, its target)
+    when written and synced, removed if anything fails. A failure to write is an OSError
+    naming `path` (its filename; its strerror says "cannot write: ..."): a bare errno had not
+    said which file, and a full disk had left a truncated file. An existing file keeps its
+    permissions; a new one gets the umask's. A target that is no regular file (a FIFO,
+    /dev/full) or is named under /dev or /proc (/dev/stdout, even redirected to a file: the
+    rename would put a new file in place of the shell's) is written directly."""
+    given = Path(path)
+    try:
+        mode = os.stat(given).st_mode
+    except FileNotFoundError:
+        mode = None
+    except OSError as err:
+        raise _cannot_write(given, err) from err
+    device = Path(os.path.abspath(given)).parts[1:2] in (("dev",), ("proc",))
+    if device or (mode is not None and not stat.S_ISREG(mode)):
+        try:
+            yield given
+        except OSError as err:
+            raise _cannot_write(given, err) from err
+        return
+    target = Path(os.path.realpath(given))
+    tmp = target.with_name(f".{target.stem}.partial-{secrets.token_hex(4)}{target.suffix}")
+    try:
+        os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+        if mode is not None:
+            os.chmod(tmp, stat.S_IMODE(mode))
+        yield tmp
+        fd = os.open(tmp, os.O_RDONLY)
+        try:
+            os.fsync(fd)  # a delayed allocation's ENOSPC comes here, before the rename
+        finally:
+            os.close(fd)
+        os.replace(tmp, target)
+    except BaseException as err:
+        with suppress(OSError):
+            tmp.unlink()
+        if isinstance(err, OSError):
+            raise _cannot_write(given, err) from err
+        raise
+
+
+@contextmanager
+def text_output(path: str | Path, newline: str | None = None) -> Iterator[TextIO]:
+    """The UTF-8 text file `path`, open for writing, put in place whole when the block ends
+    (see `replacing`); `newline` as open takes it ('' for the csv module)."""
+    with replacing(path) as tmp, tmp.open("w", encoding="utf-8", newline=newline) as fh:
+        yield fh
+
+
+def write_text(path: str | Path, text: str) -> None:
+    """Write `text` as the UTF-8 file `path`, whole or not at all (see `replacing`)."""
+    with text_output(path) as fh:
+        fh.write(text)
+
+
+def _cannot_write(path: Path, err: OSError) -> OSError:
+    """`err` as an OSError of the same errno naming `path` as the file that was not written."""
+    return OSError(err.errno, f"cannot write: {err.strerror or err}", str(path))

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from io_helpers import DATA_DIR, ROOT, SCENE_FILE, read_bag, stamp_ns
+from io_helpers import DATA_DIR, ROOT, SCENE_FILE, read_bag, run_python, stamp_ns
 from rosbags.highlevel import AnyReader
 
 from mount_twin.cli import main
@@ -430,3 +430,97 @@ def test_matplotlib_writes_every_figure_format_taken() -> None:
     from mount_twin.commands.common import FIGURE_FORMATS
 
     assert set(FIGURE_FORMATS) <= set(FigureCanvasBase.get_supported_filetypes())
+
+
+@pytest.fixture(scope="module")
+def shock_out(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """An output bag: the pump's replay of the bundled half-sine shock."""
+    out = tmp_path_factory.mktemp("shock") / "out"
+    args = ["replay", str(ROOT / "bags" / "half_sine_shock_10khz"), "--scene", str(SCENE_FILE)]
+    assert main([*args, "-o", str(out), "--no-progress"]) == 0
+    return out
+
+
+FULL = "/dev/full"
+"""A device every write to fails with ENOSPC, as on a full disk."""
+
+
+@pytest.mark.skipif(not Path(FULL).exists(), reason=f"no {FULL}")
+@pytest.mark.parametrize(
+    "command",
+    [
+        "replay bags/half_sine_shock_10khz --scene config/pump_8_mounts.scene.yaml -o OUT "
+        "--no-progress --json X",
+        "srs bags/genset_shock_10khz --json X",
+        "srs bags/genset_shock_10khz --csv X",
+        "report BAG -o X",
+        "dashboard config/pump_8_mounts.scene.yaml --plotjuggler X",
+        "dashboard config/pump_8_mounts.scene.yaml --foxglove X",
+    ],
+    ids=["replay-json", "srs-json", "srs-csv", "report", "plotjuggler", "foxglove"],
+)
+def test_a_text_output_that_cannot_be_written_exits_2_naming_it(
+    tmp_path: Path,
+    shock_out: Path,
+    command: str,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Each printed "mount-twin: error: [Errno 28] No space left on device": no file named."""
+    monkeypatch.chdir(ROOT)
+    args = [
+        {"X": FULL, "OUT": str(tmp_path / "out"), "BAG": str(shock_out)}.get(a, a)
+        for a in command.split()
+    ]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.endswith(f"mount-twin: error: {FULL}: cannot write: No space left on device\n")
+
+
+LIMITED = (
+    "import resource, sys\n"
+    "resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))\n"
+    "from mount_twin.cli import main\n"
+    "sys.exit(main(sys.argv[1:]))\n"
+)
+"""A mount-twin process that cannot write a file beyond 4 KiB (EFBIG, as a full disk)."""
+
+
+@pytest.mark.parametrize("existing", [False, True], ids=["new", "replaced"])
+def test_an_output_the_disk_cannot_take_is_named_and_leaves_no_part_of_it(
+    tmp_path: Path, shock_out: Path, existing: bool
+) -> None:
+    """A full disk left an 8192-byte r.html and an empty pose.csv, the error naming neither;
+    a report that was there is left as it was, not truncated."""
+    html, tables = tmp_path / "r.html", tmp_path / "tables"
+    if existing:
+        tables.mkdir()
+        html.write_text("the last report", encoding="utf-8")
+        (tables / "pose.csv").write_text("the last pose", encoding="utf-8")
+    before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+    report = run_python("-c", LIMITED, "report", str(shock_out), "-o", str(html))
+    assert report.returncode == 2, report.stderr
+    assert report.stderr.endswith(f"mount-twin: error: {html}: cannot write: File too large\n")
+    export = run_python("-c", LIMITED, "export", str(shock_out), "--csv", str(tables))
+    assert export.returncode == 2, export.stderr
+    pose = tables / "pose.csv"
+    assert export.stderr.endswith(f"mount-twin: error: {pose}: cannot write: File too large\n")
+    assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
+
+
+def test_an_output_replaced_keeps_its_mode_and_a_symlink_to_it(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """Written at a new name and renamed into place: the rename must not put a file in place
+    of the link, nor a private file (a temporary file's 0600) in place of a shared one; a
+    device (no file to rename over) is written to."""
+    layout, link = tmp_path / "layout.xml", tmp_path / "link.xml"
+    layout.write_text("old", encoding="utf-8")
+    layout.chmod(0o640)
+    link.symlink_to(layout.name)
+    assert main(["dashboard", str(SCENE_FILE), "--plotjuggler", str(link)]) == 0
+    assert link.is_symlink() and layout.read_text(encoding="utf-8").startswith("<?xml")
+    assert layout.stat().st_mode & 0o777 == 0o640
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["layout.xml", "link.xml"]
+    assert main(["dashboard", str(SCENE_FILE), "--plotjuggler", "/dev/stdout"]) == 0
+    assert capfd.readouterr().out.startswith("<?xml")

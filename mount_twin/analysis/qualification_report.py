@@ -14,6 +14,7 @@ from mount_twin.analysis.html_page import fingerprint, page, png, produced_by, s
 from mount_twin.analysis.log_labels import plain_log_labels
 from mount_twin.analysis.qualification import InputRun, Plan
 from mount_twin.scene.description import Scene
+from mount_twin.textfiles import write_text
 
 
 def write_qualification_report(
@@ -31,7 +32,7 @@ def write_qualification_report(
         *scene_section(scene),
     ]
     out = Path(path)
-    out.write_text(page(f"qualification of {scene.name}", sections), encoding="utf-8")
+    write_text(out, page(f"qualification of {scene.name}", sections))
     return out
 
 

@@ -40,6 +40,7 @@ from mount_twin.io.output_tables import (
     read_output_bag,
 )
 from mount_twin.scene.description import STANDARD_GRAVITY, Scene
+from mount_twin.textfiles import write_text
 
 if TYPE_CHECKING:
     from mount_twin.analysis.srs import Spectrum
@@ -314,7 +315,7 @@ def write_report(
         _eventstable(events) if events else "<p>none</p>",
     ]
     out = Path(html_path)
-    out.write_text(page(title, sections), encoding="utf-8")
+    write_text(out, page(title, sections))
     return out
 
 

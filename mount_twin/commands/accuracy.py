@@ -188,8 +188,9 @@ def _write_csv(rows: list[Accuracy], path: str) -> None:
     import dataclasses
 
     from mount_twin.analysis.accuracy import Accuracy
+    from mount_twin.textfiles import text_output
 
-    with open(path, "w", newline="", encoding="utf-8") as fh:
+    with text_output(path, newline="") as fh:
         writer = csv.writer(fh)
         columns = [f.name for f in dataclasses.fields(Accuracy)]
         writer.writerow(columns)

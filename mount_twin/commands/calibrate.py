@@ -143,6 +143,7 @@ def _write_scene(source: str, out: Path, cal: Calibration, lines: list[str]) -> 
     import yaml
 
     from mount_twin.scene.loader import read_scene_yaml
+    from mount_twin.textfiles import write_text
 
     data = read_scene_yaml(source)
     for raw, mount in zip(data["mounts"], cal.scene.mounts, strict=True):
@@ -159,7 +160,7 @@ def _write_scene(source: str, out: Path, cal: Calibration, lines: list[str]) -> 
         written["lag_s"] = sensor.lag_s
     head = [f"# calibrated from {source} by mount-twin calibrate", *(f"# {ln}" for ln in lines)]
     text = "\n".join(head) + "\n" + yaml.safe_dump(data, sort_keys=False)
-    out.write_text(text, encoding="utf-8")
+    write_text(out, text)
 
 
 def _plot(png: str, scene: Scene, cal: Calibration, foundation: Signal, body: Signal) -> None:

@@ -19,6 +19,7 @@ def run(args: argparse.Namespace) -> int:
 
     from mount_twin.analysis.dashboards import foxglove_layout, plotjuggler_layout
     from mount_twin.commands.common import check_targets, load_scene
+    from mount_twin.textfiles import write_text
 
     if not (args.plotjuggler or args.foxglove):
         msg = "give --plotjuggler XML and/or --foxglove JSON"
@@ -30,6 +31,6 @@ def run(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     for path, text in ((args.plotjuggler, plotjuggler_layout), (args.foxglove, foxglove_layout)):
         if path:
-            Path(path).write_text(text(scene), encoding="utf-8")
+            write_text(path, text(scene))
             print(f"layout: {path}")
     return 0

@@ -182,10 +182,9 @@ def _said(r: InputRun, done: int, total: int) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from mount_twin.analysis.qualification import judge, verdict_text
     from mount_twin.commands.common import check_targets, json_text, load_scene, new_directory
+    from mount_twin.textfiles import write_text
 
     check_targets(json=args.json, report=args.report)
     plan = plan_of(args)
@@ -205,7 +204,7 @@ def run(args: argparse.Namespace) -> int:
     doc = judge(runs, plan)
     print(verdict_text(doc))
     if args.json:
-        Path(args.json).write_text(json_text(doc), encoding="utf-8")
+        write_text(args.json, json_text(doc))
         print(f"json: {args.json}")
     if args.report:
         from mount_twin.analysis.qualification_report import write_qualification_report

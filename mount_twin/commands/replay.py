@@ -145,9 +145,10 @@ def _report(
     print(summary.text())
     if options.json_path:
         from mount_twin.commands.common import json_text
+        from mount_twin.textfiles import write_text
 
         text = json_text(summary.to_dict(), indent=2)
-        Path(options.json_path).write_text(text, encoding="utf-8")
+        write_text(options.json_path, text)
         print(f"json: {options.json_path}")
     if options.plot:
         from mount_twin.plot import plot_output_bag  # matplotlib only when asked for

@@ -331,9 +331,8 @@ def _write_json(
     zeta: float,
 ) -> None:
     """The spectra (as --csv has them), and with a design the verdict and its bands."""
-    from pathlib import Path
-
     from mount_twin.commands.common import json_text
+    from mount_twin.textfiles import write_text
 
     doc = {
         "input": args.input,
@@ -362,7 +361,7 @@ def _write_json(
             for axis, c in checks.items()
         },
     }
-    Path(args.json).write_text(json_text(doc), encoding="utf-8")
+    write_text(args.json, json_text(doc))
 
 
 class Column(NamedTuple):
@@ -459,7 +458,9 @@ def _write_csv(path: str, freqs: np.ndarray, columns: list[Column]) -> None:
     """`frequency_hz` and one column per spectrum, every value to full precision."""
     import csv
 
-    with open(path, "w", newline="", encoding="utf-8") as fh:
+    from mount_twin.textfiles import text_output
+
+    with text_output(path, newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["frequency_hz", *(c.name for c in columns)])
         w.writerows(

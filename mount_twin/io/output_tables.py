@@ -26,6 +26,7 @@ from mount_twin.errors import BagError
 from mount_twin.io.bag_info import require_existing
 from mount_twin.io.messages import DIAGNOSTICS, OUTPUTS, TYPESTORE, Readback, output_table
 from mount_twin.kinds.events import EVENT_IS_ERROR
+from mount_twin.textfiles import replacing, text_output
 
 LEVELS = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
 EVENT = re.compile(r"(\w+) ×(\d+) \(first (\d+\.\d+) s, \|F\| max ([\d.e+-]+) N\)")
@@ -197,7 +198,8 @@ def write_tables(tables: list[Table], directory: str | Path, fmt: str = "csv") -
             import pyarrow.parquet as pq
 
             columns = {k: v.tolist() if v.dtype == object else v for k, v in table.columns.items()}
-            pq.write_table(pa.table(columns), path)
+            with replacing(path) as tmp:
+                pq.write_table(pa.table(columns), tmp)
         else:
             _write_csv(table, path)
         files.append(path)
@@ -208,7 +210,7 @@ def _write_csv(table: Table, path: Path) -> None:
     import csv
 
     names = list(table.columns)
-    with path.open("w", newline="", encoding="utf-8") as fh:
+    with text_output(path, newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(names)
         for row in zip(*(table.columns[n].tolist() for n in names), strict=True):
