@@ -34,7 +34,7 @@ from mount_twin.engine.batch import (
     MountEvent,
     OutputBatch,
 )
-from mount_twin.engine.estimate import ErrorEstimate
+from mount_twin.engine.estimate import NOT_INTEGRATED, ErrorEstimate
 from mount_twin.engine.health import (
     EVENTS_KEY,
     INTEGRATION,
@@ -68,7 +68,7 @@ def _estimate_text(est: ErrorEstimate | None) -> str:
     if est is None:
         return "estimated integration error: not estimated (integration.error_estimate: false)"
     if not est.estimated:
-        return "estimated integration error: none (no input interval was integrated)"
+        return f"estimated integration error: {NOT_INTEGRATED}"
     text = (
         f"estimated integration error: mount forces {est.force_error_rel:.2g} of the largest "
         f"({est.force_error_n:.3g} N), attitude {est.attitude_error_rad:.2g} rad, over the run"
@@ -124,13 +124,7 @@ class ReplaySummary:
     def nothing_accepted(self) -> str:
         """Why no input sample was accepted ('' if some were): the rejection counts, and the
         bag's header.frame_id when it is the wrong one."""
-        detail = ""
-        if self.wrong_frame_id is not None:
-            from mount_twin.scene.reader import shown  # a 1 MB frame id, shortened
-
-            frame = shown(self.wrong_frame_id)
-            detail = f"; the bag's header.frame_id is {frame}: see input.frame_id"
-        return intake.nothing_accepted(self.counts, detail)
+        return intake.nothing_accepted(self.counts, self.wrong_frame_id)
 
     @property
     def real_time_factor(self) -> float:

@@ -5,6 +5,7 @@ the summary's JSON, the report and the sweep, checked against the output bag's o
 
 from __future__ import annotations
 
+import html
 import json
 import re
 from pathlib import Path
@@ -15,6 +16,8 @@ import yaml
 from io_helpers import CONFIG, ROOT, read_bag
 
 from mount_twin.cli import main
+from mount_twin.io.bag import write_bag
+from mount_twin.io.messages import IMU, imu_messages
 from mount_twin.scene.loader import read_scene_yaml
 from mount_twin.sweeps.cases import check
 from mount_twin.sweeps.runner import FAILED, run_case, summary
@@ -116,6 +119,44 @@ def test_a_replay_that_accepted_nothing_says_so_at_error_in_its_summary_and_bag(
     assert f"no sample accepted by the end of the input: {n_in} received, all rejected" in (
         status.message
     )
+
+
+def _all_nan_bag(path: Path, n: int) -> Path:
+    """A bag of `n` deck IMU samples at 1 kHz whose specific force is NaN on every axis."""
+    stamps = 1_700_000_000 * 10**9 + np.arange(n, dtype=np.int64) * 10**6
+    accel = np.full((n, 3), np.nan)
+    write_bag(
+        path, "/deck/imu", IMU, iter(imu_messages(stamps, accel, np.zeros((n, 3)), "deck_imu"))
+    )
+    return path
+
+
+@pytest.mark.parametrize("bad", ["non_finite", "wrong_frame"])
+def test_the_report_of_a_run_that_accepted_nothing_says_so_and_why_in_its_heading(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], bad: str
+) -> None:
+    """Its page opened "Verdict: ERROR", its estimated error read "mount forces nan of the
+    largest", its peaks table was empty and its utilisation plot flat at 0, as a machine at
+    rest: nothing said that no sample had been taken. It says why as the replay did."""
+    if bad == "non_finite":
+        code, doc, out = _replay(tmp_path, PUMP, _all_nan_bag(tmp_path / "nan", 1000))
+        why = "1000 received, rejected: {'rejected_non_finite': 1000})"
+    else:
+        code, doc, out = _replay(tmp_path, PUMP, SHOCK, "--frame-id", "not_the_imu")
+        n_in = len(read_bag(SHOCK)[1]["/deck/imu"])
+        why = f"{n_in} received, rejected: {{'rejected_wrong_frame': {n_in}}}; the bag's header"
+    assert code == 3
+    said = doc["nothing_accepted"]
+    assert said.startswith(f"no input sample was accepted ({why}")
+    capsys.readouterr()
+    page = tmp_path / "r.html"
+    assert main(["report", str(out), "--scene", str(PUMP), "-o", str(page)]) == 0
+    text = html.unescape(page.read_text(encoding="utf-8"))
+    assert f"<h2>Verdict: ERROR: {said}</h2>" in text
+    assert not re.search(r"\bnan\b", text, re.IGNORECASE)
+    assert "none (no input interval was integrated)" in text
+    assert "<h2>Utilisation</h2>" not in text
+    assert "<h2>Peaks (largest magnitude at one instant)</h2>\n<p>none: no input sample" in text
 
 
 @pytest.mark.parametrize(

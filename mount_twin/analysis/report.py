@@ -28,7 +28,9 @@ from mount_twin.analysis.html_page import fingerprint, page, png, produced_by, s
 from mount_twin.analysis.html_page import table as html_table
 from mount_twin.analysis.log_labels import plain_log_labels
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
+from mount_twin.engine.estimate import NOT_INTEGRATED
 from mount_twin.engine.health import UTILISATION_KEY
+from mount_twin.engine.intake import nothing_accepted
 from mount_twin.errors import ModelError
 from mount_twin.io.bag import partial_marker
 from mount_twin.io.messages import WRENCHES_OUTPUT
@@ -36,6 +38,7 @@ from mount_twin.io.output_tables import (
     Event,
     Table,
     events_of,
+    input_values,
     integration_values,
     read_output_bag,
 )
@@ -62,10 +65,24 @@ def utilisation_of(diagnostics: Table) -> dict[str, tuple[np.ndarray, np.ndarray
     return {k: (np.array(t), np.array(u)) for k, (t, u) in series.items()}
 
 
-def _verdict(diagnostics: Table | None) -> tuple[str, dict[str, str]]:
+def _nothing_accepted(diagnostics: Table | None) -> str:
+    """Why no input sample of the run was accepted, as its replay's summary says it, from the
+    counts of its last input status ('' if some were, or the bag holds no counts)."""
+    values = input_values(diagnostics)
+    counts = {
+        k: int(v)
+        for k, v in values.items()
+        if (k in ("received", "accepted") or k.startswith("rejected_")) and v.isdigit()
+    }
+    if "accepted" not in counts:
+        return ""
+    return nothing_accepted(counts, values.get("last_wrong_frame_id"))
+
+
+def _verdict(diagnostics: Table | None, nothing: str) -> tuple[str, dict[str, str]]:
     """The run's verdict from its diagnostics (FAILED if the integration ever failed, else the
-    worst level of any status but the live-only `mount_twin: ros`), and the last integration
-    status' values."""
+    worst level of any status but the live-only `mount_twin: ros`, with `nothing`: why no
+    input sample was accepted, if none was), and the last integration status' values."""
     if diagnostics is None or not len(diagnostics):
         return "no diagnostics in the bag", {}
     c = diagnostics.columns
@@ -76,6 +93,8 @@ def _verdict(diagnostics: Table | None) -> tuple[str, dict[str, str]]:
     integration = integration_values(diagnostics)
     if int(integration.get("failures_total", "0")):
         return f"{FAILED} ({integration['failures_total']} integration failures)", integration
+    if nothing:
+        return f"{LEVEL_NAMES[worst]}: {nothing}", integration
     return LEVEL_NAMES[worst], integration
 
 
@@ -84,12 +103,13 @@ def _provenance_section(
     output_bag: str | Path,
     input_path: str | Path | None,
     scene: Scene | None,
+    nothing: str,
     input_note: str = "",
 ) -> list[str]:
-    """The verdict, what produced the page from what (with `input_note` on the input bag:
-    what of it was left out), the solver's settings and estimated error, and the scene as
-    loaded."""
-    verdict, integration = _verdict(diagnostics)
+    """The verdict (with `nothing`: why no input sample was accepted, if none was), what
+    produced the page from what (with `input_note` on the input bag: what of it was left
+    out), the solver's settings and estimated error, and the scene as loaded."""
+    verdict, integration = _verdict(diagnostics, nothing)
     partial = partial_marker(output_bag)
     rows = [
         ["verdict (worst over the run)", verdict],
@@ -117,11 +137,13 @@ def _provenance_section(
                 f"atol {integ.atol:g}, error estimate {'on' if integ.error_estimate else 'off'}",
             ],
         ]
-    if integration.get("est_force_error_rel_run"):
+    if est := integration.get("est_force_error_rel_run"):
         rows.append(
             [
                 "estimated integration error over the run",
-                f"mount forces {integration['est_force_error_rel_run']} of the largest, "
+                NOT_INTEGRATED  # NaN: no interval estimated
+                if est == "nan"
+                else f"mount forces {est} of the largest, "
                 f"attitude {integration.get('est_attitude_error_rad_run', '?')} rad",
             ]
         )
@@ -285,7 +307,10 @@ def write_report(
     if input_name:
         title += f" (input {input_name})"
     sections = [f"<h1>{html.escape(title)}</h1>"]
-    sections += _provenance_section(diagnostics, output_bag, input_path, scene, input_note)
+    nothing = _nothing_accepted(diagnostics)
+    sections += _provenance_section(
+        diagnostics, output_bag, input_path, scene, nothing, input_note
+    )
     if "pose" in tables and "angles" in tables:
         sections += [
             "<h2>Input and response</h2>",
@@ -294,7 +319,7 @@ def write_report(
             ),
         ]
     sections += _forces_sections(mounts, events)
-    if utilisation:
+    if utilisation and not nothing:  # a run without motion: its 0 would read as at rest
         sections += [
             "<h2>Utilisation</h2>",
             png(lambda fig: _draw_utilisation(fig, utilisation, kinds), (10, 4)),
@@ -307,7 +332,9 @@ def write_report(
         sections.append(_displacement_line(tables["pose"]))
     sections += [
         f"<h2>Peaks ({peak_label(scene.outputs.decimation if scene else 1)})</h2>",
-        html_table(
+        "<p>none: no input sample was accepted</p>"
+        if nothing
+        else html_table(
             ["mount", "kind", PEAK_FORCE, PEAK_COUPLE, "utilisation max"],
             _peak_rows(mounts, kinds, utilisation),
         ),

@@ -17,6 +17,8 @@ FORCE_ERROR, ATTITUDE_ERROR, FORCE_SCALE, FAILURES, UNCARRIED, N_FIGURES = range
 """Slots of the figures: largest |ΔF| (N), largest |Δα|, |Δγ|, |Δδ| (rad), largest |F|
 component (N), failed checks (intervals whose local error could not be measured), states the
 estimate does not carry (`engine.estimator.DENSE_MAX`)."""
+NOT_INTEGRATED = "none (no input interval was integrated)"
+"""The estimated error of a run where nothing was estimated (`ErrorEstimate.estimated` false)."""
 WARN_FORCE_ERROR_REL = 0.01
 """An estimated mount-force error above this share of the largest force is a WARN: the results
 are not to be trusted to the percent (tighten integration.rtol)."""

@@ -22,6 +22,8 @@ from mount_twin.scene.description import Scene
 PREFIX = "mount_twin"
 INTEGRATION = f"{PREFIX}: integration"
 """Name of the integration status."""
+INPUT = f"{PREFIX}: input"
+"""Name of the input status."""
 
 PEAK_KEYS = tuple(f"peak_{axis}" for axis in ("fx_N", "fy_N", "fz_N", "tx_Nm", "ty_Nm", "tz_Nm"))
 """A mount status' keys of its peak wrench components in this period (N, N·m, mount axes)."""
@@ -505,7 +507,7 @@ class HealthWindow:
             level = max(level, ERROR if share > LOST_ERROR else WARN)
             parts.append(_lost_text(lost, share, lost_from_stamps, nominal_s, reported))
         values = self._input_values(counts, rate_hz, lost, nominal_s, stalled_s)
-        return HealthStatus(f"{PREFIX}: input", level, "; ".join(parts) or "ok", values)
+        return HealthStatus(INPUT, level, "; ".join(parts) or "ok", values)
 
     def _stall_text(
         self, new: Counter[str], new_rejected: dict[str, int], stalled_s: float

@@ -109,12 +109,17 @@ def rejected(counts: Mapping[str, int]) -> dict[str, int]:
     return {k: v for k, v in counts.items() if k.startswith("rejected_") and v}
 
 
-def nothing_accepted(counts: Mapping[str, int], detail: str = "") -> str:
+def nothing_accepted(counts: Mapping[str, int], wrong_frame_id: str | None = None) -> str:
     """Why no input sample was accepted, from an engine's `counts` ('' if some were): how many
-    were received and why each was rejected, then `detail`. A run like that has no figures:
-    a peak of 0 N would read as a machine at rest."""
+    were received and why each was rejected, and the last `wrong_frame_id` rejected if any. A
+    run like that has no figures: a peak of 0 N would read as a machine at rest."""
     if counts.get("accepted", 0):
         return ""
+    detail = ""
+    if wrong_frame_id is not None:
+        from mount_twin.scene.reader import shown  # a 1 MB frame id, shortened
+
+        detail = f"; the bag's header.frame_id is {shown(wrong_frame_id)}: see input.frame_id"
     why = f"{counts.get('received', 0)} received, rejected: {rejected(counts)}{detail}"
     return f"no input sample was accepted ({why})"
 

@@ -21,7 +21,7 @@ import numpy as np
 from rosbags.highlevel import AnyReader
 
 from mount_twin.engine.batch import event_level
-from mount_twin.engine.health import INTEGRATION
+from mount_twin.engine.health import INPUT, INTEGRATION
 from mount_twin.errors import BagError
 from mount_twin.io.bag_info import require_existing
 from mount_twin.io.messages import DIAGNOSTICS, OUTPUTS, TYPESTORE, Readback, output_table
@@ -159,10 +159,22 @@ def events_of(diagnostics: Table, origin_ns: int) -> list[Event]:
 def integration_values(diagnostics: Table | None) -> dict[str, str]:
     """The key-values of the run's last integration status (`failures_total`, the error
     estimate, …); empty where the bag holds none."""
+    return _last_values(diagnostics, INTEGRATION)
+
+
+def input_values(diagnostics: Table | None) -> dict[str, str]:
+    """The key-values of the run's last input status (the counts over the run: `received`,
+    `accepted`, `rejected_<reason>`, …; `last_wrong_frame_id`); empty where the bag holds
+    none."""
+    return _last_values(diagnostics, INPUT)
+
+
+def _last_values(diagnostics: Table | None, name: str) -> dict[str, str]:
+    """The key-values of the last status called `name`; empty where the bag holds none."""
     if diagnostics is None:
         return {}
     c = diagnostics.columns
-    rows = [v for s, v in zip(c["status"], c["values"], strict=True) if s == INTEGRATION]
+    rows = [v for s, v in zip(c["status"], c["values"], strict=True) if s == name]
     return json.loads(rows[-1]) if rows else {}
 
 
