@@ -28,6 +28,8 @@ def plot_output_bag(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from mount_twin.textfiles import replacing
+
     tables = {t.name: t for t in read_output_bag(bag)}
     body = "body_imu_predicted" in tables and "body_imu_residual" in tables
     fig, axes = plt.subplots(4 if body else 3, 1, sharex=True, figsize=(10, 12 if body else 9))
@@ -81,6 +83,7 @@ def plot_output_bag(
     fig.suptitle(title or str(bag))
     fig.tight_layout()
     out = Path(png)
-    fig.savefig(out, dpi=110)
+    with replacing(out) as tmp:  # whole or not at all, a failure naming it
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
     return out

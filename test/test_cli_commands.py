@@ -508,6 +508,17 @@ def test_an_output_the_disk_cannot_take_is_named_and_leaves_no_part_of_it(
     assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
 
 
+def test_a_figure_the_disk_cannot_take_is_named_and_leaves_no_part_of_it(
+    tmp_path: Path,
+) -> None:
+    """`show -o lay.png` on a full disk printed a bare errno, naming no file."""
+    png = tmp_path / "lay.png"
+    done = run_python("-c", LIMITED, "show", str(SCENE_FILE), "-o", str(png))
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.endswith(f"mount-twin: error: {png}: cannot write: File too large\n")
+    assert not list(tmp_path.iterdir())
+
+
 def test_an_output_replaced_keeps_its_mode_and_a_symlink_to_it(
     tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:

@@ -63,6 +63,8 @@ def draw_layout(scene: Scene, png: str | Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from mount_twin.textfiles import replacing
+
     fig = plt.figure(figsize=(15, 5.5))
     ax3 = fig.add_subplot(1, 3, 1, projection="3d")
     views = _Views(ax3, [fig.add_subplot(1, 3, 2 + k) for k in range(2)])
@@ -78,7 +80,8 @@ def draw_layout(scene: Scene, png: str | Path) -> Path:
     )
     fig.tight_layout()
     out = Path(png)
-    fig.savefig(out, dpi=110)
+    with replacing(out) as tmp:  # whole or not at all, a failure naming it
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
     return out
 

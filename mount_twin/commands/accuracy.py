@@ -226,6 +226,7 @@ def _plot(
     import matplotlib.pyplot as plt
 
     from mount_twin.analysis.log_labels import plain_log_labels
+    from mount_twin.textfiles import replacing
 
     fig, ax = plt.subplots(figsize=(7, 5))
     wall = [r.wall_s_per_sim_s for r in rows]
@@ -267,5 +268,6 @@ def _plot(
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
-    fig.savefig(png, dpi=110)
+    with replacing(png) as tmp:  # whole or not at all, a failure naming it
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)

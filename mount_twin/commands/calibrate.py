@@ -172,6 +172,7 @@ def _plot(png: str, scene: Scene, cal: Calibration, foundation: Signal, body: Si
     from scipy.interpolate import CubicSpline
 
     from mount_twin.analysis.calibration import predict
+    from mount_twin.textfiles import replacing
 
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(10, 8))
     shown = [(scene, "nominal", "tab:gray"), (cal.scene, "calibrated", "tab:red")]
@@ -197,5 +198,6 @@ def _plot(png: str, scene: Scene, cal: Calibration, foundation: Signal, body: Si
     )
     axes[-1].set_xlabel("time [s]")
     fig.tight_layout()
-    fig.savefig(png, dpi=100)
+    with replacing(png) as tmp:  # whole or not at all, a failure naming it
+        fig.savefig(tmp, dpi=100)
     plt.close(fig)

@@ -486,6 +486,7 @@ def _plot(
     import matplotlib.pyplot as plt
 
     from mount_twin.io.csv_import import G
+    from mount_twin.textfiles import replacing
 
     scale, ylabel = (
         (G, "peak absolute acceleration [g]")
@@ -524,5 +525,6 @@ def _plot(
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(png, dpi=110)
+    with replacing(png) as tmp:  # whole or not at all, a failure naming it
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)

@@ -64,6 +64,8 @@ def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from mount_twin.textfiles import replacing
+
     lines = trade_off(rows, spec)
     rated = any(not math.isnan(p[2]) for points in lines.values() for p in points)
     fig, axes = plt.subplots(2 if rated else 1, 1, figsize=(8, 8 if rated else 5), sharex=True)
@@ -85,6 +87,7 @@ def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> 
     panels[0].set_title(f"{Path(spec.source).name}: markers o OK, s WARN, v ERROR", fontsize=9)
     fig.tight_layout()
     out = Path(png)
-    fig.savefig(out, dpi=110)
+    with replacing(out) as tmp:  # whole or not at all, a failure naming it
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
     return out
