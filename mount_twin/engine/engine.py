@@ -87,7 +87,8 @@ class TwinEngine:
         self._pushed = 0
         """Samples pushed so far (a held one once)."""
         self._done_at = (0, math.nan)
-        """(position among the samples pushed, stamp s) of the last sample the twin did."""
+        """(position among the samples pushed, stamp s) of the last sample the twin did,
+        where decimation left it unpublished (`CoreDriver.tail_pending`)."""
 
     @property
     def state(self) -> np.ndarray:
@@ -302,7 +303,7 @@ class TwinEngine:
             step = driver.advance(segment, index, rows)
             out.append(step.rows)
             done = step.done
-            if done:
+            if done and driver.tail_pending:  # its last sample unpublished (decimation)
                 self._done_at = (
                     frame.first_id + int(frame.relative(index[done - 1 : done])[0]),
                     float(frame.stamps[index[done - 1]]),
