@@ -155,6 +155,19 @@ def test_run_in_one_frame_equals_a_push_then_a_flush(scene_file: str, record) ->
     assert a.counts == b.counts
 
 
+def _alike_in_chunks(scene, bag: Path, tmp_path: Path) -> dict:
+    """The output bag of `bag` replayed in chunks of 100000 (`comparable_messages`), checked to
+    be the same in chunks of 1 and 7."""
+    bags = {}
+    for chunk in (1, 7, 100_000):
+        out = tmp_path / f"out_{chunk}"
+        replay(scene, bag, out, chunk=chunk, progress=False)
+        bags[chunk] = comparable_messages(out)
+    for chunk in (1, 7):
+        assert bags[chunk] == bags[100_000], f"chunks of {chunk} differ from one of 100000"
+    return bags[100_000]
+
+
 def test_messages_the_engine_cannot_take_count_where_they_came_in_any_chunking(
     tmp_path: Path,
 ) -> None:
@@ -175,16 +188,10 @@ def test_messages_the_engine_cannot_take_count_where_they_came_in_any_chunking(
     msgs[zero] = (msgs[zero][0], bytes(TYPESTORE.serialize_cdr(msg, IMU)))
     bag = tmp_path / "bad"
     write_bag(bag, "/deck/imu", IMU, iter(msgs))
-    bags = {}
-    for chunk in (1, 7, 100_000):
-        out = tmp_path / f"out_{chunk}"
-        replay(scene, bag, out, chunk=chunk, progress=False)
-        bags[chunk] = comparable_messages(out)
-    for chunk in (1, 7):
-        assert bags[chunk] == bags[100_000], f"chunks of {chunk} differ from one of 100000"
+    whole = _alike_in_chunks(scene, bag, tmp_path)
     inputs = [
         dict(values)
-        for _, statuses in bags[100_000]["/diagnostics"]
+        for _, statuses in whole["/diagnostics"]
         for name, _, _, values in statuses
         if name == "mount_twin: input"
     ]
@@ -211,15 +218,9 @@ def test_a_decimated_replay_publishes_each_runs_last_sample_at_its_stamp_in_any_
     bag = tmp_path / "rejected_stretch"
     write_bag(bag, "/deck/imu", IMU, iter(msgs))
     stamps = [stamp_ns(TYPESTORE.deserialize_cdr(raw, IMU)) for _, raw in msgs]
-    bags = {}
-    for chunk in (1, 7, 100_000):
-        out = tmp_path / f"out_{chunk}"
-        replay(scene, bag, out, chunk=chunk, progress=False)
-        bags[chunk] = comparable_messages(out)
-    for chunk in (1, 7):
-        assert bags[chunk] == bags[100_000], f"chunks of {chunk} differ from one of 100000"
-    (pose_topic,) = [t for t in bags[1] if t.endswith("/pose")]
-    published = [stamp for stamp, _ in bags[1][pose_topic]]
+    whole = _alike_in_chunks(scene, bag, tmp_path)
+    (pose_topic,) = [t for t in whole if t.endswith("/pose")]
+    published = [stamp for stamp, _ in whole[pose_topic]]
     # each run: its start, every 7th sample after it, and its last (1199 before the
     # restart at 1800, 2499 at the end; neither is a 7th)
     rows = [*range(0, 1200, 7), 1199, *range(1800, 2500, 7), 2499]
