@@ -316,3 +316,44 @@ def test_a_still_body_refuses_every_parameter_and_has_no_nrms() -> None:
     assert cal.values == {"stiffness": 1.0, "damping": 1.0, "yaw": 0.0, "lag": 0.0}
     assert math.isnan(cal.nrms_before) and math.isnan(cal.nrms_after)
     assert math.isnan(cal_mod.nrms(np.ones((50, 3)), np.tile([0.0, 0.0, 9.81], (50, 1))))
+
+
+def test_a_bag_record_with_samples_not_finite_is_refused_naming_them(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A body bag with 20 NaN readings was taken for a body that does not move ("varies by
+    nan m/s²"); a bag on another topic was told of `input.topic` and `replay --topic`, for the
+    body's record of `calibrate`."""
+    from io_helpers import read_raw
+
+    from mount_twin.io.bag import write_bag
+    from mount_twin.io.messages import IMU, TYPESTORE
+
+    scene = str(SHAKE / "block.scene.yaml")
+    ground, top = tmp_path / "ground", tmp_path / "top"
+    for csv_path, bag, topic in (
+        ("sine_2hz_trial1_ground_excerpt.csv", ground, "/imu/data"),
+        ("sine_2hz_trial1_top_excerpt.csv", top, "/machine/imu"),
+    ):
+        assert main(["import-csv", str(SHAKE / csv_path), "-o", str(bag), "--topic", topic]) == 0
+    ((topic, msgs),) = read_raw(top).items()
+    for i in range(600, 620):
+        msg = TYPESTORE.deserialize_cdr(msgs[i][1], IMU)
+        msg.linear_acceleration.z = math.nan
+        msgs[i] = (msgs[i][0], bytes(TYPESTORE.serialize_cdr(msg, IMU)))
+    damaged = tmp_path / "top_nan"
+    write_bag(damaged, topic, IMU, iter(msgs))
+    capsys.readouterr()
+    out = str(tmp_path / "cal.scene.yaml")
+    for command in ("calibrate", "track"):
+        args = [command, scene, "--foundation", str(ground), "--body", str(damaged)]
+        assert main([*args, *(["-o", out] if command == "calibrate" else [])]) == 2
+        err = capsys.readouterr().err
+        assert (
+            f"{damaged}: /machine/imu: 20 of {len(msgs)} samples not finite, the first its " in err
+        )
+    assert (
+        main(["calibrate", scene, "--foundation", str(ground), "--body", str(ground), "-o", out])
+        == 2
+    )
+    assert f"{ground}: no topic '/machine/imu' (body_sensor.topic);" in capsys.readouterr().err

@@ -51,12 +51,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+FOUNDATION_KEYS = ("input.topic", "input.msg_type")
+BODY_KEYS = ("body_sensor.topic", "a body_sensor (an IMU)")
+"""What sets each record's topic and type, for a bag's errors (`InputBag`)."""
+
+
 def _read_record(
-    path: str, topic: str, msg_type: str, base: TimeBase | None
+    path: str, topic: str, msg_type: str, base: TimeBase | None, keys: tuple[str, str]
 ) -> tuple[Signal, TimeBase | None]:
     """A record: an Xsens DOT CSV, a recorder CSV (their stamps as written), or a bag's `topic`
     (stamps in seconds from `base`, else from its first stamp's whole second: the base
-    returned, for the other record of a pair to share)."""
+    returned, for the other record of a pair to share). A bag's sample not finite is refused,
+    as a CSV's cell is: named, with how many."""
     from pathlib import Path
 
     from mount_twin.io.messages import TimeBase
@@ -65,10 +71,22 @@ def _read_record(
 
     if Path(path).suffix.lower() == ".csv":
         return read_csv_record(path), base
+    import numpy as np
+
+    from mount_twin.engine.intake import readable
     from mount_twin.io.input_samples import read_input
     from mount_twin.scene.description import InputSpec
 
-    decoded = read_input(path, InputSpec(msg_type=msg_type, topic=topic))
+    decoded = read_input(path, InputSpec(msg_type=msg_type, topic=topic), keys)
+    bad = np.flatnonzero(~readable(decoded.accel, decoded.gyro))
+    if bad.shape[0]:
+        first = int(bad[0])
+        msg = (
+            f"{path}: {topic}: {bad.shape[0]} of {decoded.stamps_ns.shape[0]} samples not "
+            f"finite, the first its message {first} (stamp {int(decoded.stamps_ns[first])} ns): "
+            "a fit needs every sample it compares"
+        )
+        raise ValueError(msg)
     base = base or TimeBase.at(int(decoded.stamps_ns[0]))
     return Signal(base.seconds(decoded.stamps_ns), decoded.accel, decoded.gyro), base
 
@@ -86,8 +104,10 @@ def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
         msg = f"{args.scene}: no body_sensor: where is the body's IMU and how is it turned?"
         raise ValueError(msg)
     spec = scene.input
-    foundation, base = _read_record(args.foundation, spec.topic, spec.msg_type, None)
-    body, _ = _read_record(args.body, scene.body_sensor.topic, IMU, base)
+    foundation, base = _read_record(
+        args.foundation, spec.topic, spec.msg_type, None, FOUNDATION_KEYS
+    )
+    body, _ = _read_record(args.body, scene.body_sensor.topic, IMU, base, BODY_KEYS)
     if still := still_body(foundation, body):
         msg = f"{args.body}: {still}"
         raise ValueError(msg)

@@ -10,10 +10,11 @@ from mount_twin.io.messages import Decoded, TimeBase, decode_inputs
 from mount_twin.scene.description import InputSpec
 
 
-def read_input(bag: str | Path, spec: InputSpec) -> Decoded:
+def read_input(bag: str | Path, spec: InputSpec, keys: tuple[str, str] | None = None) -> Decoded:
     """The decodable samples of the input topic `spec.topic` in `bag` with a positive stamp
-    (sensor frame, as recorded); an error names the bag if there is none."""
-    with InputBag(bag, spec.topic, spec.msg_type) as reader:
+    (sensor frame, as recorded); an error names the bag if there is none. `keys`: what sets
+    the topic and the type, for errors (`InputBag`'s; default: the scene's input)."""
+    with InputBag(bag, spec.topic, spec.msg_type, *([keys] if keys else [])) as reader:
         raws = [raw for chunk in reader.chunks(10_000) for raw in chunk]
     decoded = decode_inputs(raws, spec.msg_type)
     decoded = decoded.select(decoded.stamps_ns > 0)
