@@ -71,22 +71,19 @@ def _read_record(
 
     if Path(path).suffix.lower() == ".csv":
         return read_csv_record(path), base
-    import numpy as np
-
+    from mount_twin.commands.common import refuse_not_finite
     from mount_twin.engine.intake import readable
     from mount_twin.io.input_samples import read_input
     from mount_twin.scene.description import InputSpec
 
     decoded = read_input(path, InputSpec(msg_type=msg_type, topic=topic), keys)
-    bad = np.flatnonzero(~readable(decoded.accel, decoded.gyro))
-    if bad.shape[0]:
-        first = int(bad[0])
-        msg = (
-            f"{path}: {topic}: {bad.shape[0]} of {decoded.stamps_ns.shape[0]} samples not "
-            f"finite, the first its message {first} (stamp {int(decoded.stamps_ns[first])} ns): "
-            "a fit needs every sample it compares"
-        )
-        raise ValueError(msg)
+    refuse_not_finite(
+        readable(decoded.accel, decoded.gyro),
+        "samples",
+        f"{path}: {topic}:",
+        lambda i: f"its message {i} (stamp {int(decoded.stamps_ns[i])} ns)",
+        "a fit needs every sample it compares",
+    )
     base = base or TimeBase.at(int(decoded.stamps_ns[0]))
     return Signal(base.seconds(decoded.stamps_ns), decoded.accel, decoded.gyro), base
 

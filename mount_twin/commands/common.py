@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from itertools import pairwise
 from pathlib import Path
@@ -14,6 +14,8 @@ from typing import TYPE_CHECKING
 from mount_twin.errors import MountTwinError
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from mount_twin.io.signals import Signal
     from mount_twin.scene.description import Scene
 
@@ -180,6 +182,26 @@ def write_signal(
     return write_bag(
         out, topic, IMU, iter(imu_messages(stamps, sig.accel, sig.gyro, frame_id)), storage
     )
+
+
+def not_finite(ok: np.ndarray, noun: str) -> tuple[np.ndarray, str]:
+    """The samples `ok` (bool, one per sample) does not mark, and how many of how many they
+    are ('K of N <noun> not finite'; '' where there is none): the count a refusal of a
+    record's damaged samples gives, beside its first one's place."""
+    import numpy as np
+
+    bad = np.flatnonzero(~ok)
+    return bad, f"{bad.shape[0]} of {ok.shape[0]} {noun} not finite" if bad.shape[0] else ""
+
+
+def refuse_not_finite(
+    ok: np.ndarray, noun: str, where: str, place: Callable[[int], str], why: str
+) -> None:
+    """Refuse a record where `ok` does not mark every sample: ValueError '<where> K of N <noun>
+    not finite, the first <place(its index)>: <why>'."""
+    bad, said = not_finite(ok, noun)
+    if said:
+        raise ValueError(f"{where} {said}, the first {place(int(bad[0]))}: {why}")
 
 
 def read_design_table(path: str) -> tuple[list[float], list[float]]:

@@ -85,12 +85,14 @@ def finite_input(path: str, topic: str, decoded: Decoded) -> tuple[Decoded, str]
     and would join those around the hole. So is a record with no finite sample."""
     import numpy as np
 
+    from mount_twin.commands.common import not_finite
     from mount_twin.engine.intake import READING_LIMIT, readable
 
     ok = readable(decoded.accel, decoded.gyro)
-    if ok.all():
+    bad, count = not_finite(ok, "samples")
+    if not count:
         return decoded, ""
-    bad, finite = np.flatnonzero(~ok), np.flatnonzero(ok)
+    finite = np.flatnonzero(ok)
     inside = bad[(bad > finite[0]) & (bad < finite[-1])] if finite.size else bad
     first = int((inside if inside.size else bad)[0])
     readings = np.concatenate([decoded.accel[first], decoded.gyro[first]]).tolist()
@@ -98,7 +100,7 @@ def finite_input(path: str, topic: str, decoded: Decoded) -> tuple[Decoded, str]
     t = (int(decoded.stamps_ns[first]) - int(decoded.stamps_ns[0])) * 1e-9
     axis = f"{('accel', 'gyro')[k // 3]} {'xyz'[k % 3]}"
     said = f"sample {first} (t = {t:.6g} s from the first) has {axis} {readings[k]!r}"
-    where = f"{path}: {topic}: {bad.size} of {ok.size} samples not finite"
+    where = f"{path}: {topic}: {count}"
     if not finite.size:
         msg = f"{where}, none finite: {said}"
         raise ValueError(msg)

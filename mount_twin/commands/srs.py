@@ -222,16 +222,16 @@ def _check_channels(values: np.ndarray, axes: tuple[str, ...], t: np.ndarray, na
     axes), naming the axis, how many and the first (sample, t s from the record's start)."""
     import numpy as np
 
+    from mount_twin.commands.common import refuse_not_finite
+
     for axis in axes:
-        bad = np.flatnonzero(~np.isfinite(values[:, AXES.index(axis)]))
-        if bad.shape[0]:
-            first = int(bad[0])
-            msg = (
-                f"{name}: axis {axis} has {bad.shape[0]} of {values.shape[0]} values not "
-                f"finite, the first at sample {first} (t = {t[first]:.6g} s): a damaged or "
-                "dead channel has no spectrum"
-            )
-            raise ValueError(msg)
+        refuse_not_finite(
+            np.isfinite(values[:, AXES.index(axis)]),
+            "values",
+            f"{name}: axis {axis} has",
+            lambda i: f"at sample {i} (t = {t[i]:.6g} s)",
+            "a damaged or dead channel has no spectrum",
+        )
 
 
 def _frequencies(args: argparse.Namespace, rate_hz: float) -> np.ndarray:
