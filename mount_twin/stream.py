@@ -53,19 +53,9 @@ class _Kept:
         """These and a push's samples (positions from `first_id`, stamps ns, rates rad/s
         where there is a body IMU, else None), as far as `wanted` (increasing positions, each
         of these or of the push: the engine's `pending_ids` after it)."""
-        n, k, m = stamps_ns.shape[0], self.ids.shape[0], wanted.shape[0]
+        n = stamps_ns.shape[0]
         ns = np.concatenate([self.ns, stamps_ns])
         rates = self.rate if rate is None else np.concatenate([self.rate, rate])
-        contiguous = not k or int(self.ids[-1]) - int(self.ids[0]) == k - 1 == first_id - 1 - int(
-            self.ids[0]
-        )
-        if m and contiguous and int(wanted[-1]) - int(wanted[0]) == m - 1:
-            # the common case: kept, pushed and wanted samples each consecutive
-            lo = int(wanted[0]) - (first_id - k)
-            if lo >= 0 and lo + m <= k + n:
-                return _Kept(
-                    wanted, ns[lo : lo + m], rates if rate is None else rates[lo : lo + m]
-                )
         ids = np.concatenate([self.ids, np.arange(first_id, first_id + n, dtype=np.int64)])
         at = np.searchsorted(ids, wanted)
         if at.shape[0] and (at[-1] >= ids.shape[0] or (ids[at] != wanted).any()):
@@ -76,10 +66,10 @@ class _Kept:
     def renumbered(self, out: OutputBatch, first_id: int) -> OutputBatch:
         """`out` (positions relative to a push whose first sample is at `first_id`; negative:
         earlier samples) with its rows' and reports' earlier samples numbered into these kept
-        ones, appended after the push's: −1 the last kept. As they are where these are the
-        samples just before the push (no rejected samples since the oldest). Raises
-        RuntimeError for an earlier sample not kept (its stamp is lost: a mistake, never a
-        guess)."""
+        ones, appended after the push's: −1 the last kept. Unchanged where these are the
+        samples just before the push (no rejected sample since the oldest), the usual case.
+        Raises RuntimeError for an earlier sample not kept (its stamp is lost: a mistake,
+        never a guess)."""
         k = self.ids.shape[0]
         reported = [r.sample for r in out.health]
         oldest = min(int(out.sample.min()) if len(out) else 0, *reported, 0)
