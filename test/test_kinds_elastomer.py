@@ -240,8 +240,15 @@ MASS, CG_Z, K1Z, K3Z, CZ, RATIO = 200.0, 0.3, 2.0e5, 5.0e8, 150.0, 0.7
 BASE_AMP, BASE_HZ, RATE, DURATION = 4.0, 5.0, 400.0, 1.5  # m/s², Hz, samples/s, s
 
 
-def loop_reference(t: np.ndarray, a: np.ndarray, z0: float, bw: dict) -> np.ndarray:
-    """[z, z', w] at the stamps, solve_ivp per sample interval with the input linear in it."""
+def virgin_w(z: float, n: int) -> float:
+    """The Bouc–Wen state of a mount loaded slowly from unloaded to deflection z (m): the
+    closed form of monotone loading, odd in z."""
+    return math.copysign(float(monotone_z(np.array(abs(z)), n)), z)
+
+
+def loop_reference(t: np.ndarray, a: np.ndarray, z0: float, w0: float, bw: dict) -> np.ndarray:
+    """[z, z', w] at the stamps from rest at (z0, w0), solve_ivp per sample interval with the
+    input linear in it."""
 
     def rhs(tt, s, t0, a0, slope):
         z, zd, w = s
@@ -250,7 +257,7 @@ def loop_reference(t: np.ndarray, a: np.ndarray, z0: float, bw: dict) -> np.ndar
         return [zd, zdd, bouc_wen_rate(w, zd, bw)]
 
     out = np.zeros((t.size, 3))
-    out[0] = [z0, 0.0, 0.0]
+    out[0] = [z0, 0.0, w0]
     for j in range(1, t.size):
         slope = (a[j] - a[j - 1]) / (t[j] - t[j - 1])
         sol = solve_ivp(
@@ -287,8 +294,14 @@ def test_single_dof_hysteresis_loop_through_the_engine_matches_an_independent_in
     out = engine.run(SampleBatch(t, accel, np.zeros((t.size, 3)), ["imu"] * t.size))
     assert len(out) == t.size
 
-    z0 = brentq(lambda z: RATIO * (K1Z * z + K3Z * z**3) + MASS * G, -0.1, 0.0, xtol=1e-16)
-    ref = loop_reference(t, a, z0, bw)
+    # the start: at rest under gravity, its w on the loading curve (set down slowly)
+    z0 = brentq(
+        lambda z: RATIO * (K1Z * z + K3Z * z**3) + (1.0 - RATIO) * K1Z * virgin_w(z, n) + MASS * G,
+        -0.1,
+        0.0,
+        xtol=1e-16,
+    )
+    ref = loop_reference(t, a, z0, virgin_w(z0, n), bw)
     z_twin = out.pose[:, 2] - CG_Z
     swing = np.max(np.abs(ref[:, 0] - z0))
     assert swing > 2.0 * Z_MAX, "the base motion should drive the mount through full loops"

@@ -10,6 +10,7 @@ import numpy as np
 from mount_twin.errors import ModelError, require
 from mount_twin.kinds import CODES, KINDS, N_PAR, check_dispatch
 from mount_twin.model import newton
+from mount_twin.model.loading import VirginAxes, virgin_axes
 from mount_twin.physics.dynamics import (
     INPUT_SIZE,
     OK,
@@ -19,6 +20,7 @@ from mount_twin.physics.dynamics import (
     new_scratch,
     rhs,
 )
+from mount_twin.physics.jacobian import STEP as CENTRAL_STEP
 from mount_twin.physics.jacobian import central_columns
 from mount_twin.physics.rotations import rpy_matrices, rpy_matrix
 from mount_twin.scene.built import check_built
@@ -178,7 +180,8 @@ def initial_state(
     steadily at `rate_rad_s` (Ω, rad/s, F): the body then rests relative to the foundation,
     its mounts carrying the centrifugal load too (a deck that rolls at the first sample).
     `internal`: the mounts' internal states to start with (a restart keeps a broken bolt
-    broken and a yielded one stretched); None: all zero, a new machine.
+    broken and a yielded one stretched); None: a new machine, its internal states zero but its
+    hysteretic ones on their loading curves (`model.loading`) in equilibrium mode.
     """
     scene = model.scene
     nf = len(scene.dofs)
@@ -190,7 +193,7 @@ def initial_state(
         y0[2 * nf :] = internal
     if scene.initial.mode == "given":
         return y0
-    return static_equilibrium(model, y0, specific_force, rate_rad_s)
+    return static_equilibrium(model, y0, specific_force, rate_rad_s, loaded=internal is None)
 
 
 def static_equilibrium(
@@ -198,11 +201,14 @@ def static_equilibrium(
     y_guess: np.ndarray,
     specific_force: np.ndarray,
     rate_rad_s: np.ndarray | None = None,
+    *,
+    loaded: bool = False,
 ) -> np.ndarray:
     """State at rest relative to F where the free generalized accelerations vanish (Newton on
     the coordinates from those of `y_guess`; least squares where Newton does not get there),
     the foundation turning at `rate_rad_s` (rad/s, F; None: not turning); internal mount
-    states as in `y_guess`."""
+    states as in `y_guess`, but with `loaded` each hysteretic one on its axis's loading curve
+    at the pose (`model.loading`: a new machine set down slowly)."""
     nf = len(model.scene.dofs)
     q_guess = y_guess[:nf]
     m, s = model.arrays, model.new_scratch()
@@ -211,15 +217,25 @@ def static_equilibrium(
     y[2 * nf :] = y_guess[2 * nf :]
     dydt = np.zeros(model.n_state)
     by_q, work = np.empty((model.n_state, nf)), np.empty((2, model.n_state))
+    virgin = virgin_axes(m) if loaded else None
+    deflection = np.empty((0 if m.nl is None else m.nl.kind.shape[0], 3))
+
+    def at(q: np.ndarray) -> None:
+        """y at the pose q (its hysteretic states on their loading curves, where loaded)."""
+        y[:nf] = q
+        if virgin is not None:
+            y[virgin.state] = virgin.z(virgin.deflections(y, m, s, deflection))
 
     def accelerations(q: np.ndarray) -> np.ndarray:
-        y[:nf] = q
+        at(q)
         if rhs(0.0, y, m, s, u, dydt) != OK:
             return np.full(nf, 1e6)
         return dydt[nf : 2 * nf].copy()
 
     def stiffness(q: np.ndarray) -> np.ndarray:
         """∂(accelerations)/∂q; NaN off the chart (Newton then gives up)."""
+        if virgin is not None:
+            return _loaded_stiffness(virgin, q, y, u, m, s, deflection)
         y[:nf] = q
         if not central_columns(y, 0.0, m, s, u, work[0], work[1], by_q):
             return np.full((nf, nf), np.nan)
@@ -245,8 +261,49 @@ def static_equilibrium(
         )
         raise ModelError(msg)
     _check_restrained(model, jac)
-    y[:nf] = q
+    at(q)
     return y.copy()
+
+
+def _loaded_stiffness(
+    virgin: VirginAxes,
+    q: np.ndarray,
+    y: np.ndarray,
+    u: np.ndarray,
+    m: ModelArrays,
+    s: Scratch,
+    deflection: np.ndarray,
+) -> np.ndarray:
+    """∂(free generalized accelerations)/∂q with each hysteretic state on its loading curve,
+    z = Z(x(q)): central differences along the curve's tangent (e_c, Z'(x)·∂x/∂q_c), as
+    `central_columns` takes them along e_c (the same relative step); NaN off the chart. y:
+    the state to move (left at q's states)."""
+    nf = q.shape[0]
+    y[:nf] = q
+    z = virgin.z(virgin.deflections(y, m, s, deflection))
+    slope = virgin.slope(z)
+    jac = np.empty((nf, nf))
+    dydt = np.empty(y.shape[0])
+    for col in range(nf):
+        h = (q[col] + CENTRAL_STEP * max(1.0, abs(q[col]))) - q[col]
+        ends = []
+        for sign in (1.0, -1.0):
+            y[:nf] = q
+            y[col] += sign * h
+            ends.append(virgin.deflections(y, m, s, deflection))
+        dz = slope * (ends[0] - ends[1]) / (2.0 * h)
+        rates = []
+        for sign in (1.0, -1.0):
+            y[:nf] = q
+            y[col] += sign * h
+            y[virgin.state] = z + sign * h * dz
+            if rhs(0.0, y, m, s, u, dydt) != OK:
+                return np.full((nf, nf), np.nan)
+            rates.append(dydt[nf : 2 * nf].copy())
+        jac[:, col] = (rates[0] - rates[1]) / (2.0 * h)
+    y[:nf] = q
+    y[virgin.state] = z
+    return jac
 
 
 def _allowed_residual(

@@ -201,6 +201,9 @@ outputs = _core.outputs
 """`evaluate` when s already holds the body motion at y (the last `rhs` was at y)."""
 mount_wrenches = _core.mount_wrenches
 """mount_wrenches(y, m, s, wrenches): each mount's force (N) and couple (N·m), in its axes."""
+mount_deflections = _core.mount_deflections
+"""mount_deflections(y, m, s, d) -> cos θ: each non-linear mount's deflection (m) in its axes
+at y into d (k, 3); NaN off the chart (d not written)."""
 linear_utilisation = _core.linear_utilisation
 """linear_utilisation(y, m, s, wrenches, peak): fold each linear mount's utilisation at the
 body motion of y that s holds (the largest over its axes of |travel| / rated travel and

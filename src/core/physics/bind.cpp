@@ -94,6 +94,16 @@ void bind_physics(py::module_& mod) {
       "its wrenches in their axes) into peak, its running maxima.",
       py::arg("y"), py::arg("m"), py::arg("s"), py::arg("wrenches"), py::arg("peak"));
   mod.def(
+      "mount_deflections",
+      [](py::handle y_, py::handle m_, py::handle s_, py::handle d_) {
+        auto [m, s, y] = call(m_, s_, y_);
+        if (!m.has_nl) throw py::value_error("mount_deflections: the model has no non-linear mounts");
+        return physics::mount_deflections(y, m, s, convert::matc<3>(d_, "d", m.nl.k));
+      },
+      "Each non-linear mount's deflection (m, its axes) at y into d (k, 3); returns cos θ "
+      "(NaN off the chart, d not written).",
+      py::arg("y"), py::arg("m"), py::arg("s"), py::arg("d"));
+  mod.def(
       "mount_monitors",
       [](py::handle y_, py::handle y0_, py::handle nl_, py::handle s_, py::handle g_,
          py::handle util_) {

@@ -198,6 +198,20 @@ inline void mount_wrenches(Vec y, const Model& m, Scratch& s, M6 wrenches) {
   }
 }
 
+/// Each non-linear mount's deflection in its own axes (m) at y into d (k, 3) (the start of
+/// hysteretic mounts on their loading curve reads it: model/loading.py). Returns cos θ (NaN
+/// off the chart: d is then not written).
+inline double mount_deflections(Vec y, const Model& m, Scratch& s, M3 d) {
+  const double ct = body_motion(y, m, s);
+  if (!(ct > 0.0)) return NAN;
+  const Motion mo = Motion::of(s);
+  for (idx i = 0; i < m.nl.k; ++i) {
+    local_motion(i, m.nl, mo, s);
+    for (int j = 0; j < 3; ++j) d(i, j) = s.loc(0, j);
+  }
+  return ct;
+}
+
 /// Event functions g (k, NE) and utilisation util (k) of each non-linear mount at y (its body
 /// motion computed); then their discrete switches. Returns whether one switched (y jumped).
 inline bool mount_monitors(Vec y, Vec y0, const NonLinear& nl, Scratch& s, Mat g, Vec util) {
