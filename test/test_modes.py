@@ -340,12 +340,15 @@ def test_frequencies_equal_those_of_the_twins_linearised_right_hand_side() -> No
 
 # ------------------------------------------------------------------ non-linear kinds
 def test_elastomers_enter_by_their_tangent_with_the_bouc_wen_branch() -> None:
-    """Four elastomers (cubic backbone, Bouc–Wen share 1 − a) at (±a, ±b) in the CG's plane.
-    At rest z = 0 and the backbone carries the weight: a·(k₁x₀ + k₃x₀³) = −m·g/4. For small
-    motions ż = A·ẋ, so the vertical tangent is a·(k₁ + 3k₃x₀²) + (1 − a)·k₁·A: bounce
+    """Four elastomers (cubic backbone, Bouc–Wen share 1 − a) at (±a, ±b) in the CG's plane,
+    set down slowly: at rest z₀ = Z(x₀) on the loading curve (n = 1: Z(x) = (A/c)·(1 − e^(−c·x))
+    for x ≥ 0, odd, c = β + γ), and a·(k₁x₀ + k₃x₀³) + (1 − a)·k₁·z₀ = −m·g/4. ż's slope in ẋ
+    there is A − (β + γ)·|z₀| loading and A + (β − γ)·|z₀| unloading, entering with their mean
+    A − γ·|z₀|: the vertical tangent is a·(k₁ + 3k₃x₀²) + (1 − a)·k₁·(A − γ·|z₀|): bounce
     √(4k_t/m)/2π, pitch √(4k_t·a²/I_yy)/2π. The same frequencies come from the twin's state
-    Jacobian with the z states in it (their zero eigenvalues left out)."""
+    Jacobian at its start with the z states in it (their zero eigenvalues left out)."""
     m_, a, b, k1, k3, share, big_a = 400.0, 0.5, 0.3, 4.0e5, 1.0e10, 0.7, 1.2
+    beta, gamma = 40.0, 30.0
     inertia = [30.0, 50.0, 70.0, 0.0, 0.0, 0.0]
     layout = [
         kind_mount(
@@ -354,13 +357,23 @@ def test_elastomers_enter_by_their_tangent_with_the_bouc_wen_branch() -> None:
             p,
             stiffness_linear=[2.0e5, 2.0e5, k1],
             stiffness_cubic=[0.0, 0.0, k3],
-            hysteresis={"ratio": share, "A": big_a, "beta": 40.0, "gamma": 30.0},
+            hysteresis={"ratio": share, "A": big_a, "beta": beta, "gamma": gamma},
         )
         for i, p in enumerate(corners(a, b))
     ]
     data = base_scene(m_, [0.0, 0.0, 0.0], inertia, layout)
-    x0 = brentq(lambda x: share * (k1 * x + k3 * x**3) + m_ * G / 4, -0.1, 0.0)
-    kt = share * (k1 + 3 * k3 * x0 * x0) + (1 - share) * k1 * big_a
+
+    def z_of(x: float) -> float:
+        return math.copysign(big_a / (beta + gamma) * -math.expm1(-(beta + gamma) * abs(x)), x)
+
+    x0 = brentq(
+        lambda x: share * (k1 * x + k3 * x**3) + (1 - share) * k1 * z_of(x) + m_ * G / 4,
+        -0.1,
+        0.0,
+        xtol=1e-16,
+    )
+    assert abs(z_of(x0)) > 0.8 * abs(x0) * big_a  # off the curve's linear start: it counts
+    kt = share * (k1 + 3 * k3 * x0 * x0) + (1 - share) * k1 * (big_a - gamma * abs(z_of(x0)))
     result = analyse(data)
     assert by_dominant(result, "z").frequency_hz == pytest.approx(
         math.sqrt(4 * kt / m_) / TWO_PI, rel=1e-6

@@ -3,7 +3,9 @@
 Everything comes from the twin itself, so every mount kind enters as it is simulated:
 
 - Equilibrium: the model's own solver (`static_equilibrium`) under the scene's nominal gravity
-  (specific force g along +z of F, foundation at rest), the mounts' internal states at zero.
+  (specific force g along +z of F, foundation at rest), as the twin starts a new machine: the
+  mounts' internal states at zero but the hysteretic ones on their loading curves
+  (`model.loading`).
 - Linearisation: central differences (`model.stiffness.jacobian`) of the twin's right-hand side
   about it give ∂q″/∂q, ∂q″/∂q′, ∂q″/∂s and ∂s′/∂q′ (q: the free coordinates, m and rad; s: the
   mounts' internal states). The kinds expose no closed tangent, so this is how elastomers,
@@ -12,7 +14,8 @@ Everything comes from the twin itself, so every mount kind enters as it is simul
   with zero clearance and no load) enters with the mean of its two slopes. Internal states are
   rate-independent (Bouc–Wen z, slip, plastic elongation): at rest s′ = S·q′, so for small
   motions s − s_eq = S·(q − q_eq), and their forces add to the stiffness (a Bouc–Wen axis at z
-  = 0 adds (1 − a)·k₀·A to its tangent a·F_el′).
+  adds (1 − a)·k₀·(A − γ·|z|ⁿ) to its tangent a·F_el′: the mean of its loading and unloading
+  slopes, A − (β + γ)·|z|ⁿ and A + (β − γ)·|z|ⁿ, which meet at z = 0).
 - Matrices, in the generalized coordinates q (the twin's: X, Y, Z of the CG and the chart angles
   α, γ, δ; units kg, kg·m², N/m, N/rad, N·m/rad, N·s/m, N·m·s/rad): with P (6×n) the map from
   q′ to the CG velocity and the angular velocity in F at equilibrium (P = blockdiag(1, R·B), R
@@ -192,7 +195,7 @@ def modes(scene: Scene, *, geometric: bool = True) -> Modes:
     model = assemble(scene)
     nf = len(scene.dofs)
     g_up = np.array([0.0, 0.0, scene.input.g])
-    y_eq = static_equilibrium(model, np.zeros(model.n_state), g_up)
+    y_eq = static_equilibrium(model, np.zeros(model.n_state), g_up, loaded=True)
     jac = jacobian(model, y_eq, gravity_input(0.0, g_up))
     q, v, s = slice(0, nf), slice(nf, 2 * nf), slice(2 * nf, model.n_state)
     q6 = model.arrays.q_fixed.copy()
