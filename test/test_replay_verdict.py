@@ -63,6 +63,24 @@ def test_a_replay_whose_integration_fails_is_failed_with_its_count_and_cause(
     assert "too many substeps" in err
     help_text = _help(capsys)
     assert "6 FAILED" in help_text
+    # its report says so, and exits as the replay did (it exited 0 whatever the run)
+    page = tmp_path / "r.html"
+    assert main(["report", str(tmp_path / "out"), "-o", str(page), "--fail-on", "never"]) == 6
+    assert f"<h2>Verdict: FAILED ({n} integration failures)</h2>" in page.read_text("utf-8")
+    assert f"mount-twin: error: {n} integration failures" in capsys.readouterr().err
+
+
+def test_a_report_exits_as_its_runs_diagnostics_reach_fail_on(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The genset's shock opens its joints: an ERROR run, which exits 0 unless --fail-on."""
+    code, doc, out = _replay(tmp_path, GENSET, GENSET_BAG)
+    assert code == 0 and doc["verdict"] == "ERROR"
+    page = str(tmp_path / "r.html")
+    assert main(["report", str(out), "-o", page]) == 0
+    assert main(["report", str(out), "-o", page, "--fail-on", "error"]) == 4
+    assert "mount-twin: diagnostics reached ERROR (--fail-on error)" in capsys.readouterr().err
+    assert main(["report", str(out), "-o", page, "--fail-on", "warn"]) == 4
 
 
 def _help(capsys: pytest.CaptureFixture[str]) -> str:
@@ -150,7 +168,8 @@ def test_the_report_of_a_run_that_accepted_nothing_says_so_and_why_in_its_headin
     assert said.startswith(f"no input sample was accepted ({why}")
     capsys.readouterr()
     page = tmp_path / "r.html"
-    assert main(["report", str(out), "--scene", str(PUMP), "-o", str(page)]) == 0
+    assert main(["report", str(out), "--scene", str(PUMP), "-o", str(page)]) == 3  # as replay
+    assert f"mount-twin: error: {said}" in capsys.readouterr().err
     text = html.unescape(page.read_text(encoding="utf-8"))
     assert f"<h2>Verdict: ERROR: {said}</h2>" in text
     assert not re.search(r"\bnan\b", text, re.IGNORECASE)

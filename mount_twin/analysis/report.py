@@ -11,7 +11,7 @@ from __future__ import annotations
 import html
 import json
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -79,40 +79,54 @@ def _nothing_accepted(diagnostics: Table | None) -> str:
     return nothing_accepted(counts, values.get("last_wrong_frame_id"))
 
 
-def _verdict(diagnostics: Table | None, nothing: str) -> tuple[str, dict[str, str]]:
+class RunVerdict(NamedTuple):
+    """A run's verdict as its output bag's diagnostics tell it.
+
+    text: as the page heads it; worst_level: the worst diagnostics level over the run (index
+    in LEVEL_NAMES; None: the bag holds no diagnostics); failure: how often the integration
+    failed ('' if never: else the run is FAILED); nothing: why no input sample was accepted
+    ('' if some were)."""
+
+    text: str
+    worst_level: int | None
+    failure: str
+    nothing: str
+
+
+def _verdict(diagnostics: Table | None, nothing: str) -> tuple[RunVerdict, dict[str, str]]:
     """The run's verdict from its diagnostics (FAILED if the integration ever failed, else the
     worst level of any status but the live-only `mount_twin: ros`, with `nothing`: why no
     input sample was accepted, if none was), and the last integration status' values."""
     if diagnostics is None or not len(diagnostics):
-        return "no diagnostics in the bag", {}
+        return RunVerdict("no diagnostics in the bag", None, "", nothing), {}
     c = diagnostics.columns
     worst = OK
     for status, level in zip(c["status"], c["level"], strict=True):
         if status != "mount_twin: ros" and level in LEVEL_NAMES:
             worst = max(worst, LEVEL_NAMES.index(level))
     integration = integration_values(diagnostics)
-    if int(integration.get("failures_total", "0")):
-        return f"{FAILED} ({integration['failures_total']} integration failures)", integration
+    if failures := int(integration.get("failures_total", "0")):
+        failure = f"{failures} integration failures"
+        return RunVerdict(f"{FAILED} ({failure})", worst, failure, nothing), integration
     if nothing:
-        return f"{LEVEL_NAMES[worst]}: {nothing}", integration
-    return LEVEL_NAMES[worst], integration
+        return RunVerdict(f"{LEVEL_NAMES[worst]}: {nothing}", worst, "", nothing), integration
+    return RunVerdict(LEVEL_NAMES[worst], worst, "", nothing), integration
 
 
 def _provenance_section(
-    diagnostics: Table | None,
+    verdict: RunVerdict,
+    integration: dict[str, str],
     output_bag: str | Path,
     input_path: str | Path | None,
     scene: Scene | None,
-    nothing: str,
     input_note: str = "",
 ) -> list[str]:
-    """The verdict (with `nothing`: why no input sample was accepted, if none was), what
-    produced the page from what (with `input_note` on the input bag: what of it was left
-    out), the solver's settings and estimated error, and the scene as loaded."""
-    verdict, integration = _verdict(diagnostics, nothing)
+    """The verdict, what produced the page from what (with `input_note` on the input bag:
+    what of it was left out), the solver's settings and estimated error (`integration`: the
+    last integration status' values), and the scene as loaded."""
     partial = partial_marker(output_bag)
     rows = [
-        ["verdict (worst over the run)", verdict],
+        ["verdict (worst over the run)", verdict.text],
         *([["partial run", f"the bag stops early: {partial}"]] if partial else []),
         ["produced by", produced_by()],
         ["output bag", f"{output_bag} ({fingerprint(Path(output_bag))})"],
@@ -147,7 +161,7 @@ def _provenance_section(
                 f"attitude {integration.get('est_attitude_error_rad_run', '?')} rad",
             ]
         )
-    heading = f"Verdict: {verdict}" + (" (partial run)" if partial else "")
+    heading = f"Verdict: {verdict.text}" + (" (partial run)" if partial else "")
     out = [f"<h2>{html.escape(heading)}</h2>", html_table(["", ""], rows)]
     if scene is not None:
         out += scene_section(scene)
@@ -160,17 +174,18 @@ def _srs_section(
     design: tuple[list[float], list[float]] | None = None,
     tolerance_db: tuple[float, float] = TOLERANCE_DB,
     design_name: str = "",
-) -> list[str]:
+) -> tuple[list[str], bool | None]:
     """The input's shock response spectra (5 % damping; gravity and bias taken out as
     `mount-twin srs` does by default, the mean of a quiet head), per axis of F; with a design
     spectrum (Hz, g), the design on the plot, each axis's margin (dB) in the table and its
-    PASS/FAIL line (`analysis.design_margin`, as `mount-twin srs --design`)."""
+    PASS/FAIL line (`analysis.design_margin`, as `mount-twin srs --design`). Also whether
+    every axis passed (None: nothing judged)."""
     from mount_twin.analysis.srs import gravity_offset, octave_frequencies, srs
 
     t = (stamps_ns - stamps_ns[0]) * 1e-9
     rate = (len(t) - 1) / float(t[-1]) if len(t) > 1 and t[-1] > 0 else 0.0
     if rate <= 0.0:
-        return []
+        return [], None
     freqs = octave_frequencies(5.0, min(2000.0, rate / 10.0), 6)
     offset, removed = gravity_offset(t, f)
     spectra = {axis: srs(f[:, k] - offset[k], rate, freqs, 0.05) for k, axis in enumerate("xyz")}
@@ -189,12 +204,13 @@ def _srs_section(
         f"<p><b>design {html.escape(design_name)}</b>, axis {a}: {html.escape(c.summary())}</p>"
         for a, c in checks.items()
     ]
-    return [
+    sections = [
         f"<h2>Shock response spectra of the input (ζ = 5 %, {html.escape(removed)} removed)</h2>",
         *verdicts,
         png(lambda fig: _draw_srs(fig, spectra, design), (9, 4.5)),
         html_table(head, _srs_rows(freqs, spectra, checks)),
     ]
+    return sections, (all(c.passed for c in checks.values()) if checks else None)
 
 
 def _draw_srs(
@@ -284,7 +300,7 @@ def write_report(
     design: tuple[list[float], list[float]] | None = None,
     tolerance_db: tuple[float, float] = TOLERANCE_DB,
     design_name: str = "",
-) -> Path:
+) -> ReportPage:
     """Write the report page. `input_samples`: (stamps ns, specific force (n, 3) m/s² in F) of
     the record, to plot beside the response, every value finite; `input_path`: the record's
     bag, hashed for its provenance; `input_note`: what of it was left out (its samples not
@@ -308,8 +324,9 @@ def write_report(
         title += f" (input {input_name})"
     sections = [f"<h1>{html.escape(title)}</h1>"]
     nothing = _nothing_accepted(diagnostics)
+    verdict, integration = _verdict(diagnostics, nothing)
     sections += _provenance_section(
-        diagnostics, output_bag, input_path, scene, nothing, input_note
+        verdict, integration, output_bag, input_path, scene, input_note
     )
     if "pose" in tables and "angles" in tables:
         sections += [
@@ -324,8 +341,12 @@ def write_report(
             "<h2>Utilisation</h2>",
             png(lambda fig: _draw_utilisation(fig, utilisation, kinds), (10, 4)),
         ]
+    design_passed = None
     if input_samples is not None:
-        sections += _srs_section(*input_samples, design, tolerance_db, design_name)
+        srs_sections, design_passed = _srs_section(
+            *input_samples, design, tolerance_db, design_name
+        )
+        sections += srs_sections
     if scene is not None:
         sections += _modes_section(scene)
     if "pose" in tables:
@@ -343,7 +364,16 @@ def write_report(
     ]
     out = Path(html_path)
     write_text(out, page(title, sections))
-    return out
+    return ReportPage(out, verdict, design_passed)
+
+
+class ReportPage(NamedTuple):
+    """A report written: its file, the run's verdict, and whether the input's spectra passed
+    the design (None: no design judged them)."""
+
+    path: Path
+    verdict: RunVerdict
+    design_passed: bool | None
 
 
 def _check_scene_is_the_bags(scene: Scene, in_bag: set[str], output_bag: str | Path) -> None:

@@ -163,19 +163,27 @@ EXIT_NOTHING_ACCEPTED, EXIT_FAIL_ON, EXIT_FAILED = 3, 4, 6
 
 
 def verdict(summary: ReplaySummary, fail_on: str) -> int:
-    """The exit status of a replay: 3 if no input sample was accepted (saying why: the bag
-    holds some, `InputBag` saw to it), 6 if the integration failed (FAILED), 4 if the run's
-    worst diagnostics level reached `fail_on`, else 0."""
-    if nothing := summary.nothing_accepted():
+    """The exit status of a replay (`run_exit_status`; the bag holds input samples, `InputBag`
+    saw to it, so none accepted says why)."""
+    return run_exit_status(
+        summary.nothing_accepted(), summary.failure, summary.worst_level, fail_on
+    )
+
+
+def run_exit_status(nothing: str, failure: str, worst_level: int, fail_on: str) -> int:
+    """The exit status of a run, saying why on stderr: 3 if no input sample was accepted
+    (`nothing`: why), 6 if the integration failed (FAILED; `failure`: how often and why), 4 if
+    its worst diagnostics level (an index in LEVEL_NAMES) reached `fail_on`, else 0."""
+    if nothing:
         print(f"mount-twin: error: {nothing}", file=sys.stderr)
         return EXIT_NOTHING_ACCEPTED
-    if summary.failure:
-        print(f"mount-twin: error: {summary.failure}", file=sys.stderr)
+    if failure:
+        print(f"mount-twin: error: {failure}", file=sys.stderr)
         return EXIT_FAILED
-    if fail_on != "never" and summary.worst_level >= FAIL_ON.index(fail_on):
+    if fail_on != "never" and worst_level >= FAIL_ON.index(fail_on):
         from mount_twin.engine.batch import LEVEL_NAMES
 
-        level = LEVEL_NAMES[summary.worst_level]
+        level = LEVEL_NAMES[worst_level]
         print(f"mount-twin: diagnostics reached {level} (--fail-on {fail_on})", file=sys.stderr)
         return EXIT_FAIL_ON
     return 0

@@ -3,18 +3,30 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from typing import TYPE_CHECKING
 
+from mount_twin.commands.replay import EXIT_FAIL_ON, FAIL_ON, run_exit_status
 from mount_twin.commands.srs import add_design_arguments, tolerance_of
 
 if TYPE_CHECKING:
+    from mount_twin.analysis.report import ReportPage
     from mount_twin.io.messages import Decoded
 
 NAME = "report"
 HELP = "one HTML page of a replay: input and response, signed mount forces, utilisation, events"
+EXIT_STATUS = (
+    "exit status: 0 done; 2 bad input, a failed write (the message names the file), or "
+    "--fail-on on a bag without diagnostics; 3 the run accepted no input sample; 4 the run's "
+    "diagnostics reached --fail-on, or with --design a spectrum out of the design's "
+    "tolerance somewhere; 6 the run FAILED (its integration failed), whatever --fail-on says. "
+    "3, 4 and 6 are the replay's for the run, and the page is written; a partial run is "
+    "warned of on stderr"
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.epilog = EXIT_STATUS
     parser.add_argument("bag", help="output bag of `mount-twin replay`")
     parser.add_argument("-o", "--output", default="report.html", help="HTML file to write")
     parser.add_argument("--scene", help="the replay's scene YAML (mount kinds, names)")
@@ -24,7 +36,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_design_arguments(
         parser,
         "the input's spectra (--input) are judged against it: the design on their plot, the "
-        "margins in their table, a PASS/FAIL line per axis",
+        "margins in their table, a PASS/FAIL line per axis, exit 4 on FAIL",
+    )
+    parser.add_argument(
+        "--fail-on",
+        choices=FAIL_ON,
+        default="never",
+        help="exit 4 if the worst diagnostics level of the run reaches this (default: never); "
+        "a FAILED run exits 6 whatever this says",
     )
 
 
@@ -73,8 +92,22 @@ def run(args: argparse.Namespace) -> int:
         tolerance_db=tolerance,
         design_name=Path(args.design).name if args.design else "",
     )
-    print(f"report: {out}")
-    return 0
+    print(f"report: {out.path}")
+    return _exit_status(out, args.fail_on)
+
+
+def _exit_status(out: ReportPage, fail_on: str) -> int:
+    """The run's exit status as `mount-twin replay` gave it (`run_exit_status`), else 4 where
+    the design judged a spectrum FAIL."""
+    v = out.verdict
+    if v.worst_level is None and fail_on != "never":
+        msg = f"--fail-on {fail_on}: the bag holds no diagnostics to judge"
+        raise ValueError(msg)
+    status = run_exit_status(v.nothing, v.failure, v.worst_level or 0, fail_on)
+    if status == 0 and out.design_passed is False:
+        print("mount-twin: the input's spectra FAIL the design (--design)", file=sys.stderr)
+        return EXIT_FAIL_ON
+    return status
 
 
 def finite_input(path: str, topic: str, decoded: Decoded) -> tuple[Decoded, str]:
