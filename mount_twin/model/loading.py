@@ -29,7 +29,7 @@ from mount_twin.kinds import ELASTOMER, elastomer
 from mount_twin.physics.dynamics import ModelArrays, Scratch, mount_deflections
 
 BISECTIONS = 64
-"""Halvings of [0, 1) for z/z_u: past the 53 bits of a double."""
+"""Halvings of the bracket of z/z_u: past the 53 bits of a double."""
 
 
 @dataclass(frozen=True)
@@ -70,7 +70,11 @@ def virgin_z(a: np.ndarray, c: np.ndarray, n: np.ndarray, x: np.ndarray) -> np.n
 
     z_u = (a / c) ** (1.0 / n)
     target = np.abs(x)
-    lo, hi = np.zeros_like(target), np.ones_like(target)
+    # z/z_u is bracketed by n = 1's curve below (dz/dx = A·(1 − (z/z_u)ⁿ) ≥ A·(1 − z/z_u)) and
+    # the tangent at 0 above: a bracket as narrow as z is small, so the halvings resolve z
+    # relative to itself, not to z_u
+    reach = a * target / z_u
+    lo, hi = -np.expm1(-reach), np.minimum(reach, 1.0)
     for _ in range(BISECTIONS):
         mid = 0.5 * (lo + hi)
         reached = z_u * mid / a * hyp2f1(1.0, 1.0 / n, 1.0 + 1.0 / n, mid**n)
