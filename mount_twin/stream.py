@@ -13,9 +13,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from mount_twin.engine.batch import HealthReport, OutputBatch
+from mount_twin.engine.batch import ERROR, HealthReport, OutputBatch
 from mount_twin.engine.body_check import BodyCheck, BodyComparison
 from mount_twin.engine.engine import TwinEngine
+from mount_twin.engine.health import ENDED, INPUT
 from mount_twin.engine.intake import rising, rotated
 from mount_twin.errors import require
 from mount_twin.io.messages import (
@@ -312,6 +313,23 @@ class TwinStream:
         stamped `stamp_ns` (the clock: there is no input stamp to answer)."""
         self._stalled_ns = max(self._stalled_ns, stamp_ns)
         return [encode_report(self.scene, self.engine.report_stalled(waited_s), stamp_ns)]
+
+    def ended_without_input(self, source: str, stamp_ns: int) -> list[tuple[str, int, bytes]]:
+        """The last report of a live stream that never received an input message (`finish`
+        has none to give: its period is empty), stamped `stamp_ns` (the node's clock) or the
+        last stall report's stamp if later: the stall report's statuses, the input status an
+        ERROR saying `no input received on <source>`, with its counts (received 0). Live only:
+        a replay of a bag without input has no stamp to put it at (its summary says so)."""
+        report = self.engine.report_stalled(ENDED)
+        report.statuses = [
+            replace(s, level=ERROR, message=f"no input received on {source}")
+            if s.name == INPUT
+            else s
+            for s in report.statuses
+        ]
+        self.final_report = report
+        stamp_ns = max(stamp_ns, self._stalled_ns)
+        return [encode_report(self.scene, report, stamp_ns)]
 
     def finish(self) -> list[Encoded]:
         """The end of the stream (end of a bag, node shutdown): the outputs the gyro delay

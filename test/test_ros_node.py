@@ -337,6 +337,60 @@ def test_diagnostics_go_out_every_clock_period_without_input() -> None:
     assert ros and ros[-1][0] == ERROR and ACCEL in ros[-1][1], ros
 
 
+@pytest.mark.parametrize(
+    ("stall_period_s", "sig"),
+    [("0.5", signal.SIGINT), ("3600.0", signal.SIGTERM)],
+    ids=["after_stall_reports", "before_any_stall_report"],
+)
+def test_a_node_stopped_without_input_says_so_in_its_last_report(
+    stall_period_s: str, sig: int
+) -> None:
+    """A node that never received an input message (here: listening on a topic nobody
+    publishes, a sensor on /deck/imu beside it) publishes, at its SIGINT or SIGTERM, a last
+    report: the input ERROR, naming the topic and type it listened on, received 0, after the
+    stall reports (never stamped before them) or alone where it was stopped before the first;
+    exit 0. It published nothing at shutdown: a monitor kept the last stall report, or, for a
+    node stopped within its first stall period, nothing at all, never learning why."""
+    domain = fresh_domain()
+    peer = Peer(domain)
+    peer.record({"/diagnostics": DIAGNOSTICS})
+    sensor = peer.publisher(IMU, "/deck/imu")  # not the topic the node listens on
+    args = ["--params-file", str(PARAMS_FILE), "-p", "input.topic:=/deck/imu_raw"]
+    node = NodeProcess(domain, [*args, "-p", f"stall_period_s:={stall_period_s}"])
+    try:
+        if stall_period_s == "0.5":  # the reports prove the diagnostics reach the peer
+            assert peer.take_until(lambda: len(peer.got["/diagnostics"]) >= 2, 60.0), node.stop()
+        else:  # discovered both ways (the node waits for a matched subscriber's ack)
+            assert wait_for(lambda: peer.connected("/diagnostics"), 60.0), node.failed()
+            peer.take_until(lambda: False, 1.0)
+            assert peer.got["/diagnostics"] == []  # no stall period has passed
+        for raw in _imu(*_at_rest(10)):
+            sensor.publish(raw)
+        stalls = len(peer.got["/diagnostics"])
+        code = stop_and_take(node, peer, lambda: len(peer.got["/diagnostics"]) > stalls, sig)
+    finally:
+        node.stop(signal.SIGKILL)
+        peer.close()
+    assert code == 0, node.stderr
+    assert "Traceback" not in node.stderr, node.stderr
+    reports = diagnostics(peer.got["/diagnostics"])
+    assert len(reports) >= stalls + 1, node.stderr
+    *before, (stamp, statuses) = reports
+    assert all(s <= stamp for s, _ in before)  # /diagnostics never goes back
+    by_name = {name: (level, msg, values) for name, level, msg, values in statuses}
+    level, msg, values = by_name["mount_twin: input"]
+    assert level == ERROR, msg
+    assert msg.startswith(f"no input received on /deck/imu_raw ({IMU}) over the node's life"), msg
+    assert (values["received"], values["accepted"], values["topic"]) == ("0", "0", "/deck/imu_raw")
+    # the statuses of every report: the input's, integration, attitude, one per mount
+    stall_names = [[n for n, *_ in st] for _, st in before]
+    assert all(names == [n for n, *_ in statuses] for names in stall_names)
+    assert len(statuses) == 3 + 8
+    if before:  # the stall reports, unchanged: ERROR, "no input received for 500 ms"
+        stalled = [{n: (lv, m) for n, lv, m, _ in st}["mount_twin: input"] for _, st in before]
+        assert all(s == (ERROR, "no input received for 500 ms") for s in stalled), stalled
+
+
 def _node_parameters(
     args: list[str], set_mass: bool = False
 ) -> tuple[list[str], list, list, list]:

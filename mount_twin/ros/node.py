@@ -343,13 +343,23 @@ class MountTwinNode(Node):
 
     def finish(self) -> None:
         """Take what is still waiting, process the queue, publish the last, partial
-        diagnostics period, and wait (up to SHUTDOWN_ACK_S) until every reliable subscriber
-        has acknowledged it all; a topic still unacknowledged then is named in a warning."""
+        diagnostics period (where no input message ever came, a last report saying so, on
+        which topic, at ERROR: a run that produced nothing never reads as fine), and wait (up
+        to SHUTDOWN_ACK_S) until every reliable subscriber has acknowledged it all; a topic
+        still unacknowledged then is named in a warning."""
         self._pending.extend(take_waiting(self._sub, TAKE_LIMIT))
         self._drain()
         if self._body_sub is not None:
             self._publish(self.stream.process_body(take_waiting(self._body_sub, TAKE_LIMIT)))
         self._publish(messages_of(self.stream.finish()))
+        if not self.stream.engine.counts["received"]:  # nothing to report on: say so, ERROR
+            life = time.monotonic() - self._started
+            source = (
+                f"{self._sub.topic_name} ({self.scene.input.msg_type}) over the node's life "
+                f"({life:.1f} s)"
+            )
+            now = self.get_clock().now().nanoseconds
+            self._publish(self.stream.ended_without_input(source, now))
         self._submit_fits()
         self._publish_fits(wait=True)
         deadline = time.monotonic() + SHUTDOWN_ACK_S
