@@ -468,6 +468,25 @@ def test_stall_with_only_rejected_samples_says_why(n_nan: int) -> None:
     assert not eng.running
 
 
+def test_the_end_after_a_stall_report_says_what_came_before_it() -> None:
+    """Rejected samples only, a stall report that took them, then the stream's end: the last
+    report read "no input received by the end of the input" beside values counting 50
+    received."""
+    eng = engine()
+    eng.push(batch(ramp(50), frame_ids="imu_link"))
+    assert status(eng.report_stalled(1.0)).message.startswith(
+        "no sample accepted for 1.0 s: 50 received, all rejected"
+    )
+    (last,) = eng.flush().health
+    st = status(last)
+    assert st.level == ERROR
+    assert st.message == (
+        "no input received since the last report, by the end of the input "
+        "(50 received before it, 0 accepted)"
+    )
+    assert st.values["received"] == "50" and st.values["accepted"] == "0"
+
+
 def test_stall_of_a_running_twin_then_reports_continue() -> None:
     # the gyro raw: no delayed samples, so a flush right after the stall report has nothing new
     eng = engine(scene_with(input={"gyro_filter": "none"}))

@@ -479,7 +479,7 @@ class HealthWindow:
         all_rejected = False
         if stalled_s is not None:
             level = ERROR
-            stall, all_rejected = self._stall_text(new, new_rejected, stalled_s)
+            stall, all_rejected = self._stall_text(new, counts, new_rejected, stalled_s)
             parts.append(stall)
         for stamp, _, _, notes in self.starts:
             for note_level, text in notes:
@@ -510,12 +510,24 @@ class HealthWindow:
         return HealthStatus(INPUT, level, "; ".join(parts) or "ok", values)
 
     def _stall_text(
-        self, new: Counter[str], new_rejected: dict[str, int], stalled_s: float
+        self,
+        new: Counter[str],
+        counts: Counter[str],
+        new_rejected: dict[str, int],
+        stalled_s: float,
     ) -> tuple[str, bool]:
         """What a stall (`stalled_s`: s since the last report, or ENDED) found in this window,
-        and whether every sample received was rejected (`new_rejected`: count per reason)."""
+        and whether every sample received was rejected (`new_rejected`: count per reason);
+        `counts`: the run's, to say what came before the window at the stream's end."""
         waited = "by the end of the input" if stalled_s == ENDED else f"for {_seconds(stalled_s)}"
         if not new["received"]:
+            if stalled_s == ENDED and counts["received"]:  # not "over the run": the values
+                # say what came before (a stall report took it)
+                return (
+                    f"no input received since the last report, {waited} ({counts['received']} "
+                    f"received before it, {counts['accepted']} accepted)",
+                    False,
+                )
             return f"no input received {waited}", False
         if not new["accepted"]:
             all_rejected = sum(new_rejected.values()) > 0
