@@ -270,18 +270,54 @@ def test_an_offset_the_motion_cannot_show_is_refused_not_fitted_to_zero_plus_or_
     assert re.search(r"sensor_y.*refused.*does not move it at all", said), said
 
 
-def _dead_top(tmp_path: Path) -> Path:
-    """The shake table's block record (trial 1) as a sensor that died before it began: every
-    data row's Acc and Gyr cells a constant 0, 0, 9.81 m/s² and 0 deg/s (the stamps kept)."""
-    lines = (SHAKE / "sine_2hz_trial1_top_excerpt.csv").read_text().splitlines()
+def _rewritten(side: str, out: Path, reading) -> Path:
+    """The shake table's trial-1 record of `side` (ground or top) written to `out` with every
+    data row's Acc and Gyr cells replaced by `reading()`'s six numbers (m/s², deg/s), the
+    stamps kept."""
+    lines = (SHAKE / f"sine_2hz_trial1_{side}_excerpt.csv").read_text().splitlines()
     start = next(i for i, ln in enumerate(lines) if ln.startswith("PacketCounter,")) + 1
     for i in range(start + 1, len(lines)):  # the export's first data row is all zeros
         cells = lines[i].split(",")
-        cells[5:11] = ["0", "0", "9.81", "0", "0", "0"]
+        cells[5:11] = [repr(float(v)) for v in reading()]
         lines[i] = ",".join(cells)
-    dead = tmp_path / "top_dead.csv"
-    dead.write_text("\n".join(lines) + "\n")
-    return dead
+    out.write_text("\n".join(lines) + "\n")
+    return out
+
+
+def _dead_top(tmp_path: Path) -> Path:
+    """The shake table's block record (trial 1) as a sensor that died before it began: every
+    data row's Acc and Gyr cells a constant 0, 0, 9.81 m/s² and 0 deg/s (the stamps kept)."""
+    return _rewritten("top", tmp_path / "top_dead.csv", lambda: (0.0, 0.0, 9.81, 0.0, 0.0, 0.0))
+
+
+STILL_NOISE = 0.01
+"""m/s² per axis and sample: a MEMS IMU's noise; a still record's specific force varies by
+√3 times this (RMS about its mean, all axes)."""
+
+
+def _still_ground(tmp_path: Path) -> Path:
+    """The shake table's table record (trial 1) as the table's sensor would read it standing
+    still: gravity along its z and STILL_NOISE of white noise on each axis (0.05 deg/s on the
+    gyro), the stamps kept: a foundation record that does not move (a still deck, the wrong
+    topic, a record taken in harbour)."""
+    rng = np.random.default_rng(11)
+    return _rewritten(
+        "ground",
+        tmp_path / "ground_still.csv",
+        lambda: (
+            *(np.array([0.0, 0.0, 9.81]) + rng.normal(0.0, STILL_NOISE, 3)),
+            *rng.normal(0.0, 0.05, 3),
+        ),
+    )
+
+
+def _said_still(err: str, record: str) -> float:
+    """The RMS (m/s²) a refusal says the `record` (foundation or body) record varies by."""
+    found = re.search(
+        rf"the {record} record does not move: its specific force varies by (\S+) m/s² RMS", err
+    )
+    assert found, err
+    return float(found.group(1))
 
 
 @pytest.mark.parametrize("command", ["calibrate", "track"])
@@ -300,6 +336,70 @@ def test_a_body_record_that_does_not_move_is_refused_at_load_naming_it(
     err = capsys.readouterr().err
     assert f"{dead}: the body record does not move" in err, err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("body", ["moving", "dead"])
+@pytest.mark.parametrize("command", ["calibrate", "track"])
+def test_a_foundation_record_that_does_not_move_is_refused_at_load_naming_it(
+    command: str, body: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The table's sensor standing still (gravity and a MEMS IMU's noise) against the block's
+    real record: calibrate printed every parameter refused, an NRMS of 1.000 before and after,
+    wrote the scene and exited 0; track judged its one window "not judged" (exit 1; with other
+    noise, stiffness ×1.25 ± 0.06, OK, exit 0). Against a dead block record, the body was
+    blamed, "1e-12 of the foundation's (0.0174 m/s²)". Refused, exit 2, naming the file, the
+    measure (√3 × the noise put in) and the threshold; the foundation is told before the body
+    (a body is judged against its foundation's motion, and there is none)."""
+    still = _still_ground(tmp_path)
+    top = _dead_top(tmp_path) if body == "dead" else SHAKE / "sine_2hz_trial1_top_excerpt.csv"
+    out = tmp_path / "c.scene.yaml"
+    files = ["--foundation", str(still), "--body", str(top)]
+    tail = ["-o", str(out)] if command == "calibrate" else ["--window", "10"]
+    assert main([command, str(SHAKE / "block.scene.yaml"), *files, *tail]) == 2
+    err = capsys.readouterr().err
+    assert f"{still}: the foundation record does not move" in err, err
+    assert _said_still(err, "foundation") == pytest.approx(math.sqrt(3.0) * STILL_NOISE, rel=0.1)
+    assert f"at most {cal_mod.STILL_FOUNDATION:g} m/s²" in err, err
+    assert "the body record" not in err, err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("body", ["moving", "still"])
+def test_a_still_foundation_refuses_every_parameter(body: str) -> None:
+    """Through the API (a window of track's or of the live tracker's): the pump's deck
+    standing still, 0.01 m/s² of noise on gravity, under the body record of the pump on
+    ship motion with vibration (another record's: the wrong topic) or a body as still as its
+    deck. Both were "fitted": stiffness ×0.29 ± 0.01 and lag 2.6 ± 0.3 ms (the other record's
+    truth: 0.7 and 12 ms), and stiffness ×0.028 ± 0.001, yaw 29.6° ± 0.7°. Every parameter is
+    refused saying the foundation does not move, and held at its nominal value."""
+    rng = np.random.default_rng(3)
+    deck = _vibrating_deck()
+    standing = np.array([0.0, 0.0, 9.80665]) + rng.normal(0.0, STILL_NOISE, deck.accel.shape)
+    still = Signal(deck.t, standing, rng.normal(0.0, 1e-3, deck.gyro.shape))
+    if body == "moving":
+        _, record = _pair(_pump(), deck, TRUTH)
+    else:
+        noise = rng.normal(0.0, STILL_NOISE, deck.accel.shape)
+        record = Signal(deck.t, np.array([0.0, 0.0, 9.80665]) + noise, np.zeros_like(noise))
+    cal = cal_mod.calibrate(_pump(), still, record)
+    assert set(cal.refused) == set(FITTED) and not cal.sigma
+    assert all("the foundation record does not move" in why for why in cal.refused.values())
+    assert cal.values == {"stiffness": 1.0, "damping": 1.0, "yaw": 0.0, "lag": 0.0}
+
+
+def test_a_foundation_that_moves_a_little_more_than_the_threshold_is_not_still() -> None:
+    """The threshold against known motion: a 1 Hz sway of amplitude a along x has an RMS of
+    a/√2; at 1.2 times the threshold the foundation moves, at 0.8 times it does not (a body
+    following it is never the one refused)."""
+    t = np.arange(0.0, 10.0, 1.0 / RATE)
+    for factor, still in ((1.2, False), (0.8, True)):
+        sway = np.zeros((t.size, 3))
+        sway[:, 0] = factor * cal_mod.STILL_FOUNDATION * math.sqrt(2.0) * np.sin(2 * math.pi * t)
+        sway[:, 2] = 9.80665
+        deck = Signal(t, sway, np.zeros_like(sway))
+        said = cal_mod.still_record(deck, deck)
+        assert (said is not None) == still, (factor, said)
+        assert said is None or said.record == "foundation", said
 
 
 def test_a_still_body_refuses_every_parameter_and_has_no_nrms() -> None:

@@ -6,7 +6,7 @@ consecutive windows of the records, each after a settling lead (the twin starts 
 window's first sample, so the first `LEAD_S` are fitted out), and gives each window a level:
 WARN where a scale's 3σ interval lies wholly outside `Band.warn`, ERROR where it lies outside
 `Band.error`. A window whose fit refuses a parameter says so and is not judged on it; one whose
-fit refuses every scale (a body record that does not move, a fit no better than the scene) is
+fit refuses every scale (a record that does not move, a fit no better than the scene) is
 not judged at all, and that is a WARN: it cannot say the mounts are OK (as a window the live
 tracker cannot fit, `ageing_live.run_job`).
 """

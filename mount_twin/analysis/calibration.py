@@ -28,8 +28,9 @@ fit's Jacobian and residual (`(JᵀJ)⁻¹ s²`; the residual's own correlation 
 bound). A parameter the record cannot identify (relative 1σ past `MAX_REL_SIGMA`, an angle
 past 2°, a lag past a sample) is refused by name and held at its nominal value, and the rest is
 fitted again; a fit that predicts the body no better than the nominal scene is refused whole.
-A body record that does not move (`still_body`: a dead or disconnected sensor, another
-machine's record) leaves nothing to fit: every parameter is refused, saying so.
+A record that does not move (`still_record`: a foundation's still deck, the wrong topic or a
+record taken in harbour; a body's dead or disconnected sensor, another machine's record) leaves
+nothing to fit: every parameter is refused, saying so.
 """
 
 from __future__ import annotations
@@ -71,13 +72,21 @@ EDGE_S = 0.25
 
 MIN_OVERLAP = 10
 """Body samples the fit needs within the foundation record (`EDGE_S` off each end) at least."""
+STILL_FOUNDATION = 0.05
+"""A foundation record whose dynamic RMS (its specific force about its mean, all three axes:
+gravity and bias out) over the compared span is at most this, m/s², does not move
+(`still_record`): what it holds is its sensor's noise (a MEMS IMU's 0.01 m/s² per axis is
+0.017 all axes; the shake table's Xsens DOT reads 0.022 in the first second of its trial
+records, before the table starts), and a body's motion is none of the twin's to fit. A deck
+that moves moves more: the slow roll and heave alone of `signals.ship_motion` 0.72 m/s², the
+shake table 1.3. A sensor noisier than this at rest (a 100 g shock accelerometer at 20 kHz
+reads 0.83) is not told from motion here; the fit's own refusals remain."""
 STILL_SHARE = 0.01
-"""A body record whose dynamic RMS (its specific force about its mean, all three axes: gravity
-and bias out) is at most this share of the foundation's over the compared span does not move
-(`still_body`). Below its mounts' modes a body follows its foundation (a share near 1 or
-more: 2.1 on the shake table), and no mount isolates 40 dB over the whole of a record that
-moves at all; a sensor that reads a constant, or only its own noise (a MEMS IMU's 0.01 m/s²
-is this share of a 1 m/s² foundation), does."""
+"""A body record whose dynamic RMS (as `STILL_FOUNDATION`'s) is at most this share of the
+foundation's over the compared span does not move (`still_record`). Below its mounts' modes a
+body follows its foundation (a share near 1 or more: 2.1 on the shake table), and no mount
+isolates 40 dB over the whole of a record that moves at all; a sensor that reads a constant, or
+only its own noise (a MEMS IMU's 0.01 m/s² is this share of a 1 m/s² foundation), does."""
 NRMS_RESOLUTION = 1e-9
 """`nrms` of a measured signal whose spread about its mean is at most this share of its size
 is undefined (nan): what is left after the mean is out is rounding, not motion."""
@@ -94,7 +103,7 @@ class Calibration:
         refused: parameter → why the record cannot identify it.
         nrms_before, nrms_after: the body sensor's normalised RMS error (‖pred − meas‖ /
             ‖meas‖, means out, all axes) with the nominal scene and the calibrated one; nan
-            where the body record does not move (`still_body`).
+            where a record does not move (`still_record`: nothing is fitted).
         scene: the calibrated scene.
     """
 
@@ -233,29 +242,46 @@ def _dynamic_rms(accel: np.ndarray) -> float:
     return float(np.sqrt(((accel - accel.mean(axis=0)) ** 2).sum(axis=1).mean()))
 
 
-def still_body(foundation: Signal, body: Signal) -> str | None:
-    """Why the body record shows no motion to fit the twin to, or None where it moves (or
-    too few of its samples overlap the foundation's to say: the fit tells that itself). Over
-    the compared span (`_compared`), the body's dynamic RMS at most `STILL_SHARE` of the
-    foundation's there (both m/s²)."""
+@dataclass(frozen=True)
+class Still:
+    """A record of a pair that does not move (`still_record`): which ("foundation" or
+    "body"), and why, with the measure and the threshold."""
+
+    record: str
+    why: str
+
+
+def still_record(foundation: Signal, body: Signal) -> Still | None:
+    """Which record of the pair shows no motion to fit the twin by, and why; None where both
+    move (or too few body samples overlap the foundation's to say: the fit tells that itself).
+    Over the compared span (`_compared`), each record's dynamic RMS (`_dynamic_rms`, m/s²):
+    the foundation's at most `STILL_FOUNDATION`, then the body's at most `STILL_SHARE` of the
+    foundation's (a body is judged against its foundation's motion: the foundation first)."""
     keep = _compared(foundation, body)
     if np.count_nonzero(keep) < MIN_OVERLAP:
         return None
     t = body.t[keep]
     during = (foundation.t >= t[0]) & (foundation.t <= t[-1])
     moved, shaken = _dynamic_rms(body.accel[keep]), _dynamic_rms(foundation.accel[during])
-    if moved > STILL_SHARE * shaken:
+    if shaken <= STILL_FOUNDATION:
+        record, rms = "foundation", shaken
+        said = (
+            f"at most {STILL_FOUNDATION:g} m/s²: its sensor's noise, a still deck (the wrong "
+            "topic, or a record taken in harbour): nothing moves the mounts to fit them by"
+        )
+    elif moved <= STILL_SHARE * shaken:
+        record, rms = "body", moved
+        said = (
+            f"{moved / shaken:.2g} of the foundation's ({shaken:.3g} m/s²), at most "
+            f"{STILL_SHARE:g}: a dead or disconnected sensor, or not this machine's record"
+        )
+    else:
         return None
-    share = (
-        f"{moved / shaken:.2g} of the foundation's ({shaken:.3g} m/s²), at most {STILL_SHARE:g}"
-        if shaken > 0.0
-        else "and the foundation's not at all"
+    why = (
+        f"the {record} record does not move: its specific force varies by {rms:.3g} m/s² RMS "
+        f"about its mean from {t[0]:.6g} to {t[-1]:.6g} s, {said}"
     )
-    return (
-        f"the body record does not move: its specific force varies by {moved:.3g} m/s² RMS "
-        f"about its mean from {t[0]:.6g} to {t[-1]:.6g} s, {share}: a dead or disconnected "
-        "sensor, or not this machine's record"
-    )
+    return Still(record, why)
 
 
 def prediction_error(
@@ -384,8 +410,8 @@ def calibrate(
     scene: Scene, foundation: Signal, body: Signal, fit: tuple[str, ...] = PARAMETERS
 ) -> Calibration:
     """Fit `fit` (of PARAMETERS) so that the twin on `foundation` predicts `body` (module
-    docstring); refuse, by name, what the record cannot identify (all of it where the body
-    record does not move: `still_body`)."""
+    docstring); refuse, by name, what the record cannot identify (all of it where a record
+    does not move: `still_record`)."""
     known = (*PARAMETERS, *ON_REQUEST)
     unknown = [
         n for n in fit if n.partition(":")[0] not in known or (":" in n and not is_mount_scale(n))
@@ -407,8 +433,8 @@ def calibrate(
         if is_mount_scale(name):
             scaled_mounts(name, scene)
     nominal = {n: 1.0 if is_scale(n) else 0.0 for n in (*fit, "yaw", "lag")}
-    if still := still_body(foundation, body):
-        refused = dict.fromkeys(fit, still)
+    if still := still_record(foundation, body):
+        refused = dict.fromkeys(fit, still.why)
         return Calibration(nominal, {}, refused, math.nan, math.nan, calibrated_scene(scene, {}))
     free = list(fit)
     refused = {}

@@ -90,9 +90,10 @@ def _read_record(
 
 def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
     """The scene (it must have a body_sensor) and its (foundation, body) records, on one
-    clock, from `args.scene`, `args.foundation` and `args.body`; a body record that does not
-    move (`calibration.still_body`) is refused, naming its file."""
-    from mount_twin.analysis.calibration import still_body
+    clock, from `args.scene`, `args.foundation` and `args.body`; a record that does not move
+    (`calibration.still_record`: a still foundation, a body still beside its foundation's
+    motion) is refused, naming its file."""
+    from mount_twin.analysis.calibration import still_record
     from mount_twin.commands.common import load_scene
     from mount_twin.io.messages import IMU
 
@@ -105,8 +106,9 @@ def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
         args.foundation, spec.topic, spec.msg_type, None, FOUNDATION_KEYS
     )
     body, _ = _read_record(args.body, scene.body_sensor.topic, IMU, base, BODY_KEYS)
-    if still := still_body(foundation, body):
-        msg = f"{args.body}: {still}"
+    if still := still_record(foundation, body):
+        path = args.foundation if still.record == "foundation" else args.body
+        msg = f"{path}: {still.why}"
         raise ValueError(msg)
     return scene, foundation, body
 

@@ -2,7 +2,8 @@
 window along a recorded pair, each window judged against a band (`mount_twin.analysis.ageing`):
 mounts that harden, creep or loosen show as a stiffness or damping scale leaving 1. Exit 0 all
 windows OK, 1 some WARN (a window whose fit refuses every scale is not judged: a WARN), 4 some
-ERROR. A body record that does not move is refused at load (`calibrate.read_pair`).
+ERROR. A record that does not move (a still foundation, a dead body sensor) is refused at
+load (`calibrate.read_pair`).
 """
 
 from __future__ import annotations
