@@ -364,6 +364,35 @@ def test_a_foundation_record_that_does_not_move_is_refused_at_load_naming_it(
     assert not out.exists()
 
 
+def test_a_still_bag_record_is_refused_naming_its_bag_and_topic(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The same records as bags (the foundation's on the scene's input topic, the body's on
+    its body_sensor.topic): a still foundation's refusal names the bag and the topic it read
+    (the wrong topic is one way to read a still deck), and so does a dead body's."""
+    scene = str(SHAKE / "block.scene.yaml")
+    bags = {}
+    for name, csv_path, topic in (
+        ("still", _still_ground(tmp_path), "/imu/data"),
+        ("ground", SHAKE / "sine_2hz_trial1_ground_excerpt.csv", "/imu/data"),
+        ("top", SHAKE / "sine_2hz_trial1_top_excerpt.csv", "/machine/imu"),
+        ("dead", _dead_top(tmp_path), "/machine/imu"),
+    ):
+        bags[name] = tmp_path / f"{name}_bag"
+        assert main(["import-csv", str(csv_path), "-o", str(bags[name]), "--topic", topic]) == 0
+    capsys.readouterr()
+    out = tmp_path / "c.scene.yaml"
+    for foundation, body, record, named in (
+        ("still", "top", "foundation", f"{bags['still']}: /imu/data"),
+        ("ground", "dead", "body", f"{bags['dead']}: /machine/imu"),
+    ):
+        files = ["--foundation", str(bags[foundation]), "--body", str(bags[body])]
+        assert main(["calibrate", scene, *files, "-o", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert f"{named}: the {record} record does not move" in err, err
+        assert not out.exists()
+
+
 @pytest.mark.parametrize("body", ["moving", "still"])
 def test_a_still_foundation_refuses_every_parameter(body: str) -> None:
     """Through the API (a window of track's or of the live tracker's): the pump's deck

@@ -56,6 +56,13 @@ BODY_KEYS = ("body_sensor.topic", "a body_sensor (an IMU)")
 """What sets each record's topic and type, for a bag's errors (`InputBag`)."""
 
 
+def _is_csv(path: str) -> bool:
+    """Whether a record is a CSV (else a bag), by its name."""
+    from pathlib import Path
+
+    return Path(path).suffix.lower() == ".csv"
+
+
 def _read_record(
     path: str, topic: str, msg_type: str, base: TimeBase | None, keys: tuple[str, str]
 ) -> tuple[Signal, TimeBase | None]:
@@ -63,13 +70,11 @@ def _read_record(
     (stamps in seconds from `base`, else from its first stamp's whole second: the base
     returned, for the other record of a pair to share). A bag's sample not finite is refused,
     as a CSV's cell is: named, with how many."""
-    from pathlib import Path
-
     from mount_twin.io.messages import TimeBase
     from mount_twin.io.signals import Signal
     from mount_twin.io.xsens_csv import read_csv_record
 
-    if Path(path).suffix.lower() == ".csv":
+    if _is_csv(path):
         return read_csv_record(path), base
     from mount_twin.commands.common import refuse_not_finite
     from mount_twin.engine.intake import readable
@@ -92,7 +97,7 @@ def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
     """The scene (it must have a body_sensor) and its (foundation, body) records, on one
     clock, from `args.scene`, `args.foundation` and `args.body`; a record that does not move
     (`calibration.still_record`: a still foundation, a body still beside its foundation's
-    motion) is refused, naming its file."""
+    motion) is refused, naming its file (and a bag's topic)."""
     from mount_twin.analysis.calibration import still_record
     from mount_twin.commands.common import load_scene
     from mount_twin.io.messages import IMU
@@ -107,8 +112,11 @@ def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
     )
     body, _ = _read_record(args.body, scene.body_sensor.topic, IMU, base, BODY_KEYS)
     if still := still_record(foundation, body):
-        path = args.foundation if still.record == "foundation" else args.body
-        msg = f"{path}: {still.why}"
+        path, topic = {
+            "foundation": (args.foundation, spec.topic),
+            "body": (args.body, scene.body_sensor.topic),
+        }[still.record]
+        msg = f"{path}: {still.why}" if _is_csv(path) else f"{path}: {topic}: {still.why}"
         raise ValueError(msg)
     return scene, foundation, body
 
