@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import html
 import re
 from pathlib import Path
 
@@ -261,3 +262,23 @@ def test_an_inputs_sample_not_finite_between_finite_ones_is_refused_naming_it(
         "first) has accel x nan, between finite samples" in err
     ), err
     assert not page.exists()
+
+
+def test_a_run_replayed_with_topic_reports_its_input_from_that_topic(tmp_path: Path) -> None:
+    """`replay --topic /hull/imu` ran the record on /hull/imu; `report --input` of that run read
+    the scene's /deck/imu instead, refused the bag (exit 2) and told the user to pass
+    `replay --topic`, an option `report` has not. The page reads the topic the run read, and
+    says it."""
+    pump = CONFIG / "pump_8_mounts.scene.yaml"
+    bag, out, page = tmp_path / "hull_bag", tmp_path / "out", tmp_path / "page.html"
+    generate = ["generate", "half-sine", "-o", str(bag), "--peak", "150", "--pulse", "0.008"]
+    assert main([*generate, "--topic", "/hull/imu", "--frame-id", "hull_imu"]) == 0
+    replay_args = ["replay", str(bag), "--scene", str(pump), "-o", str(out), "--no-progress"]
+    assert main([*replay_args, "--topic", "/hull/imu", "--frame-id", "hull_imu"]) == 0
+    report = ["report", str(out), "--scene", str(pump), "--input", str(bag), "-o", str(page)]
+    assert main(report) == 0
+    text = html.unescape(page.read_text(encoding="utf-8"))
+    assert "/hull/imu (sensor_msgs/msg/Imu)" in text  # the run's input, as the page names it
+    said = "/hull/imu (the run's, from `replay --topic`; the file's: /deck/imu)"
+    assert re.findall(r">([^<>]*/deck/imu[^<>]*)<", text) == [said]
+    assert "Shock response spectra of the input" in text  # the record was read

@@ -80,7 +80,12 @@ def scene_section(scene: Scene) -> list[str]:
     not read from a file)."""
     if not Path(scene.source).is_file():
         return []
-    effective = effective_parameters({"scene_file": scene.source}, "report").values
+    effective = dict(effective_parameters({"scene_file": scene.source}, "report").values)
+    if effective.get("input.topic", scene.input.topic) != scene.input.topic:  # replay --topic
+        effective["input.topic"] = (
+            f"{scene.input.topic} (the run's, from `replay --topic`; "
+            f"the file's: {effective['input.topic']})"
+        )
     return [
         "<h2>Scene as loaded</h2>",
         table(

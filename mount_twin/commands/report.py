@@ -12,6 +12,7 @@ from mount_twin.commands.srs import add_design_arguments, tolerance_of
 if TYPE_CHECKING:
     from mount_twin.analysis.report import ReportPage
     from mount_twin.io.messages import Decoded
+    from mount_twin.scene.description import Scene
 
 NAME = "report"
 HELP = "one HTML page of a replay: input and response, signed mount forces, utilisation, events"
@@ -62,6 +63,8 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(msg)
     design = read_design_table(args.design) if args.design else None
     scene = load_scene(args.scene) if args.scene else None
+    if scene is not None and args.input:
+        scene = _as_replayed(scene, args.bag)
     samples, note = None, ""
     if args.input:
         if scene is None:
@@ -70,7 +73,8 @@ def run(args: argparse.Namespace) -> int:
         from mount_twin.io.input_samples import read_input
         from mount_twin.physics.rotations import rpy_matrix
 
-        decoded = read_input(args.input, scene.input)
+        keys = ("the topic the run read: is this its input bag?", "input.msg_type")
+        decoded = read_input(args.input, scene.input, keys)
         decoded, note = finite_input(args.input, scene.input.topic, decoded)
         if note:
             print(note)
@@ -94,6 +98,20 @@ def run(args: argparse.Namespace) -> int:
     )
     print(f"report: {out.path}")
     return _exit_status(out, args.fail_on)
+
+
+def _as_replayed(scene: Scene, output_bag: str) -> Scene:
+    """The scene with the input topic its run read (`replay --topic` may have replaced the
+    scene's), as the output bag's input status records it: the input bag is read from that
+    topic, and the page names it."""
+    from dataclasses import replace
+
+    from mount_twin.io.output_tables import replayed_input_topic
+
+    topic = replayed_input_topic(output_bag)
+    if topic is None or topic == scene.input.topic:
+        return scene
+    return replace(scene, input=replace(scene.input, topic=topic))
 
 
 def _exit_status(out: ReportPage, fail_on: str) -> int:
