@@ -40,6 +40,7 @@ from mount_twin.engine.health import (
     INTEGRATION,
     NOW_KEY,
     UTILISATION_KEY,
+    ratio_text,
     tilt_from_quaternions,
 )
 from mount_twin.errors import BagError, DamagedBagError, require
@@ -191,7 +192,9 @@ class ReplaySummary:
             lines.append(
                 "  peak utilisation (bolt F/F_y, rubber deflection/rated, key F/allowable):"
             )
-            lines += [f"    {n:>12}: {u:.3f}" for n, u in self.utilisation_max.items()]
+            lines += [
+                f"    {n:>12}: {ratio_text(u, '.3f')}" for n, u in self.utilisation_max.items()
+            ]
         return lines
 
     def _body_lines(self) -> list[str]:

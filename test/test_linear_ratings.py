@@ -107,3 +107,38 @@ def test_a_shock_past_the_rating_is_an_error_and_near_it_a_warning() -> None:
     _, status = _run(_engine([0.0, 0.0, peak / 0.95], [0.0, 0.0, 0.0]), shock)
     assert status.level == WARN
     assert float(status.values["utilisation_max"]) == pytest.approx(0.95, rel=1e-6)
+
+
+def test_a_utilisation_just_under_1_does_not_read_as_1() -> None:
+    """At rest at 0.9998 of its rated load the mount is at WARN (past 1 − alarm_margin, below
+    1): its status said "utilisation 1", the limit whose reaching is an ERROR, beside mounts
+    at ERROR saying "utilisation 1.1". The number said is the one judged: below 1."""
+    load = MASS * G / 4
+    engine = _engine([0.0, 0.0, 0.0], [0.0, 0.0, load / 0.9998])
+    _, status = _run(engine)
+    assert engine.utilisation_max["m0"] == pytest.approx(0.9998, rel=1e-9)
+    assert status.level == WARN
+    said = float(status.message.removeprefix("utilisation "))
+    assert said < 1.0
+    assert said == pytest.approx(0.9998, abs=5e-5)
+
+
+def test_the_replay_summary_does_not_round_a_utilisation_under_1_up_to_1(tmp_path) -> None:
+    """The replay's summary printed the same mount's peak utilisation as "1.000"."""
+    from mount_twin.cli import main
+    from mount_twin.replay import replay
+
+    load = MASS * G / 4
+    engine = _engine([0.0, 0.0, 0.0], [0.0, 0.0, load / 0.9998])
+    bag = tmp_path / "still"
+    quiet = ["--peak", "1e-4", "--pulse", "0.01", "--rate", "1000", "--duration", "0.5"]
+    topic = ["--topic", engine.scene.input.topic]
+    assert main(["generate", "half-sine", "-o", str(bag), *quiet, *topic]) == 0
+    summary = replay(engine.scene, bag, tmp_path / "out", progress=False)
+    assert summary.utilisation_max["m0"] == pytest.approx(0.9998, abs=2e-5)
+    text = summary.text()
+    peaks = text.split("peak utilisation")[1]
+    (line,) = [s for s in peaks.splitlines() if s.strip().startswith("m0:")]
+    said = float(line.split(":")[1])
+    assert said < 1.0
+    assert said == pytest.approx(0.9998, abs=5e-5)

@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from mount_twin.analysis.srs import damping_ratio
+from mount_twin.engine.health import ratio_text
 from mount_twin.scene.loader import read_scene_yaml
 from mount_twin.scene.reader import Reader
 
@@ -164,7 +165,8 @@ def _broken(run: InputRun, plan: Plan) -> list[str]:
             f"{name}: {message}" for name, level, message in run.statuses if level in levels
         )
         out.append(f"diagnostics reached {run.verdict} ({said})")
-    over = [f"{m} {u:.3f}" for m, u in run.utilisation.items() if u > plan.max_utilisation]
+    limit = plan.max_utilisation
+    over = [f"{m} {ratio_text(u, '.3f', limit)}" for m, u in run.utilisation.items() if u > limit]
     if over:
         out.append(f"utilisation over {plan.max_utilisation:g}: {', '.join(over)}")
     return out

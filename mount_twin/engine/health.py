@@ -55,6 +55,19 @@ NAMED_FRAMES = 3
 """Wrong frame_ids named in a message (the rest are elided)."""
 
 
+def ratio_text(value: float, spec: str = ".3g", limit: float = 1.0) -> str:
+    """A utilisation (or another ratio judged against `limit`) as text, `format(value, spec)`
+    with more digits where rounding would carry it onto or across the limit: 0.99983 reads
+    0.9998, not 1 (the limit, whose reaching is an ERROR, said of a mount at WARN)."""
+    text = format(value, spec)
+    kind = spec[-1]
+    digits = int(spec[1:-1])
+    while (float(text) >= limit) != (value >= limit) and digits < 17:
+        digits += 1
+        text = format(value, f".{digits}{kind}")
+    return text
+
+
 def tilt_from_quaternions(quat: np.ndarray) -> np.ndarray:
     """Tilt θ of body z from the vertical of F, rad, for (k, 4) quaternions (x, y, z, w)."""
     return tilt_from_cos(1.0 - 2.0 * (quat[:, 0] ** 2 + quat[:, 1] ** 2))  # R₃₃ = cos θ
@@ -679,7 +692,7 @@ def _event_values(events: list[MountEvent], origin_s: int) -> dict[str, str]:
 def _events_text(events: list[MountEvent], utilisation: float, origin_s: int) -> str:
     """'joint_opened ×3 (first 1.234567 s, |F| max 4.5e+04 N); …', or the utilisation."""
     if not events:
-        return "ok" if not utilisation > 0.0 else f"utilisation {utilisation:.3g}"
+        return "ok" if not utilisation > 0.0 else f"utilisation {ratio_text(utilisation)}"
     parts = []
     for name, same in _by_kind(events).items():
         parts.append(

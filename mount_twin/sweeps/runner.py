@@ -28,7 +28,7 @@ from mount_twin.analysis.figures import (
 )
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, SampleBatch
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.engine.health import tilt_from_quaternions
+from mount_twin.engine.health import ratio_text, tilt_from_quaternions
 from mount_twin.engine.intake import nothing_accepted
 from mount_twin.errors import MountTwinError
 from mount_twin.model.assemble import assemble
@@ -317,8 +317,8 @@ def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
             if rated:
                 r = min(rated, key=utilisation)
                 best.append(
-                    f"  {case.name}: {utilisation(r):.3g}, case {r['case']} ({setting(r)}) "
-                    f"{r['verdict']}"
+                    f"  {case.name}: {ratio_text(utilisation(r))}, case {r['case']} "
+                    f"({setting(r)}) {r['verdict']}"
                 )
         if best:
             lines += ["lowest largest utilisation, per input:", *best]
