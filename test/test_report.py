@@ -282,3 +282,23 @@ def test_a_run_replayed_with_topic_reports_its_input_from_that_topic(tmp_path: P
     said = "/hull/imu (the run's, from `replay --topic`; the file's: /deck/imu)"
     assert re.findall(r">([^<>]*/deck/imu[^<>]*)<", text) == [said]
     assert "Shock response spectra of the input" in text  # the record was read
+
+
+def test_an_input_axis_without_motion_shows_no_infinite_margin(genset_run, tmp_path) -> None:
+    """The genset's shock has nothing fore-aft (x): its spectrum there is 0, and the page read
+    "short by inf dB" and a margin column of "-inf". It says the axis has no response."""
+    out, _ = genset_run
+    table = tmp_path / "d.csv"
+    table.write_text("frequency_hz,accel_g\n10,10\n1000,10\n", "utf-8")
+    page = tmp_path / "p.html"
+    args = ["report", str(out), "--scene", str(GENSET), "--input", str(BAG), "-o", str(page)]
+    assert main([*args, "--design", str(table)]) == 4
+    spectra = html.unescape(page.read_text(encoding="utf-8")).split("<h2>Shock response")[1]
+    spectra = spectra[: spectra.index("<h2>", 1)]
+    assert "inf" not in spectra and "nan" not in spectra
+    assert re.search(
+        r"axis x: 0 of \d+ frequencies [^<]*: FAIL: no response at 10–905.1 Hz", spectra
+    )
+    rows = re.findall(r"<tr>(.*?)</tr>", spectra[spectra.index("<th>margin x dB</th>") :])
+    x_cells = [re.findall(r"<td>([^<]*)</td>", r)[-3] for r in rows[1:]]
+    assert set(x_cells) == {"–", "no response"}

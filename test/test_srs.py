@@ -566,3 +566,22 @@ def test_a_dead_channel_is_refused_not_left_out_of_the_verdict(
         assert f"axis x has {count} of 2000 values not finite, the first at sample {first} " in err
         assert f"(t = {t[first]:.6g} s)" in err
         assert main(["srs", str(bag), "--axis", "z", "--freqs", "10"]) == 0
+
+
+def test_an_axis_with_no_response_is_said_so_not_short_by_inf_db() -> None:
+    """A record with nothing on an axis (the bundled shocks have no fore-aft component) has a
+    spectrum of 0 there: judged against a design it fell short by "inf dB", its margins -inf.
+    It is FAIL, saying the spectrum is 0 there; where some frequencies respond, by how much
+    the others fall short, in dB."""
+    freqs = np.array([10.0, 20.0, 40.0, 80.0])
+    nothing = check_design(freqs, np.zeros(4), [10.0, 80.0], [1.0, 1.0])
+    said = nothing.summary()
+    assert not nothing.passed
+    assert said == "0 of 4 frequencies within -1.5/+3 dB: FAIL: no response at 10–80 Hz"
+    some = check_design(freqs, np.array([0.0, 0.5, 0.0, 1.0]), [10.0, 80.0], [1.0, 1.0])
+    said = some.summary()
+    assert "inf" not in said and "nan" not in said
+    assert said == (
+        "1 of 4 frequencies within -1.5/+3 dB: FAIL: short by 6.02 dB at 10–40 Hz "
+        "(no response at 10 and 40 Hz)"
+    )

@@ -10,6 +10,7 @@ usual log-log plot); frequencies outside its range are not judged.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -85,12 +86,30 @@ class DesignCheck:
             return f"{head}: PASS"
         if not n:
             return f"{head}: FAIL (no frequency in the design's range)"
-        where = "; ".join(
-            f"{kind} by {abs(worst):.2f} dB at "
-            + (f"{f0:.4g} Hz" if f0 == f1 else f"{f0:.4g}–{f1:.4g} Hz")
-            for f0, f1, kind, worst in self.bands()
-        )
+        where = "; ".join(self._band_text(*band) for band in self.bands())
         return f"{head}: FAIL: {where}"
+
+    def _band_text(self, f0: float, f1: float, kind: str, worst: float) -> str:
+        """'short by 6.02 dB at 10–40 Hz'; where the spectrum is 0 (no response: its margin
+        −∞ dB), that, naming the frequencies unless the whole run is."""
+        where = f"{f0:.4g} Hz" if f0 == f1 else f"{f0:.4g}–{f1:.4g} Hz"
+        if math.isfinite(worst):
+            return f"{kind} by {abs(worst):.2f} dB at {where}"
+        f = self.frequency_hz
+        run = (f >= f0) & (f <= f1)
+        margin = self.margin_db[run]
+        if not np.isfinite(margin).any():
+            return f"no response at {where}"
+        silent = [f"{x:.4g}" for x in f[run][~np.isfinite(margin)]]
+        named = (
+            f"{', '.join(silent[:-1])} and {silent[-1]} Hz"
+            if len(silent) > 1
+            else f"{silent[0]} Hz"
+        )
+        if len(silent) > 3:
+            named = f"{len(silent)} of them"
+        short = float(margin[np.isfinite(margin)].min())
+        return f"{kind} by {abs(short):.2f} dB at {where} (no response at {named})"
 
 
 def check_design(

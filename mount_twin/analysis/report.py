@@ -247,13 +247,18 @@ def _srs_rows(
             *(f"{spectra[a].maximax[k] / STANDARD_GRAVITY:.4g}" for a in "xyz"),
             f"{z.pseudo_velocity[k]:.4g}",
             *(
-                f"{margins[a][fk]:+.2f}" if fk in margins[a] else "–"
+                _margin_cell(margins[a][fk]) if fk in margins[a] else "–"
                 for a in ("xyz" if checks else "")
             ),
         ]
         for k, fk in enumerate(freqs.tolist())
         if k % 3 == 0
     ]
+
+
+def _margin_cell(margin_db: float) -> str:
+    """A margin in dB for the spectra table; a spectrum of 0 (−∞ dB) has no response."""
+    return f"{margin_db:+.2f}" if np.isfinite(margin_db) else "no response"
 
 
 def _modes_section(scene: Scene) -> list[str]:
