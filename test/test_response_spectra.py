@@ -168,3 +168,24 @@ def test_a_response_that_cannot_be_taken_is_refused_naming_why(
     args = ["srs", str(SHOCK), *(str(design) if a == "DESIGN" else a for a in extra)]
     assert main(args) == 2
     assert re.search(says, capsys.readouterr().err)
+
+
+def test_the_plots_title_fits_in_the_figure(tmp_path: Path, monkeypatch) -> None:
+    """The title of a mount's spectra (the bag, the scene, the mount, ζ and what was taken out)
+    ran past both edges of the PNG: "f genset_shock_10khz replayed on … the first 100 sam"."""
+    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    shown = []
+    close = plt.close
+    monkeypatch.setattr(plt, "close", lambda fig=None: shown.append(fig) or close(fig))
+    bag = ROOT / "bags/genset_shock_10khz"
+    png = tmp_path / "s.png"
+    args = ["srs", str(bag), "--response", "mount:foot_fl", "--scene", str(GENSET)]
+    assert main([*args, "--plot", str(png)]) == 0
+    (fig,) = shown
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    title = fig.axes[0].title
+    box, page = title.get_window_extent(renderer), fig.bbox
+    assert "foot_fl" in title.get_text()
+    assert page.x0 <= box.x0 and box.x1 <= page.x1 and box.y1 <= page.y1

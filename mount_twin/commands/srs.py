@@ -480,6 +480,8 @@ def _plot(
 ) -> None:
     """Maximax, primary and residual of one axis (maximax of each with all) in g (a force's in
     its `unit`), log-log, against the design spectrum; the frequencies above fs/10 shaded."""
+    import textwrap
+
     import matplotlib
 
     matplotlib.use("Agg")
@@ -521,7 +523,7 @@ def _plot(
     ax.set_ylim(top * 1e-3, top * 2.0)  # the residual of a short record falls off to nothing
     ax.set_xlabel("natural frequency [Hz]")
     ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=9)
+    ax.set_title(textwrap.fill(title, 90), fontsize=9)  # a long bag or mount name: two lines
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
