@@ -141,7 +141,7 @@ class ReplaySummary:
             *([f"  {nothing}"] if (nothing := self.nothing_accepted()) else []),
             *([f"  {FAILED}: {self.failure}"] if self.failure else []),
             f"  input samples: {c.get('received', 0)} received, {c.get('accepted', 0)} accepted, "
-            f"rejected: {intake.rejected(c) or 'none'}, gaps: {c.get('gaps', 0)}, "
+            f"rejected: {intake.counted_text(c, 'rejected_')}, gaps: {c.get('gaps', 0)}, "
             f"restarts: {c.get('restarts', 0)}, integration failures: "
             f"{c.get('integration_failures', 0)}",
             *(
@@ -204,12 +204,10 @@ class ReplaySummary:
             return []
         if not c.get("received", 0):
             return [f"  body IMU {self.body_topic}: no message (not in the bag; --body names one)"]
-        missed = {
-            k: v for k, v in c.items() if v and k not in ("received", "accepted", "compared")
-        }
+        missed = {k: v for k, v in c.items() if k not in ("received", "accepted", "compared")}
         return [
             f"  body IMU {self.body_topic}: {c['received']} received, {c.get('compared', 0)} "
-            f"compared with the twin, not compared: {missed or 'none'} (its agreement: "
+            f"compared with the twin, not compared: {intake.counted_text(missed)} (its agreement: "
             f"{BODY_STATUS} below)"
         ]
 

@@ -268,7 +268,7 @@ def test_replay_where_no_sample_is_accepted_exits_3_naming_the_frames(
     assert main(["replay", str(bag), "--scene", str(scene), *out]) == 3
     printed = capsys.readouterr()
     assert "no input sample was accepted (50 received" in printed.err
-    assert "'rejected_wrong_frame': 50" in printed.err and "frame_id is 'imu_link'" in printed.err
+    assert "rejected: wrong_frame 50" in printed.err and "frame_id is 'imu_link'" in printed.err
     # no figures: peaks of 0 N and a utilisation of 0 read as a machine at rest
     assert "motion and mount loads: none, no input sample was accepted" in printed.out
     assert "peak mount loads" not in printed.out and "peak utilisation" not in printed.out

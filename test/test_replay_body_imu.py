@@ -111,6 +111,11 @@ def test_a_body_imu_never_compared_is_a_warning_not_silence(
     assert status["message"].startswith("no window of the body IMU was judged over the run: ")
     assert "0 of 1200 messages compared" in status["message"]
     assert "rejected_wrong_frame_id 1200" in status["message"]
+    said = capsys.readouterr().out  # the summary's line, in words (it printed a Python dict)
+    assert (
+        f"body IMU {BODY_TOPIC}: 1200 received, 0 compared with the twin, not compared: "
+        "rejected_wrong_frame_id 1200 (its agreement:" in said
+    )
 
 
 def test_a_body_bag_for_a_scene_without_a_body_sensor_is_refused(

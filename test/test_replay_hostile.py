@@ -92,7 +92,7 @@ def test_negative_and_zero_stamps_are_rejected_and_counted_and_never_reach_the_o
     out = tmp_path / "out"
     assert _replay(bag, out) == 0
     summary = capsys.readouterr().out
-    assert "'rejected_zero_stamp': 1" in summary and "'rejected_negative_stamp': 2" in summary
+    assert "zero_stamp 1" in summary and "negative_stamp 2" in summary
     _, got = read_bag(out)
     ((static_time, static),) = got["/tf_static"]
     first = stamp_ns(TYPESTORE.deserialize_cdr(msgs[1][1], IMU))
@@ -375,7 +375,7 @@ def test_messages_of_1_mb_frame_ids_are_read_in_bounded_chunks(
     assert sizes == [32, 8]  # 32 MiB of 1 MiB messages, then the rest
     assert _replay(bag, tmp_path / "out") == 3
     err = capsys.readouterr().err
-    assert "rejected: {'rejected_wrong_frame': 40}; the bag's header.frame_id is 'fff" in err
+    assert "rejected: wrong_frame 40; the bag's header.frame_id is 'fff" in err
     assert len(err) < 1000
 
 
@@ -412,7 +412,7 @@ def test_an_unreadable_ros1_message_is_counted_never_raised(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     assert _replay(_garbage_ros1_bag(tmp_path / "in.bag"), tmp_path / "out") == 3
-    assert "3 received, rejected: {'rejected_undecodable': 3}" in capsys.readouterr().err
+    assert "3 received, rejected: undecodable 3" in capsys.readouterr().err
 
 
 def test_a_ros1_bag_cut_short_is_an_error_naming_it_and_the_repair(

@@ -227,7 +227,7 @@ def test_an_inputs_samples_not_finite_after_the_others_are_skipped_as_the_replay
     first = _pump_input(tmp_path / "first_second", n=1000)
     out = tmp_path / "out"
     assert main(["replay", str(tail), "--scene", pump, "-o", str(out), "--no-progress"]) == 0
-    assert "'rejected_non_finite': 9000" in capsys.readouterr().out
+    assert "rejected: non_finite 9000" in capsys.readouterr().out
     pages = {}
     for bag in (tail, first):
         page = tmp_path / f"{bag.name}.html"

@@ -104,9 +104,11 @@ class Judged(NamedTuple):
     suspect: dict[str, np.ndarray]
 
 
-def rejected(counts: Mapping[str, int]) -> dict[str, int]:
-    """The non-zero rejection counts of an engine's `counts` (rejected_<reason>)."""
-    return {k: v for k, v in counts.items() if k.startswith("rejected_") and v}
+def counted_text(counts: Mapping[str, int], prefix: str = "") -> str:
+    """The non-zero counts of `counts` whose key starts with `prefix`, as a reader takes them:
+    'non_finite 3, wrong_frame 40' (the prefix off), or 'none'."""
+    kept = [(k, v) for k, v in counts.items() if k.startswith(prefix) and v]
+    return ", ".join(f"{k.removeprefix(prefix)} {v}" for k, v in kept) or "none"
 
 
 def nothing_accepted(counts: Mapping[str, int], wrong_frame_id: str | None = None) -> str:
@@ -120,7 +122,10 @@ def nothing_accepted(counts: Mapping[str, int], wrong_frame_id: str | None = Non
         from mount_twin.scene.reader import shown  # a 1 MB frame id, shortened
 
         detail = f"; the bag's header.frame_id is {shown(wrong_frame_id)}: see input.frame_id"
-    why = f"{counts.get('received', 0)} received, rejected: {rejected(counts)}{detail}"
+    why = (
+        f"{counts.get('received', 0)} received, rejected: "
+        f"{counted_text(counts, 'rejected_')}{detail}"
+    )
     return f"no input sample was accepted ({why})"
 
 
