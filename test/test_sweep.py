@@ -160,7 +160,7 @@ def test_a_case_where_no_input_sample_is_accepted_is_a_failed_row(tmp_path: Path
     row = run_case(spec.base, spec.source, case)
     assert row["verdict"] == FAILED
     assert row["error"].startswith("no input sample was accepted (")
-    assert "rejected_wrong_frame" in row["error"]
+    assert "rejected: wrong_frame" in row["error"]
     assert not [k for k in row if k.startswith(("peak_force", "utilisation"))]  # none made
 
 
