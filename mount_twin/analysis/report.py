@@ -40,7 +40,6 @@ from mount_twin.io.output_tables import (
     events_of,
     input_values,
     integration_values,
-    read_output_bag,
 )
 from mount_twin.scene.description import STANDARD_GRAVITY, Scene
 from mount_twin.textfiles import write_text
@@ -297,6 +296,7 @@ def write_report(
     output_bag: str | Path,
     html_path: str | Path,
     *,
+    bag_tables: list[Table],
     input_samples: tuple[np.ndarray, np.ndarray] | None = None,
     scene: Scene | None = None,
     input_name: str = "",
@@ -306,14 +306,15 @@ def write_report(
     tolerance_db: tuple[float, float] = TOLERANCE_DB,
     design_name: str = "",
 ) -> ReportPage:
-    """Write the report page. `input_samples`: (stamps ns, specific force (n, 3) m/s² in F) of
-    the record, to plot beside the response, every value finite; `input_path`: the record's
-    bag, hashed for its provenance; `input_note`: what of it was left out (its samples not
-    finite), said beside it; `design` (Hz, g): a design spectrum the input's spectra are
-    judged against (within `tolerance_db`), named `design_name` (its file). The page opens
-    with the verdict, what produced it and with what settings, and the scene as loaded (every
-    value with its meaning and unit)."""
-    tables = {t.name: t for t in read_output_bag(output_bag)}
+    """Write the report page of the output bag whose tables are `bag_tables` (`read_output_bag` of
+    `output_bag`, which the page names, hashes and checks for a partial run). `input_samples`:
+    (stamps ns, specific force (n, 3) m/s² in F) of the record, to plot beside the response, every
+    value finite; `input_path`: the record's bag, hashed for its provenance; `input_note`: what of
+    it was left out (its samples not finite), said beside it; `design` (Hz, g): a design spectrum
+    the input's spectra are judged against (within `tolerance_db`), named `design_name` (its file).
+    The page opens with the verdict, what produced it and with what settings, and the scene as
+    loaded (every value with its meaning and unit)."""
+    tables = {t.name: t for t in bag_tables}
     mounts = {k.removeprefix("mount_"): t for k, t in tables.items() if k.startswith("mount_")}
     origin = min(int(t.columns["stamp_ns"][0]) for t in tables.values() if len(t))
     diagnostics = tables.get("diagnostics")

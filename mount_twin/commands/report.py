@@ -12,6 +12,7 @@ from mount_twin.commands.srs import add_design_arguments, tolerance_of
 if TYPE_CHECKING:
     from mount_twin.analysis.report import ReportPage
     from mount_twin.io.messages import Decoded
+    from mount_twin.io.output_tables import Table
     from mount_twin.scene.description import Scene
 
 NAME = "report"
@@ -56,6 +57,7 @@ def run(args: argparse.Namespace) -> int:
     require("matplotlib", "mount-twin report")
     from mount_twin.analysis.report import write_report
     from mount_twin.commands.common import load_scene, read_design_table, warn_if_partial
+    from mount_twin.io.output_tables import read_output_bag
 
     tolerance = tolerance_of(args)
     if args.design and not args.input:
@@ -63,8 +65,9 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(msg)
     design = read_design_table(args.design) if args.design else None
     scene = load_scene(args.scene) if args.scene else None
-    if scene is not None and args.input:
-        scene = _as_replayed(scene, args.bag)
+    tables = read_output_bag(args.bag)
+    if scene is not None:
+        scene = _as_replayed(scene, tables)
     samples, note = None, ""
     if args.input:
         if scene is None:
@@ -87,6 +90,7 @@ def run(args: argparse.Namespace) -> int:
     out = write_report(
         args.bag,
         args.output,
+        bag_tables=tables,
         input_samples=samples,
         scene=scene,
         input_name=name,
@@ -100,16 +104,17 @@ def run(args: argparse.Namespace) -> int:
     return _exit_status(out, args.fail_on)
 
 
-def _as_replayed(scene: Scene, output_bag: str) -> Scene:
+def _as_replayed(scene: Scene, tables: list[Table]) -> Scene:
     """The scene with the input topic its run read (`replay --topic` may have replaced the
-    scene's), as the output bag's input status records it: the input bag is read from that
-    topic, and the page names it."""
+    scene's), as the output bag's input status records it (`tables`: the bag's): the input bag
+    is read from that topic, and the page names it."""
     from dataclasses import replace
 
-    from mount_twin.io.output_tables import replayed_input_topic
+    from mount_twin.io.output_tables import input_values
 
-    topic = replayed_input_topic(output_bag)
-    if topic is None or topic == scene.input.topic:
+    diagnostics = next((t for t in tables if t.name == "diagnostics"), None)
+    topic = input_values(diagnostics).get("topic")
+    if not topic or topic == scene.input.topic:
         return scene
     return replace(scene, input=replace(scene.input, topic=topic))
 

@@ -169,26 +169,6 @@ def input_values(diagnostics: Table | None) -> dict[str, str]:
     return _last_values(diagnostics, INPUT)
 
 
-def replayed_input_topic(path: str | Path) -> str | None:
-    """The input topic the run that wrote the output bag at `path` read (its first input
-    status' `topic`: the scene's `input.topic`, or what `replay --topic` put in its place);
-    None where the bag holds no input status. Reads the diagnostics up to that status only."""
-    require_existing(path)
-    try:
-        with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
-            conns = [c for c in reader.connections if c.msgtype == DIAGNOSTICS]
-            for conn, _, raw in reader.messages(connections=conns) if conns else ():
-                msg: Any = reader.deserialize(raw, conn.msgtype)
-                for st in msg.status:
-                    if st.name == INPUT:
-                        topic = {kv.key: kv.value for kv in st.values}.get("topic")
-                        return str(topic) if topic else None
-    except Exception as err:  # rosbags raises its own types for unreadable bags
-        msg_text = f"{path}: cannot read the output bag: {err}"
-        raise BagError(msg_text) from err
-    return None
-
-
 def _last_values(diagnostics: Table | None, name: str) -> dict[str, str]:
     """The key-values of the last status called `name`; empty where the bag holds none."""
     if diagnostics is None:
