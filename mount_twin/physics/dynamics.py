@@ -95,7 +95,8 @@ class Scratch(NamedTuple):
       for `outputs` to take): read by the mount laws and the rest of `rhs` at that y.
     - `mount_loads` (inside `rhs`) fills total_force, total_moment (the linear mounts' own
       couples summed through one law: it is linear in their K_r, C_r), and for the non-linear
-      mounts arm, force, couple, loc and sink: read by `rhs` itself.
+      mounts sink (their internal-state rates go into dydt; their motion and loads are the
+      core's locals).
     - `rhs(t, y, u)` fills all of the above, then f_s, big_w, big_w_dot, rel, w_x_rel,
       kin_rate, moment_b, w_b, w_dot_b, acc, w_abs, h, i_w, and with fewer than three free
       rotations rhs_rot and mass_rot (the Cholesky factor of Jᵀ I J; with three, B⁻¹·I⁻¹
@@ -105,8 +106,8 @@ class Scratch(NamedTuple):
     - `run_samples` fills rate_step (the jump of Ω' at a sample): read by
       `rhs_after_rate_step`.
     - `mount_wrenches`, `mount_monitors`, `outputs` and `evaluate` (which calls `body_motion`
-      first) overwrite arm, force, couple, loc and sink where the model has non-linear
-      mounts; their results go to the caller's arrays.
+      first) overwrite sink where the model has non-linear mounts; their results go to the
+      caller's arrays.
     """
 
     q: np.ndarray  # (6,)
@@ -121,9 +122,6 @@ class Scratch(NamedTuple):
     phi_rate: np.ndarray  # (3,) its rate J(φ)⁻¹·R·ω, rad/s
     couple_map: np.ndarray  # (3, 3) J(φ)⁻ᵀ: a force conjugate to φ → its couple in F
     quat: np.ndarray  # (4,)
-    arm: np.ndarray  # (3,)
-    force: np.ndarray  # (3,)
-    couple: np.ndarray  # (3,)
     total_force: np.ndarray  # (3,) N, in F
     total_moment: np.ndarray  # (3,) N·m about the CG, in F
     f_s: np.ndarray  # (3,) specific force at the sensor, F
@@ -141,7 +139,6 @@ class Scratch(NamedTuple):
     mass_rot: np.ndarray  # (3, 3) reduced rotational mass matrix
     rhs_rot: np.ndarray  # (3,)
     rate_step: np.ndarray  # (3,) jump of Ω' at a sample, rad/s², F
-    loc: np.ndarray  # (6, 3) local deflection, rate, rotation, rate, force, couple of a mount
     sink: np.ndarray  # (n_state,) internal-state rates nobody needs (outputs, monitors)
 
 
@@ -160,9 +157,6 @@ def new_scratch(n_state: int) -> Scratch:
         phi_rate=np.zeros(3),
         couple_map=np.eye(3),
         quat=np.zeros(4),
-        arm=np.zeros(3),
-        force=np.zeros(3),
-        couple=np.zeros(3),
         total_force=np.zeros(3),
         total_moment=np.zeros(3),
         f_s=np.zeros(3),
@@ -180,7 +174,6 @@ def new_scratch(n_state: int) -> Scratch:
         mass_rot=np.zeros((3, 3)),
         rhs_rot=np.zeros(3),
         rate_step=np.zeros(3),
-        loc=np.zeros((6, 3)),
         sink=np.zeros(n_state),
     )
 

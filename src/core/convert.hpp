@@ -218,9 +218,6 @@ inline Scratch scratch(py::handle s) {
   o.phi_rate = v3("phi_rate");
   o.couple_map = m33("couple_map");
   o.quat = vec(field(s, "quat"), "Scratch.quat", 4);
-  o.arm = v3("arm");
-  o.force = v3("force");
-  o.couple = v3("couple");
   o.total_force = v3("total_force");
   o.total_moment = v3("total_moment");
   o.f_s = v3("f_s");
@@ -238,7 +235,6 @@ inline Scratch scratch(py::handle s) {
   o.mass_rot = m33("mass_rot");
   o.rhs_rot = v3("rhs_rot");
   o.rate_step = v3("rate_step");
-  o.loc = matc<3>(field(s, "loc"), "Scratch.loc", 6);
   o.sink = vec(field(s, "sink"), "Scratch.sink");
   return o;
 }

@@ -50,11 +50,10 @@ struct Scratch {
   M3 rot, kin, kin_rate;
   Vec omega, omega_f, phi, phi_rate;
   M3 couple_map;
-  Vec quat, arm, force, couple, total_force, total_moment, f_s, big_w, big_w_dot, rel, w_x_rel,
+  Vec quat, total_force, total_moment, f_s, big_w, big_w_dot, rel, w_x_rel,
       moment_b, w_b, w_dot_b, acc, w_abs, h, i_w;
   M3 mass_rot;
   Vec rhs_rot, rate_step;
-  M3 loc;    // (6, 3)
   Vec sink;  // (n_state,)
 };
 

@@ -97,40 +97,52 @@ inline void out_of_axes(const NonLinear& nl, idx i, const double* local, double*
   }
 }
 
-/// Deflection, rate, rotation vector and its rate of non-linear mount i in its axes into
-/// s.loc rows 0..3 (rows 2, 3 NaN for a kind without a rotational law); its arm into s.arm.
-inline void local_motion(idx i, const NonLinear& nl, const Motion& mo, Scratch& s) {
+/// A non-linear mount's motion and load in its own axes, held in locals: through the scratch's
+/// views, which may alias, values stored one by one and read back as a pair stalled on store
+/// forwarding (43 % of `local_motion`'s time on the bundled genset).
+struct MountLocal {
+  double arm[3];  // m, F: the lever arm R·p
+  double d[3];    // m: deflection
+  double v[3];    // m/s: its rate
+  double phi[3];  // rad: rotation vector (NaN for a kind without a rotational law)
+  double w[3];    // rad/s: its rate (NaN likewise)
+  double f[3];    // N: force on the body
+  double c[3];    // N·m: generalized couple, conjugate to phi
+};
+
+/// Deflection, rate, rotation vector and its rate of non-linear mount i in its axes, and its
+/// arm, into ml.
+inline void local_motion(idx i, const NonLinear& nl, const Motion& mo, MountLocal& ml) {
   double de[6];
-  point_motion(&nl.point(i, 0), mo, s.arm.d, de);
-  const M3 loc = s.loc;
-  into_axes(nl, i, de[0], de[1], de[2], loc.row(0).d);
-  into_axes(nl, i, de[3], de[4], de[5], loc.row(1).d);
+  point_motion(&nl.point(i, 0), mo, ml.arm, de);
+  into_axes(nl, i, de[0], de[1], de[2], ml.d);
+  into_axes(nl, i, de[3], de[4], de[5], ml.v);
   if (nl.rotational[i]) {
-    into_axes(nl, i, mo.phi[0], mo.phi[1], mo.phi[2], loc.row(2).d);
-    into_axes(nl, i, mo.rate[0], mo.rate[1], mo.rate[2], loc.row(3).d);
+    into_axes(nl, i, mo.phi[0], mo.phi[1], mo.phi[2], ml.phi);
+    into_axes(nl, i, mo.rate[0], mo.rate[1], mo.rate[2], ml.w);
   } else {
     for (int j = 0; j < 3; ++j) {
-      loc(2, j) = NAN;
-      loc(3, j) = NAN;
+      ml.phi[j] = NAN;
+      ml.w[j] = NAN;
     }
   }
 }
 
-/// Load of non-linear mount i in its axes into s.loc rows 4, 5; its state rates into dydt.
-inline void nl_load(idx i, Vec y, const NonLinear& nl, const Motion& mo, Scratch& s,
+/// Load of non-linear mount i in its axes into ml.f, ml.c (its motion first); its state rates
+/// into dydt.
+inline void nl_load(idx i, Vec y, const NonLinear& nl, const Motion& mo, MountLocal& ml,
                     Vec dydt) {
-  local_motion(i, nl, mo, s);
-  const M3 loc = s.loc;
-  kinds::kind_load(nl.kind[i], &nl.par(i, 0), y, nl.state[i], loc.row(0).d, loc.row(1).d,
-                   loc.row(2).d, loc.row(3).d, dydt, loc.row(4).d, loc.row(5).d);
+  local_motion(i, nl, mo, ml);
+  kinds::kind_load(nl.kind[i], &nl.par(i, 0), y, nl.state[i], ml.d, ml.v, ml.phi, ml.w, dydt,
+                   ml.f, ml.c);
 }
 
-/// c = J(φ)⁻ᵀ·Qᵢ·s.loc[5]: the couple on the body (F) of mount i's generalized force.
-inline void nl_couple(idx i, const NonLinear& nl, Scratch& s, Vec c) {
-  const M3 cmap = s.couple_map;
-  out_of_axes(nl, i, s.loc.row(5).d, c.d);
+/// c = J(φ)⁻ᵀ·Qᵢ·ml.c: the couple on the body (F) of mount i's generalized force.
+inline void nl_couple(idx i, const NonLinear& nl, const Motion& mo, const MountLocal& ml,
+                      double* c) {
+  out_of_axes(nl, i, ml.c, c);
   const double c0 = c[0], c1 = c[1], c2 = c[2];
-  for (int j = 0; j < 3; ++j) c[j] = cmap(j, 0) * c0 + cmap(j, 1) * c1 + cmap(j, 2) * c2;
+  for (int j = 0; j < 3; ++j) c[j] = mo.cmap[j][0] * c0 + mo.cmap[j][1] * c1 + mo.cmap[j][2] * c2;
 }
 
 inline void add_load(const double* arm, const double* f, const double* c, double* total_f,
@@ -156,18 +168,13 @@ inline void mount_loads(Vec y, const Model& m, Scratch& s, Vec dydt) {
   }
   if (m.has_nl) {
     const NonLinear& nl = m.nl;
-    const Vec f = s.force, c = s.couple;
+    MountLocal ml;
     for (idx i = 0; i < nl.k; ++i) {
-      nl_load(i, y, nl, mo, s, dydt);
-      out_of_axes(nl, i, s.loc.row(4).d, f.d);
-      if (nl.rotational[i]) {
-        nl_couple(i, nl, s, c);
-      } else {
-        c[0] = 0.0;
-        c[1] = 0.0;
-        c[2] = 0.0;
-      }
-      add_load(s.arm.d, f.d, c.d, total_f, total_m);
+      double f[3], c[3] = {0.0, 0.0, 0.0};
+      nl_load(i, y, nl, mo, ml, dydt);
+      out_of_axes(nl, i, ml.f, f);
+      if (nl.rotational[i]) nl_couple(i, nl, mo, ml, c);
+      add_load(ml.arm, f, c, total_f, total_m);
     }
   }
   for (int j = 0; j < 3; ++j) {
@@ -182,18 +189,18 @@ inline void mount_wrenches(Vec y, const Model& m, Scratch& s, M6 wrenches) {
   linear_wrenches(m, mo, wrenches);
   if (!m.has_nl) return;
   const NonLinear& nl = m.nl;
-  const M3 loc = s.loc;
-  const Vec c = s.couple;
+  MountLocal ml;
   for (idx i = 0; i < nl.k; ++i) {
-    nl_load(i, y, nl, mo, s, s.sink);
+    nl_load(i, y, nl, mo, ml, s.sink);
     if (nl.rotational[i]) {
-      nl_couple(i, nl, s, c);
-      into_axes(nl, i, c[0], c[1], c[2], loc.row(5).d);
+      double c[3];
+      nl_couple(i, nl, mo, ml, c);
+      into_axes(nl, i, c[0], c[1], c[2], ml.c);
     }
     const idx row = nl.slot[i];
     for (int j = 0; j < 3; ++j) {
-      wrenches(row, j) = loc(4, j);
-      wrenches(row, 3 + j) = loc(5, j);
+      wrenches(row, j) = ml.f[j];
+      wrenches(row, 3 + j) = ml.c[j];
     }
   }
 }
@@ -205,9 +212,10 @@ inline double mount_deflections(Vec y, const Model& m, Scratch& s, M3 d) {
   const double ct = body_motion(y, m, s);
   if (!(ct > 0.0)) return NAN;
   const Motion mo = Motion::of(s);
+  MountLocal ml;
   for (idx i = 0; i < m.nl.k; ++i) {
-    local_motion(i, m.nl, mo, s);
-    for (int j = 0; j < 3; ++j) d(i, j) = s.loc(0, j);
+    local_motion(i, m.nl, mo, ml);
+    for (int j = 0; j < 3; ++j) d(i, j) = ml.d[j];
   }
   return ct;
 }
@@ -215,15 +223,15 @@ inline double mount_deflections(Vec y, const Model& m, Scratch& s, M3 d) {
 /// Event functions g (k, NE) and utilisation util (k) of each non-linear mount at y (its body
 /// motion computed); then their discrete switches. Returns whether one switched (y jumped).
 inline bool mount_monitors(Vec y, Vec y0, const NonLinear& nl, Scratch& s, Mat g, Vec util) {
-  const M3 loc = s.loc;
   const Motion mo = Motion::of(s);
+  MountLocal ml;
   bool switched = false;
   for (idx i = 0; i < nl.k; ++i) {
-    local_motion(i, nl, mo, s);
+    local_motion(i, nl, mo, ml);
     const idx code = nl.kind[i], o = nl.state[i];
     const double* p = &nl.par(i, 0);
-    util[i] = kinds::kind_monitor(code, p, y, y0, o, loc.row(0).d, loc.row(1).d, g.row(i));
-    if (kinds::kind_update(code, p, y, o, loc.row(0).d)) switched = true;
+    util[i] = kinds::kind_monitor(code, p, y, y0, o, ml.d, ml.v, g.row(i));
+    if (kinds::kind_update(code, p, y, o, ml.d)) switched = true;
   }
   return switched;
 }

@@ -52,15 +52,16 @@ struct Motion {
 /// Displacement d (m) and velocity ḋ (m/s) in F of body point `point` from its reference
 /// position into de[0..2], de[3..5]; the lever arm R·p (m, F) into `arm`.
 inline void point_motion(const double* point, const Motion& mo, double* arm, double* de) {
-  for (int j = 0; j < 3; ++j) {
-    arm[j] = mo.rot[j][0] * point[0] + mo.rot[j][1] * point[1] + mo.rot[j][2] * point[2];
-  }
-  de[0] = mo.q[0] + arm[0] - point[0];
-  de[1] = mo.q[1] + arm[1] - point[1];
-  de[2] = mo.q[2] + arm[2] - point[2];
-  de[3] = mo.qd[0] + mo.w[1] * arm[2] - mo.w[2] * arm[1];
-  de[4] = mo.qd[1] + mo.w[2] * arm[0] - mo.w[0] * arm[2];
-  de[5] = mo.qd[2] + mo.w[0] * arm[1] - mo.w[1] * arm[0];
+  const double p[3] = {point[0], point[1], point[2]};  // locals: arm may alias point
+  double a[3];
+  for (int j = 0; j < 3; ++j) a[j] = mo.rot[j][0] * p[0] + mo.rot[j][1] * p[1] + mo.rot[j][2] * p[2];
+  de[0] = mo.q[0] + a[0] - p[0];
+  de[1] = mo.q[1] + a[1] - p[1];
+  de[2] = mo.q[2] + a[2] - p[2];
+  de[3] = mo.qd[0] + mo.w[1] * a[2] - mo.w[2] * a[1];
+  de[4] = mo.qd[1] + mo.w[2] * a[0] - mo.w[0] * a[2];
+  de[5] = mo.qd[2] + mo.w[0] * a[1] - mo.w[1] * a[0];
+  for (int j = 0; j < 3; ++j) arm[j] = a[j];
 }
 
 /// Kelvin–Voigt force (N, F) −(K·d + C·ḋ) of a mount of stiffness k (N/m) and damping c
