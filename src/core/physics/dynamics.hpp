@@ -20,12 +20,14 @@ namespace mt::physics {
 /// cos θ below which the state counts as off the chart (dynamics.py COS_TILT_MIN).
 constexpr double COS_TILT_MIN = 1.0e-6;
 
-/// Fill s.q, s.qd, s.trig, s.rot, s.kin, s.omega, s.omega_f (and s.phi, s.quat, s.phi_rate,
-/// s.couple_map where m.rotation_read, else NaN) from y; returns cos θ (NaN off the chart).
-inline double body_motion(Vec y, const Model& m, Scratch& s) {
-  const Vec q = s.q, qd = s.qd, trig = s.trig, omega = s.omega, omega_f = s.omega_f;
-  const M3 rot = s.rot, kin = s.kin;
+/// The body motion at y into mo, and into s.q, s.qd, s.trig, s.rot, s.kin, s.omega, s.omega_f
+/// (and s.phi, s.quat, s.phi_rate, s.couple_map where m.rotation_read, else NaN); returns
+/// cos θ (NaN off the chart: mo is then incomplete). Computed in locals, the scratch written
+/// once: read back through its views, which may alias, values just stored one by one stalled
+/// on store forwarding (the pump's rhs).
+inline double body_motion(Vec y, const Model& m, Scratch& s, Motion& mo) {
   const idx nt = m.free_trans.n, nr = m.free_rot.n, nf = nt + nr;
+  double q[6], qd[6], trig[6];
   for (int i = 0; i < 6; ++i) {
     q[i] = m.q_fixed[i];
     qd[i] = 0.0;
@@ -43,31 +45,61 @@ inline double body_motion(Vec y, const Model& m, Scratch& s) {
     trig[i] = std::sin(angle);
     trig[3 + i] = std::cos(angle);
   }
+  for (int i = 0; i < 6; ++i) {
+    s.q[i] = q[i];
+    s.qd[i] = qd[i];
+    s.trig[i] = trig[i];
+  }
   const double sa = trig[0], sg = trig[1], sd = trig[2], ca = trig[3], cg = trig[4],
                cd = trig[5];
+  const M3 rot{&mo.rot[0][0], 3};
   const double ct = rotation_from_chart(sa, sg, cg, sd, cd, rot);
-  if (!(ct > COS_TILT_MIN)) return NAN;
-  kinematic_matrix(sa, ca, sg, cg, ct, kin);
-  for (int i = 0; i < 3; ++i) omega[i] = kin(i, 0) * qd[3] + kin(i, 1) * qd[4] + kin(i, 2) * qd[5];
+  if (std::isnan(ct)) return NAN;  // rot not written
   for (int i = 0; i < 3; ++i) {
-    omega_f[i] = rot(i, 0) * omega[0] + rot(i, 1) * omega[1] + rot(i, 2) * omega[2];
+    for (int j = 0; j < 3; ++j) s.rot(i, j) = mo.rot[i][j];
   }
-  const Vec phi = s.phi, phi_rate = s.phi_rate;
-  const M3 cmap = s.couple_map;
+  if (!(ct > COS_TILT_MIN)) return NAN;
+  double kin[3][3], omega[3];
+  kinematic_matrix(sa, ca, sg, cg, ct, M3{&kin[0][0], 3});
+  for (int i = 0; i < 3; ++i) omega[i] = kin[i][0] * qd[3] + kin[i][1] * qd[4] + kin[i][2] * qd[5];
+  for (int i = 0; i < 3; ++i) {
+    mo.w[i] = rot(i, 0) * omega[0] + rot(i, 1) * omega[1] + rot(i, 2) * omega[2];
+    mo.q[i] = q[i];
+    mo.qd[i] = qd[i];
+  }
   if (m.rotation_read) {
-    rotation_vector(rot, s.quat, phi);
-    couple_map(phi, s.quat, cmap);
+    double quat[4];
+    const Vec phi{mo.phi, 3};
+    rotation_vector(rot, Vec{quat, 4}, phi);
+    couple_map(phi, Vec{quat, 4}, M3{&mo.cmap[0][0], 3});
     for (int i = 0; i < 3; ++i) {
-      phi_rate[i] = cmap(0, i) * omega_f[0] + cmap(1, i) * omega_f[1] + cmap(2, i) * omega_f[2];
+      mo.rate[i] = mo.cmap[0][i] * mo.w[0] + mo.cmap[1][i] * mo.w[1] + mo.cmap[2][i] * mo.w[2];
     }
+    for (int i = 0; i < 4; ++i) s.quat[i] = quat[i];
   } else {
     for (int i = 0; i < 3; ++i) {
-      phi[i] = NAN;
-      phi_rate[i] = NAN;
-      for (int j = 0; j < 3; ++j) cmap(i, j) = NAN;
+      mo.phi[i] = NAN;
+      mo.rate[i] = NAN;
+      for (int j = 0; j < 3; ++j) mo.cmap[i][j] = NAN;
     }
   }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      s.kin(i, j) = kin[i][j];
+      s.couple_map(i, j) = mo.cmap[i][j];
+    }
+    s.omega[i] = omega[i];
+    s.omega_f[i] = mo.w[i];
+    s.phi[i] = mo.phi[i];
+    s.phi_rate[i] = mo.rate[i];
+  }
   return ct;
+}
+
+/// `body_motion` into the scratch alone.
+inline double body_motion(Vec y, const Model& m, Scratch& s) {
+  Motion mo;
+  return body_motion(y, m, s, mo);
 }
 
 /// out = Qᵢᵀ·x: a vector of F in non-linear mount i's axes (copied where they are F's).
@@ -155,10 +187,9 @@ inline void add_load(const double* arm, const double* f, const double* c, double
   total_m[2] += arm[0] * f[1] - arm[1] * f[0] + c[2];
 }
 
-/// Sum the mount loads on the body into s.total_force, s.total_moment (F, about the CG);
-/// the internal-state rates of the mounts that have them into dydt.
-inline void mount_loads(Vec y, const Model& m, Scratch& s, Vec dydt) {
-  const Motion mo = Motion::of(s);
+/// Sum the mount loads on the body at the motion mo into s.total_force, s.total_moment (F,
+/// about the CG); the internal-state rates of the mounts that have them into dydt.
+inline void mount_loads(Vec y, const Model& m, const Motion& mo, Scratch& s, Vec dydt) {
   double total_f[3] = {0.0, 0.0, 0.0}, total_m[3] = {0.0, 0.0, 0.0};
   linear_loads(m, mo, total_f, total_m);
   if (m.lin_point.rows > 0) {  // their own couples, through their summed K_r, C_r
@@ -209,9 +240,9 @@ inline void mount_wrenches(Vec y, const Model& m, Scratch& s, M6 wrenches) {
 /// hysteretic mounts on their loading curve reads it: model/loading.py). Returns cos θ (NaN
 /// off the chart: d is then not written).
 inline double mount_deflections(Vec y, const Model& m, Scratch& s, M3 d) {
-  const double ct = body_motion(y, m, s);
+  Motion mo;
+  const double ct = body_motion(y, m, s, mo);
   if (!(ct > 0.0)) return NAN;
-  const Motion mo = Motion::of(s);
   MountLocal ml;
   for (idx i = 0; i < m.nl.k; ++i) {
     local_motion(i, m.nl, mo, ml);
@@ -398,9 +429,10 @@ inline bool rotational(const Model& m, Scratch& s, double ct, Vec dydt, idx firs
 }
 
 inline int rhs(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt) {
-  const double ct = body_motion(y, m, s);
+  Motion mo;
+  const double ct = body_motion(y, m, s, mo);
   if (!(ct > 0.0)) return OFF_CHART;
-  mount_loads(y, m, s, dydt);
+  mount_loads(y, m, mo, s, dydt);
   const idx nt = m.free_trans.n, nr = m.free_rot.n, nf = nt + nr;
   for (idx k = 0; k < nf; ++k) dydt[k] = y[nf + k];
   const double tau = t - u[0];
