@@ -66,18 +66,21 @@ def exprb32_advance(
 ) -> int: ...
 def forget(settings: _A) -> None: ...
 def phi_functions(k: _A, n: int, h: float, b: Any) -> bool: ...
-def run_samples(
-    integ: Any,
-    m: Any,
-    s: Any,
-    u: _A,
-    y: _A,
-    samples: Any,
-    opts: Any,
-    out: Any,
-    watch: Any,
-    estimate: Any,
-) -> tuple[int, int]: ...
+
+class Loop:
+    def __init__(
+        self,
+        integ: Any,
+        m: Any,
+        s: Any,
+        u: _A,
+        y: _A,
+        opts: Any,
+        watch: Any,
+        estimate: Any,
+    ) -> None: ...
+
+def run_samples(loop: Loop, samples: Any, out: Any) -> tuple[int, int]: ...
 def watch_mounts(
     y: _A, nl: Any, s: Any, watch: Any, t0: float, t1: float, wrenches: _A, settings: _A
 ) -> int: ...

@@ -146,24 +146,19 @@ def test_each_methods_tables_are_the_cores(name: str) -> None:
 
 
 def test_the_loop_refuses_work_arrays_too_small_for_the_method(pump) -> None:
-    """run_samples checks the stepper's work rows against its method before the loop starts:
-    a dopri54-sized array handed to ros34pw2 is refused by name, not overrun."""
-    from mount_twin.engine.driver import published_buffers
-    from mount_twin.engine.kernel import Integrator, RunOptions, Samples, new_watch, run_samples
+    """The loop checks the stepper's work rows against its method when it is bound, before
+    any run: a dopri54-sized array handed to ros34pw2 is refused by name, not overrun."""
+    from mount_twin.engine.kernel import Integrator, Loop, RunOptions, new_watch
     from mount_twin.integrate.stepper import new_stepper
 
     model, y, u = pump
     small = new_stepper("dopri54", model.n_state, 1e-6, 1e-9, 100)
     rows = methods.METHODS["ros34pw2"].work_rows(model.n_state)
     integ = Integrator(methods.ROS34PW2, small.settings, small.work2d, small.work1d, small.result)
-    t = np.array([0.0, 1e-3])
-    samples = Samples(t, np.tile(u[1:4], (2, 1)), np.zeros((2, 3)))
-    counter, peak = np.zeros(1, dtype=np.int64), np.zeros((model.n_mounts, 6))
-    out = published_buffers(2, counter, peak, np.zeros(model.arrays.lin_slot.shape[0]))
     watch = new_watch(0, N_EVENTS, model.n_state)
     opts = RunOptions(False, 1, False)
-    args = (model.arrays, model.new_scratch(), u.copy(), y.copy(), samples, opts, out, watch)
+    args = (model.arrays, model.new_scratch(), u.copy(), y.copy(), opts, watch)
     with pytest.raises(
         ValueError, match=rf"Integrator\.work2d: 7 rows where method 1 needs {rows}"
     ):
-        run_samples(integ, *args, None)
+        Loop(integ, *args, None)

@@ -30,6 +30,7 @@ from mount_twin.engine.estimator import Estimator, new_estimator
 from mount_twin.engine.health import HealthWindow
 from mount_twin.engine.kernel import (
     Integrator,
+    Loop,
     Published,
     RunOptions,
     Samples,
@@ -192,6 +193,8 @@ class CoreDriver:
             scene.input.hold == "first_order",
         )
         self.estimator = _new_estimator(model, (self._watch.g.shape[0], self._watch.g.shape[1]))
+        self._loop: tuple[tuple[object, ...], Loop] | None = None
+        """The arrays bound last, and their `Loop` (`_bound`)."""
         self._choosing = integ.method == AUTO
         """`auto` has not made its first choice yet (made at the first interval)."""
         if self._choosing:
@@ -241,6 +244,24 @@ class CoreDriver:
             np.maximum(watch.util_peak, watch.util, out=watch.util_peak)
         return pose, wrenches
 
+    def _bound(self) -> Loop:
+        """The core's loop over the arrays now held: the one bound before, unless one of them
+        was replaced since (a start's y; a method switch's stepper and estimate)."""
+        arrays = (
+            self._integ,
+            self.model.arrays,
+            self._scratch,
+            self._u,
+            self.y,
+            self._options,
+            self._watch,
+            self.estimator,
+        )
+        bound = self._loop
+        if bound is None or any(a is not b for a, b in zip(arrays, bound[0], strict=True)):
+            self._loop = bound = (arrays, Loop(*arrays))
+        return bound[1]
+
     def choose_at_start(self, stamp: float) -> None:
         """`auto`'s first choice, at the interval from the start into the sample at `stamp`
         (s); nothing otherwise."""
@@ -256,18 +277,7 @@ class CoreDriver:
         buf = published_buffers(
             len(segment.t), self._counter, self._peak, self._linear_util, rows.of_run(index)
         )
-        done, status = run_samples(
-            self._integ,
-            self.model.arrays,
-            self._scratch,
-            self._u,
-            self.y,
-            segment,
-            self._options,
-            buf,
-            self._watch,
-            self.estimator,
-        )
+        done, status = run_samples(self._bound(), segment, buf)
         events = self._drain_events()
         self._health.add_steps(buf.step_log[1 : done + 1])
         if self.estimator is not None:

@@ -136,24 +136,34 @@ monitor_switches = _core.monitor_switches
 utilisation util and discrete switches at a sample (y_prev: the state at the previous one, then
 y); a switch (y jumped) clears settings[CHAINED]; returns whether one switched. The twin's
 watch takes its switches through it."""
-run_samples = _core.run_samples
-"""run_samples(integ, m, s, u, y, samples, opts, out, watch, estimate) -> (done, status):
-advance y through samples 1..n−1 of `samples`; sample 0 is the last one already done
-(src/core/engine/kernel.hpp; the loop releases the GIL).
+Loop = _core.Loop
+"""Loop(integ, m, s, u, y, opts, watch, estimate): the arrays `run_samples` advances, converted
+and checked once (dtype, shape against the model: a wrong one raises naming it), held so their
+views stay valid. Their contents may change between runs; to replace an array or a tuple
+(a start's new y, a method switch's stepper and estimate), bind a new Loop (`CoreDriver` does).
+The model's arrays are read at binding: a model is never changed in place.
 
 Args:
     integ: the stepper (`Integrator`); m, s: the model's arrays and scratch; u: the input
         vector the right-hand side reads (filled here per interval); y: the state.
-    samples: `Samples`; opts: `RunOptions`; out: `Published` (buffers of n rows).
+    opts: `RunOptions`.
     watch: the non-linear mounts' event functions, utilisation peaks and event log
         (`Watch`, read only where the model has such mounts); events are located by linear
         interpolation inside the sample interval.
     estimate: the live error estimate's arrays: `engine.estimator.Estimator` (a model of linear
         mounts), `engine.companion.Companion` (with non-linear ones), or None (off).
+"""
+run_samples = _core.run_samples
+"""run_samples(loop, samples, out) -> (done, status): advance the loop's y through samples
+1..n−1 of `samples`; sample 0 is the last one already done (src/core/engine/kernel.hpp; the
+loop releases the GIL).
+
+Args:
+    loop: a `Loop`.
+    samples: `Samples`; out: `Published` (buffers of n rows), both checked at each call.
 
 Returns:
     (index of the last sample done, status: 0 when all are done; AT_EVENT when the run ended
     at that sample because it logged an event that may stiffen the scene, past
-    watch.stop_after; else the stepper's failure at the next sample). Every array is checked
-    (dtype, shape against the model) before the loop starts: a wrong one raises naming it.
+    watch.stop_after; else the stepper's failure at the next sample).
 """

@@ -51,10 +51,20 @@ engine::Watch watch(py::handle obj, idx k, idx n_state) {
   w.events = convert::mat(field(obj, "events"), "Watch.events", -1, 4);
   w.n_events = counter(field(obj, "n_events"), "Watch.n_events");
   w.y_prev = convert::vec(field(obj, "y_prev"), "Watch.y_prev", n_state);
-  w.stop_after = *scalar(field(obj, "stop_after"), "Watch.stop_after");
+  w.stop_after = scalar(field(obj, "stop_after"), "Watch.stop_after");
   w.stiffens = convert::mat(field(obj, "stiffens"), "Watch.stiffens", k, w.g.cols);
   w.n_stiffening = counter(field(obj, "n_stiffening"), "Watch.n_stiffening");
   return w;
+}
+
+/// The estimator's state slots the loop indexes by: ValueError unless valid.
+void check_estimator_state(const engine::Estimator& c) {
+  const double nc = c.state[engine::N_CARRIED];
+  if (!(c.state[engine::CHECK_EVERY] >= 1.0) || !(c.state[engine::LINEARISE_EVERY] >= 1.0) ||
+      !(nc >= 0.0 && nc <= static_cast<double>(c.carried.n))) {
+    throw py::value_error("Estimator.state: CHECK_EVERY and LINEARISE_EVERY must be >= 1, "
+                          "N_CARRIED within the slots");
+  }
 }
 
 engine::Estimator estimator(py::handle obj, idx n_state, idx n_mounts) {
@@ -93,12 +103,7 @@ engine::Estimator estimator(py::handle obj, idx n_state, idx n_mounts) {
   c.wrenches = convert::matc<6>(field(obj, "wrenches"), "Estimator.wrenches", n_mounts);
   c.state = convert::vec(field(obj, "state"), "Estimator.state", engine::N_ESTIMATOR_SLOTS);
   c.figures = convert::vec(field(obj, "figures"), "Estimator.figures", N_FIGURES);
-  const double nc = c.state[engine::N_CARRIED];
-  if (!(c.state[engine::CHECK_EVERY] >= 1.0) || !(c.state[engine::LINEARISE_EVERY] >= 1.0) ||
-      !(nc >= 0.0 && nc <= static_cast<double>(np))) {
-    throw py::value_error("Estimator.state: CHECK_EVERY and LINEARISE_EVERY must be >= 1, "
-                          "N_CARRIED within the slots");
-  }
+  check_estimator_state(c);
   return c;
 }
 
@@ -118,6 +123,65 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
   return c;
 }
 
+/// run_samples' arrays, converted and checked once: converting its hundred-odd fields at
+/// every call took 25–40 µs, most of what one live sample costs the core. The Loop holds the
+/// Python objects, so the views stay valid: NamedTuples and arrays, whose fields cannot be
+/// rebound (the driver binds anew when it replaces one: a start's y, a method switch).
+/// The estimator's state slots, which Python may change between calls, are checked again at
+/// each (`refresh`).
+struct Loop {
+  py::object refs[8];
+  Model m;
+  Scratch s;
+  Vec u, y;
+  engine::Integrator integ;
+  engine::RunOptions opts;
+  engine::Watch w;
+  engine::Estimator est;
+  engine::Companion comp;
+  engine::Estimator* ep = nullptr;
+  engine::Companion* cp = nullptr;
+
+  Loop(py::handle integ_, py::handle m_, py::handle s_, py::handle u_, py::handle y_,
+       py::handle opts_, py::handle watch_, py::handle estimate_)
+      : refs{py::reinterpret_borrow<py::object>(integ_), py::reinterpret_borrow<py::object>(m_),
+             py::reinterpret_borrow<py::object>(s_), py::reinterpret_borrow<py::object>(u_),
+             py::reinterpret_borrow<py::object>(y_), py::reinterpret_borrow<py::object>(opts_),
+             py::reinterpret_borrow<py::object>(watch_),
+             py::reinterpret_borrow<py::object>(estimate_)} {
+    m = convert::model(m_);
+    s = convert::scratch(s_);
+    y = convert::vec(y_, "y");
+    convert::check_state(m, y);
+    convert::check_scratch(s, y.n, "s");
+    const idx n_state = y.n;
+    const idx k = m.has_nl ? m.nl.k : 0;
+    const idx n_mounts = m.lin_point.rows + k;
+    integ = integrator(integ_, "Integrator", n_state);
+    opts.zero_order = field(opts_, "zero_order").cast<bool>();
+    opts.decimation = field(opts_, "decimation").cast<idx>();
+    opts.chain = field(opts_, "chain").cast<bool>();
+    if (opts.decimation < 1) throw py::value_error("RunOptions.decimation: below 1");
+    w = watch(watch_, k, n_state);
+    if (py::hasattr(estimate_, "carried")) {
+      est = estimator(estimate_, n_state, n_mounts);
+      ep = &est;
+    } else if (!estimate_.is_none()) {
+      comp = companion(estimate_, n_state, n_mounts, k, w.g.cols);
+      cp = &comp;
+    }
+    u = convert::vec(u_, "u", INPUT_SIZE);
+  }
+  // ep and cp point into this object: built in place (py::init), never copied or moved.
+  Loop(const Loop&) = delete;
+  Loop& operator=(const Loop&) = delete;
+
+  /// Check again what Python may have changed since the binding.
+  void refresh() const {
+    if (ep != nullptr) check_estimator_state(est);
+  }
+};
+
 }  // namespace
 
 void bind_engine(py::module_& mod) {
@@ -132,30 +196,27 @@ void bind_engine(py::module_& mod) {
   mod.attr("PERIOD_SHARE") = engine::PERIOD_SHARE;
   mod.attr("BOUND_PERIOD_SHARE") = engine::BOUND_PERIOD_SHARE;
   mod.attr("SPIKE_RATIO") = engine::SPIKE_RATIO;
+  py::class_<Loop>(mod, "Loop",
+                   "The per-sample loop's arrays (`run_samples`): each is converted and "
+                   "checked (dtype, shape against the model) here, once; the Loop holds them, "
+                   "and sees their contents as they change.")
+      .def(py::init<py::handle, py::handle, py::handle, py::handle, py::handle, py::handle,
+                    py::handle, py::handle>(),
+           py::arg("integ"), py::arg("m"), py::arg("s"), py::arg("u"), py::arg("y"),
+           py::arg("opts"), py::arg("watch"), py::arg("estimate"))
+      .def("__repr__", [](const Loop& loop) {
+        return "<Loop of " + std::to_string(loop.y.n) + " states>";
+      });
   mod.def(
       "run_samples",
-      [](py::handle integ_, py::handle m_, py::handle s_, py::handle u_, py::handle y_,
-         py::handle samples_, py::handle opts_, py::handle out_, py::handle watch_,
-         py::handle estimate_) {
-        const Model m = convert::model(m_);
-        Scratch s = convert::scratch(s_);
-        const Vec y = convert::vec(y_, "y");
-        convert::check_state(m, y);
-        convert::check_scratch(s, y.n, "s");
-        const idx n_state = y.n;
-        const idx k = m.has_nl ? m.nl.k : 0;
-        const idx n_mounts = m.lin_point.rows + k;
-        engine::Integrator integ = integrator(integ_, "Integrator", n_state);
+      [](Loop& loop, py::handle samples_, py::handle out_) {
+        const Model& m = loop.m;
+        const idx n_mounts = m.lin_point.rows + (m.has_nl ? m.nl.k : 0);
         engine::Samples smp;
         smp.t = convert::vec(field(samples_, "t"), "Samples.t");
         const idx n = smp.t.n;
         smp.f = convert::matc<3>(field(samples_, "f"), "Samples.f", n);
         smp.w = convert::matc<3>(field(samples_, "w"), "Samples.w", n);
-        engine::RunOptions opts;
-        opts.zero_order = field(opts_, "zero_order").cast<bool>();
-        opts.decimation = field(opts_, "decimation").cast<idx>();
-        opts.chain = field(opts_, "chain").cast<bool>();
-        if (opts.decimation < 1) throw py::value_error("RunOptions.decimation: below 1");
         engine::Published out;
         out.counter = counter(field(out_, "counter"), "Published.counter");
         out.peak = convert::matc<6>(field(out_, "peak"), "Published.peak", n_mounts);
@@ -173,32 +234,19 @@ void bind_engine(py::module_& mod) {
             out.step_log.rows < n) {
           throw py::value_error("Published: buffers shorter than the samples");
         }
-        engine::Watch w = watch(watch_, k, n_state);
-        engine::Estimator est;
-        engine::Estimator* ep = nullptr;
-        engine::Companion comp;
-        engine::Companion* cp = nullptr;
-        if (py::hasattr(estimate_, "carried")) {
-          est = estimator(estimate_, n_state, n_mounts);
-          ep = &est;
-        } else if (!estimate_.is_none()) {
-          comp = companion(estimate_, n_state, n_mounts, k, w.g.cols);
-          cp = &comp;
-        }
-        const Vec u = convert::vec(u_, "u", INPUT_SIZE);
+        loop.refresh();
         engine::RunResult r;
         {
           py::gil_scoped_release release;  // the loop touches no Python object
-          r = engine::run_samples(integ, m, s, u, y, smp, opts, out, w, ep, cp);
+          r = engine::run_samples(loop.integ, m, loop.s, loop.u, loop.y, smp, loop.opts, out,
+                                  loop.w, loop.ep, loop.cp);
         }
         return py::make_tuple(r.done, r.status);
       },
-      "Advance y through samples 1..n−1 of `samples` (row 0: the last one done); returns "
-      "(index of the last sample done, status: 0 all done, AT_EVENT, or the stepper's "
+      "Advance the bound y through samples 1..n−1 of `samples` (row 0: the last one done); "
+      "returns (index of the last sample done, status: 0 all done, AT_EVENT, or the stepper's "
       "failure).",
-      py::arg("integ"), py::arg("m"), py::arg("s"), py::arg("u"), py::arg("y"),
-      py::arg("samples"), py::arg("opts"), py::arg("out"), py::arg("watch"),
-      py::arg("estimate"));
+      py::arg("loop"), py::arg("samples"), py::arg("out"));
   mod.def(
       "watch_mounts",
       [](py::handle y_, py::handle nl_, py::handle s_, py::handle watch_, double t0, double t1,

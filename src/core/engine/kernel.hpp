@@ -23,7 +23,7 @@ struct Watch {
   Mat events;        // (cap, 4) [crossing time s, mount slot, event index, |force| N]
   idx* n_events;     // (1,) rows written (may exceed cap)
   Vec y_prev;
-  double stop_after;  // s; inf: never
+  const double* stop_after;  // (1,) s; inf: never
   Mat stiffens;      // (k, NE) 1.0 where an event may stiffen the scene
   idx* n_stiffening;  // (1,)
 };
@@ -225,7 +225,7 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
       *out.counter = 0;
       *out.cos_tilt_min = py_min(*out.cos_tilt_min, s.rot(2, 2));
     }
-    if (*watch.n_stiffening > stiffening && smp.t[j] > watch.stop_after) {
+    if (*watch.n_stiffening > stiffening && smp.t[j] > *watch.stop_after) {
       return {j, AT_EVENT};
     }
   }
