@@ -29,6 +29,7 @@ from mount_twin.io.messages import (
     encode_output_blocks,
     encode_outputs,
     encode_report,
+    output_streams,
 )
 from mount_twin.model.assemble import assemble
 from mount_twin.scene.description import Scene
@@ -125,6 +126,7 @@ class TwinStream:
         self.engine = TwinEngine(assemble(scene))
         # rosbags generates a type's serializer at its first use and the output layouts are
         # probed then: ~40 ms that would otherwise delay the first live sample.
+        self._streams = output_streams(scene)
         encode_outputs(scene, OutputBatch.empty(len(scene.mounts)), np.zeros(0, np.int64))
         self.base: TimeBase | None = None
         self.last_outputs: OutputBatch | None = None
@@ -305,8 +307,8 @@ class TwinStream:
         if len(out):
             self._last_ns = int(stamps_ns[out.sample[-1]])
         if self.blocks:
-            return encode_output_blocks(self.scene, out, stamps_ns)
-        return [*encode_outputs(self.scene, out, stamps_ns)]
+            return encode_output_blocks(self.scene, out, stamps_ns, self._streams)
+        return [*encode_outputs(self.scene, out, stamps_ns, self._streams)]
 
     def stalled(self, waited_s: float, stamp_ns: int) -> list[tuple[str, int, bytes]]:
         """A report now, after `waited_s` (s) of the node's clock without any (live only),
