@@ -40,7 +40,7 @@ import numpy as np
 
 from mount_twin.errors import SceneError
 from mount_twin.kinds.elastomer import Elastomer
-from mount_twin.scene.description import LinearMount, Scene, SceneWarning, Vec3
+from mount_twin.scene.description import LinearMount, Mount, Scene, SceneWarning, Vec3
 from mount_twin.scene.statics import AXES, Statics, loose_dofs, statics
 
 STIFFNESS_LIMIT = 1.0e13
@@ -57,6 +57,8 @@ GYRATION_MIN_M = 1.0e-4
 """Smallest principal radius of gyration √(I/m), m, of a body whose rotation is free: a
 machine, or a lab specimen of a few grams, is far larger; less is a unit error."""
 INPUT_IMU = "sensor_msgs/msg/Imu"
+UNITS_OR_MOUNT = "stiffness or mass in the wrong units, or the wrong mount?"
+"""What a mount's static load or deflection past its rating likely means."""
 
 
 def check_scene(
@@ -232,19 +234,45 @@ def _sag(scene: Scene, st: Statics, mount_paths: Sequence[str]) -> list[SceneWar
 
 
 def _ratings(scene: Scene, st: Statics, mount_paths: Sequence[str]) -> list[SceneWarning]:
+    """The ratings by the statics of the nominal stiffness."""
+    return rating_warnings(
+        scene, mount_paths, st.deflection, st.force, "under the weight", UNITS_OR_MOUNT
+    )
+
+
+def ratings(mount: Mount) -> tuple[tuple[str, tuple[float, ...]], ...]:
+    """(key, rating per local axis, 0 where unrated) of each rated quantity of `mount`: a
+    linear mount's rated_load (N) and rated_travel (m), an elastomer's rated_deflection (m)."""
+    if isinstance(mount, LinearMount):
+        return (("rated_load", mount.rated_load), ("rated_travel", mount.rated_travel))
+    if isinstance(mount, Elastomer):
+        return (("rated_deflection", mount.rated_deflection),)
+    return ()
+
+
+def rating_warnings(
+    scene: Scene,
+    mount_paths: Sequence[str],
+    deflection: np.ndarray,
+    force: np.ndarray,
+    basis: str,
+    hint: str,
+) -> list[SceneWarning]:
     """Static load and deflection of each mount against its rated values, where it has any:
-    one warning per rated key, at the mount most over its rating."""
+    one warning per rated key, at the mount most over its rating.
+
+    Args:
+        scene: the scene.
+        mount_paths: key path of each mount, for messages.
+        deflection, force: (n, 3) each mount's static deflection (m) and force (N) in its
+            local axes.
+        basis: where they are taken, for messages ("under the weight").
+        hint: what a mount past its rating likely means, for messages.
+    """
     over: dict[str, list[tuple[float, int, int, float, float]]] = {}
     for i, mount in enumerate(scene.mounts):
-        rated: list[tuple[str, np.ndarray, tuple[float, ...]]] = []
-        if isinstance(mount, LinearMount):
-            rated = [
-                ("rated_load", st.force[i], mount.rated_load),
-                ("rated_travel", st.deflection[i], mount.rated_travel),
-            ]
-        elif isinstance(mount, Elastomer):
-            rated = [("rated_deflection", st.deflection[i], mount.rated_deflection)]
-        for key, value, limit in rated:
+        for key, limit in ratings(mount):
+            value = force[i] if key == "rated_load" else deflection[i]
             for j, (v, r) in enumerate(zip(value, limit, strict=True)):
                 if abs(v) > r > 0.0:
                     over.setdefault(key, []).append((abs(v) / r, i, j, abs(v), r))
@@ -256,10 +284,9 @@ def _ratings(scene: Scene, st: Statics, mount_paths: Sequence[str]) -> list[Scen
             SceneWarning(
                 scene.source,
                 f"{mount_paths[i]}.{key}",
-                f"the static {what} under the weight, {static:.4g} {unit} along local "
+                f"the static {what} {basis}, {static:.4g} {unit} along local "
                 f"{AXES[j]}, is {ratio:.3g} times the rated {rating:.4g} {unit}"
-                f"{_others(len({c[1] for c in cases}) - 1)}: stiffness or mass in the wrong "
-                "units, or the wrong mount?",
+                f"{_others(len({c[1] for c in cases}) - 1)}: {hint}",
             )
         )
     return found
