@@ -315,8 +315,9 @@ class SceneWarning:
 @dataclass(frozen=True)
 class Scene:
     """A complete scene; `source` names the file or parameter set it came from, `warnings` what
-    the loader found implausible in it (not part of its value: two scenes that differ only in
-    their warnings are equal)."""
+    the loader found implausible in it, and `mount_paths` the key path of each mount in
+    messages, as the loader named them (neither is part of its value: two scenes that differ
+    only in them are equal)."""
 
     name: str
     body: Body
@@ -331,3 +332,11 @@ class Scene:
     ageing: Ageing | None = None
     source: str = "<memory>"
     warnings: tuple[SceneWarning, ...] = field(default=(), compare=False)
+    mount_paths: tuple[str, ...] = field(default=(), compare=False)
+
+    def mount_path(self, i: int) -> str:
+        """Key path of mount i in messages: as its loader named it (mounts.<name> in a
+        parameter set), else mounts[i]."""
+        if len(self.mount_paths) == len(self.mounts):
+            return self.mount_paths[i]
+        return f"mounts[{i}]"

@@ -139,7 +139,7 @@ def scene_from_dict(
     )
     top.finish()
     warnings = check_scene(scene, paths, refuse_unheld=refuse_unheld)
-    return dataclasses.replace(scene, warnings=warnings)
+    return dataclasses.replace(scene, warnings=warnings, mount_paths=tuple(paths))
 
 
 def _body(r: Reader) -> Body:
