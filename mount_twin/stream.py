@@ -119,11 +119,12 @@ class TwinStream:
 
     def __init__(self, scene: Scene, *, blocks: bool = False) -> None:
         require(scene, Scene, "TwinStream(scene)")
-        self.scene = scene
         self.blocks = blocks
         """Per-row outputs come as `RowBlock`s (a bag writer's) rather than message by message
         (a publisher's): the same bytes, in the same order (`messages_of`)."""
         self.engine = TwinEngine(assemble(scene))
+        self.scene = self.engine.scene
+        """`scene` as assembled: its warnings with those of its start (`model.ratings`)."""
         # rosbags generates a type's serializer at its first use and the output layouts are
         # probed then: ~40 ms that would otherwise delay the first live sample.
         self._streams = output_streams(scene)

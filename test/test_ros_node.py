@@ -37,6 +37,7 @@ from ros_harness import (
     wait_for,
     wait_for_node,
 )
+from test_start_loaded import C_SOFT, RATED, rated_scene, start_sag
 
 from mount_twin.engine.batch import ERROR, OK
 from mount_twin.engine.delay_line import delay_samples
@@ -517,6 +518,29 @@ def test_configuration_errors_end_the_node_with_one_line_naming_the_parameter(
     assert code == 2, node.stderr
     assert len(lines) == 1 and names in lines[0], node.stderr
     assert "Traceback" not in node.stderr
+
+
+def test_the_node_logs_at_start_the_ratings_its_start_passes(tmp_path: Path) -> None:
+    """A scene's warnings are logged at start; on hysteretic mounts, with the ratings judged
+    at the start the node solves (`model.ratings`), which the loader leaves to it: the mount
+    named by its parameter, the start's sag in closed form (`test_start_loaded`)."""
+    path = tmp_path / "rated.scene.yaml"
+    path.write_text(yaml.safe_dump(rated_scene(RATED)), encoding="utf-8")
+    domain = fresh_domain()
+    peer = Peer(domain)
+    peer.record({"/diagnostics": DIAGNOSTICS})
+    node = NodeProcess(domain, ["-p", f"scene_file:={path}", "-p", "stall_period_s:=0.5"])
+    try:  # a stall report: the node has started
+        assert peer.take_until(lambda: len(peer.got["/diagnostics"]) >= 1, 60.0), node.stop()
+    finally:
+        code = node.stop()
+        peer.close()
+    assert code == 0, node.stderr
+    sag = -start_sag(C_SOFT, 1)
+    (line,) = [ln for ln in node.stderr.splitlines() if "rated_deflection" in ln]
+    assert "[WARN]" in line
+    assert f"{path}: mounts.r.rated_deflection: the static deflection at the start" in line
+    assert f"{sag:.4g} m along local z, is {sag / RATED:.3g} times the rated 0.012 m" in line
 
 
 def test_a_params_file_key_given_twice_ends_the_node_naming_the_file_and_lines(

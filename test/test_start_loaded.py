@@ -7,7 +7,9 @@ dz/dx = A − (β + γ)·|z|ⁿ. Truths written here, independently of the packa
   and, for other n, solve_ivp of dz/dx at rtol 1e-13;
 - the equilibrium of a 6-DOF body on four inclined, off-centre mounts solved here by scipy's
   least squares on this file's own statics (the mounts' local deflections from the pose through
-  the chart of physics notes §2, the force law k₁x + k₃x³ and (1 − a)·k₀·z, moments about the CG).
+  the chart of physics notes §2, the force law k₁x + k₃x³ and (1 − a)·k₀·z, moments about the CG);
+- the rating warnings' figures: the one-DOF start's sag from the n = 1 closed form (brentq on
+  the weight carried), and a linear spring's load k·|Z| beside it.
 """
 
 from __future__ import annotations
@@ -16,14 +18,18 @@ import math
 
 import numpy as np
 import pytest
+import yaml
 from kinds_helpers import kind_mount
-from physics_helpers import G, base_scene, build, chart_to_matrix_ref, rpy
+from physics_helpers import G, base_scene, build, chart_to_matrix_ref, mount, rpy
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, least_squares
 
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.engine.engine import TwinEngine
+from mount_twin.model.assemble import assemble
 from mount_twin.model.loading import virgin_z
+from mount_twin.scene.loader import scene_from_dict
+from mount_twin.scene.params import as_params, effective_parameters
 
 MASS, CG_Z = 100.0, 0.3  # kg, m
 K0 = 1.0e5  # N/m
@@ -75,6 +81,17 @@ def test_virgin_curve_matches_its_closed_form_and_an_integration_of_its_slope(a,
         assert abs(z) <= z_u  # never past its asymptote
 
 
+def start_sag(c: float, n: int, k_linear: float = 0.0) -> float:
+    """Z (m, < 0) of MASS at rest on one vertical mount of this file (A = 1, β + γ = c),
+    beside a linear spring k_linear (N/m), the z state on its loading curve."""
+
+    def weight_carried(x: float) -> float:
+        spring = (k_linear + RATIO * K0) * x
+        return spring + (1.0 - RATIO) * K0 * curve_closed(x, 1.0, c, n) + MASS * G
+
+    return brentq(weight_carried, -0.1, 0.0, xtol=1e-17, rtol=1e-15)
+
+
 def hysteretic(name: str, position, rpy_=(0.0, 0.0, 0.0), k3: float = 0.0, bw=None) -> dict:
     bw = bw or {"A": 1.0, "beta": 120.0, "gamma": 80.0, "n": 1.0}
     return kind_mount(
@@ -117,10 +134,7 @@ def test_one_dof_start_rests_where_the_loading_curve_carries_the_weight(n):
         )
     )
 
-    def weight_carried(x: float) -> float:
-        return RATIO * K0 * x + (1.0 - RATIO) * K0 * curve_closed(x, 1.0, c, n) + MASS * G
-
-    x0 = brentq(weight_carried, -0.1, 0.0, xtol=1e-17, rtol=1e-15)
+    x0 = start_sag(c, n)
     engine, out = still(model)
     assert out.pose[0, 2] - CG_Z == pytest.approx(x0, rel=1e-10)
     z_state = dict(zip(model.state_names, engine.state, strict=True))["r.z_z"]
@@ -189,3 +203,98 @@ def test_six_dof_start_on_inclined_mounts_is_the_equilibrium_with_every_axis_on_
     assert np.abs(d_ref).min() > 1e-5
     # and the body stays at rest there
     assert np.ptp(out.pose[:, :3], axis=0).max() <= 1e-11 * sag
+
+
+# ----------------------------------------------------------------- ratings judged at the start
+BW_SOFT = {"A": 1.0, "beta": 120.0, "gamma": 80.0, "n": 1.0}  # β + γ = 200, as reported
+C_SOFT = 200.0
+RATED = 0.012  # m
+
+
+def rated_scene(rated_z: float, hysteresis: bool = True, **sections) -> dict:
+    """MASS on one vertical elastomer (this file's, BW_SOFT) rated `rated_z` (m) along its z,
+    z the only free DOF; `sections` replace the scene's own."""
+    rubber = hysteretic("r", [0.0, 0.0, 0.0], bw=BW_SOFT)
+    rubber["rated_deflection"] = [0.0, 0.0, rated_z]
+    if not hysteresis:
+        del rubber["hysteresis"]
+    data = base_scene(MASS, [0.0, 0.0, CG_Z], [5.0, 6.0, 7.0, 0, 0, 0], [rubber], ["z"])
+    return {**data, **sections}
+
+
+def rating_warnings(scene) -> list:
+    return [w for w in scene.warnings if ".rated_" in w.path]
+
+
+def test_a_start_past_its_rated_deflection_on_the_loading_curve_is_warned_of_at_load(
+    tmp_path, capsys
+):
+    """As reported: the tangent at zero load (k₀ = 1e5 N/m) sags 9.81 mm, within the rated
+    12 mm, and nothing was said at load; the start the twin uses, on the loading curve, sags
+    21.2 mm (closed form), 1.77 times the rating, and every report then said ERROR. The
+    warning gives the start's figures, by every path a scene's warnings take: the assembled
+    model's scene, the command line's stderr at load, the node's stream."""
+    from mount_twin.cli import main
+    from mount_twin.stream import TwinStream
+
+    x0 = start_sag(C_SOFT, 1)
+    assert MASS * G / K0 < RATED < 1.5 * RATED < -x0
+    said = f"{-x0:.4g} m along local z, is {-x0 / RATED:.3g} times the rated 0.012 m"
+    scene = scene_from_dict(rated_scene(RATED), "<rated>")
+    assert rating_warnings(scene) == []  # the loader leaves it to the start
+    model = assemble(scene)
+    (warning,) = rating_warnings(model.scene)
+    assert warning.path == "mounts[0].rated_deflection"
+    assert "static deflection at the start" in warning.message
+    assert said in warning.message
+    assert model.scene.warnings == (*scene.warnings, warning)
+    # assembled again (the command line's scene, then the engine's), said once
+    assert assemble(model.scene).scene.warnings == model.scene.warnings
+    assert TwinStream(scene).scene.warnings == model.scene.warnings
+
+    path = tmp_path / "rated.scene.yaml"
+    path.write_text(yaml.safe_dump(rated_scene(RATED)))
+    assert main(["info", str(path)]) == 0
+    (line,) = [s for s in capsys.readouterr().err.splitlines() if "rated_deflection" in s]
+    assert line.startswith(f"mount-twin: warning: {path}: mounts[0].rated_deflection: ")
+    assert said in line
+
+
+def test_a_linear_mount_beside_hysteretic_ones_is_judged_at_the_start_by_its_parameter_path():
+    """A linear spring beside the hysteretic mount carries k·|Z| at the start (closed form),
+    past a rated load the tangent statics keep it within; a parameter set names it by its
+    parameter (mounts.<name>)."""
+    k_lin = 5.0e4
+    x0 = start_sag(C_SOFT, 1, k_linear=k_lin)
+    tangent_load = k_lin * MASS * G / (k_lin + K0)
+    rated_load = 1.2 * tangent_load
+    assert k_lin * -x0 > 1.1 * rated_load
+    data = rated_scene(0.0)
+    spring = mount("lin", [0.0, 0.0, 0.0], [k_lin] * 3 + [0.0] * 3)
+    data["mounts"].append({**spring, "rated_load": [0.0, 0.0, rated_load]})
+    scene = effective_parameters(as_params(data), "params").scene
+    assert rating_warnings(scene) == []
+    (warning,) = rating_warnings(assemble(scene).scene)
+    assert warning.path == "mounts.lin.rated_load"
+    ratio = k_lin * -x0 / rated_load
+    assert f"{k_lin * -x0:.4g} N along local z, is {ratio:.3g} times the rated" in warning.message
+
+
+@pytest.mark.parametrize(
+    ("hysteresis", "mode"), [(True, "equilibrium"), (True, "given"), (False, "equilibrium")]
+)
+def test_a_rating_is_warned_of_once_by_the_statics_that_give_the_start(hysteresis, mode):
+    """Rated 8 mm, past the tangent's 9.81 mm sag too: a hysteretic start at equilibrium is
+    warned of once, with the loading curve's sag; a given start (z = 0, at its pose) and a
+    mount without hysteresis keep the loader's tangent statics, and the assembly adds none."""
+    rated = 0.008
+    data = rated_scene(rated, hysteresis, initial_state={"mode": mode})
+    scene = scene_from_dict(data, "<rated>")
+    model = assemble(scene)
+    (warning,) = rating_warnings(model.scene)
+    loaded = hysteresis and mode == "equilibrium"
+    sag = -start_sag(C_SOFT, 1) if loaded else MASS * G / K0
+    where = "at the start" if loaded else "under the weight"
+    assert f"static deflection {where}" in warning.message
+    assert f"{sag:.4g} m along local z, is {sag / rated:.3g} times" in warning.message
+    assert rating_warnings(scene) == ([] if loaded else [warning])

@@ -110,7 +110,10 @@ def check_targets(*, figures: tuple[str, ...] = ("plot",), **targets: str | None
 def load_scene(path: str | Path, input_overrides: Mapping[str, str] | None = None) -> Scene:
     """The scene file at `path`, with `input` fields replaced by `input_overrides` (checked like
     the file's own); each of its warnings (units? a message type's convention?) is printed on
-    stderr, so that no command runs a scene it found implausible without saying so."""
+    stderr, so that no command runs a scene it found implausible without saying so. A scene
+    whose ratings are judged at the start the twin uses (`scene.checks.rated_at_start`) is
+    assembled for them: its start is solved here, and again where the command assembles it."""
+    from mount_twin.scene.checks import rated_at_start
     from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
 
     data = read_scene_yaml(path)
@@ -119,6 +122,10 @@ def load_scene(path: str | Path, input_overrides: Mapping[str, str] | None = Non
         data["input"] = {**data.get("input", {}), **input_overrides}
         source += f" (with input {', '.join(sorted(input_overrides))} from the command line)"
     scene = scene_from_dict(data, source, refuse_unheld=True)
+    if rated_at_start(scene):
+        from mount_twin.model.assemble import assemble
+
+        scene = assemble(scene).scene
     for warning in scene.warnings:
         print(f"mount-twin: warning: {warning}", file=sys.stderr)
     return scene

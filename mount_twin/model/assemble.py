@@ -11,6 +11,7 @@ from mount_twin.errors import ModelError, require
 from mount_twin.kinds import CODES, KINDS, N_PAR, check_dispatch
 from mount_twin.model import newton
 from mount_twin.model.loading import VirginAxes, virgin_axes
+from mount_twin.model.ratings import start_ratings
 from mount_twin.physics.dynamics import (
     INPUT_SIZE,
     OK,
@@ -33,7 +34,8 @@ class Model:
     """A scene ready to integrate.
 
     Attributes:
-        scene: the description it was built from.
+        scene: the description it was built from, with the warnings of its start
+            (`model.ratings`).
         arrays: the core's arrays.
         state_names: name of each state entry (q of free DOFs, then their rates).
         sensor_rotation: 3×3 rotation of the input sensor frame into F.
@@ -78,7 +80,9 @@ def _inverse(rated: tuple[float, ...]) -> list[float]:
 def assemble(scene: Scene) -> Model:
     """Build the core's arrays of `scene` and solve its nominal start state (done once, at
     load; raises ModelError where the mounts cannot hold the body, SceneError for a value of
-    a scene built in code that no loader would have taken: `scene.built`)."""
+    a scene built in code that no loader would have taken: `scene.built`). The model's scene
+    adds to its warnings the mounts past their ratings at that start, where the loader left
+    them to it (`model.ratings`)."""
     require(scene, Scene, "assemble(scene)")
     check_built(scene)
     body = scene.body
@@ -123,8 +127,11 @@ def assemble(scene: Scene) -> Model:
         rotation_read=bool(lin) or (nl is not None and bool(nl.rotational.any())),
     )
     unsolved = Model(scene, arrays, tuple(names), rpy_matrix(*scene.input.sensor_rpy), np.empty(0))
-    gravity_up = np.array([0.0, 0.0, scene.input.g])
-    return replace(unsolved, nominal_state=initial_state(unsolved, gravity_up))
+    start = initial_state(unsolved, np.array([0.0, 0.0, scene.input.g]))
+    found = start_ratings(scene, arrays, start)
+    if found:  # a scene assembled twice (the command line's, then the engine's) says them once
+        scene = replace(scene, warnings=tuple(dict.fromkeys((*scene.warnings, *found))))
+    return replace(unsolved, scene=scene, nominal_state=start)
 
 
 def in_f(axes: np.ndarray, values: np.ndarray) -> np.ndarray:

@@ -140,7 +140,7 @@ class MountTwinNode(Node):
             + "outputs "
             + ", ".join(p.topic_name for p in self._pubs.values())
         )
-        for warning in self.scene.warnings:  # implausible values: units? a type's convention?
+        for warning in self.stream.scene.warnings:  # implausible: units? the start's ratings?
             self.get_logger().warning(str(warning))
 
     def _create_outputs(self) -> dict[str, Publisher]:

@@ -20,7 +20,10 @@ Warnings (SceneWarning, kept on `Scene.warnings`): values that load but are like
   (`initial_state.mode: given`) a free body is what torque-free and free-flight studies want;
 - a DOF the weight overturns (negative stiffness: a CG high above soft mounts);
 - a static sag of the CG or of a mount's attachment point beyond SAG_WARN_M (stiffness in N/mm
-  sags a thousand times more), and a mount's static load or deflection beyond its rated values;
+  sags a thousand times more), and a mount's static load or deflection beyond its rated values
+  (for a scene whose start sets hysteretic mounts down along their loading curves, softer than
+  these statics, the assembly judges the ratings at that start instead: `rated_at_start`,
+  `model.ratings`);
 - a mount, the body IMU or the deck IMU farther from the CG than FAR_FACTOR times the body's
   largest radius of gyration, and a radius of gyration beyond GYRATION_WARN_M (positions in
   mm, inertia in kg·mm²);
@@ -234,7 +237,10 @@ def _sag(scene: Scene, st: Statics, mount_paths: Sequence[str]) -> list[SceneWar
 
 
 def _ratings(scene: Scene, st: Statics, mount_paths: Sequence[str]) -> list[SceneWarning]:
-    """The ratings by the statics of the nominal stiffness."""
+    """The ratings by the statics of the nominal stiffness, unless the model judges them at
+    its start (`rated_at_start`)."""
+    if rated_at_start(scene):
+        return []
     return rating_warnings(
         scene, mount_paths, st.deflection, st.force, "under the weight", UNITS_OR_MOUNT
     )
@@ -248,6 +254,20 @@ def ratings(mount: Mount) -> tuple[tuple[str, tuple[float, ...]], ...]:
     if isinstance(mount, Elastomer):
         return (("rated_deflection", mount.rated_deflection),)
     return ()
+
+
+def rated_at_start(scene: Scene) -> bool:
+    """Whether the scene's ratings are judged at the start the twin uses (`model.ratings`, at
+    assembly) rather than here: a start at equilibrium sets hysteretic mounts down along their
+    loading curves (`model.loading`), softer than the nominal tangent at zero load (400 kg on
+    four mounts of k₀ = 1e5 N/m, a = 0.3, β + γ = 200 start 21.2 mm down, where the tangent
+    says 9.8), and a mount is rated."""
+    hysteretic = any(
+        isinstance(m, Elastomer) and m.hysteresis is not None and m.hysteresis.axes
+        for m in scene.mounts
+    )
+    rated = any(r > 0.0 for m in scene.mounts for _, limit in ratings(m) for r in limit)
+    return scene.initial.mode == "equilibrium" and hysteretic and rated
 
 
 def rating_warnings(

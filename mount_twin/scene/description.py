@@ -315,9 +315,9 @@ class SceneWarning:
 @dataclass(frozen=True)
 class Scene:
     """A complete scene; `source` names the file or parameter set it came from, `warnings` what
-    the loader found implausible in it, and `mount_paths` the key path of each mount in
-    messages, as the loader named them (neither is part of its value: two scenes that differ
-    only in them are equal)."""
+    the loader found implausible in it, and the assembly at its start (`model.ratings`), and
+    `mount_paths` the key path of each mount in messages, as the loader named them (neither is
+    part of its value: two scenes that differ only in them are equal)."""
 
     name: str
     body: Body

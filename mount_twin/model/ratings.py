@@ -1,0 +1,46 @@
+"""The load-time rating check at the start the twin uses, where tangent statics miss it.
+
+`scene.checks` judges each mount's static load and deflection against its ratings by the
+statics of the nominal stiffness: exact for linear mounts, and for a hysteretic (Bouc–Wen)
+mount at zero load only. A new machine's start sets its hysteretic mounts down along their
+loading curves (`model.loading`), which soften as they load: 400 kg on four mounts of k₀ =
+1e5 N/m, a = 0.3, β + γ = 200 start 21.2 mm down where the tangent says 9.8, past a rated
+12 mm that the tangent statics found unreached, and every mount was then an ERROR from the
+first report without a word at load. For such a scene (`scene.checks.rated_at_start`) the
+loader leaves the ratings to this check, which takes every rated mount's deflection and
+force at the start state the assembly solved, and says what it finds as the loader's
+warnings do (`Scene.warnings`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mount_twin.physics.dynamics import ModelArrays, body_motion, mount_wrenches, new_scratch
+from mount_twin.physics.rotations import rpy_matrices
+from mount_twin.scene.checks import UNITS_OR_MOUNT, rated_at_start, rating_warnings
+from mount_twin.scene.description import Scene, SceneWarning
+
+AT_START = "at the start (the weight set down along the hysteretic mounts' loading curves)"
+"""Where the figures are taken, for the warnings' messages."""
+FROM_THE_START = f"its utilisation is past 1 from the first report (ERROR); {UNITS_OR_MOUNT}"
+"""What such a mount means: utilisation counts from the start."""
+
+
+def start_ratings(scene: Scene, m: ModelArrays, y: np.ndarray) -> tuple[SceneWarning, ...]:
+    """Warnings of the mounts loaded or deflected past their ratings at the start state `y`
+    (the nominal one of `m`, at rest on the chart); none for a scene whose ratings the loader
+    judges (`rated_at_start`)."""
+    if not rated_at_start(scene):
+        return ()
+    s = new_scratch(y.shape[0])
+    body_motion(y, m, s)  # the start's motion: s.q (its frozen DOFs too) and s.rot, body → F
+    wrenches = np.zeros((len(scene.mounts), 6))
+    mount_wrenches(y, m, s, wrenches)
+    arm = np.array([mt.position for mt in scene.mounts]) - np.array(scene.body.cg)
+    shift = s.q[:3] + arm @ (s.rot - np.eye(3)).T  # each attachment point's, in F
+    axes = rpy_matrices([mt.orientation_rpy for mt in scene.mounts])
+    deflection = np.einsum("nji,nj->ni", axes, shift)
+    paths = [scene.mount_path(i) for i in range(len(scene.mounts))]
+    found = rating_warnings(scene, paths, deflection, wrenches[:, :3], AT_START, FROM_THE_START)
+    return tuple(found)
