@@ -302,3 +302,45 @@ def test_an_input_axis_without_motion_shows_no_infinite_margin(genset_run, tmp_p
     rows = re.findall(r"<tr>(.*?)</tr>", spectra[spectra.index("<th>margin x dB</th>") :])
     x_cells = [re.findall(r"<td>([^<]*)</td>", r)[-3] for r in rows[1:]]
     assert set(x_cells) == {"–", "no response"}
+
+
+PUMP = CONFIG / "pump_8_mounts.scene.yaml"
+
+
+@pytest.fixture(scope="module")
+def pump_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The pump's output bag of the bundled half-sine shock, replayed by the command line."""
+    out = tmp_path_factory.mktemp("pump") / "out"
+    bag = ROOT / "bags" / "half_sine_shock_10khz"
+    assert main(["replay", str(bag), "--scene", str(PUMP), "-o", str(out), "--no-progress"]) == 0
+    return out
+
+
+def _table_rows(page: str, heading: str) -> list[list[str]]:
+    """The data rows' cells of the first table after the heading that starts with `heading`."""
+    part = page[page.index(f"<h2>{heading}") :]
+    part = part[part.index("<table") : part.index("</table>")]
+    rows = re.findall(r"<tr>(.*?)</tr>", part)[1:]
+    return [re.findall(r"<td>([^<]*)</td>", row) for row in rows]
+
+
+def test_the_reports_effective_masses_read_as_modes_prints_them(
+    pump_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The pump is symmetric about its x-z plane: its lateral-roll modes move no mass fore-aft
+    or vertically. `modes` printed those masses 0.0, the report 1.268e-25 kg (the eigenvectors'
+    round-off, to four significant figures). Both now show every effective mass alike."""
+    capsys.readouterr()
+    assert main(["modes", str(PUMP)]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    head = next(i for i, line in enumerate(printed) if "effective mass kg along" in line)
+    by_modes = [line.split()[2:5] for line in printed[head + 2 : head + 8]]
+    page = tmp_path / "r.html"
+    assert main(["report", str(pump_run), "--scene", str(PUMP), "-o", str(page)]) == 0
+    rows = _table_rows(page.read_text(encoding="utf-8"), "Modes (about the static")
+    assert [r[4:7] for r in rows] == by_modes
+    lateral = [r for r in rows if r[3].split()[0] in ("y", "alpha")]
+    assert len(lateral) == 2, rows  # lateral-roll, and roll-lateral
+    for r in lateral:
+        assert (r[4], r[6]) == ("0.0", "0.0"), r  # x and z: none, by symmetry
+        assert float(r[5]) > 0.0, r

@@ -27,6 +27,7 @@ from mount_twin.analysis.figures import (
 from mount_twin.analysis.html_page import fingerprint, page, png, produced_by, scene_section
 from mount_twin.analysis.html_page import table as html_table
 from mount_twin.analysis.log_labels import plain_log_labels
+from mount_twin.analysis.modes_text import effective_mass_text
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
 from mount_twin.engine.estimate import NOT_INTEGRATED
 from mount_twin.engine.health import UTILISATION_KEY
@@ -270,14 +271,14 @@ def _modes_section(scene: Scene) -> list[str]:
         return ["<h2>Modes</h2>", f"<p>not computed: {html.escape(str(err))}</p>"]
     rows = []
     for i, m in enumerate(result.modes, 1):
-        main_dof = max(m.energy_fraction, key=lambda d: m.energy_fraction[d])
+        main_dof = m.dominant_dof
         rows.append(
             [
                 str(i),
                 f"{m.frequency_hz:.4g}",
                 f"{100 * m.damping_ratio:.2f}",
                 f"{main_dof} {100 * m.energy_fraction[main_dof]:.0f} %",
-                *(f"{m.effective_mass_kg.get(a, 0.0):.4g}" for a in "xyz"),
+                *(effective_mass_text(m.effective_mass_kg[a]) for a in "xyz"),
             ]
         )
     head = [

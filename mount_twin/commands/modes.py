@@ -6,6 +6,8 @@ import argparse
 import dataclasses
 from typing import TYPE_CHECKING, Any
 
+from mount_twin.analysis.modes_text import effective_mass_text, fixed
+
 if TYPE_CHECKING:
     from mount_twin.analysis.modes import Line, Modes
     from mount_twin.scene.description import Scene
@@ -92,9 +94,9 @@ def table(scene: Scene, result: Modes) -> str:
     for i, m in enumerate(result.modes, 1):
         main = m.dominant_dof
         lines.append(
-            f"{i:>4} {m.frequency_hz:>9.3f} {_fixed(100 * m.damping_ratio, 2):>6}  "
-            f"{main:<6}{_fixed(100 * m.energy_fraction[main], 0):>4} %  "
-            + "".join(f"{_fixed(100 * m.energy_fraction[d], 1):>7}" for d in dofs)
+            f"{i:>4} {m.frequency_hz:>9.3f} {fixed(100 * m.damping_ratio, 2):>6}  "
+            f"{main:<6}{fixed(100 * m.energy_fraction[main], 0):>4} %  "
+            + "".join(f"{fixed(100 * m.energy_fraction[d], 1):>7}" for d in dofs)
         )
     unstable = [str(i) for i, m in enumerate(result.modes, 1) if m.frequency_hz < 0.0]
     if unstable:
@@ -103,7 +105,7 @@ def table(scene: Scene, result: Modes) -> str:
             "equilibrium is unstable (the weight's geometric stiffness exceeds the mounts')"
         )
     exact = ", ".join(
-        f"{c.frequency_hz:.3f} ({_fixed(100 * c.damping_ratio, 2)})" for c in result.complex_modes
+        f"{c.frequency_hz:.3f} ({fixed(100 * c.damping_ratio, 2)})" for c in result.complex_modes
     )
     lines += [
         "ζ: proportional-damping approximation φᵀCφ/2ω; the damped linearisation's eigenvalues",
@@ -124,14 +126,15 @@ def _masses(result: Modes) -> list[str]:
         f"{'':>4} {'':>9}  {head}  {head}",
     ]
     for i, m in enumerate(result.modes, 1):
-        masses = "".join(f"{_fixed(m.effective_mass_kg[a], 1):>10}" for a in "xyz")
-        inertias = "".join(f"{_fixed(m.effective_inertia_kg_m2[a], 2):>10}" for a in "xyz")
+        masses = "".join(f"{effective_mass_text(m.effective_mass_kg[a]):>10}" for a in "xyz")
+        inertias = "".join(f"{fixed(m.effective_inertia_kg_m2[a], 2):>10}" for a in "xyz")
         lines.append(f"{i:>4} {m.frequency_hz:>9.3f}  {masses}  {inertias}")
     sums = "".join(
-        f"{_fixed(sum(m.effective_mass_kg[a] for m in result.modes), 1):>10}" for a in "xyz"
+        f"{effective_mass_text(sum(m.effective_mass_kg[a] for m in result.modes)):>10}"
+        for a in "xyz"
     )
     sums_i = "".join(
-        f"{_fixed(sum(m.effective_inertia_kg_m2[a] for m in result.modes), 2):>10}" for a in "xyz"
+        f"{fixed(sum(m.effective_inertia_kg_m2[a] for m in result.modes), 2):>10}" for a in "xyz"
     )
     lines.append(f"{'sum':>4} {'':>9}  {sums}  {sums_i}")
     return lines
@@ -148,8 +151,8 @@ def _mounts(result: Modes) -> list[str]:
         + "".join(f"{h:>9}" for h in ("dx", "dy", "dz")),
     ]
     for ml in result.mounts:
-        forces = "".join(f"{_fixed(v, 1):>10}" for v in ml.force_n)
-        travel = "".join(f"{_fixed(1e3 * v, 4):>9}" for v in ml.deflection_m)
+        forces = "".join(f"{fixed(v, 1):>10}" for v in ml.force_n)
+        travel = "".join(f"{fixed(1e3 * v, 4):>9}" for v in ml.deflection_m)
         lines.append(f"{ml.name:<{width}}  {ml.kind:<13}{forces}{travel}")
     total = [sum(ml.force_in_f_n[k] for ml in result.mounts) for k in range(3)]
     carried = (
@@ -157,7 +160,7 @@ def _mounts(result: Modes) -> list[str]:
         if "z" in result.dofs
         else "z is frozen: its constraint holds the weight, less what the mounts carry"
     )
-    lines.append(f"sum of the forces in F: {', '.join(_fixed(v, 1) for v in total)} N ({carried})")
+    lines.append(f"sum of the forces in F: {', '.join(fixed(v, 1) for v in total)} N ({carried})")
     return lines
 
 
@@ -182,12 +185,7 @@ def _centre(result: Modes) -> list[str]:
         + "".join(f"{a:>9}" for a in "xyz"),
     ]
     lines += [
-        f"  {label:<69}" + "".join(f"{'-' if v is None else _fixed(v, 3):>9}" for v in at)
+        f"  {label:<69}" + "".join(f"{'-' if v is None else fixed(v, 3):>9}" for v in at)
         for label, at in rows
     ]
     return lines
-
-
-def _fixed(value: float, decimals: int) -> str:
-    """`value` with `decimals` decimals, without a sign on a rounded zero (−0.0)."""
-    return f"{round(value, decimals) + 0.0:.{decimals}f}"
