@@ -174,6 +174,13 @@ def test_the_report_of_a_run_that_accepted_nothing_says_so_and_why_in_its_headin
     assert f"<h2>Verdict: ERROR: {said}</h2>" in text
     assert not re.search(r"\bnan\b", text, re.IGNORECASE)
     assert "none (no input interval was integrated)" in text
+    # the gyro filter's latency is designed at the first sample's interval: never, here (the
+    # page read "latency 0 s", as if outputs had followed their input at once)
+    conditioning = re.search(r"<td>input conditioning</td><td>([^<]*)</td>", text)
+    assert conditioning, text
+    assert "gyro_filter linear_phase (no latency figure: no input sample was accepted)" in (
+        conditioning.group(1)
+    )
     assert "<h2>Utilisation</h2>" not in text
     assert "<h2>Peaks (largest magnitude at one instant)</h2>\n<p>none: no input sample" in text
 

@@ -137,13 +137,19 @@ def _provenance_section(
             rows.append(["input samples left out", input_note])
     if scene is not None:
         spec, integ = scene.input, scene.integration
+        # the gyro filter's latency is set by its design, at the first accepted samples' rate
+        latency = (
+            "no latency figure: no input sample was accepted"
+            if verdict.nothing
+            else f"latency {integration.get('latency_s', '?')} s"
+        )
         rows += [
             ["scene", f"{scene.name} from {scene.source}"],
             ["input", f"{spec.topic} ({spec.msg_type}), frame {spec.frame_id or 'any'}"],
             [
                 "input conditioning",
-                f"gyro_filter {spec.gyro_filter} (latency {integration.get('latency_s', '?')} s),"
-                f" hold {spec.hold}, gaps > {spec.max_gap_s:g} s: {spec.gap_policy}",
+                f"gyro_filter {spec.gyro_filter} ({latency}), hold {spec.hold}, "
+                f"gaps > {spec.max_gap_s:g} s: {spec.gap_policy}",
             ],
             [
                 "solver",
