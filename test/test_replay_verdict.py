@@ -232,7 +232,7 @@ def test_peak_force_and_displacement_are_one_definition_in_json_report_and_sweep
     page = tmp_path / "r.html"
     assert main(["report", str(out), "-o", str(page)]) == 0
     html = page.read_text(encoding="utf-8")
-    assert f"max_cg_displacement_from_start_m (CG): {moved:.6g}" in html
+    assert f"max CG displacement from start, m: {moved:.6g}" in html
     for mount, value in peak.items():
         assert f"<td>{mount}</td><td></td><td>{value:.4g}</td>" in html
         # its utilisation, from the bag's diagnostics, as the summary's to the digits shown

@@ -344,3 +344,27 @@ def test_the_reports_effective_masses_read_as_modes_prints_them(
     for r in lateral:
         assert (r[4], r[6]) == ("0.0", "0.0"), r  # x and z: none, by symmetry
         assert float(r[5]) > 0.0, r
+
+
+def test_the_reports_figures_are_labelled_in_words_with_their_units(
+    pump_run: Path, tmp_path: Path
+) -> None:
+    """The page labelled its figures with the JSON's keys: a paragraph
+    "max_cg_displacement_from_start_m (CG): 0.00815331" and peak columns
+    "peak_force_magnitude_N", "peak_couple_magnitude_Nm". It says them in words, units after."""
+    page = tmp_path / "r.html"
+    assert main(["report", str(pump_run), "--scene", str(PUMP), "-o", str(page)]) == 0
+    text = html.unescape(page.read_text(encoding="utf-8"))
+    for key in ("max_cg_displacement_from_start_m", "peak_force_magnitude_N", "_Nm"):
+        assert key not in text
+    peaks = text[text.index("<h2>Peaks (") :]
+    head = re.findall(r"<th>([^<]*)</th>", peaks[: peaks.index("</tr>")])
+    assert head == [
+        "mount",
+        "kind",
+        "peak force |F|, N",
+        "peak couple |M|, N·m",
+        "utilisation max",
+    ]
+    moved = re.search(r"<p>max CG displacement from start, m: ([^<]*)</p>", text)
+    assert moved and 0.0 < float(moved.group(1)) < 0.1, moved  # the pump moves mm, not m

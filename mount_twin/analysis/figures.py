@@ -22,6 +22,12 @@ PEAK_FORCE = "peak_force_magnitude_N"
 PEAK_COUPLE = "peak_couple_magnitude_Nm"
 DISPLACEMENT = "max_cg_displacement_from_start_m"
 TRAVEL = "travel_max_m"
+LABELS = {
+    PEAK_FORCE: "peak force |F|, N",
+    PEAK_COUPLE: "peak couple |M|, N·m",
+    DISPLACEMENT: "max CG displacement from start, m",
+}
+"""The figures in words, with their units, where a person reads them (the report's page)."""
 
 
 def peak_label(decimation: int) -> str:

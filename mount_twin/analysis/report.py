@@ -18,6 +18,7 @@ import numpy as np
 from mount_twin.analysis.design_margin import TOLERANCE_DB, DesignCheck, check_design
 from mount_twin.analysis.figures import (
     DISPLACEMENT,
+    LABELS,
     PEAK_COUPLE,
     PEAK_FORCE,
     displacement_from_start,
@@ -369,7 +370,7 @@ def write_report(
         "<p>none: no input sample was accepted</p>"
         if nothing
         else html_table(
-            ["mount", "kind", PEAK_FORCE, PEAK_COUPLE, "utilisation max"],
+            ["mount", "kind", LABELS[PEAK_FORCE], LABELS[PEAK_COUPLE], "utilisation max"],
             _peak_rows(mounts, kinds, utilisation),
         ),
         "<h2>Events</h2>",
@@ -506,7 +507,7 @@ def _displacement_line(pose: Table) -> str:
     """The CG's largest displacement from its first published position (m), a paragraph."""
     position = np.stack([pose.columns[f"{a}_m"] for a in "xyz"], axis=1)
     moved = displacement_from_start(position, position[0])
-    return f"<p>{DISPLACEMENT} (CG): {moved:.6g}</p>"
+    return f"<p>{LABELS[DISPLACEMENT]}: {moved:.6g}</p>"
 
 
 def _peak_rows(
