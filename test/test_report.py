@@ -13,7 +13,7 @@ from io_helpers import CONFIG, ROOT, read_bag
 
 from mount_twin.analysis.report import events_of
 from mount_twin.cli import main
-from mount_twin.io.output_tables import read_output_bag
+from mount_twin.io.output_tables import input_values, read_output_bag
 from mount_twin.replay import replay
 from mount_twin.scene.loader import load_scene_file
 
@@ -368,3 +368,26 @@ def test_the_reports_figures_are_labelled_in_words_with_their_units(
     ]
     moved = re.search(r"<p>max CG displacement from start, m: ([^<]*)</p>", text)
     assert moved and 0.0 < float(moved.group(1)) < 0.1, moved  # the pump moves mm, not m
+
+
+@pytest.mark.parametrize(("expected", "named"), [("hull_imu", "hull_imu"), ("", "any")])
+def test_a_run_replayed_with_frame_id_is_reported_with_the_frame_it_expected(
+    tmp_path: Path, expected: str, named: str
+) -> None:
+    """`replay --frame-id hull_imu` (or '', any frame) ran a record from the hull's IMU; the
+    output bag did not record the frame the run expected, and the page's input row named the
+    scene's deck_imu, which would have rejected every sample. The run's input status records
+    it, and the page names it."""
+    bag, out, page = tmp_path / "hull_bag", tmp_path / "out", tmp_path / "page.html"
+    generate = ["generate", "half-sine", "-o", str(bag), "--peak", "150", "--pulse", "0.008"]
+    assert main([*generate, "--frame-id", "hull_imu"]) == 0
+    replay_args = ["replay", str(bag), "--scene", str(PUMP), "-o", str(out), "--no-progress"]
+    assert main([*replay_args, "--frame-id", expected]) == 0
+    diagnostics = next(t for t in read_output_bag(out) if t.name == "diagnostics")
+    assert input_values(diagnostics)["frame_id"] == expected
+    report = ["report", str(out), "--scene", str(PUMP), "--input", str(bag), "-o", str(page)]
+    assert main(report) == 0
+    text = html.unescape(page.read_text(encoding="utf-8"))
+    assert "<td>input</td><td>/deck/imu (sensor_msgs/msg/Imu), frame " + named + "</td>" in text
+    said = "(the run's, from `replay --frame-id`; the file's: deck_imu)"
+    assert f"<td>input.frame_id</td><td>{named} {said}</td>" in text

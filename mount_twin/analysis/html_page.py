@@ -81,11 +81,15 @@ def scene_section(scene: Scene) -> list[str]:
     if not Path(scene.source).is_file():
         return []
     effective = dict(effective_parameters({"scene_file": scene.source}, "report").values)
-    if effective.get("input.topic", scene.input.topic) != scene.input.topic:  # replay --topic
-        effective["input.topic"] = (
-            f"{scene.input.topic} (the run's, from `replay --topic`; "
-            f"the file's: {effective['input.topic']})"
-        )
+    for key, ran, option in (
+        ("input.topic", scene.input.topic, "--topic"),
+        ("input.frame_id", scene.input.frame_id, "--frame-id"),
+    ):
+        if effective.get(key, ran) != ran:  # the run's, from `replay --topic`, `--frame-id`
+            effective[key] = (
+                f"{ran or 'any'} (the run's, from `replay {option}`; "
+                f"the file's: {effective[key] or 'any'})"
+            )
     return [
         "<h2>Scene as loaded</h2>",
         table(

@@ -105,18 +105,18 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _as_replayed(scene: Scene, tables: list[Table]) -> Scene:
-    """The scene with the input topic its run read (`replay --topic` may have replaced the
-    scene's), as the output bag's input status records it (`tables`: the bag's): the input bag
-    is read from that topic, and the page names it."""
+    """The scene with the input topic its run read and the header.frame_id it expected there
+    (`replay --topic`, `--frame-id` may have replaced the scene's), as the output bag's input
+    status records them (`tables`: the bag's; a bag written before the frame_id was recorded
+    leaves the scene's): the input bag is read from that topic, and the page names both."""
     from dataclasses import replace
 
     from mount_twin.io.output_tables import input_values
 
     diagnostics = next((t for t in tables if t.name == "diagnostics"), None)
-    topic = input_values(diagnostics).get("topic")
-    if not topic or topic == scene.input.topic:
-        return scene
-    return replace(scene, input=replace(scene.input, topic=topic))
+    values, spec = input_values(diagnostics), scene.input
+    topic, frame_id = values.get("topic", spec.topic), values.get("frame_id", spec.frame_id)
+    return replace(scene, input=replace(spec, topic=topic, frame_id=frame_id))
 
 
 def _exit_status(out: ReportPage, fail_on: str) -> int:

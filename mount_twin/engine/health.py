@@ -586,12 +586,14 @@ class HealthWindow:
         nominal_s: float,
         stalled_s: float | None,
     ) -> dict[str, str]:
-        """The input status' values: the topic, the rate of this window (`_input_rate`), the
-        cumulative counts, the samples `lost` in this window at the nominal interval
-        `nominal_s` (s), the time since the last report (`stalled_s`, s) and the last start's
-        specific force (m/s²) and tilt (rad)."""
+        """The input status' values: the topic and the header.frame_id expected there (the
+        scene's, or what `replay --topic`, `--frame-id` put in their place: a report names the
+        run's), the rate of this window (`_input_rate`), the cumulative counts, the samples
+        `lost` in this window at the nominal interval `nominal_s` (s), the time since the last
+        report (`stalled_s`, s) and the last start's specific force (m/s²) and tilt (rad)."""
         values = {
             "topic": self.scene.input.topic,
+            "frame_id": self.scene.input.frame_id,
             "rate_hz": "n/a" if math.isnan(rate_hz) else f"{rate_hz:.1f}",
             **{k: str(counts[k]) for k in ("received", "accepted", "gaps", "restarts")},
             **{k: str(v) for k, v in sorted(counts.items()) if k.startswith("rejected_")},
