@@ -156,7 +156,10 @@ class ReplaySummary:
             f"  {self.written} messages written over {self.stamp_span_s:.3f} s of stamps in "
             f"{self.wall_s:.2f} s wall: real-time factor {self.real_time_factor:.1f}",
             f"  {_estimate_text(self.error_estimate)}",
-            f"  latency: outputs {self.latency[0]} samples ({self.latency[1] * 1e3:.1f} ms) "
+            # the gyro filter is designed at the accepted samples' rate: without any, no latency
+            "  latency: no figure, no input sample was accepted"
+            if nothing
+            else f"  latency: outputs {self.latency[0]} samples ({self.latency[1] * 1e3:.1f} ms) "
             "after their input, at its stamps (input.gyro_filter; none: no latency)",
         ]
         if nothing:
@@ -230,8 +233,8 @@ class ReplaySummary:
             "real_time_factor": self.real_time_factor,
             DISPLACEMENT: self.displacement_max_m if known else None,
             "max_tilt_rad": self.tilt_max_rad if known else None,
-            "latency_samples": self.latency[0],
-            "latency_s": self.latency[1],
+            "latency_samples": self.latency[0] if known else None,
+            "latency_s": self.latency[1] if known else None,
             "error_estimate": self.error_estimate.as_dict() if self.error_estimate else None,
             "body_sensor": None
             if self.body_counts is None

@@ -272,9 +272,13 @@ def test_replay_where_no_sample_is_accepted_exits_3_naming_the_frames(
     # no figures: peaks of 0 N and a utilisation of 0 read as a machine at rest
     assert "motion and mount loads: none, no input sample was accepted" in printed.out
     assert "peak mount loads" not in printed.out and "peak utilisation" not in printed.out
+    # nor a latency: the gyro filter is designed at the accepted samples' rate (it read
+    # "outputs 0 samples (0.0 ms) after their input", as if they followed it at once)
+    assert "  latency: no figure, no input sample was accepted\n" in printed.out
     summary = json.loads((tmp_path / "s.json").read_text(encoding="utf-8"))
     assert summary["max_cg_displacement_from_start_m"] is None
     assert summary["max_tilt_rad"] is None
+    assert summary["latency_samples"] is None and summary["latency_s"] is None
     assert {v for m in summary["mounts"].values() for v in m.values()} == {None}
 
 
