@@ -109,6 +109,7 @@ class ReplaySummary:
     body_topic: str = ""
     damaged: str = ""  # the input's damage, where the replay stopped at it ('' if none)
     decimation: int = 1  # outputs.decimation: what the peaks are (`figures.peak_label`)
+    frame_id_setting: str = "input.frame_id"  # what set the frame id expected, to point at
 
     @property
     def worst_level(self) -> int:
@@ -124,8 +125,8 @@ class ReplaySummary:
 
     def nothing_accepted(self) -> str:
         """Why no input sample was accepted ('' if some were): the rejection counts, and the
-        bag's header.frame_id when it is the wrong one."""
-        return intake.nothing_accepted(self.counts, self.wrong_frame_id)
+        bag's header.frame_id when it is the wrong one, pointing at what set the one expected."""
+        return intake.nothing_accepted(self.counts, self.wrong_frame_id, self.frame_id_setting)
 
     @property
     def real_time_factor(self) -> float:

@@ -278,3 +278,44 @@ def test_the_worst_mount_status_over_a_replay_reads_the_peak_utilisation_or_the_
         worst = doc["diagnostics_worst"][f"mount_twin: mount {mount}"]
         assert worst["level"] == "ERROR"
         assert re.search(rf"joint_opened ×\d+ \(first {first:.6f} s", worst["message"]), worst
+
+
+@pytest.mark.parametrize("set_by", ["scene", "option"])
+def test_a_run_that_accepted_nothing_points_at_the_frame_id_the_user_set(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], set_by: str
+) -> None:
+    """A record from the hull's IMU (hull_imu) run expecting port_imu: set in the scene's
+    input.frame_id, or by `replay --frame-id port_imu` over the pump's deck_imu. The replay's
+    summary, its stderr, its JSON and the report's heading said "see input.frame_id" either
+    way, sending a user who had typed the option to a scene key that was not what rejected
+    the samples. Each names what the user set."""
+    bag = tmp_path / "hull_bag"
+    generate = ["generate", "half-sine", "-o", str(bag), "--peak", "150", "--pulse", "0.008"]
+    assert main([*generate, "--frame-id", "hull_imu"]) == 0
+    if set_by == "scene":
+        data = read_scene_yaml(PUMP)
+        data["input"] = {**data["input"], "frame_id": "port_imu"}
+        scene = tmp_path / "port.scene.yaml"
+        scene.write_text(yaml.safe_dump(data), encoding="utf-8")
+        code, doc, out = _replay(tmp_path, scene, bag)
+        setting, other = "input.frame_id", "replay --frame-id"
+    else:
+        scene = PUMP
+        code, doc, out = _replay(tmp_path, scene, bag, "--frame-id", "port_imu")
+        setting, other = "replay --frame-id", "input.frame_id"
+    assert code == 3
+    n_in = len(read_bag(bag)[1]["/deck/imu"])
+    said = (
+        f"no input sample was accepted ({n_in} received, rejected: wrong_frame {n_in}; the "
+        f"bag's header.frame_id is 'hull_imu': see {setting})"
+    )
+    assert doc["nothing_accepted"] == said
+    replayed = capsys.readouterr()
+    assert f"  {said}\n" in replayed.out
+    assert f"mount-twin: error: {said}\n" in replayed.err
+    page = tmp_path / "r.html"
+    assert main(["report", str(out), "--scene", str(scene), "-o", str(page)]) == 3
+    assert f"mount-twin: error: {said}\n" in capsys.readouterr().err
+    text = html.unescape(page.read_text(encoding="utf-8"))
+    assert f"<h2>Verdict: ERROR: {said}</h2>" in text
+    assert f"see {other}" not in text

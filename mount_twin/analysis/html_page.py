@@ -75,21 +75,47 @@ def produced_by() -> str:
     return f"mount_twin {package_version('mount_twin')}, {now}"
 
 
+def _file_parameters(scene: Scene) -> dict[str, Any]:
+    """Every parameter of the file `scene` was read from, with its value there (none for a
+    scene not read from a file)."""
+    if not Path(scene.source).is_file():
+        return {}
+    return dict(effective_parameters({"scene_file": scene.source}, "report").values)
+
+
+def _replaced(scene: Scene, in_file: dict[str, Any]) -> dict[str, tuple[str, str]]:
+    """Of `scene`'s input settings, those whose value differs from the file's (`in_file`), each
+    with the option that replaced it (`replay --topic`, `--frame-id`) and the run's value
+    (`report` gives the scene those its run read and expected, as its output bag recorded)."""
+    from mount_twin.commands.replay import INPUT_OPTIONS
+
+    ran = {"input.topic": scene.input.topic, "input.frame_id": scene.input.frame_id}
+    return {
+        key: (option, ran[key])
+        for key, option in INPUT_OPTIONS.items()
+        if in_file.get(key, ran[key]) != ran[key]
+    }
+
+
+def frame_id_setting(scene: Scene | None) -> str:
+    """What set the header.frame_id the run of `scene` expected, for a message to point at:
+    `replay --frame-id` where it replaced the file's, else the scene's input.frame_id (also
+    without a scene: the page cannot tell)."""
+    key = "input.frame_id"
+    replaced = _replaced(scene, _file_parameters(scene)) if scene is not None else {}
+    return replaced[key][0] if key in replaced else key
+
+
 def scene_section(scene: Scene) -> list[str]:
     """The scene as loaded: every parameter with its value, meaning and unit (none for a scene
     not read from a file)."""
-    if not Path(scene.source).is_file():
+    effective = _file_parameters(scene)
+    if not effective:
         return []
-    effective = dict(effective_parameters({"scene_file": scene.source}, "report").values)
-    for key, ran, option in (
-        ("input.topic", scene.input.topic, "--topic"),
-        ("input.frame_id", scene.input.frame_id, "--frame-id"),
-    ):
-        if effective.get(key, ran) != ran:  # the run's, from `replay --topic`, `--frame-id`
-            effective[key] = (
-                f"{ran or 'any'} (the run's, from `replay {option}`; "
-                f"the file's: {effective[key] or 'any'})"
-            )
+    for key, (option, ran) in _replaced(scene, effective).items():
+        effective[key] = (
+            f"{ran or 'any'} (the run's, from `{option}`; the file's: {effective[key] or 'any'})"
+        )
     return [
         "<h2>Scene as loaded</h2>",
         table(

@@ -25,7 +25,14 @@ from mount_twin.analysis.figures import (
     peak_label,
     peak_magnitudes,
 )
-from mount_twin.analysis.html_page import fingerprint, page, png, produced_by, scene_section
+from mount_twin.analysis.html_page import (
+    fingerprint,
+    frame_id_setting,
+    page,
+    png,
+    produced_by,
+    scene_section,
+)
 from mount_twin.analysis.html_page import table as html_table
 from mount_twin.analysis.log_labels import plain_log_labels
 from mount_twin.analysis.modes_text import effective_mass_text
@@ -66,18 +73,19 @@ def utilisation_of(diagnostics: Table) -> dict[str, tuple[np.ndarray, np.ndarray
     return {k: (np.array(t), np.array(u)) for k, (t, u) in series.items()}
 
 
-def _nothing_accepted(diagnostics: Table | None) -> str:
+def _nothing_accepted(diagnostics: Table | None, scene: Scene | None) -> str:
     """Why no input sample of the run was accepted, as its replay's summary says it, from the
-    counts of its last input status ('' if some were, or the bag holds no counts)."""
+    counts of its last input status ('' if some were, or the bag holds no counts), pointing at
+    what set the frame id it expected (`frame_id_setting`: the run of `scene`)."""
     values = input_values(diagnostics)
     counts = {
         k: int(v)
         for k, v in values.items()
         if (k in ("received", "accepted") or k.startswith("rejected_")) and v.isdigit()
     }
-    if "accepted" not in counts:
+    if counts.get("accepted") != 0:  # some were, or no counts: the scene's file is not read
         return ""
-    return nothing_accepted(counts, values.get("last_wrong_frame_id"))
+    return nothing_accepted(counts, values.get("last_wrong_frame_id"), frame_id_setting(scene))
 
 
 class RunVerdict(NamedTuple):
@@ -337,7 +345,7 @@ def write_report(
     if input_name:
         title += f" (input {input_name})"
     sections = [f"<h1>{html.escape(title)}</h1>"]
-    nothing = _nothing_accepted(diagnostics)
+    nothing = _nothing_accepted(diagnostics, scene)
     verdict, integration = _verdict(diagnostics, nothing)
     sections += _provenance_section(
         verdict, integration, output_bag, input_path, scene, input_note

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -31,6 +31,9 @@ EXIT_STATUS = (
     "(custom_data mount_twin.partial: why, and up to which stamp)."
 )
 """The replay's exit statuses (mount_twin.cli's EXIT_* and `verdict`), in its --help."""
+INPUT_OPTIONS = {"input.topic": "replay --topic", "input.frame_id": "replay --frame-id"}
+"""The scene's input settings that --topic and --frame-id replace, and the option as a message
+or the report names it where it did."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -130,12 +133,22 @@ def replay_and_report(
         )
     except DamagedBagError as err:  # exit 5, after the summary of what came before it
         if err.summary is not None:
-            _report(err.summary, scene_path, output, options)
-            if err.summary.failure:  # said too: the exit status names the damage alone
-                print(f"mount-twin: error: {err.summary.failure}", file=sys.stderr)
+            up_to = _as_set(err.summary, input_overrides)
+            _report(up_to, scene_path, output, options)
+            if up_to.failure:  # said too: the exit status names the damage alone
+                print(f"mount-twin: error: {up_to.failure}", file=sys.stderr)
         raise
+    summary = _as_set(summary, input_overrides)
     _report(summary, scene_path, output, options)
     return verdict(summary, options.fail_on)
+
+
+def _as_set(summary: ReplaySummary, input_overrides: dict[str, str] | None) -> ReplaySummary:
+    """The summary pointing at what the user set: `replay --frame-id` where it replaced the
+    scene's input.frame_id (a wrong frame id was set there, not in the scene)."""
+    if not input_overrides or "frame_id" not in input_overrides:
+        return summary
+    return replace(summary, frame_id_setting=INPUT_OPTIONS["input.frame_id"])
 
 
 def _report(

@@ -111,17 +111,23 @@ def counted_text(counts: Mapping[str, int], prefix: str = "") -> str:
     return ", ".join(f"{k.removeprefix(prefix)} {v}" for k, v in kept) or "none"
 
 
-def nothing_accepted(counts: Mapping[str, int], wrong_frame_id: str | None = None) -> str:
+def nothing_accepted(
+    counts: Mapping[str, int],
+    wrong_frame_id: str | None = None,
+    frame_id_setting: str = "input.frame_id",
+) -> str:
     """Why no input sample was accepted, from an engine's `counts` ('' if some were): how many
-    were received and why each was rejected, and the last `wrong_frame_id` rejected if any. A
-    run like that has no figures: a peak of 0 N would read as a machine at rest."""
+    were received and why each was rejected, and the last `wrong_frame_id` rejected if any,
+    pointing at what set the frame id expected (`frame_id_setting`: the scene's key, or the
+    option that replaced it). A run like that has no figures: a peak of 0 N would read as a
+    machine at rest."""
     if counts.get("accepted", 0):
         return ""
     detail = ""
     if wrong_frame_id is not None:
         from mount_twin.scene.reader import shown  # a 1 MB frame id, shortened
 
-        detail = f"; the bag's header.frame_id is {shown(wrong_frame_id)}: see input.frame_id"
+        detail = f"; the bag's header.frame_id is {shown(wrong_frame_id)}: see {frame_id_setting}"
     why = (
         f"{counts.get('received', 0)} received, rejected: "
         f"{counted_text(counts, 'rejected_')}{detail}"
