@@ -319,3 +319,33 @@ def test_a_run_that_accepted_nothing_points_at_the_frame_id_the_user_set(
     text = html.unescape(page.read_text(encoding="utf-8"))
     assert f"<h2>Verdict: ERROR: {said}</h2>" in text
     assert f"see {other}" not in text
+
+
+@pytest.mark.parametrize("method", ["auto", "dopri54"])
+def test_the_report_of_a_run_that_accepted_nothing_says_no_method_ran(
+    tmp_path: Path, method: str
+) -> None:
+    """No sample accepted, no interval integrated: the page's solver row read "auto (ran:
+    auto)" (the status' method before any choice), as if the twin had run. It says that no
+    method ran; a run that integrated names the one it ran, as before."""
+    data = read_scene_yaml(PUMP)
+    data["integration"] = {**data["integration"], "method": method}
+    scene = tmp_path / f"{method}.scene.yaml"
+    scene.write_text(yaml.safe_dump(data), encoding="utf-8")
+    rows = {}
+    for run, bag in (("none", _all_nan_bag(tmp_path / "nan", 1000)), ("shock", SHOCK)):
+        out, page = tmp_path / f"{run}_out", tmp_path / f"{run}.html"
+        status = 3 if run == "none" else 0
+        args = ["replay", str(bag), "--scene", str(scene), "-o", str(out), "--no-progress"]
+        assert main(args) == status
+        assert main(["report", str(out), "--scene", str(scene), "-o", str(page)]) == status
+        text = html.unescape(page.read_text(encoding="utf-8"))
+        solver = re.search(r"<td>solver</td><td>([^<]*)</td>", text)
+        assert solver, text
+        rows[run] = solver.group(1)
+    said = f"{method} (no method ran: no input sample was accepted), rtol 1e-06, atol 1e-09"
+    assert rows["none"].startswith(said), rows["none"]
+    ran = re.match(rf"{method} \(ran: (\w+)", rows["shock"])
+    assert ran, rows["shock"]
+    chosen = ran.group(1)  # auto names the method it chose
+    assert chosen in ("dopri54", "ros34pw2", "exprb32") and method in ("auto", chosen), chosen

@@ -152,6 +152,12 @@ def _provenance_section(
             if verdict.nothing
             else f"latency {integration.get('latency_s', '?')} s"
         )
+        # the status names the scene's method until one runs (`auto`: until it chooses)
+        ran = (
+            "no method ran: no input sample was accepted"
+            if verdict.nothing
+            else f"ran: {integration.get('method', '?')}"
+        )
         rows += [
             ["scene", f"{scene.name} from {scene.source}"],
             ["input", f"{spec.topic} ({spec.msg_type}), frame {spec.frame_id or 'any'}"],
@@ -162,7 +168,7 @@ def _provenance_section(
             ],
             [
                 "solver",
-                f"{integ.method} (ran: {integration.get('method', '?')}), rtol {integ.rtol:g}, "
+                f"{integ.method} ({ran}), rtol {integ.rtol:g}, "
                 f"atol {integ.atol:g}, error estimate {'on' if integ.error_estimate else 'off'}",
             ],
         ]
