@@ -346,6 +346,24 @@ def test_the_reports_effective_masses_read_as_modes_prints_them(
         assert float(r[5]) > 0.0, r
 
 
+def test_the_reports_mode_frequencies_read_as_modes_prints_them(
+    pump_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`modes` printed the pump's yaw mode at 12.315 Hz and its surge mode at 7.830 Hz, the
+    report's modes table 12.32 and 7.83 (four significant figures): the same mode read two
+    ways. Both give every frequency to 1 mHz."""
+    capsys.readouterr()
+    assert main(["modes", str(PUMP)]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    head = next(i for i, line in enumerate(printed) if line.split()[:3] == ["mode", "f", "Hz"])
+    by_modes = [line.split()[1] for line in printed[head + 2 : head + 8]]
+    page = tmp_path / "r.html"
+    assert main(["report", str(pump_run), "--scene", str(PUMP), "-o", str(page)]) == 0
+    rows = _table_rows(page.read_text(encoding="utf-8"), "Modes (about the static")
+    assert [r[1] for r in rows] == by_modes
+    assert all(re.fullmatch(r"\d+\.\d{3}", f) for f in by_modes), by_modes
+
+
 def test_the_reports_figures_are_labelled_in_words_with_their_units(
     pump_run: Path, tmp_path: Path
 ) -> None:

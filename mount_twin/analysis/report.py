@@ -35,7 +35,7 @@ from mount_twin.analysis.html_page import (
 )
 from mount_twin.analysis.html_page import table as html_table
 from mount_twin.analysis.log_labels import plain_log_labels
-from mount_twin.analysis.modes_text import effective_mass_text
+from mount_twin.analysis.modes_text import effective_mass_text, frequency_text
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
 from mount_twin.engine.estimate import NOT_INTEGRATED
 from mount_twin.engine.health import UTILISATION_KEY
@@ -296,7 +296,7 @@ def _modes_section(scene: Scene) -> list[str]:
         rows.append(
             [
                 str(i),
-                f"{m.frequency_hz:.4g}",
+                frequency_text(m.frequency_hz),
                 f"{100 * m.damping_ratio:.2f}",
                 f"{main_dof} {100 * m.energy_fraction[main_dof]:.0f} %",
                 *(effective_mass_text(m.effective_mass_kg[a]) for a in "xyz"),

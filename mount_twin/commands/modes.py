@@ -6,7 +6,7 @@ import argparse
 import dataclasses
 from typing import TYPE_CHECKING, Any
 
-from mount_twin.analysis.modes_text import effective_mass_text, fixed
+from mount_twin.analysis.modes_text import effective_mass_text, fixed, frequency_text
 
 if TYPE_CHECKING:
     from mount_twin.analysis.modes import Line, Modes
@@ -94,7 +94,7 @@ def table(scene: Scene, result: Modes) -> str:
     for i, m in enumerate(result.modes, 1):
         main = m.dominant_dof
         lines.append(
-            f"{i:>4} {m.frequency_hz:>9.3f} {fixed(100 * m.damping_ratio, 2):>6}  "
+            f"{i:>4} {frequency_text(m.frequency_hz):>9} {fixed(100 * m.damping_ratio, 2):>6}  "
             f"{main:<6}{fixed(100 * m.energy_fraction[main], 0):>4} %  "
             + "".join(f"{fixed(100 * m.energy_fraction[d], 1):>7}" for d in dofs)
         )
@@ -105,7 +105,8 @@ def table(scene: Scene, result: Modes) -> str:
             "equilibrium is unstable (the weight's geometric stiffness exceeds the mounts')"
         )
     exact = ", ".join(
-        f"{c.frequency_hz:.3f} ({fixed(100 * c.damping_ratio, 2)})" for c in result.complex_modes
+        f"{frequency_text(c.frequency_hz)} ({fixed(100 * c.damping_ratio, 2)})"
+        for c in result.complex_modes
     )
     lines += [
         "ζ: proportional-damping approximation φᵀCφ/2ω; the damped linearisation's eigenvalues",
@@ -128,7 +129,7 @@ def _masses(result: Modes) -> list[str]:
     for i, m in enumerate(result.modes, 1):
         masses = "".join(f"{effective_mass_text(m.effective_mass_kg[a]):>10}" for a in "xyz")
         inertias = "".join(f"{fixed(m.effective_inertia_kg_m2[a], 2):>10}" for a in "xyz")
-        lines.append(f"{i:>4} {m.frequency_hz:>9.3f}  {masses}  {inertias}")
+        lines.append(f"{i:>4} {frequency_text(m.frequency_hz):>9}  {masses}  {inertias}")
     sums = "".join(
         f"{effective_mass_text(sum(m.effective_mass_kg[a] for m in result.modes)):>10}"
         for a in "xyz"
