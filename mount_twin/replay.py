@@ -22,6 +22,7 @@ from mount_twin.analysis.figures import (
     mount_travel,
     peak_label,
     peak_magnitudes,
+    peak_text,
 )
 from mount_twin.engine import intake
 from mount_twin.engine.agreement import NAME as BODY_STATUS
@@ -191,7 +192,7 @@ class ReplaySummary:
             f"  peak mount loads ({peak_label(self.decimation)}): |F| [N]  |M| [N·m]",
         ]
         for name, peak in self.peaks.items():
-            lines.append(f"    {name:>12}: " + " ".join(f"{v:10.1f}" for v in peak))
+            lines.append(f"    {name:>12}: " + " ".join(f"{peak_text(v):>10}" for v in peak))
         if self.utilisation_max:
             lines.append(
                 "  peak utilisation (bolt F/F_y, rubber deflection/rated, key F/allowable):"

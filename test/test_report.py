@@ -364,6 +364,35 @@ def test_the_reports_mode_frequencies_read_as_modes_prints_them(
     assert all(re.fullmatch(r"\d+\.\d{3}", f) for f in by_modes), by_modes
 
 
+def test_the_reports_peak_loads_read_as_the_replay_summary_prints_them(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The pump's front mounts under the bundled shock: the replay's summary printed their
+    peak |F| as 10848.2 N, the report's peaks table as 1.085e+04 (and |M| 0.9 against
+    0.9104 N·m): the same figure in two forms. Both print every mount's peak |F| and |M| as
+    the summary does, to 0.1 N and 0.1 N·m; each is the bag's own largest magnitude."""
+    out, page = tmp_path / "out", tmp_path / "r.html"
+    bag = ROOT / "bags" / "half_sine_shock_10khz"
+    capsys.readouterr()
+    assert main(["replay", str(bag), "--scene", str(PUMP), "-o", str(out), "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    by_summary = {
+        name: [force, couple]
+        for name, force, couple in re.findall(r"^ +(\w+): +([\d.]+) +([\d.]+)$", printed, re.M)
+    }
+    assert main(["report", str(out), "--scene", str(PUMP), "-o", str(page)]) == 0
+    rows = _table_rows(page.read_text(encoding="utf-8"), "Peaks (")
+    assert {r[0]: r[2:4] for r in rows} == by_summary
+    _, msgs = read_bag(out)
+    for name, (force, couple) in by_summary.items():
+        wrench = [m.wrench for _, m in msgs[f"/mount_twin/mounts/{name}/wrench"]]
+        f = max(np.linalg.norm([w.force.x, w.force.y, w.force.z]) for w in wrench)
+        c = max(np.linalg.norm([w.torque.x, w.torque.y, w.torque.z]) for w in wrench)
+        assert abs(float(force) - f) <= 0.05 and abs(float(couple) - c) <= 0.05, (name, f, c)
+        assert re.fullmatch(r"\d+\.\d", force) and re.fullmatch(r"\d+\.\d", couple), name
+    assert list(by_summary) == [m.name for m in load_scene_file(PUMP).mounts]
+
+
 def test_the_reports_figures_are_labelled_in_words_with_their_units(
     pump_run: Path, tmp_path: Path
 ) -> None:

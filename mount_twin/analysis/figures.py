@@ -42,6 +42,12 @@ def peak_label(decimation: int) -> str:
     )
 
 
+def peak_text(value: float) -> str:
+    """A peak |F| (N) or |M| (N·m) as the replay's summary and the report print it, to 0.1: the
+    same figure read the same in both."""
+    return f"{value:.1f}"
+
+
 def peak_magnitudes(wrenches: np.ndarray) -> np.ndarray:
     """Per mount, the largest |F| (N) and |M| (N·m) of the (k, n, 6) wrenches (force, couple
     in mount axes) over their k rows: (n, 2); zeros for k = 0."""

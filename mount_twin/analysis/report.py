@@ -24,6 +24,7 @@ from mount_twin.analysis.figures import (
     displacement_from_start,
     peak_label,
     peak_magnitudes,
+    peak_text,
 )
 from mount_twin.analysis.html_page import (
     fingerprint,
@@ -540,8 +541,8 @@ def _peak_rows(
             [
                 name,
                 kinds.get(name, ""),
-                f"{force:.4g}",
-                f"{couple:.4g}",
+                peak_text(force),
+                peak_text(couple),
                 "n/a" if u is None else f"{float(u[1].max()):.3g}",
             ]
         )
