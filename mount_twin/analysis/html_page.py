@@ -87,7 +87,7 @@ def _replaced(scene: Scene, in_file: dict[str, Any]) -> dict[str, tuple[str, str
     """Of `scene`'s input settings, those whose value differs from the file's (`in_file`), each
     with the option that replaced it (`replay --topic`, `--frame-id`) and the run's value
     (`report` gives the scene those its run read and expected, as its output bag recorded)."""
-    from mount_twin.commands.replay import INPUT_OPTIONS
+    from mount_twin.commands.common import INPUT_OPTIONS
 
     ran = {"input.topic": scene.input.topic, "input.frame_id": scene.input.frame_id}
     return {

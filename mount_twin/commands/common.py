@@ -107,6 +107,11 @@ def check_targets(*, figures: tuple[str, ...] = ("plot",), **targets: str | None
             raise ValueError(msg)
 
 
+INPUT_OPTIONS = {"input.topic": "replay --topic", "input.frame_id": "replay --frame-id"}
+"""The scene's input settings that --topic and --frame-id replace, and the option as a message
+or the report names it where it did."""
+
+
 def load_scene(path: str | Path, input_overrides: Mapping[str, str] | None = None) -> Scene:
     """The scene file at `path`, with `input` fields replaced by `input_overrides` (checked like
     the file's own); each of its warnings (units? a message type's convention?) is printed on

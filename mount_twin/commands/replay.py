@@ -8,7 +8,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mount_twin.commands.common import positive_int
+from mount_twin.commands.common import INPUT_OPTIONS, positive_int
 
 if TYPE_CHECKING:
     from mount_twin.replay import ReplaySummary
@@ -31,9 +31,6 @@ EXIT_STATUS = (
     "(custom_data mount_twin.partial: why, and up to which stamp)."
 )
 """The replay's exit statuses (mount_twin.cli's EXIT_* and `verdict`), in its --help."""
-INPUT_OPTIONS = {"input.topic": "replay --topic", "input.frame_id": "replay --frame-id"}
-"""The scene's input settings that --topic and --frame-id replace, and the option as a message
-or the report names it where it did."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
