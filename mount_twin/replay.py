@@ -23,6 +23,7 @@ from mount_twin.analysis.figures import (
     peak_label,
     peak_magnitudes,
     peak_text,
+    utilisation_text,
 )
 from mount_twin.engine import intake
 from mount_twin.engine.agreement import NAME as BODY_STATUS
@@ -41,7 +42,6 @@ from mount_twin.engine.health import (
     INTEGRATION,
     NOW_KEY,
     UTILISATION_KEY,
-    ratio_text,
     tilt_from_quaternions,
 )
 from mount_twin.errors import BagError, DamagedBagError, require
@@ -198,7 +198,7 @@ class ReplaySummary:
                 "  peak utilisation (bolt F/F_y, rubber deflection/rated, key F/allowable):"
             )
             lines += [
-                f"    {n:>12}: {ratio_text(u, '.3f')}" for n, u in self.utilisation_max.items()
+                f"    {n:>12}: {utilisation_text(u)}" for n, u in self.utilisation_max.items()
             ]
         return lines
 

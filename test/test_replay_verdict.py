@@ -15,6 +15,7 @@ import pytest
 import yaml
 from io_helpers import CONFIG, ROOT, read_bag
 
+from mount_twin.analysis.figures import utilisation_text
 from mount_twin.cli import main
 from mount_twin.io.bag import write_bag
 from mount_twin.io.messages import IMU, imu_messages
@@ -238,7 +239,7 @@ def test_peak_force_and_displacement_are_one_definition_in_json_report_and_sweep
         # its utilisation, from the bag's diagnostics, as the summary's to the digits shown
         # (the genset's key_y, 0.51451, read back from four digits as 0.5145, showed 0.514)
         u = doc["mounts"][mount]["utilisation_max"]
-        cells = rf"<td>{mount}</td>(<td>[^<]*</td>){{3}}<td>{u:.3g}</td>"
+        cells = rf"<td>{mount}</td>(<td>[^<]*</td>){{3}}<td>{utilisation_text(u)}</td>"
         assert u is not None and re.search(cells, html), (mount, u)
 
     sweep = tmp_path / "sweep.yaml"

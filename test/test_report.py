@@ -380,9 +380,13 @@ def test_the_reports_peak_loads_read_as_the_replay_summary_prints_them(
         name: [force, couple]
         for name, force, couple in re.findall(r"^ +(\w+): +([\d.]+) +([\d.]+)$", printed, re.M)
     }
+    utilisation = dict(re.findall(r"^ +(\w+): ([\d.]+)$", printed, re.M))
     assert main(["report", str(out), "--scene", str(PUMP), "-o", str(page)]) == 0
     rows = _table_rows(page.read_text(encoding="utf-8"), "Peaks (")
     assert {r[0]: r[2:4] for r in rows} == by_summary
+    # the utilisation too: the page printed 3 significant figures (0.99983 read "1", the
+    # ERROR limit, for a mount at WARN), the summary 3 decimals with the digits that keep it
+    assert {r[0]: r[4] for r in rows} == utilisation
     _, msgs = read_bag(out)
     for name, (force, couple) in by_summary.items():
         wrench = [m.wrench for _, m in msgs[f"/mount_twin/mounts/{name}/wrench"]]

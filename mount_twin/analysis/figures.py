@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from mount_twin.engine.health import ratio_text
+
 PEAK_FORCE = "peak_force_magnitude_N"
 PEAK_COUPLE = "peak_couple_magnitude_Nm"
 DISPLACEMENT = "max_cg_displacement_from_start_m"
@@ -46,6 +48,13 @@ def peak_text(value: float) -> str:
     """A peak |F| (N) or |M| (N·m) as the replay's summary and the report print it, to 0.1: the
     same figure read the same in both."""
     return f"{value:.1f}"
+
+
+def utilisation_text(value: float) -> str:
+    """A mount's peak utilisation as the replay's summary and the report print it: to 0.001,
+    with more digits where rounding would carry it onto or across 1, the ERROR limit
+    (`ratio_text`: 0.99983 reads 0.9998)."""
+    return ratio_text(value, ".3f")
 
 
 def peak_magnitudes(wrenches: np.ndarray) -> np.ndarray:

@@ -25,6 +25,7 @@ from mount_twin.analysis.figures import (
     peak_label,
     peak_magnitudes,
     peak_text,
+    utilisation_text,
 )
 from mount_twin.analysis.html_page import (
     fingerprint,
@@ -543,7 +544,7 @@ def _peak_rows(
                 kinds.get(name, ""),
                 peak_text(force),
                 peak_text(couple),
-                "n/a" if u is None else f"{float(u[1].max()):.3g}",
+                "n/a" if u is None else utilisation_text(float(u[1].max())),
             ]
         )
     return rows
