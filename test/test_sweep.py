@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 from io_helpers import CONFIG, ROOT
 
+from mount_twin.analysis.figures import peak_text, utilisation_text
 from mount_twin.cli import main
 from mount_twin.errors import SceneError
 from mount_twin.scene.loader import read_scene_yaml
@@ -263,7 +264,12 @@ def test_the_command_reports_and_exits_6_when_a_case_failed(
             key=lambda r: max(r[f"utilisation.{n}"] for n in names),
         )
         value = max(best[f"utilisation.{n}"] for n in names)
-        assert f"  {name}: {value:.3g}, case {best['case']} (" in out, name
+        assert f"  {name}: {utilisation_text(value)}, case {best['case']} (" in out, name
+    # the largest peak force, as the replay's summary and the report print a peak (it read
+    # 1.337e+04 N beside their 13370.0)
+    top = max(done, key=lambda r: max(r[f"peak_force_magnitude_N.{n}"] for n in names))
+    force = max(top[f"peak_force_magnitude_N.{n}"] for n in names)
+    assert f"highest peak mount force: {peak_text(force)} N, case {top['case']} (" in out
     assert rows() == before + 4  # the 4 failed cases rerun, their rows appended
 
 

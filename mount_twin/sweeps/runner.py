@@ -25,10 +25,12 @@ from mount_twin.analysis.figures import (
     PEAK_FORCE,
     displacement_from_start,
     peak_magnitudes,
+    peak_text,
+    utilisation_text,
 )
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, SampleBatch
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.engine.health import ratio_text, tilt_from_quaternions
+from mount_twin.engine.health import tilt_from_quaternions
 from mount_twin.engine.intake import nothing_accepted
 from mount_twin.errors import MountTwinError
 from mount_twin.model.assemble import assemble
@@ -304,7 +306,7 @@ def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
 
         for label, r in (("lowest", min(done, key=peak)), ("highest", max(done, key=peak))):
             lines.append(
-                f"{label} peak mount force: {peak(r):.4g} N, case {r['case']} "
+                f"{label} peak mount force: {peak_text(peak(r))} N, case {r['case']} "
                 f"({r['input']}; {setting(r)}) {r['verdict']}"
             )
 
@@ -317,7 +319,7 @@ def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
             if rated:
                 r = min(rated, key=utilisation)
                 best.append(
-                    f"  {case.name}: {ratio_text(utilisation(r))}, case {r['case']} "
+                    f"  {case.name}: {utilisation_text(utilisation(r))}, case {r['case']} "
                     f"({setting(r)}) {r['verdict']}"
                 )
         if best:
