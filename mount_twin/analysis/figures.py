@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from mount_twin.engine.health import ratio_text
+from mount_twin.physics.rotations import point_displacements
 
 PEAK_FORCE = "peak_force_magnitude_N"
 PEAK_COUPLE = "peak_couple_magnitude_Nm"
@@ -83,6 +84,5 @@ def mount_travel(
     reference pose, where every mount is unstressed); zeros for k = 0."""
     if not position.shape[0]:
         return np.zeros(points.shape[0])
-    arm = points - cg  # (n, 3)
-    d = (position - cg)[:, None, :] + np.einsum("kij,nj->kni", rotation, arm) - arm
+    d = point_displacements(position - cg, rotation, points - cg)
     return np.linalg.norm(d, axis=2).max(axis=0)

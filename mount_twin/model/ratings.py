@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from mount_twin.physics.dynamics import ModelArrays, body_motion, mount_wrenches, new_scratch
-from mount_twin.physics.rotations import rpy_matrices
+from mount_twin.physics.rotations import point_displacements, rpy_matrices
 from mount_twin.scene.checks import UNITS_OR_MOUNT, rated_at_start, rating_warnings
 from mount_twin.scene.description import Scene, SceneWarning
 
@@ -38,7 +38,7 @@ def start_ratings(scene: Scene, m: ModelArrays, y: np.ndarray) -> tuple[SceneWar
     wrenches = np.zeros((len(scene.mounts), 6))
     mount_wrenches(y, m, s, wrenches)
     arm = np.array([mt.position for mt in scene.mounts]) - np.array(scene.body.cg)
-    shift = s.q[:3] + arm @ (s.rot - np.eye(3)).T  # each attachment point's, in F
+    shift = point_displacements(s.q[None, :3], s.rot[None], arm)[0]  # each attachment point's
     axes = rpy_matrices([mt.orientation_rpy for mt in scene.mounts])
     deflection = np.einsum("nji,nj->ni", axes, shift)
     paths = [scene.mount_path(i) for i in range(len(scene.mounts))]

@@ -27,6 +27,14 @@ def rpy_matrices(angles: list[tuple[float, float, float]]) -> np.ndarray:
     return np.array([rpy_matrix(*a) for a in angles]).reshape(-1, 3, 3)
 
 
+def point_displacements(shift: np.ndarray, rotation: np.ndarray, arms: np.ndarray) -> np.ndarray:
+    """Displacements (k, n, 3), m in F, of the body points at `arms` (n, 3: m from the CG, in F
+    at the reference pose, where B's axes are F's) in k poses: the CG displaced by `shift`
+    (k, 3), m in F, the body turned by `rotation` (k, 3, 3), body → F. shift + R·a − a, as the
+    core's `point_motion`."""
+    return shift[:, None, :] + np.einsum("kij,nj->kni", rotation, arms) - arms
+
+
 def quaternion_from_matrix(rot: np.ndarray, out: np.ndarray) -> None:
     """Unit quaternion (x, y, z, w), w ≥ 0, of a rotation matrix (Shepperd's method)."""
     tr = rot[0, 0] + rot[1, 1] + rot[2, 2]

@@ -124,9 +124,10 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
 }
 
 /// run_samples' arrays, converted and checked once: converting its hundred-odd fields at
-/// every call took 25–40 µs, most of what one live sample costs the core. The Loop holds the
-/// Python objects, so the views stay valid: NamedTuples and arrays, whose fields cannot be
-/// rebound (the driver binds anew when it replaces one: a start's y, a method switch).
+/// every call took 36–42 µs with nothing to advance, where one sample's work is a few µs. The
+/// Loop holds the Python objects, so the views stay valid: NamedTuples and arrays, whose
+/// fields cannot be rebound (the driver binds anew when it replaces one: a start's y, a
+/// method switch).
 /// The estimator's state slots, which Python may change between calls, are checked again at
 /// each (`refresh`).
 struct Loop {
