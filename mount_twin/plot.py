@@ -23,12 +23,9 @@ def plot_output_bag(
     mount events (engine stamps + origin_s = header stamps, s) marked on the forces at their
     reported |F|: ERROR red triangles, WARN orange dots; with a body IMU comparison in the bag,
     its measured specific force against the twin's prediction below."""
-    import matplotlib
+    from mount_twin.figure_files import pyplot, save_png
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from mount_twin.textfiles import replacing
+    plt = pyplot()
 
     tables = {t.name: t for t in read_output_bag(bag)}
     body = "body_imu_predicted" in tables and "body_imu_residual" in tables
@@ -81,9 +78,4 @@ def plot_output_bag(
         ax.grid(True, alpha=0.3)
         ax.legend(loc="upper right", fontsize=7, ncol=4)
     fig.suptitle(title or str(bag))
-    fig.tight_layout()
-    out = Path(png)
-    with replacing(out) as tmp:  # whole or not at all, a failure naming it
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return out
+    return save_png(fig, png)

@@ -19,11 +19,9 @@ from mount_twin.scene.params import effective_parameters, parameter_description
 
 def png(draw: Callable[[Any], None], size: tuple[float, float]) -> str:
     """A figure drawn by `draw(fig)`, as an <img> with the PNG inline."""
-    import matplotlib
+    from mount_twin.figure_files import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     fig = plt.figure(figsize=size)
     draw(fig)
     fig.tight_layout()

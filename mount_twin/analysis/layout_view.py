@@ -58,12 +58,9 @@ def layout_size(scene: Scene) -> float:
 
 def draw_layout(scene: Scene, png: str | Path) -> Path:
     """Write the three views of `scene` to `png`; returns its path."""
-    import matplotlib
+    from mount_twin.figure_files import pyplot, save_png
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from mount_twin.textfiles import replacing
+    plt = pyplot()
 
     fig = plt.figure(figsize=(15, 5.5))
     ax3 = fig.add_subplot(1, 3, 1, projection="3d")
@@ -78,12 +75,7 @@ def draw_layout(scene: Scene, png: str | Path) -> Path:
         f"DOFs {', '.join(scene.dofs)} — {scene.source}",
         fontsize=10,
     )
-    fig.tight_layout()
-    out = Path(png)
-    with replacing(out) as tmp:  # whole or not at all, a failure naming it
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return out
+    return save_png(fig, png)
 
 
 class _Views:

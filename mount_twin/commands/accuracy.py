@@ -220,13 +220,10 @@ def _plot(
     png: str,
     title: str,
 ) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     from mount_twin.analysis.log_labels import plain_log_labels
-    from mount_twin.textfiles import replacing
+    from mount_twin.figure_files import pyplot, save_png
+
+    plt = pyplot()
 
     fig, ax = plt.subplots(figsize=(7, 5))
     wall = [r.wall_s_per_sim_s for r in rows]
@@ -267,7 +264,4 @@ def _plot(
     ax.set_title(f"work-precision: {title}", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8, loc="best")
-    fig.tight_layout()
-    with replacing(png) as tmp:  # whole or not at all, a failure naming it
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
+    save_png(fig, png)

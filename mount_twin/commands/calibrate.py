@@ -192,14 +192,12 @@ def _write_scene(source: str, out: Path, cal: Calibration, lines: list[str]) -> 
 
 def _plot(png: str, scene: Scene, cal: Calibration, foundation: Signal, body: Signal) -> None:
     """The body record's axes against the prediction, nominal and calibrated."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from scipy.interpolate import CubicSpline
 
     from mount_twin.analysis.calibration import predict
-    from mount_twin.textfiles import replacing
+    from mount_twin.figure_files import pyplot, save_png
+
+    plt = pyplot()
 
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(10, 8))
     shown = [(scene, "nominal", "tab:gray"), (cal.scene, "calibrated", "tab:red")]
@@ -224,7 +222,4 @@ def _plot(png: str, scene: Scene, cal: Calibration, foundation: Signal, body: Si
         fontsize=9,
     )
     axes[-1].set_xlabel("time [s]")
-    fig.tight_layout()
-    with replacing(png) as tmp:  # whole or not at all, a failure naming it
-        fig.savefig(tmp, dpi=100)
-    plt.close(fig)
+    save_png(fig, png, dpi=100)

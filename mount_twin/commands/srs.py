@@ -482,13 +482,10 @@ def _plot(
     its `unit`), log-log, against the design spectrum; the frequencies above fs/10 shaded."""
     import textwrap
 
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    from mount_twin.figure_files import pyplot, save_png
     from mount_twin.io.csv_import import G
-    from mount_twin.textfiles import replacing
+
+    plt = pyplot()
 
     scale, ylabel = (
         (G, "peak absolute acceleration [g]")
@@ -526,7 +523,4 @@ def _plot(
     ax.set_title(textwrap.fill(title, 90), fontsize=9)  # a long bag or mount name: two lines
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    with replacing(png) as tmp:  # whole or not at all, a failure naming it
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
+    save_png(fig, png)

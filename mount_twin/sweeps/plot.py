@@ -59,12 +59,9 @@ def _sortable(value: Any) -> tuple[int, float, str]:
 def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> Path:
     """Write the plot of `trade_off`: the force above, the utilisation below (its limit, 1,
     dashed; that panel only where a mount is rated)."""
-    import matplotlib
+    from mount_twin.figure_files import pyplot, save_png
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from mount_twin.textfiles import replacing
+    plt = pyplot()
 
     lines = trade_off(rows, spec)
     rated = any(not math.isnan(p[2]) for points in lines.values() for p in points)
@@ -85,9 +82,4 @@ def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> 
     varied = columns(spec)[2 : 2 + len(spec.variations)]
     panels[-1].set_xlabel(varied[0] if varied else "case")
     panels[0].set_title(f"{Path(spec.source).name}: markers o OK, s WARN, v ERROR", fontsize=9)
-    fig.tight_layout()
-    out = Path(png)
-    with replacing(out) as tmp:  # whole or not at all, a failure naming it
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return out
+    return save_png(fig, png)
