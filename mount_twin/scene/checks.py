@@ -21,9 +21,10 @@ Warnings (SceneWarning, kept on `Scene.warnings`): values that load but are like
 - a DOF the weight overturns (negative stiffness: a CG high above soft mounts);
 - a static sag of the CG or of a mount's attachment point beyond SAG_WARN_M (stiffness in N/mm
   sags a thousand times more), and a mount's static load or deflection beyond its rated values
-  (for a scene whose start sets hysteretic mounts down along their loading curves, softer than
-  these statics, the assembly judges the ratings at that start instead: `rated_at_start`,
-  `model.ratings`);
+  (for a scene whose start at equilibrium the assembly solves with non-linear mount laws, which
+  these statics misjudge — a softening force table, cubic terms, snubbers, hysteretic mounts on
+  their loading curves, clearances — it judges the ratings at that start instead:
+  `rated_at_start`, `model.ratings`);
 - a mount, the body IMU or the deck IMU farther from the CG than FAR_FACTOR times the body's
   largest radius of gyration, and a radius of gyration beyond GYRATION_WARN_M (positions in
   mm, inertia in kg·mm²);
@@ -43,6 +44,7 @@ import numpy as np
 
 from mount_twin.errors import SceneError
 from mount_twin.kinds.elastomer import Elastomer
+from mount_twin.kinds.shear_key import ShearKey
 from mount_twin.scene.description import LinearMount, Mount, Scene, SceneWarning, Vec3
 from mount_twin.scene.statics import AXES, Statics, loose_dofs, statics
 
@@ -258,16 +260,36 @@ def ratings(mount: Mount) -> tuple[tuple[str, tuple[float, ...]], ...]:
 
 def rated_at_start(scene: Scene) -> bool:
     """Whether the scene's ratings are judged at the start the twin uses (`model.ratings`, at
-    assembly) rather than here: a start at equilibrium sets hysteretic mounts down along their
-    loading curves (`model.loading`), softer than the nominal tangent at zero load (400 kg on
-    four mounts of k₀ = 1e5 N/m, a = 0.3, β + γ = 200 start 21.2 mm down, where the tangent
-    says 9.8), and a mount is rated."""
-    hysteretic = any(
-        isinstance(m, Elastomer) and m.hysteresis is not None and m.hysteresis.axes
-        for m in scene.mounts
-    )
+    assembly) rather than here: a start at equilibrium, a mount whose static law is not its
+    nominal tangent (`nonlinear_at_rest`), whose equilibrium the assembly solves with that law,
+    and a mount rated. The tangent at zero load misjudges such a start: 400 kg on four
+    elastomers whose force table softens from 1e5 N/m start 14.4 mm down where the tangent
+    says 9.8 (a rated 12 mm passed unwarned), and on hysteretic ones set down along their
+    loading curves (`model.loading`; k₀ = 1e5 N/m, a = 0.3, β + γ = 200) 21.2 mm; a stiffening
+    law (cubic terms, a snubber) starts short of the tangent's sag."""
+    nonlinear = any(nonlinear_at_rest(m) for m in scene.mounts)
     rated = any(r > 0.0 for m in scene.mounts for _, limit in ratings(m) for r in limit)
-    return scene.initial.mode == "equilibrium" and hysteretic and rated
+    return scene.initial.mode == "equilibrium" and nonlinear and rated
+
+
+def nonlinear_at_rest(mount: Mount) -> bool:
+    """Whether `mount`'s static force law departs from its nominal tangent (`scene.statics`)
+    under a load: an elastomer with a force table, cubic stiffness, a snubber or hysteresis; a
+    shear key with a clearance or an engagement height; a bolted joint (it opens, and its
+    face slips); any other kind. A linear mount, an elastomer of k₁ alone and a key that bears
+    from zero are their tangents."""
+    if isinstance(mount, LinearMount):
+        return False
+    if isinstance(mount, Elastomer):
+        return bool(
+            mount.force_table
+            or any(k3 > 0.0 for k3 in mount.stiffness_cubic)
+            or (mount.hysteresis is not None and mount.hysteresis.axes)
+            or (mount.snubber is not None and mount.snubber.axes)
+        )
+    if isinstance(mount, ShearKey):
+        return mount.clearance > 0.0 or mount.engagement_height > 0.0
+    return True
 
 
 def rating_warnings(
