@@ -350,3 +350,22 @@ def test_the_report_of_a_run_that_accepted_nothing_says_no_method_ran(
     assert ran, rows["shock"]
     chosen = ran.group(1)  # auto names the method it chose
     assert chosen in ("dopri54", "ros34pw2", "exprb32") and method in ("auto", chosen), chosen
+
+
+def test_a_replay_that_accepted_nothing_says_its_integration_did_not_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every sample rejected (another frame id), nothing integrated: the summary's diagnostics,
+    its JSON and the output bag's last integration status read "ok", as if the twin had run
+    clean. They say it did not run, and why."""
+    code, doc, out = _replay(tmp_path, PUMP, SHOCK, "--frame-id", "not_the_imu")
+    assert code == 3
+    said = "not run: no input sample was accepted"
+    assert doc["diagnostics_worst"]["mount_twin: integration"] == {"level": "OK", "message": said}
+    text = capsys.readouterr().out
+    assert f"    OK    mount_twin: integration: {said}\n" in text
+    assert "integration: ok" not in text
+    _, msgs = read_bag(out)
+    (report,) = [m for _, m in msgs["/diagnostics"]]
+    (status,) = [s for s in report.status if s.name == "mount_twin: integration"]
+    assert status.message == said

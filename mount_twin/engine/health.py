@@ -24,6 +24,9 @@ INTEGRATION = f"{PREFIX}: integration"
 """Name of the integration status."""
 INPUT = f"{PREFIX}: input"
 """Name of the input status."""
+NOT_RUN = "not run: no input sample was accepted"
+"""The integration status' text while no input sample has been accepted (it had read "ok",
+as if the twin had integrated the run clean)."""
 
 PEAK_KEYS = tuple(f"peak_{axis}" for axis in ("fx_N", "fy_N", "fz_N", "tx_Nm", "ty_Nm", "tz_Nm"))
 """A mount status' keys of its peak wrench components in this period (N, N·m, mount axes)."""
@@ -338,10 +341,11 @@ class HealthWindow:
         """The integration status of this window (`span`: the stamp time its input intervals
         cover, s; over its wall time, the real-time factor): stepper failures and
         a stop (ERROR), notes on how the input is taken and an estimated error past
-        WARN_FORCE_ERROR_REL (WARN); the solver's settings and figures as values."""
+        WARN_FORCE_ERROR_REL (WARN); the solver's settings and figures as values. Before any
+        input sample is accepted, NOT_RUN."""
         integ = self.scene.integration
         rtf = span / self.wall if self.wall > 0 and span > 0 else math.nan
-        level, step_text = self._stepper_status()
+        level, step_text = self._stepper_status() if counts["accepted"] else (OK, NOT_RUN)
         estimate = self._estimate_values()
         warning = estimate_warning(ErrorEstimate.of(self.estimate_run)) if estimate else None
         for note in (*self.notes, warning):
