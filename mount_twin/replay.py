@@ -40,6 +40,7 @@ from mount_twin.engine.estimate import NOT_INTEGRATED, ErrorEstimate
 from mount_twin.engine.health import (
     EVENTS_KEY,
     INTEGRATION,
+    NOT_DESIGNED,
     NOW_KEY,
     UTILISATION_KEY,
     tilt_from_quaternions,
@@ -104,7 +105,8 @@ class ReplaySummary:
     start_s: float = 0.0  # engine seconds of the first output (event times count from it)
     error_estimate: ErrorEstimate | None = None  # the live estimate over the run (None: off)
     failure: str = ""  # how often the integration failed and why ('' if never)
-    latency: tuple[int, float] = (0, 0.0)  # samples, s: outputs after their input (gyro delay)
+    # samples, s: outputs after their input (gyro delay; None: the filter never designed)
+    latency: tuple[int, float] | None = (0, 0.0)
     travel_max_m: dict[str, float] = field(default_factory=dict)  # per mount (`figures.TRAVEL`)
     body_counts: dict[str, int] | None = None  # the body IMU's (None: no body_sensor)
     body_topic: str = ""
@@ -158,11 +160,7 @@ class ReplaySummary:
             f"  {self.written} messages written over {self.stamp_span_s:.3f} s of stamps in "
             f"{self.wall_s:.2f} s wall: real-time factor {self.real_time_factor:.1f}",
             f"  {_estimate_text(self.error_estimate)}",
-            # the gyro filter is designed at the accepted samples' rate: without any, no latency
-            "  latency: no figure, no input sample was accepted"
-            if nothing
-            else f"  latency: outputs {self.latency[0]} samples ({self.latency[1] * 1e3:.1f} ms) "
-            "after their input, at its stamps (input.gyro_filter; none: no latency)",
+            f"  latency: {self._latency_text(nothing)}",
         ]
         if nothing:
             lines.append("  motion and mount loads: none, no input sample was accepted")
@@ -182,6 +180,19 @@ class ReplaySummary:
         ]
         lines.append(f"  verdict: {self.verdict}")
         return "\n".join(lines)
+
+    def _latency_text(self, nothing: str) -> str:
+        """How late the outputs follow their input; no figure where no sample was accepted
+        (`nothing`) or the gyro filter, designed at the accepted samples' rate, never was."""
+        if nothing:
+            return "no figure, no input sample was accepted"
+        if self.latency is None:
+            return f"no figure, {NOT_DESIGNED}"
+        samples, seconds = self.latency
+        return (
+            f"outputs {samples} samples ({seconds * 1e3:.1f} ms) after their input, at its "
+            "stamps (input.gyro_filter; none: no latency)"
+        )
 
     def _figure_lines(self) -> list[str]:
         """The run's motion, peak mount loads and utilisations (a run that accepted samples)."""
@@ -221,6 +232,7 @@ class ReplaySummary:
         from the first output, `stamp_s` are header stamps."""
         util = self.utilisation_max
         known = not self.nothing_accepted()  # else no figures: null, not a machine at rest
+        latency = self.latency if known else None
         return {
             "input_bag": self.input_bag,
             "output_bag": self.output_bag,
@@ -235,8 +247,8 @@ class ReplaySummary:
             "real_time_factor": self.real_time_factor,
             DISPLACEMENT: self.displacement_max_m if known else None,
             "max_tilt_rad": self.tilt_max_rad if known else None,
-            "latency_samples": self.latency[0] if known else None,
-            "latency_s": self.latency[1] if known else None,
+            "latency_samples": None if latency is None else latency[0],
+            "latency_s": None if latency is None else latency[1],
             "error_estimate": self.error_estimate.as_dict() if self.error_estimate else None,
             "body_sensor": None
             if self.body_counts is None

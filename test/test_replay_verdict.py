@@ -369,3 +369,43 @@ def test_a_replay_that_accepted_nothing_says_its_integration_did_not_run(
     (report,) = [m for _, m in msgs["/diagnostics"]]
     (status,) = [s for s in report.status if s.name == "mount_twin: integration"]
     assert status.message == said
+
+
+def _one_sample_bag(path: Path) -> Path:
+    """A bag of one deck IMU sample, at rest."""
+    stamps = np.array([1_700_000_000 * 10**9], dtype=np.int64)
+    accel, gyro = np.array([[0.0, 0.0, 9.80665]]), np.zeros((1, 3))
+    write_bag(path, "/deck/imu", IMU, iter(imu_messages(stamps, accel, gyro, "deck_imu")))
+    return path
+
+
+@pytest.mark.parametrize("gyro_filter", ["linear_phase", "none"])
+def test_a_run_whose_gyro_filter_was_never_designed_has_no_latency_figure(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], gyro_filter: str
+) -> None:
+    """One sample accepted: no interval to take the rate of, so `linear_phase` designed no
+    filter, and the summary, its JSON and the report's page read "0 samples (0.0 ms)", "0",
+    "latency 0 s", as if the outputs followed their input at once. They say there is no
+    figure, and why; `none` has no latency, and says 0 as before."""
+    data = read_scene_yaml(PUMP)
+    data["input"] = {**data["input"], "gyro_filter": gyro_filter}
+    scene = tmp_path / f"{gyro_filter}.scene.yaml"
+    scene.write_text(yaml.safe_dump(data), encoding="utf-8")
+    code, doc, out = _replay(tmp_path, scene, _one_sample_bag(tmp_path / "one"))
+    assert code == 0 and doc["counts"]["accepted"] == 1
+    text = capsys.readouterr().out
+    page = tmp_path / "r.html"
+    assert main(["report", str(out), "--scene", str(scene), "-o", str(page)]) == 0
+    conditioning = re.search(
+        r"<td>input conditioning</td><td>([^<]*)</td>", html.unescape(page.read_text("utf-8"))
+    )
+    assert conditioning
+    if gyro_filter == "none":
+        assert doc["latency_samples"] == 0 and doc["latency_s"] == 0.0
+        assert "  latency: outputs 0 samples (0.0 ms) after their input" in text
+        assert "gyro_filter none (latency 0 s)" in conditioning.group(1)
+        return
+    why = "the gyro filter was never designed: no two input samples were accepted without a "
+    assert doc["latency_samples"] is None and doc["latency_s"] is None
+    assert f"  latency: no figure, {why}restart between them\n" in text
+    assert f"gyro_filter linear_phase (no latency figure: {why}" in conditioning.group(1)

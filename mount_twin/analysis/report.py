@@ -40,7 +40,7 @@ from mount_twin.analysis.log_labels import plain_log_labels
 from mount_twin.analysis.modes_text import effective_mass_text, frequency_text
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
 from mount_twin.engine.estimate import NOT_INTEGRATED
-from mount_twin.engine.health import UTILISATION_KEY
+from mount_twin.engine.health import NOT_DESIGNED, UTILISATION_KEY
 from mount_twin.engine.intake import nothing_accepted
 from mount_twin.errors import ModelError
 from mount_twin.io.bag import partial_marker
@@ -149,10 +149,13 @@ def _provenance_section(
     if scene is not None:
         spec, integ = scene.input, scene.integration
         # the gyro filter's latency is set by its design, at the first accepted samples' rate
+        latency_s = integration.get("latency_s", "?")
         latency = (
             "no latency figure: no input sample was accepted"
             if verdict.nothing
-            else f"latency {integration.get('latency_s', '?')} s"
+            else f"no latency figure: {NOT_DESIGNED}"
+            if latency_s == "n/a"
+            else f"latency {latency_s} s"
         )
         # the status names the scene's method until one runs (`auto`: until it chooses)
         ran = (

@@ -8,6 +8,7 @@ from collections import Counter
 import numpy as np
 
 from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus, MountEvent
+from mount_twin.engine.delay_line import filter_bands
 from mount_twin.engine.estimate import (
     FORCE_SCALE,
     N_FIGURES,
@@ -27,6 +28,13 @@ INPUT = f"{PREFIX}: input"
 NOT_RUN = "not run: no input sample was accepted"
 """The integration status' text while no input sample has been accepted (it had read "ok",
 as if the twin had integrated the run clean)."""
+NOT_DESIGNED = (
+    "the gyro filter was never designed: no two input samples were accepted without a restart "
+    "between them"
+)
+"""Why a run of `input.gyro_filter: linear_phase` has no latency figure (`HealthWindow.latency`
+None): the filter is designed at the rate of its first accepted samples (it had read 0 s, as
+if the outputs followed their input at once)."""
 
 PEAK_KEYS = tuple(f"peak_{axis}" for axis in ("fx_N", "fy_N", "fz_N", "tx_Nm", "ty_Nm", "tz_Nm"))
 """A mount status' keys of its peak wrench components in this period (N, N·m, mount axes)."""
@@ -102,8 +110,9 @@ class HealthWindow:
         """Why it stopped (`stop`)."""
         self.last_wrong_frame_id: str | None = None
         """header.frame_id of the last sample rejected as wrong_frame (any period)."""
-        self.latency = (0, 0.0)
-        """Samples and seconds by which outputs follow their input (the gyro delay)."""
+        self.latency: tuple[int, float] | None = None if filter_bands(scene.input) else (0, 0.0)
+        """Samples and seconds by which outputs follow their input (the gyro delay); None until
+        the `linear_phase` filter is designed (NOT_DESIGNED), the others have none."""
 
     def _reset(self) -> None:
         self.published = False
@@ -368,8 +377,8 @@ class HealthWindow:
                 "real_time_factor": f"{rtf:.1f}",
                 "failures_total": str(counts["integration_failures"]),
                 "method_switches_total": str(counts["method_switches"]),
-                "latency_samples": str(self.latency[0]),
-                "latency_s": f"{self.latency[1]:.6g}",
+                "latency_samples": "n/a" if self.latency is None else str(self.latency[0]),
+                "latency_s": "n/a" if self.latency is None else f"{self.latency[1]:.6g}",
             },
         )
 
