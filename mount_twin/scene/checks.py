@@ -328,13 +328,13 @@ def rating_warnings(
                 f"{mount_paths[i]}.{key}",
                 f"the static {what} {basis}, {static:.4g} {unit} along local "
                 f"{AXES[j]}, is {ratio:.3g} times the rated {rating:.4g} {unit}"
-                f"{_others(len({c[1] for c in cases}) - 1)}: {hint}",
+                f"{more_mounts(len({c[1] for c in cases}) - 1)}: {hint}",
             )
         )
     return found
 
 
-def _others(n: int) -> str:
+def more_mounts(n: int) -> str:
     """' (and n more mounts)', or '' for none."""
     return f" (and {n} more mounts)" if n else ""
 
@@ -379,7 +379,7 @@ def _farthest(
         SceneWarning(
             scene.source,
             points[i][0],
-            f"{arms[i]:.4g} m from the CG{_others(far.size - 1)}, {arms[i] / gyration:.3g} "
+            f"{arms[i]:.4g} m from the CG{more_mounts(far.size - 1)}, {arms[i] / gyration:.3g} "
             f"times the body's largest radius of gyration ({gyration:.3g} m): {meaning}; "
             "positions in millimetres?",
         )
