@@ -116,8 +116,9 @@ def load_scene(path: str | Path, input_overrides: Mapping[str, str] | None = Non
     """The scene file at `path`, with `input` fields replaced by `input_overrides` (checked like
     the file's own); each of its warnings (units? a message type's convention?) is printed on
     stderr, so that no command runs a scene it found implausible without saying so. A scene
-    whose ratings are judged at the start the twin uses (`scene.checks.rated_at_start`) is
-    assembled for them: its start is solved here, and again where the command assembles it."""
+    whose ratings or force limits are judged at the start the twin uses
+    (`scene.checks.rated_at_start`) is assembled for them: its start is solved here, and again
+    where the command assembles it."""
     from mount_twin.scene.checks import rated_at_start
     from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
 

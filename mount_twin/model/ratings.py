@@ -10,19 +10,42 @@ force table softens from 1e5 N/m start 14.4 mm down where the tangent says 9.8, 
 12 mm that the tangent statics found unreached (on four Bouc–Wen mounts of k₀ = 1e5 N/m,
 a = 0.3, β + γ = 200: 21.2 mm), and every mount was then an ERROR from the first report without
 a word at load; one that stiffens (cubic terms, a snubber) was warned of where it starts
-within. For such a scene (`scene.checks.rated_at_start`) the loader leaves the ratings to this
+within. For such a scene (`scene.checks.tangent_misjudges`) the loader leaves the ratings to this
 check, which takes every rated mount's deflection and force at the start state the assembly
 solved, and says what it finds as the loader's warnings do (`Scene.warnings`).
+
+A shear key's allowable force and a bolted joint's yield and ultimate force
+(`scene.checks.limits`) are judged here only, at that start, for any scene whose start is at
+equilibrium: a machine whose weight (with its bolts' preload) already put a key past its
+allowable force or a bolt past its yield read ERROR from the first report without a word at
+load. The force judged is the one its utilisation divides, read back from the utilisation the
+mounts' monitors give at the start (`physics.dynamics.mount_monitors`, as the engine's first
+report takes it), so the warned ratio is that report's.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from mount_twin.kinds import N_EVENTS
 from mount_twin.kinds.elastomer import Elastomer
-from mount_twin.physics.dynamics import ModelArrays, body_motion, mount_wrenches, new_scratch
+from mount_twin.physics.dynamics import (
+    ModelArrays,
+    Scratch,
+    body_motion,
+    mount_monitors,
+    mount_wrenches,
+    new_scratch,
+)
 from mount_twin.physics.rotations import point_displacements, rpy_matrices
-from mount_twin.scene.checks import UNITS_OR_MOUNT, rated_at_start, rating_warnings
+from mount_twin.scene.checks import (
+    UNITS_OR_MOUNT,
+    limits,
+    more_mounts,
+    rated_at_start,
+    rating_warnings,
+    tangent_misjudges,
+)
 from mount_twin.scene.description import Scene, SceneWarning
 
 AT_START = "at the start (the weight's equilibrium on the mounts' own force laws{})"
@@ -31,27 +54,90 @@ hysteretic)."""
 LOADING_CURVES = ", hysteretic ones set down along their loading curves"
 FROM_THE_START = f"its utilisation is past 1 from the first report (ERROR); {UNITS_OR_MOUNT}"
 """What such a mount means: utilisation counts from the start."""
+ELASTIC = (
+    ", the bolt taken as elastic there (its plastic elongation starts at 0; one that yielded as "
+    "the machine was set down would have stretched and lost preload)"
+)
+"""What the start is for a bolt past its yield force."""
+BOLT_FORCE = "the bolt force F_S (its preload and its share of the load)"
+LIMITED = {
+    "allowable_force": ("the key's force", "its allowable force", "", ""),
+    "yield_force": (BOLT_FORCE, "its yield force", ELASTIC, ""),
+    "ultimate_force": (
+        BOLT_FORCE,
+        "its ultimate force",
+        ELASTIC,
+        "it breaks at the start (bolt_fractured), and ",
+    ),
+}
+"""Each limit key (`scene.checks.limits`): what its force is, what the limit is, what the start
+is, and what passing it means beside FROM_THE_START, for the warnings' messages."""
 
 
 def start_ratings(scene: Scene, m: ModelArrays, y: np.ndarray) -> tuple[SceneWarning, ...]:
-    """Warnings of the mounts loaded or deflected past their ratings at the start state `y`
-    (the nominal one of `m`, at rest on the chart); none for a scene whose ratings the loader
-    judges (`rated_at_start`)."""
+    """Warnings of the mounts loaded or deflected past their ratings, and of the keys and bolts
+    past their force limits, at the start state `y` (the nominal one of `m`, at rest on the
+    chart); none for a scene whose start the loader judges (`rated_at_start`), and no ratings
+    where it judges those (`tangent_misjudges`)."""
     if not rated_at_start(scene):
         return ()
     s = new_scratch(y.shape[0])
     body_motion(y, m, s)  # the start's motion: s.q (its frozen DOFs too) and s.rot, body → F
-    wrenches = np.zeros((len(scene.mounts), 6))
-    mount_wrenches(y, m, s, wrenches)
-    arm = np.array([mt.position for mt in scene.mounts]) - np.array(scene.body.cg)
-    shift = point_displacements(s.q[None, :3], s.rot[None], arm)[0]  # each attachment point's
-    axes = rpy_matrices([mt.orientation_rpy for mt in scene.mounts])
-    deflection = np.einsum("nji,nj->ni", axes, shift)
     paths = [scene.mount_path(i) for i in range(len(scene.mounts))]
     hysteretic = any(
         isinstance(mt, Elastomer) and mt.hysteresis is not None and mt.hysteresis.axes
         for mt in scene.mounts
     )
     where = AT_START.format(LOADING_CURVES if hysteretic else "")
-    found = rating_warnings(scene, paths, deflection, wrenches[:, :3], where, FROM_THE_START)
-    return tuple(found)
+    found = []
+    if tangent_misjudges(scene):
+        wrenches = np.zeros((len(scene.mounts), 6))
+        mount_wrenches(y, m, s, wrenches)
+        arm = np.array([mt.position for mt in scene.mounts]) - np.array(scene.body.cg)
+        shift = point_displacements(s.q[None, :3], s.rot[None], arm)[0]  # each attachment point's
+        axes = rpy_matrices([mt.orientation_rpy for mt in scene.mounts])
+        deflection = np.einsum("nji,nj->ni", axes, shift)
+        found = rating_warnings(scene, paths, deflection, wrenches[:, :3], where, FROM_THE_START)
+    return (*found, *limit_warnings(scene, m, y, s, paths, where))
+
+
+def limit_warnings(
+    scene: Scene, m: ModelArrays, y: np.ndarray, s: Scratch, paths: list[str], basis: str
+) -> list[SceneWarning]:
+    """Each key's and bolt's force at state `y` (s holding its body motion) against its force
+    limits (`scene.checks.limits`): one warning per limit key, at the mount most past it.
+
+    The force is its utilisation there (the mounts' monitors, `mount_monitors`, on a copy of y:
+    a bolt past its ultimate force breaks in it) times the limit the utilisation divides (the
+    first of `limits`), so the warned ratio to that limit is the utilisation itself.
+
+    Args:
+        scene, m: the scene and its core arrays.
+        paths: key path of each mount, for messages.
+        basis: where the state is taken, for messages.
+    """
+    nl = m.nl
+    if nl is None:
+        return []
+    util = np.zeros(nl.slot.shape[0])
+    mount_monitors(y.copy(), y, nl, s, np.zeros((util.shape[0], N_EVENTS)), util)
+    over: dict[str, list[tuple[float, int, float, float]]] = {}
+    for row, i in enumerate(nl.slot.tolist()):
+        own = limits(scene.mounts[i])
+        for key, limit in own:
+            ratio = float(util[row]) * (own[0][1] / limit)
+            if ratio > 1.0:
+                over.setdefault(key, []).append((ratio, i, float(util[row]) * own[0][1], limit))
+    found = []
+    for key, cases in over.items():
+        ratio, i, force, limit = max(cases)
+        what, of, start, means = LIMITED[key]
+        found.append(
+            SceneWarning(
+                scene.source,
+                f"{paths[i]}.{key}",
+                f"{what} {basis}, {force:.4g} N, is {ratio:.3g} times {of} {limit:.4g} N"
+                f"{more_mounts(len(cases) - 1)}{start}: {means}{FROM_THE_START}",
+            )
+        )
+    return found

@@ -24,7 +24,8 @@ Warnings (SceneWarning, kept on `Scene.warnings`): values that load but are like
   (for a scene whose start at equilibrium the assembly solves with non-linear mount laws, which
   these statics misjudge — a softening force table, cubic terms, snubbers, hysteretic mounts on
   their loading curves, clearances — it judges the ratings at that start instead:
-  `rated_at_start`, `model.ratings`);
+  `rated_at_start`, `model.ratings`); a shear key's allowable force and a bolted joint's yield
+  and ultimate force (`limits`) are judged at that start only (`model.ratings`);
 - a mount, the body IMU or the deck IMU farther from the CG than FAR_FACTOR times the body's
   largest radius of gyration, and a radius of gyration beyond GYRATION_WARN_M (positions in
   mm, inertia in kg·mm²);
@@ -43,6 +44,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from mount_twin.errors import SceneError
+from mount_twin.kinds.bolted_joint import BoltedJoint
 from mount_twin.kinds.elastomer import Elastomer
 from mount_twin.kinds.shear_key import ShearKey
 from mount_twin.scene.description import LinearMount, Mount, Scene, SceneWarning, Vec3
@@ -240,8 +242,8 @@ def _sag(scene: Scene, st: Statics, mount_paths: Sequence[str]) -> list[SceneWar
 
 def _ratings(scene: Scene, st: Statics, mount_paths: Sequence[str]) -> list[SceneWarning]:
     """The ratings by the statics of the nominal stiffness, unless the model judges them at
-    its start (`rated_at_start`)."""
-    if rated_at_start(scene):
+    its start (`tangent_misjudges`)."""
+    if tangent_misjudges(scene):
         return []
     return rating_warnings(
         scene, mount_paths, st.deflection, st.force, "under the weight", UNITS_OR_MOUNT
@@ -250,7 +252,8 @@ def _ratings(scene: Scene, st: Statics, mount_paths: Sequence[str]) -> list[Scen
 
 def ratings(mount: Mount) -> tuple[tuple[str, tuple[float, ...]], ...]:
     """(key, rating per local axis, 0 where unrated) of each rated quantity of `mount`: a
-    linear mount's rated_load (N) and rated_travel (m), an elastomer's rated_deflection (m)."""
+    linear mount's rated_load (N) and rated_travel (m), an elastomer's rated_deflection (m).
+    The force limits of keys and bolts are `limits`."""
     if isinstance(mount, LinearMount):
         return (("rated_load", mount.rated_load), ("rated_travel", mount.rated_travel))
     if isinstance(mount, Elastomer):
@@ -258,15 +261,37 @@ def ratings(mount: Mount) -> tuple[tuple[str, tuple[float, ...]], ...]:
     return ()
 
 
+def limits(mount: Mount) -> tuple[tuple[str, float], ...]:
+    """(key, N) of each force limit of `mount`, the first the one its utilisation divides (its
+    kind's `monitor`): a shear key's allowable_force (utilisation: its force over it; none at
+    0, not monitored), a bolted joint's yield_force (utilisation F_S/F_y) and ultimate_force.
+    None for other kinds, whose ratings are `ratings`."""
+    if isinstance(mount, ShearKey):
+        return (("allowable_force", mount.allowable_force),) if mount.allowable_force else ()
+    if isinstance(mount, BoltedJoint):
+        return (("yield_force", mount.yield_force), ("ultimate_force", mount.ultimate_force))
+    return ()
+
+
 def rated_at_start(scene: Scene) -> bool:
-    """Whether the scene's ratings are judged at the start the twin uses (`model.ratings`, at
-    assembly) rather than here: a start at equilibrium, a mount whose static law is not its
-    nominal tangent (`nonlinear_at_rest`), whose equilibrium the assembly solves with that law,
-    and a mount rated. The tangent at zero load misjudges such a start: 400 kg on four
-    elastomers whose force table softens from 1e5 N/m start 14.4 mm down where the tangent
-    says 9.8 (a rated 12 mm passed unwarned), and on hysteretic ones set down along their
-    loading curves (`model.loading`; k₀ = 1e5 N/m, a = 0.3, β + γ = 200) 21.2 mm; a stiffening
-    law (cubic terms, a snubber) starts short of the tangent's sag."""
+    """Whether the load-time check needs the start the twin uses (`model.ratings`, at
+    assembly): a start at equilibrium, and ratings the tangent statics misjudge
+    (`tangent_misjudges`) or a mount with a force limit (`limits`: a key's, a bolt's), which
+    only the start's own mount laws give: a bolt's force is its preload and its share of the
+    weight, and it is the figure the utilisation of every report divides."""
+    limited = any(limits(m) for m in scene.mounts)
+    return scene.initial.mode == "equilibrium" and (limited or tangent_misjudges(scene))
+
+
+def tangent_misjudges(scene: Scene) -> bool:
+    """Whether the scene's ratings (`ratings`) are judged at the start the twin uses
+    (`model.ratings`, at assembly) rather than here: a start at equilibrium, a mount whose
+    static law is not its nominal tangent (`nonlinear_at_rest`), whose equilibrium the assembly
+    solves with that law, and a mount rated. The tangent at zero load misjudges such a start:
+    400 kg on four elastomers whose force table softens from 1e5 N/m start 14.4 mm down where
+    the tangent says 9.8 (a rated 12 mm passed unwarned), and on hysteretic ones set down along
+    their loading curves (`model.loading`; k₀ = 1e5 N/m, a = 0.3, β + γ = 200) 21.2 mm; a
+    stiffening law (cubic terms, a snubber) starts short of the tangent's sag."""
     nonlinear = any(nonlinear_at_rest(m) for m in scene.mounts)
     rated = any(r > 0.0 for m in scene.mounts for _, limit in ratings(m) for r in limit)
     return scene.initial.mode == "equilibrium" and nonlinear and rated
