@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import html
 import re
@@ -362,6 +363,36 @@ def test_the_reports_mode_frequencies_read_as_modes_prints_them(
     rows = _table_rows(page.read_text(encoding="utf-8"), "Modes (about the static")
     assert [r[1] for r in rows] == by_modes
     assert all(re.fullmatch(r"\d+\.\d{3}", f) for f in by_modes), by_modes
+
+
+def test_the_reports_damping_and_energy_shares_read_as_modes_prints_them(
+    pump_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch
+) -> None:
+    """An undamped mode's ζ = φᵀCφ/2ω comes out of round-off of either sign: at −1e-19 the
+    report's modes table printed "-0.00" (its own format) where `modes` printed 0.00. Both
+    print ζ and the dominant DOF's energy share by one rule, a rounded zero without a sign.
+    The pump's modes, its first mode's damping replaced by that round-off."""
+    from mount_twin.analysis import modes as modal
+
+    real = modal.modes(load_scene_file(PUMP))
+    first = dataclasses.replace(real.modes[0], damping_ratio=-1e-19)
+    rounded = dataclasses.replace(real, modes=(first, *real.modes[1:]))
+    monkeypatch.setattr(modal, "modes", lambda *args, **kwargs: rounded)
+    capsys.readouterr()
+    assert main(["modes", str(PUMP)]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    head = next(i for i, line in enumerate(printed) if line.split()[:3] == ["mode", "f", "Hz"])
+    by_modes = [line.split()[2:6] for line in printed[head + 2 : head + 8]]  # ζ, DOF, share, %
+    page = tmp_path / "r.html"
+    assert main(["report", str(pump_run), "--scene", str(PUMP), "-o", str(page)]) == 0
+    rows = _table_rows(page.read_text(encoding="utf-8"), "Modes (about the static")
+    assert [[r[2], *r[3].split()] for r in rows] == by_modes
+    for r, m in zip(rows, rounded.modes, strict=True):
+        assert float(r[2]) == pytest.approx(100 * m.damping_ratio, abs=0.005), r
+        dof, share, _ = r[3].split()
+        assert dof == max(m.energy_fraction, key=m.energy_fraction.__getitem__), r
+        assert float(share) == pytest.approx(100 * m.energy_fraction[dof], abs=0.5), r
+    assert rows[0][2] == "0.00"  # not -0.00
 
 
 def test_the_reports_peak_loads_read_as_the_replay_summary_prints_them(

@@ -37,7 +37,12 @@ from mount_twin.analysis.html_page import (
 )
 from mount_twin.analysis.html_page import table as html_table
 from mount_twin.analysis.log_labels import plain_log_labels
-from mount_twin.analysis.modes_text import effective_mass_text, frequency_text
+from mount_twin.analysis.modes_text import (
+    damping_text,
+    effective_mass_text,
+    energy_share_text,
+    frequency_text,
+)
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
 from mount_twin.engine.estimate import NOT_INTEGRATED
 from mount_twin.engine.health import NOT_DESIGNED, UTILISATION_KEY
@@ -302,8 +307,8 @@ def _modes_section(scene: Scene) -> list[str]:
             [
                 str(i),
                 frequency_text(m.frequency_hz),
-                f"{100 * m.damping_ratio:.2f}",
-                f"{main_dof} {100 * m.energy_fraction[main_dof]:.0f} %",
+                damping_text(m.damping_ratio),
+                f"{main_dof} {energy_share_text(m.energy_fraction[main_dof])} %",
                 *(effective_mass_text(m.effective_mass_kg[a]) for a in "xyz"),
             ]
         )

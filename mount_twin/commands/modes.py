@@ -6,7 +6,13 @@ import argparse
 import dataclasses
 from typing import TYPE_CHECKING, Any
 
-from mount_twin.analysis.modes_text import effective_mass_text, fixed, frequency_text
+from mount_twin.analysis.modes_text import (
+    damping_text,
+    effective_mass_text,
+    energy_share_text,
+    fixed,
+    frequency_text,
+)
 
 if TYPE_CHECKING:
     from mount_twin.analysis.modes import Line, Modes
@@ -94,9 +100,9 @@ def table(scene: Scene, result: Modes) -> str:
     for i, m in enumerate(result.modes, 1):
         main = m.dominant_dof
         lines.append(
-            f"{i:>4} {frequency_text(m.frequency_hz):>9} {fixed(100 * m.damping_ratio, 2):>6}  "
-            f"{main:<6}{fixed(100 * m.energy_fraction[main], 0):>4} %  "
-            + "".join(f"{fixed(100 * m.energy_fraction[d], 1):>7}" for d in dofs)
+            f"{i:>4} {frequency_text(m.frequency_hz):>9} {damping_text(m.damping_ratio):>6}  "
+            f"{main:<6}{energy_share_text(m.energy_fraction[main]):>4} %  "
+            + "".join(f"{energy_share_text(m.energy_fraction[d], 1):>7}" for d in dofs)
         )
     unstable = [str(i) for i, m in enumerate(result.modes, 1) if m.frequency_hz < 0.0]
     if unstable:
@@ -105,7 +111,7 @@ def table(scene: Scene, result: Modes) -> str:
             "equilibrium is unstable (the weight's geometric stiffness exceeds the mounts')"
         )
     exact = ", ".join(
-        f"{frequency_text(c.frequency_hz)} ({fixed(100 * c.damping_ratio, 2)})"
+        f"{frequency_text(c.frequency_hz)} ({damping_text(c.damping_ratio)})"
         for c in result.complex_modes
     )
     lines += [
