@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import html
+import json
 import re
 from pathlib import Path
 
@@ -401,7 +402,7 @@ def test_the_reports_peak_loads_read_as_the_replay_summary_prints_them(
     """The pump's front mounts under the bundled shock: the replay's summary printed their
     peak |F| as 10848.2 N, the report's peaks table as 1.085e+04 (and |M| 0.9 against
     0.9104 N·m): the same figure in two forms. Both print every mount's peak |F| and |M| as
-    the summary does, to 0.1 N and 0.1 N·m; each is the bag's own largest magnitude."""
+    the summary does; each is the bag's own largest magnitude, to the digits shown."""
     out, page = tmp_path / "out", tmp_path / "r.html"
     bag = ROOT / "bags" / "half_sine_shock_10khz"
     capsys.readouterr()
@@ -423,9 +424,45 @@ def test_the_reports_peak_loads_read_as_the_replay_summary_prints_them(
         wrench = [m.wrench for _, m in msgs[f"/mount_twin/mounts/{name}/wrench"]]
         f = max(np.linalg.norm([w.force.x, w.force.y, w.force.z]) for w in wrench)
         c = max(np.linalg.norm([w.torque.x, w.torque.y, w.torque.z]) for w in wrench)
-        assert abs(float(force) - f) <= 0.05 and abs(float(couple) - c) <= 0.05, (name, f, c)
-        assert re.fullmatch(r"\d+\.\d", force) and re.fullmatch(r"\d+\.\d", couple), name
+        for cell, value in ((force, f), (couple, c)):
+            last = 10.0 ** -len(cell.partition(".")[2])  # the last digit shown
+            assert abs(float(cell) - value) <= 0.5 * last * (1 + 1e-9), (name, cell, value)
     assert list(by_summary) == [m.name for m in load_scene_file(PUMP).mounts]
+
+
+def test_peak_couples_print_to_significant_figures_as_forces_do(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The pump's mounts put a couple of 0.91 N·m on the body (500 N·m/rad about each axis):
+    the replay's summary and the report printed every one of them "0.9", to 0.1 N·m, one
+    significant figure where a force has five. Every peak |F| and |M| is printed to four
+    significant figures at least (a force keeps its 0.1 N), in the summary and the report
+    alike, each the summary JSON's figure to the digits shown."""
+    doc_path = tmp_path / "summary.json"
+    bag = ROOT / "bags" / "half_sine_shock_10khz"
+    out = tmp_path / "out"
+    args = ["replay", str(bag), "--scene", str(PUMP), "-o", str(out)]
+    capsys.readouterr()
+    assert main([*args, "--no-progress", "--json", str(doc_path)]) == 0
+    printed = capsys.readouterr().out
+    doc = json.loads(doc_path.read_text(encoding="utf-8"))["mounts"]
+    by_summary = {
+        name: [force, couple]
+        for name, force, couple in re.findall(r"^ +(\w+): +([\d.]+) +([\d.]+)$", printed, re.M)
+    }
+    page = tmp_path / "r.html"
+    assert main(["report", str(out), "--scene", str(PUMP), "-o", str(page)]) == 0
+    rows = _table_rows(page.read_text(encoding="utf-8"), "Peaks (")
+    assert {r[0]: r[2:4] for r in rows} == by_summary
+    assert set(by_summary) == set(doc)
+    for name, cells in by_summary.items():
+        values = (doc[name]["peak_force_magnitude_N"], doc[name]["peak_couple_magnitude_Nm"])
+        assert 0.1 < values[1] < 10.0, values  # a couple that 0.1 N·m resolved to one figure
+        for cell, value in zip(cells, values, strict=True):
+            whole, _, decimals = cell.partition(".")
+            assert len((whole + decimals).lstrip("0")) >= 4 and len(decimals) >= 1, cell
+            shown = 10.0 ** -len(decimals)
+            assert abs(float(cell) - value) <= 0.5 * shown * (1 + 1e-9), (name, cell, value)
 
 
 def test_the_reports_figures_are_labelled_in_words_with_their_units(
