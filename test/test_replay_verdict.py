@@ -19,6 +19,7 @@ from mount_twin.analysis.figures import peak_text, utilisation_text
 from mount_twin.cli import main
 from mount_twin.io.bag import write_bag
 from mount_twin.io.messages import IMU, imu_messages
+from mount_twin.io.output_tables import input_values, read_output_bag
 from mount_twin.scene.loader import read_scene_yaml
 from mount_twin.sweeps.cases import check
 from mount_twin.sweeps.runner import FAILED, run_case, summary
@@ -320,6 +321,42 @@ def test_a_run_that_accepted_nothing_points_at_the_frame_id_the_user_set(
     text = html.unescape(page.read_text(encoding="utf-8"))
     assert f"<h2>Verdict: ERROR: {said}</h2>" in text
     assert f"see {other}" not in text
+
+
+def test_a_report_without_its_scene_names_the_frame_expected_and_both_settings(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The same runs as above, reported without --scene: the output bag's input status
+    records the frame the run expected, not what set it, and the heading said "see
+    input.frame_id" for both, sending the user who had typed `replay --frame-id` to a scene
+    key. It names the frame expected (the bag's record) and both settings, alike for both."""
+    bag = tmp_path / "hull_bag"
+    generate = ["generate", "half-sine", "-o", str(bag), "--peak", "150", "--pulse", "0.008"]
+    assert main([*generate, "--frame-id", "hull_imu"]) == 0
+    data = read_scene_yaml(PUMP)
+    data["input"] = {**data["input"], "frame_id": "port_imu"}
+    port = tmp_path / "port.scene.yaml"
+    port.write_text(yaml.safe_dump(data), encoding="utf-8")
+    headings = []
+    runs = (("scene", port, ()), ("option", PUMP, ("--frame-id", "port_imu")))
+    for set_by, scene, extra in runs:
+        (tmp_path / set_by).mkdir()
+        code, _, out = _replay(tmp_path / set_by, scene, bag, *extra)
+        assert code == 3
+        diagnostics = next(t for t in read_output_bag(out) if t.name == "diagnostics")
+        expected = input_values(diagnostics)["frame_id"]
+        assert expected == "port_imu"
+        page = tmp_path / set_by / "r.html"
+        capsys.readouterr()
+        assert main(["report", str(out), "-o", str(page)]) == 3
+        heading = re.search(r"<h2>Verdict: ERROR: ([^<]*)</h2>", page.read_text(encoding="utf-8"))
+        assert heading, set_by
+        said = html.unescape(heading.group(1))
+        assert f"mount-twin: error: {said}\n" in capsys.readouterr().err
+        assert "header.frame_id is 'hull_imu'" in said and repr(expected) in said, said
+        assert "input.frame_id" in said and "replay --frame-id" in said, said
+        headings.append(said)
+    assert headings[0] == headings[1]
 
 
 @pytest.mark.parametrize("method", ["auto", "dopri54"])

@@ -95,12 +95,20 @@ def _replaced(scene: Scene, in_file: dict[str, Any]) -> dict[str, tuple[str, str
     }
 
 
-def frame_id_setting(scene: Scene | None) -> str:
+def frame_id_setting(scene: Scene | None, expected: str | None = None) -> str:
     """What set the header.frame_id the run of `scene` expected, for a message to point at:
-    `replay --frame-id` where it replaced the file's, else the scene's input.frame_id (also
-    without a scene: the page cannot tell)."""
+    `replay --frame-id` where it replaced the file's, else the scene's input.frame_id. Without
+    the scene no one can tell which: the output bag's input status records the frame the run
+    expected (`expected`; None in a bag written before it was recorded), not what set it. Then
+    both, and the frame expected where the bag has it."""
     key = "input.frame_id"
-    replaced = _replaced(scene, _file_parameters(scene)) if scene is not None else {}
+    if scene is None:
+        from mount_twin.commands.common import INPUT_OPTIONS
+        from mount_twin.scene.reader import shown  # a 1 MB frame id, shortened
+
+        frame = "the one" if expected is None else f"the {shown(expected)}"
+        return f"the scene's {key} or {INPUT_OPTIONS[key]}, whichever set {frame} the run expected"
+    replaced = _replaced(scene, _file_parameters(scene))
     return replaced[key][0] if key in replaced else key
 
 

@@ -83,7 +83,8 @@ def utilisation_of(diagnostics: Table) -> dict[str, tuple[np.ndarray, np.ndarray
 def _nothing_accepted(diagnostics: Table | None, scene: Scene | None) -> str:
     """Why no input sample of the run was accepted, as its replay's summary says it, from the
     counts of its last input status ('' if some were, or the bag holds no counts), pointing at
-    what set the frame id it expected (`frame_id_setting`: the run of `scene`)."""
+    what set the frame id it expected (`frame_id_setting`: the run of `scene`; without it,
+    the frame the status records)."""
     values = input_values(diagnostics)
     counts = {
         k: int(v)
@@ -92,7 +93,8 @@ def _nothing_accepted(diagnostics: Table | None, scene: Scene | None) -> str:
     }
     if counts.get("accepted") != 0:  # some were, or no counts: the scene's file is not read
         return ""
-    return nothing_accepted(counts, values.get("last_wrong_frame_id"), frame_id_setting(scene))
+    setting = frame_id_setting(scene, values.get("frame_id"))
+    return nothing_accepted(counts, values.get("last_wrong_frame_id"), setting)
 
 
 class RunVerdict(NamedTuple):

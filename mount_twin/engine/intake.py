@@ -118,9 +118,9 @@ def nothing_accepted(
 ) -> str:
     """Why no input sample was accepted, from an engine's `counts` ('' if some were): how many
     were received and why each was rejected, and the last `wrong_frame_id` rejected if any,
-    pointing at what set the frame id expected (`frame_id_setting`: the scene's key, or the
-    option that replaced it). A run like that has no figures: a peak of 0 N would read as a
-    machine at rest."""
+    pointing at what set the frame id expected (`frame_id_setting`: the scene's key, the
+    option that replaced it, or both where that cannot be told). A run like that has no
+    figures: a peak of 0 N would read as a machine at rest."""
     if counts.get("accepted", 0):
         return ""
     detail = ""
