@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import dataclasses
 import hashlib
 import html
@@ -124,9 +125,10 @@ def _margins(page: str) -> list[float]:
 
 
 def test_a_design_spectrum_judges_the_inputs_spectra(genset_run, tmp_path: Path) -> None:
-    """With --design, the input's spectra are judged: a PASS/FAIL line per axis and each axis's
-    margin 20 log10(spectrum/design) in the table. Doubling the design lowers every margin by
-    20 log10 2 = 6.02 dB, and a design far below the record is exceeded on every axis."""
+    """With --design (--axis all), the input's spectra are judged: a PASS/FAIL line per axis
+    and each axis's margin 20 log10(spectrum/design) in the table. Doubling the design lowers
+    every margin by 20 log10 2 = 6.02 dB, and a design far below the record is exceeded on
+    every axis."""
     out, _ = genset_run
     pages = []
     for name, level_g in (("d1", 10.0), ("d2", 20.0), ("tiny", 1e-3)):
@@ -134,7 +136,7 @@ def test_a_design_spectrum_judges_the_inputs_spectra(genset_run, tmp_path: Path)
         table.write_text(f"frequency_hz,accel_g\n10,{level_g}\n1000,{level_g}\n", "utf-8")
         page = tmp_path / f"{name}.html"
         args = ["report", str(out), "--scene", str(GENSET), "--input", str(BAG), "-o", str(page)]
-        code = main([*args, "--design", str(table)])
+        code = main([*args, "--design", str(table), "--axis", "all"])
         pages.append(page.read_text(encoding="utf-8"))
         spectra = pages[-1].split("<h2>Shock response")[1]
         assert code == (4 if ": FAIL" in spectra else 0), name  # as srs --design exits
@@ -149,6 +151,52 @@ def test_a_design_spectrum_judges_the_inputs_spectra(genset_run, tmp_path: Path)
     assert re.search(
         r"axis z: 0 of \d+ frequencies within -1.5/\+3 dB[^<]*: FAIL: over by", spectra
     )
+
+
+def test_a_design_judges_the_axes_axis_names_as_srs_does(
+    genset_run, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`srs --design --axis z` judges the vertical; `report --design` had no --axis and judged
+    x, y and z against the one design, so a vertical design failed any record with nothing
+    fore-aft (the genset's shock: "no response" along x), exit 4. It takes srs's --axis
+    (default z): the design made of the record's own vertical spectrum (`srs --csv`) passes
+    along z in both, its line the same in both, and fails along all three."""
+    out, _ = genset_run
+    capsys.readouterr()
+    spectrum = tmp_path / "z.csv"
+    assert main(["srs", str(BAG), "--axis", "z", "--csv", str(spectrum)]) == 0
+    rows = list(csv.DictReader(spectrum.open(encoding="utf-8")))
+    design = tmp_path / "vertical.csv"
+    design.write_text(
+        "frequency_hz,accel_g\n" + "".join(f"{r['frequency_hz']},{r['maximax']}\n" for r in rows),
+        encoding="utf-8",
+    )
+    lines = {}
+    for axis in ("x", "z"):
+        capsys.readouterr()
+        code = main(["srs", str(BAG), "--design", str(design), "--axis", axis])
+        line = re.search(
+            rf"^design {re.escape(str(design))}, axis {axis} maximax: (.*)$",
+            capsys.readouterr().out,
+            re.M,
+        )
+        assert line, axis
+        lines[axis] = line.group(1)
+        assert code == (0 if axis == "z" else 4), (axis, lines[axis])
+    args = ["report", str(out), "--scene", str(GENSET), "--input", str(BAG), "--design"]
+    for given, judged, status in (
+        ([], "z", 0),
+        (["--axis", "z"], "z", 0),
+        (["--axis", "all"], "xyz", 4),
+    ):
+        page = tmp_path / f"{'_'.join(given) or 'default'}.html"
+        assert main([*args, str(design), *given, "-o", str(page)]) == status, given
+        text = html.unescape(page.read_text(encoding="utf-8"))
+        said = dict(re.findall(r"<p><b>design vertical.csv</b>, axis (\w): ([^<]*)</p>", text))
+        assert list(said) == list(judged), given
+        assert re.findall(r"<th>margin (\w) dB</th>", text) == list(judged), given
+        for axis in set(said) & set(lines):
+            assert said[axis] == lines[axis], (given, axis)
 
 
 def test_a_design_needs_the_input(genset_run, capsys: pytest.CaptureFixture[str]) -> None:
@@ -294,7 +342,7 @@ def test_an_input_axis_without_motion_shows_no_infinite_margin(genset_run, tmp_p
     table.write_text("frequency_hz,accel_g\n10,10\n1000,10\n", "utf-8")
     page = tmp_path / "p.html"
     args = ["report", str(out), "--scene", str(GENSET), "--input", str(BAG), "-o", str(page)]
-    assert main([*args, "--design", str(table)]) == 4
+    assert main([*args, "--design", str(table), "--axis", "all"]) == 4
     spectra = html.unescape(page.read_text(encoding="utf-8")).split("<h2>Shock response")[1]
     spectra = spectra[: spectra.index("<h2>", 1)]
     assert "inf" not in spectra and "nan" not in spectra

@@ -207,12 +207,13 @@ def _srs_section(
     design: tuple[list[float], list[float]] | None = None,
     tolerance_db: tuple[float, float] = TOLERANCE_DB,
     design_name: str = "",
+    design_axes: tuple[str, ...] = ("z",),
 ) -> tuple[list[str], bool | None]:
     """The input's shock response spectra (5 % damping; gravity and bias taken out as
     `mount-twin srs` does by default, the mean of a quiet head), per axis of F; with a design
-    spectrum (Hz, g), the design on the plot, each axis's margin (dB) in the table and its
-    PASS/FAIL line (`analysis.design_margin`, as `mount-twin srs --design`). Also whether
-    every axis passed (None: nothing judged)."""
+    spectrum (Hz, g), the design on the plot, and for each of `design_axes` its margin (dB) in
+    the table and its PASS/FAIL line (`analysis.design_margin`, as `mount-twin srs --design
+    --axis`). Also whether every axis judged passed (None: nothing judged)."""
     from mount_twin.analysis.srs import gravity_offset, octave_frequencies, srs
 
     t = (stamps_ns - stamps_ns[0]) * 1e-9
@@ -224,15 +225,14 @@ def _srs_section(
     spectra = {axis: srs(f[:, k] - offset[k], rate, freqs, 0.05) for k, axis in enumerate("xyz")}
     checks = (
         {
-            a: check_design(freqs, s.maximax / STANDARD_GRAVITY, *design, tolerance_db)
-            for a, s in spectra.items()
+            a: check_design(freqs, spectra[a].maximax / STANDARD_GRAVITY, *design, tolerance_db)
+            for a in design_axes
         }
         if design is not None
         else {}
     )
     head = ["f Hz", "x g", "y g", "z g", "PV z m/s"]
-    if checks:
-        head += ["margin x dB", "margin y dB", "margin z dB"]
+    head += [f"margin {a} dB" for a in checks]
     verdicts = [
         f"<p><b>design {html.escape(design_name)}</b>, axis {a}: {html.escape(c.summary())}</p>"
         for a, c in checks.items()
@@ -240,23 +240,26 @@ def _srs_section(
     sections = [
         f"<h2>Shock response spectra of the input (ζ = 5 %, {html.escape(removed)} removed)</h2>",
         *verdicts,
-        png(lambda fig: _draw_srs(fig, spectra, design), (9, 4.5)),
+        png(lambda fig: _draw_srs(fig, spectra, design, tuple(checks)), (9, 4.5)),
         html_table(head, _srs_rows(freqs, spectra, checks)),
     ]
     return sections, (all(c.passed for c in checks.values()) if checks else None)
 
 
 def _draw_srs(
-    fig: Any, spectra: dict[str, Spectrum], design: tuple[list[float], list[float]] | None
+    fig: Any,
+    spectra: dict[str, Spectrum],
+    design: tuple[list[float], list[float]] | None,
+    judged: tuple[str, ...] = (),
 ) -> None:
     """The maximax spectra (g) of the axes with any response, and the design (Hz, g) if any,
-    log-log against natural frequency (Hz)."""
+    named with the axes it judges (`judged`), log-log against natural frequency (Hz)."""
     ax = fig.subplots()
     for axis, s in spectra.items():
         if s.maximax.max() > 0.0:
             ax.loglog(s.frequency_hz, s.maximax / STANDARD_GRAVITY, label=f"maximax, {axis} of F")
     if design is not None:
-        ax.loglog(*design, "k--", label="design")
+        ax.loglog(*design, "k--", label=f"design (judges {', '.join(judged)} of F)")
     ax.set_xlabel("natural frequency [Hz]")
     ax.set_ylabel("peak absolute acceleration [g]")
     plain_log_labels(ax, "y")
@@ -268,7 +271,7 @@ def _srs_rows(
     freqs: np.ndarray, spectra: dict[str, Spectrum], checks: dict[str, DesignCheck]
 ) -> list[list[str]]:
     """Every third frequency's row: f (Hz), maximax per axis (g), pseudo-velocity of z (m/s),
-    and with `checks` each axis's margin (dB; '–' where the design does not reach)."""
+    and the margin (dB; '–' where the design does not reach) of each axis `checks` judged."""
     z = spectra["z"]
     margins = {
         a: dict(zip(c.frequency_hz.tolist(), c.margin_db.tolist(), strict=True))
@@ -279,10 +282,7 @@ def _srs_rows(
             f"{fk:.4g}",
             *(f"{spectra[a].maximax[k] / STANDARD_GRAVITY:.4g}" for a in "xyz"),
             f"{z.pseudo_velocity[k]:.4g}",
-            *(
-                _margin_cell(margins[a][fk]) if fk in margins[a] else "–"
-                for a in ("xyz" if checks else "")
-            ),
+            *(_margin_cell(margins[a][fk]) if fk in margins[a] else "–" for a in checks),
         ]
         for k, fk in enumerate(freqs.tolist())
         if k % 3 == 0
@@ -337,6 +337,7 @@ def write_report(
     input_path: str | Path | None = None,
     input_note: str = "",
     design: tuple[list[float], list[float]] | None = None,
+    design_axes: tuple[str, ...] = ("z",),
     tolerance_db: tuple[float, float] = TOLERANCE_DB,
     design_name: str = "",
 ) -> ReportPage:
@@ -345,7 +346,8 @@ def write_report(
     (stamps ns, specific force (n, 3) m/s² in F) of the record, to plot beside the response, every
     value finite; `input_path`: the record's bag, hashed for its provenance; `input_note`: what of
     it was left out (its samples not finite), said beside it; `design` (Hz, g): a design spectrum
-    the input's spectra are judged against (within `tolerance_db`), named `design_name` (its file).
+    the input's spectra along `design_axes` (of F; z, as `report --design` and `srs --design`
+    judge by default) are judged against (within `tolerance_db`), named `design_name` (its file).
     The page opens with the verdict, what produced it and with what settings, and the scene as
     loaded (every value with its meaning and unit)."""
     tables = {t.name: t for t in bag_tables}
@@ -384,7 +386,7 @@ def write_report(
     design_passed = None
     if input_samples is not None:
         srs_sections, design_passed = _srs_section(
-            *input_samples, design, tolerance_db, design_name
+            *input_samples, design, tolerance_db, design_name, design_axes
         )
         sections += srs_sections
     if scene is not None:

@@ -7,7 +7,7 @@ import sys
 from typing import TYPE_CHECKING
 
 from mount_twin.commands.replay import EXIT_FAIL_ON, FAIL_ON, run_exit_status
-from mount_twin.commands.srs import add_design_arguments, tolerance_of
+from mount_twin.commands.srs import add_axis_argument, add_design_arguments, axes_of, tolerance_of
 
 if TYPE_CHECKING:
     from mount_twin.analysis.report import ReportPage
@@ -40,6 +40,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "the input's spectra (--input) are judged against it: the design on their plot, the "
         "margins in their table, a PASS/FAIL line per axis, exit 4 on FAIL",
     )
+    add_axis_argument(parser, "the axis of F whose input spectrum --design judges (as srs does)")
     parser.add_argument(
         "--fail-on",
         choices=FAIL_ON,
@@ -97,6 +98,7 @@ def run(args: argparse.Namespace) -> int:
         input_path=args.input,
         input_note=note,
         design=design,
+        design_axes=axes_of(args),
         tolerance_db=tolerance,
         design_name=Path(args.design).name if args.design else "",
     )

@@ -60,9 +60,7 @@ def _per_octave(text: str) -> float:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", help="a bag (its Imu/AccelStamped topic) or a recorder CSV")
     parser.add_argument("--topic", help="the bag's topic (default: its only Imu/AccelStamped)")
-    parser.add_argument(
-        "--axis", choices=[*AXES, "all"], default="z", help="sensor axis, or all three"
-    )
+    add_axis_argument(parser, "sensor axis")
     damping = parser.add_mutually_exclusive_group()
     damping.add_argument("--damping", type=float, help="damping ratio ζ (default 0.05)")
     damping.add_argument("--q", type=float, help="quality factor Q = 1/(2ζ), instead of ζ")
@@ -114,6 +112,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--json", metavar="FILE", help="the spectra, margins and verdict as JSON")
     parser.epilog = EXIT_STATUS
+
+
+def add_axis_argument(parser: argparse.ArgumentParser, what: str) -> None:
+    """--axis x|y|z|all, default z (`axes_of` reads it): the axis `what`, or all three. `srs`
+    (the sensor axes it computes and judges) and `report` (the axes of F its --design judges)
+    take it the same way: a design names one axis unless `all` is asked for."""
+    parser.add_argument(
+        "--axis", choices=[*AXES, "all"], default="z", help=f"{what}, or all three"
+    )
+
+
+def axes_of(args: argparse.Namespace) -> tuple[str, ...]:
+    """The axes --axis names (`add_axis_argument`), in AXES' order."""
+    return AXES if args.axis == "all" else (args.axis,)
 
 
 def add_design_arguments(parser: argparse.ArgumentParser, judged: str) -> None:
@@ -168,7 +180,7 @@ def run(args: argparse.Namespace) -> int:
     if design is not None and unit != "m/s²":
         msg = f"--design is a spectrum in g: {name} is a force (N)"
         raise ValueError(msg)
-    axes: tuple[str, ...] = AXES if args.axis == "all" else (args.axis,)
+    axes = axes_of(args)
     if not args.response:
         _check_channels(accel, axes, t, name)
     record = uniform(t, accel, args.input)
