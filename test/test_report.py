@@ -513,6 +513,21 @@ def test_peak_couples_print_to_significant_figures_as_forces_do(
             assert abs(float(cell) - value) <= 0.5 * shown * (1 + 1e-9), (name, cell, value)
 
 
+@pytest.mark.parametrize("value", [1e-18, 3.3e-7, 0.012345, 0.9104, 10848.24])
+def test_a_peak_is_printed_to_its_digits_but_never_finer_than_a_tenth_of_a_milli(
+    value: float,
+) -> None:
+    """A couple of round-off (1e-18 N·m: a symmetric machine's) printed to four significant
+    figures in positional notation read 0.000000000000000001000: a peak goes to 4 decimals at
+    most, and is the value to within half its last digit."""
+    from mount_twin.analysis.figures import peak_text
+
+    cell = peak_text(value)
+    decimals = cell.partition(".")[2]
+    assert "e" not in cell and 1 <= len(decimals) <= 4, cell
+    assert abs(float(cell) - value) <= 0.5 * 10.0 ** -len(decimals) * (1 + 1e-9), cell
+
+
 def test_the_reports_figures_are_labelled_in_words_with_their_units(
     pump_run: Path, tmp_path: Path
 ) -> None:

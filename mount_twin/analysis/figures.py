@@ -49,17 +49,21 @@ def peak_label(decimation: int) -> str:
 
 PEAK_DIGITS = 4
 """Significant figures of a printed peak |F| or |M| (the events' |F| max has as many)."""
+PEAK_DECIMALS_MAX = 4
+"""The finest a printed peak goes: 0.1 mN or mN·m (a couple of round-off, 1e-18 N·m on a
+symmetric machine, reads 0.0000, not eighteen zeros and a 1)."""
 
 
 def peak_text(value: float) -> str:
     """A peak |F| (N) or |M| (N·m) as the replay's summary, the report and the sweep print it:
     to PEAK_DIGITS significant figures, and at least to 0.1 (10848.2 N, not 1.085e+04), in
-    positional notation. To 0.1 alone a small machine's couples read 0.9 N·m for 0.9104."""
+    positional notation, to PEAK_DECIMALS_MAX decimals at most. To 0.1 alone a small machine's
+    couples read 0.9 N·m for 0.9104."""
     if not math.isfinite(value) or value == 0.0:
         return f"{value:.1f}"
     rounded = float(f"{value:.{PEAK_DIGITS - 1}e}")  # 0.099996 rounds to 0.1000, not 0.10000
     decimals = PEAK_DIGITS - 1 - math.floor(math.log10(abs(rounded)))
-    return f"{value:.{max(1, decimals)}f}"
+    return f"{value:.{min(max(1, decimals), PEAK_DECIMALS_MAX)}f}"
 
 
 def utilisation_text(value: float) -> str:
