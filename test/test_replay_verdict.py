@@ -446,3 +446,34 @@ def test_a_run_whose_gyro_filter_was_never_designed_has_no_latency_figure(
     assert doc["latency_samples"] is None and doc["latency_s"] is None
     assert f"  latency: no figure, {why}restart between them\n" in text
     assert f"gyro_filter linear_phase (no latency figure: {why}" in conditioning.group(1)
+
+
+def test_a_replay_that_accepted_nothing_says_it_computed_no_attitude_nor_mount_load(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every sample rejected (another frame id), nothing integrated: the summary said "motion
+    and mount loads: none", yet its diagnostics, its JSON and the output bag's statuses read
+    "attitude: ok" and "mount fl: ok" with peaks of 0, as a machine at rest. They say nothing
+    was computed, and why, at OK: the input status carries the run's ERROR."""
+    code, doc, out = _replay(tmp_path, PUMP, SHOCK, "--frame-id", "not_the_imu")
+    assert code == 3 and doc["verdict"] == "ERROR"
+    said = "not computed: no input sample was accepted"
+    mounts = [f"mount_twin: mount {m['name']}" for m in read_scene_yaml(PUMP)["mounts"]]
+    worst = doc["diagnostics_worst"]
+    assert worst["mount_twin: input"]["level"] == "ERROR"
+    for name in ("mount_twin: attitude", *mounts):
+        assert worst[name] == {"level": "OK", "message": said}, name
+    text = capsys.readouterr().out
+    assert f"    OK    mount_twin: attitude: {said}\n" in text
+    assert f"    OK    mount_twin: mount fl: {said}\n" in text
+    assert not re.search(r": ok$", text, re.MULTILINE), text
+    _, msgs = read_bag(out)
+    (report,) = [m for _, m in msgs["/diagnostics"]]
+    statuses = {s.name: s for s in report.status}
+    assert statuses["mount_twin: input"].level == 2
+    for name in ("mount_twin: attitude", *mounts):
+        status = statuses[name]
+        assert (status.level, status.message) == (0, said), name
+        # no figure: not a peak of 0, a machine at rest
+        figures = {v.key: v.value for v in status.values if "peak" in v.key or "max" in v.key}
+        assert figures and set(figures.values()) == {"n/a"}, (name, figures)

@@ -387,6 +387,12 @@ def test_a_node_stopped_without_input_says_so_in_its_last_report(
     stall_names = [[n for n, *_ in st] for _, st in before]
     assert all(names == [n for n, *_ in statuses] for names in stall_names)
     assert len(statuses) == 3 + 8
+    # nothing integrated: no status reads "ok" as a twin at rest (the input's ERROR says why)
+    said = "no input sample was accepted"
+    for _, report in [*before, (stamp, statuses)]:
+        for name, level, msg, _ in report[1:]:
+            verb = "not run" if name == "mount_twin: integration" else "not computed"
+            assert (level, msg) == (OK, f"{verb}: {said}"), name
     if before:  # the stall reports, unchanged: ERROR, "no input received for 500 ms"
         stalled = [{n: (lv, m) for n, lv, m, _ in st}["mount_twin: input"] for _, st in before]
         assert all(s == (ERROR, "no input received for 500 ms") for s in stalled), stalled

@@ -25,9 +25,16 @@ INTEGRATION = f"{PREFIX}: integration"
 """Name of the integration status."""
 INPUT = f"{PREFIX}: input"
 """Name of the input status."""
+ATTITUDE = f"{PREFIX}: attitude"
+"""Name of the attitude status."""
+MOUNT = f"{PREFIX}: mount "
+"""A mount status' name: MOUNT + the mount's name."""
 NOT_RUN = "not run: no input sample was accepted"
 """The integration status' text while no input sample has been accepted (it had read "ok",
 as if the twin had integrated the run clean)."""
+NOT_COMPUTED = "not computed: no input sample was accepted"
+"""The attitude and mount statuses' text while no input sample has been accepted, their
+figures "n/a" (they had read "ok" with a tilt and peaks of 0, as a machine at rest)."""
 NOT_DESIGNED = (
     "the gyro filter was never designed: no two input samples were accepted without a restart "
     "between them"
@@ -38,6 +45,8 @@ if the outputs followed their input at once)."""
 
 PEAK_KEYS = tuple(f"peak_{axis}" for axis in ("fx_N", "fy_N", "fz_N", "tx_Nm", "ty_Nm", "tz_Nm"))
 """A mount status' keys of its peak wrench components in this period (N, N·m, mount axes)."""
+TILT_KEY = "tilt_max_rad"
+"""The attitude status' key of the largest tilt in this period (rad)."""
 UTILISATION_KEY = "utilisation_max"
 """A mount status' key of its largest utilisation in this period ("n/a": none rated)."""
 EVENTS_KEY = "events"
@@ -341,10 +350,12 @@ class HealthWindow:
             new, counts, self._input_rate(), lost_from_stamps, nominal_interval_s, stalled_s
         )
         step = self._integration_status(counts, self._stamp_seconds())
-        att = self._attitude_status()
-        mounts = self._mount_statuses(utilisation, active)
+        if counts["accepted"]:
+            figures = [self._attitude_status(), *self._mount_statuses(utilisation, active)]
+        else:  # nothing integrated: no motion, no load (the input status carries the ERROR)
+            figures = self._not_computed()
         self._reset()
-        return HealthReport(stamp, sample, [inp, step, att, *mounts])
+        return HealthReport(stamp, sample, [inp, step, *figures])
 
     def _integration_status(self, counts: Counter[str], span: float) -> HealthStatus:
         """The integration status of this window (`span`: the stamp time its input intervals
@@ -410,14 +421,30 @@ class HealthWindow:
         the α/γ/δ chart degrades."""
         warn = self.scene.outputs.tilt_warn_rad
         return HealthStatus(
-            f"{PREFIX}: attitude",
+            ATTITUDE,
             WARN if self.tilt_max > warn else OK,
             f"tilt {self.tilt_max:.4g} rad ({math.degrees(self.tilt_max):.3g}°) past "
             f"outputs.tilt_warn_rad {warn:.4g}: the α/γ/δ chart degrades toward 90°"
             if self.tilt_max > warn
             else "ok",
-            {"tilt_max_rad": f"{self.tilt_max:.6g}"},
+            {TILT_KEY: f"{self.tilt_max:.6g}"},
         )
+
+    def _not_computed(self) -> list[HealthStatus]:
+        """The attitude and mount statuses before any input sample is accepted: NOT_COMPUTED
+        at OK, with their figures "n/a"."""
+        mount_values = {
+            **dict.fromkeys((*PEAK_KEYS, UTILISATION_KEY), "n/a"),
+            EVENTS_KEY: "0",
+            NOW_KEY: "none",
+        }
+        return [
+            HealthStatus(ATTITUDE, OK, NOT_COMPUTED, {TILT_KEY: "n/a"}),
+            *(
+                HealthStatus(MOUNT + m.name, OK, NOT_COMPUTED, dict(mount_values))
+                for m in self.scene.mounts
+            ),
+        ]
 
     def _estimate_values(self) -> dict[str, str]:
         """The estimated errors of the period and, `_run`, of the run so far as diagnostic
@@ -472,7 +499,7 @@ class HealthWindow:
             text = _events_text(mine, u, self.origin_s)
             if now:
                 text = f"now: {values[NOW_KEY]}" + ("" if text == "ok" else f"; {text}")
-            out.append(HealthStatus(f"{PREFIX}: mount {mount.name}", level, text, values))
+            out.append(HealthStatus(MOUNT + mount.name, level, text, values))
         return out
 
     def _input_status(
