@@ -84,6 +84,19 @@ def _estimate_text(est: ErrorEstimate | None) -> str:
     return text
 
 
+def _accuracy_text(est: ErrorEstimate | None) -> str:
+    """The JSON's word on where its accuracy figures are: as `_estimate_text` says where
+    nothing was estimated (it had read "estimated live" beside figures of 0)."""
+    if est is None:
+        return (
+            "not estimated live (integration.error_estimate: false); "
+            "`mount-twin accuracy SCENE BAG` measures it"
+        )
+    if not est.estimated:
+        return NOT_INTEGRATED
+    return "estimated live: error_estimate, over the run"
+
+
 @dataclass
 class ReplaySummary:
     """What a replay did: counts, figures and per-mount peaks (`analysis.figures`)."""
@@ -277,10 +290,7 @@ class ReplaySummary:
                 name: {"level": LEVEL_NAMES[st.level], "message": st.message}
                 for name, st in self.worst.items()
             },
-            "accuracy": "estimated live: error_estimate, over the run"
-            if self.error_estimate
-            else "not estimated live (integration.error_estimate: false); "
-            "`mount-twin accuracy SCENE BAG` measures it",
+            "accuracy": _accuracy_text(self.error_estimate),
         }
 
 

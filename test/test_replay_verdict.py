@@ -477,3 +477,46 @@ def test_a_replay_that_accepted_nothing_says_it_computed_no_attitude_nor_mount_l
         # no figure: not a peak of 0, a machine at rest
         figures = {v.key: v.value for v in status.values if "peak" in v.key or "max" in v.key}
         assert figures and set(figures.values()) == {"n/a"}, (name, figures)
+
+
+@pytest.mark.parametrize("accepted", [0, 1])
+def test_a_run_that_integrated_no_interval_has_no_error_estimate_figure(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], accepted: int
+) -> None:
+    """No input interval integrated (no sample accepted, or one): the summary said "none (no
+    input interval was integrated)", yet its JSON's error_estimate gave force_error_n and
+    attitude_error_rad 0.0 and its accuracy "estimated live: error_estimate, over the run",
+    and the bag's integration status est_force_error_n_run 0: an error of 0 for what was
+    never measured reads as an exact run. They are null, "nan" beside est_force_error_rel's,
+    and the accuracy says what the summary says; a sweep row has no number either."""
+    if accepted:
+        bag = _one_sample_bag(tmp_path / "one")
+        code, doc, out = _replay(tmp_path, PUMP, bag)
+    else:
+        bag = SHOCK
+        code, doc, out = _replay(tmp_path, PUMP, bag, "--frame-id", "not_the_imu")
+    assert (code, doc["counts"].get("accepted", 0)) == (0 if accepted else 3, accepted)
+    said = "none (no input interval was integrated)"
+    assert f"  estimated integration error: {said}\n" in capsys.readouterr().out
+    estimate = doc["error_estimate"]
+    assert estimate["force_error_rel"] is None
+    assert estimate["force_error_n"] is None and estimate["attitude_error_rad"] is None
+    assert doc["accuracy"] == said
+    _, msgs = read_bag(out)
+    *_, report = [m for _, m in msgs["/diagnostics"]]
+    (status,) = [s for s in report.status if s.name == "mount_twin: integration"]
+    values = {v.key: v.value for v in status.values}
+    for key in ("est_force_error_rel_run", "est_force_error_n_run", "est_attitude_error_rad_run"):
+        assert values[key] == "nan", (key, values[key])
+    if accepted:  # a sweep of it: a case that ran, with no estimate (not 0)
+        sweep = tmp_path / "sweep.yaml"
+        mass = read_scene_yaml(PUMP)["body"]["mass"]
+        sweep.write_text(
+            f"base: {PUMP}\nvary:\n  - key: body.mass\n    values: [{mass}]\n"
+            f"inputs:\n  - bag: {bag}\n",
+            encoding="utf-8",
+        )
+        spec = load_sweep(sweep)
+        (case,) = check(spec)
+        row = run_case(spec.base, spec.source, case)
+        assert row["verdict"] != FAILED and np.isnan(row["est_force_error_rel"]), row

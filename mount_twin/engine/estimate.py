@@ -31,10 +31,10 @@ class ErrorEstimate:
     Attributes:
         force_error_rel: largest |ΔF| over samples, mounts and force components, relative to the
             largest |F| component (the definition of `analysis.accuracy.Accuracy.force_error`);
-            NaN where no interval was integrated (a run that failed at every sample: nothing
-            was estimated, and 0.0 would read as exact).
-        force_error_n: that largest |ΔF|, N.
-        attitude_error_rad: largest |Δα|, |Δγ|, |Δδ|, rad.
+            NaN where no interval was integrated (a run that accepted no sample, or one, or
+            failed at every sample: nothing was estimated, and 0.0 would read as exact).
+        force_error_n: that largest |ΔF|, N (NaN where force_error_rel is).
+        attitude_error_rad: largest |Δα|, |Δγ|, |Δδ|, rad (NaN where force_error_rel is).
         failed_checks: intervals whose local error could not be measured (the checking
             stepper failed: the estimate misses what they committed).
         uncarried_states: the model's states whose error the estimate does not carry from
@@ -67,12 +67,14 @@ class ErrorEstimate:
 
     @classmethod
     def of(cls, figures: np.ndarray) -> ErrorEstimate:
-        """From figures as the core keeps them (N_FIGURES slots)."""
+        """From figures as the core keeps them (N_FIGURES slots); without a force scale no
+        interval was estimated, and the errors are NaN (their slots' 0 is no measurement)."""
         scale = figures[FORCE_SCALE]
+        estimated = scale > 0.0
         return cls(
-            float(figures[FORCE_ERROR] / scale) if scale > 0.0 else math.nan,
-            float(figures[FORCE_ERROR]),
-            float(figures[ATTITUDE_ERROR]),
+            float(figures[FORCE_ERROR] / scale) if estimated else math.nan,
+            float(figures[FORCE_ERROR]) if estimated else math.nan,
+            float(figures[ATTITUDE_ERROR]) if estimated else math.nan,
             int(figures[FAILURES]),
             int(figures[UNCARRIED]),
         )

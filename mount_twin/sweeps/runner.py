@@ -140,7 +140,8 @@ def _figures(scene: Scene, samples: SampleBatch) -> dict[str, Any]:
         "max_tilt_rad": float(tilt_from_quaternions(out.quaternion).max())
         if len(out)
         else math.nan,
-        # the twin's own estimate of its mount-force error (NaN: integration.error_estimate off)
+        # the twin's own estimate of its mount-force error (NaN: integration.error_estimate
+        # off, or no input interval integrated: `ErrorEstimate.estimated`)
         "est_force_error_rel": engine.error_estimate.force_error_rel
         if engine.error_estimate
         else math.nan,
