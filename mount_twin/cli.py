@@ -98,9 +98,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing left to flush
         return EXIT_SIGPIPE
     except DamagedBagError as err:
-        print(f"mount-twin: error: {err}{_partial(args)}", file=sys.stderr)
+        _say_damaged(err, args)
         return EXIT_DAMAGED
     except (MountTwinError, ValueError, OSError) as err:
+        if damage := _damage_behind(err):  # it failed after the damage (a write of the
+            _say_damaged(damage, args)  # summary up to it): neither is hidden
         print(f"mount-twin: error: {_error_text(err)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
@@ -109,6 +111,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Terminated:
         print(f"mount-twin: terminated (SIGTERM){_partial(args)}", file=sys.stderr)
         return EXIT_SIGTERM
+
+
+def _damage_behind(err: BaseException) -> DamagedBagError | None:
+    """The DamagedBagError being handled where `err` (or an error it replaced) was raised, if
+    any."""
+    seen = err.__context__
+    while seen is not None and not isinstance(seen, DamagedBagError):
+        seen = seen.__context__
+    return seen
+
+
+def _say_damaged(err: DamagedBagError, args: argparse.Namespace) -> None:
+    """Say on stderr that the input was damaged part-way, and where the output so far is."""
+    print(f"mount-twin: error: {err}{_partial(args)}", file=sys.stderr)
 
 
 def _error_text(err: Exception) -> str:

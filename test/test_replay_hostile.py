@@ -192,6 +192,23 @@ def test_bytes_zeroed_inside_an_mcap_chunk_are_no_silent_loss(
     assert data["input_damaged"].startswith(f"{bag}: damaged (chunk at byte ")
 
 
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="no /dev/full")
+def test_a_summary_that_cannot_be_written_after_damage_still_names_the_damage(
+    ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A replay stopped at damage (exit 5) whose `--json` cannot be written exits 2 (a failed
+    write), and the damage was never said: stderr held the write error alone. Both are."""
+    bag = _zeroed_at_message_1000(ship["mcap"], tmp_path / "zeroed")
+    out = tmp_path / "out"
+    args = ["replay", str(bag), "--scene", str(SCENE_FILE), "-o", str(out), "--no-progress"]
+    assert main([*args, "--json", "/dev/full"]) == 2
+    err = capsys.readouterr().err
+    assert f"mount-twin: error: {bag}: damaged (chunk at byte " in err, err
+    assert f"; {out} holds the output so far, marked partial in its metadata\n" in err
+    assert _damaged_count(err) == 1000 and "Traceback" not in err
+    assert err.endswith("mount-twin: error: /dev/full: cannot write: No space left on device\n")
+
+
 def test_what_reads_a_partial_output_bag_says_it_is_partial(
     ship: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

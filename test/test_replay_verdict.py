@@ -520,3 +520,30 @@ def test_a_run_that_integrated_no_interval_has_no_error_estimate_figure(
         (case,) = check(spec)
         row = run_case(spec.base, spec.source, case)
         assert row["verdict"] != FAILED and np.isnan(row["est_force_error_rel"]), row
+
+
+FULL = "/dev/full"
+"""A device every write to fails with ENOSPC, as on a full disk."""
+
+
+@pytest.mark.skipif(not Path(FULL).exists(), reason=f"no {FULL}")
+@pytest.mark.parametrize("run", ["nothing_accepted", "failed", "fail_on"])
+def test_a_summary_that_cannot_be_written_hides_not_the_runs_own_failure(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], run: str
+) -> None:
+    """A run that exits 3, 6 or 4 whose `--json` cannot be written exits 2 (a failed write, as
+    documented), and its own failure was never said: stderr held the write error alone, so a
+    script read a full disk where no sample had been accepted. Both are said."""
+    scene, bag, extra = {
+        "nothing_accepted": (PUMP, SHOCK, ["--frame-id", "not_the_imu"]),
+        "failed": (_failing_scene(tmp_path), SHOCK, []),
+        "fail_on": (GENSET, GENSET_BAG, ["--fail-on", "error"]),
+    }[run]
+    args = ["replay", str(bag), "--scene", str(scene), "-o", str(tmp_path / "out")]
+    assert main([*args, "--no-progress", *extra]) in (3, 4, 6)
+    own = capsys.readouterr().err.splitlines()[-1]  # the run's own line, its JSON written
+    assert own.startswith("mount-twin: "), own
+    assert main([*args[:-1], str(tmp_path / "out2"), "--no-progress", *extra, "--json", FULL]) == 2
+    err = capsys.readouterr().err
+    assert f"{own}\n" in err, err
+    assert err.endswith(f"mount-twin: error: {FULL}: cannot write: No space left on device\n")

@@ -21,7 +21,8 @@ FAIL_ON = ("never", "warn", "error")
 """`--fail-on` choices; the index of warn and error is their diagnostics level."""
 EXIT_STATUS = (
     "exit status: 0 done; 2 bad input or configuration, or a failed write (the message names "
-    "the file); 3 no input sample accepted; 4 diagnostics reached --fail-on; 6 FAILED: the "
+    "the file; a run that failed too, 3 to 6, says so before it); 3 no input sample "
+    "accepted; 4 diagnostics reached --fail-on; 6 FAILED: the "
     "integration failed at least once (the summary says how often and why), whatever "
     "--fail-on says: after a failure the twin restarts at an equilibrium or stops following, "
     "so its figures are no longer the motion the record drove; 5 input bag "
@@ -128,16 +129,22 @@ def replay_and_report(
             checkpoint=checkpoint,
             body_path=options.body,
         )
-    except DamagedBagError as err:  # exit 5, after the summary of what came before it
+    except DamagedBagError as err:  # exit 5, after the summary of what came before it (a
+        # failed write of it raises from here: cli.main says the damage beside it, exit 2)
         if err.summary is not None:
             up_to = _as_set(err.summary, input_overrides)
-            _report(up_to, scene_path, output, options)
-            if up_to.failure:  # said too: the exit status names the damage alone
-                print(f"mount-twin: error: {up_to.failure}", file=sys.stderr)
+            try:
+                _report(up_to, scene_path, output, options)
+            finally:
+                if up_to.failure:  # said too: the exit status names the damage alone
+                    print(f"mount-twin: error: {up_to.failure}", file=sys.stderr)
         raise
     summary = _as_set(summary, input_overrides)
-    _report(summary, scene_path, output, options)
-    return verdict(summary, options.fail_on)
+    try:
+        _report(summary, scene_path, output, options)
+    finally:  # said even where a write failed (exit 2), which would hide it
+        status = verdict(summary, options.fail_on)
+    return status
 
 
 def _as_set(summary: ReplaySummary, input_overrides: dict[str, str] | None) -> ReplaySummary:
