@@ -62,6 +62,34 @@ def test_a_bag_without_outputs_is_refused_naming_it(
     assert f"{bag}: no mount_twin output in the bag" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("where", ["device", "file", "under_a_file"])
+def test_a_target_that_cannot_be_a_directory_is_refused_naming_the_option_before_reading(
+    replayed: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    where: str,
+) -> None:
+    """`export BAG --csv /dev/full` read the whole bag, then said "mount-twin: error:
+    /dev/full: File exists", naming no option and not what was wrong (a file where the
+    directory of tables goes; under a file, "Not a directory"). It says so first."""
+    afile = tmp_path / "afile"
+    afile.write_text("not a directory", encoding="utf-8")
+    if where == "device" and not Path("/dev/full").exists():
+        pytest.skip("no /dev/full")
+    target = {"device": Path("/dev/full"), "file": afile, "under_a_file": afile / "tables"}[where]
+
+    def unread(*_: object) -> None:
+        raise AssertionError("the bag was read before its target was checked")
+
+    monkeypatch.setattr("mount_twin.io.output_tables.read_output_bag", unread)
+    assert main(["export", str(replayed), "--csv", str(target)]) == 2
+    said = f"{afile} is not a directory" if where == "under_a_file" else "exists, not a directory"
+    want = f"mount-twin: error: --csv {target}: {said}; export writes one file per table into "
+    assert capsys.readouterr().err == f"{want}a directory\n"
+    assert afile.read_text(encoding="utf-8") == "not a directory"
+
+
 def test_replay_json_summary_times_events_from_the_first_output(tmp_path: Path) -> None:
     import json
 

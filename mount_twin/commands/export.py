@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 NAME = "export"
 HELP = "write an output bag's pose, angles, mount wrenches and diagnostics as CSV (or Parquet)"
@@ -28,8 +29,22 @@ def run(args: argparse.Namespace) -> int:
         from mount_twin.commands.extras import require
 
         require("pyarrow", "--parquet")
+    _check_directory(f"--{fmt}", directory)
     tables = read_output_bag(args.bag)
     warn_if_partial(args.bag)
     for path, table in zip(write_tables(tables, directory, fmt), tables, strict=True):
         print(f"{path}: {len(table)} rows, columns {', '.join(table.columns)}")
     return 0
+
+
+def _check_directory(flag: str, path: str) -> None:
+    """ValueError naming `flag` where no directory of tables can be at `path` (export creates it
+    or writes into it): a file there, or in place of a directory above it. Checked before the
+    bag is read, which had been read whole to fail there ("/dev/full: File exists")."""
+    target = Path(path)
+    existing = next((p for p in (target, *target.parents) if p.exists()), None)
+    if existing is None or existing.is_dir():
+        return
+    said = "exists, not a directory" if existing == target else f"{existing} is not a directory"
+    msg = f"{flag} {path}: {said}; export writes one file per table into a directory"
+    raise ValueError(msg)
