@@ -243,18 +243,24 @@ def test_peak_force_and_displacement_are_one_definition_in_json_report_and_sweep
         cells = rf"<td>{mount}</td>(<td>[^<]*</td>){{3}}<td>{utilisation_text(u)}</td>"
         assert u is not None and re.search(cells, html), (mount, u)
 
+    row = _sweep_row(tmp_path, scene_file, scene["body"]["mass"], bag)
+    assert row["max_cg_displacement_from_start_m"] == pytest.approx(moved, rel=1e-9)
+    for mount, value in peak.items():
+        assert row[f"peak_force_magnitude_N.{mount}"] == pytest.approx(value, rel=1e-9)
+
+
+def _sweep_row(tmp_path: Path, base: Path, mass: float, bag: Path) -> dict:
+    """The row of a one-case sweep of `base` (its body mass as it is) under `bag`: a sweep
+    runs the case as a replay would."""
     sweep = tmp_path / "sweep.yaml"
     sweep.write_text(
-        f"base: {scene_file}\nvary:\n  - key: body.mass\n    values: [{scene['body']['mass']}]\n"
+        f"base: {base}\nvary:\n  - key: body.mass\n    values: [{mass}]\n"
         f"inputs:\n  - bag: {bag}\n",
         encoding="utf-8",
     )
     spec = load_sweep(sweep)
     (case,) = check(spec)
-    row = run_case(spec.base, spec.source, case)
-    assert row["max_cg_displacement_from_start_m"] == pytest.approx(moved, rel=1e-9)
-    for mount, value in peak.items():
-        assert row[f"peak_force_magnitude_N.{mount}"] == pytest.approx(value, rel=1e-9)
+    return run_case(spec.base, spec.source, case)
 
 
 def test_the_worst_mount_status_over_a_replay_reads_the_peak_utilisation_or_the_onset(
@@ -509,16 +515,7 @@ def test_a_run_that_integrated_no_interval_has_no_error_estimate_figure(
     for key in ("est_force_error_rel_run", "est_force_error_n_run", "est_attitude_error_rad_run"):
         assert values[key] == "nan", (key, values[key])
     if accepted:  # a sweep of it: a case that ran, with no estimate (not 0)
-        sweep = tmp_path / "sweep.yaml"
-        mass = read_scene_yaml(PUMP)["body"]["mass"]
-        sweep.write_text(
-            f"base: {PUMP}\nvary:\n  - key: body.mass\n    values: [{mass}]\n"
-            f"inputs:\n  - bag: {bag}\n",
-            encoding="utf-8",
-        )
-        spec = load_sweep(sweep)
-        (case,) = check(spec)
-        row = run_case(spec.base, spec.source, case)
+        row = _sweep_row(tmp_path, PUMP, read_scene_yaml(PUMP)["body"]["mass"], bag)
         assert row["verdict"] != FAILED and np.isnan(row["est_force_error_rel"]), row
 
 
