@@ -519,6 +519,34 @@ def test_a_run_that_integrated_no_interval_has_no_error_estimate_figure(
         assert row["verdict"] != FAILED and np.isnan(row["est_force_error_rel"]), row
 
 
+@pytest.mark.parametrize("accepted", [0, 1])
+def test_a_run_that_integrated_no_interval_says_its_integration_did_not_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], accepted: int
+) -> None:
+    """One sample accepted is no interval integrated (no substep taken), yet the integration
+    status read "ok", as if the twin had run the record clean; with none accepted, it said
+    "not run" beside an error_norm_max of 0, a figure of no step. Where the run took no
+    substep the status says it did not run, and why, at OK, with no stepper figure."""
+    if accepted:
+        code, doc, out = _replay(tmp_path, PUMP, _one_sample_bag(tmp_path / "one"))
+    else:
+        code, doc, out = _replay(tmp_path, PUMP, SHOCK, "--frame-id", "not_the_imu")
+    assert code == (0 if accepted else 3)
+    counts = doc["counts"]
+    assert (counts.get("accepted", 0), counts.get("substeps", 0)) == (accepted, 0)
+    worst = doc["diagnostics_worst"]["mount_twin: integration"]
+    assert worst["level"] == "OK" and worst["message"].startswith("not run: "), worst
+    why = f"({accepted} sample accepted)" if accepted else "no input sample was accepted"
+    assert worst["message"].endswith(why), worst
+    assert f"    OK    mount_twin: integration: {worst['message']}\n" in capsys.readouterr().out
+    _, msgs = read_bag(out)
+    for report in [m for _, m in msgs["/diagnostics"]]:
+        (status,) = [s for s in report.status if s.name == "mount_twin: integration"]
+        values = {v.key: v.value for v in status.values}
+        assert status.message == worst["message"]
+        assert values["error_norm_max"] == values["substeps_per_sample"] == "n/a", values
+
+
 FULL = "/dev/full"
 """A device every write to fails with ENOSPC, as on a full disk."""
 

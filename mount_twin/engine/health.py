@@ -32,6 +32,9 @@ MOUNT = f"{PREFIX}: mount "
 NOT_RUN = "not run: no input sample was accepted"
 """The integration status' text while no input sample has been accepted (it had read "ok",
 as if the twin had integrated the run clean)."""
+NOT_INTEGRATED = "not run: no input interval was integrated"
+"""The integration status' text while samples were accepted but no interval between two was
+integrated (one sample: it had read "ok", as if the twin had integrated the run clean)."""
 NOT_COMPUTED = "not computed: no input sample was accepted"
 """The attitude and mount statuses' text while no input sample has been accepted, their
 figures "n/a" (they had read "ok" with a tilt and peaks of 0, as a machine at rest)."""
@@ -112,6 +115,9 @@ class HealthWindow:
         self._last_counts: Counter[str] = Counter()
         self.estimate_run = np.zeros(N_FIGURES)
         """The error estimate's figures over the whole run (`engine.estimator`)."""
+        self.intervals_run = 0
+        """Input intervals integrated over the whole run (`add_steps`): none, the integration
+        has not run (NOT_RUN, NOT_INTEGRATED)."""
         self.stopped_at: float | None = None
         """Stamp (s) from which the twin follows no more (a given initial motion whose stepper
         failed, a start without equilibrium) until a restart; each report says so at ERROR."""
@@ -131,6 +137,7 @@ class HealthWindow:
         self.estimate = np.zeros(N_FIGURES)
         self.substeps = 0
         self.samples = 0
+        """Input intervals integrated in this window (`add_steps`: one per sample reached)."""
         self.tilt_max = 0.0
         self.failures: list[tuple[float, str]] = []
         """(stamp s, cause) of each stepper failure."""
@@ -166,6 +173,7 @@ class HealthWindow:
             self.err_max = max(self.err_max, float(step_log[:, 0].max()))
             self.substeps += int(step_log[:, 1].sum() + step_log[:, 2].sum())
             self.samples += step_log.shape[0]
+            self.intervals_run += step_log.shape[0]
 
     def add_estimate(self, figures: np.ndarray) -> None:
         """The error estimate's figures since the last call (`engine.estimator`)."""
@@ -361,11 +369,12 @@ class HealthWindow:
         """The integration status of this window (`span`: the stamp time its input intervals
         cover, s; over its wall time, the real-time factor): stepper failures and
         a stop (ERROR), notes on how the input is taken and an estimated error past
-        WARN_FORCE_ERROR_REL (WARN); the solver's settings and figures as values. Before any
-        input sample is accepted, NOT_RUN."""
+        WARN_FORCE_ERROR_REL (WARN); the solver's settings and figures as values ("n/a" where
+        this window integrated no interval). Before any input interval is integrated, NOT_RUN
+        or NOT_INTEGRATED (`_not_run`)."""
         integ = self.scene.integration
         rtf = span / self.wall if self.wall > 0 and span > 0 else math.nan
-        level, step_text = self._stepper_status() if counts["accepted"] else (OK, NOT_RUN)
+        level, step_text = self._stepper_status(counts)
         estimate = self._estimate_values()
         warning = estimate_warning(ErrorEstimate.of(self.estimate_run)) if estimate else None
         for note in (*self.notes, warning):
@@ -381,7 +390,7 @@ class HealthWindow:
                 "rtol": f"{integ.rtol:g}",
                 "atol": f"{integ.atol:g}",
                 **estimate,
-                "error_norm_max": f"{self.err_max:.3g}",
+                "error_norm_max": f"{self.err_max:.3g}" if self.samples else "n/a",
                 "substeps_per_sample": f"{self.substeps / self.samples:.2f}"
                 if self.samples
                 else "n/a",
@@ -393,9 +402,10 @@ class HealthWindow:
             },
         )
 
-    def _stepper_status(self) -> tuple[int, str]:
+    def _stepper_status(self, counts: Counter[str]) -> tuple[int, str]:
         """Level and text of the stepper in this window: ERROR with its failures and forced
-        starts (stamps in s) or a stop, else OK."""
+        starts (stamps in s) or a stop, else OK (`_not_run` where no interval was integrated
+        in the run so far)."""
 
         def listed(what: list[tuple[float, str]]) -> str:
             return "; ".join(f"{self.origin_s + t:.6f} s: {m}" for t, m in what)
@@ -413,8 +423,19 @@ class HealthWindow:
                 + (f" ({'; '.join(said)})" if said else "")
             )
         else:
-            step_text = "; ".join(said) or "ok"
+            step_text = "; ".join(said) or self._not_run(counts) or "ok"
         return (ERROR if said or self.stopped_at is not None else OK), step_text
+
+    def _not_run(self, counts: Counter[str]) -> str | None:
+        """Why the integration has not run (None: the run integrated an input interval):
+        NOT_RUN where no input sample was accepted, else NOT_INTEGRATED (one sample, or all
+        gathered toward a start)."""
+        if self.intervals_run:
+            return None
+        n = counts["accepted"]
+        if not n:
+            return NOT_RUN
+        return f"{NOT_INTEGRATED} ({n} sample{'' if n == 1 else 's'} accepted)"
 
     def _attitude_status(self) -> HealthStatus:
         """The attitude status of this window: WARN past `outputs.tilt_warn_rad` of tilt, where
