@@ -534,6 +534,30 @@ def test_stall_of_a_running_twin_then_reports_continue() -> None:
     assert first.stamp == 1.0
 
 
+def test_a_stall_after_input_says_it_computed_no_attitude_nor_mount_load() -> None:
+    """A stall report of a twin that had run: no sample accepted in its period, no row
+    published, yet its attitude and mount statuses read "ok" with a tilt and peaks of 0, as a
+    machine at rest. They say nothing was computed in the period, and why, figures "n/a"; the
+    period before, which published rows, reads as it did."""
+    eng = engine(scene_with(input={"gyro_filter": "none"}))
+    out = eng.push(batch(ramp(1001)))
+    (due,) = out.health
+    assert len(out) > 0  # rows published in the period before the stall
+    accepted = eng.counts["accepted"]
+    stalled = eng.report_stalled(1.0)
+    assert eng.counts["accepted"] == accepted and len(eng.flush()) == 0  # nothing came since
+    names = [s.name for s in due.statuses]
+    assert names == [s.name for s in stalled.statuses]
+    for name in names[2:]:  # attitude, then one per mount
+        before, after = (next(s for s in r.statuses if s.name == name) for r in (due, stalled))
+        assert before.message != after.message, name
+        figures = [k for k in before.values if "peak" in k or "max" in k]
+        assert figures and all(float(before.values[k]) >= 0.0 for k in figures), name
+        assert after.level == OK, name
+        assert after.message == "not computed in this period: no input sample was accepted in it"
+        assert {after.values[k] for k in figures} == {"n/a"}, (name, after.values)
+
+
 def test_the_real_time_factor_is_the_input_time_over_the_wall_time() -> None:
     """real_time_factor: the stamp time the window's input intervals cover over the wall time
     spent on its samples. It took the outputs' span, which the gyro delay shifts and which

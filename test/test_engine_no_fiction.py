@@ -9,13 +9,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from io_helpers import CONFIG, REST, G, batch
+from io_helpers import CONFIG, REST, G, batch, read_bag
 from physics_helpers import free_body
 
 from mount_twin.commands.common import write_signal
-from mount_twin.engine.batch import ERROR
+from mount_twin.engine.batch import ERROR, OK
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.engine.health import INTEGRATION
+from mount_twin.engine.health import ATTITUDE, INTEGRATION, MOUNT
 from mount_twin.io.signals import Signal
 from mount_twin.model.assemble import assemble
 from mount_twin.replay import replay
@@ -145,6 +145,31 @@ def test_a_machine_nothing_holds_any_more_publishes_nothing_and_says_why() -> No
         assert "no static equilibrium" in status.message and "bolt_fractured" in status.message
 
 
+def test_the_periods_a_twin_follows_no_more_say_they_computed_no_attitude_nor_load() -> None:
+    """A twin stopped by a failure (a given motion) publishes nothing in the periods after,
+    yet their attitude and mount statuses read "ok" with a tilt and peaks of 0, as a machine
+    at rest. They say nothing was computed in the period and why (the stop, whose stamp the
+    engine holds), figures "n/a"; the periods that published rows read as they did."""
+    engine = _tumbling_engine()
+    out = engine.run(batch(1.0 + np.arange(2000) * 1e-3, np.zeros((2000, 3)), frame_ids=""))
+    stop = engine.health.stopped_at
+    assert stop is not None and not engine.running
+    published = [r for r in out.health if (out.stamps > r.stamp - 0.5).any()]
+    silent = [r for r in out.health if r.stamp - 0.5 > out.stamps[-1]]
+    assert published and silent and len(published) + len(silent) == len(out.health)
+    why = f"not computed in this period: the twin follows no more since {stop:.6f} s"
+    for report in published:
+        (attitude,) = [s for s in report.statuses if s.name == ATTITUDE]
+        assert attitude.message != why and float(attitude.values["tilt_max_rad"]) > 0.0
+    for report in silent:
+        figures = [s for s in report.statuses if s.name == ATTITUDE or s.name.startswith(MOUNT)]
+        assert len(figures) == 1 + len(engine.scene.mounts)
+        for status in figures:
+            assert (status.level, status.message) == (OK, why), status
+            measured = {k: v for k, v in status.values.items() if "peak" in k or "max" in k}
+            assert measured and set(measured.values()) == {"n/a"}, status
+
+
 def test_the_replay_summary_says_what_was_not_followed_and_why(tmp_path: Path) -> None:
     scene, t, f = _hanging_genset()
     bag = tmp_path / "hanging"
@@ -162,3 +187,11 @@ def test_the_replay_summary_says_what_was_not_followed_and_why(tmp_path: Path) -
     status = summary.worst[INTEGRATION]
     assert status.level == ERROR and "no static equilibrium" in status.message
     assert summary.to_dict()["diagnostics_worst"][INTEGRATION]["message"] == status.message
+    # the bag's last period, after the stop, computed nothing and says so; the run's worst
+    # attitude is still of a period that computed one (a figure, not "n/a")
+    *_, last = [m for _, m in read_bag(tmp_path / "out")[1]["/diagnostics"]]
+    (attitude,) = [s for s in last.status if s.name == ATTITUDE]
+    assert attitude.message.startswith("not computed in this period: the twin follows no more")
+    assert [v.value for v in attitude.values] == ["n/a"]
+    assert float(summary.worst[ATTITUDE].values["tilt_max_rad"]) >= 0.0
+    assert summary.to_dict()["diagnostics_worst"][ATTITUDE]["level"] == "OK"

@@ -38,6 +38,9 @@ integrated (one sample: it had read "ok", as if the twin had integrated the run 
 NOT_COMPUTED = "not computed: no input sample was accepted"
 """The attitude and mount statuses' text while no input sample has been accepted, their
 figures "n/a" (they had read "ok" with a tilt and peaks of 0, as a machine at rest)."""
+NOT_COMPUTED_HERE = "not computed in this period"
+"""The attitude and mount statuses' text, with why, for a period that computed no motion and
+no mount load after samples were accepted before it (a stall, a twin that follows no more)."""
 NOT_DESIGNED = (
     "the gyro filter was never designed: no two input samples were accepted without a restart "
     "between them"
@@ -358,12 +361,28 @@ class HealthWindow:
             new, counts, self._input_rate(), lost_from_stamps, nominal_interval_s, stalled_s
         )
         step = self._integration_status(counts, self._stamp_seconds())
-        if counts["accepted"]:
-            figures = [self._attitude_status(), *self._mount_statuses(utilisation, active)]
-        else:  # nothing integrated: no motion, no load (the input status carries the ERROR)
-            figures = self._not_computed()
+        why = self._not_computed(counts, new)
+        att = self._attitude_status(why)
+        mounts = self._mount_statuses(utilisation, active, why)
         self._reset()
-        return HealthReport(stamp, sample, [inp, step, *figures])
+        return HealthReport(stamp, sample, [inp, step, att, *mounts])
+
+    def _not_computed(self, counts: Counter[str], new: Counter[str]) -> str | None:
+        """Why this window computed no motion and no mount load, for the attitude and mount
+        statuses (None: it did): it published no row and integrated no input interval. The
+        input status carries a stall's ERROR, the integration status a stop's."""
+        if self.published or self.samples:
+            return None
+        if not counts["accepted"]:
+            return NOT_COMPUTED
+        if not new["accepted"]:
+            return f"{NOT_COMPUTED_HERE}: no input sample was accepted in it"
+        if self.stopped_at is not None:
+            return (
+                f"{NOT_COMPUTED_HERE}: the twin follows no more since "
+                f"{self.origin_s + self.stopped_at:.6f} s"
+            )
+        return f"{NOT_COMPUTED_HERE}: none of its samples was integrated yet"
 
     def _integration_status(self, counts: Counter[str], span: float) -> HealthStatus:
         """The integration status of this window (`span`: the stamp time its input intervals
@@ -437,9 +456,11 @@ class HealthWindow:
             return NOT_RUN
         return f"{NOT_INTEGRATED} ({n} sample{'' if n == 1 else 's'} accepted)"
 
-    def _attitude_status(self) -> HealthStatus:
+    def _attitude_status(self, not_computed: str | None) -> HealthStatus:
         """The attitude status of this window: WARN past `outputs.tilt_warn_rad` of tilt, where
-        the α/γ/δ chart degrades."""
+        the α/γ/δ chart degrades; `not_computed` (`_not_computed`) at OK, tilt "n/a"."""
+        if not_computed is not None:
+            return HealthStatus(ATTITUDE, OK, not_computed, {TILT_KEY: "n/a"})
         warn = self.scene.outputs.tilt_warn_rad
         return HealthStatus(
             ATTITUDE,
@@ -450,22 +471,6 @@ class HealthWindow:
             else "ok",
             {TILT_KEY: f"{self.tilt_max:.6g}"},
         )
-
-    def _not_computed(self) -> list[HealthStatus]:
-        """The attitude and mount statuses before any input sample is accepted: NOT_COMPUTED
-        at OK, with their figures "n/a"."""
-        mount_values = {
-            **dict.fromkeys((*PEAK_KEYS, UTILISATION_KEY), "n/a"),
-            EVENTS_KEY: "0",
-            NOW_KEY: "none",
-        }
-        return [
-            HealthStatus(ATTITUDE, OK, NOT_COMPUTED, {TILT_KEY: "n/a"}),
-            *(
-                HealthStatus(MOUNT + m.name, OK, NOT_COMPUTED, dict(mount_values))
-                for m in self.scene.mounts
-            ),
-        ]
 
     def _estimate_values(self) -> dict[str, str]:
         """The estimated errors of the period and, `_run`, of the run so far as diagnostic
@@ -492,11 +497,17 @@ class HealthWindow:
         }
 
     def _mount_statuses(
-        self, utilisation: np.ndarray, active: dict[str, list[tuple[str, bool]]]
+        self,
+        utilisation: np.ndarray,
+        active: dict[str, list[tuple[str, bool]]],
+        not_computed: str | None,
     ) -> list[HealthStatus]:
         """One status per mount: peak wrench per axis, utilisation, events by name, and the
-        conditions holding now."""
+        conditions holding now; `not_computed` (`_not_computed`) in place of "ok", peaks and
+        utilisation "n/a" (the conditions holding keep their level)."""
         warn_at = 1.0 - self.scene.outputs.alarm_margin
+        if not_computed is not None:
+            utilisation = np.full_like(utilisation, math.nan)
         events: dict[str, list[MountEvent]] = {}
         for event in self.events:
             events.setdefault(event.mount, []).append(event)
@@ -512,12 +523,17 @@ class HealthWindow:
                 level = WARN
             else:
                 level = OK
-            values = {key: f"{v:.6g}" for key, v in zip(PEAK_KEYS, peak, strict=True)}
+            values = {
+                key: "n/a" if not_computed else f"{v:.6g}"
+                for key, v in zip(PEAK_KEYS, peak, strict=True)
+            }
             values[UTILISATION_KEY] = "n/a" if math.isnan(u) else f"{u:.6g}"
             values[EVENTS_KEY] = str(len(mine))
             values.update(_event_values(mine, self.origin_s))
             values[NOW_KEY] = ", ".join(name for name, _ in now) or "none"
             text = _events_text(mine, u, self.origin_s)
+            if text == "ok" and not_computed:
+                text = not_computed
             if now:
                 text = f"now: {values[NOW_KEY]}" + ("" if text == "ok" else f"; {text}")
             out.append(HealthStatus(MOUNT + mount.name, level, text, values))
