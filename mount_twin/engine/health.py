@@ -32,7 +32,7 @@ MOUNT = f"{PREFIX}: mount "
 NOT_RUN = "not run: no input sample was accepted"
 """The integration status' text while no input sample has been accepted (it had read "ok",
 as if the twin had integrated the run clean)."""
-NOT_INTEGRATED = "not run: no input interval was integrated"
+NO_INTERVAL_RUN = "not run: no input interval was integrated"
 """The integration status' text while samples were accepted but no interval between two was
 integrated (one sample: it had read "ok", as if the twin had integrated the run clean)."""
 NOT_COMPUTED = "not computed: no input sample was accepted"
@@ -120,7 +120,7 @@ class HealthWindow:
         """The error estimate's figures over the whole run (`engine.estimator`)."""
         self.intervals_run = 0
         """Input intervals integrated over the whole run (`add_steps`): none, the integration
-        has not run (NOT_RUN, NOT_INTEGRATED)."""
+        has not run (NOT_RUN, NO_INTERVAL_RUN)."""
         self.stopped_at: float | None = None
         """Stamp (s) from which the twin follows no more (a given initial motion whose stepper
         failed, a start without equilibrium) until a restart; each report says so at ERROR."""
@@ -390,7 +390,7 @@ class HealthWindow:
         a stop (ERROR), notes on how the input is taken and an estimated error past
         WARN_FORCE_ERROR_REL (WARN); the solver's settings and figures as values ("n/a" where
         this window integrated no interval). Before any input interval is integrated, NOT_RUN
-        or NOT_INTEGRATED (`_not_run`)."""
+        or NO_INTERVAL_RUN (`_not_run`)."""
         integ = self.scene.integration
         rtf = span / self.wall if self.wall > 0 and span > 0 else math.nan
         level, step_text = self._stepper_status(counts)
@@ -447,14 +447,14 @@ class HealthWindow:
 
     def _not_run(self, counts: Counter[str]) -> str | None:
         """Why the integration has not run (None: the run integrated an input interval):
-        NOT_RUN where no input sample was accepted, else NOT_INTEGRATED (one sample, or all
+        NOT_RUN where no input sample was accepted, else NO_INTERVAL_RUN (one sample, or all
         gathered toward a start)."""
         if self.intervals_run:
             return None
         n = counts["accepted"]
         if not n:
             return NOT_RUN
-        return f"{NOT_INTEGRATED} ({n} sample{'' if n == 1 else 's'} accepted)"
+        return f"{NO_INTERVAL_RUN} ({n} sample{'' if n == 1 else 's'} accepted)"
 
     def _attitude_status(self, not_computed: str | None) -> HealthStatus:
         """The attitude status of this window: WARN past `outputs.tilt_warn_rad` of tilt, where
