@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import nullcontext
@@ -72,9 +73,14 @@ def _estimate_text(est: ErrorEstimate | None) -> str:
         return "estimated integration error: not estimated (integration.error_estimate: false)"
     if not est.estimated:
         return f"estimated integration error: {NOT_INTEGRATED}"
+    forces = (
+        f"{est.force_error_rel:.2g} of the largest ({est.force_error_n:.3g} N)"
+        if math.isfinite(est.force_error_rel)
+        else f"{est.force_error_n:.3g} N (no mount carried a force to relate it to)"
+    )
     text = (
-        f"estimated integration error: mount forces {est.force_error_rel:.2g} of the largest "
-        f"({est.force_error_n:.3g} N), attitude {est.attitude_error_rad:.2g} rad, over the run"
+        f"estimated integration error: mount forces {forces}, "
+        f"attitude {est.attitude_error_rad:.2g} rad, over the run"
     )
     if est.lower_bound:
         text += (

@@ -106,7 +106,7 @@ class TwinEngine:
         """The estimated error of everything published so far (None: `error_estimate` off)."""
         if self._driver.estimator is None:
             return None
-        return ErrorEstimate.of(self.health.estimate_run)
+        return self.health.run_estimate()
 
     @property
     def failure_text(self) -> str:

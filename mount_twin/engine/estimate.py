@@ -32,9 +32,11 @@ class ErrorEstimate:
         force_error_rel: largest |ΔF| over samples, mounts and force components, relative to the
             largest |F| component (the definition of `analysis.accuracy.Accuracy.force_error`);
             NaN where no interval was integrated (a run that accepted no sample, or one, or
-            failed at every sample: nothing was estimated, and 0.0 would read as exact).
-        force_error_n: that largest |ΔF|, N (NaN where force_error_rel is).
-        attitude_error_rad: largest |Δα|, |Δγ|, |Δδ|, rad (NaN where force_error_rel is).
+            failed at every sample: nothing was estimated, and 0.0 would read as exact), and
+            where no mount carried a force (a body tumbling free: nothing to relate it to).
+        force_error_n: that largest |ΔF|, N (NaN where no interval was integrated).
+        attitude_error_rad: largest |Δα|, |Δγ|, |Δδ|, rad (NaN where no interval was
+            integrated).
         failed_checks: intervals whose local error could not be measured (the checking
             stepper failed: the estimate misses what they committed).
         uncarried_states: the model's states whose error the estimate does not carry from
@@ -50,8 +52,8 @@ class ErrorEstimate:
 
     @property
     def estimated(self) -> bool:
-        """Whether any interval was estimated (force_error_rel is a number)."""
-        return not math.isnan(self.force_error_rel)
+        """Whether any interval was estimated (attitude_error_rad is a number)."""
+        return not math.isnan(self.attitude_error_rad)
 
     def as_dict(self) -> dict[str, float | int | None]:
         """The fields for JSON: NaN as None (strict JSON has no NaN)."""
@@ -66,13 +68,14 @@ class ErrorEstimate:
         return self.failed_checks > 0 or self.uncarried_states > 0
 
     @classmethod
-    def of(cls, figures: np.ndarray) -> ErrorEstimate:
-        """From figures as the core keeps them (N_FIGURES slots); without a force scale no
-        interval was estimated, and the errors are NaN (their slots' 0 is no measurement)."""
-        scale = figures[FORCE_SCALE]
-        estimated = scale > 0.0
+    def of(cls, figures: np.ndarray, intervals: int) -> ErrorEstimate:
+        """From figures as the core keeps them (N_FIGURES slots) over `intervals` integrated
+        input intervals: with none, nothing was estimated and the errors are NaN (their slots'
+        0 is no measurement). The force scale cannot tell: a body tumbling free on mounts that
+        carry no force has one of 0 and an attitude error estimated at every interval."""
+        scale, estimated = figures[FORCE_SCALE], intervals > 0
         return cls(
-            float(figures[FORCE_ERROR] / scale) if estimated else math.nan,
+            float(figures[FORCE_ERROR] / scale) if estimated and scale > 0.0 else math.nan,
             float(figures[FORCE_ERROR]) if estimated else math.nan,
             float(figures[ATTITUDE_ERROR]) if estimated else math.nan,
             int(figures[FAILURES]),

@@ -183,6 +183,11 @@ class HealthWindow:
         accumulate(self.estimate, figures)
         accumulate(self.estimate_run, figures)
 
+    def run_estimate(self) -> ErrorEstimate:
+        """The error estimate over the run so far (no figures before an interval was
+        integrated)."""
+        return ErrorEstimate.of(self.estimate_run, self.intervals_run)
+
     def add_outputs(self, stamps: np.ndarray, pose: np.ndarray, wrenches: np.ndarray) -> None:
         """Published rows: their stamps (s), poses and mount wrenches (N, N·m, mount axes)."""
         if stamps.shape[0] == 0:
@@ -395,7 +400,7 @@ class HealthWindow:
         rtf = span / self.wall if self.wall > 0 and span > 0 else math.nan
         level, step_text = self._stepper_status(counts)
         estimate = self._estimate_values()
-        warning = estimate_warning(ErrorEstimate.of(self.estimate_run)) if estimate else None
+        warning = estimate_warning(self.run_estimate()) if estimate else None
         for note in (*self.notes, warning):
             if note is not None:
                 level = max(level, WARN)
@@ -484,7 +489,7 @@ class HealthWindow:
             return {}
         period = self.estimate.copy()
         period[FORCE_SCALE] = self.estimate_run[FORCE_SCALE]
-        est, run = ErrorEstimate.of(period), ErrorEstimate.of(self.estimate_run)
+        est, run = ErrorEstimate.of(period, self.samples), self.run_estimate()
         return {
             "est_force_error_rel": f"{est.force_error_rel:.2g}",
             "est_force_error_n": f"{est.force_error_n:.3g}",
