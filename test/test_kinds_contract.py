@@ -240,6 +240,7 @@ def fake_kind(name: str = "end_stop") -> ModuleType:
     module.EVENTS = ("stop_contact",)
     module.EVENT_ERROR = (False,)
     module.EVENT_STIFFENS = (True,)
+    module.EVENT_SWITCHES = (False,)
     module.ROTATIONAL = False
     module.RESTUCK = ()
     module.PARAMETERS = {}
@@ -290,7 +291,7 @@ def test_a_module_lacking_part_of_the_contract_is_refused(name: str) -> None:
         check_modules({"other_name": fake_kind()})
 
 
-@pytest.mark.parametrize("table", ["EVENT_ERROR", "EVENT_STIFFENS"])
+@pytest.mark.parametrize("table", ["EVENT_ERROR", "EVENT_STIFFENS", "EVENT_SWITCHES"])
 def test_an_event_table_of_another_length_than_the_events_is_refused(table: str) -> None:
     """Each event has its level and whether it may stiffen the scene (`auto` looks again)."""
     module = fake_kind()
@@ -309,6 +310,18 @@ def test_only_contact_events_may_stiffen_a_scene() -> None:
         if flag
     }
     assert stiffening == {("shear_key", "key_contact"), ("elastomer", "snubber_contact")}
+
+
+def test_only_a_bolt_breaking_is_a_discrete_switch() -> None:
+    """`update` switches a bolt to broken and nothing else: its event is the one a start that
+    breaks it reports (`EVENT_SWITCHES`); the others holding at a start are states."""
+    switches = {
+        (name, event)
+        for name, module in KINDS.items()
+        for event, flag in zip(module.EVENTS, module.EVENT_SWITCHES, strict=True)
+        if flag
+    }
+    assert switches == {("bolted_joint", "bolt_fractured")}
 
 
 def test_a_kind_that_reads_the_rotation_must_declare_it(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -3,7 +3,8 @@ checks (`read`: every key read, then `Reader.finish`, then the checks across key
 misspelt key is named rather than the check it makes fail), its parameter row (`pack`),
 internal states (and which of them a restart resets: `RESTUCK`), force law (`load`), event
 functions (`monitor`), discrete switches between samples (`update`, which says whether it
-switched: the state then jumped, and a stepper must not start from a stage it took before) and
+switched: the state then jumped, and a stepper must not start from a stage it took before;
+`EVENT_SWITCHES` names the events that are such a switch, which a start reports too) and
 its stiffness at the unstressed pose (`nominal_tangent`: statics, modes and `auto`'s first
 choice read it). A module's `load`, `monitor` and `update` are plain Python: the reference the
 compiled core's port of the kind (src/core/kinds/<kind>.hpp) is held to.
@@ -57,6 +58,7 @@ MODULE_NAMES = (
     "EVENTS",
     "EVENT_ERROR",
     "EVENT_STIFFENS",
+    "EVENT_SWITCHES",
     "ROTATIONAL",
     "RESTUCK",
     "PARAMETERS",
@@ -102,7 +104,7 @@ def check_modules(kinds: Mapping[str, ModuleType]) -> None:
         if name != module.KIND:
             msg = f"KINDS maps {name!r} to {module.__name__}, whose KIND is {module.KIND!r}"
             raise KindContractError(msg)
-        for table in ("EVENT_ERROR", "EVENT_STIFFENS"):
+        for table in ("EVENT_ERROR", "EVENT_STIFFENS", "EVENT_SWITCHES"):
             if len(getattr(module, table)) != len(module.EVENTS):
                 msg = f"kind {name!r}: {table} and EVENTS differ in length"
                 raise KindContractError(msg)

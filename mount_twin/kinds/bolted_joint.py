@@ -43,6 +43,10 @@ EVENT_ERROR = (True, True, False, True)
 EVENT_STIFFENS = (False, False, False, False)
 """Whether each event can make the scene stiffer (`auto` then looks at it again): a joint that
 yields, opens, slips or breaks only loses stiffness."""
+EVENT_SWITCHES = (False, False, False, True)
+"""Whether each event is a discrete switch of `update` (the bolt breaking): one that a start's
+monitors make is reported as that event at the start; the others holding at a start are
+states there, not events."""
 STATES = ("plastic_elongation", "slip_x", "slip_y", "fractured")
 RESTUCK = ("slip_x", "slip_y")
 """States a restart sets to zero: the joint face's stick point, where it stuck relative to a

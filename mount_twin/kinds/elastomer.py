@@ -26,6 +26,8 @@ EVENTS = ("snubber_contact", "over_travel")
 EVENT_ERROR = (False, True)
 EVENT_STIFFENS = (True, False)
 """A snubber that touches stiffens the mount (`auto` looks again); over-travel is in contact."""
+EVENT_SWITCHES = (False, False)
+"""No event is a discrete switch (`update` never switches)."""
 RESTUCK: tuple[str, ...] = ()
 """States a restart sets to zero (none: all of this kind's states are kept)."""
 ROTATIONAL = True

@@ -22,6 +22,9 @@ EVENT_ERROR = (False, True)
 EVENT_STIFFENS = (True, False)
 """A key that closes its clearance stiffens the scene (`auto` looks again); overload is in
 contact."""
+EVENT_SWITCHES = (False, False)
+"""No event is a discrete switch (`update` never switches): a key past its allowable force at
+a start is a state there, not an event."""
 STATES: tuple[str, ...] = ()
 RESTUCK: tuple[str, ...] = ()
 """States a restart sets to zero (none: all of this kind's states are kept)."""
