@@ -167,6 +167,14 @@ class CoreDriver:
             slot: (scene.mounts[slot].name, KINDS[scene.mounts[slot].kind])
             for slot in model.nonlinear_slots
         }
+        nl = model.arrays.nl
+        self._own_states = [
+            slice(int(o), int(o) + len(kind.state_names(scene.mounts[slot])))
+            for o, (slot, (_, kind)) in zip(
+                [] if nl is None else nl.state.tolist(), self._event_meta.items(), strict=True
+            )
+        ]
+        """Each non-linear mount's internal states in y, in the core's order (empty: none)."""
         stiffens = np.zeros((len(model.nonlinear_slots), N_EVENTS))
         for i, (_, kind) in enumerate(self._event_meta.values()):
             stiffens[i, : len(kind.EVENTS)] = kind.EVENT_STIFFENS
@@ -218,17 +226,19 @@ class CoreDriver:
         self.stepper.reset()
         self._peak[:] = 0.0
         self.last = (stamp, f.copy(), w.copy())
-        outputs = self._start_outputs()
+        outputs = self._start_outputs(stamp)
         if isinstance(self.estimator, Estimator):
             estimator.restart(self.estimator)
         elif self.estimator is not None:
             companion.restart(self.estimator, self.y)
         return outputs
 
-    def _start_outputs(self) -> tuple[np.ndarray, np.ndarray]:
-        """Outputs (pose row, wrenches) of the state; arms the mount monitors there and folds
-        its utilisation into the window's (a start is published: a run that fails at its
-        first interval still shows the load it started under)."""
+    def _start_outputs(self, stamp: float) -> tuple[np.ndarray, np.ndarray]:
+        """Outputs (pose row, wrenches) of the state at `stamp` (s); arms the mount monitors
+        there and folds its utilisation into the window's (a start is published: a run that
+        fails at its first interval still shows the load it started under). A discrete switch
+        the start's monitors make (a bolt past its ultimate force breaks) is that mount's
+        event at the start (`_log_start_switches`)."""
         model, y = self.model, self.y
         pose, wrenches = np.zeros(pose_row.WIDTH), np.zeros((model.n_mounts, 6))
         ct = evaluate(y, model.arrays, self._scratch, pose, wrenches)
@@ -240,9 +250,38 @@ class CoreDriver:
         if nl is not None:
             watch = self._watch
             watch.y_prev[:] = y
-            mount_monitors(y, y, nl, self._scratch, watch.g_prev, watch.util)
+            if mount_monitors(y, y, nl, self._scratch, watch.g_prev, watch.util):
+                self._log_start_switches(watch.y_prev, stamp, wrenches)
             np.maximum(watch.util_peak, watch.util, out=watch.util_peak)
         return pose, wrenches
+
+    def _log_start_switches(self, before: np.ndarray, stamp: float, wrenches: np.ndarray) -> None:
+        """Log the discrete switches the start's monitors just made, from state `before` to
+        `self.y`, as the loop logs an event: at the start's `stamp` (s), with the mount's force
+        magnitude at the start (`wrenches`, before the switch: the load it switched under).
+
+        In the loop a switch is seen as its event function crossing 0 since the sample before;
+        a start has no sample before, and its monitors leave the function past 0 in g_prev, so
+        no crossing would ever show it. What a start reports is only what switched there: the
+        mounts whose internal states the switch changed, under each event of its kind that is
+        a switch (`EVENT_SWITCHES`) and holds. Conditions merely holding at the start (a key
+        bearing, a joint open under preload, a bolt past its yield) are states, not events; a
+        mount whose damage a restart kept (a bolt broken before) does not switch again."""
+        watch, y = self._watch, self.y
+        for i, (slot, (_, kind)) in enumerate(self._event_meta.items()):
+            own = self._own_states[i]
+            if np.array_equal(y[own], before[own]):
+                continue
+            for e, is_switch in enumerate(kind.EVENT_SWITCHES):
+                if not (is_switch and watch.g_prev[i, e] >= 0.0):
+                    continue
+                k = int(watch.n_events[0])
+                watch.n_events[0] += 1
+                if k < watch.events.shape[0]:
+                    r0, r1, r2 = wrenches[slot, :3].tolist()
+                    force = math.sqrt(r0 * r0 + r1 * r1 + r2 * r2)  # as the core's log takes it
+                    watch.events[k] = (stamp, slot, e, force)
+        self._drain_events()
 
     def _bound(self) -> Loop:
         """The core's loop over the arrays now held: the one bound before, unless one of them
