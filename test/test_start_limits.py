@@ -18,14 +18,13 @@ the key's force k_key·(s − c) and the bolt's F_S = F_V + k_S·s.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
-from kinds_helpers import kind_mount
-from physics_helpers import G, base_scene, mount
+from hung_helpers import BOLT, K_KEY, K_P, K_S, MASS, K, hung_scene
+from physics_helpers import G
 
 from mount_twin.engine.batch import ERROR, SampleBatch
 from mount_twin.engine.engine import TwinEngine
@@ -34,12 +33,7 @@ from mount_twin.scene.checks import rated_at_start
 from mount_twin.scene.loader import load_scene_file, scene_from_dict
 from mount_twin.scene.params import as_params, effective_parameters
 
-MASS, CG_Z = 400.0, 0.25  # kg, m
-K = 2.0e5  # N/m, each spring along z
-K_KEY = 8.0e5  # N/m, the key along z
-K_S, K_P, F_V = 1.0e6, 3.0e6, 5000.0  # N/m, N/m, N: a hanger's bolt
-CORNERS = ((0.4, 0.3), (-0.4, 0.3), (-0.4, -0.3), (0.4, -0.3))
-KEY, BOLT = 4, 5  # their indices in the scene's mounts
+F_V = 5000.0  # N: the hanger's bolt's preload
 AT_START = "at the start (the weight's equilibrium on the mounts' own force laws)"
 
 
@@ -67,32 +61,8 @@ def hung(
     rated_load: float = 0.0,
 ) -> dict:
     """The scene of this file's truths; springs rated `rated_load` (N) along z, 0: unrated."""
-    springs = [
-        {
-            **mount(f"s{i}", [x, y, 0.0], [1.0e5, 1.0e5, K, 0.0, 0.0, 0.0]),
-            "rated_load": [0.0, 0.0, rated_load],
-        }
-        for i, (x, y) in enumerate(CORNERS)
-    ]
-    key = kind_mount(
-        "shear_key",
-        "key",
-        stiffness=[0.0, 0.0, K_KEY],
-        clearance=clearance,
-        allowable_force=allowable,
-    )
-    bolt = kind_mount(
-        "bolted_joint",
-        "bolt",
-        rpy=[math.pi, 0.0, 0.0],  # local z down: the foot lifts off as the body sinks
-        bolt_stiffness=K_S,
-        clamp_stiffness=K_P,
-        preload=F_V,
-        yield_force=yield_force,
-        ultimate_force=ultimate_force,
-    )
-    mounts = [*springs, key, bolt]
-    return base_scene(MASS, [0.0, 0.0, CG_Z], [30.0, 40.0, 50.0, 0, 0, 0], mounts)
+    key = {"clearance": clearance, "allowable_force": allowable}
+    return hung_scene(F_V, yield_force, ultimate_force, key, rated_load)
 
 
 def limited(scene) -> dict[str, str]:

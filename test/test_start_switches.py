@@ -26,15 +26,14 @@ and the joint's force on the body is −F_S.
 from __future__ import annotations
 
 import json
-import math
 import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
-from kinds_helpers import kind_mount
-from physics_helpers import G, base_scene, mount
+from hung_helpers import K_KEY, K_P, K_S, MASS, K, hung_scene
+from physics_helpers import G
 
 from mount_twin.cli import main
 from mount_twin.engine.batch import ERROR, MountEvent, SampleBatch
@@ -46,11 +45,7 @@ from mount_twin.io.output_tables import read_output_bag
 from mount_twin.model.assemble import Model, assemble
 from mount_twin.scene.loader import scene_from_dict
 
-MASS, CG_Z = 400.0, 0.25  # kg, m
-K, K_KEY = 2.0e5, 8.0e5  # N/m, each spring and the key along z
-K_S, K_P = 1.0e6, 3.0e6  # N/m, the hanger's bolt and its clamped parts
 PRELOAD = {"closed": 5000.0, "open": 500.0}  # N: the joint closed or open at the start
-CORNERS = ((0.4, 0.3), (-0.4, 0.3), (-0.4, -0.3), (0.4, -0.3))
 ORIGIN_NS = 1_700_000_000 * 10**9
 T0_NS = ORIGIN_NS + 7 * 10**6  # the first sample's stamp
 DT_NS = 10**6  # 1 kHz
@@ -84,20 +79,7 @@ def joint_force(joint: str) -> float:
 
 def hung(joint: str, yield_force: float, ultimate_force: float, allowable: float = 0.0) -> dict:
     """The scene of this file's truths; the key allowed `allowable` (N, 0: not monitored)."""
-    stiffness = [1.0e5, 1.0e5, K, 0.0, 0.0, 0.0]
-    springs = [mount(f"s{i}", [x, y, 0.0], stiffness) for i, (x, y) in enumerate(CORNERS)]
-    key = kind_mount("shear_key", "key", stiffness=[0.0, 0.0, K_KEY], allowable_force=allowable)
-    bolt = kind_mount(
-        "bolted_joint",
-        "bolt",
-        rpy=[math.pi, 0.0, 0.0],  # local z down: the foot lifts off as the body sinks
-        bolt_stiffness=K_S,
-        clamp_stiffness=K_P,
-        preload=PRELOAD[joint],
-        yield_force=yield_force,
-        ultimate_force=ultimate_force,
-    )
-    return base_scene(MASS, [0.0, 0.0, CG_Z], [30.0, 40.0, 50.0, 0, 0, 0], [*springs, key, bolt])
+    return hung_scene(PRELOAD[joint], yield_force, ultimate_force, {"allowable_force": allowable})
 
 
 def broken_at_start(joint: str) -> dict:
