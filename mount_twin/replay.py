@@ -41,6 +41,8 @@ from mount_twin.engine.estimate import NOT_INTEGRATED, ErrorEstimate
 from mount_twin.engine.health import (
     EVENTS_KEY,
     INTEGRATION,
+    NEVER_STARTED,
+    NO_SAMPLE_ACCEPTED,
     NOT_DESIGNED,
     NOW_KEY,
     UTILISATION_KEY,
@@ -132,6 +134,7 @@ class ReplaySummary:
     damaged: str = ""  # the input's damage, where the replay stopped at it ('' if none)
     decimation: int = 1  # outputs.decimation: what the peaks are (`figures.peak_label`)
     frame_id_setting: str = "input.frame_id"  # what set the frame id expected, to point at
+    never_started: str = ""  # why the twin never started (`HealthWindow.never_started`)
 
     @property
     def worst_level(self) -> int:
@@ -150,6 +153,15 @@ class ReplaySummary:
         bag's header.frame_id when it is the wrong one, pointing at what set the one expected."""
         return intake.nothing_accepted(self.counts, self.wrong_frame_id, self.frame_id_setting)
 
+    def followed_nothing(self) -> str:
+        """Why the run has no motion and no mount loads ('' if it has): no input sample was
+        accepted, or the twin never started (`never_started`); either exits 3 (`verdict`)."""
+        return self.nothing_accepted() or self.never_started
+
+    def _nothing_because(self) -> str:
+        """`followed_nothing` without its details, after "none, " or "no figure, "."""
+        return NO_SAMPLE_ACCEPTED if self.nothing_accepted() else NEVER_STARTED
+
     @property
     def real_time_factor(self) -> float:
         """Stamp time processed per wall second."""
@@ -161,7 +173,7 @@ class ReplaySummary:
         lines = [
             f"replayed {self.input_bag} -> {self.output_bag}",
             *([f"  input damaged, replayed up to the damage: {d}"] if (d := self.damaged) else []),
-            *([f"  {nothing}"] if (nothing := self.nothing_accepted()) else []),
+            *([f"  {nothing}"] if (nothing := self.followed_nothing()) else []),
             *([f"  {FAILED}: {self.failure}"] if self.failure else []),
             f"  input samples: {c.get('received', 0)} received, {c.get('accepted', 0)} accepted, "
             f"rejected: {intake.counted_text(c, 'rejected_')}, gaps: {c.get('gaps', 0)}, "
@@ -182,7 +194,7 @@ class ReplaySummary:
             f"  latency: {self._latency_text(nothing)}",
         ]
         if nothing:
-            lines.append("  motion and mount loads: none, no input sample was accepted")
+            lines.append(f"  motion and mount loads: none, {self._nothing_because()}")
         else:
             lines += self._figure_lines()
         lines.append(f"  mount events: {len(self.events) or 'none'}")
@@ -201,10 +213,10 @@ class ReplaySummary:
         return "\n".join(lines)
 
     def _latency_text(self, nothing: str) -> str:
-        """How late the outputs follow their input; no figure where no sample was accepted
-        (`nothing`) or the gyro filter, designed at the accepted samples' rate, never was."""
+        """How late the outputs follow their input; no figure where the run followed nothing
+        (`nothing`: why) or the gyro filter, designed at the accepted samples' rate, never was."""
         if nothing:
-            return "no figure, no input sample was accepted"
+            return f"no figure, {self._nothing_because()}"
         if self.latency is None:
             return f"no figure, {NOT_DESIGNED}"
         samples, seconds = self.latency
@@ -250,7 +262,7 @@ class ReplaySummary:
         """The summary as JSON-ready data, units in the key names; event times `t_s` count
         from the first output, `stamp_s` are header stamps."""
         util = self.utilisation_max
-        known = not self.nothing_accepted()  # else no figures: null, not a machine at rest
+        known = not self.followed_nothing()  # else no figures: null, not a machine at rest
         latency = self.latency if known else None
         return {
             "input_bag": self.input_bag,
@@ -259,6 +271,7 @@ class ReplaySummary:
             "failure": self.failure or None,
             "input_damaged": self.damaged or None,
             "nothing_accepted": self.nothing_accepted() or None,
+            "never_started": self.never_started or None,
             "diagnostics_worst_level": LEVEL_NAMES[self.worst_level],
             "counts": dict(self.counts),
             "stamp_span_s": self.stamp_span_s,
@@ -576,4 +589,5 @@ def _summary(
         None if stream.body is None else dict(stream.body.counts),
         scene.body_sensor.topic if scene.body_sensor else "",
         decimation=scene.outputs.decimation,
+        never_started=engine.health.never_started(engine.counts),
     )

@@ -558,6 +558,27 @@ def test_a_stall_after_input_says_it_computed_no_attitude_nor_mount_load() -> No
         assert {after.values[k] for k in figures} == {"n/a"}, (name, after.values)
 
 
+@pytest.mark.parametrize("pushed", [1001, 1])
+def test_a_stall_says_its_period_integrated_nothing(pushed: int) -> None:
+    """A stall report of a twin that had integrated (no sample accepted in its period, no
+    interval integrated) read "integration: ok" beside stepper figures of "n/a". It says its
+    period integrated nothing, and why; a run that never integrated an interval (one sample)
+    still says so of the run."""
+    eng = engine(scene_with(input={"gyro_filter": "none"}))
+    eng.push(batch(ramp(pushed)))
+    intervals, substeps = eng.health.intervals_run, eng.counts["substeps"]
+    assert intervals == pushed - 1  # the first sample is the start
+    stalled = eng.report_stalled(1.0)
+    assert (eng.health.intervals_run, eng.counts["substeps"]) == (intervals, substeps)
+    after = status(stalled, "integration")
+    assert after.level == OK, after
+    assert after.values["error_norm_max"] == after.values["substeps_per_sample"] == "n/a"
+    if intervals:
+        assert after.message == "not run in this period: no input sample was accepted in it"
+    else:
+        assert after.message == "not run: no input interval was integrated (1 sample accepted)"
+
+
 def test_the_real_time_factor_is_the_input_time_over_the_wall_time() -> None:
     """real_time_factor: the stamp time the window's input intervals cover over the wall time
     spent on its samples. It took the outputs' span, which the gyro delay shifts and which

@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from io_helpers import CONFIG, REST, G, batch, read_bag
+from io_helpers import CONFIG, REST, ROOT, G, batch, pump_scene_file, read_bag
 from physics_helpers import free_body
 
 from mount_twin.commands.common import write_signal
@@ -195,3 +195,49 @@ def test_the_replay_summary_says_what_was_not_followed_and_why(tmp_path: Path) -
     assert [v.value for v in attitude.values] == ["n/a"]
     assert float(summary.worst[ATTITUDE].values["tilt_max_rad"]) >= 0.0
     assert summary.to_dict()["diagnostics_worst"][ATTITUDE]["level"] == "OK"
+
+
+def test_a_period_decimation_left_without_a_row_has_no_tilt_nor_peak_of_0(tmp_path: Path) -> None:
+    """outputs.decimation above a period's samples: the period integrates them and publishes
+    no row, and its attitude and mount statuses read a tilt and peaks of 0, as a machine at
+    rest, while its peaks went into the next row published. Its tilt and peaks (figures of
+    published rows) are "n/a" and it says why; its utilisation, folded in at every sample, is
+    its own; a period that published rows has its figures."""
+    path = pump_scene_file(
+        tmp_path,
+        input={"gyro_filter": "none"},  # rows at their samples' stamps: each in its period
+        outputs={"decimation": 1000, "diagnostics_period_s": 0.01},  # 100 samples at 10 kHz
+    )
+    replay(
+        load_scene_file(path),
+        ROOT / "bags" / "half_sine_shock_10khz",
+        tmp_path / "out",
+        progress=False,
+    )
+    _, msgs = read_bag(tmp_path / "out")
+    rows = np.array([t for t, _ in msgs["/mount_twin/pose"]])
+    seen = {"without": 0, "with": 0}
+    before = 0
+    for stamp, report in msgs["/diagnostics"]:
+        published = int(np.count_nonzero((rows > before) & (rows <= stamp)))
+        before = stamp
+        statuses = {s.name: s for s in report.status}
+        integrated = statuses[INTEGRATION].values
+        if any(v.key == "substeps_per_sample" and v.value == "n/a" for v in integrated):
+            continue  # integrated nothing: "not computed" (tested elsewhere)
+        seen["with" if published else "without"] += 1
+        for name, status in statuses.items():
+            if name != ATTITUDE and not name.startswith(MOUNT):
+                continue
+            values = {v.key: v.value for v in status.values}
+            figures = {
+                v for k, v in values.items() if k.startswith("peak_") or k == "tilt_max_rad"
+            }
+            if published:
+                assert "n/a" not in figures, (name, values)
+                continue
+            assert figures == {"n/a"}, (name, values)
+            assert "no row published in this period" in status.message, status
+            if name.startswith(MOUNT):
+                assert float(values["utilisation_max"]) > 0.0, values
+    assert seen["without"] > 0 and seen["with"] > 0, seen

@@ -414,10 +414,10 @@ def test_a_replay_that_accepted_nothing_says_its_integration_did_not_run(
     assert status.message == said
 
 
-def _one_sample_bag(path: Path) -> Path:
-    """A bag of one deck IMU sample, at rest."""
-    stamps = np.array([1_700_000_000 * 10**9], dtype=np.int64)
-    accel, gyro = np.array([[0.0, 0.0, 9.80665]]), np.zeros((1, 3))
+def _one_sample_bag(path: Path, n: int = 1) -> Path:
+    """A bag of one deck IMU sample (or `n`, at 1 kHz), at rest."""
+    stamps = 1_700_000_000 * 10**9 + np.arange(n, dtype=np.int64) * 10**6
+    accel, gyro = np.tile([0.0, 0.0, 9.80665], (n, 1)), np.zeros((n, 3))
     write_bag(path, "/deck/imu", IMU, iter(imu_messages(stamps, accel, gyro, "deck_imu")))
     return path
 
@@ -545,6 +545,46 @@ def test_a_run_that_integrated_no_interval_says_its_integration_did_not_run(
         values = {v.key: v.value for v in status.values}
         assert status.message == worst["message"]
         assert values["error_norm_max"] == values["substeps_per_sample"] == "n/a", values
+
+
+def test_a_replay_too_short_to_start_the_twin_says_so_and_does_not_pass(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Three samples accepted where a start takes five (initial_state.gravity_samples): the
+    twin never started, nothing marked the period as having content, and the replay wrote no
+    diagnostics report at all, while its summary read peaks and utilisations of 0, "worst over
+    the run: OK", verdict OK, exit 0. The output bag ends with a report that says what
+    happened, the integration at ERROR, and the summary has no figures and exits 3."""
+    gather, n = 5, 3
+    data = read_scene_yaml(PUMP)
+    data["initial_state"] = {**data["initial_state"], "gravity_samples": gather}
+    scene = tmp_path / "gather.scene.yaml"
+    scene.write_text(yaml.safe_dump(data), encoding="utf-8")
+    code, doc, out = _replay(tmp_path, scene, _one_sample_bag(tmp_path / "three", n))
+    counts = doc["counts"]
+    assert (counts["accepted"], counts.get("starts", 0), counts.get("substeps", 0)) == (n, 0, 0)
+    assert code == 3 and doc["verdict"] == "ERROR" and doc["nothing_accepted"] is None
+    said = doc["never_started"]
+    assert said and f"{n} samples accepted" in said and f"{gather}" in said, said
+    assert f"mount-twin: error: {said}\n" in capsys.readouterr().err
+    assert doc["max_tilt_rad"] is None and doc["max_cg_displacement_from_start_m"] is None
+    assert {m["peak_force_magnitude_N"] for m in doc["mounts"].values()} == {None}
+    _, msgs = read_bag(out)
+    assert "/mount_twin/pose" not in msgs  # the twin published nothing
+    (report,) = [m for _, m in msgs["/diagnostics"]]
+    statuses = {s.name: s for s in report.status}
+    inputs = {v.key: v.value for v in statuses["mount_twin: input"].values}
+    assert int(inputs["accepted"]) == n and statuses["mount_twin: input"].level == 0
+    integration = statuses["mount_twin: integration"]
+    assert integration.level == 2 and integration.message == said
+    assert doc["diagnostics_worst"]["mount_twin: integration"]["message"] == said
+    values = {v.key: v.value for v in integration.values}
+    assert values["error_norm_max"] == values["substeps_per_sample"] == "n/a", values
+    for name, status in statuses.items():
+        if name.startswith(("mount_twin: attitude", "mount_twin: mount ")):
+            figures = {v.value for v in status.values if "peak" in v.key or "max" in v.key}
+            assert status.level == 0 and figures == {"n/a"}, (name, status)
+            assert status.message.startswith("not computed in this period: "), status
 
 
 FULL = "/dev/full"

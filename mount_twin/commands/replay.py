@@ -22,7 +22,8 @@ FAIL_ON = ("never", "warn", "error")
 EXIT_STATUS = (
     "exit status: 0 done; 2 bad input or configuration, or a failed write (the message names "
     "the file; a run that failed too, 3 to 6, says so before it); 3 no input sample "
-    "accepted; 4 diagnostics reached --fail-on; 6 FAILED: the "
+    "accepted, or too few to start the twin (initial_state.gravity_samples); 4 diagnostics "
+    "reached --fail-on; 6 FAILED: the "
     "integration failed at least once (the summary says how often and why), whatever "
     "--fail-on says: after a failure the twin restarts at an equilibrium or stops following, "
     "so its figures are no longer the motion the record drove; 5 input bag "
@@ -181,16 +182,17 @@ EXIT_NOTHING_ACCEPTED, EXIT_FAIL_ON, EXIT_FAILED = 3, 4, 6
 
 def verdict(summary: ReplaySummary, fail_on: str) -> int:
     """The exit status of a replay (`run_exit_status`; the bag holds input samples, `InputBag`
-    saw to it, so none accepted says why)."""
+    saw to it, so none accepted says why, as a twin that never started does)."""
     return run_exit_status(
-        summary.nothing_accepted(), summary.failure, summary.worst_level, fail_on
+        summary.followed_nothing(), summary.failure, summary.worst_level, fail_on
     )
 
 
 def run_exit_status(nothing: str, failure: str, worst_level: int, fail_on: str) -> int:
-    """The exit status of a run, saying why on stderr: 3 if no input sample was accepted
-    (`nothing`: why), 6 if the integration failed (FAILED; `failure`: how often and why), 4 if
-    its worst diagnostics level (an index in LEVEL_NAMES) reached `fail_on`, else 0."""
+    """The exit status of a run, saying why on stderr: 3 if no input sample was accepted or
+    the twin never started (`nothing`: why), 6 if the integration failed (FAILED; `failure`:
+    how often and why), 4 if its worst diagnostics level (an index in LEVEL_NAMES) reached
+    `fail_on`, else 0."""
     if nothing:
         print(f"mount-twin: error: {nothing}", file=sys.stderr)
         return EXIT_NOTHING_ACCEPTED

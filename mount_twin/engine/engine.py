@@ -388,10 +388,10 @@ class TwinEngine:
         self._reporting.add(tail, frame)
         last_stamp = self._intake.last_stamp
         if last_stamp is not None:
-            if self.health.pending:
-                return [self._reporting.report(last_stamp, last, parts)]
+            if self.health.pending(self.counts):
+                return [self._reporting.report(last_stamp, last, parts, ended=True)]
         elif self.counts["received"] and not self.counts["accepted"]:
-            return [self._reporting.report(math.nan, last, parts, stalled_s=ENDED)]
+            return [self._reporting.report(math.nan, last, parts, stalled_s=ENDED, ended=True)]
         return []
 
     def report_stalled(self, waited_s: float) -> HealthReport:

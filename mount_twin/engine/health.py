@@ -29,18 +29,32 @@ ATTITUDE = f"{PREFIX}: attitude"
 """Name of the attitude status."""
 MOUNT = f"{PREFIX}: mount "
 """A mount status' name: MOUNT + the mount's name."""
-NOT_RUN = "not run: no input sample was accepted"
+NO_SAMPLE_ACCEPTED = "no input sample was accepted"
+"""Why a run computed nothing at all (NOT_RUN, NOT_COMPUTED; the replay's summary)."""
+NOT_RUN = f"not run: {NO_SAMPLE_ACCEPTED}"
 """The integration status' text while no input sample has been accepted (it had read "ok",
 as if the twin had integrated the run clean)."""
 NO_INTERVAL_RUN = "not run: no input interval was integrated"
 """The integration status' text while samples were accepted but no interval between two was
 integrated (one sample: it had read "ok", as if the twin had integrated the run clean)."""
-NOT_COMPUTED = "not computed: no input sample was accepted"
+NOT_COMPUTED = f"not computed: {NO_SAMPLE_ACCEPTED}"
 """The attitude and mount statuses' text while no input sample has been accepted, their
 figures "n/a" (they had read "ok" with a tilt and peaks of 0, as a machine at rest)."""
 NOT_COMPUTED_HERE = "not computed in this period"
 """The attitude and mount statuses' text, with why, for a period that computed no motion and
 no mount load after samples were accepted before it (a stall, a twin that follows no more)."""
+NOT_RUN_HERE = "not run in this period"
+"""The integration status' text, with why, for a period that integrated no input interval in a
+run that integrated some before it (a stall, a restart gathering its samples): its stepper
+figures "n/a" (it had read "ok")."""
+NOT_PUBLISHED_HERE = "no row published in this period"
+"""The attitude and mount statuses' text, with why, for a period that integrated samples but
+published none of them (`outputs.decimation` above its samples): its tilt and peaks, figures of
+published rows, "n/a" (they had read 0, a machine at rest), the utilisation its own."""
+NEVER_STARTED = "the twin never started"
+"""What a run that accepted samples but ended before a start says (`HealthWindow.never_started`):
+fewer samples than `initial_state.gravity_samples` (it had written no report at all, and its
+replay read OK)."""
 NOT_DESIGNED = (
     "the gyro filter was never designed: no two input samples were accepted without a restart "
     "between them"
@@ -126,6 +140,9 @@ class HealthWindow:
         failed, a start without equilibrium) until a restart; each report says so at ERROR."""
         self.stopped_why = ""
         """Why it stopped (`stop`)."""
+        self.gathering: tuple[int, int] | None = None
+        """(samples gathered, samples a start takes) while samples are gathered toward a start
+        (`starts.Starts.gather`); None otherwise."""
         self.last_wrong_frame_id: str | None = None
         """header.frame_id of the last sample rejected as wrong_frame (any period)."""
         self.latency: tuple[int, float] | None = None if filter_bands(scene.input) else (0, 0.0)
@@ -158,10 +175,32 @@ class HealthWindow:
         self.notes: list[str] = []
         """Warnings on how the input is taken (a gyro filter the sample rate cannot carry)."""
 
-    @property
-    def pending(self) -> bool:
-        """Whether anything was recorded since the last report."""
-        return bool(self.samples or self.events or self.failures or self.starts or self.published)
+    def pending(self, counts: Counter[str]) -> bool:
+        """Whether anything happened since the last report: an input sample received (the
+        engine's `counts`; samples merely gathered toward a start leave nothing else) or
+        anything recorded."""
+        new = counts["received"] - self._last_counts["received"]
+        return bool(
+            new or self.samples or self.events or self.failures or self.starts or self.published
+        )
+
+    def gathered_text(self) -> str:
+        """'3 of the initial_state.gravity_samples 5 gathered toward a start', or '' where no
+        start is gathered (`gathering`)."""
+        if self.gathering is None:
+            return ""
+        k, n = self.gathering
+        return f"{k} of the initial_state.gravity_samples {n} gathered toward a start"
+
+    def never_started(self, counts: Counter[str]) -> str:
+        """Why the twin never started though input samples were accepted ('' if it started,
+        or none was accepted: NOT_RUN says that): NEVER_STARTED, the samples accepted and
+        those gathered toward the start. Said at the input's end, a run's verdict."""
+        n = counts["accepted"]
+        if counts["starts"] or not n:
+            return ""
+        gathered = self.gathered_text()
+        return f"{NEVER_STARTED}: {_samples(n)} accepted{', ' if gathered else ''}{gathered}"
 
     def gyro_designed(self, stamp: float, design: Design) -> None:
         """The gyro filter designed at the interval into `stamp` (s): its latency from now on;
@@ -346,6 +385,7 @@ class HealthWindow:
         lost_from_stamps: int = 0,
         nominal_interval_s: float = math.nan,
         stalled_s: float | None = None,
+        ended: bool = False,
     ) -> HealthReport:
         """Statuses at `stamp` (s), after pushed sample `sample`, for the window so far, which
         then starts anew.
@@ -358,17 +398,21 @@ class HealthWindow:
         `lost_from_stamps`, `nominal_interval_s` (s): `lost_estimate` of this window (already
         added to counts["lost_estimated"]). `stalled_s`: set by a live adapter's stall timer,
         the clock time (s) since the last report, or `ENDED` when the input ended (a bag) with
-        no sample accepted since; the input status is then an ERROR.
+        no sample accepted since; the input status is then an ERROR. `ended`: the stream's
+        last report (a run whose twin never started then says so at ERROR).
         """
         new = counts - self._last_counts
         self._last_counts = counts.copy()
         inp = self._input_status(
             new, counts, self._input_rate(), lost_from_stamps, nominal_interval_s, stalled_s
         )
-        step = self._integration_status(counts, self._stamp_seconds())
+        step = self._integration_status(counts, new, self._stamp_seconds(), ended)
         why = self._not_computed(counts, new)
-        att = self._attitude_status(why)
-        mounts = self._mount_statuses(utilisation, active, why)
+        if why is not None:  # no utilisation either
+            utilisation = np.full_like(utilisation, math.nan)
+        unpublished = why or self._not_published()
+        att = self._attitude_status(unpublished)
+        mounts = self._mount_statuses(utilisation, active, unpublished)
         self._reset()
         return HealthReport(stamp, sample, [inp, step, att, *mounts])
 
@@ -380,25 +424,43 @@ class HealthWindow:
             return None
         if not counts["accepted"]:
             return NOT_COMPUTED
-        if not new["accepted"]:
-            return f"{NOT_COMPUTED_HERE}: no input sample was accepted in it"
-        if self.stopped_at is not None:
-            return (
-                f"{NOT_COMPUTED_HERE}: the twin follows no more since "
-                f"{self.origin_s + self.stopped_at:.6f} s"
-            )
-        return f"{NOT_COMPUTED_HERE}: none of its samples was integrated yet"
+        return f"{NOT_COMPUTED_HERE}: {self._idle_why(new)}"
 
-    def _integration_status(self, counts: Counter[str], span: float) -> HealthStatus:
+    def _not_published(self) -> str | None:
+        """Why this window, which integrated samples, has no tilt nor peak of its own (None: it
+        published rows, the figures' source): `outputs.decimation` published none of them, and
+        the peaks since the last row go into the next one (`driver.CoreDriver.close_run`)."""
+        if self.published:
+            return None
+        d = self.scene.outputs.decimation
+        return (
+            f"{NOT_PUBLISHED_HERE}: {_samples(self.samples)} integrated, outputs.decimation "
+            f"{d} publishes one in {d}; their peak loads go into the next row published"
+        )
+
+    def _idle_why(self, new: Counter[str]) -> str:
+        """Why this window integrated no input interval where samples were accepted before it
+        or in it (`new`: this window's counts): none accepted in it, the twin follows no more,
+        a start gathering its samples (`gathered_text`), or the gyro delay still holds them."""
+        if not new["accepted"]:
+            return "no input sample was accepted in it"
+        if self.stopped_at is not None:
+            return f"the twin follows no more since {self.origin_s + self.stopped_at:.6f} s"
+        return self.gathered_text() or "none of its samples was integrated yet"
+
+    def _integration_status(
+        self, counts: Counter[str], new: Counter[str], span: float, ended: bool
+    ) -> HealthStatus:
         """The integration status of this window (`span`: the stamp time its input intervals
         cover, s; over its wall time, the real-time factor): stepper failures and
         a stop (ERROR), notes on how the input is taken and an estimated error past
         WARN_FORCE_ERROR_REL (WARN); the solver's settings and figures as values ("n/a" where
         this window integrated no interval). Before any input interval is integrated, NOT_RUN
-        or NO_INTERVAL_RUN (`_not_run`)."""
+        or NO_INTERVAL_RUN, NOT_RUN_HERE for a later window that integrated none (`_not_run`);
+        at the input's end (`ended`) a twin that never started is an ERROR (`never_started`)."""
         integ = self.scene.integration
         rtf = span / self.wall if self.wall > 0 and span > 0 else math.nan
-        level, step_text = self._stepper_status(counts)
+        level, step_text = self._stepper_status(counts, new, ended)
         estimate = self._estimate_values()
         warning = estimate_warning(self.run_estimate()) if estimate else None
         for note in (*self.notes, warning):
@@ -426,10 +488,12 @@ class HealthWindow:
             },
         )
 
-    def _stepper_status(self, counts: Counter[str]) -> tuple[int, str]:
+    def _stepper_status(
+        self, counts: Counter[str], new: Counter[str], ended: bool
+    ) -> tuple[int, str]:
         """Level and text of the stepper in this window: ERROR with its failures and forced
-        starts (stamps in s) or a stop, else OK (`_not_run` where no interval was integrated
-        in the run so far)."""
+        starts (stamps in s) or a stop, or a twin that never started by the input's end
+        (`ended`), else OK (`_not_run` where this window integrated no interval)."""
 
         def listed(what: list[tuple[float, str]]) -> str:
             return "; ".join(f"{self.origin_s + t:.6f} s: {m}" for t, m in what)
@@ -446,26 +510,36 @@ class HealthWindow:
                 "the stamps jumping back) finds a state to start from"
                 + (f" ({'; '.join(said)})" if said else "")
             )
+        elif ended and (never := self.never_started(counts)):
+            said.append(never)
+            step_text = "; ".join(said)
         else:
-            step_text = "; ".join(said) or self._not_run(counts) or "ok"
+            step_text = "; ".join(said) or self._not_run(counts, new) or "ok"
         return (ERROR if said or self.stopped_at is not None else OK), step_text
 
-    def _not_run(self, counts: Counter[str]) -> str | None:
-        """Why the integration has not run (None: the run integrated an input interval):
-        NOT_RUN where no input sample was accepted, else NO_INTERVAL_RUN (one sample, or all
-        gathered toward a start)."""
-        if self.intervals_run:
+    def _not_run(self, counts: Counter[str], new: Counter[str]) -> str | None:
+        """Why this window integrated no input interval (None: it integrated one): NOT_RUN
+        where no input sample was accepted, NO_INTERVAL_RUN where the run integrated none yet
+        (one sample, or all gathered toward a start), else NOT_RUN_HERE and why
+        (`_idle_why`)."""
+        if self.samples:
             return None
         n = counts["accepted"]
         if not n:
             return NOT_RUN
-        return f"{NO_INTERVAL_RUN} ({n} sample{'' if n == 1 else 's'} accepted)"
+        if not self.intervals_run:
+            gathered = self.gathered_text()
+            return (
+                f"{NO_INTERVAL_RUN} ({_samples(n)} accepted{', ' if gathered else ''}{gathered})"
+            )
+        return f"{NOT_RUN_HERE}: {self._idle_why(new)}"
 
-    def _attitude_status(self, not_computed: str | None) -> HealthStatus:
+    def _attitude_status(self, no_rows: str | None) -> HealthStatus:
         """The attitude status of this window: WARN past `outputs.tilt_warn_rad` of tilt, where
-        the α/γ/δ chart degrades; `not_computed` (`_not_computed`) at OK, tilt "n/a"."""
-        if not_computed is not None:
-            return HealthStatus(ATTITUDE, OK, not_computed, {TILT_KEY: "n/a"})
+        the α/γ/δ chart degrades; `no_rows` (`_not_computed`, `_not_published`: why it has no
+        published row) at OK, tilt "n/a"."""
+        if no_rows is not None:
+            return HealthStatus(ATTITUDE, OK, no_rows, {TILT_KEY: "n/a"})
         warn = self.scene.outputs.tilt_warn_rad
         return HealthStatus(
             ATTITUDE,
@@ -505,14 +579,13 @@ class HealthWindow:
         self,
         utilisation: np.ndarray,
         active: dict[str, list[tuple[str, bool]]],
-        not_computed: str | None,
+        no_rows: str | None,
     ) -> list[HealthStatus]:
-        """One status per mount: peak wrench per axis, utilisation, events by name, and the
-        conditions holding now; `not_computed` (`_not_computed`) in place of "ok", peaks and
-        utilisation "n/a" (the conditions holding keep their level)."""
+        """One status per mount: peak wrench per axis, utilisation (NaN: none), events by
+        name, and the conditions holding now; `no_rows` (`_not_computed`, `_not_published`:
+        why the window has no published row) said beside them, "ok" aside, the peaks "n/a"
+        (the conditions holding keep their level)."""
         warn_at = 1.0 - self.scene.outputs.alarm_margin
-        if not_computed is not None:
-            utilisation = np.full_like(utilisation, math.nan)
         events: dict[str, list[MountEvent]] = {}
         for event in self.events:
             events.setdefault(event.mount, []).append(event)
@@ -529,7 +602,7 @@ class HealthWindow:
             else:
                 level = OK
             values = {
-                key: "n/a" if not_computed else f"{v:.6g}"
+                key: "n/a" if no_rows else f"{v:.6g}"
                 for key, v in zip(PEAK_KEYS, peak, strict=True)
             }
             values[UTILISATION_KEY] = "n/a" if math.isnan(u) else f"{u:.6g}"
@@ -537,8 +610,8 @@ class HealthWindow:
             values.update(_event_values(mine, self.origin_s))
             values[NOW_KEY] = ", ".join(name for name, _ in now) or "none"
             text = _events_text(mine, u, self.origin_s)
-            if text == "ok" and not_computed:
-                text = not_computed
+            if no_rows:
+                text = no_rows if text == "ok" else f"{text}; {no_rows}"
             if now:
                 text = f"now: {values[NOW_KEY]}" + ("" if text == "ok" else f"; {text}")
             out.append(HealthStatus(MOUNT + mount.name, level, text, values))
@@ -733,6 +806,11 @@ def _median(values: np.ndarray) -> float:
         return float(np.partition(values, half)[half])
     low, high = np.partition(values, (half - 1, half))[half - 1 : half + 1]
     return float((low + high) / 2.0)
+
+
+def _samples(n: int) -> str:
+    """'1 sample', '3 samples'."""
+    return f"{n} sample{'' if n == 1 else 's'}"
 
 
 def _seconds(t: float) -> str:

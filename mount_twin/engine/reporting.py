@@ -70,10 +70,13 @@ class Reporting:
         sample: int,
         parts: list[Part] | None = None,
         stalled_s: float | None = None,
+        *,
+        ended: bool = False,
     ) -> HealthReport:
         """The report due at `stamp` (s), after sample `sample` and the output rows of `parts`
         (those published before it in its batch); `stalled_s`: the input stalled that long (s,
-        `health.ENDED`: the record ended) without a report falling due. Ends the window."""
+        `health.ENDED`: the record ended) without a report falling due; `ended`: the stream's
+        last report. Ends the window."""
         per_mount = np.full(self._n_mounts, math.nan)
         per_mount[self._driver.rated] = self._driver.window_utilisation()
         lost, nominal = self._health.lost_estimate()
@@ -88,6 +91,7 @@ class Reporting:
             lost_from_stamps=lost,
             nominal_interval_s=nominal,
             stalled_s=stalled_s,
+            ended=ended,
         )
         report.rows = sum(p.pose.shape[0] for p in parts or ())
         self._driver.end_window()

@@ -114,6 +114,7 @@ class Starts:
         ends (gathering `gravity_samples` only at a push's end answered fewer samples the
         smaller the pushes)."""
         self._failed, self._gathered = True, []
+        self._health.gathering = None
 
     def gather(self, run: Run, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Take a run's samples toward a start (`initial.gravity_samples` of them).
@@ -123,11 +124,14 @@ class Starts:
         """
         if run.restart:  # a gap or a stamp jump: gravity is gathered again
             self._gathered, self._failed = [], False
-        need = (1 if self._failed else self._start_samples) - len(self._gathered)
+        takes = 1 if self._failed else self._start_samples
+        need = takes - len(self._gathered)
         taken = run.index[:need]
         self._gathered.extend(f[taken])
         if need > len(taken):
+            self._health.gathering = (len(self._gathered), takes)
             return run.index[:0], np.empty((0, 3))
+        self._health.gathering = None
         gathered, self._gathered = np.array(self._gathered), []
         return run.index[len(taken) - 1 :], gathered
 
