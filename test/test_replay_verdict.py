@@ -554,13 +554,15 @@ def test_a_replay_too_short_to_start_the_twin_says_so_and_does_not_pass(
     twin never started, nothing marked the period as having content, and the replay wrote no
     diagnostics report at all, while its summary read peaks and utilisations of 0, "worst over
     the run: OK", verdict OK, exit 0. The output bag ends with a report that says what
-    happened, the integration at ERROR, and the summary has no figures and exits 3."""
+    happened, the integration at ERROR, and the summary has no figures and exits 3; a sweep of
+    it is a FAILED case."""
     gather, n = 5, 3
     data = read_scene_yaml(PUMP)
     data["initial_state"] = {**data["initial_state"], "gravity_samples": gather}
     scene = tmp_path / "gather.scene.yaml"
     scene.write_text(yaml.safe_dump(data), encoding="utf-8")
-    code, doc, out = _replay(tmp_path, scene, _one_sample_bag(tmp_path / "three", n))
+    bag = _one_sample_bag(tmp_path / "three", n)
+    code, doc, out = _replay(tmp_path, scene, bag)
     counts = doc["counts"]
     assert (counts["accepted"], counts.get("starts", 0), counts.get("substeps", 0)) == (n, 0, 0)
     assert code == 3 and doc["verdict"] == "ERROR" and doc["nothing_accepted"] is None
@@ -585,6 +587,9 @@ def test_a_replay_too_short_to_start_the_twin_says_so_and_does_not_pass(
             figures = {v.value for v in status.values if "peak" in v.key or "max" in v.key}
             assert status.level == 0 and figures == {"n/a"}, (name, status)
             assert status.message.startswith("not computed in this period: "), status
+    # a sweep of it is a case that failed, not a machine at rest (its row had read peaks of 0)
+    row = _sweep_row(tmp_path, scene, data["body"]["mass"], bag)
+    assert row["verdict"] == FAILED and row["error"] == said, row
 
 
 FULL = "/dev/full"

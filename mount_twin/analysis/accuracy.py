@@ -44,7 +44,6 @@ from mount_twin.engine.batch import OutputBatch, SampleBatch
 from mount_twin.engine.delay_line import conditioned_rates, filter_bands
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.estimate import ErrorEstimate
-from mount_twin.engine.intake import nothing_accepted
 from mount_twin.errors import MountTwinError
 from mount_twin.model.assemble import assemble
 from mount_twin.scene.description import Scene
@@ -223,7 +222,7 @@ def run_at(
     out = engine.run(samples)
     wall = time.perf_counter() - t0
     counts = engine.counts
-    if nothing := nothing_accepted(counts):  # no run to measure
+    if nothing := engine.followed_nothing:  # no run to measure
         raise MountTwinError(nothing)
     intervals = max(counts["accepted"] - counts["starts"], 1)
     return Run(

@@ -27,7 +27,7 @@ from mount_twin.engine.driver import CoreDriver
 from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.gyro_filter import Design
 from mount_twin.engine.health import ENDED, HealthWindow
-from mount_twin.engine.intake import Intake, Judged, runs
+from mount_twin.engine.intake import Intake, Judged, nothing_accepted, runs
 from mount_twin.engine.kernel import AT_EVENT, Samples
 from mount_twin.engine.reporting import Reporting
 from mount_twin.engine.rows import BatchRows, Part, Tail
@@ -107,6 +107,15 @@ class TwinEngine:
         if self._driver.estimator is None:
             return None
         return self.health.run_estimate()
+
+    @property
+    def followed_nothing(self) -> str:
+        """Why the twin followed none of the input ('' if it did): no sample accepted
+        (`intake.nothing_accepted`), or too few to start it (`HealthWindow.never_started`). A
+        run like that has no figures: a sweep's case or an accuracy run is FAILED, not a
+        machine at rest."""
+        counts = self.counts
+        return nothing_accepted(counts) or self.health.never_started(counts)
 
     @property
     def failure_text(self) -> str:

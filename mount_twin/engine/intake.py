@@ -18,7 +18,7 @@ import numpy as np
 
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.engine.delay_line import Run
-from mount_twin.engine.health import PLATEAU_G, SATURATION_SHARE, HealthWindow
+from mount_twin.engine.health import NO_SAMPLE_ACCEPTED, PLATEAU_G, SATURATION_SHARE, HealthWindow
 from mount_twin.model.assemble import Model
 from mount_twin.scene.description import InputSpec
 
@@ -132,7 +132,7 @@ def nothing_accepted(
         f"{counts.get('received', 0)} received, rejected: "
         f"{counted_text(counts, 'rejected_')}{detail}"
     )
-    return f"no input sample was accepted ({why})"
+    return f"{NO_SAMPLE_ACCEPTED} ({why})"
 
 
 def rotated(rows: np.ndarray, rot: np.ndarray) -> np.ndarray:

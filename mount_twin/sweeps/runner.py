@@ -31,7 +31,6 @@ from mount_twin.analysis.figures import (
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, SampleBatch
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.health import tilt_from_quaternions
-from mount_twin.engine.intake import nothing_accepted
 from mount_twin.errors import MountTwinError
 from mount_twin.model.assemble import assemble
 from mount_twin.physics import pose_row
@@ -120,7 +119,7 @@ def run_cases(base: dict[str, Any], source: str, cases: list[Case]) -> list[dict
 def _figures(scene: Scene, samples: SampleBatch) -> dict[str, Any]:
     engine = TwinEngine(assemble(scene))
     out = engine.run(samples)
-    if nothing := nothing_accepted(engine.counts):  # no figures, as a case that raised
+    if nothing := engine.followed_nothing:  # no figures, as a case that raised
         return {"verdict": FAILED, "error": nothing}
     reports = out.health
     worst = max((s.level for r in reports for s in r.statuses), default=0)
