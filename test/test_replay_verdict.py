@@ -555,7 +555,7 @@ def test_a_replay_too_short_to_start_the_twin_says_so_and_does_not_pass(
     diagnostics report at all, while its summary read peaks and utilisations of 0, "worst over
     the run: OK", verdict OK, exit 0. The output bag ends with a report that says what
     happened, the integration at ERROR, and the summary has no figures and exits 3; a sweep of
-    it is a FAILED case."""
+    it is a FAILED case, and its report says it and exits 3 too."""
     gather, n = 5, 3
     data = read_scene_yaml(PUMP)
     data["initial_state"] = {**data["initial_state"], "gravity_samples": gather}
@@ -590,6 +590,12 @@ def test_a_replay_too_short_to_start_the_twin_says_so_and_does_not_pass(
     # a sweep of it is a case that failed, not a machine at rest (its row had read peaks of 0)
     row = _sweep_row(tmp_path, scene, data["body"]["mass"], bag)
     assert row["verdict"] == FAILED and row["error"] == said, row
+    # its report says so and exits as the replay did (it had read ERROR, exit 0, peaks of 0)
+    page = tmp_path / "r.html"
+    capsys.readouterr()
+    assert main(["report", str(out), "-o", str(page)]) == 3
+    assert f"mount-twin: error: {said}\n" in capsys.readouterr().err
+    assert "<p>none: the twin never started</p>" in page.read_text(encoding="utf-8")
 
 
 FULL = "/dev/full"

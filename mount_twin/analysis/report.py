@@ -45,7 +45,13 @@ from mount_twin.analysis.modes_text import (
 )
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
 from mount_twin.engine.estimate import NOT_INTEGRATED
-from mount_twin.engine.health import NOT_DESIGNED, UTILISATION_KEY
+from mount_twin.engine.health import (
+    INTEGRATION,
+    NEVER_STARTED,
+    NO_SAMPLE_ACCEPTED,
+    NOT_DESIGNED,
+    UTILISATION_KEY,
+)
 from mount_twin.engine.intake import nothing_accepted
 from mount_twin.errors import ModelError
 from mount_twin.io.bag import partial_marker
@@ -97,13 +103,31 @@ def _nothing_accepted(diagnostics: Table | None, scene: Scene | None) -> str:
     return nothing_accepted(counts, values.get("last_wrong_frame_id"), setting)
 
 
+def _followed_nothing(diagnostics: Table | None, scene: Scene | None) -> str:
+    """Why the twin followed none of the input, as its replay says it ('' if it did): no input
+    sample accepted (`_nothing_accepted`), or too few to start it, which the stream's last
+    integration status says (`health.NEVER_STARTED`). Either has no figures, and exits 3."""
+    if nothing := _nothing_accepted(diagnostics, scene):
+        return nothing
+    if diagnostics is None:
+        return ""
+    c = diagnostics.columns
+    said = [m for st, m in zip(c["status"], c["message"], strict=True) if st == INTEGRATION]
+    return said[-1] if said and said[-1].startswith(NEVER_STARTED) else ""
+
+
+def _why_none(nothing: str) -> str:
+    """`_followed_nothing`'s reason without its details, after "none: " or "no figure: "."""
+    return NEVER_STARTED if nothing.startswith(NEVER_STARTED) else NO_SAMPLE_ACCEPTED
+
+
 class RunVerdict(NamedTuple):
     """A run's verdict as its output bag's diagnostics tell it.
 
     text: as the page heads it; worst_level: the worst diagnostics level over the run (index
     in LEVEL_NAMES; None: the bag holds no diagnostics); failure: how often the integration
-    failed ('' if never: else the run is FAILED); nothing: why no input sample was accepted
-    ('' if some were)."""
+    failed ('' if never: else the run is FAILED); nothing: why the twin followed none of the
+    input ('' if it did: `_followed_nothing`)."""
 
     text: str
     worst_level: int | None
@@ -113,8 +137,8 @@ class RunVerdict(NamedTuple):
 
 def _verdict(diagnostics: Table | None, nothing: str) -> tuple[RunVerdict, dict[str, str]]:
     """The run's verdict from its diagnostics (FAILED if the integration ever failed, else the
-    worst level of any status but the live-only `mount_twin: ros`, with `nothing`: why no
-    input sample was accepted, if none was), and the last integration status' values."""
+    worst level of any status but the live-only `mount_twin: ros`, with `nothing`: why the
+    twin followed none of the input, if it did not), and the last integration status' values."""
     if diagnostics is None or not len(diagnostics):
         return RunVerdict("no diagnostics in the bag", None, "", nothing), {}
     c = diagnostics.columns
@@ -158,7 +182,7 @@ def _provenance_section(
         # the gyro filter's latency is set by its design, at the first accepted samples' rate
         latency_s = integration.get("latency_s", "?")
         latency = (
-            "no latency figure: no input sample was accepted"
+            f"no latency figure: {_why_none(verdict.nothing)}"
             if verdict.nothing
             else f"no latency figure: {NOT_DESIGNED}"
             if latency_s == "n/a"
@@ -166,7 +190,7 @@ def _provenance_section(
         )
         # the status names the scene's method until one runs (`auto`: until it chooses)
         ran = (
-            "no method ran: no input sample was accepted"
+            f"no method ran: {_why_none(verdict.nothing)}"
             if verdict.nothing
             else f"ran: {integration.get('method', '?')}"
         )
@@ -365,7 +389,7 @@ def write_report(
     if input_name:
         title += f" (input {input_name})"
     sections = [f"<h1>{html.escape(title)}</h1>"]
-    nothing = _nothing_accepted(diagnostics, scene)
+    nothing = _followed_nothing(diagnostics, scene)
     verdict, integration = _verdict(diagnostics, nothing)
     sections += _provenance_section(
         verdict, integration, output_bag, input_path, scene, input_note
@@ -395,7 +419,7 @@ def write_report(
         sections.append(_displacement_line(tables["pose"]))
     sections += [
         f"<h2>Peaks ({peak_label(scene.outputs.decimation if scene else 1)})</h2>",
-        "<p>none: no input sample was accepted</p>"
+        f"<p>none: {html.escape(_why_none(nothing))}</p>"
         if nothing
         else html_table(
             ["mount", "kind", LABELS[PEAK_FORCE], LABELS[PEAK_COUPLE], "utilisation max"],
