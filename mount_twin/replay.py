@@ -164,8 +164,18 @@ class ReplaySummary:
 
     @property
     def real_time_factor(self) -> float:
-        """Stamp time processed per wall second."""
-        return self.stamp_span_s / self.wall_s if self.wall_s > 0 else float("nan")
+        """Stamp time processed per wall second; NaN where no stamp time was processed (a run
+        that answered no sample: its 0.0 had read as a twin that could not keep up)."""
+        if self.stamp_span_s > 0.0 and self.wall_s > 0.0:
+            return self.stamp_span_s / self.wall_s
+        return math.nan
+
+    def _speed_text(self) -> str:
+        """'real-time factor 11.0', or why there is none."""
+        rtf = self.real_time_factor
+        if math.isnan(rtf):
+            return "no real-time factor (no stamp time processed)"
+        return f"real-time factor {rtf:.1f}"
 
     def text(self) -> str:
         """Human-readable summary."""
@@ -189,7 +199,7 @@ class ReplaySummary:
                 else []
             ),
             f"  {self.written} messages written over {self.stamp_span_s:.3f} s of stamps in "
-            f"{self.wall_s:.2f} s wall: real-time factor {self.real_time_factor:.1f}",
+            f"{self.wall_s:.2f} s wall: {self._speed_text()}",
             f"  {_estimate_text(self.error_estimate)}",
             f"  latency: {self._latency_text(nothing)}",
         ]
@@ -276,7 +286,7 @@ class ReplaySummary:
             "counts": dict(self.counts),
             "stamp_span_s": self.stamp_span_s,
             "wall_s": self.wall_s,
-            "real_time_factor": self.real_time_factor,
+            "real_time_factor": None if math.isnan(rtf := self.real_time_factor) else rtf,
             DISPLACEMENT: self.displacement_max_m if known else None,
             "max_tilt_rad": self.tilt_max_rad if known else None,
             "latency_samples": None if latency is None else latency[0],

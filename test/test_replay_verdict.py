@@ -400,7 +400,7 @@ def test_a_replay_that_accepted_nothing_says_its_integration_did_not_run(
 ) -> None:
     """Every sample rejected (another frame id), nothing integrated: the summary's diagnostics,
     its JSON and the output bag's last integration status read "ok", as if the twin had run
-    clean. They say it did not run, and why."""
+    clean. They say it did not run, and why; and the run has no real-time factor."""
     code, doc, out = _replay(tmp_path, PUMP, SHOCK, "--frame-id", "not_the_imu")
     assert code == 3
     said = "not run: no input sample was accepted"
@@ -412,6 +412,9 @@ def test_a_replay_that_accepted_nothing_says_its_integration_did_not_run(
     (report,) = [m for _, m in msgs["/diagnostics"]]
     (status,) = [s for s in report.status if s.name == "mount_twin: integration"]
     assert status.message == said
+    # no stamp time processed: no speed (it had read "real-time factor 0.0", a twin too slow)
+    assert doc["real_time_factor"] is None
+    assert "s wall: no real-time factor (no stamp time processed)\n" in text
 
 
 def _one_sample_bag(path: Path, n: int = 1) -> Path:
