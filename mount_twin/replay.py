@@ -41,12 +41,11 @@ from mount_twin.engine.estimate import NOT_INTEGRATED, ErrorEstimate
 from mount_twin.engine.health import (
     EVENTS_KEY,
     INTEGRATION,
-    NEVER_STARTED,
-    NO_SAMPLE_ACCEPTED,
     NOT_DESIGNED,
     NOW_KEY,
     UTILISATION_KEY,
     tilt_from_quaternions,
+    why_none,
 )
 from mount_twin.errors import BagError, DamagedBagError, require
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
@@ -158,10 +157,6 @@ class ReplaySummary:
         accepted, or the twin never started (`never_started`); either exits 3 (`verdict`)."""
         return self.nothing_accepted() or self.never_started
 
-    def _nothing_because(self) -> str:
-        """`followed_nothing` without its details, after "none, " or "no figure, "."""
-        return NO_SAMPLE_ACCEPTED if self.nothing_accepted() else NEVER_STARTED
-
     @property
     def real_time_factor(self) -> float:
         """Stamp time processed per wall second; NaN where no stamp time was processed (a run
@@ -204,7 +199,7 @@ class ReplaySummary:
             f"  latency: {self._latency_text(nothing)}",
         ]
         if nothing:
-            lines.append(f"  motion and mount loads: none, {self._nothing_because()}")
+            lines.append(f"  motion and mount loads: none, {why_none(self.followed_nothing())}")
         else:
             lines += self._figure_lines()
         lines.append(f"  mount events: {len(self.events) or 'none'}")
@@ -226,7 +221,7 @@ class ReplaySummary:
         """How late the outputs follow their input; no figure where the run followed nothing
         (`nothing`: why) or the gyro filter, designed at the accepted samples' rate, never was."""
         if nothing:
-            return f"no figure, {self._nothing_because()}"
+            return f"no figure, {why_none(self.followed_nothing())}"
         if self.latency is None:
             return f"no figure, {NOT_DESIGNED}"
         samples, seconds = self.latency

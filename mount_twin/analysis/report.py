@@ -48,9 +48,9 @@ from mount_twin.engine.estimate import NOT_INTEGRATED
 from mount_twin.engine.health import (
     INTEGRATION,
     NEVER_STARTED,
-    NO_SAMPLE_ACCEPTED,
     NOT_DESIGNED,
     UTILISATION_KEY,
+    why_none,
 )
 from mount_twin.engine.intake import nothing_accepted
 from mount_twin.errors import ModelError
@@ -116,11 +116,6 @@ def _followed_nothing(diagnostics: Table | None, scene: Scene | None) -> str:
     return said[-1] if said and said[-1].startswith(NEVER_STARTED) else ""
 
 
-def _why_none(nothing: str) -> str:
-    """`_followed_nothing`'s reason without its details, after "none: " or "no figure: "."""
-    return NEVER_STARTED if nothing.startswith(NEVER_STARTED) else NO_SAMPLE_ACCEPTED
-
-
 class RunVerdict(NamedTuple):
     """A run's verdict as its output bag's diagnostics tell it.
 
@@ -182,7 +177,7 @@ def _provenance_section(
         # the gyro filter's latency is set by its design, at the first accepted samples' rate
         latency_s = integration.get("latency_s", "?")
         latency = (
-            f"no latency figure: {_why_none(verdict.nothing)}"
+            f"no latency figure: {why_none(verdict.nothing)}"
             if verdict.nothing
             else f"no latency figure: {NOT_DESIGNED}"
             if latency_s == "n/a"
@@ -190,7 +185,7 @@ def _provenance_section(
         )
         # the status names the scene's method until one runs (`auto`: until it chooses)
         ran = (
-            f"no method ran: {_why_none(verdict.nothing)}"
+            f"no method ran: {why_none(verdict.nothing)}"
             if verdict.nothing
             else f"ran: {integration.get('method', '?')}"
         )
@@ -419,7 +414,7 @@ def write_report(
         sections.append(_displacement_line(tables["pose"]))
     sections += [
         f"<h2>Peaks ({peak_label(scene.outputs.decimation if scene else 1)})</h2>",
-        f"<p>none: {html.escape(_why_none(nothing))}</p>"
+        f"<p>none: {html.escape(why_none(nothing))}</p>"
         if nothing
         else html_table(
             ["mount", "kind", LABELS[PEAK_FORCE], LABELS[PEAK_COUPLE], "utilisation max"],

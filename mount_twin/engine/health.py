@@ -55,6 +55,8 @@ NEVER_STARTED = "the twin never started"
 """What a run that accepted samples but ended before a start says (`HealthWindow.never_started`):
 fewer samples than `initial_state.gravity_samples` (it had written no report at all, and its
 replay read OK)."""
+
+
 NOT_DESIGNED = (
     "the gyro filter was never designed: no two input samples were accepted without a restart "
     "between them"
@@ -116,6 +118,12 @@ def tilt_from_quaternions(quat: np.ndarray) -> np.ndarray:
 def tilt_from_cos(cos_tilt: np.ndarray | float) -> np.ndarray:
     """Tilt θ, rad, from cos θ = R₃₃ (clipped to [−1, 1]: rounding may step past it)."""
     return np.arccos(np.clip(cos_tilt, -1.0, 1.0))
+
+
+def why_none(nothing: str) -> str:
+    """A run's reason for having followed none of its input (`nothing`: no sample accepted,
+    or NEVER_STARTED and its details) without the details, after "none, " or "no figure: "."""
+    return NEVER_STARTED if nothing.startswith(NEVER_STARTED) else NO_SAMPLE_ACCEPTED
 
 
 class HealthWindow:

@@ -230,6 +230,11 @@ def nominal_tangent(e: Elastomer) -> tuple[tuple[float, ...], tuple[str, ...]]:
     return (*k, *e.rotational_stiffness), (*keys, *rot)
 
 
+def hysteretic(e: Elastomer) -> bool:
+    """Whether `e` carries a Bouc–Wen state on any axis."""
+    return e.hysteresis is not None and bool(e.hysteresis.axes)
+
+
 def state_names(e: Elastomer) -> tuple[str, ...]:
     """Bouc–Wen z per hysteretic axis (none without hysteresis)."""
     if e.hysteresis is None:

@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from mount_twin.kinds import N_EVENTS
-from mount_twin.kinds.elastomer import Elastomer
+from mount_twin.kinds.elastomer import Elastomer, hysteretic
 from mount_twin.physics.dynamics import (
     ModelArrays,
     Scratch,
@@ -84,11 +84,8 @@ def start_ratings(scene: Scene, m: ModelArrays, y: np.ndarray) -> tuple[SceneWar
     s = new_scratch(y.shape[0])
     body_motion(y, m, s)  # the start's motion: s.q (its frozen DOFs too) and s.rot, body → F
     paths = [scene.mount_path(i) for i in range(len(scene.mounts))]
-    hysteretic = any(
-        isinstance(mt, Elastomer) and mt.hysteresis is not None and mt.hysteresis.axes
-        for mt in scene.mounts
-    )
-    where = AT_START.format(LOADING_CURVES if hysteretic else "")
+    loading = any(isinstance(mt, Elastomer) and hysteretic(mt) for mt in scene.mounts)
+    where = AT_START.format(LOADING_CURVES if loading else "")
     found = []
     if tangent_misjudges(scene):
         wrenches = np.zeros((len(scene.mounts), 6))

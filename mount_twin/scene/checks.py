@@ -45,7 +45,7 @@ import numpy as np
 
 from mount_twin.errors import SceneError
 from mount_twin.kinds.bolted_joint import BoltedJoint
-from mount_twin.kinds.elastomer import Elastomer
+from mount_twin.kinds.elastomer import Elastomer, hysteretic
 from mount_twin.kinds.shear_key import ShearKey
 from mount_twin.scene.description import LinearMount, Mount, Scene, SceneWarning, Vec3
 from mount_twin.scene.statics import AXES, Statics, loose_dofs, statics
@@ -309,7 +309,7 @@ def nonlinear_at_rest(mount: Mount) -> bool:
         return bool(
             mount.force_table
             or any(k3 > 0.0 for k3 in mount.stiffness_cubic)
-            or (mount.hysteresis is not None and mount.hysteresis.axes)
+            or hysteretic(mount)
             or (mount.snubber is not None and mount.snubber.axes)
         )
     if isinstance(mount, ShearKey):
