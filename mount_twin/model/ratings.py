@@ -15,15 +15,17 @@ check, which takes every rated mount's deflection and force at the start state t
 solved, and says what it finds as the loader's warnings do (`Scene.warnings`).
 
 A shear key's allowable force and a bolted joint's yield and ultimate force
-(`scene.checks.limits`) are judged here only, at that start, for any scene whose start is at
-equilibrium: a machine whose weight (with its bolts' preload) already put a key past its
-allowable force or a bolt past its yield read ERROR from the first report without a word at
+(`scene.checks.limits`) are judged here only, at that start, whichever it is: a machine whose
+weight (with its bolts' preload) already put a key past its allowable force or a bolt past its
+yield, or that was given a pose that did, read ERROR from the first report without a word at
 load. The force judged is the one its utilisation divides, read back from the utilisation the
 mounts' monitors give at the start (`physics.dynamics.mount_monitors`, as the engine's first
 report takes it), so the warned ratio is that report's.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -49,14 +51,19 @@ from mount_twin.scene.checks import (
 from mount_twin.scene.description import Scene, SceneWarning
 
 AT_START = "at the start (the weight's equilibrium on the mounts' own force laws{})"
-"""Where the figures are taken, for the warnings' messages ({}: LOADING_CURVES where a mount is
-hysteretic)."""
+"""Where the figures of a start at equilibrium are taken, for the warnings' messages ({}:
+LOADING_CURVES where a mount is hysteretic)."""
 LOADING_CURVES = ", hysteretic ones set down along their loading curves"
-FROM_THE_START = f"its utilisation is past 1 from the first report (ERROR); {UNITS_OR_MOUNT}"
-"""What such a mount means: utilisation counts from the start."""
+AT_GIVEN = "at the given start (initial_state.pose and velocity, not the weight's equilibrium)"
+"""Where the figures of a given start are taken, for the warnings' messages (hysteretic states
+start at 0 there)."""
+PAST_1 = "its utilisation is past 1 from the first report (ERROR); "
+"""What such a mount means: utilisation counts from the start; then what it likely means."""
+POSE_OR_MOUNT = "initial_state.pose or stiffness in the wrong units, or the wrong mount?"
+"""What a mount past its rating at a given start likely means (the mass plays no part there)."""
 ELASTIC = (
-    ", the bolt taken as elastic there (its plastic elongation starts at 0; one that yielded as "
-    "the machine was set down would have stretched and lost preload)"
+    ", the bolt taken as elastic there (its plastic elongation starts at 0; one that yielded on "
+    "its way there would have stretched and lost preload)"
 )
 """What the start is for a bolt past its yield force."""
 BOLT_FORCE = "the bolt force F_S (its preload and its share of the load)"
@@ -71,21 +78,43 @@ LIMITED = {
     ),
 }
 """Each limit key (`scene.checks.limits`): what its force is, what the limit is, what the start
-is, and what passing it means beside FROM_THE_START, for the warnings' messages."""
+is, and what passing it means beside `Basis.means`, for the warnings' messages."""
+
+
+@dataclass(frozen=True)
+class Basis:
+    """Where a start's figures are taken, and what a mount past a limit there means, for the
+    warnings' messages.
+
+    Attributes:
+        where: the start ("at the given start (…)").
+        means: utilisation past 1 from the first report, and what that likely means.
+    """
+
+    where: str
+    means: str
+
+
+def start_basis(scene: Scene) -> Basis:
+    """The `Basis` of the start `scene` takes: its given pose and velocity, or the weight's
+    equilibrium on the mounts' own laws (hysteretic ones on their loading curves)."""
+    if scene.initial.mode == "given":
+        return Basis(AT_GIVEN, PAST_1 + POSE_OR_MOUNT)
+    loading = any(isinstance(mt, Elastomer) and hysteretic(mt) for mt in scene.mounts)
+    return Basis(AT_START.format(LOADING_CURVES if loading else ""), PAST_1 + UNITS_OR_MOUNT)
 
 
 def start_ratings(scene: Scene, m: ModelArrays, y: np.ndarray) -> tuple[SceneWarning, ...]:
     """Warnings of the mounts loaded or deflected past their ratings, and of the keys and bolts
-    past their force limits, at the start state `y` (the nominal one of `m`, at rest on the
-    chart); none for a scene whose start the loader judges (`rated_at_start`), and no ratings
-    where it judges those (`tangent_misjudges`)."""
+    past their force limits, at the start state `y` (the nominal one of `m`: at rest on the
+    chart, or the given pose and velocity); none for a scene whose start the loader judges
+    (`rated_at_start`), and no ratings where it judges those (`tangent_misjudges`)."""
     if not rated_at_start(scene):
         return ()
     s = new_scratch(y.shape[0])
     body_motion(y, m, s)  # the start's motion: s.q (its frozen DOFs too) and s.rot, body → F
     paths = [scene.mount_path(i) for i in range(len(scene.mounts))]
-    loading = any(isinstance(mt, Elastomer) and hysteretic(mt) for mt in scene.mounts)
-    where = AT_START.format(LOADING_CURVES if loading else "")
+    basis = start_basis(scene)
     found = []
     if tangent_misjudges(scene):
         wrenches = np.zeros((len(scene.mounts), 6))
@@ -94,12 +123,14 @@ def start_ratings(scene: Scene, m: ModelArrays, y: np.ndarray) -> tuple[SceneWar
         shift = point_displacements(s.q[None, :3], s.rot[None], arm)[0]  # each attachment point's
         axes = rpy_matrices([mt.orientation_rpy for mt in scene.mounts])
         deflection = np.einsum("nji,nj->ni", axes, shift)
-        found = rating_warnings(scene, paths, deflection, wrenches[:, :3], where, FROM_THE_START)
-    return (*found, *limit_warnings(scene, m, y, s, paths, where))
+        found = rating_warnings(
+            scene, paths, deflection, wrenches[:, :3], basis.where, basis.means
+        )
+    return (*found, *limit_warnings(scene, m, y, s, paths, basis))
 
 
 def limit_warnings(
-    scene: Scene, m: ModelArrays, y: np.ndarray, s: Scratch, paths: list[str], basis: str
+    scene: Scene, m: ModelArrays, y: np.ndarray, s: Scratch, paths: list[str], basis: Basis
 ) -> list[SceneWarning]:
     """Each key's and bolt's force at state `y` (s holding its body motion) against its force
     limits (`scene.checks.limits`): one warning per limit key, at the mount most past it.
@@ -111,7 +142,7 @@ def limit_warnings(
     Args:
         scene, m: the scene and its core arrays.
         paths: key path of each mount, for messages.
-        basis: where the state is taken, for messages.
+        basis: where the state is taken and what passing a limit there means, for messages.
     """
     nl = m.nl
     if nl is None:
@@ -133,8 +164,8 @@ def limit_warnings(
             SceneWarning(
                 scene.source,
                 f"{paths[i]}.{key}",
-                f"{what} {basis}, {force:.4g} N, is {ratio:.3g} times {of} {limit:.4g} N"
-                f"{more_mounts(len(cases) - 1)}{start}: {means}{FROM_THE_START}",
+                f"{what} {basis.where}, {force:.4g} N, is {ratio:.3g} times {of} {limit:.4g} N"
+                f"{more_mounts(len(cases) - 1)}{start}: {means}{basis.means}",
             )
         )
     return found

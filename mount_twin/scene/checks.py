@@ -25,7 +25,8 @@ Warnings (SceneWarning, kept on `Scene.warnings`): values that load but are like
   these statics misjudge — a softening force table, cubic terms, snubbers, hysteretic mounts on
   their loading curves, clearances — it judges the ratings at that start instead:
   `rated_at_start`, `model.ratings`); a shear key's allowable force and a bolted joint's yield
-  and ultimate force (`limits`) are judged at that start only (`model.ratings`);
+  and ultimate force (`limits`) are judged at the start only, at equilibrium or given
+  (`model.ratings`);
 - a mount, the body IMU or the deck IMU farther from the CG than FAR_FACTOR times the body's
   largest radius of gyration, and a radius of gyration beyond GYRATION_WARN_M (positions in
   mm, inertia in kg·mm²);
@@ -275,12 +276,11 @@ def limits(mount: Mount) -> tuple[tuple[str, float], ...]:
 
 def rated_at_start(scene: Scene) -> bool:
     """Whether the load-time check needs the start the twin uses (`model.ratings`, at
-    assembly): a start at equilibrium, and ratings the tangent statics misjudge
-    (`tangent_misjudges`) or a mount with a force limit (`limits`: a key's, a bolt's), which
-    only the start's own mount laws give: a bolt's force is its preload and its share of the
-    weight, and it is the figure the utilisation of every report divides."""
-    limited = any(limits(m) for m in scene.mounts)
-    return scene.initial.mode == "equilibrium" and (limited or tangent_misjudges(scene))
+    assembly): a mount with a force limit (`limits`: a key's, a bolt's), at a start at
+    equilibrium or a given one, which only the start's own mount laws give (a bolt's force is
+    its preload and its share of the load, and it is the figure the utilisation of every report
+    divides), or ratings the tangent statics misjudge (`tangent_misjudges`)."""
+    return any(limits(m) for m in scene.mounts) or tangent_misjudges(scene)
 
 
 def tangent_misjudges(scene: Scene) -> bool:
