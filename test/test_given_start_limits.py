@@ -1,17 +1,21 @@
-"""Force limits judged at a given start, at its pose and velocity.
+"""Ratings and force limits judged at a given start, at its pose and velocity.
 
 With `initial_state.mode: given` the twin starts at the pose and velocity the scene gives, not
 at the weight's equilibrium. A key's allowable force and a bolt's yield and ultimate force were
 judged at load at an equilibrium start only: a pose given past them loaded without a word and
-every report was ERROR from the first one. They are now judged at the given state, by the
-mounts' own laws, with the figure the first report's utilisation divides.
+every report was ERROR from the first one. The ratings were judged by the tangent statics
+under the weight, a state the twin does not start in: a pose given past a rating passed
+unwarned, and one given at the reference (the mounts unstressed) was warned of a load it does
+not start under. Both are now judged at the given state, by the mounts' own laws, with the
+figure the first report's utilisation divides.
 
 Truths written here, independently of the package (SI units):
 - a vertical shear key of stiffness k_key and clearance c, at a pose that moves it down by
   z_key: force k_key·(z_key − c) (0 within the clearance);
 - a bolted joint (VDI 2230 joint diagram, kinds/bolted_joint.py) whose foot is lifted u from
   its preloaded rest: bolt force F_S = F_V + k_S·u, the joint closed (clamp force
-  F_V − k_P·u > 0) while u < F_V/k_P, the bolt alone past it.
+  F_V − k_P·u > 0) while u < F_V/k_P, the bolt alone past it;
+- a linear Kelvin–Voigt mount deflected d at the rate v along z: force k·d + c·v.
 """
 
 from __future__ import annotations
@@ -20,6 +24,7 @@ import numpy as np
 import pytest
 import yaml
 from hung_helpers import BOLT, CG_Z, CORNERS, K_P, K_S, MASS, K, hung_scene
+from hung_helpers import K_KEY as K_KEY_HUNG
 from kinds_helpers import kind_mount
 from physics_helpers import G, base_scene, mount
 
@@ -33,6 +38,7 @@ BOLT_FORCE = "the bolt force F_S (its preload and its share of the load)"
 PAST_1 = "its utilisation is past 1 from the first report (ERROR)"
 K_KEY, CLEARANCE, ALLOWABLE = 1.0e9, 2.0e-4, 5.0e4  # N/m, m, N: the keyed scene's key
 F_V = 5000.0  # N: the hung scene's bolt preload
+C = 2000.0  # N·s/m: the linear springs' damping along z
 INERTIA = [30.0, 40.0, 50.0, 0.0, 0.0, 0.0]  # kg·m²
 
 
@@ -183,3 +189,80 @@ def test_a_bolt_given_past_its_ultimate_force_is_warned_that_it_breaks_at_the_st
     assert statuses["bolt"].level == ERROR
     assert statuses["bolt"].values["bolt_fractured.count"] == "1"
     assert statuses["bolt"].values["bolt_fractured.first_stamp_ns"] == "1000000000"
+
+
+def test_a_given_start_within_its_limits_and_ratings_is_not_warned_of_whatever_the_weight():
+    """The hung scene given 0.3 mm down: its fitted key bears K_KEY·0.3 mm = 240 N (allowed
+    10 % more), its bolt F_S = F_V + k_S·0.3 mm = 5300 N (yielding 3 % above it), its springs
+    K·0.3 mm = 60 N each, rated 100 N: within all, nothing is said and the first report is not
+    an ERROR. The tangent statics under the weight load each spring with
+    m·g·K/(4K + K_KEY + k_S + k_P) = 140 N (the closed joint's k_S + k_P), past its rating:
+    the loader warned of that, a state the twin does not start in. This file's key given
+    0.24 mm down (4e4 N, 0.8 of its allowable) is not warned of either."""
+    lift = 3.0e-4
+    key_force, bolt_force, spring_load = K_KEY_HUNG * lift, F_V + K_S * lift, K * lift
+    assert spring_load < 100.0 < MASS * G * K / (4.0 * K + K_KEY_HUNG + K_S + K_P)
+    data = hung_given(lift, 1.03 * bolt_force, 1.2 * bolt_force, 1.1 * key_force, 100.0)
+    model = assemble(scene_from_dict(data, "<hung>"))
+    assert model.scene.warnings == ()
+    engine, statuses = first_report(model)
+    assert engine.utilisation_max["key"] == pytest.approx(1.0 / 1.1, rel=1e-9)
+    assert engine.utilisation_max["bolt"] == pytest.approx(1.0 / 1.03, rel=1e-9)
+    assert engine.utilisation_max["s0"] == pytest.approx(spring_load / 100.0, rel=1e-9)
+    assert all(status.level != ERROR for status in statuses.values())
+
+    z_key = 2.4e-4
+    model = assemble(scene_from_dict(keyed(-z_key), "<keyed>"))
+    assert model.scene.warnings == ()
+    engine, statuses = first_report(model)
+    force = K_KEY * (z_key - CLEARANCE)
+    assert engine.utilisation_max["key"] == pytest.approx(force / ALLOWABLE, rel=1e-9)
+    assert statuses["key"].level != ERROR
+
+
+def four_springs(rated_load: float, initial: dict) -> dict:
+    """MASS on four vertical linear springs K with damping C along z at the corners, each rated
+    `rated_load` (N) along z: no non-linear mount."""
+    springs = [
+        {
+            **mount(f"s{i}", [x, y, 0.0], [1.0e5, 1.0e5, K, 0, 0, 0], [0, 0, C, 0, 0, 0]),
+            "rated_load": [0.0, 0.0, rated_load],
+        }
+        for i, (x, y) in enumerate(CORNERS)
+    ]
+    return base_scene(MASS, [0.0, 0.0, CG_Z], INERTIA, springs, initial=initial)
+
+
+def test_linear_mounts_given_far_from_the_weight_s_equilibrium_are_judged_at_the_given_state():
+    """Four linear springs (no non-linear mount: the tangent statics are exact under the
+    weight) given 2 mm below the weight's 4.9 mm sag, moving down at 0.1 m/s: each carries
+    K·(sag + 2 mm) + C·0.1 m/s = 1581 N, 1.25 times a rated load of 1265 N that the weight's
+    981 N is within (the loader said nothing). One warning, with the given state's load (not
+    "static": the damping's share counts), the first report's utilisation."""
+    sag = MASS * G / (4.0 * K)
+    depth, rate = sag + 2.0e-3, 0.1
+    load = K * depth + C * rate
+    rating = load / 1.25
+    assert rating > MASS * G / 4.0
+    model = assemble(scene_from_dict(four_springs(rating, given_start(-depth, -rate)), "<lin>"))
+    (path, said), *others = rated(model.scene).items()
+    assert others == []
+    assert path in {f"mounts[{i}].rated_load" for i in range(4)}
+    assert said.startswith(f"the load {AT_GIVEN}, {load:.4g} N along local z, is 1.25 times")
+    assert "(and 3 more mounts)" in said
+    engine, statuses = first_report(model)
+    for i in range(4):
+        assert engine.utilisation_max[f"s{i}"] == pytest.approx(1.25, rel=1e-9)
+        assert statuses[f"s{i}"].level == ERROR
+
+
+def test_linear_mounts_given_at_the_reference_are_not_judged_under_a_weight_they_start_without():
+    """The same springs rated 800 N, below the weight's 981 N share, given at the reference
+    pose at rest: they start unstressed (the first report's utilisation 0), so nothing is said
+    at load; the loader's statics under the weight warned of them."""
+    assert MASS * G / 4.0 > 800.0
+    model = assemble(scene_from_dict(four_springs(800.0, given_start(0.0)), "<lin>"))
+    assert rated(model.scene) == {}
+    engine, statuses = first_report(model)
+    assert engine.utilisation_max["s0"] == 0.0
+    assert statuses["s0"].level != ERROR

@@ -280,21 +280,36 @@ def test_a_linear_mount_beside_hysteretic_ones_is_judged_at_the_start_by_its_par
     assert f"{k_lin * -x0:.4g} N along local z, is {ratio:.3g} times the rated" in warning.message
 
 
-@pytest.mark.parametrize(
-    ("hysteresis", "mode"), [(True, "equilibrium"), (True, "given"), (False, "equilibrium")]
-)
-def test_a_rating_is_warned_of_once_by_the_statics_that_give_the_start(hysteresis, mode):
+@pytest.mark.parametrize("hysteresis", [True, False])
+def test_a_rating_is_warned_of_once_by_the_statics_that_give_the_start(hysteresis):
     """Rated 8 mm, past the tangent's 9.81 mm sag too: a hysteretic start at equilibrium is
-    warned of once, with the loading curve's sag; a given start (z = 0, at its pose) and a
-    mount without hysteresis keep the loader's tangent statics, and the assembly adds none."""
+    warned of once, with the loading curve's sag; a mount without hysteresis keeps the
+    loader's tangent statics, and the assembly adds none."""
     rated = 0.008
-    data = rated_scene(rated, hysteresis, initial_state={"mode": mode})
+    data = rated_scene(rated, hysteresis, initial_state={"mode": "equilibrium"})
     scene = scene_from_dict(data, "<rated>")
     model = assemble(scene)
     (warning,) = rating_warnings(model.scene)
-    loaded = hysteresis and mode == "equilibrium"
-    sag = -start_sag(C_SOFT, 1) if loaded else MASS * G / K0
-    where = "at the start" if loaded else "under the weight"
+    sag = -start_sag(C_SOFT, 1) if hysteresis else MASS * G / K0
+    where = "at the start" if hysteresis else "under the weight"
     assert f"static deflection {where}" in warning.message
     assert f"{sag:.4g} m along local z, is {sag / rated:.3g} times" in warning.message
-    assert rating_warnings(scene) == ([] if loaded else [warning])
+    assert rating_warnings(scene) == ([] if hysteresis else [warning])
+
+
+def test_a_given_start_on_a_hysteretic_mount_is_judged_at_its_pose():
+    """A given start is its pose, its Bouc–Wen state at 0: given at the reference (z = 0) the
+    mount starts unstressed, and nothing is said of a rated 8 mm that the tangent's 9.81 mm sag
+    under the weight passes; given at the loading curve's sag, its deflection there is warned
+    of once, at the given start (no loading curve)."""
+    rated = 0.008
+    at_rest = {"mode": "given", "pose": [0.0] * 6, "velocity": [0.0] * 6}
+    scene = scene_from_dict(rated_scene(rated, initial_state=at_rest), "<rated>")
+    assert rating_warnings(assemble(scene).scene) == []
+    sag = -start_sag(C_SOFT, 1)
+    down = {**at_rest, "pose": [0.0, 0.0, -sag, 0.0, 0.0, 0.0]}
+    model = assemble(scene_from_dict(rated_scene(rated, initial_state=down), "<rated>"))
+    (warning,) = rating_warnings(model.scene)
+    assert warning.message.startswith("the deflection at the given start (initial_state.pose")
+    assert f"{sag:.4g} m along local z, is {sag / rated:.3g} times" in warning.message
+    assert "loading curve" not in warning.message

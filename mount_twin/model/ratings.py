@@ -1,18 +1,23 @@
 """The load-time rating check at the start the twin uses, where tangent statics miss it.
 
 `scene.checks` judges each mount's static load and deflection against its ratings by the
-statics of the nominal stiffness: exact for linear mounts, and for a non-linear one at zero
-load only. A new machine's start at equilibrium is solved with the mounts' own laws
-(`model.assemble.static_equilibrium`: force tables, cubic terms, snubbers, clearances, bolted
-joints, and hysteretic mounts set down along their loading curves, `model.loading`), and a
-law that softens as it loads starts past its tangent's sag: 400 kg on four elastomers whose
-force table softens from 1e5 N/m start 14.4 mm down where the tangent says 9.8, past a rated
-12 mm that the tangent statics found unreached (on four Bouc–Wen mounts of k₀ = 1e5 N/m,
-a = 0.3, β + γ = 200: 21.2 mm), and every mount was then an ERROR from the first report without
-a word at load; one that stiffens (cubic terms, a snubber) was warned of where it starts
-within. For such a scene (`scene.checks.tangent_misjudges`) the loader leaves the ratings to this
-check, which takes every rated mount's deflection and force at the start state the assembly
-solved, and says what it finds as the loader's warnings do (`Scene.warnings`).
+statics of the nominal stiffness under the weight: exact for linear mounts at equilibrium, and
+for a non-linear one at zero load only. A new machine's start at equilibrium is solved with the
+mounts' own laws (`model.assemble.static_equilibrium`: force tables, cubic terms, snubbers,
+clearances, bolted joints, and hysteretic mounts set down along their loading curves,
+`model.loading`), and a law that softens as it loads starts past its tangent's sag: 400 kg on
+four elastomers whose force table softens from 1e5 N/m start 14.4 mm down where the tangent
+says 9.8, past a rated 12 mm that the tangent statics found unreached (on four Bouc–Wen mounts
+of k₀ = 1e5 N/m, a = 0.3, β + γ = 200: 21.2 mm), and every mount was then an ERROR from the
+first report without a word at load; one that stiffens (cubic terms, a snubber) was warned of
+where it starts within. A given start (`initial_state.mode: given`) is its pose and velocity,
+not the weight's equilibrium, whatever the mounts: a pose given past a rating was an ERROR from
+the first report without a word, and one given at the reference (the mounts unstressed) was
+warned of a load it does not start under. For such a scene (`scene.checks.tangent_misjudges`)
+the loader leaves the ratings to this check, which takes every rated mount's deflection and
+force (a linear mount's damping force at the given velocity too) at the start state the
+assembly solved or was given, and says what it finds as the loader's warnings do
+(`Scene.warnings`).
 
 A shear key's allowable force and a bolted joint's yield and ultimate force
 (`scene.checks.limits`) are judged here only, at that start, whichever it is: a machine whose
@@ -89,19 +94,21 @@ class Basis:
     Attributes:
         where: the start ("at the given start (…)").
         means: utilisation past 1 from the first report, and what that likely means.
+        static: whether the start is at rest in equilibrium (its loads static ones).
     """
 
     where: str
     means: str
+    static: bool
 
 
 def start_basis(scene: Scene) -> Basis:
     """The `Basis` of the start `scene` takes: its given pose and velocity, or the weight's
     equilibrium on the mounts' own laws (hysteretic ones on their loading curves)."""
     if scene.initial.mode == "given":
-        return Basis(AT_GIVEN, PAST_1 + POSE_OR_MOUNT)
+        return Basis(AT_GIVEN, PAST_1 + POSE_OR_MOUNT, static=False)
     loading = any(isinstance(mt, Elastomer) and hysteretic(mt) for mt in scene.mounts)
-    return Basis(AT_START.format(LOADING_CURVES if loading else ""), PAST_1 + UNITS_OR_MOUNT)
+    return Basis(AT_START.format(LOADING_CURVES if loading else ""), PAST_1 + UNITS_OR_MOUNT, True)
 
 
 def start_ratings(scene: Scene, m: ModelArrays, y: np.ndarray) -> tuple[SceneWarning, ...]:
@@ -118,13 +125,13 @@ def start_ratings(scene: Scene, m: ModelArrays, y: np.ndarray) -> tuple[SceneWar
     found = []
     if tangent_misjudges(scene):
         wrenches = np.zeros((len(scene.mounts), 6))
-        mount_wrenches(y, m, s, wrenches)
+        mount_wrenches(y, m, s, wrenches)  # at y's velocity too: a linear mount's damping
         arm = np.array([mt.position for mt in scene.mounts]) - np.array(scene.body.cg)
         shift = point_displacements(s.q[None, :3], s.rot[None], arm)[0]  # each attachment point's
         axes = rpy_matrices([mt.orientation_rpy for mt in scene.mounts])
         deflection = np.einsum("nji,nj->ni", axes, shift)
         found = rating_warnings(
-            scene, paths, deflection, wrenches[:, :3], basis.where, basis.means
+            scene, paths, deflection, wrenches[:, :3], basis.where, basis.means, basis.static
         )
     return (*found, *limit_warnings(scene, m, y, s, paths, basis))
 

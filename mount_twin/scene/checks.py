@@ -21,12 +21,12 @@ Warnings (SceneWarning, kept on `Scene.warnings`): values that load but are like
 - a DOF the weight overturns (negative stiffness: a CG high above soft mounts);
 - a static sag of the CG or of a mount's attachment point beyond SAG_WARN_M (stiffness in N/mm
   sags a thousand times more), and a mount's static load or deflection beyond its rated values
-  (for a scene whose start at equilibrium the assembly solves with non-linear mount laws, which
-  these statics misjudge — a softening force table, cubic terms, snubbers, hysteretic mounts on
-  their loading curves, clearances — it judges the ratings at that start instead:
-  `rated_at_start`, `model.ratings`); a shear key's allowable force and a bolted joint's yield
-  and ultimate force (`limits`) are judged at the start only, at equilibrium or given
-  (`model.ratings`);
+  (where these statics are not the start the twin takes, the assembly judges the ratings at
+  that start instead, `rated_at_start`, `model.ratings`: a given start, at its pose and
+  velocity, and a start at equilibrium that it solves with non-linear mount laws — a softening
+  force table, cubic terms, snubbers, hysteretic mounts on their loading curves, clearances);
+  a shear key's allowable force and a bolted joint's yield and ultimate force (`limits`) are
+  judged at that start only, whichever it is (`model.ratings`);
 - a mount, the body IMU or the deck IMU farther from the CG than FAR_FACTOR times the body's
   largest radius of gyration, and a radius of gyration beyond GYRATION_WARN_M (positions in
   mm, inertia in kg·mm²);
@@ -276,25 +276,31 @@ def limits(mount: Mount) -> tuple[tuple[str, float], ...]:
 
 def rated_at_start(scene: Scene) -> bool:
     """Whether the load-time check needs the start the twin uses (`model.ratings`, at
-    assembly): a mount with a force limit (`limits`: a key's, a bolt's), at a start at
-    equilibrium or a given one, which only the start's own mount laws give (a bolt's force is
-    its preload and its share of the load, and it is the figure the utilisation of every report
-    divides), or ratings the tangent statics misjudge (`tangent_misjudges`)."""
+    assembly): ratings the tangent statics misjudge there (`tangent_misjudges`: any at a given
+    start) or a mount with a force limit (`limits`: a key's, a bolt's), which only the start's
+    own mount laws give: a bolt's force is its preload and its share of the load, and it is the
+    figure the utilisation of every report divides."""
     return any(limits(m) for m in scene.mounts) or tangent_misjudges(scene)
 
 
 def tangent_misjudges(scene: Scene) -> bool:
     """Whether the scene's ratings (`ratings`) are judged at the start the twin uses
-    (`model.ratings`, at assembly) rather than here: a start at equilibrium, a mount whose
-    static law is not its nominal tangent (`nonlinear_at_rest`), whose equilibrium the assembly
-    solves with that law, and a mount rated. The tangent at zero load misjudges such a start:
-    400 kg on four elastomers whose force table softens from 1e5 N/m start 14.4 mm down where
-    the tangent says 9.8 (a rated 12 mm passed unwarned), and on hysteretic ones set down along
-    their loading curves (`model.loading`; k₀ = 1e5 N/m, a = 0.3, β + γ = 200) 21.2 mm; a
-    stiffening law (cubic terms, a snubber) starts short of the tangent's sag."""
-    nonlinear = any(nonlinear_at_rest(m) for m in scene.mounts)
+    (`model.ratings`, at assembly) rather than here, by the statics of the nominal tangent under
+    the weight: a mount rated, and a start those statics are not.
+
+    - A given start (`initial_state.mode: given`) is its pose and velocity, not the weight's
+      equilibrium: 400 kg given 2 mm below the 4.9 mm sag of four linear 2e5 N/m mounts starts
+      each at 1.4 times the load the weight gives it, and the first report's utilisation is
+      that (a pose given at the reference, the mounts unstressed, starts them at zero).
+    - A start at equilibrium that the assembly solves with a mount's own law where it is not
+      its nominal tangent (`nonlinear_at_rest`): 400 kg on four elastomers whose force table
+      softens from 1e5 N/m start 14.4 mm down where the tangent says 9.8 (a rated 12 mm passed
+      unwarned), and on hysteretic ones set down along their loading curves (`model.loading`;
+      k₀ = 1e5 N/m, a = 0.3, β + γ = 200) 21.2 mm; a stiffening law (cubic terms, a snubber)
+      starts short of the tangent's sag."""
     rated = any(r > 0.0 for m in scene.mounts for _, limit in ratings(m) for r in limit)
-    return scene.initial.mode == "equilibrium" and nonlinear and rated
+    given = scene.initial.mode == "given"
+    return rated and (given or any(nonlinear_at_rest(m) for m in scene.mounts))
 
 
 def nonlinear_at_rest(mount: Mount) -> bool:
@@ -324,17 +330,18 @@ def rating_warnings(
     force: np.ndarray,
     basis: str,
     hint: str,
+    static: bool = True,
 ) -> list[SceneWarning]:
-    """Static load and deflection of each mount against its rated values, where it has any:
-    one warning per rated key, at the mount most over its rating.
+    """Load and deflection of each mount against its rated values, where it has any: one
+    warning per rated key, at the mount most over its rating.
 
     Args:
         scene: the scene.
         mount_paths: key path of each mount, for messages.
-        deflection, force: (n, 3) each mount's static deflection (m) and force (N) in its
-            local axes.
+        deflection, force: (n, 3) each mount's deflection (m) and force (N) in its local axes.
         basis: where they are taken, for messages ("under the weight").
         hint: what a mount past its rating likely means, for messages.
+        static: whether they are static ones (at rest in equilibrium), for messages.
     """
     over: dict[str, list[tuple[float, int, int, float, float]]] = {}
     for i, mount in enumerate(scene.mounts):
@@ -345,14 +352,14 @@ def rating_warnings(
                     over.setdefault(key, []).append((abs(v) / r, i, j, abs(v), r))
     found = []
     for key, cases in over.items():
-        ratio, i, j, static, rating = max(cases)
+        ratio, i, j, value, rating = max(cases)
         what, unit = ("load", "N") if key == "rated_load" else ("deflection", "m")
         found.append(
             SceneWarning(
                 scene.source,
                 f"{mount_paths[i]}.{key}",
-                f"the static {what} {basis}, {static:.4g} {unit} along local "
-                f"{AXES[j]}, is {ratio:.3g} times the rated {rating:.4g} {unit}"
+                f"the {'static ' if static else ''}{what} {basis}, {value:.4g} {unit} along "
+                f"local {AXES[j]}, is {ratio:.3g} times the rated {rating:.4g} {unit}"
                 f"{more_mounts(len({c[1] for c in cases}) - 1)}: {hint}",
             )
         )
