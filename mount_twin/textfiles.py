@@ -89,6 +89,36 @@ def write_text(path: str | Path, text: str) -> None:
         fh.write(text)
 
 
+def on_disk(path: Path) -> Path | None:
+    """`path` or the nearest directory above it that is there, a dangling symlink included:
+    Path.exists follows a link and reads a dangling one as absent, where mkdir then fails
+    with "File exists" (None if none is: a relative path's "." always is)."""
+    return next((p for p in (path, *path.parents) if os.path.lexists(p)), None)
+
+
+def no_directory(path: Path) -> str:
+    """Why `path`, which is there (`on_disk`), is no directory to make one in or to write
+    into: '' if it is one (or a symlink to one), else "PATH is a symlink to TARGET, which does
+    not exist" or "PATH is not a directory"."""
+    if path.is_dir():
+        return ""
+    if path.is_symlink() and not path.exists():
+        return f"{path} is a symlink to {os.readlink(path)}, which does not exist"
+    return f"{path} is not a directory"
+
+
+def new_directory_refusal(path: str | Path) -> str:
+    """Why no new directory can be made at `path` (with the missing ones above it): '' if one
+    can; "exists" if a directory or file is there; else what is in the way at or above it
+    (`no_directory`: a dangling symlink, or a file where a directory goes). Checked before
+    long work: the write at its end had failed with "File exists" or rosbags' traceback."""
+    target = Path(path)
+    if target.exists():
+        return "exists"
+    there = on_disk(target)
+    return "" if there is None else no_directory(there)
+
+
 def _cannot_write(path: Path, err: OSError) -> OSError:
     """`err` as an OSError of the same errno naming `path` as the file that was not written."""
     return OSError(err.errno, f"cannot write: {err.strerror or err}", str(path))

@@ -181,6 +181,36 @@ def test_a_bag_writer_refuses_an_existing_output_with_exit_2_and_leaves_it(
     assert {f.name: f.read_bytes() for f in out.iterdir()} == before
 
 
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["generate", "ship-motion", "--duration", "0.01"],
+        ["import-csv", "config/sample_shock.csv"],
+        ["replay", "bags/ship_motion_1khz", "--scene", "config/pump_8_mounts.scene.yaml"],
+        ["synthesize", "--spectrum", "config/shock_spectrum_vertical.csv", "--seeds", "1"],
+    ],
+    ids=lambda c: c[0],
+)
+@pytest.mark.parametrize("where", ["at_the_output", "above_the_output"])
+def test_a_dangling_symlink_where_an_output_directory_goes_is_refused_naming_it(
+    tmp_path: Path, command: list[str], where: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A symlink to a missing directory as -o (or above it) read as absent: generate and
+    import-csv died with rosbags' traceback (exit 1, "exists already, not overwriting", also
+    for the one above), replay and synthesize said "File exists". It is refused naming the
+    link and where it points, and left as it was."""
+    missing = tmp_path / "missing"
+    link = tmp_path / "link"
+    link.symlink_to(missing)
+    out = link if where == "at_the_output" else link / "bag"
+    args = [a if not a.startswith(("config/", "bags/")) else str(ROOT / a) for a in command]
+    assert main([*args, "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"mount-twin: error: {out}: "), err
+    assert f"{link} is a symlink to {missing}, which does not exist" in err
+    assert link.is_symlink() and not missing.exists()
+
+
 def test_import_csv_of_a_missing_file_exits_2(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -90,6 +90,32 @@ def test_a_target_that_cannot_be_a_directory_is_refused_naming_the_option_before
     assert afile.read_text(encoding="utf-8") == "not a directory"
 
 
+@pytest.mark.parametrize("where", ["at_the_target", "above_the_target"])
+def test_a_dangling_symlink_in_the_way_is_refused_naming_it_before_reading(
+    replayed: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    where: str,
+) -> None:
+    """A symlink to a missing directory as the target (or above it) read as absent: the bag
+    was read whole, then "mount-twin: error: LINK: File exists", naming no option and not
+    why. It is refused first, naming the link and where it points; the link is left."""
+    link = tmp_path / "tables"
+    link.symlink_to(tmp_path / "missing")
+    target = link if where == "at_the_target" else link / "csv"
+
+    def unread(*_: object) -> None:
+        raise AssertionError("the bag was read before its target was checked")
+
+    monkeypatch.setattr("mount_twin.io.output_tables.read_output_bag", unread)
+    assert main(["export", str(replayed), "--csv", str(target)]) == 2
+    err = capsys.readouterr().err
+    said = f"{link} is a symlink to {tmp_path / 'missing'}, which does not exist"
+    assert err.startswith(f"mount-twin: error: --csv {target}: {said}"), err
+    assert link.is_symlink() and not (tmp_path / "missing").exists()
+
+
 def test_replay_json_summary_times_events_from_the_first_output(tmp_path: Path) -> None:
     import json
 

@@ -150,11 +150,15 @@ def warn_if_partial(bag: str | Path) -> str:
 
 @contextmanager
 def new_directory(path: str | Path, command: str) -> Iterator[Path]:
-    """A directory `command` creates for its outputs (ValueError if it exists), removed again
-    if the command fails before putting anything in it: an empty one blocked the rerun."""
+    """A directory `command` creates for its outputs (ValueError if it exists, or if a dangling
+    symlink or a file is in its way: `textfiles.new_directory_refusal`), removed again if the
+    command fails before putting anything in it: an empty one blocked the rerun."""
+    from mount_twin.textfiles import new_directory_refusal
+
     out = Path(path)
-    if out.exists():
-        msg = f"{out}: exists; {command} writes a new directory"
+    if why := new_directory_refusal(out):
+        said = f"exists; {command} writes a new directory" if why == "exists" else why
+        msg = f"{out}: {said}"
         raise ValueError(msg)
     out.mkdir(parents=True)
     try:

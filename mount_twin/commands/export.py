@@ -39,12 +39,15 @@ def run(args: argparse.Namespace) -> int:
 
 def _check_directory(flag: str, path: str) -> None:
     """ValueError naming `flag` where no directory of tables can be at `path` (export creates it
-    or writes into it): a file there, or in place of a directory above it. Checked before the
-    bag is read, which had been read whole to fail there ("/dev/full: File exists")."""
+    or writes into it): a file there, or in place of a directory above it, or a dangling
+    symlink at or above it. Checked before the bag is read, which had been read whole to fail
+    there ("/dev/full: File exists", "LINK: File exists")."""
+    from mount_twin.textfiles import no_directory, on_disk
+
     target = Path(path)
-    existing = next((p for p in (target, *target.parents) if p.exists()), None)
-    if existing is None or existing.is_dir():
+    existing = on_disk(target)
+    if existing is None or not (why := no_directory(existing)):
         return
-    said = "exists, not a directory" if existing == target else f"{existing} is not a directory"
+    said = "exists, not a directory" if target.exists() else why
     msg = f"{flag} {path}: {said}; export writes one file per table into a directory"
     raise ValueError(msg)

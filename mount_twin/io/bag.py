@@ -34,6 +34,7 @@ from mount_twin.io.mcap_salvage import Salvage, salvage
 from mount_twin.io.mcap_writer import McapBagWriter
 from mount_twin.io.messages import TYPESTORE, Encoded, RowBlock
 from mount_twin.io.raw_rows import joined, nbytes
+from mount_twin.textfiles import new_directory_refusal
 
 _INFINITE = QosTime(9223372036, 854775807)
 """RMW_DURATION_INFINITE (sec, nsec), as a Jazzy recording stores a default deadline/lifespan."""
@@ -525,9 +526,15 @@ class OutputBag:
 
 
 def check_new_bag(path: str | Path) -> None:
-    """Raise BagError if `path` exists: an output bag is always new (rosbags cannot overwrite)."""
-    if Path(path).exists():
+    """Raise BagError if `path` exists (an output bag is always new: rosbags cannot overwrite)
+    or no directory can be made there (`textfiles.new_directory_refusal`: a dangling symlink
+    at or above it, a file above it)."""
+    why = new_directory_refusal(path)
+    if why == "exists":
         msg = f"{path}: output bag exists; choose another path or remove it"
+        raise BagError(msg)
+    if why:
+        msg = f"{path}: cannot create the bag: {why}"
         raise BagError(msg)
 
 
