@@ -389,13 +389,13 @@ def test_water_entry_csv_imports_and_replays(
     assert disp < 0.2, f"a 47 g, ms-long shock moved the CG by {disp} m"
 
 
-def _refused(command: str, target: Path, out: Path) -> str:
-    """Run `command` (bundled paths from the repository root) with X for `target` and OUT for
-    `out`, check that it exits 2, and return the long name of the option that took X."""
+def _refused(command: str, target: Path, out: Path, bag: Path | None = None) -> str:
+    """Run `command` (bundled paths from the repository root) with X for `target`, OUT for
+    `out` and BAG for `bag`, check that it exits 2, and return the long name of the option
+    that took X."""
     words = command.split()
-    args = [
-        {"X": str(target), "OUT": str(out)}.get(a, str(ROOT / a) if "/" in a else a) for a in words
-    ]
+    given = {"X": str(target), "OUT": str(out), "BAG": str(bag)}
+    args = [given.get(a, str(ROOT / a) if "/" in a else a) for a in words]
     assert main(args) == 2
     flag = words[words.index("X") - 1]
     return {"-o": "--output"}.get(flag, flag)
@@ -418,17 +418,38 @@ CALIBRATE = (
         CALIBRATE.replace("-o OUT --plot X", "-o X"),
         "qualify config/genset_bolted_keyed.scene.yaml --plan config/qualify_genset.yaml -o OUT "
         "--report X",
+        "report BAG -o X",
     ],
     ids=lambda c: c.split()[0],
 )
+@pytest.mark.parametrize("through", [False, True], ids=["path", "symlink"])
 def test_a_target_no_file_can_be_written_at_is_refused_before_the_work(
-    tmp_path: Path, command: str, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path,
+    command: str,
+    through: bool,
+    shock_out: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
     """A --json in a missing directory: the replay ran to its end, then exit 2 (its verdict's
-    exit status lost)."""
-    target = tmp_path / "missing" / "x"
-    flag = _refused(command, target, tmp_path / "out")
-    assert f"mount-twin: error: {flag} {target}: there is no directory" in capsys.readouterr().err
+    exit status lost). So did one through a symlink into a missing directory (the link's own
+    directory was checked, not its target's), and `report -o` anywhere: it read the bags
+    first."""
+    missing = tmp_path / "missing" / "x"
+    target = tmp_path / "link" if through else missing
+    if through:
+        target.symlink_to(missing)
+
+    def unread(*_: object) -> None:
+        raise AssertionError("the bag was read before the target was checked")
+
+    monkeypatch.setattr("mount_twin.io.output_tables.read_output_bag", unread)
+    flag = _refused(command, target, tmp_path / "out", shock_out)
+    err = capsys.readouterr().err
+    said = f"a symlink to {missing}: " if through else ""
+    assert (
+        f"mount-twin: error: {flag} {target}: {said}there is no directory {missing.parent}" in err
+    )
     assert not (tmp_path / "out").exists()
 
 

@@ -4,6 +4,7 @@ what is implausible in it, writing a signal as a bag."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
@@ -86,8 +87,9 @@ FIGURE_FORMATS = ("png", "svg", "pdf", "svgz", "eps", "ps", "jpg", "jpeg", "tif"
 
 def check_targets(*, figures: tuple[str, ...] = ("plot",), **targets: str | None) -> None:
     """ValueError naming the option (`--json` for json=...) of the first given path a file
-    cannot be written at (its directory missing, or a directory there; for the options named
-    in `figures`, a name not ending in one of FIGURE_FORMATS): checked before long work, which
+    cannot be written at (its directory missing, or a directory there; through a symlink, its
+    target's directory missing: the file is written there; for the options named in
+    `figures`, a name not ending in one of FIGURE_FORMATS): checked before long work, which
     had run to its end to fail there with exit 2, its own exit status lost."""
     for option, path in targets.items():
         if path is None:
@@ -96,8 +98,11 @@ def check_targets(*, figures: tuple[str, ...] = ("plot",), **targets: str | None
         if target.is_dir():
             msg = f"{flag} {path}: is a directory"
             raise ValueError(msg)
-        if not target.parent.is_dir():
-            msg = f"{flag} {path}: there is no directory {target.parent}"
+        link = target.is_symlink()
+        directory = Path(os.path.realpath(target)).parent if link else target.parent
+        if not directory.is_dir():
+            via = f"a symlink to {os.readlink(target)}: " if link else ""
+            msg = f"{flag} {path}: {via}there is no directory {directory}"
             raise ValueError(msg)
         if option in figures and target.suffix.lower().lstrip(".") not in FIGURE_FORMATS:
             msg = (

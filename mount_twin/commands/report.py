@@ -57,9 +57,15 @@ def run(args: argparse.Namespace) -> int:
 
     require("matplotlib", "mount-twin report")
     from mount_twin.analysis.report import write_report
-    from mount_twin.commands.common import load_scene, read_design_table, warn_if_partial
+    from mount_twin.commands.common import (
+        check_targets,
+        load_scene,
+        read_design_table,
+        warn_if_partial,
+    )
     from mount_twin.io.output_tables import read_output_bag
 
+    check_targets(output=args.output)
     tolerance = tolerance_of(args)
     if args.design and not args.input:
         msg = "--design judges the input's spectra: it needs --input (and --scene)"
