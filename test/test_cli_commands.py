@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -590,3 +591,44 @@ def test_an_output_replaced_keeps_its_mode_and_a_symlink_to_it(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["layout.xml", "link.xml"]
     assert main(["dashboard", str(SCENE_FILE), "--plotjuggler", "/dev/stdout"]) == 0
     assert capfd.readouterr().out.startswith("<?xml")
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        "srs IN/ship_motion_1khz.mcap --csv IN/ship_motion_1khz.mcap",
+        "srs IN --json IN/metadata.yaml",
+        "report RUN -o RUN/out.mcap",
+        "dashboard SCENE --foxglove SCENE",
+        "replay IN --scene SCENE -o NEW --no-progress --json SCENE",
+        "accuracy SCENE IN --rtol 1e-4 --csv IN/ship_motion_1khz.mcap",
+    ],
+    ids=["srs-csv", "srs-json", "report", "dashboard", "replay", "accuracy"],
+)
+def test_an_output_that_would_replace_an_input_is_refused_before_the_work(
+    tmp_path: Path, shock_out: Path, command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`srs BAG.mcap --csv BAG.mcap` replaced the recording with its spectrum, `report RUN -o
+    RUN/out.mcap` the run with a web page, `dashboard S --foxglove S` the scene with a
+    layout: each exit 0, the input lost. Refused naming the option and the input, which is
+    left as it was."""
+    paths = {
+        "IN": tmp_path / "in",
+        "RUN": tmp_path / "out",
+        "SCENE": tmp_path / "scene.yaml",
+        "NEW": tmp_path / "new",
+    }
+    shutil.copytree(ROOT / "bags" / "ship_motion_1khz", paths["IN"])
+    shutil.copytree(shock_out, paths["RUN"])
+    shutil.copy(SCENE_FILE, paths["SCENE"])
+    before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+    words = command.split()
+    parts = [w.partition("/") for w in words]
+    args = [str(paths[head]) + sep + tail if head in paths else head for head, sep, tail in parts]
+    assert main(args) == 2
+    flag = {"-o": "--output"}.get(words[-2], words[-2])
+    err = capsys.readouterr().err
+    assert err.startswith(f"mount-twin: error: {flag} {args[-1]}: would replace "), err
+    assert "which this command reads" in err
+    assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
+    assert not paths["NEW"].exists()

@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
         if not lo <= rtol <= hi:
             msg = f"--rtol: {rtol!r} is outside [{lo:g}, {hi:g}] (integration.rtol's range)"
             raise ValueError(msg)
-    check_targets(csv=args.csv, plot=args.plot)
+    check_targets(csv=args.csv, plot=args.plot, reads=(args.scene, args.bag))
     if args.plot:
         from mount_twin.commands.extras import require
 

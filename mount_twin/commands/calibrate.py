@@ -127,7 +127,9 @@ def run(args: argparse.Namespace) -> int:
     from mount_twin.analysis.calibration import calibrate
     from mount_twin.commands.common import check_targets
 
-    check_targets(plot=args.plot, output=args.output)
+    check_targets(
+        plot=args.plot, output=args.output, reads=(args.scene, args.foundation, args.body)
+    )
     out = Path(args.output)
     if out.exists():
         msg = f"{out}: exists; calibrate writes a new scene file"

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from itertools import pairwise
 from pathlib import Path
@@ -85,12 +85,19 @@ FIGURE_FORMATS = ("png", "svg", "pdf", "svgz", "eps", "ps", "jpg", "jpeg", "tif"
 """The file name endings a figure may have: formats matplotlib writes (tested)."""
 
 
-def check_targets(*, figures: tuple[str, ...] = ("plot",), **targets: str | None) -> None:
+def check_targets(
+    *,
+    figures: tuple[str, ...] = ("plot",),
+    reads: Iterable[str | Path | None] = (),
+    **targets: str | None,
+) -> None:
     """ValueError naming the option (`--json` for json=...) of the first given path a file
     cannot be written at (its directory missing, or a directory there; through a symlink, its
     target's directory missing: the file is written there; for the options named in
-    `figures`, a name not ending in one of FIGURE_FORMATS): checked before long work, which
-    had run to its end to fail there with exit 2, its own exit status lost."""
+    `figures`, a name not ending in one of FIGURE_FORMATS), or whose file would replace one
+    the command reads (`reads`: its input files and bags; None where not given): checked
+    before long work, which had run to its end to fail there with exit 2, its own exit status
+    lost, or to replace the recording or scene it had read (exit 0)."""
     for option, path in targets.items():
         if path is None:
             continue
@@ -110,6 +117,25 @@ def check_targets(*, figures: tuple[str, ...] = ("plot",), **targets: str | None
                 f"{', '.join('.' + f for f in FIGURE_FORMATS)}"
             )
             raise ValueError(msg)
+        if replaced := _input_replaced(target, reads):
+            msg = f"{flag} {path}: would replace {replaced}, which this command reads"
+            raise ValueError(msg)
+
+
+def _input_replaced(target: Path, reads: Iterable[str | Path | None]) -> str:
+    """Which of the files or bags `reads` a file written at `target` would replace ('' for
+    none): the file itself, or a file of a bag directory ("a file of BAG")."""
+    if not target.is_file():
+        return ""
+    real = Path(os.path.realpath(target))
+    for given in reads:
+        if given is None or not os.path.exists(given):
+            continue
+        if os.path.samefile(target, given):
+            return str(given)
+        if os.path.isdir(given) and Path(os.path.realpath(given)) in real.parents:
+            return f"a file of {given}"
+    return ""
 
 
 INPUT_OPTIONS = {"input.topic": "replay --topic", "input.frame_id": "replay --frame-id"}

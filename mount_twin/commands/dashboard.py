@@ -27,7 +27,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plotjuggler and args.foxglove and Path(args.plotjuggler) == Path(args.foxglove):
         msg = f"--plotjuggler and --foxglove name one file, {args.foxglove}: one would overwrite"
         raise ValueError(msg)
-    check_targets(plotjuggler=args.plotjuggler, foxglove=args.foxglove)
+    check_targets(plotjuggler=args.plotjuggler, foxglove=args.foxglove, reads=(args.scene,))
     scene = load_scene(args.scene)
     for path, text in ((args.plotjuggler, plotjuggler_layout), (args.foxglove, foxglove_layout)):
         if path:

@@ -186,7 +186,7 @@ def run(args: argparse.Namespace) -> int:
     from mount_twin.commands.common import check_targets, json_text, load_scene, new_directory
     from mount_twin.textfiles import write_text
 
-    check_targets(json=args.json, report=args.report)
+    check_targets(json=args.json, report=args.report, reads=(args.scene, args.spectrum, args.plan))
     plan = plan_of(args)
     scene = load_scene(args.scene)  # a bad scene fails here, before anything is synthesised
     for axis in plan.spectra:

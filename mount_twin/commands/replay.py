@@ -116,7 +116,7 @@ def replay_and_report(
     from mount_twin.errors import DamagedBagError
     from mount_twin.replay import replay
 
-    check_targets(json=options.json_path, plot=options.plot)
+    check_targets(json=options.json_path, plot=options.plot, reads=(scene_path, bag, options.body))
     scene = load_scene(scene_path, input_overrides)
     from mount_twin.commands.stopping import checkpoint
 

@@ -65,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
     )
     from mount_twin.io.output_tables import read_output_bag
 
-    check_targets(output=args.output)
+    check_targets(output=args.output, reads=(args.bag, args.scene, args.input, args.design))
     tolerance = tolerance_of(args)
     if args.design and not args.input:
         msg = "--design judges the input's spectra: it needs --input (and --scene)"

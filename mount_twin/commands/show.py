@@ -22,6 +22,6 @@ def run(args: argparse.Namespace) -> int:
     from mount_twin.analysis.layout_view import draw_layout
     from mount_twin.commands.common import check_targets, load_scene
 
-    check_targets(output=args.output, figures=("output",))
+    check_targets(output=args.output, figures=("output",), reads=(args.scene,))
     print(f"layout: {draw_layout(load_scene(args.scene), args.output)}")
     return 0

@@ -168,7 +168,12 @@ def run(args: argparse.Namespace) -> int:
     from mount_twin.analysis.srs import ACCURATE_SHARE, damping_ratio, gravity_offset, srs
     from mount_twin.commands.common import check_targets, read_design_table
 
-    check_targets(plot=args.plot, json=args.json, csv=args.csv)
+    check_targets(
+        plot=args.plot,
+        json=args.json,
+        csv=args.csv,
+        reads=(args.input, args.scene, args.design),
+    )
     if args.plot:
         from mount_twin.commands.extras import require
 
