@@ -174,6 +174,37 @@ def test_results_that_are_no_regular_file_are_an_error_before_any_case_runs(
     assert "/dev/full: the results CSV is no regular file" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("where", ["other_csv", "the_sweep_file", "missing_directory"])
+def test_results_no_sweep_can_append_to_are_an_error_naming_them_before_any_case_runs(
+    tmp_path: Path,
+    where: str,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """-o of a CSV without a `case` column (or the sweep file itself) died with a KeyError
+    traceback (exit 1); -o into a missing directory started the cluster, then said only
+    "FILE: No such file or directory". Each is refused before the cluster starts, naming the
+    file; what is there is left as it was."""
+    sweep = _sweep_file(tmp_path)
+    other = tmp_path / "other.csv"
+    other.write_text("time,az\n0.0,1.0\n", encoding="utf-8")
+    out = {"other_csv": other, "the_sweep_file": sweep}.get(where, tmp_path / "no" / "r.csv")
+    before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+
+    def no_cluster(*_: object) -> None:
+        raise AssertionError("the cluster was started before the results file was checked")
+
+    monkeypatch.setattr("mount_twin.sweeps.runner.dask_client", no_cluster)
+    assert main(["sweep", str(sweep), "-o", str(out), "--workers", "1", "--no-progress"]) == 2
+    said = {
+        "other_csv": f"{out}: its columns are not this sweep's",
+        "the_sweep_file": f"--output {out}: would replace {sweep}, which this command reads",
+        "missing_directory": f"--output {out}: there is no directory {out.parent}",
+    }[where]
+    assert said in capsys.readouterr().err
+    assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
+
+
 @pytest.fixture(scope="module")
 def swept(tmp_path_factory: pytest.TempPathFactory):
     tmp = tmp_path_factory.mktemp("sweep")

@@ -41,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
     from mount_twin.commands.extras import require
     from mount_twin.commands.replay import EXIT_FAILED
 
-    check_targets(plot=args.plot, parquet=args.parquet, reads=(args.sweep,))
+    check_targets(output=args.output, plot=args.plot, parquet=args.parquet, reads=(args.sweep,))
     require("dask.distributed", "mount-twin sweep")
     if args.plot:
         require("matplotlib", "--plot")

@@ -151,15 +151,28 @@ def _figures(scene: Scene, samples: SampleBatch) -> dict[str, Any]:
     return row
 
 
-def finished_cases(results: Path) -> set[str]:
-    """Ids of the cases already in a results CSV (FAILED ones are run again)."""
+def finished_cases(results: Path, head: list[str]) -> set[str]:
+    """Ids of the cases already in a results CSV (FAILED ones are run again). MountTwinError
+    if it has other columns than `head` (this sweep's): another sweep's, an older mount_twin's
+    or no results at all, refused before any case runs (a CSV without a `case` column died
+    with a KeyError, the cases already run)."""
     if not results.exists():
         return set()
     if not results.is_file():  # /dev/full, /dev/zero: read back for ever
         msg = f"{results}: the results CSV is no regular file (it is read back and appended to)"
         raise ValueError(msg)
     with results.open(encoding="utf-8", newline="") as fh:
-        return {r["case"] for r in csv.DictReader(fh) if r.get("verdict") != FAILED}
+        had = next(csv.reader(fh), None)
+        if had is None:  # empty: new
+            return set()
+        if had != head:
+            msg = (
+                f"{results}: its columns are not this sweep's (another sweep, or an older "
+                f"mount_twin's column names); missing {sorted(set(head) - set(had))}, not "
+                f"ours {sorted(set(had) - set(head))}: write to a new file"
+            )
+            raise MountTwinError(msg)
+        return {r["case"] for r in csv.DictReader(fh, had) if r.get("verdict") != FAILED}
 
 
 def run_sweep(
@@ -175,10 +188,10 @@ def run_sweep(
     `workers` processes, one thread each; default one per core). `progress(done, total)` is
     called after each case."""
     path = Path(results)
-    todo = [c for c in expand(spec) if c.case_id not in finished_cases(path)]
+    head = columns(spec)
+    todo = [c for c in expand(spec) if c.case_id not in finished_cases(path, head)]
     if not todo:
         return []
-    head = columns(spec)
     rows = []
     with dask_client(scheduler, workers) as client:
         # Cases go out in batches, a few per worker, so that the scheduler's cost per task is
@@ -200,18 +213,9 @@ def run_sweep(
 
 @contextmanager
 def _appender(path: Path, head: list[str]) -> Iterator[Callable[[dict[str, Any]], None]]:
-    """Append rows to a CSV (header written if the file is new), flushed row by row."""
+    """Append rows to a CSV (header written if the file is new), flushed row by row; its
+    columns were checked by `finished_cases`."""
     new = not path.exists() or path.stat().st_size == 0
-    if not new:
-        with path.open(encoding="utf-8", newline="") as fh:
-            had = next(csv.reader(fh), [])
-        if had != head:
-            msg = (
-                f"{path}: its columns are not this sweep's (another sweep, or an older "
-                f"mount_twin's column names); missing {sorted(set(head) - set(had))}, not "
-                f"ours {sorted(set(had) - set(head))}: write to a new file"
-            )
-            raise MountTwinError(msg)
     with path.open("a", encoding="utf-8", newline="") as fh:
         writer = csv.DictWriter(fh, head, extrasaction="raise")
         if new:
