@@ -124,3 +124,32 @@ def test_a_damaged_bag_whose_run_failed_says_both(
     captured = capsys.readouterr()
     assert f"{bag}: damaged (" in captured.err and "integration failed " in captured.err
     assert "verdict: FAILED" in captured.out
+
+
+@pytest.mark.parametrize("command", ["accuracy", "report"])
+def test_an_analysis_of_a_truncated_mcap_exits_2_saying_it_analysed_none_of_it(
+    tmp_path: Path, command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """accuracy and report --input read their input whole: on a truncated mcap they printed
+    nothing and wrote nothing, yet exited 5 saying "the N messages ... before the damage were
+    processed", replay's word for a run summarised up to the damage."""
+    bag = _cut_copy(tmp_path / "cut", lambda n: int(n * 0.6))
+    page = tmp_path / "r.html"
+    if command == "accuracy":
+        args = ["accuracy", PUMP, str(bag), "--rtol", "1e-4"]
+    else:
+        run = tmp_path / "run"
+        whole = str(ROOT / "bags" / "ship_motion_1khz")
+        assert main(["replay", whole, "--scene", PUMP, "-o", str(run), "--no-progress"]) == 0
+        args = ["report", str(run), "--scene", PUMP, "--input", str(bag), "-o", str(page)]
+    capsys.readouterr()
+    assert main(args) == 2
+    captured = capsys.readouterr()
+    assert captured.err.count("mount-twin: error: ") == 1, captured.err
+    assert captured.err.startswith(f"mount-twin: error: {bag}: damaged (")
+    assert "processed" not in captured.err
+    assert captured.err.endswith(
+        f"{bag} is damaged part-way, and this analysis reads its record whole: none of it was "
+        "analysed (`mount-twin replay` runs what comes before the damage)\n"
+    )
+    assert not page.exists()

@@ -210,7 +210,7 @@ class InputBag:
             msg = (
                 f"{self.path}: damaged ({salvaged.damage}); the {before + len(raws)} messages "
                 f"of {self.topic} before the damage{_up_to(salvaged.messages[-1][0])} were "
-                "processed"
+                "read"
             )
             raise DamagedBagError(msg)
 
