@@ -98,3 +98,25 @@ def test_a_synthesis_that_fails_before_writing_leaves_no_directory(
     assert main([*args, "--start", "0"]) == 2
     assert "stamped 0 ns" in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["synthesize", "srs"])
+def test_a_design_spectrum_that_is_no_text_is_an_error_naming_it(
+    tmp_path: Path, command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A binary file given as the design spectrum (a bag's mcap) said only "'utf-8' codec
+    can't decode byte 0x89 in position 0", naming no file; one with a field past csv's limit
+    ended in csv's traceback (exit 1)."""
+    root = Path(__file__).resolve().parents[1]
+    (mcap,) = (root / "bags" / "ship_motion_1khz").glob("*.mcap")
+    long_field = tmp_path / "long_field.csv"
+    long_field.write_text("frequency_hz,accel_g\n10," + "9" * 200_000 + "\n", encoding="utf-8")
+    for design, said in ((mcap, "<file>: not UTF-8 text"), (long_field, "not a CSV table")):
+        if command == "synthesize":
+            args = ["synthesize", "--spectrum", str(design), "-o", str(tmp_path / "out")]
+        else:
+            args = ["srs", str(root / "bags" / "genset_shock_10khz"), "--design", str(design)]
+        assert main(args) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"mount-twin: error: {design}: {said}"), err
+        assert not (tmp_path / "out").exists()

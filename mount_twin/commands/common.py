@@ -254,15 +254,23 @@ def refuse_not_finite(
 
 def read_design_table(path: str) -> tuple[list[float], list[float]]:
     """A design spectrum's (frequencies Hz, accelerations g) from its `frequency_hz,accel_g`
-    CSV."""
+    CSV; a file that is no text, or no table (a field past csv's limit), is an error naming
+    it (`io.csv_import.read_csv_text`: it had said "'utf-8' codec can't decode byte 0x89",
+    or ended in csv's traceback)."""
     import csv
+    import io
 
-    with open(path, encoding="utf-8-sig") as fh:
-        reader = csv.DictReader(fh)
+    from mount_twin.io.csv_import import read_csv_text
+
+    reader = csv.DictReader(io.StringIO(read_csv_text(Path(path))))
+    try:
         if not {"frequency_hz", "accel_g"} <= set(reader.fieldnames or ()):
             msg = f"{path}: a design spectrum needs the columns frequency_hz and accel_g"
             raise ValueError(msg)
         rows = list(reader)
+    except csv.Error as err:  # no ValueError: it had ended in a traceback, exit 1
+        msg = f"{path}: not a CSV table ({err})"
+        raise ValueError(msg) from None
     try:
         f = [float(r["frequency_hz"]) for r in rows]
         a = [float(r["accel_g"]) for r in rows]

@@ -92,7 +92,7 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     path = Path(path)
     lines = [
         (n, line)
-        for n, line in enumerate(_read_text(path).splitlines(), 1)
+        for n, line in enumerate(read_csv_text(path).splitlines(), 1)
         if line.strip() and not line.lstrip().startswith("#")
     ]
     if not lines:
@@ -166,9 +166,9 @@ def check_increasing(path: Path, t: np.ndarray, rows: list[int], column: str) ->
         raise _cell_fail(path, rows[int(back[0]) + 1], column, "time does not increase")
 
 
-def _read_text(path: Path) -> str:
+def read_csv_text(path: Path) -> str:
     """The file's text (at most CSV_MAX_BYTES, UTF-8, a byte-order mark dropped); errors name
-    the file."""
+    the file (ValueError "FILE: <file>: ..."). Any CSV a command reads is read so."""
     try:
         # utf-8-sig drops a byte-order mark
         return read_limited(path, CSV_MAX_BYTES, "CSV_MAX_BYTES", "utf-8-sig")
