@@ -585,3 +585,34 @@ def test_an_axis_with_no_response_is_said_so_not_short_by_inf_db() -> None:
         "1 of 4 frequencies within -1.5/+3 dB: FAIL: short by 6.02 dB at 10–40 Hz "
         "(no response at 10 and 40 Hz)"
     )
+
+
+def test_a_design_reaching_past_the_spectrums_frequencies_is_not_passed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A record sampled at 1 kHz has spectra up to fs/10 = 100 Hz (the default --fmax; its
+    1/6-octave frequencies from 5 Hz end at 5·2^(26/6) = 100.8 > 100, so at 89.8 Hz). Judged
+    against a 10–1000 Hz design, the design's 89.8–1000 Hz (a decade of its two, reaching past
+    one 1/6-octave step from 89.8 Hz) was never compared: it said PASS, exit 0. It is not
+    passed, and says which part of the design was not judged."""
+    freqs = octave_frequencies(10.0, 100.0)  # 10 … 89.8 Hz
+    met = check_design(freqs, np.ones_like(freqs), [10.0, 1000.0], [1.0, 1.0])
+    assert met.within.all() and not met.passed
+    assert "the design's 89.8–1000 Hz is beyond the spectrum's frequencies" in met.summary()
+    step = 2.0 ** (1.0 / 6.0)  # within one step of the design's ends: covered
+    assert check_design(freqs, np.ones_like(freqs), [10.0, freqs[-1] * step], [1, 1]).passed
+    t = np.arange(1000) / 1000.0
+    pulse = np.where((t >= 0.1) & (t <= 0.111), np.sin(np.pi * (t - 0.1) / 0.011), 0.0)
+    record = tmp_path / "half_sine_1khz.csv"
+    rows = "".join(f"{x!r},0,0,{10.0 * p!r}\n" for x, p in zip(t, pulse, strict=True))
+    record.write_text("t [s],ax [g],ay [g],az [g]\n" + rows, encoding="utf-8")
+    design = _design_file(tmp_path / "design.csv", [10.0, 1000.0], [10.0, 10.0])
+    args = ["srs", str(record), "--fmin", "10", "--design", str(design)]
+    assert main([*args, "--tolerance-db", "-60", "60"]) == EXIT_OUT_OF_TOLERANCE
+    said = capsys.readouterr().out
+    assert "20 of 20 frequencies within -60/+60 dB" in said and "PASS" not in said
+    assert "89.8–1000 Hz is beyond the spectrum's frequencies (10–89.8 Hz)" in said
+    doc = tmp_path / "s.json"
+    assert main([*args, "--json", str(doc)]) == EXIT_OUT_OF_TOLERANCE
+    result = json.loads(doc.read_text(encoding="utf-8"))
+    assert result["axes"]["z"]["design_not_reached_hz"] == [[pytest.approx(89.797), 1000.0]]

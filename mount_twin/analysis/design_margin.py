@@ -5,7 +5,10 @@ A shock test or a synthesised input meets a specification when its spectrum lies
 tolerance band about the design spectrum at every frequency the design covers (commonly
 −1.5 dB / +3 dB: MIL-STD-810H Method 516.8 and the usual synthesis practice). The design table
 (frequency, acceleration) is interpolated log-log between its points (straight lines on the
-usual log-log plot); frequencies outside its range are not judged.
+usual log-log plot); frequencies outside its range are not judged. A design reaching more than
+one of the spectrum's own steps (the ratio of its first two or last two frequencies) past the
+spectrum's lowest or highest frequency is not met there, nor passed: a record at 1 kHz has
+spectra to 100 Hz, and a 10–1000 Hz design judged on them alone had passed.
 """
 
 from __future__ import annotations
@@ -28,6 +31,8 @@ class DesignCheck:
         design, spectrum: the design's and the spectrum's values there (one unit, any).
         tolerance_db: (low, high): the band about the design, dB (low < 0 < high).
         skipped: how many of the spectrum's frequencies lie outside the design's range.
+        unreached: the design's ranges (from Hz, to Hz) beyond the spectrum's frequencies
+            by more than a step of theirs: not judged, so not passed.
     """
 
     frequency_hz: np.ndarray
@@ -35,6 +40,9 @@ class DesignCheck:
     spectrum: np.ndarray
     tolerance_db: tuple[float, float]
     skipped: int
+    unreached: tuple[tuple[float, float], ...] = ()
+    reached: tuple[float, float] = (math.nan, math.nan)
+    """The spectrum's lowest and highest frequency, Hz."""
 
     @property
     def margin_db(self) -> np.ndarray:
@@ -50,8 +58,9 @@ class DesignCheck:
 
     @property
     def passed(self) -> bool:
-        """Within the band at every frequency judged (and at least one judged)."""
-        return bool(self.frequency_hz.shape[0]) and bool(self.within.all())
+        """Within the band at every frequency judged (at least one), and the design's whole
+        range judged (nothing `unreached`)."""
+        return bool(self.frequency_hz.shape[0]) and bool(self.within.all()) and not self.unreached
 
     def bands(self) -> list[tuple[float, float, str, float]]:
         """The runs of consecutive frequencies out of the band: (first Hz, last Hz, 'short'
@@ -86,8 +95,14 @@ class DesignCheck:
             return f"{head}: PASS"
         if not n:
             return f"{head}: FAIL (no frequency in the design's range)"
-        where = "; ".join(self._band_text(*band) for band in self.bands())
-        return f"{head}: FAIL: {where}"
+        where = [self._band_text(*band) for band in self.bands()]
+        low_hz, high_hz = self.reached
+        where += [
+            f"the design's {f0:.4g}–{f1:.4g} Hz is beyond the spectrum's frequencies "
+            f"({low_hz:.4g}–{high_hz:.4g} Hz), not judged"
+            for f0, f1 in self.unreached
+        ]
+        return f"{head}: FAIL: {'; '.join(where)}"
 
     def _band_text(self, f0: float, f1: float, kind: str, worst: float) -> str:
         """'short by 6.02 dB at 10–40 Hz'; where the spectrum is 0 (no response: its margin
@@ -126,4 +141,19 @@ def check_design(
     f = frequency_hz[inside]
     at = np.exp(np.interp(np.log(f), np.log(design_hz), np.log(design)))
     skipped = int((~inside).sum())
-    return DesignCheck(f, at, spectrum[inside], tolerance_db, skipped)
+    ordered = np.sort(np.asarray(frequency_hz, float))
+    low, high = float(ordered[0]), float(ordered[-1])
+    # a design ending one of the spectrum's steps past it is reached (1e-9: rounding)
+    step_low, step_high = (
+        (float(ordered[1] / ordered[0]), float(ordered[-1] / ordered[-2]))
+        if ordered.size > 1
+        else (1.0, 1.0)
+    )
+    unreached = []
+    if design_hz[0] < low / step_low / (1.0 + 1e-9):
+        unreached.append((float(design_hz[0]), low))
+    if design_hz[-1] > high * step_high * (1.0 + 1e-9):
+        unreached.append((high, float(design_hz[-1])))
+    return DesignCheck(
+        f, at, spectrum[inside], tolerance_db, skipped, tuple(unreached), (low, high)
+    )

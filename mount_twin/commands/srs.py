@@ -40,7 +40,8 @@ holds equal: this module does not import numpy before it runs)."""
 EXIT_OUT_OF_TOLERANCE = 4
 EXIT_STATUS = (
     "exit status: 0 done (with --design: every axis within the tolerance); 2 bad input; "
-    f"{EXIT_OUT_OF_TOLERANCE} a spectrum out of the design's tolerance somewhere"
+    f"{EXIT_OUT_OF_TOLERANCE} a spectrum out of the design's tolerance somewhere, or the design "
+    "reaching past its frequencies"
 )
 
 
@@ -370,6 +371,7 @@ def _write_json(
                 "summary": c.summary(),
                 "judged": int(c.frequency_hz.shape[0]),
                 "not_judged": c.skipped,
+                "design_not_reached_hz": [list(r) for r in c.unreached],
                 "out_of_band": [
                     {"from_hz": f0, "to_hz": f1, "kind": kind, "worst_db": worst}
                     for f0, f1, kind, worst in c.bands()
