@@ -329,7 +329,7 @@ def test_an_fmax_of_0_is_refused_not_read_as_the_default(
     """`--fmax 0` gave the spectrum up to the default (0.1 of the rate) with exit 0."""
     out = tmp_path / "s.csv"
     assert main(["srs", str(GENSET), "--fmax", "0", "--csv", str(out)]) == 2
-    assert "0 < f_min ≤ f_max" in capsys.readouterr().err
+    assert "--fmax 0 Hz: a natural frequency lies above 0 Hz" in capsys.readouterr().err
     assert not out.exists()
 
 
@@ -616,3 +616,31 @@ def test_a_design_reaching_past_the_spectrums_frequencies_is_not_passed(
     assert main([*args, "--json", str(doc)]) == EXIT_OUT_OF_TOLERANCE
     result = json.loads(doc.read_text(encoding="utf-8"))
     assert result["axes"]["z"]["design_not_reached_hz"] == [[pytest.approx(89.797), 1000.0]]
+
+
+@pytest.mark.parametrize(
+    ("options", "named"),
+    [
+        (["--freqs", "10", "600"], "--freqs 600 Hz"),
+        (["--fmax", "600"], "--fmax 600 Hz"),
+        (["--fmin", "2000"], "--fmin 2000 Hz"),
+        (["--fmin", "0"], "--fmin 0 Hz"),
+    ],
+)
+def test_frequencies_a_record_cannot_have_are_refused_naming_the_option(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], options: list[str], named: str
+) -> None:
+    """A record sampled at 1 kHz has no spectrum at or above its Nyquist frequency, 500 Hz;
+    its default --fmax is fs/10 = 100 Hz. The refusal named no option ('natural frequencies
+    must lie between 0 and half the sampling rate', or 'f_min = 2000.0 Hz, f_max = 100.0 Hz'
+    for an --fmax the user never gave): it names the option, its value and the bound."""
+    t = np.arange(1000) / 1000.0
+    record = tmp_path / "rec_1khz.csv"
+    rows = "".join(f"{x!r},0,0,{math.sin(40.0 * x)!r}\n" for x in t)
+    record.write_text("t [s],ax [g],ay [g],az [g]\n" + rows, encoding="utf-8")
+    assert main(["srs", str(record), "--gravity", "none", *options]) == 2
+    err = capsys.readouterr().err
+    assert f"{named}: a natural frequency lies above 0 Hz and below half the record's " in err
+    assert "(500 Hz)" in err
+    assert main(["srs", str(record), "--gravity", "none", "--fmin", "200"]) == 2
+    assert "--fmin 200 Hz: above --fmax (default fs/10 = 100 Hz)" in capsys.readouterr().err

@@ -259,9 +259,22 @@ def _frequencies(args: argparse.Namespace, rate_hz: float) -> np.ndarray:
 
     from mount_twin.analysis.srs import ACCURATE_SHARE, octave_frequencies
 
+    nyquist = 0.5 * rate_hz
+    fmax = ACCURATE_SHARE * rate_hz if args.fmax is None else args.fmax
+    given = [("--freqs", f) for f in args.freqs or ()] or [("--fmin", args.fmin), ("--fmax", fmax)]
+    for flag, f in given:
+        if not 0.0 < f < nyquist:
+            msg = (
+                f"{flag} {f:g} Hz: a natural frequency lies above 0 Hz and below half the "
+                f"record's sampling rate ({nyquist:g} Hz)"
+            )
+            raise ValueError(msg)
     if args.freqs:
         return np.array(args.freqs)
-    fmax = ACCURATE_SHARE * rate_hz if args.fmax is None else args.fmax  # 0 is refused
+    if args.fmin > fmax:
+        said = f"{fmax:g} Hz" if args.fmax is not None else f"default fs/10 = {fmax:g} Hz"
+        msg = f"--fmin {args.fmin:g} Hz: above --fmax ({said})"
+        raise ValueError(msg)
     return octave_frequencies(args.fmin, fmax, args.octave)
 
 
