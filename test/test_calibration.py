@@ -338,6 +338,27 @@ def test_a_body_record_that_does_not_move_is_refused_at_load_naming_it(
     assert not out.exists()
 
 
+@pytest.mark.parametrize("command", ["calibrate", "track"])
+def test_records_that_do_not_overlap_are_refused_at_load_naming_both_files(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The table of trial 1 (device clock 2528.77–2544.77 s) with the block of trial 2
+    (2578.07–2594.07 s, 33 s after the first ended): the refusal said "the body record" and
+    "the records", naming neither file. It names both, with their spans, exit 2."""
+    out = tmp_path / "c.scene.yaml"
+    ground = str(SHAKE / "sine_2hz_trial1_ground_excerpt.csv")
+    top = str(SHAKE / "sine_2hz_trial2_top_excerpt.csv")
+    tail = ["-o", str(out)] if command == "calibrate" else ["--window", "10"]
+    args = [command, str(SHAKE / "block.scene.yaml"), "--foundation", ground, "--body", top]
+    assert main([*args, *tail]) == 2
+    err = capsys.readouterr().err
+    assert (
+        f"--body {top} (2578.07 to 2594.07 s) has 0 samples within --foundation {ground}'s" in err
+    )
+    assert "(2528.77 to 2544.77 s, 0.25 s off each end)" in err
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("body", ["moving", "dead"])
 @pytest.mark.parametrize("command", ["calibrate", "track"])
 def test_a_foundation_record_that_does_not_move_is_refused_at_load_naming_it(

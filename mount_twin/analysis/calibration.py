@@ -235,6 +235,24 @@ def _compared(foundation: Signal, body: Signal) -> np.ndarray:
     return (body.t > foundation.t[0] + EDGE_S) & (body.t < foundation.t[-1] - EDGE_S)
 
 
+def overlap_problem(
+    foundation: Signal,
+    body: Signal,
+    named: tuple[str, str] = ("the body record", "the foundation's"),
+) -> str:
+    """Why the fit cannot compare the pair ('' where it can): fewer than `MIN_OVERLAP` body
+    samples within the foundation record, `EDGE_S` off each end. `named`: how the body record
+    and the foundation's (possessive) are said (the command names their files)."""
+    overlap = int(np.count_nonzero(_compared(foundation, body)))
+    if overlap >= MIN_OVERLAP:
+        return ""
+    return (
+        f"{named[0]} ({body.t[0]:.6g} to {body.t[-1]:.6g} s) has {overlap} samples within "
+        f"{named[1]} ({foundation.t[0]:.6g} to {foundation.t[-1]:.6g} s, {EDGE_S:g} s off each "
+        f"end), fewer than {MIN_OVERLAP}: the two records must overlap on one clock"
+    )
+
+
 def _dynamic_rms(accel: np.ndarray) -> float:
     """The RMS of (k, 3) specific force about its mean, all axes, m/s² (0 for no sample)."""
     if not accel.shape[0]:
@@ -312,15 +330,9 @@ class _Problem:
 
     def __init__(self, scene: Scene, foundation: Signal, body: Signal, free: list[str]) -> None:
         self.scene, self.foundation, self.free = scene, foundation, free
+        if problem := overlap_problem(foundation, body):
+            raise ValueError(problem)
         keep = _compared(foundation, body)
-        if (overlap := int(np.count_nonzero(keep))) < MIN_OVERLAP:
-            msg = (
-                f"the body record ({body.t[0]:.6g} to {body.t[-1]:.6g} s) has "
-                f"{overlap} samples within the foundation's ({foundation.t[0]:.6g} "
-                f"to {foundation.t[-1]:.6g} s, {EDGE_S:g} s off each end), fewer than "
-                f"{MIN_OVERLAP}: the two records must overlap on one clock"
-            )
-            raise ValueError(msg)
         self.t, self.measured = body.t[keep], body.accel[keep]
         self.scale = self.measured.std(axis=0) + 1e-12
 

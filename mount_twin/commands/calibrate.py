@@ -97,8 +97,9 @@ def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
     """The scene (it must have a body_sensor) and its (foundation, body) records, on one
     clock, from `args.scene`, `args.foundation` and `args.body`; a record that does not move
     (`calibration.still_record`: a still foundation, a body still beside its foundation's
-    motion) is refused, naming its file (and a bag's topic)."""
-    from mount_twin.analysis.calibration import still_record
+    motion) is refused, naming its file (and a bag's topic), as a pair that does not overlap
+    on one clock is (`calibration.overlap_problem`), naming both."""
+    from mount_twin.analysis.calibration import overlap_problem, still_record
     from mount_twin.commands.common import load_scene
     from mount_twin.io.messages import IMU
 
@@ -111,6 +112,9 @@ def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
         args.foundation, spec.topic, spec.msg_type, None, FOUNDATION_KEYS
     )
     body, _ = _read_record(args.body, scene.body_sensor.topic, IMU, base, BODY_KEYS)
+    named = (f"--body {args.body}", f"--foundation {args.foundation}'s")
+    if apart := overlap_problem(foundation, body, named):
+        raise ValueError(apart)
     if still := still_record(foundation, body):
         path, topic = {
             "foundation": (args.foundation, spec.topic),
