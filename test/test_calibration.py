@@ -507,3 +507,16 @@ def test_a_bag_record_with_samples_not_finite_is_refused_naming_them(
         == 2
     )
     assert f"{ground}: no topic '/machine/imu' (body_sensor.topic);" in capsys.readouterr().err
+
+
+def test_records_too_short_to_compare_are_refused_for_that_not_for_their_clocks() -> None:
+    """0.4 s of both records on one clock: the fit compares the body samples from 0.25 s after
+    the foundation record's start to 0.25 s before its end (EDGE_S), none of 0.4 s. It was
+    told "the two records must overlap on one clock", which they do."""
+    foundation, body = _pair(_pump(), ship_motion(rate_hz=RATE, total=0.4), {})
+    assert body.t[0] < foundation.t[-1] and foundation.t[0] < body.t[-1]  # they overlap
+    with pytest.raises(ValueError) as err:
+        cal_mod.calibrate(_pump(), foundation, body, ("stiffness",))
+    said = str(err.value)
+    assert "overlap on one clock" not in said
+    assert "0.395 s long" in said and "longer than 0.5 s" in said

@@ -241,15 +241,25 @@ def overlap_problem(
     named: tuple[str, str] = ("the body record", "the foundation's"),
 ) -> str:
     """Why the fit cannot compare the pair ('' where it can): fewer than `MIN_OVERLAP` body
-    samples within the foundation record, `EDGE_S` off each end. `named`: how the body record
+    samples within the foundation record, `EDGE_S` off each end (records apart on the clock, or
+    too short: said which). `named`: how the body record
     and the foundation's (possessive) are said (the command names their files)."""
     overlap = int(np.count_nonzero(_compared(foundation, body)))
     if overlap >= MIN_OVERLAP:
         return ""
+    if max(body.t[0], foundation.t[0]) < min(body.t[-1], foundation.t[-1]):  # too short
+        length = float(foundation.t[-1] - foundation.t[0])
+        why = (
+            f"the foundation record is {length:.3g} s long: give records longer than "
+            f"{2.0 * EDGE_S:g} s (its first and last {EDGE_S:g} s are not compared), with at "
+            f"least {MIN_OVERLAP} body samples between"
+        )
+    else:
+        why = "the two records must overlap on one clock"
     return (
         f"{named[0]} ({body.t[0]:.6g} to {body.t[-1]:.6g} s) has {overlap} samples within "
         f"{named[1]} ({foundation.t[0]:.6g} to {foundation.t[-1]:.6g} s, {EDGE_S:g} s off each "
-        f"end), fewer than {MIN_OVERLAP}: the two records must overlap on one clock"
+        f"end), fewer than {MIN_OVERLAP}: {why}"
     )
 
 
