@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import math
+import shutil
 from pathlib import Path
 
 import pytest
@@ -342,3 +343,26 @@ def test_a_cluster_of_fewer_than_one_worker_is_refused_at_once() -> None:
             dask_client(workers=workers),
         ):
             pytest.fail("a cluster came up")
+
+
+def test_a_retried_case_that_succeeds_is_no_longer_counted_failed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A bag still being copied when the sweep ran (its folder empty) fails its cases; rerun
+    once it is in place, they succeed. Their first, FAILED rows stayed in the table the summary
+    and the exit status read: "4 cases" of a 2-case sweep, "ERROR 2, FAILED 2", exit 6."""
+    bag = tmp_path / "shock"
+    bag.mkdir()  # there, but not yet its files
+    text = SWEEP.replace(str(ROOT / "bags" / "half_sine_shock_10khz"), str(bag))
+    text = text.split("  - name: dhs", maxsplit=1)[0].replace("[1100.0, -5.0]", "[1100.0]")
+    sweep, results = str(_sweep_file(tmp_path, text)), str(tmp_path / "results.csv")
+    args = ["sweep", sweep, "-o", results, "--workers", "1", "--no-progress"]
+    assert main(args) == 6
+    assert "verdicts: FAILED 2\n" in capsys.readouterr().out
+    bag.rmdir()
+    shutil.copytree(ROOT / "bags" / "half_sine_shock_10khz", bag)
+    assert main(args) == 0  # each case's latest run succeeded
+    out = capsys.readouterr().out
+    assert out.startswith(f"2 cases in {results}\n")
+    assert "verdicts: ERROR 2\n" in out  # the bundled shock overloads the pump's mounts
+    assert [r["verdict"] for r in read_results(results)] == ["ERROR", "ERROR"]

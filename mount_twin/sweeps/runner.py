@@ -237,12 +237,14 @@ TEXT_COLUMNS = frozenset({"case", "input", "verdict", "error", "first_event"})
 
 
 def read_results(results: str | Path) -> list[dict[str, Any]]:
-    """The rows of a results CSV, typed: each column but `TEXT_COLUMNS` whose every non-empty
-    cell is an integer holds ints, one whose every non-empty cell is a number floats (an
-    empty cell, a failed case's figure: None), any other text; so `DataFrame(rows)` has
-    numeric columns."""
+    """The rows of a results CSV, one per case: a case run again (a rerun retries the FAILED
+    ones, appending their new rows) is its latest row, in its first row's place. Typed: each
+    column but `TEXT_COLUMNS` whose every non-empty cell is an integer holds ints, one whose
+    every non-empty cell is a number floats (an empty cell, a failed case's figure: None), any
+    other text; so `DataFrame(rows)` has numeric columns."""
     with Path(results).open(encoding="utf-8", newline="") as fh:
-        rows: list[dict[str, Any]] = list(csv.DictReader(fh))
+        latest = {r["case"]: r for r in csv.DictReader(fh)}
+    rows: list[dict[str, Any]] = list(latest.values())
     for name in rows[0] if rows else ():
         if name not in TEXT_COLUMNS:
             convert = _column_type([r[name] for r in rows if r[name] != ""])
