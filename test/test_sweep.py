@@ -366,3 +366,37 @@ def test_a_retried_case_that_succeeds_is_no_longer_counted_failed(
     assert out.startswith(f"2 cases in {results}\n")
     assert "verdicts: ERROR 2\n" in out  # the bundled shock overloads the pump's mounts
     assert [r["verdict"] for r in read_results(results)] == ["ERROR", "ERROR"]
+
+
+def test_the_plot_takes_a_first_varied_value_that_is_no_number_in_the_files_order(
+    tmp_path: Path,
+) -> None:
+    """A sweep of mounts[fl].position (spec.py's own example) ran every case and then failed at
+    --plot: "could not convert string to float: '[0.9, 0.4, 0.0]'" (exit 2, the sweep's own
+    exit status lost). Values that are no numbers are placed side by side in the sweep file's
+    order, each labelled as the table writes it."""
+    pytest.importorskip("matplotlib")
+    positions = "[[1.0, 0.4, 0.0], [0.9, 0.4, 0.0]]"
+    text = SWEEP.replace(
+        "key: mounts[*].stiffness\n    scale: [0.5, 2.0]",
+        "key: mounts[fl].position\n    values: " + positions,
+    )
+    text = text.replace("[1100.0, -5.0]", "[1100.0]")
+    sweep, results, png = _sweep_file(tmp_path, text), tmp_path / "r.csv", tmp_path / "r.png"
+    args = ["sweep", str(sweep), "-o", str(results), "--plot", str(png)]
+    assert main([*args, "--workers", "1", "--no-progress"]) == 0
+    assert png.stat().st_size > 10_000
+    spec, rows = load_sweep(sweep), read_results(results)
+    lines = trade_off(rows, spec)
+    assert list(lines) == ["half_sine_shock_10khz body.mass=1100.0", "dhs body.mass=1100.0"]
+    for label, points in lines.items():
+        assert [p[0] for p in points] == [0.0, 1.0]
+        for p in points:
+            (r,) = (  # the row of that place's position
+                r
+                for r in rows
+                if label.startswith(r["input"] + " ")
+                and r["mounts[fl].position"] == ["[1.0, 0.4, 0.0]", "[0.9, 0.4, 0.0]"][int(p[0])]
+            )
+            names = [m["name"] for m in spec.base["mounts"]]
+            assert p[1] == max(r[f"peak_force_magnitude_N.{n}"] for n in names) * 1e-3

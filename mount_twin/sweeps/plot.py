@@ -8,7 +8,13 @@ import math
 from pathlib import Path
 from typing import Any
 
-from mount_twin.sweeps.runner import FAILED, columns, largest_peak_force, largest_utilisation
+from mount_twin.sweeps.runner import (
+    FAILED,
+    columns,
+    largest_peak_force,
+    largest_utilisation,
+    setting_text,
+)
 from mount_twin.sweeps.spec import SweepSpec
 
 MARKS = {"OK": "o", "WARN": "s", "ERROR": "v"}
@@ -16,8 +22,23 @@ MARKS = {"OK": "o", "WARN": "s", "ERROR": "v"}
 
 
 Point = tuple[float, float, float, str]
-"""A case on a line: the first varied value, its largest peak mount force (kN), its largest
-utilisation (NaN: no mount rated) and its verdict."""
+"""A case on a line: the first varied value (or its place, `places`), its largest peak mount
+force (kN), its largest utilisation (NaN: no mount rated) and its verdict."""
+
+
+def places(rows: list[dict[str, Any]], spec: SweepSpec) -> dict[str, int] | None:
+    """Where each first varied value goes on the x axis when one is no number (a position, a
+    switch, a method's name): its place in the sweep file's values, by its text in the table
+    (`setting_text`; one the file no longer has, after them). None where every value is a
+    number: the axis is then the values'."""
+    values = spec.variations[0].values if spec.variations else ()
+    if all(_is_number(v) for v in values):
+        return None
+    at = {setting_text(v): i for i, v in enumerate(values)}
+    key = columns(spec)[2]
+    for r in rows:
+        at.setdefault(str(r[key]), len(at))
+    return at
 
 
 def trade_off(rows: list[dict[str, Any]], spec: SweepSpec) -> dict[str, list[Point]]:
@@ -31,6 +52,7 @@ def trade_off(rows: list[dict[str, Any]], spec: SweepSpec) -> dict[str, list[Poi
         others = tuple(_sortable(r[k]) for k in varied[1:])
         return (order.get(r["input"], len(order)), str(r["input"]), *others)
 
+    at = places(rows, spec)
     lines: dict[str, list[Point]] = {}
     for r in sorted(rows, key=line_key):
         if r["verdict"] == FAILED or not varied:
@@ -38,7 +60,7 @@ def trade_off(rows: list[dict[str, Any]], spec: SweepSpec) -> dict[str, list[Poi
         label = " ".join([r["input"], *(f"{k}={r[k]}" for k in varied[1:])])
         lines.setdefault(label, []).append(
             (
-                float(r[varied[0]]),
+                float(r[varied[0]]) if at is None else float(at[str(r[varied[0]])]),
                 largest_peak_force(r, names) * 1e-3,
                 largest_utilisation(r, names),
                 r["verdict"],
@@ -49,9 +71,13 @@ def trade_off(rows: list[dict[str, Any]], spec: SweepSpec) -> dict[str, list[Poi
     return lines
 
 
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
 def _sortable(value: Any) -> tuple[int, float, str]:
     """A varied value as a sort key: numbers by value, before anything else by its text."""
-    if isinstance(value, int | float) and not isinstance(value, bool):
+    if _is_number(value):
         return (0, float(value), "")
     return (1, 0.0, str(value))
 
@@ -81,5 +107,7 @@ def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> 
         ax.legend(fontsize=7)
     varied = columns(spec)[2 : 2 + len(spec.variations)]
     panels[-1].set_xlabel(varied[0] if varied else "case")
+    if (at := places(rows, spec)) is not None:
+        panels[-1].set_xticks(list(at.values()), list(at), fontsize=8)
     panels[0].set_title(f"{Path(spec.source).name}: markers o OK, s WARN, v ERROR", fontsize=9)
     return save_png(fig, png)

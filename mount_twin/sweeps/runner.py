@@ -97,7 +97,7 @@ def run_case(base: dict[str, Any], source: str, case: Case) -> dict[str, Any]:
     """One row of figures for `case` (never raises: a failure is a FAILED row)."""
     row: dict[str, Any] = {"case": case.case_id, "input": case.input.name}
     for key, op, value in case.settings:
-        row[key if op == "set" else f"{key} (scale)"] = json.dumps(value)
+        row[key if op == "set" else f"{key} (scale)"] = setting_text(value)
     t0 = time.perf_counter()
     try:
         scene = scene_from_dict(
@@ -109,6 +109,11 @@ def run_case(base: dict[str, Any], source: str, case: Case) -> dict[str, Any]:
         row.update(verdict=FAILED, error=f"{type(err).__name__}: {err}")
     row["wall_s"] = time.perf_counter() - t0
     return row
+
+
+def setting_text(value: Any) -> str:
+    """A varied value as a row holds it: JSON (a number, true, "text", [0.9, 0.4, 0.0])."""
+    return json.dumps(value)
 
 
 def run_cases(base: dict[str, Any], source: str, cases: list[Case]) -> list[dict[str, Any]]:
