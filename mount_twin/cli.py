@@ -35,6 +35,7 @@ class Command(Protocol):
 
     NAME: str
     HELP: str
+    # optional: STOPS_AT_CHECKPOINTS (bool), STOPPED_OUTPUT (str), read with getattr
 
     def add_arguments(self, parser: argparse.ArgumentParser) -> None: ...
 
@@ -90,6 +91,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         # never lands inside the writing of a bag; others stop at once.
         polls = getattr(modules[args.cmd], "STOPS_AT_CHECKPOINTS", False)
         stopping.install(polls)
+    held = getattr(modules[args.cmd], "STOPPED_OUTPUT", "")
     try:
         code = modules[args.cmd].run(args)
         sys.stdout.flush()  # here, not at exit: a reader gone (`| head`) is seen below
@@ -98,18 +100,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing left to flush
         return EXIT_SIGPIPE
     except DamagedBagError as err:
-        _say_damaged(err, args)
+        _say_damaged(err, args, held)
         return EXIT_DAMAGED
     except (MountTwinError, ValueError, OSError) as err:
         if damage := _damage_behind(err):  # it failed after the damage (a write of the
-            _say_damaged(damage, args)  # summary up to it): neither is hidden
+            _say_damaged(damage, args, held)  # summary up to it): neither is hidden
         print(f"mount-twin: error: {_error_text(err)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"mount-twin: interrupted (SIGINT){_partial(args)}", file=sys.stderr)
+        print(f"mount-twin: interrupted (SIGINT){_partial(args, held)}", file=sys.stderr)
         return EXIT_SIGINT
     except Terminated:
-        print(f"mount-twin: terminated (SIGTERM){_partial(args)}", file=sys.stderr)
+        print(f"mount-twin: terminated (SIGTERM){_partial(args, held)}", file=sys.stderr)
         return EXIT_SIGTERM
 
 
@@ -122,9 +124,9 @@ def _damage_behind(err: BaseException) -> DamagedBagError | None:
     return seen
 
 
-def _say_damaged(err: DamagedBagError, args: argparse.Namespace) -> None:
+def _say_damaged(err: DamagedBagError, args: argparse.Namespace, held: str) -> None:
     """Say on stderr that the input was damaged part-way, and where the output so far is."""
-    print(f"mount-twin: error: {err}{_partial(args)}", file=sys.stderr)
+    print(f"mount-twin: error: {err}{_partial(args, held)}", file=sys.stderr)
 
 
 def _error_text(err: Exception) -> str:
@@ -136,11 +138,14 @@ def _error_text(err: Exception) -> str:
     return str(err)
 
 
-def _partial(args: argparse.Namespace) -> str:
-    """Where a stopped command's partial output is, if it writes one."""
+def _partial(args: argparse.Namespace, held: str) -> str:
+    """Where a stopped command's output so far is and what it `held` there: its module's
+    STOPPED_OUTPUT (replay's bag is finished and marked partial, a sweep's table holds the
+    finished cases); '' for a command without one, whose files are written whole or not at all
+    (a report.html already there is the previous run's, not this one's)."""
     out = getattr(args, "output", None)
-    if out and Path(out).exists():
-        return f"; {out} holds the output so far, marked partial in its metadata"
+    if held and out and Path(out).exists():
+        return f"; {out} {held}"
     return ""
 
 

@@ -400,3 +400,34 @@ def test_the_plot_takes_a_first_varied_value_that_is_no_number_in_the_files_orde
             )
             names = [m["name"] for m in spec.base["mounts"]]
             assert p[1] == max(r[f"peak_force_magnitude_N.{n}"] for n in names) * 1e-3
+
+
+def test_a_stopped_sweep_says_what_its_table_holds_and_a_rerun_runs_the_rest(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C after the first case: the CSV holds that case's row, whole, and nothing marks it
+    (a CSV has no metadata), yet the sweep said "holds the output so far, marked partial in its
+    metadata", the replay's words for its output bag."""
+    from mount_twin.sweeps import runner
+
+    run_sweep_now = runner.run_sweep
+
+    def stopped_after_one(*args: object, **kwargs: object) -> object:
+        def progress(done: int, total: int) -> None:
+            raise KeyboardInterrupt
+
+        return run_sweep_now(*args, **{**kwargs, "progress": progress})
+
+    monkeypatch.setattr(runner, "run_sweep", stopped_after_one)
+    text = SWEEP.split("  - name: dhs", maxsplit=1)[0]
+    sweep, results = str(_sweep_file(tmp_path, text)), tmp_path / "results.csv"
+    args = ["sweep", sweep, "-o", str(results), "--workers", "1", "--no-progress"]
+    assert main(args) == 130
+    err = capsys.readouterr().err
+    assert "marked partial" not in err
+    assert f"; {results} holds the rows of the cases finished before the stop" in err
+    with results.open(encoding="utf-8") as fh:
+        assert len(list(csv.DictReader(fh))) == 1  # the one case finished, and nothing else
+    monkeypatch.setattr(runner, "run_sweep", run_sweep_now)
+    assert main(args) == 6  # the negative mass FAILED
+    assert len(read_results(results)) == 4  # the other three run, the first kept

@@ -5,11 +5,14 @@ from __future__ import annotations
 import argparse
 
 from mount_twin.commands.common import DEFAULT_BAG, DEFAULT_SCENE, share_dir
+from mount_twin.commands.replay import STOPPED_OUTPUT as REPLAY_STOPPED_OUTPUT
 from mount_twin.commands.replay import ReplayOptions, add_plot_argument, replay_and_report
 
 NAME = "demo"
 HELP = "replay the bundled bag through the bundled default scene"
 STOPS_AT_CHECKPOINTS = True
+STOPPED_OUTPUT = REPLAY_STOPPED_OUTPUT
+"""A stopped demo's output bag is the replay's: finished and marked partial."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -17,6 +17,8 @@ NAME = "replay"
 HELP = "replay a bag through the twin into an mcap bag"
 STOPS_AT_CHECKPOINTS = True
 """SIGINT and SIGTERM stop the replay between chunks (mount_twin.commands.stopping)."""
+STOPPED_OUTPUT = "holds the output so far, marked partial in its metadata"
+"""What its output bag holds when a signal or a damaged input stopped it (mount_twin.cli)."""
 FAIL_ON = ("never", "warn", "error")
 """`--fail-on` choices; the index of warn and error is their diagnostics level."""
 EXIT_STATUS = (

@@ -8,9 +8,15 @@ from mount_twin.commands.common import positive_int
 
 NAME = "sweep"
 HELP = "run a design sweep (scene variants × inputs) on a local or remote Dask cluster"
+STOPPED_OUTPUT = (
+    "holds the rows of the cases finished before the stop, each whole (nothing marks the "
+    "file: a rerun skips them and runs the rest)"
+)
+"""What the results CSV holds when a signal stopped the sweep (mount_twin.cli)."""
 EXIT_STATUS = (
     "exit status: 0 every case ran (whatever its verdict); 6 a case FAILED (its row and the "
-    "summary say why); 2 bad input or configuration"
+    "summary say why); 2 bad input or configuration; 130 SIGINT (Ctrl-C), 143 SIGTERM: the "
+    "results CSV holds the cases finished before the stop, and a rerun runs the rest"
 )
 
 
