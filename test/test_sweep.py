@@ -431,3 +431,15 @@ def test_a_stopped_sweep_says_what_its_table_holds_and_a_rerun_runs_the_rest(
     monkeypatch.setattr(runner, "run_sweep", run_sweep_now)
     assert main(args) == 6  # the negative mass FAILED
     assert len(read_results(results)) == 4  # the other three run, the first kept
+
+
+def test_the_local_clusters_workers_leave_ctrl_c_to_the_command() -> None:
+    """Ctrl-C reaches the terminal's whole process group: each local worker printed a
+    KeyboardInterrupt traceback (30 lines of asyncio and multiprocessing) beside the command's
+    own "interrupted (SIGINT)" line, though the command stops them with its cluster."""
+    import signal
+
+    with dask_client(workers=1) as client:
+        ignored = client.run(lambda: signal.getsignal(signal.SIGINT) is signal.SIG_IGN)
+    assert list(ignored.values()) == [True]
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # this process's own

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -26,11 +27,20 @@ def dask_client(scheduler: str | None = None, workers: int | None = None) -> Ite
         )
     client = Client(scheduler or cluster)
     try:
+        if cluster is not None:  # its workers, not a shared cluster's
+            client.run(_ignore_sigint)
         yield client
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _ignore_sigint() -> None:
+    """Run in each worker process of a local cluster: Ctrl-C, which reaches the terminal's whole
+    process group, is the command's, which stops the workers with the cluster (each had printed
+    a KeyboardInterrupt traceback beside the command's own line)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def results_as_completed(
