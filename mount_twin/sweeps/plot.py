@@ -84,7 +84,8 @@ def _sortable(value: Any) -> tuple[int, float, str]:
 
 def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> Path:
     """Write the plot of `trade_off`: the force above, the utilisation below (its limit, 1,
-    dashed; that panel only where a mount is rated)."""
+    dashed; that panel only where a mount is rated); its title counts the FAILED cases left
+    out."""
     from mount_twin.figure_files import pyplot, save_png
 
     plt = pyplot()
@@ -109,5 +110,9 @@ def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> 
     panels[-1].set_xlabel(varied[0] if varied else "case")
     if (at := places(rows, spec)) is not None:
         panels[-1].set_xticks(list(at.values()), list(at), fontsize=8)
-    panels[0].set_title(f"{Path(spec.source).name}: markers o OK, s WARN, v ERROR", fontsize=9)
+    failed = sum(r["verdict"] == FAILED for r in rows)  # no figures to draw
+    left_out = f"; {failed} FAILED case{'s' * (failed != 1)} not drawn" if failed else ""
+    panels[0].set_title(
+        f"{Path(spec.source).name}: markers o OK, s WARN, v ERROR{left_out}", fontsize=9
+    )
     return save_png(fig, png)
