@@ -73,3 +73,45 @@ def test_every_mount_kind_has_its_own_colour() -> None:
 
     assert set(KIND_COLOURS) == {"linear", *KINDS}
     assert len(set(KIND_COLOURS.values())) == len(KIND_COLOURS)
+
+
+def test_a_shear_keys_line_of_action_is_along_its_stiff_axis_not_z() -> None:
+    """The genset's keys bear along x (key_x, stiffness [1e9, 0, 0]) and y (key_y, [0, 1e9,
+    0]) of F and leave z free, yet each was drawn with a vertical dashed line of action, as if
+    it carried the weight. The dashed lines through a key now run along its stiff axes; a
+    foot's (its bolt) stays vertical."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from mount_twin.analysis.layout_view import _draw_scene, _Views
+    from mount_twin.scene import load_scene_file
+
+    scene = load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml")
+    fig = plt.figure()
+    views = _Views(
+        fig.add_subplot(1, 3, 1, projection="3d"), [fig.add_subplot(1, 3, k) for k in (2, 3)]
+    )
+    _draw_scene(views, scene)
+
+    def dashed_through(ax: object, u: float, v: float) -> list[tuple[float, float]]:
+        """Directions (du, dv) of the dashed lines through (u, v) in a 2-D view."""
+        out = []
+        for line in ax.get_lines():  # type: ignore[attr-defined]
+            (u0, u1), (v0, v1) = line.get_xdata(), line.get_ydata()
+            if (
+                line.get_linestyle() == "--"
+                and np.isclose((u0 + u1) / 2, u)
+                and np.isclose((v0 + v1) / 2, v)
+            ):
+                d = np.array([u1 - u0, v1 - v0])
+                if np.linalg.norm(d) > 0.0:  # (a line across the view is a point in it)
+                    out.append(tuple(np.round(d / np.linalg.norm(d), 9) + 0.0))
+        return out
+
+    side, end = views.flat  # x–z and y–z of F
+    assert dashed_through(side, -1.3, 0.0) == [(1.0, 0.0)]  # key_x at x = −1.3: along x
+    assert dashed_through(end, 0.0, 0.0) == [(1.0, 0.0)]  # key_y, on the centre line: along y
+    assert dashed_through(side, 1.1, 0.0) == [(0.0, 1.0)] * 2  # foot_fl, foot_fr: the bolts
+    plt.close(fig)

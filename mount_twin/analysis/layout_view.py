@@ -2,8 +2,9 @@
 
 Three views of the reference pose: 3-D, side (x–z of F) and end (y–z of F). Drawn: the axes of
 the foundation frame F at its origin; the CG; each mount at its position, coloured by kind,
-with its own axes (x red, y green, z blue, as RViz draws frames) and the line of action of its
-local z (dashed, through the mount, both ways), so an inclined mount pointing the wrong way,
+with its own axes (x red, y green, z blue, as RViz draws frames) and its line of action (dashed,
+through the mount, both ways): its local z, or for a mount that takes no load along z (a shear
+key) each local axis it is stiff along, so an inclined mount pointing the wrong way,
 lines of action meeting below the mounts, or positions in millimetres show at a glance; the
 IMUs (the foundation's, the body's) with their axes. matplotlib is imported here only (the
 `plot` extra).
@@ -17,7 +18,8 @@ from typing import Any
 import numpy as np
 
 from mount_twin.physics.rotations import rpy_matrix
-from mount_twin.scene.description import Scene, Vec3
+from mount_twin.scene.description import Mount, Scene, Vec3
+from mount_twin.scene.statics import nominal_tangent
 
 KIND_COLOURS = {
     "linear": "tab:blue",
@@ -134,13 +136,14 @@ def _draw_scene(views: _Views, scene: Scene) -> None:
     for m in scene.mounts:
         p, rot = np.array(m.position), rpy_matrix(*m.orientation_rpy)
         colour = KIND_COLOURS.get(m.kind, "tab:gray")
-        views.segment(
-            p - reach * rot[:, 2],
-            p + reach * rot[:, 2],
-            color=colour,
-            linestyle="--",
-            linewidth=0.8,
-        )
+        for k in acting_axes(m):
+            views.segment(
+                p - reach * rot[:, k],
+                p + reach * rot[:, k],
+                color=colour,
+                linestyle="--",
+                linewidth=0.8,
+            )
         views.frame(p, rot, arrow, 1.2)
         views.point(p, m.name, color=colour, s=30)
     for (label, position, rpy), colour in zip(sensors(scene), SENSOR_COLOURS, strict=False):
@@ -148,6 +151,13 @@ def _draw_scene(views: _Views, scene: Scene) -> None:
         views.point(np.array(position), label, color=colour, marker="^", s=40)
     cg = np.array(scene.body.cg)
     views.point(cg, f"CG ({scene.frames.body})", color="black", marker="o", s=70)
+
+
+def acting_axes(mount: Mount) -> tuple[int, ...]:
+    """The local axes (0 x, 1 y, 2 z) a mount's line of action is drawn along: z, unless its
+    nominal stiffness along z is 0 (a shear key, free in z): then each axis it is stiff along."""
+    k = nominal_tangent(mount).stiffness[:3]
+    return (2,) if k[2] > 0.0 else tuple(j for j in range(3) if k[j] > 0.0)
 
 
 def _dress(views: _Views, kinds: list[str]) -> None:
@@ -163,7 +173,7 @@ def _dress(views: _Views, kinds: list[str]) -> None:
     _equal_3d(ax3)
     ax3.set_title("3-D (F: x red, y green, z blue)", fontsize=9)
     for ax, (title, i, j) in zip(views.flat, VIEWS, strict=True):
-        ax.set_title(f"{title}; dashed: each mount's z line of action", fontsize=9)
+        ax.set_title(f"{title}; dashed: each mount's line of action", fontsize=9)
         ax.set_xlabel(f"{'xyz'[i]} [m]")
         ax.set_ylabel(f"{'xyz'[j]} [m]")
         ax.set_aspect("equal", adjustable="datalim")
