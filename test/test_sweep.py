@@ -456,3 +456,29 @@ def test_the_plot_says_how_many_failed_cases_it_leaves_out(
     spec, results, _ = swept
     svg = plot_sweep(read_results(results), spec, tmp_path / "sweep.svg")
     assert "4 FAILED cases not drawn" in svg.read_text(encoding="utf-8")
+
+
+def test_the_plots_force_axis_reads_the_forces_not_an_offset_from_them(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A variation that hardly moves the force (outputs.decimation: 7853.547 and 7853.555 N,
+    the peak held between published rows) had its force axis ticked 48 … 54 beneath a small
+    "1e−6+7.8535": read as 54 kN, not 7.85 kN. Its ticks are now the forces, in kN."""
+    matplotlib = pytest.importorskip("matplotlib")
+    monkeypatch.setitem(matplotlib.rcParams, "svg.fonttype", "none")  # text kept as text
+    spec = load_sweep(_sweep_file(tmp_path, SWEEP.replace("[1100.0, -5.0]", "[1100.0]")))
+    names = [m["name"] for m in spec.base["mounts"]]
+    rows = [
+        {
+            "case": f"c{k}",
+            "input": "dhs",
+            "mounts[*].stiffness (scale)": scale,
+            "body.mass": 1100.0,
+            "verdict": "OK",
+            **{f"peak_force_magnitude_N.{n}": force for n in names},
+            **{f"utilisation.{n}": 0.87 for n in names},
+        }
+        for k, (scale, force) in enumerate(((0.5, 7853.547), (2.0, 7853.555)))
+    ]
+    text = plot_sweep(rows, spec, tmp_path / "sweep.svg").read_text(encoding="utf-8")
+    assert "7.8535" in text and "+7.8535" not in text  # a tick reads the force itself

@@ -104,6 +104,9 @@ def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> 
     ylabels = ("largest peak mount force [kN]", "largest utilisation [-]")
     for ax, ylabel in zip(panels, ylabels, strict=False):
         ax.set_ylabel(ylabel)
+        # ticks that read the values: close ones were ticked as an offset (48 … 54 under
+        # "1e−6+7.8535"), which reads as 54 kN
+        ax.ticklabel_format(axis="y", useOffset=False)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
     varied = columns(spec)[2 : 2 + len(spec.variations)]
