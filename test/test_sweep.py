@@ -482,3 +482,47 @@ def test_the_plots_force_axis_reads_the_forces_not_an_offset_from_them(
     ]
     text = plot_sweep(rows, spec, tmp_path / "sweep.svg").read_text(encoding="utf-8")
     assert "7.8535" in text and "+7.8535" not in text  # a tick reads the force itself
+
+
+def test_a_rerun_after_the_base_scene_changed_runs_every_case_of_the_new_design(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A case's id hashed what it sets and its input's name only: after the base scene's mass
+    was doubled, a rerun skipped every case as finished and summarised the old design. Its
+    cases now run again, as a single run of the edited scene does, and the old rows are left
+    out of the summary, which says how many."""
+    base = tmp_path / "pump.scene.yaml"
+    base.write_text(PUMP.read_text(encoding="utf-8"), encoding="utf-8")
+    text = SWEEP.replace(str(PUMP), str(base)).replace(
+        "  - key: body.mass\n    values: [1100.0, -5.0]\n", ""
+    )
+    text = text.split("  - bag:")[0] + "  - name: dhs" + text.split("  - name: dhs")[1]
+    sweep, results = _sweep_file(tmp_path, text), tmp_path / "r.csv"
+    args = ["sweep", str(sweep), "-o", str(results), "--workers", "1", "--no-progress"]
+    assert main(args) == 0
+    assert capsys.readouterr().out.startswith(f"2 cases in {results}\n")
+    first = read_results(results)
+    base.write_text(
+        base.read_text(encoding="utf-8").replace("mass: 1200.0", "mass: 2400.0"), encoding="utf-8"
+    )
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"2 cases in {results} (and 2 of cases this sweep no longer has")
+    spec = load_sweep(sweep)
+    assert spec.base["body"]["mass"] == 2400.0
+    table = read_results(results)
+    assert len(table) == 4 and {r["case"] for r in first} <= {r["case"] for r in table}
+    names = [m["name"] for m in spec.base["mounts"]]
+    for case in check(spec):  # the edited scene's own single runs
+        alone = run_case(spec.base, spec.source, case)
+        (row,) = (r for r in table if r["case"] == case.case_id)
+        for n in names:
+            key = f"peak_force_magnitude_N.{n}"
+            assert row[key] == pytest.approx(alone[key], rel=1e-12)
+            old = next(
+                r[key]
+                for r in first
+                if r["input"] == row["input"]
+                and r["mounts[*].stiffness (scale)"] == row["mounts[*].stiffness (scale)"]
+            )
+            assert row[key] != pytest.approx(old, rel=1e-3), n  # twice the mass: not the old

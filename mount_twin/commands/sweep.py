@@ -32,7 +32,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=positive_int,
         help="local cluster worker processes (default: one per core)",
     )
-    parser.add_argument("--parquet", metavar="FILE", help="also write the table as Parquet")
+    parser.add_argument("--parquet", metavar="FILE", help="also write this sweep's rows as Parquet")
     parser.add_argument(
         "--plot",
         metavar="PNG",
@@ -69,8 +69,10 @@ def run(args: argparse.Namespace) -> int:
 
     run_sweep(spec, args.output, scheduler=args.scheduler, workers=args.workers, progress=progress)
     bar.close()
-    rows = read_results(args.output)
-    print(f"{len(rows)} cases in {args.output}")
+    ids = {c.case_id for c in cases}
+    table = read_results(args.output)
+    rows = [r for r in table if r["case"] in ids]
+    print(f"{len(rows)} cases in {args.output}{_others(len(table) - len(rows))}")
     print(summary(rows, spec))
     if args.parquet:
         import pyarrow as pa
@@ -83,3 +85,14 @@ def run(args: argparse.Namespace) -> int:
 
         print(f"plot: {plot_sweep(rows, spec, args.plot)}")
     return 0 if all(r["verdict"] != FAILED for r in rows) else EXIT_FAILED
+
+
+def _others(n: int) -> str:
+    """What the results CSV holds beside this sweep's cases (n of other cases' ids), which the
+    summary, the exit status, --parquet and --plot leave out."""
+    if not n:
+        return ""
+    return (
+        f" (and {n} of cases this sweep no longer has: run with another base scene, input or "
+        "value; not counted here)"
+    )

@@ -32,8 +32,11 @@ class Case:
 
 
 def expand(spec: SweepSpec) -> list[Case]:
-    """Every case of the sweep, in a stable order, each with a stable id (a hash of what it
-    sets and its input: a rerun recognises finished cases)."""
+    """Every case of the sweep, in a stable order, each with a stable id: a hash of the base
+    scene's mapping, what the case sets and its input's definition (name, bag path, generate
+    options), so that a rerun recognises finished cases and only those. An id of what it sets
+    and its input's name alone had a rerun after an edit of the base scene (or of a generated
+    input) skip every case as finished, its table and summary the old design's."""
     columns = [[(v.key, v.op, x) for x in v.values] for v in spec.variations]
     combos = (
         itertools.product(*columns) if spec.combine == "product" else zip(*columns, strict=True)
@@ -41,7 +44,8 @@ def expand(spec: SweepSpec) -> list[Case]:
     cases = []
     for combo in combos:
         for inp in spec.inputs:
-            text = json.dumps([list(combo), inp.name], sort_keys=True, default=str)
+            what = [spec.base, list(combo), [inp.name, inp.bag, list(inp.generate)]]
+            text = json.dumps(what, sort_keys=True, default=str)
             cases.append(Case(hashlib.sha1(text.encode()).hexdigest()[:12], tuple(combo), inp))
     return cases
 
