@@ -227,7 +227,7 @@ def test_q_and_damping_and_octave_options_agree(tmp_path: Path) -> None:
     a, b = tmp_path / "a.csv", tmp_path / "b.csv"
     common = ["srs", str(GENSET), "--fmin", "20", "--fmax", "640"]
     assert main([*common, "--damping", "0.05", "--octave", "1/3", "--csv", str(a)]) == 0
-    assert main([*common, "--q", "10", "--freqs", "20", "40", "80", "--csv", str(b)]) == 0
+    assert main([*common[:2], "--q", "10", "--freqs", "20", "40", "80", "--csv", str(b)]) == 0
     by_f = {float(r["frequency_hz"]): r["maximax"] for r in _rows(a)}
     assert len(by_f) == 16
     assert all(by_f[float(r["frequency_hz"])] == r["maximax"] for r in _rows(b))
@@ -644,3 +644,26 @@ def test_frequencies_a_record_cannot_have_are_refused_naming_the_option(
     assert "(500 Hz)" in err
     assert main(["srs", str(record), "--gravity", "none", "--fmin", "200"]) == 2
     assert "--fmin 200 Hz: above --fmax (default fs/10 = 100 Hz)" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "spacing",
+    [["--octave", "1/3"], ["--fmin", "5"], ["--fmax", "1000"], ["--fmin", "20", "--fmax", "640"]],
+)
+def test_frequencies_given_beside_a_spacing_are_refused_naming_the_options(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], spacing: list[str]
+) -> None:
+    """`--freqs 50 100 --fmin 20 --fmax 640` ran at 50 and 100 Hz alone, without a word of the
+    spacing it set aside; `--fmin 5` is the default's value, given all the same."""
+    table = tmp_path / "srs.csv"
+    args = ["srs", str(GENSET), "--freqs", "50", "100", *spacing, "--csv", str(table)]
+    assert main(args) == 2
+    said = capsys.readouterr()
+    named = ", ".join(s for s in spacing if s.startswith("--"))
+    assert said.err == (
+        f"mount-twin: error: --freqs with {named}: give the frequencies (--freqs) or their "
+        "spacing (--octave, --fmin, --fmax), not both\n"
+    )
+    assert said.out == "" and not table.exists()
+    assert main(["srs", str(GENSET), "--freqs", "50", "100", "--csv", str(table)]) == 0
+    assert [float(r["frequency_hz"]) for r in _rows(table)] == [50.0, 100.0]

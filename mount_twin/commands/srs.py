@@ -37,6 +37,10 @@ TABLE_ALL = ("maximax", "pseudo_velocity")
 TOLERANCE_DB = (-1.5, 3.0)
 """--tolerance-db's default (`mount_twin.analysis.design_margin.TOLERANCE_DB`, which a test
 holds equal: this module does not import numpy before it runs)."""
+OCTAVE, FMIN_HZ = "1/6", 5.0
+"""--octave's and --fmin's defaults (--fmax's is fs/10, of the record)."""
+SPACING = ("octave", "fmin", "fmax")
+"""The options of the frequencies' spacing, which --freqs replaces."""
 EXIT_OUT_OF_TOLERANCE = 4
 EXIT_STATUS = (
     "exit status: 0 done (with --design: every axis within the tolerance); 2 bad input; "
@@ -66,16 +70,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     damping.add_argument("--damping", type=float, help="damping ratio ζ (default 0.05)")
     damping.add_argument("--q", type=float, help="quality factor Q = 1/(2ζ), instead of ζ")
     parser.add_argument(
-        "--freqs", type=float, nargs="+", metavar="HZ", help="natural frequencies, Hz"
+        "--freqs",
+        type=float,
+        nargs="+",
+        metavar="HZ",
+        help="natural frequencies, Hz, instead of --octave, --fmin and --fmax",
     )
+    # The spacing parses to None when not given (its defaults applied in `_frequencies`), so
+    # that one given beside --freqs is refused, not set aside without a word.
     parser.add_argument(
         "--octave",
         type=_per_octave,
-        default="1/6",
         metavar="1/N",
-        help="fractional-octave spacing from --fmin to --fmax, without --freqs",
+        help=f"fractional-octave spacing from --fmin to --fmax (default {OCTAVE})",
     )
-    parser.add_argument("--fmin", type=float, default=5.0, help="lowest frequency, Hz")
+    parser.add_argument("--fmin", type=float, help=f"lowest frequency, Hz (default {FMIN_HZ:g})")
     parser.add_argument(
         "--fmax",
         type=float,
@@ -175,6 +184,12 @@ def run(args: argparse.Namespace) -> int:
         csv=args.csv,
         reads=(args.input, args.scene, args.design),
     )
+    if args.freqs and (spacing := [f"--{o}" for o in SPACING if getattr(args, o) is not None]):
+        msg = (
+            f"--freqs with {', '.join(spacing)}: give the frequencies (--freqs) or their "
+            f"spacing ({', '.join('--' + o for o in SPACING)}), not both"
+        )
+        raise ValueError(msg)
     if args.plot:
         from mount_twin.commands.extras import require
 
@@ -253,15 +268,16 @@ def _check_channels(values: np.ndarray, axes: tuple[str, ...], t: np.ndarray, na
 
 
 def _frequencies(args: argparse.Namespace, rate_hz: float) -> np.ndarray:
-    """The natural frequencies, Hz: --freqs, else --octave spacing from --fmin to --fmax
-    (default: where the filter is accurate at `rate_hz`)."""
+    """The natural frequencies, Hz: --freqs, else --octave spacing (default OCTAVE) from --fmin
+    (default FMIN_HZ) to --fmax (default: where the filter is accurate at `rate_hz`)."""
     import numpy as np
 
     from mount_twin.analysis.srs import ACCURATE_SHARE, octave_frequencies
 
     nyquist = 0.5 * rate_hz
+    fmin = FMIN_HZ if args.fmin is None else args.fmin
     fmax = ACCURATE_SHARE * rate_hz if args.fmax is None else args.fmax
-    given = [("--freqs", f) for f in args.freqs or ()] or [("--fmin", args.fmin), ("--fmax", fmax)]
+    given = [("--freqs", f) for f in args.freqs or ()] or [("--fmin", fmin), ("--fmax", fmax)]
     for flag, f in given:
         if not 0.0 < f < nyquist:
             msg = (
@@ -271,11 +287,11 @@ def _frequencies(args: argparse.Namespace, rate_hz: float) -> np.ndarray:
             raise ValueError(msg)
     if args.freqs:
         return np.array(args.freqs)
-    if args.fmin > fmax:
+    if fmin > fmax:
         said = f"{fmax:g} Hz" if args.fmax is not None else f"default fs/10 = {fmax:g} Hz"
-        msg = f"--fmin {args.fmin:g} Hz: above --fmax ({said})"
+        msg = f"--fmin {fmin:g} Hz: above --fmax ({said})"
         raise ValueError(msg)
-    return octave_frequencies(args.fmin, fmax, args.octave)
+    return octave_frequencies(fmin, fmax, args.octave or _per_octave(OCTAVE))
 
 
 def _spectrum_columns(spectra: dict[str, Spectrum], unit: str) -> list[Column]:
