@@ -236,3 +236,17 @@ def test_a_shock_along_a_dof_the_scene_freezes_is_refused(
     assert main([*args, "--seeds", "1", "--workers", "1"]) == 2
     assert "--axis x: the scene freezes x (dofs z, alpha, gamma)" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_a_synthesis_number_out_of_its_range_is_refused_naming_its_option_and_value(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """It said "--seeds must be ≥ 1, --head ≥ 0 s and --rate > 0 Hz", whichever was wrong."""
+    args = ["qualify", str(CONFIG / "pump_8_mounts.scene.yaml"), "-o", str(tmp_path / "q")]
+    spectrum = str(CONFIG / "shock_spectrum_vertical.csv")
+    for option, value, says in (("--seeds", "-2", "≥ 1, got -2"), ("--head", "-1", "≥ 0, got -1")):
+        with pytest.raises(SystemExit) as stop:
+            main([*args, "--spectrum", spectrum, option, value])
+        assert stop.value.code == 2
+        assert f"argument {option}: must be {says}" in capsys.readouterr().err
+    assert not (tmp_path / "q").exists()

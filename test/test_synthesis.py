@@ -120,3 +120,25 @@ def test_a_design_spectrum_that_is_no_text_is_an_error_naming_it(
         err = capsys.readouterr().err
         assert err.startswith(f"mount-twin: error: {design}: {said}"), err
         assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "says"),
+    [
+        ("--seeds", "0", "must be ≥ 1, got 0"),
+        ("--head", "-0.5", "must be ≥ 0, got -0.5"),
+        ("--rate", "0", "must be > 0, got 0"),
+        ("--rate", "nan", "must be > 0, got nan"),
+    ],
+)
+def test_a_synthesis_number_out_of_its_range_is_refused_naming_its_option_and_value(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], option: str, value: str, says: str
+) -> None:
+    """It said "--seeds must be ≥ 1, --head ≥ 0 s and --rate > 0 Hz", whichever was wrong."""
+    spectrum = Path(__file__).resolve().parents[1] / "config" / "shock_spectrum_vertical.csv"
+    out = tmp_path / "synth"
+    with pytest.raises(SystemExit) as stop:
+        main(["synthesize", "--spectrum", str(spectrum), "-o", str(out), option, value])
+    assert stop.value.code == 2
+    assert f"argument {option}: {says}" in capsys.readouterr().err
+    assert not out.exists()

@@ -56,6 +56,35 @@ def non_negative_int(text: str) -> int:
     return _integer_from(text, 0)
 
 
+def positive_float(text: str) -> float:
+    """argparse type of a rate (Hz): a finite number > 0, else refused at parse, naming the
+    option and its value (`synthesize --rate 0` had said "--seeds must be ≥ 1, --head ≥ 0 s
+    and --rate > 0 Hz", whichever was wrong)."""
+    return _number_from(text, 0.0, above=True)
+
+
+def non_negative_float(text: str) -> float:
+    """argparse type of a duration (s): a finite number ≥ 0, else refused at parse, naming the
+    option and its value."""
+    return _number_from(text, 0.0, above=False)
+
+
+def _number_from(text: str, low: float, *, above: bool) -> float:
+    """`text` as a finite float > low (`above`) or ≥ low, else argparse's error (it names the
+    option)."""
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        msg = f"{text!r} is not a number"
+        raise argparse.ArgumentTypeError(msg) from None
+    if not (math.isfinite(value) and (value > low if above else value >= low)):
+        msg = f"must be {'>' if above else '≥'} {low:g}, got {text}"
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
 def _integer_from(text: str, low: int) -> int:
     """`text` as an integer ≥ low, else argparse's error (it names the option)."""
     try:

@@ -82,9 +82,6 @@ def plan_of(args: argparse.Namespace) -> Plan:
             **{o: v for o, v in args.synthesis_defaults.items() if o not in given},
         }
     )
-    if args.seeds < 1 or args.head < 0.0 or not args.rate > 0.0:
-        msg = "--seeds must be ≥ 1, --head ≥ 0 s and --rate > 0 Hz"
-        raise ValueError(msg)
     zeta = damping_ratio(args.damping, args.q)
     return Plan(
         {args.axis: args.spectrum},

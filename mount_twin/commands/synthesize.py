@@ -7,7 +7,12 @@ import argparse
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
-from mount_twin.commands.common import non_negative_int
+from mount_twin.commands.common import (
+    non_negative_float,
+    non_negative_int,
+    positive_float,
+    positive_int,
+)
 from mount_twin.commands.srs import add_tolerance_argument, tolerance_of
 from mount_twin.io.epoch import DEFAULT_START_NS
 
@@ -33,16 +38,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def add_synthesis_arguments(parser: argparse.ArgumentParser, *, required: bool = True) -> None:
     """The options of a synthesis (also `qualify`'s, whose --plan may stand for them, so
     --spectrum is not `required` there): spectrum, seeds, rate, axis, damping, tolerance,
-    head."""
+    head; a count, rate or duration out of its range is refused at parse, naming it."""
     parser.add_argument(
         "--spectrum",
         required=required,
         metavar="CSV",
         help="the design spectrum (frequency_hz,accel_g), maximax, interpolated log-log",
     )
-    parser.add_argument("--seeds", type=int, default=3, help="time histories, one per seed")
+    parser.add_argument(
+        "--seeds", type=positive_int, default=3, help="time histories, one per seed"
+    )
     parser.add_argument("--first-seed", type=non_negative_int, default=0, help="the first seed")
-    parser.add_argument("--rate", type=float, default=20000.0, help="sampling rate, Hz")
+    parser.add_argument("--rate", type=positive_float, default=20000.0, help="sampling rate, Hz")
     parser.add_argument(
         "--axis", choices=["x", "y", "z"], default="z", help="sensor axis of the shock"
     )
@@ -51,7 +58,10 @@ def add_synthesis_arguments(parser: argparse.ArgumentParser, *, required: bool =
     damping.add_argument("--q", type=float, help="quality factor Q = 1/(2ζ), instead of ζ")
     add_tolerance_argument(parser, "the band about the design every frequency must meet")
     parser.add_argument(
-        "--head", type=float, default=0.05, help="rest before the shock, s (the start checks)"
+        "--head",
+        type=non_negative_float,
+        default=0.05,
+        help="rest before the shock, s (the start checks)",
     )
 
 
@@ -62,9 +72,6 @@ def synthesized(args: argparse.Namespace) -> Iterator[tuple[int, Synthesis, Sign
     from mount_twin.analysis.synthesis import imu_record, synthesize
     from mount_twin.commands.common import read_design_table
 
-    if args.seeds < 1 or args.head < 0.0 or not args.rate > 0.0:
-        msg = "--seeds must be ≥ 1, --head ≥ 0 s and --rate > 0 Hz"
-        raise ValueError(msg)
     low, high = tolerance_of(args)
     design = read_design_table(args.spectrum)
     zeta = damping_ratio(args.damping, args.q)
