@@ -280,3 +280,12 @@ AGEING_PUMP = {
     "ageing": {"window_s": 20.0},
 }
 """The pump with its body IMU on /machine/imu and ageing tracked in windows of 20 s."""
+
+
+def unmeetable_design(path: Path) -> Path:
+    """A design no synthesis meets within -1.5/+3 dB: 100 g at 20 Hz between 1 g at 10 and
+    40 Hz. An oscillator an octave off a 20 Hz motion still responds to it (one at 40 Hz
+    follows it, its peak at least the motion's; one at 10 Hz is moved by about a third of it),
+    where the design asks for 40 dB less."""
+    path.write_text("frequency_hz,accel_g\n10,1\n20,100\n40,1\n", encoding="utf-8")
+    return path

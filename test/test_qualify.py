@@ -250,3 +250,18 @@ def test_a_synthesis_number_out_of_its_range_is_refused_naming_its_option_and_va
         assert stop.value.code == 2
         assert f"argument {option}: must be {says}" in capsys.readouterr().err
     assert not (tmp_path / "q").exists()
+
+
+def test_a_spectrum_the_synthesis_cannot_meet_is_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The error named the seed, not the design file (`unmeetable_design`)."""
+    from io_helpers import unmeetable_design
+
+    spectrum = unmeetable_design(tmp_path / "notch.csv")
+    out = tmp_path / "q"
+    args = ["qualify", str(CONFIG / "pump_8_mounts.scene.yaml"), "--spectrum", str(spectrum)]
+    assert main([*args, "-o", str(out), "--rate", "1000", "--seeds", "1", "--workers", "1"]) == 2
+    err = capsys.readouterr().err
+    assert f"mount-twin: error: {spectrum}: the synthesis (seed 0) did not meet" in err, err
+    assert not out.exists()

@@ -142,3 +142,19 @@ def test_a_synthesis_number_out_of_its_range_is_refused_naming_its_option_and_va
     assert stop.value.code == 2
     assert f"argument {option}: {says}" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_a_spectrum_the_synthesis_cannot_meet_is_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The error named the seed ("the synthesis (seed 0) did not meet the design") but not
+    the design file."""
+    from io_helpers import unmeetable_design
+
+    spectrum = unmeetable_design(tmp_path / "notch.csv")
+    out = tmp_path / "synth"
+    args = ["synthesize", "--spectrum", str(spectrum), "-o", str(out), "--rate", "1000"]
+    assert main([*args, "--seeds", "1"]) == 2
+    err = capsys.readouterr().err
+    assert f"mount-twin: error: {spectrum}: the synthesis (seed 0) did not meet" in err, err
+    assert not out.exists()

@@ -100,16 +100,22 @@ def run_input(scene_path: str, plan: Plan, axis: str, seed: int, out: str) -> In
     from pathlib import Path
 
     from mount_twin.analysis.qualification import InputRun
-    from mount_twin.analysis.synthesis import imu_record, synthesize
+    from mount_twin.analysis.synthesis import imu_record
     from mount_twin.commands.common import load_scene, read_design_table, write_signal
+    from mount_twin.commands.synthesize import synthesis_of
     from mount_twin.engine.batch import LEVEL_NAMES
     from mount_twin.io.epoch import DEFAULT_START_NS
     from mount_twin.replay import replay
 
     scene = load_scene(scene_path)
-    design = read_design_table(plan.spectra[axis])
-    shock = synthesize(
-        *design, plan.rate_hz, damping=plan.damping, seed=seed, tolerance_db=plan.tolerance_db
+    spectrum = plan.spectra[axis]
+    shock = synthesis_of(
+        spectrum,
+        read_design_table(spectrum),
+        plan.rate_hz,
+        damping=plan.damping,
+        seed=seed,
+        tolerance_db=plan.tolerance_db,
     )
     sig = imu_record(shock, plan.rate_hz, axis, plan.head_s)
     bag_in, bag_out = (

@@ -65,11 +65,32 @@ def add_synthesis_arguments(parser: argparse.ArgumentParser, *, required: bool =
     )
 
 
+def synthesis_of(
+    spectrum: str,
+    design: tuple[list[float], list[float]],
+    rate_hz: float,
+    *,
+    damping: float,
+    seed: int,
+    tolerance_db: tuple[float, float],
+) -> Synthesis:
+    """`analysis.synthesis.synthesize` of the `design` (Hz, g) read from the file `spectrum`,
+    for synthesize and qualify: its refusal (a design it cannot meet, one past rate/10) names
+    the file, where it had named the seed alone."""
+    from mount_twin.analysis.synthesis import synthesize
+
+    try:
+        return synthesize(*design, rate_hz, damping=damping, seed=seed, tolerance_db=tolerance_db)
+    except ValueError as err:
+        msg = f"{spectrum}: {err}"
+        raise ValueError(msg) from None
+
+
 def synthesized(args: argparse.Namespace) -> Iterator[tuple[int, Synthesis, Signal]]:
     """Per seed of `args` (add_synthesis_arguments): the seed, the shock and its Imu record;
     the design spectrum and the plan printed first."""
     from mount_twin.analysis.srs import damping_ratio
-    from mount_twin.analysis.synthesis import imu_record, synthesize
+    from mount_twin.analysis.synthesis import imu_record
     from mount_twin.commands.common import read_design_table
 
     low, high = tolerance_of(args)
@@ -80,7 +101,9 @@ def synthesized(args: argparse.Namespace) -> Iterator[tuple[int, Synthesis, Sign
         f"ζ = {zeta:g}, tolerance {low:+g}/{high:+g} dB"
     )
     for seed in range(args.first_seed, args.first_seed + args.seeds):
-        shock = synthesize(*design, args.rate, damping=zeta, seed=seed, tolerance_db=(low, high))
+        shock = synthesis_of(
+            args.spectrum, design, args.rate, damping=zeta, seed=seed, tolerance_db=(low, high)
+        )
         yield seed, shock, imu_record(shock, args.rate, args.axis, args.head)
 
 
