@@ -520,3 +520,25 @@ def test_records_too_short_to_compare_are_refused_for_that_not_for_their_clocks(
     said = str(err.value)
     assert "overlap on one clock" not in said
     assert "0.395 s long" in said and "longer than 0.5 s" in said
+
+
+def test_every_figure_calibrate_prints_carries_its_unit() -> None:
+    """It printed "lag: 18.89 ms ± 0.29 (1σ)": the 1σ without its unit. A lag of 18.89 ms is
+    0.01889 s; an angle of 1.672° is 0.02918 rad; 12.3 mm is 0.0123 m; scales are factors."""
+    from mount_twin.analysis.calibration import Calibration
+    from mount_twin.commands.calibrate import describe
+
+    cal = Calibration(
+        {"stiffness": 1.23, "lag": 0.01889, "yaw": math.radians(-1.672), "sensor_x": 0.0123},
+        {"stiffness": 0.0024, "lag": 0.00029, "yaw": math.radians(0.62), "sensor_x": 0.0004},
+        {},
+        1.035,
+        0.587,
+        load_scene_file(SHAKE / "block.scene.yaml"),
+    )
+    assert describe(cal)[:4] == [
+        "stiffness: ×1.23 ± 0.0024 (1σ)",
+        "lag: 18.89 ms ± 0.29 ms (1σ)",
+        "yaw: -1.672° ± 0.62° (1σ)",
+        "sensor_x: 12.3 mm ± 0.4 mm (1σ)",
+    ]

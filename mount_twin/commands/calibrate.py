@@ -151,7 +151,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def describe(cal: Calibration) -> list[str]:
-    """Each parameter with its 1σ or why it is refused, and the residual before and after."""
+    """Each parameter with its 1σ or why it is refused, and the residual before and after;
+    every figure in its unit (a scale factor as ×value, its 1σ a plain number): the 1σ had
+    none ("lag: 18.89 ms ± 0.29 (1σ)")."""
     degrees = ("°", 57.29577951308232)
     millimetres = ("mm", 1e3)
     units = {"roll": degrees, "pitch": degrees, "yaw": degrees, "lag": ("ms", 1e3)}
@@ -161,14 +163,25 @@ def describe(cal: Calibration) -> list[str]:
     for name, value in cal.values.items():
         unit, k = units.get(name, ("×", 1.0))  # the rest are scale factors
         if name in cal.sigma:
-            lines.append(f"{name}: {k * value:.4g} {unit} ± {k * cal.sigma[name]:.2g} (1σ)")
+            sigma = k * cal.sigma[name]
+            spread = f"{sigma:.2g}" if unit == "×" else _in_unit(sigma, ".2g", unit)
+            lines.append(f"{name}: {_in_unit(k * value, '.4g', unit)} ± {spread} (1σ)")
         elif name in cal.refused:
-            lines.append(f"{name}: refused, {cal.refused[name]}; kept at {k * value:g} {unit}")
+            kept = _in_unit(k * value, "g", unit)
+            lines.append(f"{name}: refused, {cal.refused[name]}; kept at {kept}")
     lines.append(
         f"body sensor, normalised RMS error: {cal.nrms_before:.3f} before, {cal.nrms_after:.3f}"
         " after"
     )
     return lines
+
+
+def _in_unit(value: float, spec: str, unit: str) -> str:
+    """`value` formatted by `spec` in `unit`: 18.89 ms, -1.672°, or a scale factor ×1.23."""
+    text = format(value, spec)
+    if unit == "×":
+        return f"×{text}"
+    return f"{text}{'' if unit == '°' else ' '}{unit}"
 
 
 def _write_scene(source: str, out: Path, cal: Calibration, lines: list[str]) -> None:
