@@ -169,3 +169,59 @@ def test_a_window_in_which_every_scale_is_refused_is_not_judged_ok(
     assert [(f.start_s, f.level) for f in fits] == [(2.0, "OK"), (32.0, "WARN")]
     assert not fits[1].values and set(fits[1].refused) == {"stiffness", "damping"}
     assert "not judged" in fits[1].why
+
+
+def _cut(record: Signal, end_s: float) -> Signal:
+    """`record`'s samples stamped up to `end_s`."""
+    keep = record.t <= end_s
+    return Signal(record.t[keep], record.accel[keep], record.gyro[keep])
+
+
+@pytest.mark.parametrize(
+    ("end_s", "says"),
+    [
+        # 5 s overlap: 3 s after the lead, and a window is longer than 4 s: none can fit
+        (
+            5.0,
+            "3 s after the 2 s lead, and a window is longer than 4 s: track needs records "
+            "overlapping by more than 6 s",
+        ),
+        # 20 s: 18 s after the lead, one 30 s window does not fit, a shorter one does
+        (
+            20.0,
+            "18 s after the 2 s lead: less than one window of 30 s (give one of more than "
+            "4 s and at most 18 s)",
+        ),
+    ],
+)
+def test_records_too_short_for_a_window_are_told_what_would_fit(
+    ageing_pair: tuple[Path, Signal, Signal], end_s: float, says: str
+) -> None:
+    """Records shorter than the lead were told "give a shorter one" (window), where no window
+    (more than 4 s) could fit."""
+    d, foundation, body = ageing_pair
+    scene = load_scene_file(d / "pump.scene.yaml")
+    with pytest.raises(ValueError, match=f"^the records hold {re.escape(says)}$"):
+        track(scene, _cut(foundation, end_s), body, 30.0)
+
+
+def test_a_part_window_left_at_the_end_is_said(
+    ageing_pair: tuple[Path, Signal, Signal],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """40 s of records, windows of 30 s after the 2 s lead: one window, 2–32 s, and the last
+    8 s (32–40 s) in none, which went without a word."""
+    d, foundation, _ = ageing_pair
+    short = _cut(foundation, 40.0)
+    rows = np.column_stack([short.t, short.accel, short.gyro])
+    cut = tmp_path / "foundation_40s.csv"
+    np.savetxt(cut, rows, delimiter=",", header="t,ax,ay,az,wx,wy,wz", comments="")
+    files = ["--foundation", str(cut), "--body", str(d / "body.csv")]
+    assert main(["track", str(d / "pump.scene.yaml"), "--window", "30", *files]) == 0
+    said = capsys.readouterr()
+    assert [ln.split()[0] for ln in said.out.splitlines()[1:]] == ["2.0–32.0"]
+    assert said.err == (
+        "mount-twin: warning: the last 8 s of the records, 32–40 s, are in no window: less "
+        "than one of 30 s\n"
+    )

@@ -3,7 +3,8 @@
 Rubber hardens or creeps and a bolt loosens slowly; a calibrated scene and a body IMU show it as
 a stiffness or damping scale that leaves 1. `track` fits `fit` (`analysis.calibration`) on
 consecutive windows of the records, each after a settling lead (the twin starts at rest at the
-window's first sample, so the first `LEAD_S` are fitted out), and gives each window a level:
+window's first sample, so the first `LEAD_S` are fitted out; what is left after the last whole
+window is in none, `left_over`), and gives each window a level:
 WARN where a scale's 3σ interval lies wholly outside `Band.warn`, ERROR where it lies outside
 `Band.error`. A window whose fit refuses a parameter says so and is not judged on it; one whose
 fit refuses every scale (a record that does not move, a fit no better than the scene) is
@@ -22,6 +23,8 @@ from mount_twin.scene.description import Scene, ageing_bands_problem
 LEAD_S = 2.0
 """Each window's records start this much earlier: the twin's start transient settles there,
 and the fit skips it."""
+SHORTEST_S = 2.0 * LEAD_S
+"""A window must be longer than this, s."""
 LEVELS = ("OK", "WARN", "ERROR")
 
 
@@ -107,17 +110,10 @@ def track(
             )
             raise ValueError(msg)
         scaled_mounts(name, scene)
-    if window_s <= 2.0 * LEAD_S:
-        msg = f"window {window_s:g} s: give more than {2.0 * LEAD_S:g} s (the lead settles)"
+    if window_s <= SHORTEST_S:
+        msg = f"window {window_s:g} s: give more than {SHORTEST_S:g} s (the lead settles)"
         raise ValueError(msg)
-    first, stop = float(max(foundation.t[0], body.t[0])), float(min(foundation.t[-1], body.t[-1]))
-    if stop <= first:
-        msg = (
-            "the records do not overlap on one clock: the foundation's runs "
-            f"{foundation.t[0]:.6g} to {foundation.t[-1]:.6g} s, the body's {body.t[0]:.6g} "
-            f"to {body.t[-1]:.6g} s"
-        )
-        raise ValueError(msg)
+    first, stop = overlap(foundation, body)
     start = first + LEAD_S  # the twin settles on the foundation over the lead
     fits = []
     while start + window_s <= stop + 1e-9:
@@ -126,12 +122,48 @@ def track(
         fits.append(fit_window(scene, records, (start, end), fit, band))
         start = end
     if not fits:
-        msg = (
-            f"the records hold {max(stop - start, 0.0):.4g} s after the {LEAD_S:g} s lead: less "
-            f"than one window of {window_s:g} s (give a shorter one)"
-        )
+        left = max(stop - start, 0.0)
+        held = f"the records hold {left:.4g} s after the {LEAD_S:g} s lead"
+        if left <= SHORTEST_S:  # no window fits: "give a shorter one" was not true
+            msg = (
+                f"{held}, and a window is longer than {SHORTEST_S:g} s: track needs records "
+                f"overlapping by more than {LEAD_S + SHORTEST_S:g} s"
+            )
+        else:
+            msg = (
+                f"{held}: less than one window of {window_s:g} s (give one of more than "
+                f"{SHORTEST_S:g} s and at most {left:.4g} s)"
+            )
         raise ValueError(msg)
     return fits
+
+
+def overlap(foundation: Signal, body: Signal) -> tuple[float, float]:
+    """The first and last stamp (s) the records both cover; ValueError where they do not
+    overlap on one clock, saying each one's span."""
+    first, stop = float(max(foundation.t[0], body.t[0])), float(min(foundation.t[-1], body.t[-1]))
+    if stop <= first:
+        msg = (
+            "the records do not overlap on one clock: the foundation's runs "
+            f"{foundation.t[0]:.6g} to {foundation.t[-1]:.6g} s, the body's {body.t[0]:.6g} "
+            f"to {body.t[-1]:.6g} s"
+        )
+        raise ValueError(msg)
+    return first, stop
+
+
+def left_over(fits: list[WindowFit], foundation: Signal, body: Signal, window_s: float) -> str:
+    """What of the records `track` fitted in no window, in words ('' for nothing): the part
+    after its last window (of `fits`), shorter than one, which it had dropped without a
+    word."""
+    _, stop = overlap(foundation, body)
+    end = fits[-1].end_s
+    if stop - end <= 1e-9:  # track's own tolerance on a window's end
+        return ""
+    return (
+        f"the last {stop - end:.4g} s of the records, {end:.6g}–{stop:.6g} s, are in no "
+        f"window: less than one of {window_s:g} s"
+    )
 
 
 def window_table(fits: list[WindowFit]) -> list[str]:

@@ -3,7 +3,8 @@ window along a recorded pair, each window judged against a band (`mount_twin.ana
 mounts that harden, creep or loosen show as a stiffness or damping scale leaving 1. Exit 0 all
 windows OK, 1 some WARN (a window whose fit refuses every scale is not judged: a WARN), 4 some
 ERROR. A record that does not move (a still foundation, a dead body sensor) is refused at
-load (`calibrate.read_pair`).
+load (`calibrate.read_pair`). The part of the records after the last whole window is fitted
+in none: a warning says how much.
 """
 
 from __future__ import annotations
@@ -45,7 +46,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from mount_twin.analysis.ageing import Band, track, window_table
+    import sys
+
+    from mount_twin.analysis.ageing import Band, left_over, track, window_table
     from mount_twin.commands.calibrate import read_pair
     from mount_twin.scene.description import Ageing
 
@@ -57,5 +60,7 @@ def run(args: argparse.Namespace) -> int:
     fits = track(scene, foundation, body, window, fit, band)
     print(f"{'window s':<19} level fit")
     print("\n".join(window_table(fits)))
+    if dropped := left_over(fits, foundation, body, window):
+        print(f"mount-twin: warning: {dropped}", file=sys.stderr)
     levels = {f.level for f in fits}
     return EXIT_ERROR if "ERROR" in levels else EXIT_WARN if "WARN" in levels else 0
