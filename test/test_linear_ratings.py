@@ -142,3 +142,28 @@ def test_the_replay_summary_does_not_round_a_utilisation_under_1_up_to_1(tmp_pat
     said = float(line.split(":")[1])
     assert said < 1.0
     assert said == pytest.approx(0.9998, abs=5e-5)
+
+
+@pytest.mark.parametrize(
+    ("over", "says"),
+    [
+        (1.002, "is 1.002 times the rated"),  # 1 to 3 figures, 1.002 to 4
+        (1.0 + 1e-6, "is {excess:.3g} N past the rated"),  # 1 to 4 figures: the excess, N
+    ],
+)
+def test_a_load_a_hair_past_its_rating_never_reads_as_1_times_it(over: float, says: str) -> None:
+    """Four equal mounts share the weight, mg/4 each; m0 rated `over` times less. The warning
+    read "is 1 times the rated", a load at its rating, not past it."""
+    load = MASS * G / 4
+    rated = load / over
+    mounts = [
+        mount(f"m{i}", (x, y, 0.0), (KH, KH, K, 0.0, 0.0, 0.0))
+        for i, (x, y) in enumerate([(0.5, 0.3), (-0.5, 0.3), (-0.5, -0.3), (0.5, -0.3)])
+    ]
+    mounts[0]["rated_load"] = [0.0, 0.0, rated]
+    data = base_scene(MASS, [0.0, 0.0, 0.2], [100.0, 150.0, 200.0, 0.0, 0.0, 0.0], mounts)
+    (warning,) = [w for w in scene_from_dict(data, "<hair>").warnings if "rated" in w.message]
+    assert warning.path.endswith("mounts[0].rated_load")
+    assert f"{load:.4g} N along local z, " in warning.message
+    assert says.format(excess=load - rated) + f" {rated:.4g} N" in warning.message
+    assert "is 1 times" not in warning.message

@@ -18,6 +18,7 @@ the key's force k_key·(s − c) and the bolt's F_S = F_V + k_S·s.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -204,3 +205,17 @@ def test_the_bundled_genset_starts_within_its_limits():
     scene = load_scene_file(Path(__file__).parents[1] / "config/genset_bolted_keyed.scene.yaml")
     assert rated_at_start(scene)
     assert assemble(scene).scene.warnings == ()
+
+
+def test_a_force_a_hair_past_its_limit_never_reads_as_1_times_it():
+    """The key's force at the start 1e-6 of itself past its allowable force: "is 1 times its
+    allowable force", a force at its limit, not past it. Past by 1e-6 of F, it is past by
+    F·1e-6 N (to the start's 1e-9)."""
+    force_key = key_force(0.0)
+    allowable = force_key * (1.0 - 1e-6)
+    model = assemble(scene_from_dict(hung(allowable, 2.0 * F_V, 3.0 * F_V), "<hung>"))
+    said = limited(model.scene)["mounts[4].allowable_force"]
+    excess = re.search(r", is (\S+) N past its allowable force ", said)
+    assert excess is not None, said
+    assert float(excess.group(1)) == pytest.approx(force_key * 1e-6, rel=0.01)
+    assert f"its allowable force {allowable:.4g} N: " in said

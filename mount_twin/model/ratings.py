@@ -49,6 +49,7 @@ from mount_twin.scene.checks import (
     UNITS_OR_MOUNT,
     limits,
     more_mounts,
+    past_limit,
     rated_at_start,
     rating_warnings,
     tangent_misjudges,
@@ -165,13 +166,14 @@ def limit_warnings(
                 over.setdefault(key, []).append((ratio, i, float(util[row]) * own[0][1], limit))
     found = []
     for key, cases in over.items():
-        ratio, i, force, limit = max(cases)
+        _, i, force, limit = max(cases)
         what, of, start, means = LIMITED[key]
         found.append(
             SceneWarning(
                 scene.source,
                 f"{paths[i]}.{key}",
-                f"{what} {basis.where}, {force:.4g} N, is {ratio:.3g} times {of} {limit:.4g} N"
+                f"{what} {basis.where}, {force:.4g} N, is {past_limit(force, limit, 'N')} "
+                f"{of} {limit:.4g} N"
                 f"{more_mounts(len(cases) - 1)}{start}: {means}{basis.means}",
             )
         )

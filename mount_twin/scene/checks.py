@@ -352,18 +352,32 @@ def rating_warnings(
                     over.setdefault(key, []).append((abs(v) / r, i, j, abs(v), r))
     found = []
     for key, cases in over.items():
-        ratio, i, j, value, rating = max(cases)
+        _, i, j, value, rating = max(cases)
         what, unit = ("load", "N") if key == "rated_load" else ("deflection", "m")
         found.append(
             SceneWarning(
                 scene.source,
                 f"{mount_paths[i]}.{key}",
                 f"the {'static ' if static else ''}{what} {basis}, {value:.4g} {unit} along "
-                f"local {AXES[j]}, is {ratio:.3g} times the rated {rating:.4g} {unit}"
+                f"local {AXES[j]}, is {past_limit(value, rating, unit)} the rated "
+                f"{rating:.4g} {unit}"
                 f"{more_mounts(len({c[1] for c in cases}) - 1)}: {hint}",
             )
         )
     return found
+
+
+def past_limit(value: float, limit: float, unit: str) -> str:
+    """How far `value` is past `limit` (0 < limit < value, both in `unit`), in the words that
+    follow "is" and precede the limit: "1.23 times" to 3 significant figures, to 4 where 3 read
+    1 ("1.002 times"), and where 4 do too, the excess ("0.00196 N past"; "just past" where a
+    ratio judged past 1 is the limit to the last bit). A load-time warning had read "is 1
+    times its allowable force": a force at its limit, not past it."""
+    ratio = value / limit
+    for digits in (3, 4):
+        if float(text := f"{ratio:.{digits}g}") > 1.0:
+            return f"{text} times"
+    return f"{value - limit:.3g} {unit} past" if value > limit else "just past"
 
 
 def more_mounts(n: int) -> str:
