@@ -282,6 +282,27 @@ AGEING_PUMP = {
 """The pump with its body IMU on /machine/imu and ageing tracked in windows of 20 s."""
 
 
+def disk_full_after(monkeypatch: Any, bags: int) -> list[str]:
+    """`commands.common.write_signal` (synthesize's and qualify's bag writer) writes `bags`
+    bags, then fails at the next as a full disk does (OSError ENOSPC naming it): a run that
+    fails part-way. Returns the bags written, as they are."""
+    import errno
+
+    from mount_twin.commands import common
+
+    written: list[str] = []
+    real = common.write_signal
+
+    def write_signal(sig: Any, out: str, *args: Any) -> int:
+        if len(written) == bags:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), out)
+        written.append(out)
+        return real(sig, out, *args)
+
+    monkeypatch.setattr(common, "write_signal", write_signal)
+    return written
+
+
 def unmeetable_design(path: Path) -> Path:
     """A design no synthesis meets within -1.5/+3 dB: 100 g at 20 Hz between 1 g at 10 and
     40 Hz. An oscillator an octave off a 20 Hz motion still responds to it (one at 40 Hz

@@ -265,3 +265,23 @@ def test_a_spectrum_the_synthesis_cannot_meet_is_named(
     err = capsys.readouterr().err
     assert f"mount-twin: error: {spectrum}: the synthesis (seed 0) did not meet" in err, err
     assert not out.exists()
+
+
+def test_a_qualification_that_fails_part_way_leaves_no_directory(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The disk fills at the second input's bag, after the first input and its replay were
+    written: the directory was kept, half a qualification without a verdict, and refused the
+    rerun ("exists")."""
+    from io_helpers import disk_full_after
+
+    out = tmp_path / "q"
+    written = disk_full_after(monkeypatch, 1)
+    args = ["qualify", str(CONFIG / "pump_8_mounts.scene.yaml"), "-o", str(out)]
+    spectrum = str(_table(tmp_path / "d.csv", 1.0))
+    assert main([*args, "--spectrum", spectrum, "--seeds", "2", "--workers", "1"]) == 2
+    assert written == [str(out / "input_z_seed_0")]
+    err = capsys.readouterr().err
+    assert f"mount-twin: error: {out / 'input_z_seed_1'}: No space left on device" in err
+    assert f"mount-twin: warning: {out}: removed, with what qualify wrote in it" in err
+    assert not out.exists() and tmp_path.is_dir()

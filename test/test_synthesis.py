@@ -158,3 +158,22 @@ def test_a_spectrum_the_synthesis_cannot_meet_is_named(
     err = capsys.readouterr().err
     assert f"mount-twin: error: {spectrum}: the synthesis (seed 0) did not meet" in err, err
     assert not out.exists()
+
+
+def test_a_synthesis_that_fails_part_way_leaves_no_directory(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The disk fills at the second seed's bag: the first seed's bag was kept, the directory
+    read as a result of one seed, and the rerun was refused ("exists")."""
+    from io_helpers import disk_full_after
+
+    spectrum = Path(__file__).resolve().parents[1] / "config" / "shock_spectrum_vertical.csv"
+    out = tmp_path / "synth"
+    written = disk_full_after(monkeypatch, 1)
+    args = ["synthesize", "--spectrum", str(spectrum), "-o", str(out), "--seeds", "2"]
+    assert main(args) == 2
+    assert written == [str(out / "seed_0")]
+    err = capsys.readouterr().err
+    assert f"mount-twin: error: {out / 'seed_1'}: No space left on device" in err
+    assert f"mount-twin: warning: {out}: removed, with what synthesize wrote in it" in err
+    assert not out.exists() and tmp_path.is_dir()

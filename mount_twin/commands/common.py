@@ -211,8 +211,11 @@ def warn_if_partial(bag: str | Path) -> str:
 @contextmanager
 def new_directory(path: str | Path, command: str) -> Iterator[Path]:
     """A directory `command` creates for its outputs (ValueError if it exists, or if a dangling
-    symlink or a file is in its way: `textfiles.new_directory_refusal`), removed again if the
-    command fails before putting anything in it: an empty one blocked the rerun."""
+    symlink or a file is in its way: `textfiles.new_directory_refusal`), removed again with
+    what the command put in it if the command stops before its end (an error, a signal): an
+    empty one blocked the rerun, and one holding the outputs so far (the first seeds of
+    synthesize, half a qualification without its verdict) read as a finished result and
+    blocked the rerun too. It holds nothing else: it is new, made by this run."""
     from mount_twin.textfiles import new_directory_refusal
 
     out = Path(path)
@@ -224,9 +227,33 @@ def new_directory(path: str | Path, command: str) -> Iterator[Path]:
     try:
         yield out
     except BaseException:
-        if not any(out.iterdir()):
-            out.rmdir()
+        _remove_unfinished(out, command)
         raise
+
+
+def _remove_unfinished(out: Path, command: str) -> None:
+    """Remove the directory `out` that `command` made and stopped before finishing, saying so
+    on stderr if it held anything (or that it could not be removed: the error that stopped the
+    command is the one reported)."""
+    import shutil
+
+    if not any(out.iterdir()):
+        out.rmdir()
+        return
+    try:
+        shutil.rmtree(out)
+    except OSError as err:
+        print(
+            f"mount-twin: warning: {out}: {command} stopped before its end: what it wrote there "
+            f"is no result, and could not be removed ({err})",
+            file=sys.stderr,
+        )
+        return
+    print(
+        f"mount-twin: warning: {out}: removed, with what {command} wrote in it: it stopped "
+        "before its end, and its outputs so far are no result",
+        file=sys.stderr,
+    )
 
 
 def write_signal(
