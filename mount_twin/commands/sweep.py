@@ -32,7 +32,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=positive_int,
         help="local cluster worker processes (default: one per core)",
     )
-    parser.add_argument("--parquet", metavar="FILE", help="also write this sweep's rows as Parquet")
+    parser.add_argument(
+        "--parquet", metavar="FILE", help="also write this sweep's rows as Parquet"
+    )
     parser.add_argument(
         "--plot",
         metavar="PNG",
