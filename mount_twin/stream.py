@@ -227,10 +227,12 @@ class TwinStream:
         return reports
 
     def _track_foundation(self, decoded: Decoded) -> None:
-        """Deck samples into the ageing tracker: those with finite values, the input's
-        frame_id (if it names one) and rising stamps."""
+        """Deck samples into the ageing tracker: those with finite values, every reading
+        provided, the input's frame_id (if it names one) and rising stamps."""
         assert self.ageing is not None and self.base is not None
         good = np.isfinite(np.hstack([decoded.accel, decoded.gyro])).all(axis=1)
+        if decoded.unprovided is not None:
+            good &= ~decoded.unprovided.any(axis=1)
         expected = self.scene.input.frame_id
         if expected:
             good &= np.array([f == expected for f in decoded.frame_ids], bool)

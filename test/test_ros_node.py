@@ -304,6 +304,62 @@ def test_bad_input_is_counted_and_the_node_keeps_running(tmp_path: Path) -> None
     assert final["restarts"] == "0"
 
 
+def _unprovided(raws: list[bytes], field: str) -> list[bytes]:
+    """`raws` (Imu) with `field` (linear_acceleration or angular_velocity) marked not provided
+    (REP-145: its covariance[0] = -1) and holding a value a sensor without it might send."""
+    out = []
+    for raw in raws:
+        msg = TYPESTORE.deserialize_cdr(raw, IMU)
+        covariance = np.zeros(9)
+        covariance[0] = -1.0
+        setattr(msg, f"{field}_covariance", covariance)
+        value = getattr(msg, field)
+        value.x, value.y, value.z = (
+            (0.0, 0.0, 0.0) if field == "linear_acceleration" else (5.0,) * 3
+        )
+        out.append(bytes(TYPESTORE.serialize_cdr(msg, IMU)))
+    return out
+
+
+def test_a_reading_its_imu_marks_not_provided_is_rejected_live_as_in_the_replay(
+    tmp_path: Path,
+) -> None:
+    """An Imu whose linear_acceleration_covariance[0] or angular_velocity_covariance[0] is -1
+    says it has no such reading (REP-145: disregard it): such a sample is counted
+    (rejected_no_acceleration, rejected_no_angular_velocity) and skipped, never answered, and
+    the live node publishes what the replay of the same messages writes. Taken, the zeros of a
+    missing accelerometer drove the twin as a free fall and a 5 rad/s placeholder rate as a
+    spinning deck, reported ok."""
+    scene = scene_from_params(dict(flatten(_params())), str(PARAMS_FILE))
+    stamps, accel = _at_rest(1500)
+    good = _imu(stamps, accel)
+    raws = [
+        *good[:500],
+        *_unprovided(good[500:530], "linear_acceleration"),
+        *good[530:900],
+        *_unprovided(good[900:940], "angular_velocity"),
+        *good[940:],
+    ]
+    want = replayed(scene, raws, tmp_path)
+    args = ["--params-file", str(PARAMS_FILE), "-p", "stall_period_s:=3600.0"]
+    peer, node, code = run_live(scene, args, raws, 1000.0, expect_outputs=1500 - 70)
+    peer.close()
+    assert code == 0, node.stderr
+    pose = resolve("~/pose", NODE_NAME)
+    assert len(peer.got[pose]) == len(want[pose]) == 1500 - 70
+    assert peer.got[pose] == want[pose]
+    assert diagnostics(peer.got["/diagnostics"]) == diagnostics(want["/diagnostics"])
+    _, _, final = _statuses(peer)[-1]["mount_twin: input"]
+    assert (final["rejected_no_acceleration"], final["rejected_no_angular_velocity"]) == (
+        "30",
+        "40",
+    )
+    assert (final["received"], final["accepted"]) == ("1500", "1430")
+    assert final["lost_estimated"] == "0"  # received and skipped: their stamps leave no hole
+    mounts = [s for name, s in _statuses(peer)[-1].items() if name.startswith("mount_twin: mount")]
+    assert len(mounts) == 8 and all(lv == OK for lv, _, _ in mounts), mounts
+
+
 def test_diagnostics_go_out_every_clock_period_without_input() -> None:
     """No input: ERROR 'no input' every period; then only wrong-frame input: ERROR naming the
     frames; a publisher of another type on the input topic is named under mount_twin: ros."""

@@ -28,12 +28,15 @@ class SampleBatch:
         accel: (n, 3) acceleration, m/s², sensor frame (specific force if it includes gravity).
         gyro: (n, 3) angular velocity, rad/s, sensor frame.
         frame_ids: header.frame_id of each sample.
+        unprovided: (n, 2) bool, where a sample's message marks its acceleration, its angular
+            velocity not provided (REP-145); None: every reading is provided.
     """
 
     stamps: np.ndarray
     accel: np.ndarray
     gyro: np.ndarray
     frame_ids: list[str]
+    unprovided: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         """Arrays of float64 whatever holds the numbers (lists, float32, integers; no copy of
@@ -80,8 +83,9 @@ class SampleBatch:
     def part(self, keep: slice) -> SampleBatch:
         """The samples at the positions `keep` takes (views of the arrays where numpy gives
         them)."""
+        unset = None if self.unprovided is None else self.unprovided[keep]
         return SampleBatch(
-            self.stamps[keep], self.accel[keep], self.gyro[keep], self.frame_ids[keep]
+            self.stamps[keep], self.accel[keep], self.gyro[keep], self.frame_ids[keep], unset
         )
 
     @classmethod
@@ -94,6 +98,14 @@ class SampleBatch:
             np.concatenate([p.accel for p in parts]).reshape(-1, 3),
             np.concatenate([p.gyro for p in parts]).reshape(-1, 3),
             [fid for p in parts for fid in p.frame_ids],
+            None
+            if all(p.unprovided is None for p in parts)
+            else np.concatenate(
+                [
+                    np.zeros((len(p), 2), bool) if p.unprovided is None else p.unprovided
+                    for p in parts
+                ]
+            ),
         )
 
 

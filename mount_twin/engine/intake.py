@@ -262,12 +262,16 @@ class Intake:
 
     def screen(self, batch: SampleBatch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Specific force (m/s²) and Ω (rad/s) in F per sample, and which samples are finite:
-        a finite stamp and readings within ±READING_LIMIT.
+        a finite stamp and readings within ±READING_LIMIT (a reading marked not provided is
+        taken as 0 here: the sample's verdict says whether it can do without it).
 
         Other readings are zeroed before the rotation, which would otherwise warn (numpy
         RuntimeWarning: inf·0, inf − inf, overflow); their samples are rejected anyway.
         """
         accel, gyro = batch.accel, batch.gyro
+        if batch.unprovided is not None:  # readings to disregard (REP-145): `_verdict` judges
+            accel = np.where(batch.unprovided[:, :1], 0.0, accel)
+            gyro = np.where(batch.unprovided[:, 1:], 0.0, gyro)
         finite = np.isfinite(batch.stamps)
         # NaN compares false: one test for NaN, ±inf and the absurdly large.
         if not (np.abs(accel).max() <= READING_LIMIT and np.abs(gyro).max() <= READING_LIMIT):
@@ -331,6 +335,7 @@ class Intake:
         first = int(last_t is None)  # 1: the batch's first sample starts the twin
         if not (
             n > first
+            and batch.unprovided is None
             and finite.all()
             and (not spec.frame_id or batch.frame_ids.count(spec.frame_id) == n)
         ):
@@ -375,6 +380,11 @@ class Intake:
             return "non_finite"
         if self.spec.frame_id and batch.frame_ids[i] != self.spec.frame_id:
             return "wrong_frame"
+        if batch.unprovided is not None:  # REP-145: a reading to disregard
+            if batch.unprovided[i, 0]:
+                return "no_acceleration"
+            if batch.unprovided[i, 1] and self.spec.gyro_filter != "ignore":
+                return "no_angular_velocity"
         if self.last_stamp is None:
             return START
         next_t = float(batch.stamps[i + 1]) if i + 1 < len(batch) else None

@@ -76,7 +76,9 @@ class Decoded:
 
     `undecodable` counts messages that were not valid CDR of the expected type; `position`
     gives each decoded message's place among the raw messages (int64; None: they are all of
-    them, in order).
+    them, in order); `unprovided`, per decoded message (n, 2) bool, whether its acceleration
+    and its angular velocity are marked not provided (an Imu's covariance[0] = -1, REP-145:
+    to be disregarded; None: every reading is provided).
     """
 
     stamps_ns: np.ndarray
@@ -85,6 +87,7 @@ class Decoded:
     frame_ids: list[str]
     undecodable: int = 0
     position: np.ndarray | None = None
+    unprovided: np.ndarray | None = None
 
     def select(self, keep: np.ndarray) -> Decoded:
         """The messages where `keep` (bool, per decoded message) is True."""
@@ -97,6 +100,7 @@ class Decoded:
             frames,
             self.undecodable,
             places,
+            None if self.unprovided is None else self.unprovided[keep],
         )
 
     def places(self) -> np.ndarray:
@@ -107,13 +111,16 @@ class Decoded:
 
     def batch(self, base: TimeBase) -> SampleBatch:
         """Engine samples with stamps in seconds from `base`."""
-        return SampleBatch(base.seconds(self.stamps_ns), self.accel, self.gyro, self.frame_ids)
+        seconds = base.seconds(self.stamps_ns)
+        return SampleBatch(seconds, self.accel, self.gyro, self.frame_ids, self.unprovided)
 
 
 def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
     """Decode sensor_msgs/Imu (linear_acceleration, angular_velocity) or
     geometry_msgs/AccelStamped (accel.linear; its accel.angular is an angular acceleration, not a
     rate, so Ω is taken as zero).
+
+    An Imu's reading whose covariance[0] is -1 is marked not provided (`Decoded.unprovided`).
 
     rosbags decodes the first message of each frame_id; the messages that share its fixed layout
     are read in one numpy pass (`FixedLayout`; rows of `RawRows` as they lie), the rest one by
@@ -129,9 +136,10 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
             sec, nsec, *v = one
             rate = [v[3:6]] if msgtype == IMU else [[0.0, 0.0, 0.0]]
             stamp = np.array([int(sec) * 1_000_000_000 + int(nsec)], dtype=np.int64)
-            return Decoded(stamp, np.array([v[:3]]), np.array(rate), [frame])
+            unset = _unprovided(np.array([v[6:8]])) if msgtype == IMU else None
+            return Decoded(stamp, np.array([v[:3]]), np.array(rate), [frame], 0, None, unset)
     stamps = np.zeros(n, dtype=np.int64)
-    accel, gyro = np.zeros((n, 3)), np.zeros((n, 3))
+    accel, gyro, covariance = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 2))
     frames = np.full(n, "", dtype=object)
     ok = np.zeros(n, dtype=bool)
     pending = np.ones(n, dtype=bool)
@@ -145,7 +153,7 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
             continue
         ok[i] = True
         frames[i] = msg.header.frame_id
-        stamps[i], accel[i], gyro[i] = _input_values(msg, msgtype)
+        stamps[i], accel[i], gyro[i], covariance[i] = _input_values(msg, msgtype)
         if not batched:
             continue
         rest = np.flatnonzero(pending)
@@ -173,6 +181,7 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
         accel[got] = np.column_stack(cols[2:5])[1:]
         if msgtype == IMU:
             gyro[got] = np.column_stack(cols[5:8])[1:]
+            covariance[got] = np.column_stack(cols[8:10])[1:]
     bad = n - int(ok.sum())
     return Decoded(
         stamps[ok],
@@ -181,16 +190,26 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
         frames[ok].tolist(),
         bad,
         np.flatnonzero(ok) if bad else None,
+        _unprovided(covariance[ok]),
     )
 
 
-def _input_values(msg: Any, msgtype: str) -> tuple[int, tuple, tuple]:
-    """(stamp ns, acceleration, angular velocity) of one decoded input message."""
+def _unprovided(covariance: np.ndarray) -> np.ndarray | None:
+    """(n, 2) bool of the readings whose (n, 2) covariance[0] (acceleration's, angular
+    velocity's) marks them not provided (-1, REP-145); None where none is."""
+    unset = covariance == -1.0
+    return unset if unset.any() else None
+
+
+def _input_values(msg: Any, msgtype: str) -> tuple[int, tuple, tuple, tuple]:
+    """(stamp ns, acceleration, angular velocity, their covariances' [0]) of one decoded input
+    message (an AccelStamped has no covariance: 0)."""
     if msgtype == IMU:
         a, w = msg.linear_acceleration, msg.angular_velocity  # type: ignore[attr-defined]
-        return stamp_ns(msg.header), (a.x, a.y, a.z), (w.x, w.y, w.z)  # type: ignore[attr-defined]
+        unset = (msg.linear_acceleration_covariance[0], msg.angular_velocity_covariance[0])  # type: ignore[attr-defined]
+        return stamp_ns(msg.header), (a.x, a.y, a.z), (w.x, w.y, w.z), unset  # type: ignore[attr-defined]
     a = msg.accel.linear  # type: ignore[attr-defined]
-    return stamp_ns(msg.header), (a.x, a.y, a.z), (0.0, 0.0, 0.0)  # type: ignore[attr-defined]
+    return stamp_ns(msg.header), (a.x, a.y, a.z), (0.0, 0.0, 0.0), (0.0, 0.0)  # type: ignore[attr-defined]
 
 
 def _header(stamp_ns: int, frame_id: str) -> Any:
@@ -286,8 +305,9 @@ _BUILDERS: dict[str, tuple[Callable[..., Any], int]] = {
 """Builder and number of float64 fields (after sec, nanosec) of each fixed-layout type; the
 builders take the message's frame ids first (TF: parent, child; the others: header.frame_id)."""
 
-_INPUT_WANT = {IMU: range(8), ACCEL: range(5)}
-"""Fields an input decode reads: sec, nanosec, acceleration (and ω for Imu)."""
+_INPUT_WANT = {IMU: (*range(8), 30, 21), ACCEL: range(5)}
+"""Fields an input decode reads: sec, nanosec, acceleration (and for Imu ω, then
+linear_acceleration_covariance[0] and angular_velocity_covariance[0])."""
 _LAST_FRAME: dict[str, str] = {}
 """Input type → frame_id of the last message decoded through its layout (a cache)."""
 
