@@ -918,3 +918,27 @@ def test_a_stop_while_the_node_starts_exits_0_without_a_traceback(sig: int) -> N
         time.sleep(0.002)
     code = node.stop(sig)
     assert (code, node.stderr) == (0, "")
+
+
+def test_a_diagnostics_period_longer_than_a_timer_can_wait_runs_the_node() -> None:
+    """outputs.diagnostics_period_s of 1e12 s, which the scene takes (any finite period; a
+    replay runs it): the node's stall check at that period never comes, and the node answers
+    its input and exits 0. The stall timer's period overflowed rclpy's (int64 ns): the node
+    ended at start with a TypeError traceback, exit 1."""
+    domain = fresh_domain()
+    peer = Peer(domain)
+    peer.record({"/mount_twin/pose": POSE})
+    period = ["-p", "outputs.diagnostics_period_s:=1.0e+12"]
+    node = NodeProcess(domain, ["--params-file", str(PARAMS_FILE), *LOSSLESS, *period])
+    pub = peer.publisher(IMU, "/deck/imu")
+    try:
+        assert wait_for_node(pub, node), node.failed()
+        publish_paced(pub, _imu(*_at_rest(100)), 1000.0, peer)
+        peer.take_until(lambda: len(peer.got["/mount_twin/pose"]) >= 100 - GYRO_DELAY, 60.0)
+        code = stop_and_take(node, peer, lambda: len(peer.got["/mount_twin/pose"]) >= 100)
+    finally:
+        node.stop(signal.SIGKILL)
+        peer.close()
+    assert code == 0, node.stderr
+    assert "Traceback" not in node.stderr, node.stderr
+    assert len(peer.got["/mount_twin/pose"]) == 100

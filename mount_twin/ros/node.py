@@ -82,6 +82,9 @@ incompatible QoS or type, which the subscriber's side logs too) are two waitable
 and the executor builds its wait set anew at every wake-up: with the pump's 14 publishers, 31
 waitables took 1.6 ms of CPU a wake-up."""
 WATCH_PERIOD_S = 1.0
+TIMER_MAX_S = 9.0e9
+"""Longest period (s) an rclpy timer takes (int64 ns: 292 years), and one no node lives to see
+end: a longer stall period (the scene takes any finite diagnostics period) waits this long."""
 """Steady-clock period of the checks only a live node can make (publisher types, /clock)."""
 
 
@@ -117,7 +120,8 @@ class MountTwinNode(Node):
             self._batch_timer.cancel()
         self._reports = 0
         self._accepted_at_tick = 0
-        self.create_timer(self.options.stall_period(self.scene), self._on_stall_period)
+        stall_s = min(self.options.stall_period(self.scene), TIMER_MAX_S)
+        self.create_timer(stall_s, self._on_stall_period)
         self._problems: dict[str, str] = {}
         """Problems seen by events (kept); `_watch` adds the ones it finds each time."""
         self._reported: dict[str, str] = {}
