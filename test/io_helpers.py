@@ -191,22 +191,22 @@ def comparable_messages(path: Path) -> dict[str, list[tuple[int, object]]]:
         if topic != "/diagnostics":
             out[topic] = [(stamp, bytes(raw)) for stamp, raw in messages]
             continue
-        out[topic] = [
-            (
-                stamp,
-                [
-                    (
-                        s.name,
-                        s.level,
-                        s.message,
-                        [(v.key, v.value) for v in s.values if v.key != "real_time_factor"],
-                    )
-                    for s in TYPESTORE.deserialize_cdr(raw, DIAGNOSTICS).status
-                ],
-            )
-            for stamp, raw in messages
-        ]
+        out[topic] = [(stamp, comparable_diagnostics(raw)) for stamp, raw in messages]
     return out
+
+
+def comparable_diagnostics(raw: bytes) -> list[tuple[str, int, str, list[tuple[str, str]]]]:
+    """A /diagnostics message's statuses less the wall-time figures (the real-time factor
+    differs between any two runs)."""
+    return [
+        (
+            s.name,
+            s.level,
+            s.message,
+            [(v.key, v.value) for v in s.values if v.key != "real_time_factor"],
+        )
+        for s in TYPESTORE.deserialize_cdr(raw, DIAGNOSTICS).status
+    ]
 
 
 def ageing_bag(
@@ -310,3 +310,20 @@ def unmeetable_design(path: Path) -> Path:
     where the design asks for 40 dB less."""
     path.write_text("frequency_hz,accel_g\n10,1\n20,100\n40,1\n", encoding="utf-8")
     return path
+
+
+def unprovided_imu(raws: list[bytes], field: str) -> list[bytes]:
+    """`raws` (Imu) with `field` (linear_acceleration or angular_velocity) marked not provided
+    (REP-145: its covariance[0] = -1) and holding a value a sensor without it might send."""
+    out = []
+    for raw in raws:
+        msg = TYPESTORE.deserialize_cdr(raw, "sensor_msgs/msg/Imu")
+        covariance = np.zeros(9)
+        covariance[0] = -1.0
+        setattr(msg, f"{field}_covariance", covariance)
+        value = getattr(msg, field)
+        value.x, value.y, value.z = (
+            (0.0, 0.0, 0.0) if field == "linear_acceleration" else (5.0,) * 3
+        )
+        out.append(bytes(TYPESTORE.serialize_cdr(msg, "sensor_msgs/msg/Imu")))
+    return out

@@ -18,7 +18,17 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from io_helpers import SCENE_FILE, default_scene, read_bag, read_raw, run_python, stamp_ns
+from io_helpers import (
+    SCENE_FILE,
+    comparable_diagnostics,
+    default_scene,
+    read_bag,
+    read_raw,
+    run_python,
+    scene_with,
+    stamp_ns,
+    unprovided_imu,
+)
 from rosbags.rosbag1 import Writer as Ros1Writer
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
@@ -27,7 +37,7 @@ from mount_twin.cli import main
 from mount_twin.errors import BagError
 from mount_twin.io import bag as bag_module
 from mount_twin.io.bag import PARTIAL_KEY, InputBag, OutputBag, write_bag
-from mount_twin.io.messages import IMU, POSE, TYPESTORE, imu_messages
+from mount_twin.io.messages import IMU, POSE, TYPESTORE, imu_messages, messages_of
 from mount_twin.replay import replay
 
 N = 5000  # messages of a 5 s ship-motion bag at 1 kHz
@@ -484,3 +494,46 @@ def test_replay_help_lists_the_exit_statuses(capsys: pytest.CaptureFixture[str])
     text = " ".join(capsys.readouterr().out.split())
     for status in ("3 no input sample accepted", "5 input bag damaged part-way", "130 SIGINT"):
         assert status in text
+
+
+# --------------------------------------------------------------------------- readings not provided
+
+
+@pytest.mark.parametrize("gyro_filter", ["linear_phase", "ignore"])
+def test_readings_marked_not_provided_are_rejected_alike_in_any_batching(gyro_filter: str) -> None:
+    """REP-145 (covariance[0] = -1): a sample without its acceleration is rejected; one
+    without its rate too, unless the scene reads no rate (input.gyro_filter: ignore). The
+    counts and outputs are the same message by message as in one batch."""
+
+    from mount_twin.stream import TwinStream
+
+    scene = scene_with(input={"gyro_filter": gyro_filter})
+    n = 600
+    stamps = 1_700_000_000_000_000_000 + np.arange(n, dtype=np.int64) * 1_000_000
+    accel = np.tile([0.0, 0.0, 9.80665], (n, 1))
+    good = [raw for _, raw in imu_messages(stamps, accel, np.zeros_like(accel), "deck_imu")]
+    raws = [
+        *good[:200],
+        *unprovided_imu(good[200:210], "linear_acceleration"),
+        *unprovided_imu(good[210:230], "angular_velocity"),
+        *good[230:],
+    ]
+    runs = []
+    for sizes in ([n], [1] * n):
+        stream = TwinStream(scene)
+        out, at = [], 0
+        for size in sizes:
+            out += stream.process(raws[at : at + size])
+            at += size
+        out += stream.finish()
+        comparable = [
+            (t, s, comparable_diagnostics(raw) if t == "/diagnostics" else raw)
+            for t, s, raw in messages_of(out)
+        ]
+        runs.append((comparable, dict(stream.engine.counts)))
+    (whole, counts), (single, _) = runs
+    assert whole == single
+    no_rate = 0 if gyro_filter == "ignore" else 20
+    assert counts["rejected_no_acceleration"] == 10
+    assert counts.get("rejected_no_angular_velocity", 0) == no_rate
+    assert counts["accepted"] == n - 10 - no_rate and not counts.get("lost_estimated")

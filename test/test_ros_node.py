@@ -26,7 +26,7 @@ if os.environ.get("CI"):
 else:
     pytest.importorskip("rclpy")
 
-from io_helpers import PARAMS_FILE, ROOT, read_raw
+from io_helpers import PARAMS_FILE, ROOT, read_raw, unprovided_imu
 from ros_harness import (
     LOSSLESS,
     NodeProcess,
@@ -304,23 +304,6 @@ def test_bad_input_is_counted_and_the_node_keeps_running(tmp_path: Path) -> None
     assert final["restarts"] == "0"
 
 
-def _unprovided(raws: list[bytes], field: str) -> list[bytes]:
-    """`raws` (Imu) with `field` (linear_acceleration or angular_velocity) marked not provided
-    (REP-145: its covariance[0] = -1) and holding a value a sensor without it might send."""
-    out = []
-    for raw in raws:
-        msg = TYPESTORE.deserialize_cdr(raw, IMU)
-        covariance = np.zeros(9)
-        covariance[0] = -1.0
-        setattr(msg, f"{field}_covariance", covariance)
-        value = getattr(msg, field)
-        value.x, value.y, value.z = (
-            (0.0, 0.0, 0.0) if field == "linear_acceleration" else (5.0,) * 3
-        )
-        out.append(bytes(TYPESTORE.serialize_cdr(msg, IMU)))
-    return out
-
-
 def test_a_reading_its_imu_marks_not_provided_is_rejected_live_as_in_the_replay(
     tmp_path: Path,
 ) -> None:
@@ -335,9 +318,9 @@ def test_a_reading_its_imu_marks_not_provided_is_rejected_live_as_in_the_replay(
     good = _imu(stamps, accel)
     raws = [
         *good[:500],
-        *_unprovided(good[500:530], "linear_acceleration"),
+        *unprovided_imu(good[500:530], "linear_acceleration"),
         *good[530:900],
-        *_unprovided(good[900:940], "angular_velocity"),
+        *unprovided_imu(good[900:940], "angular_velocity"),
         *good[940:],
     ]
     want = replayed(scene, raws, tmp_path)
