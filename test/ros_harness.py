@@ -64,9 +64,11 @@ def ros_env(domain: int) -> dict[str, str]:
 
 
 class NodeProcess:
-    """`mount_twin_node --ros-args ARGS` in its own process."""
+    """`mount_twin_node --ros-args ARGS` in its own process (`group`: leading a process group
+    of its own, which `os.killpg` signals whole, as a terminal's Ctrl-C or systemd's stop
+    does the node and the processes it started)."""
 
-    def __init__(self, domain: int, ros_args: Iterable[str]) -> None:
+    def __init__(self, domain: int, ros_args: Iterable[str], group: bool = False) -> None:
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "mount_twin.ros.start", "--ros-args", *ros_args],
             env=ros_env(domain),
@@ -74,6 +76,7 @@ class NodeProcess:
             stderr=subprocess.PIPE,
             text=True,
             cwd=ROOT,
+            process_group=0 if group else None,
         )
         self.stdout = self.stderr = ""
         _RUNNING.append(self)

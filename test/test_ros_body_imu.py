@@ -6,6 +6,7 @@ for the same messages of both topics. In CI rclpy must be importable (see test_r
 from __future__ import annotations
 
 import os
+import signal
 from pathlib import Path
 
 import numpy as np
@@ -163,3 +164,56 @@ def test_the_node_tracks_mounts_that_age_as_the_replay_does(tmp_path: Path) -> N
     assert code == 0, node.stderr
     assert "Traceback" not in node.stderr, node.stderr
     assert got() == want
+
+
+def _children(pid: int) -> list[int]:
+    """The processes whose parent is `pid` (Linux /proc)."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:  # ended meanwhile
+            continue
+        if int(fields[1]) == pid:
+            found.append(int(stat.parent.name))
+    return found
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_stop_sent_to_the_process_group_finishes_the_ageing_fit_in_flight(
+    tmp_path: Path, sig: int
+) -> None:
+    """SIGINT or SIGTERM to the node's whole process group (a terminal's Ctrl-C, systemd's
+    stop) while an ageing fit runs in the worker process: the worker finishes it, the node
+    publishes its report and exits 0. The worker took the signal too: a KeyboardInterrupt
+    raised out of the fit's result into the node's shutdown (a traceback, killed by SIGINT,
+    the fit's report and the acknowledgement wait lost), or the worker died at SIGTERM and
+    the window read as a failed fit."""
+    scene_path = pump_scene_file(tmp_path, **AGEING_PUMP)
+    inputs = ageing_bag(tmp_path / "in", load_scene_file(scene_path), 24.0, 30.0, BODY_TOPIC)
+    domain = fresh_domain()
+    peer = Peer(domain)
+    peer.record({"/diagnostics": DIAGNOSTICS})
+    reliable_body = ["-p", f"qos_overrides.{BODY_TOPIC}.subscription.reliability:=reliable"]
+    args = ["-p", f"scene_file:={scene_path}", "-p", "stall_period_s:=3600.0"]
+    node = NodeProcess(domain, [*args, *LOSSLESS, *reliable_body], group=True)
+    pubs = {t: peer.publisher(IMU, t) for t in ("/deck/imu", BODY_TOPIC)}
+    try:
+        assert wait_for_node(pubs["/deck/imu"], node), node.failed()
+        assert wait_for(lambda: pubs[BODY_TOPIC].get_subscription_count() > 0, 30.0)
+        assert wait_for(lambda: peer.connected("/diagnostics"), 30.0)
+        for topic, _, raw in inputs:
+            pubs[topic].publish(raw)
+            peer.take()
+        # the window 2-22 s is due: its fit starts in a worker (beside the resource tracker)
+        assert wait_for(lambda: len(_children(node.proc.pid)) >= 2, 60.0), node.failed()
+        assert not statuses_named(peer.got["/diagnostics"], AGEING)  # still fitting
+        os.killpg(node.proc.pid, sig)
+        code = stop_and_take(node, peer, lambda: True)
+    finally:
+        node.stop(signal.SIGKILL)
+        peer.close()
+    assert code == 0, node.stderr
+    assert "Traceback" not in node.stderr, node.stderr
+    ((_, level, message, _),) = statuses_named(peer.got["/diagnostics"], AGEING)
+    assert level == OK, message

@@ -7,6 +7,7 @@ stamped with its window's last body stamp, so they equal a replay's.
 from __future__ import annotations
 
 import multiprocessing
+import signal
 from collections import deque
 from concurrent.futures import Future, ProcessPoolExecutor
 
@@ -17,6 +18,8 @@ from mount_twin.scene.description import Scene
 
 FIT_WAIT_S = 120.0
 """At shutdown, how long (s) the node waits for each ageing fit still running."""
+STOP_SIGNALS = frozenset({signal.SIGINT, signal.SIGTERM})
+"""The signals that stop the node, blocked in its worker (see `AgeingFits.submit`)."""
 
 
 class AgeingFits:
@@ -29,11 +32,24 @@ class AgeingFits:
 
     def submit(self, job: WindowJob) -> None:
         """Fit `job` in the worker process (started at the first: a fresh interpreter, not a
-        fork of a process running DDS threads)."""
+        fork of a process running DDS threads).
+
+        The worker is spawned with the stop signals blocked, a mask it keeps for its life: a
+        stop sent to the node's whole process group (a terminal's Ctrl-C, systemd's SIGTERM)
+        stops the node alone, which finishes the fits (`done`) and then the worker. Taken by
+        the worker too, SIGINT raised a KeyboardInterrupt out of the fit's result into the
+        node's shutdown, and SIGTERM killed the worker, its fit read as failed."""
         if self._pool is None:
             spawn = multiprocessing.get_context("spawn")
             self._pool = ProcessPoolExecutor(max_workers=1, mp_context=spawn)
-        self._pending.append((job.stamp_ns, self._pool.submit(run_job, job)))
+        # Blocked in this thread only: the node's other threads still take a stop (its
+        # handler runs in the main thread either way).
+        mask = signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
+        try:
+            future = self._pool.submit(run_job, job)  # spawns the worker the first time
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+        self._pending.append((job.stamp_ns, future))
 
     def done(self, wait: bool = False) -> list[tuple[str, int, bytes]]:
         """The reports of the fits finished in order (`wait`: all, each within FIT_WAIT_S,
