@@ -263,14 +263,17 @@ class TwinStream:
         sample the twin has answered, and the windows judged (none without a body_sensor).
         A message that cannot be compared is counted (BodyCheck.counts) and skipped: not
         valid CDR, an unset or pre-1970 stamp, a stamp not after the last, a value not
-        finite, a header.frame_id other than body_sensor.frame_id."""
+        finite, a header.frame_id other than body_sensor.frame_id, a reading marked not
+        provided (REP-145)."""
         if self.body is None:
             return []
         decoded = decode_inputs(raws, IMU)
         self.body.counts["received"] += len(raws)
         measured = np.hstack([decoded.accel, decoded.gyro])
         reason = np.full(len(raws), "undecodable", dtype=object)
-        reason[decoded.places()] = self.body.screen(decoded.stamps_ns, measured, decoded.frame_ids)
+        reason[decoded.places()] = self.body.screen(
+            decoded.stamps_ns, measured, decoded.frame_ids, decoded.unprovided
+        )
         stamps_ns = np.zeros(len(raws), np.int64)
         stamps_ns[decoded.places()] = decoded.stamps_ns
         out = self._encode_body(self.body.screened(stamps_ns, reason))

@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from io_helpers import SCENE_FILE
+from io_helpers import SCENE_FILE, unprovided_imu
 from scipy.signal import butter, sosfiltfilt
 
 from mount_twin import load_scene_file
@@ -176,9 +176,9 @@ def test_batching_and_interleaving_do_not_change_a_bit() -> None:
     assert len(reports[0]) == 3 and reports[1] == reports[0] and reports[2] == reports[0]
 
 
-def _judged(scene: Scene, machine: Scene, deck: Signal, lag_s: float = 0.0) -> Messages:
-    """The stream of `scene` compared with a body IMU on `machine` (the same twin with its
-    changes) recorded `lag_s` late, with a MEMS IMU's noise (0.01 m/s², 0.001 rad/s)."""
+def _measured(machine: Scene, deck: Signal, lag_s: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """(stamps ns, (k, 6) readings) of a body IMU on `machine` recorded `lag_s` late, with a
+    MEMS IMU's noise (0.01 m/s², 0.001 rad/s)."""
     t, truth = _whole_record(machine, deck)
     ns = _stamps(deck)[20:]
     motion_t = TimeBase.at(NS0).seconds(ns) - lag_s
@@ -187,6 +187,13 @@ def _judged(scene: Scene, machine: Scene, deck: Signal, lag_s: float = 0.0) -> M
     measured += np.hstack(
         [rng.normal(0, 0.01, (ns.shape[0], 3)), rng.normal(0, 1e-3, (ns.shape[0], 3))]
     )
+    return ns, measured
+
+
+def _judged(scene: Scene, machine: Scene, deck: Signal, lag_s: float = 0.0) -> Messages:
+    """The stream of `scene` compared with a body IMU on `machine` (the same twin with its
+    changes) recorded `lag_s` late, with a MEMS IMU's noise (0.01 m/s², 0.001 rad/s)."""
+    ns, measured = _measured(machine, deck, lag_s)
     return _chunked(scene, _deck_raws(scene, deck), _body_raws(ns, measured), 500, False)
 
 
@@ -250,6 +257,48 @@ def test_bad_body_messages_are_counted_skipped_and_reported() -> None:
     assert _imu_values(out, BODY_RESIDUAL_TOPIC)[0].shape[0] == len(good) - 6
     first = _windows(out)[0]
     assert first[0] == WARN and "rejected_wrong_frame_id 2" in first[1]
+
+
+def test_body_readings_marked_not_provided_are_counted_not_compared() -> None:
+    """REP-145: an Imu whose covariance[0] is -1 has no such reading. Every tenth body sample
+    marked (alternately its acceleration, holding zeros, and its rate, holding 5 rad/s) was
+    compared as a value: a free fall, a spin. Now such a sample is counted
+    (rejected_no_acceleration, rejected_no_angular_velocity) and skipped: the residuals and
+    every window's figures are those of the stream without those samples, and each window
+    names them (a WARN, like any rejected body message)."""
+    scene, deck = _pump(), _deck()
+    ns, measured = _measured(scene, deck)
+    raws = _body_raws(ns, measured)
+    fields = {5: "linear_acceleration", 15: "angular_velocity"}
+    marked = [
+        unprovided_imu([raw], fields[i % 20])[0] if i % 20 in fields else raw
+        for i, raw in enumerate(raws)
+    ]
+    kept = [raw for i, raw in enumerate(raws) if i % 20 not in fields]
+    deck_raws = _deck_raws(scene, deck)
+    runs = [_chunked(scene, deck_raws, body, 500, False) for body in (marked, kept)]
+    residuals = [_imu_values(out, BODY_RESIDUAL_TOPIC) for out in runs]
+    assert np.array_equal(residuals[0][0], residuals[1][0])
+    assert np.array_equal(residuals[0][1], residuals[1][1])
+    windows = [_windows(out) for out in runs]
+    assert len(windows[0]) == len(windows[1]) == 4
+    for (level, message, values), (level_kept, _, values_kept) in zip(*windows, strict=True):
+        figures = {k: v for k, v in values.items() if not k.startswith("body_")}
+        assert figures == {k: v for k, v in values_kept.items() if not k.startswith("body_")}
+        assert level_kept == OK and level == WARN and "rejected_no_acceleration" in message
+    named = [
+        sum(int(v[f"body_rejected_no_{r}"]) for _, _, v in windows[0])
+        for r in ("acceleration", "angular_velocity")
+    ]
+    assert named == [len(raws) // 20] * 2  # the last window's, after its last sample, too
+    stream = TwinStream(scene)
+    stream.process(deck_raws)
+    stream.process_body(marked)
+    stream.finish()
+    assert stream.body is not None
+    counts = stream.body.counts
+    assert counts["rejected_no_acceleration"] == counts["rejected_no_angular_velocity"] == 199
+    assert counts["accepted"] == len(kept) and counts["received"] == len(raws)
 
 
 def test_a_body_imu_whose_every_message_is_rejected_is_reported_window_by_window() -> None:

@@ -17,6 +17,7 @@ from io_helpers import (
     pump_scene_file,
     read_raw,
     statuses_named,
+    unprovided_imu,
 )
 
 from mount_twin import load_scene_file
@@ -39,15 +40,20 @@ def _scene(tmp: Path, body: bool = True) -> Path:
     return pump_scene_file(tmp, body_sensor=sensor if body else None)
 
 
-def _bags(tmp: Path) -> None:
-    """in_both: deck and body IMU; deck: the deck's alone; body: the body IMU's alone."""
+def _streams() -> dict[str, list[tuple[int, bytes]]]:
+    """(stamp ns, raw) of 6 s of deck motion and of a body IMU 2 ms after each deck sample."""
     deck = ship_motion(rate_hz=RATE, total=6.0)
     ns = STAMP0 + np.round(deck.t * 1e9).astype(np.int64)
     body = deck.accel + np.random.default_rng(4).normal(0.0, 0.05, deck.accel.shape)
-    streams = {
+    return {
         "/deck/imu": imu_messages(ns, deck.accel, deck.gyro, "deck_imu"),
         BODY_TOPIC: imu_messages(ns + 2_000_000, body, deck.gyro, ""),
     }
+
+
+def _bags(tmp: Path) -> None:
+    """in_both: deck and body IMU; deck: the deck's alone; body: the body IMU's alone."""
+    streams = _streams()
     for name, topics in (("in_both", streams), ("deck", ["/deck/imu"]), ("body", [BODY_TOPIC])):
         with OutputBag(tmp / name, dict.fromkeys(topics, IMU)) as bag:
             bag.write(
@@ -82,6 +88,37 @@ def test_a_body_imu_in_the_bag_or_in_its_own_bag_is_compared_alike(
     for topic in BODY_OUT:
         assert len(got[0][topic]) == both["body_sensor"]["counts"]["compared"]
         assert got[0][topic] == got[1][topic]
+
+
+def test_body_readings_marked_not_provided_are_counted_in_the_summary(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """10 body messages whose acceleration and 20 whose rate the IMU marks not provided
+    (covariance[0] = -1, REP-145): the replay compares none of them and says so, in the
+    summary's line and its JSON counts, as it says the body's other rejected messages."""
+    streams = _streams()
+    stamps, raws = zip(*streams[BODY_TOPIC], strict=True)
+    body = [
+        *raws[:300],
+        *unprovided_imu(list(raws[300:310]), "linear_acceleration"),
+        *raws[310:700],
+        *unprovided_imu(list(raws[700:720]), "angular_velocity"),
+        *raws[720:],
+    ]
+    streams[BODY_TOPIC] = list(zip(stamps, body, strict=True))
+    with OutputBag(tmp_path / "marked", {"/deck/imu": IMU, BODY_TOPIC: IMU}) as bag:
+        bag.write(
+            sorted(((t, s, r) for t, m in streams.items() for s, r in m), key=lambda m: m[1])
+        )
+    code, summary = _replay(tmp_path, "marked")
+    assert code == 0
+    counts = summary["body_sensor"]["counts"]
+    assert (counts["rejected_no_acceleration"], counts["rejected_no_angular_velocity"]) == (10, 20)
+    assert counts["received"] == 1200 and counts["accepted"] == 1170
+    assert counts["compared"] + counts["unanswered"] == 1170
+    said = capsys.readouterr().out
+    assert "rejected_no_acceleration 10, rejected_no_angular_velocity 20" in said
+    assert len(read_raw(tmp_path / "out_marked")[BODY_OUT[1]]) == counts["compared"]
 
 
 def test_without_the_body_topic_the_summary_says_so(

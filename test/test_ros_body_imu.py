@@ -17,7 +17,14 @@ if os.environ.get("CI"):
 else:
     pytest.importorskip("rclpy")
 
-from io_helpers import AGEING_PUMP, ageing_bag, pump_scene_file, read_raw, statuses_named
+from io_helpers import (
+    AGEING_PUMP,
+    ageing_bag,
+    pump_scene_file,
+    read_raw,
+    statuses_named,
+    unprovided_imu,
+)
 from ros_harness import (
     LOSSLESS,
     NodeProcess,
@@ -48,6 +55,7 @@ from mount_twin.scene import load_scene_file
 RATE = 500.0
 STAMP0 = 1_700_000_000_000_000_000
 BODY_TOPIC = "/machine/imu"
+MARKED = {"linear_acceleration": slice(400, 406), "angular_velocity": slice(900, 910)}
 
 
 def _scene_file(tmp: Path) -> Path:
@@ -58,13 +66,16 @@ def _scene_file(tmp: Path) -> Path:
 def _inputs() -> list[tuple[str, int, bytes]]:
     """(topic, stamp ns, raw) of 3 s of deck motion and of a body IMU 1 ms after each deck
     sample (the deck's reading with noise: a machine the twin does not describe), in stamp
-    order."""
+    order; MARKED[field] body messages mark that reading not provided (REP-145)."""
     deck = ship_motion(rate_hz=RATE, total=3.0)
     ns = STAMP0 + np.round(deck.t * 1e9).astype(np.int64)
     rng = np.random.default_rng(4)
     body = deck.accel + rng.normal(0.0, 0.05, deck.accel.shape)
     deck_msgs = imu_messages(ns, deck.accel, deck.gyro, "deck_imu")
     body_msgs = imu_messages(ns + 1_000_000, body, deck.gyro, "")
+    for field, marked in MARKED.items():
+        stamps, raws = zip(*body_msgs[marked], strict=True)
+        body_msgs[marked] = list(zip(stamps, unprovided_imu(list(raws), field), strict=True))
     return [
         (topic, stamp, raw)
         for pair in zip(deck_msgs, body_msgs, strict=True)
@@ -79,7 +90,8 @@ def _statuses(raws: list[bytes]) -> list[tuple[int, int, str, dict[str, str]]]:
 def test_the_live_body_imu_comparison_equals_the_replays(tmp_path: Path) -> None:
     """Deck and body IMU published live at 500 Hz each: every prediction and residual message
     is byte-equal to the replay's of a bag holding both topics, and so are the windows'
-    statuses on /diagnostics."""
+    statuses on /diagnostics, which count the body messages marking a reading not provided
+    (compared in neither)."""
     scene_path = _scene_file(tmp_path)
     scene = load_scene_file(scene_path)
     inputs = _inputs()
@@ -89,7 +101,13 @@ def test_the_live_body_imu_comparison_equals_the_replays(tmp_path: Path) -> None
     want = {t: [raw for _, raw in msgs] for t, msgs in read_raw(tmp_path / "out").items()}
     body_topics = [resolve(t, NODE_NAME) for t in (BODY_PREDICTED_TOPIC, BODY_RESIDUAL_TOPIC)]
     assert all(len(want[t]) > 1000 for t in body_topics)
-    assert len(_statuses(want["/diagnostics"])) == 3  # windows of 1 s over 3 s
+    windows = _statuses(want["/diagnostics"])
+    assert len(windows) == 3  # windows of 1 s over 3 s
+    named = [
+        sum(int(w[3][f"body_rejected_no_{r}"]) for w in windows)
+        for r in ("acceleration", "angular_velocity")
+    ]
+    assert named == [6, 10]
 
     domain = fresh_domain()
     peer = Peer(domain)

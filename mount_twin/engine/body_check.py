@@ -34,7 +34,7 @@ import numpy as np
 
 from mount_twin.engine.agreement import MIN_SAMPLES, NAME, agreement, window_status
 from mount_twin.engine.batch import WARN, HealthStatus
-from mount_twin.engine.intake import rising
+from mount_twin.engine.intake import provided, rising
 from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.physics import pose_row
 from mount_twin.scene.description import BodySensor, Scene
@@ -45,7 +45,15 @@ come (once body samples flow, only from the last one compared on): a body stream
 the foundation's by more loses those samples (counted `late`)."""
 PENDING_LIMIT = 100_000
 """Most body samples held waiting for the twin (a twin that stopped): the oldest go first."""
-REJECTED = ("undecodable", "nonpositive_stamp", "nonfinite", "wrong_frame_id", "stamp_back")
+REJECTED = (
+    "undecodable",
+    "nonpositive_stamp",
+    "nonfinite",
+    "wrong_frame_id",
+    "no_acceleration",
+    "no_angular_velocity",
+    "stamp_back",
+)
 """Why a body message was not taken (`BodyCheck.screen`, and undecodable): reported as
 body_rejected_<reason> in every window, zero included."""
 PROBLEMS = ("before_twin", "late", "in_gap", "unanswered", "dropped_waiting", "lost_middleware")
@@ -508,19 +516,31 @@ class BodyCheck:
         self._refusals = _Refusals(sensor)
 
     def screen(
-        self, stamps_ns: np.ndarray, measured: np.ndarray, frame_ids: list[str]
+        self,
+        stamps_ns: np.ndarray,
+        measured: np.ndarray,
+        frame_ids: list[str],
+        unprovided: np.ndarray | None = None,
     ) -> np.ndarray:
-        """Why each body message (stamps ns, (k, 6) readings, header.frame_ids) cannot be
+        """Why each body message (stamps ns, (k, 6) readings, header.frame_ids, and which
+        readings (k, 2) its message marks not provided, `Decoded.unprovided`) cannot be
         compared ('' where it can; the caller counts the others with `reject`, at their place
-        in the stream): an unset or pre-1970 stamp, a value not finite, a frame_id other than
-        body_sensor.frame_id ("": any), a stamp not after every one accepted before it."""
+        in the stream): an unset or pre-1970 stamp, a value not finite (a reading marked not
+        provided is not read), a frame_id other than body_sensor.frame_id ("": any), its
+        acceleration or its rate marked not provided (REP-145: to be disregarded; the
+        comparison's unit is the whole sample, so one without either is not compared), a
+        stamp not after every one accepted before it."""
         expected = self.sensor.frame_id
+        accel, rate = provided(measured[:, :3], measured[:, 3:], unprovided)
+        marked = np.zeros((stamps_ns.shape[0], 2), bool) if unprovided is None else unprovided
         reasons = {
             "nonpositive_stamp": stamps_ns <= 0,
-            "nonfinite": ~np.isfinite(measured).all(axis=1),
+            "nonfinite": ~(np.isfinite(accel).all(axis=1) & np.isfinite(rate).all(axis=1)),
             "wrong_frame_id": np.array(
                 [bool(expected) and f != expected for f in frame_ids], bool
             ),
+            "no_acceleration": marked[:, 0],
+            "no_angular_velocity": marked[:, 1],
         }
         why = np.full(stamps_ns.shape[0], "", dtype=object)
         for reason, bad in reasons.items():

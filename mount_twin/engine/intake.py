@@ -159,6 +159,25 @@ def readable(accel: np.ndarray, gyro: np.ndarray) -> np.ndarray:
     return _all_axes(np.abs(accel) <= READING_LIMIT) & _all_axes(np.abs(gyro) <= READING_LIMIT)
 
 
+def provided(
+    accel: np.ndarray, gyro: np.ndarray, unprovided: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray]:
+    """The (n, 3) readings with those their message marks not provided (`unprovided`, (n, 2):
+    acceleration, angular velocity; REP-145: to be disregarded) zeroed: never read as values,
+    nor judged as not finite; the sample's screening says whether it can do without them."""
+    if unprovided is None:
+        return accel, gyro
+    return np.where(unprovided[:, :1], 0.0, accel), np.where(unprovided[:, 1:], 0.0, gyro)
+
+
+def disregarded(unprovided: np.ndarray | None, n: int, reads_rate: bool = True) -> np.ndarray:
+    """(n,) which samples lack a reading that is read: their acceleration marked not provided,
+    or (`reads_rate`) their angular velocity (`unprovided`, (n, 2), None: none is marked)."""
+    if unprovided is None:
+        return np.zeros(n, bool)
+    return unprovided[:, 0] | (unprovided[:, 1] & reads_rate)
+
+
 def rising(stamps: np.ndarray, keep: np.ndarray, last: int) -> np.ndarray:
     """Of the samples `keep` marks, those (bool mask) whose integer stamp is after `last` and
     after every kept stamp before it (one going back is not after the others either, so the
@@ -268,10 +287,7 @@ class Intake:
         Other readings are zeroed before the rotation, which would otherwise warn (numpy
         RuntimeWarning: inf·0, inf − inf, overflow); their samples are rejected anyway.
         """
-        accel, gyro = batch.accel, batch.gyro
-        if batch.unprovided is not None:  # readings to disregard (REP-145): `_verdict` judges
-            accel = np.where(batch.unprovided[:, :1], 0.0, accel)
-            gyro = np.where(batch.unprovided[:, 1:], 0.0, gyro)
+        accel, gyro = provided(batch.accel, batch.gyro, batch.unprovided)  # `_verdict` judges
         finite = np.isfinite(batch.stamps)
         # NaN compares false: one test for NaN, ±inf and the absurdly large.
         if not (np.abs(accel).max() <= READING_LIMIT and np.abs(gyro).max() <= READING_LIMIT):
