@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_helpers import CONFIG, ROOT, read_raw, scene_with
+from io_helpers import CONFIG, ROOT, read_raw, scene_with, unprovided_imu
 from physics_helpers import base_scene, mount
 from scipy.integrate import solve_ivp
 
@@ -178,6 +178,42 @@ def test_a_record_the_twin_rejects_samples_of_is_referenced_as_recorded_and_said
     out = capsys.readouterr().out
     assert "so the errors include the gyro conditioning's (gyro_filter linear_phase)" in out
     assert "gyro conditioning (linear_phase): " not in out
+
+
+def test_samples_marked_not_provided_are_left_out_as_the_twin_leaves_them_out(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """20 samples whose acceleration the IMU marks not provided (covariance[0] = -1, REP-145,
+    zeros in it): the twin skips them, leaving no hole, but the reference, derived from the
+    record, held their zeros as a free fall. Now both leave them out: the figures are those of
+    the record without them, and the command names the bag and how many."""
+    (msgs,) = read_raw(ROOT / "bags" / "ship_motion_1khz", ["/deck/imu"]).values()
+    msgs = msgs[:1500]
+    stamps, raws = zip(*msgs[700:720], strict=True)
+    marked = [
+        *msgs[:700],
+        *zip(stamps, unprovided_imu(list(raws), "linear_acceleration"), strict=True),
+        *msgs[720:],
+    ]
+    write_bag(tmp_path / "marked", "/deck/imu", IMU, iter(marked))
+    write_bag(tmp_path / "kept", "/deck/imu", IMU, iter([*msgs[:700], *msgs[720:]]))
+    scene = str(CONFIG / "pump_8_mounts.scene.yaml")
+    tables, said = [], []
+    for name in ("marked", "kept"):
+        csv_path = tmp_path / f"{name}.csv"
+        args = ["accuracy", scene, str(tmp_path / name), "--rtol", "1e-4", "--csv", str(csv_path)]
+        assert main(args) == 0
+        rows = csv.DictReader(csv_path.open(encoding="utf-8"))
+        timed = ("wall_s_per_sim_s", "estimate_cost")  # the wall clock's
+        tables.append([{k: v for k, v in r.items() if k not in timed} for r in rows])
+        said.append(capsys.readouterr().err)
+    assert tables[0] == tables[1]
+    err = said[0]
+    assert (
+        f"{tmp_path / 'marked'}: /deck/imu: 20 of 1500 samples mark a reading not provided "
+        "(covariance[0] = -1, REP-145: acceleration 20, angular velocity 0), the first its "
+        f"message 700 (stamp {stamps[0]} ns): disregarded" in err
+    ), err
 
 
 def test_a_record_whose_every_sample_the_twin_rejects_is_refused_saying_why(

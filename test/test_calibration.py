@@ -542,3 +542,40 @@ def test_every_figure_calibrate_prints_carries_its_unit() -> None:
         "yaw: -1.672° ± 0.62° (1σ)",
         "sensor_x: 12.3 mm ± 0.4 mm (1σ)",
     ]
+
+
+def test_a_record_marking_a_reading_the_fit_reads_not_provided_is_refused(
+    tmp_path: Path,
+) -> None:
+    """An Imu whose covariance[0] is -1 has no such reading (REP-145): the fit took its
+    placeholder (zeros, a fixed rate) as a reading. A record marking one the fit reads is now
+    refused, as one not finite is, naming the bag, the topic and how many; a rate the run
+    does not read (input.gyro_filter: ignore) may be marked."""
+    from io_helpers import unprovided_imu
+
+    from mount_twin.commands.calibrate import BODY_KEYS, _read_record
+    from mount_twin.io.bag import write_bag
+    from mount_twin.io.messages import IMU, imu_messages
+
+    sig = ship_motion(rate_hz=200.0, total=2.0)
+    stamps = 10**18 + np.round(sig.t * 1e9).astype(np.int64)
+    msgs = imu_messages(stamps, sig.accel, sig.gyro, "")
+    for field in ("angular_velocity", "linear_acceleration"):
+        ns, raws = zip(*msgs[50:54], strict=True)
+        marked = [*msgs[:50], *zip(ns, unprovided_imu(list(raws), field), strict=True), *msgs[54:]]
+        bag = tmp_path / field
+        write_bag(bag, "/machine/imu", IMU, iter(marked))
+        said = (
+            f"{bag}: /machine/imu: 4 of 400 samples mark a reading not provided (covariance[0] "
+            f"= -1, REP-145: acceleration {4 * (field == 'linear_acceleration')}, angular "
+            f"velocity {4 * (field == 'angular_velocity')}), the first its message 50"
+        )
+        with pytest.raises(ValueError, match=re.escape(said)):
+            _read_record(str(bag), "/machine/imu", IMU, None, BODY_KEYS)
+        if field == "angular_velocity":  # a run that reads no rate
+            record, _ = _read_record(str(bag), "/machine/imu", IMU, None, BODY_KEYS, False)
+            assert record.t.shape[0] == 400
+            np.testing.assert_array_equal(record.accel, sig.accel)
+        else:
+            with pytest.raises(ValueError, match=re.escape(said)):
+                _read_record(str(bag), "/machine/imu", IMU, None, BODY_KEYS, False)

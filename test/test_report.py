@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_helpers import CONFIG, ROOT, read_bag
+from io_helpers import CONFIG, ROOT, read_bag, read_raw, unprovided_imu
 
 from mount_twin.analysis.report import events_of
 from mount_twin.cli import main
@@ -257,6 +257,51 @@ def _pump_input(path: Path, n: int = 10_000, bad: slice = slice(0)) -> Path:
     messages = imu_messages(stamps, accel, np.zeros_like(accel), "deck_imu")
     write_bag(path, "/deck/imu", IMU, iter(messages))
     return path
+
+
+def test_an_input_marking_accelerations_not_provided_is_refused_naming_the_bag(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The replay disregards 3 samples whose acceleration the IMU marks not provided
+    (covariance[0] = -1, REP-145, zeros in it); the input's spectra took their zeros as
+    readings, a hole in the shock. Refused, naming the bag, the topic and how many."""
+    from mount_twin.io.bag import write_bag
+    from mount_twin.io.messages import IMU
+
+    pump = str(CONFIG / "pump_8_mounts.scene.yaml")
+    (msgs,) = read_raw(_pump_input(tmp_path / "plain", 2000), ["/deck/imu"]).values()
+    ns, raws = zip(*msgs[1500:1503], strict=True)
+    marked = [
+        *msgs[:1500],
+        *zip(ns, unprovided_imu(list(raws), "linear_acceleration"), strict=True),
+        *msgs[1503:],
+    ]
+    write_bag(tmp_path / "marked", "/deck/imu", IMU, iter(marked))
+    out = tmp_path / "out"
+    assert (
+        main(
+            ["replay", str(tmp_path / "marked"), "--scene", pump, "-o", str(out), "--no-progress"]
+        )
+        == 0
+    )
+    assert "no_acceleration 3" in capsys.readouterr().out
+    page = tmp_path / "r.html"
+    args = [
+        "report",
+        str(out),
+        "--scene",
+        pump,
+        "--input",
+        str(tmp_path / "marked"),
+        "-o",
+        str(page),
+    ]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert (
+        f"{tmp_path / 'marked'}: /deck/imu: 3 of 2000 samples mark a reading not provided" in err
+    )
+    assert not page.exists()
 
 
 def _spectra_table(page: str) -> str:

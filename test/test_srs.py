@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_helpers import ROOT, run_python
+from io_helpers import ROOT, run_python, unprovided_imu
 from pyyeti import srs as pyyeti_srs
 from rosbags.rosbag2 import Writer
 from scipy.integrate import solve_ivp
@@ -23,6 +23,7 @@ from mount_twin.analysis.srs import damping_ratio, gravity_offset, octave_freque
 from mount_twin.cli import main
 from mount_twin.commands.common import write_signal
 from mount_twin.commands.srs import EXIT_OUT_OF_TOLERANCE, TOLERANCE_DB
+from mount_twin.io.bag import write_bag
 from mount_twin.io.messages import IMU, TYPESTORE, imu_messages
 from mount_twin.io.signals import Signal
 
@@ -284,6 +285,43 @@ def test_a_head_as_long_as_the_record_is_refused(
     assert main(["srs", str(bag), "--head", "100", "--freqs", "10"]) == 2
     assert "head_s (srs --head) 100 s: the whole record (0.9995 s)" in capsys.readouterr().err
     assert main(["srs", str(bag), "--head", "0.5", "--freqs", "10"]) == 0
+
+
+def test_a_record_marking_readings_not_provided_is_refused_or_read_by_what_it_lacks(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An Imu whose covariance[0] is -1 has no such reading (REP-145). 5 samples of a shock
+    with their acceleration marked (zeros in it) made a spectrum of a hole: refused, naming the
+    bag and how many; marked in their rate alone, which srs does not read, the spectrum is the
+    unmarked record's."""
+    t = np.arange(2000) / 2000.0
+    accel = np.tile([0.0, 0.0, G], (2000, 1))
+    accel[100:120, 0] = 50.0 * np.sin(np.pi * np.arange(20) / 20)
+    stamps = 10**18 + np.round(t * 1e9).astype(np.int64)
+    msgs = imu_messages(stamps, accel, np.zeros_like(accel), "imu")
+    tables = {}
+    for name, field in (
+        ("plain", ""),
+        ("no_rate", "angular_velocity"),
+        ("no_accel", "linear_acceleration"),
+    ):
+        ns, raws = zip(*msgs[105:110], strict=True)
+        marked = (
+            list(zip(ns, unprovided_imu(list(raws), field), strict=True))
+            if field
+            else msgs[105:110]
+        )
+        write_bag(tmp_path / name, "/imu", IMU, iter([*msgs[:105], *marked, *msgs[110:]]))
+        out = tmp_path / f"{name}.csv"
+        code = main(["srs", str(tmp_path / name), "--freqs", "20", "100", "--csv", str(out)])
+        tables[name] = (code, out.read_text(encoding="utf-8") if out.exists() else "")
+    assert tables["no_rate"] == tables["plain"] and tables["plain"][0] == 0
+    assert tables["no_accel"] == (2, "")
+    assert (
+        f"{tmp_path / 'no_accel'}: /imu: 5 of 2000 samples mark a reading not provided "
+        "(covariance[0] = -1, REP-145: acceleration 5, angular velocity 0), the first its "
+        f"message 105 (stamp {stamps[105]} ns): a spectrum takes" in capsys.readouterr().err
+    )
 
 
 def test_gravity_left_in_is_a_step_at_the_start(tmp_path: Path) -> None:

@@ -48,7 +48,8 @@ def run(args: argparse.Namespace) -> int:
     )
     from mount_twin.commands.common import check_targets, load_scene
     from mount_twin.errors import MountTwinError
-    from mount_twin.io.input_samples import read_samples
+    from mount_twin.io.input_samples import provided_input
+    from mount_twin.io.messages import TimeBase
     from mount_twin.scene.description import RTOL_RANGE
 
     lo, hi = RTOL_RANGE
@@ -62,7 +63,10 @@ def run(args: argparse.Namespace) -> int:
 
         require("matplotlib", "--plot")
     scene = load_scene(args.scene)
-    samples = read_samples(args.bag, scene.input)
+    decoded, note = provided_input(args.bag, scene.input)  # the reference holds each value
+    if note:
+        print(note, file=sys.stderr)
+    samples = decoded.batch(TimeBase.at(int(decoded.stamps_ns[0])))
     duration = float(samples.stamps[-1] - samples.stamps[0])
     print(
         f"{scene.name}: {len(samples)} samples over {duration:.3f} s from {args.bag}",

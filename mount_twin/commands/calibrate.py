@@ -64,12 +64,18 @@ def _is_csv(path: str) -> bool:
 
 
 def _read_record(
-    path: str, topic: str, msg_type: str, base: TimeBase | None, keys: tuple[str, str]
+    path: str,
+    topic: str,
+    msg_type: str,
+    base: TimeBase | None,
+    keys: tuple[str, str],
+    reads_rate: bool = True,
 ) -> tuple[Signal, TimeBase | None]:
     """A record: an Xsens DOT CSV, a recorder CSV (their stamps as written), or a bag's `topic`
     (stamps in seconds from `base`, else from its first stamp's whole second: the base
     returned, for the other record of a pair to share). A bag's sample not finite is refused,
-    as a CSV's cell is: named, with how many."""
+    as a CSV's cell is: named, with how many; so is one whose message marks a reading the fit
+    reads (its rate if `reads_rate`) not provided (REP-145)."""
     from mount_twin.io.messages import TimeBase
     from mount_twin.io.signals import Signal
     from mount_twin.io.xsens_csv import read_csv_record
@@ -78,10 +84,12 @@ def _read_record(
         return read_csv_record(path), base
     from mount_twin.commands.common import refuse_not_finite
     from mount_twin.engine.intake import readable
-    from mount_twin.io.input_samples import read_input
+    from mount_twin.io.input_samples import read_input, refuse_unprovided
     from mount_twin.scene.description import InputSpec
 
     decoded = read_input(path, InputSpec(msg_type=msg_type, topic=topic), keys)
+    why = "a fit needs every sample it compares"
+    refuse_unprovided(decoded, f"{path}: {topic}:", reads_rate, why)
     refuse_not_finite(
         readable(decoded.accel, decoded.gyro),
         "samples",
@@ -108,8 +116,9 @@ def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
         msg = f"{args.scene}: no body_sensor: where is the body's IMU and how is it turned?"
         raise ValueError(msg)
     spec = scene.input
+    reads_rate = spec.gyro_filter != "ignore"  # the twin's run reads the deck's rate
     foundation, base = _read_record(
-        args.foundation, spec.topic, spec.msg_type, None, FOUNDATION_KEYS
+        args.foundation, spec.topic, spec.msg_type, None, FOUNDATION_KEYS, reads_rate
     )
     body, _ = _read_record(args.body, scene.body_sensor.topic, IMU, base, BODY_KEYS)
     named = (f"--body {args.body}", f"--foundation {args.foundation}'s")

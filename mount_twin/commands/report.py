@@ -80,11 +80,13 @@ def run(args: argparse.Namespace) -> int:
         if scene is None:
             msg = "--input needs --scene (its input topic, sensor frame and gravity convention)"
             raise ValueError(msg)
-        from mount_twin.io.input_samples import read_input
+        from mount_twin.io.input_samples import read_input, refuse_unprovided
         from mount_twin.physics.rotations import rpy_matrix
 
         keys = ("the topic the run read: is this its input bag?", "input.msg_type")
         decoded = read_input(args.input, scene.input, keys)
+        why = "the input's spectra take every sample's acceleration as a reading, evenly spaced"
+        refuse_unprovided(decoded, f"{args.input}: {scene.input.topic}:", False, why)
         decoded, note = finite_input(args.input, scene.input.topic, decoded)
         if note:
             print(note)

@@ -445,7 +445,7 @@ def _record(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, str, str]
         sig = read_csv_record(path)
         return sig.t, sig.accel, path.name, "m/s²"
     from mount_twin.io.bag_info import bag_info
-    from mount_twin.io.input_samples import read_input
+    from mount_twin.io.input_samples import read_input, refuse_unprovided
     from mount_twin.io.messages import ACCEL, IMU
     from mount_twin.scene.description import InputSpec
 
@@ -459,6 +459,8 @@ def _record(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, str, str]
         raise ValueError(msg)
     (topic,) = chosen
     decoded = read_input(path, InputSpec(msg_type=topic.msgtype, topic=topic.name))
+    why = "a spectrum takes every sample's acceleration as a reading, evenly spaced"
+    refuse_unprovided(decoded, f"{path}: {topic.name}:", False, why)
     t = (decoded.stamps_ns - decoded.stamps_ns[0]) * 1e-9
     return t, decoded.accel, f"{path.name} {topic.name}", "m/s²"
 
@@ -492,12 +494,17 @@ def _response(args: argparse.Namespace, path: Path) -> tuple[np.ndarray, np.ndar
 
 
 def _replayed(scene: Scene, path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """(stamps s, wrenches) of the scene's twin run on the input topic of the bag at `path`."""
+    """(stamps s, wrenches) of the scene's twin run on the input topic of the bag at `path`
+    (the samples it disregards for a reading marked not provided left out, said on stderr)."""
+    import sys
+
     from mount_twin.analysis.response import followed
-    from mount_twin.io.input_samples import read_input
+    from mount_twin.io.input_samples import provided_input
     from mount_twin.io.messages import TimeBase
 
-    decoded = read_input(path, scene.input)
+    decoded, note = provided_input(path, scene.input)
+    if note:
+        print(note, file=sys.stderr)
     _, out = followed(scene, decoded.batch(TimeBase.at(int(decoded.stamps_ns[0]))), str(path))
     return out.stamps, out.wrenches
 
