@@ -158,17 +158,9 @@ def test_the_node_tracks_mounts_that_age_as_the_replay_does(tmp_path: Path) -> N
     domain = fresh_domain()
     peer = Peer(domain)
     peer.record({"/diagnostics": DIAGNOSTICS})
-    reliable_body = ["-p", f"qos_overrides.{BODY_TOPIC}.subscription.reliability:=reliable"]
-    args = ["-p", f"scene_file:={scene_path}", "-p", "stall_period_s:=3600.0"]
-    node = NodeProcess(domain, [*args, *LOSSLESS, *reliable_body])
-    pubs = {t: peer.publisher(IMU, t) for t in ("/deck/imu", BODY_TOPIC)}
+    node = _ageing_node(domain, scene_path)
     try:
-        assert wait_for_node(pubs["/deck/imu"], node), node.failed()
-        assert wait_for(lambda: pubs[BODY_TOPIC].get_subscription_count() > 0, 30.0)
-        assert wait_for(lambda: peer.connected("/diagnostics"), 30.0)
-        for topic, _, raw in inputs:
-            pubs[topic].publish(raw)
-            peer.take()
+        _send_when_connected(node, peer, inputs)
 
         def got() -> list[tuple[int, int, str, dict[str, str]]]:
             return statuses_named(peer.got["/diagnostics"], AGEING)
@@ -182,6 +174,26 @@ def test_the_node_tracks_mounts_that_age_as_the_replay_does(tmp_path: Path) -> N
     assert code == 0, node.stderr
     assert "Traceback" not in node.stderr, node.stderr
     assert got() == want
+
+
+def _ageing_node(domain: int, scene_path: Path, group: bool = False) -> NodeProcess:
+    """The node on `scene_path` in DDS domain `domain`, lossless on both IMU topics, its stall
+    reports held off (`group`: in a process group of its own, `NodeProcess`)."""
+    reliable_body = ["-p", f"qos_overrides.{BODY_TOPIC}.subscription.reliability:=reliable"]
+    args = ["-p", f"scene_file:={scene_path}", "-p", "stall_period_s:=3600.0"]
+    return NodeProcess(domain, [*args, *LOSSLESS, *reliable_body], group=group)
+
+
+def _send_when_connected(node: NodeProcess, peer: Peer, inputs: list) -> None:
+    """Publish `inputs` ((topic, stamp, raw) in order) once the node hears both topics and the
+    peer hears its /diagnostics."""
+    pubs = {t: peer.publisher(IMU, t) for t in ("/deck/imu", BODY_TOPIC)}
+    assert wait_for_node(pubs["/deck/imu"], node), node.failed()
+    assert wait_for(lambda: pubs[BODY_TOPIC].get_subscription_count() > 0, 30.0)
+    assert wait_for(lambda: peer.connected("/diagnostics"), 30.0)
+    for topic, _, raw in inputs:
+        pubs[topic].publish(raw)
+        peer.take()
 
 
 def _children(pid: int) -> list[int]:
@@ -212,17 +224,9 @@ def test_a_stop_sent_to_the_process_group_finishes_the_ageing_fit_in_flight(
     domain = fresh_domain()
     peer = Peer(domain)
     peer.record({"/diagnostics": DIAGNOSTICS})
-    reliable_body = ["-p", f"qos_overrides.{BODY_TOPIC}.subscription.reliability:=reliable"]
-    args = ["-p", f"scene_file:={scene_path}", "-p", "stall_period_s:=3600.0"]
-    node = NodeProcess(domain, [*args, *LOSSLESS, *reliable_body], group=True)
-    pubs = {t: peer.publisher(IMU, t) for t in ("/deck/imu", BODY_TOPIC)}
+    node = _ageing_node(domain, scene_path, group=True)
     try:
-        assert wait_for_node(pubs["/deck/imu"], node), node.failed()
-        assert wait_for(lambda: pubs[BODY_TOPIC].get_subscription_count() > 0, 30.0)
-        assert wait_for(lambda: peer.connected("/diagnostics"), 30.0)
-        for topic, _, raw in inputs:
-            pubs[topic].publish(raw)
-            peer.take()
+        _send_when_connected(node, peer, inputs)
         # the window 2-22 s is due: its fit starts in a worker (beside the resource tracker)
         assert wait_for(lambda: len(_children(node.proc.pid)) >= 2, 60.0), node.failed()
         assert not statuses_named(peer.got["/diagnostics"], AGEING)  # still fitting
