@@ -409,6 +409,35 @@ def test_several_wrong_frames_are_all_named() -> None:
     assert st.values["last_wrong_frame_id"] == "a"
 
 
+def _report_size(report: HealthReport) -> int:
+    """Characters of a report's texts: names, messages, keys and values."""
+    return sum(
+        len(s.name) + len(s.message) + sum(len(k) + len(v) for k, v in s.values.items())
+        for s in report.statuses
+    )
+
+
+def test_a_huge_wrong_frame_id_is_shortened_in_every_report() -> None:
+    """A hostile 100 000-character frame_id is named shortened, with its length, in the period
+    that rejected it and in the value every later report carries: it had been repeated in full,
+    450 kB of diagnostics per report."""
+    huge = "x" * 100_000
+    b = batch(ramp(1500))
+    b.frame_ids[10] = huge
+    reports = push_all(eng := engine(), [b])
+    reports += push_all(eng, [batch(ramp(2000, t0=1.5))])  # two clean periods after it
+    assert len(reports) == 3
+    for report in reports:
+        # eight mounts and three other statuses, each at most a few hundred characters
+        assert _report_size(report) < 8000
+    st = status(reports[0])
+    assert "expected frame_id 'deck_imu', got 'xxx" in st.message
+    assert "(shortened, 100000 characters)" in st.message
+    for report in reports:
+        value = status(report).values["last_wrong_frame_id"]
+        assert value.startswith("'xxx") and value.endswith("(shortened, 100000 characters)")
+
+
 # --------------------------------------------------------------------------- stalled input
 
 

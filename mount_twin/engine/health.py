@@ -19,6 +19,7 @@ from mount_twin.engine.estimate import (
 from mount_twin.engine.gyro_filter import Design
 from mount_twin.physics import pose_row
 from mount_twin.scene.description import Scene
+from mount_twin.scene.reader import kept_text, shown_text
 
 PREFIX = "mount_twin"
 INTEGRATION = f"{PREFIX}: integration"
@@ -773,7 +774,7 @@ class HealthWindow:
             },
         }
         if counts["rejected_wrong_frame"] and self.last_wrong_frame_id is not None:
-            values["last_wrong_frame_id"] = self.last_wrong_frame_id
+            values["last_wrong_frame_id"] = kept_text(self.last_wrong_frame_id)
         if stalled_s is not None and stalled_s != ENDED:
             values["since_last_report_s"] = f"{stalled_s:.6g}"
         if self.starts:
@@ -787,10 +788,11 @@ class HealthWindow:
         if reason != "wrong_frame" or not self.wrong_frames:
             return f"{reason} {n}"
         seen = list(self.wrong_frames)
-        got = ", ".join(repr(f) for f in seen[:NAMED_FRAMES])
+        got = ", ".join(shown_text(f) for f in seen[:NAMED_FRAMES])  # a hostile one shortened
         if len(seen) > NAMED_FRAMES:
             got += f" and {len(seen) - NAMED_FRAMES} more"
-        return f"{reason} {n}: expected frame_id {self.scene.input.frame_id!r}, got {got}"
+        expected = shown_text(self.scene.input.frame_id)
+        return f"{reason} {n}: expected frame_id {expected}, got {got}"
 
 
 def estimate_warning(run: ErrorEstimate) -> str | None:

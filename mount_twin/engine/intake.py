@@ -125,9 +125,10 @@ def nothing_accepted(
         return ""
     detail = ""
     if wrong_frame_id is not None:
-        from mount_twin.scene.reader import shown  # a 1 MB frame id, shortened
+        from mount_twin.scene.reader import shown_text  # a 1 MB frame id, shortened
 
-        detail = f"; the bag's header.frame_id is {shown(wrong_frame_id)}: see {frame_id_setting}"
+        said = shown_text(wrong_frame_id)
+        detail = f"; the bag's header.frame_id is {said}: see {frame_id_setting}"
     why = (
         f"{counts.get('received', 0)} received, rejected: "
         f"{counted_text(counts, 'rejected_')}{detail}"

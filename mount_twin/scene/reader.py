@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import re
 import reprlib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -46,6 +47,31 @@ def shown(value: object) -> str:
         return _SHOWN.repr(value)
     except ValueError:  # an int beyond sys.get_int_max_str_digits()
         return f"<{type(value).__name__} too long to show>"
+
+
+_SHORTENED = re.compile(r"'.*' \(shortened, [0-9]+ characters\)", re.DOTALL)
+"""What `shown_text` makes of a text it shortened."""
+
+
+def shown_text(text: str) -> str:
+    """`shown(text)`, and where that shortened it, how long it was: "'xx...xx' (shortened,
+    100000 characters)" (a frame id received off the wire may be a megabyte, and a message
+    repeating it whole is as large). A text that is already that, as read back from a value
+    `kept_text` stored, is shown as it is: shortening it again would misstate its length."""
+    if len(text) <= 2 * _SHOWN.maxstring and _SHORTENED.fullmatch(text):
+        return text
+    said = shown(text)
+    if said == repr(text[: _SHOWN.maxstring + 1]):  # not shortened: it is the text's repr
+        return said
+    return f"{said} (shortened, {len(text)} characters)"
+
+
+def kept_text(text: str) -> str:
+    """`text` as a value to store or publish: itself where `shown_text` shows it whole, else
+    `shown_text(text)`, shortened with its length (a hostile frame id, kept whole, is carried
+    into every later report)."""
+    said = shown_text(text)
+    return text if said == repr(text) else said
 
 
 class Reader:
