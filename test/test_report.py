@@ -618,3 +618,34 @@ def test_a_run_replayed_with_frame_id_is_reported_with_the_frame_it_expected(
     assert "<td>input</td><td>/deck/imu (sensor_msgs/msg/Imu), frame " + named + "</td>" in text
     said = "(the run's, from `replay --frame-id`; the file's: deck_imu)"
     assert f"<td>input.frame_id</td><td>{named} {said}</td>" in text
+
+
+@pytest.fixture(scope="module")
+def pump_ship_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The pump's output bag of the bundled ship motion, replayed by the command line."""
+    out = tmp_path_factory.mktemp("pump_ship") / "out"
+    bag = ROOT / "bags" / "ship_motion_1khz"
+    assert main(["replay", str(bag), "--scene", str(PUMP), "-o", str(out), "--no-progress"]) == 0
+    return out
+
+
+def test_without_its_scene_the_report_names_what_the_bag_records_of_the_input_and_solver(
+    pump_ship_run: Path, tmp_path: Path
+) -> None:
+    """The output bag's input status records the topic the run read and the frame it expected,
+    its integration status the method that ran and the tolerances: the page without --scene
+    left out the input and solver rows altogether. It names them now, and says the rest of the
+    settings need --scene (the scene file, read here, is the truth it must agree with)."""
+    import yaml
+
+    scene = yaml.safe_load(PUMP.read_text(encoding="utf-8"))
+    page = tmp_path / "page.html"
+    assert main(["report", str(pump_ship_run), "-o", str(page)]) == 0
+    rows = dict(_table_rows(html.unescape(page.read_text(encoding="utf-8")), "Verdict"))
+    topic, frame = scene["input"]["topic"], scene["input"]["frame_id"]
+    assert (topic, frame) == ("/deck/imu", "deck_imu")
+    assert rows["input"].startswith(f"{topic}, frame {frame}")
+    assert "--scene" in rows["input"]
+    integ = scene["integration"]
+    assert f"rtol {integ['rtol']:g}, atol {integ['atol']:g}" in rows["solver"]
+    assert "--scene" in rows["solver"]

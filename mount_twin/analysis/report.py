@@ -157,10 +157,13 @@ def _provenance_section(
     input_path: str | Path | None,
     scene: Scene | None,
     input_note: str = "",
+    recorded: dict[str, str] | None = None,
 ) -> list[str]:
     """The verdict, what produced the page from what (with `input_note` on the input bag:
-    what of it was left out), the solver's settings and estimated error (`integration`: the
-    last integration status' values), and the scene as loaded."""
+    what of it was left out), the input and the solver's settings and estimated error
+    (`integration`: the last integration status' values), and the scene as loaded; without
+    the scene, what of the input and the solver the bag records (`recorded`: the last input
+    status' values; `_recorded_settings`)."""
     partial = partial_marker(output_bag)
     rows = [
         ["verdict (worst over the run)", verdict.text],
@@ -172,7 +175,15 @@ def _provenance_section(
         rows.append(["input bag", f"{input_path} ({fingerprint(Path(input_path))})"])
         if input_note:
             rows.append(["input samples left out", input_note])
-    if scene is not None:
+    # the status names the scene's method until one runs (`auto`: until it chooses)
+    ran = (
+        f"no method ran: {why_none(verdict.nothing)}"
+        if verdict.nothing
+        else f"ran: {integration.get('method', '?')}"
+    )
+    if scene is None:
+        rows += _recorded_settings(recorded, integration, ran)
+    else:
         spec, integ = scene.input, scene.integration
         # the gyro filter's latency is set by its design, at the first accepted samples' rate
         latency_s = integration.get("latency_s", "?")
@@ -182,12 +193,6 @@ def _provenance_section(
             else f"no latency figure: {NOT_DESIGNED}"
             if latency_s == "n/a"
             else f"latency {latency_s} s"
-        )
-        # the status names the scene's method until one runs (`auto`: until it chooses)
-        ran = (
-            f"no method ran: {why_none(verdict.nothing)}"
-            if verdict.nothing
-            else f"ran: {integration.get('method', '?')}"
         )
         rows += [
             ["scene", f"{scene.name} from {scene.source}"],
@@ -345,6 +350,41 @@ def _modes_section(scene: Scene) -> list[str]:
     return ["<h2>Modes (about the static equilibrium)</h2>", html_table(head, rows)]
 
 
+def _recorded_settings(
+    recorded: dict[str, str] | None, integration: dict[str, str], ran: str
+) -> list[list[str]]:
+    """The input and solver rows of a page without the scene: what the output bag records,
+    the topic the run read and the frame it expected (`recorded`: the last input status'
+    values), the method and tolerances (`integration`: the last integration status' values;
+    `ran`: what ran), and that the rest (message type, input conditioning, the method set)
+    needs --scene. A row the bag records nothing of is left out, not guessed."""
+    rows = []
+    if recorded and "topic" in recorded:
+        frame = recorded.get("frame_id")
+        said = "frame not recorded" if frame is None else f"frame {frame or 'any'}"
+        rows.append(
+            [
+                "input",
+                f"{recorded['topic']}, {said} (as the run's input status records them; "
+                "message type and input conditioning: --scene)",
+            ]
+        )
+    if "rtol" in integration:
+        estimate = ", error estimate on" if "est_force_error_rel" in integration else ""
+        method = integration.get("method", "?")
+        rows.append(
+            [
+                "solver",
+                # until one runs the status names the method set (`ran`: no method ran)
+                f"{ran if ran.startswith('ran') else f'{method} ({ran})'}, "
+                f"rtol {integration['rtol']}, "
+                f"atol {integration.get('atol', '?')}{estimate} (as the run's integration "
+                "status records them; the method the scene set: --scene)",
+            ]
+        )
+    return rows
+
+
 def write_report(
     output_bag: str | Path,
     html_path: str | Path,
@@ -387,7 +427,13 @@ def write_report(
     nothing = _followed_nothing(diagnostics, scene)
     verdict, integration = _verdict(diagnostics, nothing)
     sections += _provenance_section(
-        verdict, integration, output_bag, input_path, scene, input_note
+        verdict,
+        integration,
+        output_bag,
+        input_path,
+        scene,
+        input_note,
+        input_values(diagnostics),
     )
     if "pose" in tables and "angles" in tables:
         sections += [
