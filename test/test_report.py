@@ -649,3 +649,43 @@ def test_without_its_scene_the_report_names_what_the_bag_records_of_the_input_an
     integ = scene["integration"]
     assert f"rtol {integ['rtol']:g}, atol {integ['atol']:g}" in rows["solver"]
     assert "--scene" in rows["solver"]
+
+
+def test_a_run_shorter_than_a_diagnostics_period_draws_one_point_per_mount(
+    tmp_path: Path,
+) -> None:
+    """A 0.05 s record under diagnostics_period_s 0.1 has one period, reported once at the
+    input's end: its utilisation figure drew each mount's one peak as a flat line across the
+    whole run, as if measured all along. It draws one point per reported period, at the
+    report's stamp."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    from mount_twin.analysis.report import _draw_utilisation, utilisation_of
+
+    bag, out = tmp_path / "in", tmp_path / "out"
+    generate = ["generate", "ship-motion", "-o", str(bag), "--rate", "1000"]
+    assert main([*generate, "--duration", "0.05"]) == 0
+    scene = load_scene_file(PUMP)
+    outputs = dataclasses.replace(scene.outputs, diagnostics_period_s=0.1)
+    replay(dataclasses.replace(scene, outputs=outputs), bag, out, progress=False)
+    diagnostics = next(t for t in read_output_bag(out) if t.name == "diagnostics")
+    utilisation = utilisation_of(diagnostics)
+    assert sorted(utilisation) == sorted(m.name for m in scene.mounts)
+    fig = Figure()
+    _draw_utilisation(fig, utilisation, {})
+    (ax,) = fig.axes
+    drawn = {
+        str(line.get_label()): (line.get_xdata(), line.get_ydata())
+        for line in ax.get_lines()
+        if line.get_label() in utilisation
+    }
+    assert sorted(drawn) == sorted(utilisation)
+    for name, (x, y) in drawn.items():
+        # 0.05 s of input is less than one period: one report, at the last sample (0.049 s
+        # after the first at 1 kHz), holding the period's peak
+        assert len(x) == len(y) == 1, name
+        assert float(x[0]) == pytest.approx(0.049, abs=1e-9)
+        assert float(y[0]) == float(utilisation[name][1][0])

@@ -579,18 +579,23 @@ def _draw_utilisation(
     fig: Any, utilisation: dict[str, tuple[np.ndarray, np.ndarray]], kinds: dict[str, str]
 ) -> None:
     """Each rated mount's peak utilisation per diagnostics period (-) against time from the
-    first output (s), and the rating (1)."""
+    first output (s), and the rating (1): one marker per report, at its stamp, holding the peak
+    of the period that ends there, the step into it spanning that period from the report
+    before. The first period's peak was held from the run's start, and a run shorter than one
+    period drew flat lines across the whole run, as if measured all along."""
     ax = fig.subplots()
     for name, (t, u) in utilisation.items():
-        # Each report holds the peak of the period that ends at it.
-        ax.step(
-            np.r_[0.0, t],
-            np.r_[u[0], u],
-            where="pre",
+        ax.plot(
+            t,
+            u,
+            drawstyle="steps-pre",
+            marker="o",
+            markersize=3,
             label=f"{name} ({kinds[name]})" if name in kinds else name,  # kinds: with a scene
         )
     ax.axhline(1.0, color="red", linestyle="--", label="rated (1)")
-    ax.set_ylabel("peak utilisation per diagnostics period [-]")
+    ax.set_xlim(left=0.0)  # the run from its first output, however few reports it has
+    ax.set_ylabel("peak utilisation of the\ndiagnostics period ending at • [-]")
     ax.set_xlabel("time from the first output [s]")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, ncol=3)
