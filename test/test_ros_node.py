@@ -707,6 +707,49 @@ def test_sim_time_without_clock_is_reported_and_with_clock_is_followed() -> None
     assert ros[-1][0] == OK, ros  # the clock came: the problem clears
 
 
+def test_sim_time_switched_on_at_run_time_counts_the_missing_clock_from_the_switch() -> None:
+    """`ros2 param set /mount_twin use_sim_time true` on a node running for seconds: the
+    "no /clock for N s" report counted N from the node's start (and came at once, its grace
+    spent long before), not from the switch. It comes after the grace of two watch periods
+    (2 s) from the switch, N at most the seconds since it."""
+    import re
+
+    from rclpy.parameter import Parameter
+    from rclpy.parameter_client import AsyncParameterClient
+
+    domain = fresh_domain()
+    peer = Peer(domain)
+    peer.record({"/diagnostics": DIAGNOSTICS})
+    node = NodeProcess(domain, ["--params-file", str(PARAMS_FILE)])
+    said: list[tuple[float, str]] = []  # (test's monotonic s at receipt, the ros status' text)
+
+    def clock_said() -> bool:
+        for status in _statuses(peer)[len(said) :]:
+            said.append((time.monotonic(), status.get("mount_twin: ros", (0, ""))[1]))
+        return any("no /clock has come" in text for _, text in said)
+
+    try:
+        client = AsyncParameterClient(peer.node, "/mount_twin")
+        assert client.wait_for_services(60.0), node.failed()
+        peer.take_until(lambda: False, 6.0)  # the node runs 6 s on wall time
+        assert not clock_said()
+        asked = time.monotonic()  # the node switches after this
+        result = peer.call(client.set_parameters([Parameter("use_sim_time", value=True)]))
+        assert all(r.successful for r in result.results), result
+        assert peer.take_until(clock_said, 20.0), "no report of the missing /clock"
+    finally:
+        code = node.stop()
+        peer.close()
+    assert code == 0, node.stderr
+    at, text = next((t, x) for t, x in said if "no /clock has come" in x)
+    found = re.search(r"no /clock has come for (\d+) s", text)
+    assert found, text
+    waited = int(found.group(1))
+    # the grace is 2 s (two watch periods) after the switch, which came after it was asked
+    # for; the report before its receipt (its seconds rounded: ≤ 0.5 s more)
+    assert 2 <= waited <= at - asked + 0.5, (waited, at - asked, text)
+
+
 def test_tf_static_is_latched_for_a_late_subscriber_and_tf_carries_the_pose() -> None:
     """/tf_static reaches a subscriber that joins seconds after the node published it (reliable,
     transient local: tf2_ros' static listener), once, with one transform per mount: byte-equal

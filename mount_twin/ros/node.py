@@ -64,6 +64,8 @@ from mount_twin.ros.rclpy_private import take_waiting
 from mount_twin.stream import TwinStream
 
 if TYPE_CHECKING:
+    from rclpy.parameter import Parameter
+
     from mount_twin.ros.ageing_fits import AgeingFits
 
 T = TypeVar("T")
@@ -126,6 +128,10 @@ class MountTwinNode(Node):
         """Problems seen by events (kept); `_watch` adds the ones it finds each time."""
         self._reported: dict[str, str] = {}
         self._started = time.monotonic()
+        self._sim_since: float | None = self._started if self._sim_time() else None
+        """Steady time (s) since which use_sim_time is true (None: false): a /clock missing is
+        counted from then, whether set at the start or later (`ros2 param set`)."""
+        self.add_post_set_parameters_callback(self._on_parameters_set)
         self.create_timer(WATCH_PERIOD_S, self._watch, clock=steady)
         self._fits: AgeingFits | None = None
         if self.scene.ageing is not None:  # the fit's modules, only for a scene that tracks
@@ -315,6 +321,14 @@ class MountTwinNode(Node):
             f"{self.scene.input.msg_type}: it never connects"
         )
 
+    def _sim_time(self) -> bool:
+        return bool(self.get_parameter("use_sim_time").value)
+
+    def _on_parameters_set(self, parameters: list[Parameter]) -> None:
+        """use_sim_time switched on (or off) at run time: a missing /clock counts from now."""
+        if any(p.name == "use_sim_time" for p in parameters):
+            self._sim_since = time.monotonic() if self._sim_time() else None
+
     def _watch(self) -> None:
         """Problems only a live node sees, published as `mount_twin: ros` while they last."""
         found = dict(self._problems)
@@ -326,9 +340,9 @@ class MountTwinNode(Node):
                     f"{info.topic_type} on {self._sub.topic_name}, expected {expected}: it never "
                     "connects"
                 )
-        waited = time.monotonic() - self._started
-        sim = self.get_parameter("use_sim_time").value
-        if sim and self.get_clock().now().nanoseconds == 0 and waited > 2.0 * WATCH_PERIOD_S:
+        sim_since = self._sim_since
+        waited = math.nan if sim_since is None else time.monotonic() - sim_since
+        if self.get_clock().now().nanoseconds == 0 and waited > 2.0 * WATCH_PERIOD_S:
             found["clock"] = (
                 f"use_sim_time is true and no /clock has come for {waited:.0f} s: diagnostics "
                 "wait for it (play bags with `ros2 bag play --clock`)"
