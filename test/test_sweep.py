@@ -526,3 +526,17 @@ def test_a_rerun_after_the_base_scene_changed_runs_every_case_of_the_new_design(
                 and r["mounts[*].stiffness (scale)"] == row["mounts[*].stiffness (scale)"]
             )
             assert row[key] != pytest.approx(old, rel=1e-3), n  # twice the mass: not the old
+
+
+def test_two_local_clusters_at_once_start_without_a_warning() -> None:
+    """Each local cluster took the dashboard's port 8787 (`dashboard_address=None` does not turn
+    it off), and a second one, a sweep beside another, warned "Port 8787 is already in use.
+    Perhaps you already have a cluster running?"."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with dask_client(workers=1) as one, dask_client(workers=1) as two:
+            assert one.submit(abs, -2).result() == 2 and two.submit(abs, -3).result() == 3
+    said = [str(w.message) for w in caught if "already in use" in str(w.message)]
+    assert not said, said

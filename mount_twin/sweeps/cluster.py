@@ -22,8 +22,10 @@ def dask_client(scheduler: str | None = None, workers: int | None = None) -> Ite
     cluster = None
     if scheduler is None:
         n = (os.cpu_count() or 1) if workers is None else workers
+        # ":0": its dashboard on a free port (None still took 8787, warning "Port 8787 is
+        # already in use" beside a second sweep or any other Dask cluster)
         cluster = LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0"
         )
     client = Client(scheduler or cluster)
     try:
