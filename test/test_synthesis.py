@@ -157,6 +157,7 @@ def test_a_spectrum_the_synthesis_cannot_meet_is_named(
     assert main([*args, "--seeds", "1"]) == 2
     err = capsys.readouterr().err
     assert f"mount-twin: error: {spectrum}: the synthesis (seed 0) did not meet" in err, err
+    assert "did not meet the design in " in err and "frequencies within -1.5/+3 dB: FAIL" in err
     assert not out.exists()
 
 

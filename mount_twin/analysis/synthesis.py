@@ -121,8 +121,8 @@ def synthesize(
     if best is not None:
         return best
     msg = (
-        f"the synthesis (seed {seed}) did not meet the design within {tolerance_db} dB in "
-        f"{max_iterations} iterations: {check.summary()}"
+        f"the synthesis (seed {seed}) did not meet the design in {max_iterations} iterations: "
+        f"{check.summary()}"  # which names the band (it had also said "within (-1.5, 3.0) dB")
     )
     raise ValueError(msg)
 
