@@ -17,7 +17,7 @@ from mount_twin.engine.batch import ERROR, HealthReport, OutputBatch
 from mount_twin.engine.body_check import BodyCheck, BodyComparison
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.health import ENDED, INPUT
-from mount_twin.engine.intake import rising, rotated
+from mount_twin.engine.intake import disregarded, provided, rising, rotated
 from mount_twin.errors import require
 from mount_twin.io.messages import (
     IMU,
@@ -227,12 +227,16 @@ class TwinStream:
         return reports
 
     def _track_foundation(self, decoded: Decoded) -> None:
-        """Deck samples into the ageing tracker: those with finite values, every reading
-        provided, the input's frame_id (if it names one) and rising stamps."""
+        """Deck samples into the ageing tracker, those the twin's intake takes too: finite
+        values, no reading the twin reads marked not provided (a rate marked so under
+        input.gyro_filter: ignore is zeroed, not dropped: `intake.disregarded`, `provided`;
+        it had been dropped, the tracker's window then short of the twin's samples), the
+        input's frame_id (if it names one) and rising stamps."""
         assert self.ageing is not None and self.base is not None
-        good = np.isfinite(np.hstack([decoded.accel, decoded.gyro])).all(axis=1)
-        if decoded.unprovided is not None:
-            good &= ~decoded.unprovided.any(axis=1)
+        accel, gyro = provided(decoded.accel, decoded.gyro, decoded.unprovided)
+        good = np.isfinite(np.hstack([accel, gyro])).all(axis=1)
+        reads_rate = self.scene.input.gyro_filter != "ignore"
+        good &= ~disregarded(decoded.unprovided, good.shape[0], reads_rate)
         expected = self.scene.input.frame_id
         if expected:
             good &= np.array([f == expected for f in decoded.frame_ids], bool)
@@ -241,7 +245,7 @@ class TwinStream:
             ns = decoded.stamps_ns[keep]
             self._ageing_last_ns = int(ns[-1])
             t = self.base.seconds(ns)
-            jobs = self.ageing.add_foundation(ns, t, decoded.accel[keep], decoded.gyro[keep])
+            jobs = self.ageing.add_foundation(ns, t, accel[keep], gyro[keep])
             self._ageing_jobs += jobs
 
     def take_ageing_jobs(self) -> list[WindowJob]:

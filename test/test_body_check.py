@@ -10,10 +10,11 @@ from __future__ import annotations
 import dataclasses
 import warnings
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 import pytest
-from io_helpers import SCENE_FILE, unprovided_imu
+from io_helpers import AGEING_PUMP, SCENE_FILE, ageing_bag, pump_scene_file, unprovided_imu
 from scipy.signal import butter, sosfiltfilt
 
 from mount_twin import load_scene_file
@@ -423,3 +424,29 @@ def test_bad_body_messages_are_reported_in_the_same_window_in_any_batching() -> 
     assert windows[1] == windows[7] == windows[len(body)]
     counted = [int(values["body_rejected_undecodable"]) for _, _, values in windows[1]]
     assert counted == [0, len(garbage)]
+
+
+def test_under_gyro_filter_ignore_the_ageing_tracker_takes_a_deck_sample_whose_rate_is_marked(
+    tmp_path: Path,
+) -> None:
+    """Under input.gyro_filter: ignore the twin reads no rate, so it takes a deck sample whose
+    rate is marked not provided (REP-145); the ageing tracker dropped it, its window then short
+    of the samples the twin ran on. It takes the same samples as from the unmarked record."""
+    sections = {**AGEING_PUMP, "input": {"gyro_filter": "ignore"}}
+    scene = load_scene_file(pump_scene_file(tmp_path, **sections))
+    messages = ageing_bag(tmp_path / "in", scene, 23.0, 30.0, "/machine/imu")
+    deck = [raw for topic, _, raw in messages if topic == "/deck/imu"]
+    body = [raw for topic, _, raw in messages if topic != "/deck/imu"]
+    marked = [
+        unprovided_imu([raw], "angular_velocity")[0] if i % 10 == 3 else raw
+        for i, raw in enumerate(deck)
+    ]
+    windows = []
+    for feed in (deck, marked):
+        stream = TwinStream(scene)
+        stream.process(feed)
+        stream.process_body(body)
+        (job,) = stream.take_ageing_jobs()
+        windows.append(job.records[0])
+    assert np.array_equal(windows[1].t, windows[0].t)
+    assert np.array_equal(windows[1].accel, windows[0].accel)
