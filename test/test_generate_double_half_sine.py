@@ -154,3 +154,21 @@ def test_generate_refuses_a_duration_that_is_no_length_naming_it(
     """`--duration nan` said "cannot convert float NaN to integer"."""
     assert main(["generate", "ship-motion", "-o", str(tmp_path / "b"), "--duration", value]) == 2
     assert f"duration must be > 0 s and finite, got {float(value)!r}" in capsys.readouterr().err
+
+
+def test_generate_refuses_stamps_a_header_cannot_hold(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """builtin_interfaces/Time holds its seconds in an int32: the last stamp it can carry is
+    2**31 − 1 s (2038-01-19 03:14:07 UTC). `--start 3e18` wrote headers whose seconds wrapped
+    to −1 294 967 296 (1928) beside log times in 2065, and exited 0."""
+    out = tmp_path / "bag"
+    last = (2**31 - 1) * 1_000_000_000 + 999_999_999
+    # 4000 samples at 10 kHz end 0.3999 s after the start: one start too late, one in time
+    start = last - 399_900_000 + 1
+    assert main(["generate", "half-sine", "-o", str(out), "--start", str(start)]) == 2
+    assert "after 2038-01-19T03:14:07Z" in capsys.readouterr().err
+    assert not out.exists()
+    assert main(["generate", "half-sine", "-o", str(out), "--start", str(start - 1)]) == 0
+    _, msgs = read_bag(out)
+    assert stamp_ns(msgs["/deck/imu"][-1][1]) == msgs["/deck/imu"][-1][0] == last

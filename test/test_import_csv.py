@@ -201,3 +201,20 @@ def test_an_xsens_row_with_a_cell_too_many_is_refused_naming_it(tmp_path: Path) 
     with pytest.raises(ValueError, match=None) as err:
         read_xsens_csv(path)
     assert str(err.value) == f"{path}: row 20: 12 cells where the header has 11"
+
+
+def test_a_csv_timed_from_the_epoch_is_refused_with_the_default_offset(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """enDAQ's exports time from the epoch: 1.7e9 s, plus the default offset of 1.7e9 s, is
+    past 2**31 − 1 s, the last second a header (int32) holds. The bag had been written with
+    header stamps wrapped to −894 967 296 s (1941), exit 0; --offset 0 writes it as recorded."""
+    path = _write(tmp_path, '"Time (s)","X (100g)","Y (100g)","Z (100g)"\n1700000000.5,0,0,1\n')
+    out = tmp_path / "bag"
+    assert main(["import-csv", str(path), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "3400000000500000000 ns is after 2038-01-19T03:14:07Z" in err and "--offset" in err
+    assert not out.exists()
+    assert main(["import-csv", str(path), "-o", str(out), "--offset", "0"]) == 0
+    _, msgs = read_bag(out)
+    assert stamp_ns(msgs["/deck/imu"][0][1]) == 1_700_000_000_500_000_000

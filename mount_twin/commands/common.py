@@ -12,7 +12,7 @@ from itertools import pairwise
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mount_twin.errors import MountTwinError
+from mount_twin.errors import BagError, MountTwinError
 
 if TYPE_CHECKING:
     import numpy as np
@@ -276,7 +276,12 @@ def write_signal(
         raise ValueError(msg)
 
     stamps = start_ns + np.rint(sig.t * 1e9).astype(np.int64)
-    check_stamp(out, topic, int(stamps.min()))
+    try:
+        check_stamp(out, topic, int(stamps.min()))
+        check_stamp(out, topic, int(stamps.max()))
+    except BagError as err:  # the stamps are the options' doing: name them
+        msg = f"{err}: start the stamps elsewhere (--start, --offset)"
+        raise BagError(msg) from None
     if (stamps == 0).any():
         msg = (
             f"{out}: {topic}: a sample would be stamped 0 ns, which ROS reads as unset (the twin "

@@ -538,11 +538,23 @@ def check_new_bag(path: str | Path) -> None:
         raise BagError(msg)
 
 
+LAST_STAMP_NS = (2**31 - 1) * 1_000_000_000 + 999_999_999
+"""The last stamp a header holds: builtin_interfaces/Time's seconds are an int32, so 2**31 − 1 s
+(2038-01-19T03:14:07Z); one later wraps to a negative second (1901–1970), silently."""
+
+
 def check_stamp(path: str | Path, topic: str, stamp_ns: int) -> None:
     """Raise BagError if a bag cannot hold a message stamped `stamp_ns` (ns): one before 1970
-    (a negative header.stamp.sec) would crash its writer and leave the file unreadable."""
+    (a negative header.stamp.sec) would crash its writer and leave the file unreadable; one
+    after LAST_STAMP_NS would be written with its header's seconds wrapped."""
     if stamp_ns < 0:
         msg = f"{path}: {topic}: stamp {stamp_ns} ns is before 1970: a bag cannot hold it"
+        raise BagError(msg)
+    if stamp_ns > LAST_STAMP_NS:
+        msg = (
+            f"{path}: {topic}: stamp {stamp_ns} ns is after 2038-01-19T03:14:07Z, the last "
+            "a header holds (its seconds are an int32)"
+        )
         raise BagError(msg)
 
 
