@@ -91,3 +91,16 @@ def test_a_bag_without_messages_has_no_start(tmp_path: Path) -> None:
         pass
     text = bag_info(empty).text()
     assert "start:     none (no message)" in text and "922337" not in text
+
+
+def test_a_bags_start_is_printed_to_the_nanosecond_it_has(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The start (the first stamp of the vehicle record in ../shared, 1432235498025043042 ns)
+    was printed through a float: 1432235498.025043011 s, its last digits made up."""
+    bag = tmp_path / "bag"
+    start = "1432235498025043042"
+    assert main(["generate", "half-sine", "-o", str(bag), "--start", start]) == 0
+    capsys.readouterr()
+    assert main(["info", str(bag)]) == 0
+    assert "start:     1432235498.025043042 s (log time)" in capsys.readouterr().out

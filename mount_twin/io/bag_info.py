@@ -40,12 +40,13 @@ class BagInfo:
     topics: list[TopicInfo]
 
     def text(self) -> str:
-        """A `ros2 bag info`-like listing."""
+        """A `ros2 bag info`-like listing; the start to the ns, in integers (a float holds
+        an epoch stamp to some 240 ns only)."""
         span = (self.end_ns - self.start_ns) * 1e-9 if self.messages else 0.0
         lines = [
             f"bag:       {self.path}",
             f"duration:  {span:.6f} s",
-            f"start:     {self.start_ns * 1e-9:.9f} s (log time)"
+            f"start:     {self.start_ns // 10**9}.{self.start_ns % 10**9:09d} s (log time)"
             if self.messages
             else "start:     none (no message)",
             f"messages:  {self.messages}",
