@@ -218,3 +218,17 @@ def test_a_csv_timed_from_the_epoch_is_refused_with_the_default_offset(
     assert main(["import-csv", str(path), "-o", str(out), "--offset", "0"]) == 0
     _, msgs = read_bag(out)
     assert stamp_ns(msgs["/deck/imu"][0][1]) == 1_700_000_000_500_000_000
+
+
+@pytest.mark.parametrize("micro", ["\u03bc", "\u00b5"], ids=["greek-mu", "micro-sign"])
+def test_microseconds_are_read_with_either_mu(tmp_path: Path, micro: str) -> None:
+    """The Greek small mu (U+03BC, what a Greek keyboard or Unicode normalisation gives) was
+    an unknown time unit 'μs', the error listing a known 'µs' (the micro sign, U+00B5) that
+    looks the same."""
+    path = _write(tmp_path, f"t [{micro}s],ax,ay,az\n0,0,0,9.8\n1500,0,0,9.8\n")
+    np.testing.assert_array_equal(read_recorder_csv(path).signal.t, [0.0, 1500e-6])
+    got = read_recorder_csv(
+        _write(tmp_path, "t,ax,ay,az\n0,0,0,9.8\n250,0,0,9.8\n", "u.csv"),
+        CsvFormat(units={"time": f"{micro}s"}),
+    ).signal
+    np.testing.assert_array_equal(got.t, [0.0, 250e-6])

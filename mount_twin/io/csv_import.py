@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import re
+import unicodedata
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -195,7 +196,7 @@ def _factors(
     scale = {}
     for role, col in roles.items():
         quantity, unit = QUANTITY[role], units[role]
-        factor = UNITS[quantity].get(unit.lower().replace(" ", ""))
+        factor = next((f for u, f in UNITS[quantity].items() if _same_unit(u, unit)), None)
         if factor is None and quantity == "accel" and RANGE_UNIT.match(unit.lower()):
             factor = G
             if not any(n.startswith("accelerometer range") for n in notes):
@@ -206,6 +207,16 @@ def _factors(
             raise _fail(path, where, f"unknown {quantity} unit {unit!r} (known: {known})")
         scale[role] = factor
     return scale, notes
+
+
+def _same_unit(a: str, b: str) -> bool:
+    """Whether two unit names are one: case and spaces aside, and compatibility characters
+    taken as what they stand for (NFKC: the micro sign µ as the Greek μ, ² as 2)."""
+
+    def key(unit: str) -> str:
+        return unicodedata.normalize("NFKC", unit).lower().replace(" ", "")
+
+    return key(a) == key(b)
 
 
 def _values(
