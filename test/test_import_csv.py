@@ -232,3 +232,15 @@ def test_microseconds_are_read_with_either_mu(tmp_path: Path, micro: str) -> Non
         CsvFormat(units={"time": f"{micro}s"}),
     ).signal
     np.testing.assert_array_equal(got.t, [0.0, 250e-6])
+
+
+def test_a_whitespace_separated_header_keeps_each_unit_with_its_name(tmp_path: Path) -> None:
+    """`Time [ms]  AccZ [g]` between spaces was split into 8 cells (each unit one), and the
+    file refused: "row 2: 4 cells where the header has 8"."""
+    path = _write(
+        tmp_path, "Time [ms]  AccX [g]  AccY [g]  AccZ (g)\n0  0,0  0,0  1,0\n0,5  0,1  0,0  1,0\n"
+    )
+    got = read_recorder_csv(path)
+    np.testing.assert_allclose(got.signal.t, [0.0, 0.0005], rtol=1e-15, atol=0)
+    np.testing.assert_allclose(got.signal.accel, [[0, 0, G], [0.1 * G, 0, G]], rtol=1e-15)
+    assert "units: time ms, accel g" in got.notes and "decimal comma" in got.notes

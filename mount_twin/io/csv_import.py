@@ -47,6 +47,8 @@ UNITS: dict[str, dict[str, float]] = {
 }
 """Unit name → factor to SI, per quantity."""
 QUANTITY = {"t": "time", **dict.fromkeys(ROLES[1:4], "accel"), **dict.fromkeys(ROLES[4:], "gyro")}
+UNIT_APART = re.compile(r"\s+(?![\[(])")
+"""Whitespace between header cells: not that before a bracketed unit (`Time [ms]`)."""
 HEADER_CELL = re.compile(r"^\s*(.*?)\s*(?:[\[(]\s*(.*?)\s*[\])])?\s*$")
 
 
@@ -260,9 +262,10 @@ def _motion(
 
 
 def _header(line: str, delimiter: str | None) -> tuple[list[str], list[str]]:
-    """Column names (lower case, spaces as _) and units ('' where none) of the header line."""
+    """Column names (lower case, spaces as _) and units ('' where none) of the header line;
+    between spaces, a unit in brackets stays with the name before it (`Time [ms]  AccZ [g]`)."""
     names, units = [], []
-    for raw in line.split(delimiter) if delimiter else line.split():
+    for raw in line.split(delimiter) if delimiter else UNIT_APART.split(line.strip()):
         cell = raw.strip().strip('"')  # quoted cells: enDAQ's "X (100g)"
         match = HEADER_CELL.match(cell)
         name, unit = (match.group(1), match.group(2) or "") if match else (cell, "")
