@@ -244,3 +244,19 @@ def test_a_whitespace_separated_header_keeps_each_unit_with_its_name(tmp_path: P
     np.testing.assert_allclose(got.signal.t, [0.0, 0.0005], rtol=1e-15, atol=0)
     np.testing.assert_allclose(got.signal.accel, [[0, 0, G], [0.1 * G, 0, G]], rtol=1e-15)
     assert "units: time ms, accel g" in got.notes and "decimal comma" in got.notes
+
+
+def test_units_the_header_does_not_give_are_said_to_be_assumed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A record in g with no unit in its header (1.0 on z at rest) is read in m/s², as
+    documented; the note said "units: time s, accel m/s^2" as if the header had said so."""
+    path = _write(tmp_path, "t,ax,ay,az,wx [deg/s],wy [deg/s],wz [deg/s]\n0,0,0,1.0,0,0,0\n")
+    assert main(["import-csv", str(path), "-o", str(tmp_path / "bag")]) == 0
+    said = capsys.readouterr().out
+    assert (
+        "units: time s, accel m/s^2, gyro deg/s (time, accel assumed: the header gives no "
+        "unit; say it with --time-unit, --accel-unit)"
+    ) in said
+    stated = _write(tmp_path, "t [s],ax [g],ay [g],az [g]\n0,0,0,1.0\n", "stated.csv")
+    assert "units: time s, accel g" in read_recorder_csv(stated).notes

@@ -124,11 +124,23 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     accel_role = f"a{fmt.axis or 'x'}"
     accel, gyro, found = _motion(values, fmt.axis, names[roles[accel_role]])
     notes += found
-    shown = {QUANTITY[r]: units[r] for r in ("t", accel_role, "wx") if r in roles}
-    notes.append("units: " + ", ".join(f"{q} {u}" for q, u in shown.items()))
+    shown = [r for r in ("t", accel_role, "wx") if r in roles]
+    given = {r: bool(fmt.units.get(QUANTITY[r]) or header_units[roles[r]]) for r in shown}
+    notes.append(_units_note({r: units[r] for r in shown}, given))
     if decimal == ",":
         notes.append("decimal comma")
     return Imported(Signal(t, accel, gyro), notes)
+
+
+def _units_note(units: dict[str, str], given: dict[str, bool]) -> str:
+    """'units: time s, accel g, ...' of the roles' `units`, saying which of them were assumed
+    (not `given` by the header nor an override) and how to say them."""
+    text = "units: " + ", ".join(f"{QUANTITY[r]} {u}" for r, u in units.items())
+    assumed = [QUANTITY[r] for r in units if not given[r]]
+    if assumed:
+        options = ", ".join(f"--{q}-unit" for q in assumed)
+        text += f" ({', '.join(assumed)} assumed: the header gives no unit; say it with {options})"
+    return text
 
 
 def check_width(path: Path, row: int, cells: list[str], header: list[str]) -> None:
