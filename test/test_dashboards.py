@@ -5,12 +5,13 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import pytest
 import yaml
-from io_helpers import CONFIG
+from io_helpers import CONFIG, ROOT
 
 from mount_twin.analysis.dashboards import foxglove_layout, plotjuggler_layout
 from mount_twin.cli import main
@@ -138,3 +139,48 @@ def test_both_layouts_into_one_file_are_refused(
     assert main(["dashboard", scene, "--plotjuggler", same, "--foxglove", same]) == 2
     assert "--plotjuggler and --foxglove name one file" in capsys.readouterr().err
     assert not Path(same).exists()
+
+
+def _readme_units() -> dict[str, str]:
+    """Topic as README.md's "What it publishes" table writes it (`~/pose`,
+    `~/mounts/<name>/wrench`) → the unit its row names first, in parentheses ("the CG's
+    position (m)", "specific force (m/s², rad/s, ...)")."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    table = text.split("## What it publishes", 1)[1].strip().split("\n\n", 1)[0]
+    units = {}
+    for row in table.splitlines()[2:]:
+        topics, _, what = (c.strip() for c in row.strip().strip("|").split("|"))
+        first = re.search(r"\(([^),]+)", what)
+        for topic in re.findall(r"`([^`]+)`", topics):
+            if first:
+                units[topic] = first.group(1).strip()
+    return units
+
+
+def _as_readme_writes(topic: str) -> str:
+    """A resolved output topic as the README's table names it."""
+    private = "~" + topic.removeprefix(f"/{NODE_NAME}")
+    return re.sub(r"^~/mounts/[^/]+/", "~/mounts/<name>/", private)
+
+
+@pytest.mark.parametrize("body", [False, True], ids=["scene", "with_body_imu"])
+@pytest.mark.parametrize("scene_name", SCENES)
+def test_foxglove_shows_each_plot_and_series_with_its_unit(scene_name: str, body: bool) -> None:
+    """Foxglove titles a panel from its config's `foxglovePanelTitle` and a series from its
+    path's `label` (else the bare message path): the layout's `title` key, which it does not
+    read, left every plot untitled and every series without its unit. The units are the
+    README's, topic by topic."""
+    scene = load_scene_file(CONFIG / f"{scene_name}.scene.yaml")
+    if body:
+        scene = dataclasses.replace(scene, body_sensor=BodySensor(position=(0.8, 0.3, 1.0)))
+    units = _readme_units()
+    for panel in json.loads(foxglove_layout(scene))["configById"].values():
+        (unit,) = {units[_as_readme_writes(p["value"].partition(".")[0])] for p in panel["paths"]}
+        assert panel.get("foxglovePanelTitle", "").endswith(f"[{unit}]"), panel
+        for path in panel["paths"]:
+            assert path.get("label", "").endswith(f"[{unit}]"), path
+    for area in ET.fromstring(plotjuggler_layout(scene)).iter("DockArea"):
+        curves = [c.get("name", "") for c in area.iter("curve")]
+        topics = {next(t for t in units if _as_readme_writes(c).startswith(t)) for c in curves}
+        (unit,) = {units[t] for t in topics}
+        assert area.get("name", "").endswith(f"[{unit}]")

@@ -4,7 +4,9 @@
 (live) or an output bag (the same topics).
 
 Series are named the way each tool names message fields: PlotJuggler `/topic/field/sub`,
-Foxglove message paths `/topic.field.sub` (plotted against the header stamp).
+Foxglove message paths `/topic.field.sub` (plotted against the header stamp). Each plot's title
+carries its unit; Foxglove also labels each series with it (PlotJuggler names a curve by its
+series only).
 """
 
 from __future__ import annotations
@@ -27,34 +29,39 @@ from mount_twin.scene.description import Scene
 COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f")
 
 
-def panels(scene: Scene) -> list[tuple[str, list[tuple[str, tuple[str, ...]]]]]:
-    """(panel title, [(topic, field path)]) of each plot of what the scene publishes: pose,
-    angles, force x, y, z, and with a body_sensor the body IMU's predicted and residual
-    specific force. ValueError where it publishes none of them."""
+Series = list[tuple[str, tuple[str, ...], str]]
+"""A plot's series: (topic, field path, label with its unit)."""
+
+
+def panels(scene: Scene) -> list[tuple[str, Series]]:
+    """(panel title, [(topic, field path, series label)]) of each plot of what the scene
+    publishes: pose, angles, force x, y, z, and with a body_sensor the body IMU's predicted and
+    residual specific force; titles and labels end with the unit. ValueError where it
+    publishes none of them."""
     published = scene.outputs
     pose = resolve(POSE_OUTPUT.topic, NODE_NAME)
     angles = resolve(ANGLES_OUTPUT.topic, NODE_NAME)
-    Series = list[tuple[str, tuple[str, ...]]]
     out: list[tuple[str, Series]] = []
     if published.pose:
-        out.append(("CG position in F [m]", [(pose, _path(POSE_OUTPUT, k)) for k in range(3)]))
+        series = [(pose, _path(POSE_OUTPUT, k), f"{a} [m]") for k, a in enumerate("xyz")]
+        out.append(("CG position in F [m]", series))
     if published.angles:
-        out.append(
-            ("α (x), γ (y), δ (z) [rad]", [(angles, _path(ANGLES_OUTPUT, k)) for k in range(3)])
-        )
+        series = [(angles, _path(ANGLES_OUTPUT, k), f"{a} [rad]") for k, a in enumerate("αγδ")]
+        out.append(("α (x), γ (y), δ (z) [rad]", series))
     if published.wrenches:
-        topics = [resolve(st.topic, NODE_NAME) for st in WRENCHES_OUTPUT.streams(scene)]
+        streams = zip(WRENCHES_OUTPUT.streams(scene), scene.mounts, strict=True)
+        topics = [(resolve(st.topic, NODE_NAME), m.name) for st, m in streams]
         for k, axis in enumerate("xyz"):
             force = _path(WRENCHES_OUTPUT, k)
-            out.append((f"mount force along mount {axis} [N]", [(t, force) for t in topics]))
+            series = [(t, force, f"{name} [N]") for t, name in topics]
+            out.append((f"mount force along mount {axis} [N]", series))
     if scene.body_sensor is not None:  # the body IMU against the twin (its axes)
         for topic, what in (
             (BODY_PREDICTED_TOPIC, "predicted"),
             (BODY_RESIDUAL_TOPIC, "residual"),
         ):
-            series: Series = [
-                (resolve(topic, NODE_NAME), ("linear_acceleration", a)) for a in "xyz"
-            ]
+            resolved = resolve(topic, NODE_NAME)
+            series = [(resolved, ("linear_acceleration", a), f"{a} [m/s²]") for a in "xyz"]
             out.append((f"body IMU specific force, {what} [m/s²]", series))
     if not out:
         msg = (
@@ -89,7 +96,7 @@ def plotjuggler_layout(scene: Scene) -> str:
             {"mode": "TimeSeries", "style": "Lines", "flip_x": "false", "flip_y": "false"},
         )
         ET.SubElement(plot, "limitY")
-        for k, (topic, field) in enumerate(series):
+        for k, (topic, field, _label) in enumerate(series):
             name = "/".join([topic, *field])
             ET.SubElement(plot, "curve", {"name": name, "color": COLOURS[k % len(COLOURS)]})
     ET.indent(root)
@@ -106,14 +113,16 @@ def foxglove_layout(scene: Scene) -> str:
         panel = f"Plot!mt{k}"
         ids.append(panel)
         config[panel] = {
-            "title": title,
+            "foxglovePanelTitle": title,  # the key Foxglove titles a panel from
+            "title": title,  # where older Foxglove Studio releases read it
             "paths": [
                 {
                     "value": f"{topic}.{'.'.join(field)}",
                     "enabled": True,
                     "timestampMethod": "headerStamp",
+                    "label": label,
                 }
-                for topic, field in series
+                for topic, field, label in series
             ],
             "showLegend": True,
             "isSynced": True,
