@@ -95,3 +95,21 @@ def test_the_diagnostics_keys_the_pages_name_are_the_ones_the_twin_reports() -> 
     reported = {k for s in out.health[-1].statuses for k in s.values}
     named = {k for page in PAGES for k in re.findall(r"`(est_[a-z_]+)`", page.read_text())}
     assert named and named <= reported, sorted(named - reported)
+
+
+def _heading_anchors(page: Path) -> set[str]:
+    """The anchors GitHub makes of a page's headings: lower case, spaces as hyphens, other
+    punctuation dropped."""
+    headings = re.findall(r"^#+ (.+)$", page.read_text(encoding="utf-8"), re.M)
+    return {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-") for h in headings}
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_link_anchors_name_headings_of_their_pages(page: Path) -> None:
+    """node.md's [Scene](scene.md#scene) and benchmarks.md's [Keeping up](node.md#as-a-ros-2-
+    package) led to the top of the page: neither heading exists."""
+    text = page.read_text(encoding="utf-8")
+    for target, anchor in re.findall(r"\]\(([^)#:]*)#([^)]+)\)", text):
+        linked = page.parent / target if target else page
+        if linked.suffix == ".md":
+            assert anchor in _heading_anchors(linked), f"{page.name}: {target}#{anchor}"
