@@ -14,7 +14,8 @@ from launch import LaunchDescription
 
 
 def generate_launch_description() -> LaunchDescription:
-    """The node, its params file, sim time for bag play, and the input topic remap."""
+    """The node, its params file and sim time for bag play (the input topic is the params
+    file's input.topic: no remap needed)."""
     share = get_package_share_directory("mount_twin")
     return LaunchDescription(
         [
