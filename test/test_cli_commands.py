@@ -632,3 +632,22 @@ def test_an_output_that_would_replace_an_input_is_refused_before_the_work(
     assert "which this command reads" in err
     assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
     assert not paths["NEW"].exists()
+
+
+def test_bags_in_directories_named_dot_bag_are_read_like_any_other(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`ros2 bag record -o run.bag` and our own writers make a rosbag2 directory of that name;
+    rosbags' AnyReader takes any name ending in .bag for a ROS 1 file, and `info`, `export` and
+    `report` failed on it with "Is a directory". 2000 Hz for 0.2 s is 400 samples, each one
+    answered by the replay (decimation 1, its gyro delay flushed at the end)."""
+    bag, out = tmp_path / "in.bag", tmp_path / "out.bag"
+    gen = ["generate", "half-sine", "-o", str(bag), "--rate", "2000", "--duration", "0.2"]
+    assert main(gen) == 0
+    assert main(["info", str(bag)]) == 0
+    assert "messages:  400\n" in capsys.readouterr().out
+    main(["replay", "--scene", str(SCENE_FILE), str(bag), "-o", str(out), "--no-progress"])
+    assert main(["export", str(out), "--csv", str(tmp_path / "tables")]) == 0
+    with (tmp_path / "tables" / "pose.csv").open(encoding="utf-8") as fh:
+        assert sum(1 for _ in fh) == 1 + 400
+    assert main(["report", str(out), "-o", str(tmp_path / "r.html")]) == 0

@@ -80,7 +80,7 @@ class InputBag:
         self.msgtype = msgtype
         self._salvage: Salvage | None = None
         try:
-            self._reader = _open_reader([self.path])
+            self._reader = _open_reader(reader_paths(self.path))
         except Exception as err:
             files = _storage_files(self.path)
             if not files:
@@ -235,6 +235,15 @@ class InputBag:
         self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None
     ) -> None:
         self.close()
+
+
+def reader_paths(path: Path) -> list[Path]:
+    """What rosbags' AnyReader is to open for the bag at `path`: the path, or, for a rosbag2
+    directory whose name ends in .bag (`ros2 bag record -o run.bag` makes one), its storage
+    files: AnyReader takes any name ending in .bag for a ROS 1 file ("Is a directory")."""
+    if path.suffix == ".bag" and path.is_dir():
+        return _storage_files(path) or [path]
+    return [path]
 
 
 def _open_reader(paths: list[Path]) -> AnyReader:

@@ -9,6 +9,7 @@ from pathlib import Path
 from rosbags.highlevel import AnyReader
 
 from mount_twin.errors import BagError
+from mount_twin.io.bag import reader_paths
 from mount_twin.io.messages import TYPESTORE
 
 
@@ -61,7 +62,7 @@ def bag_info(path: str | Path) -> BagInfo:
     """Read a bag's metadata (mcap, sqlite3 or ROS 1, as rosbags reads them); errors name it."""
     require_existing(path)
     try:
-        with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
+        with AnyReader(reader_paths(Path(path)), default_typestore=TYPESTORE) as reader:
             topics = sorted(
                 (TopicInfo(c.topic, c.msgtype, c.msgcount) for c in reader.connections),
                 key=lambda t: t.name,

@@ -23,6 +23,7 @@ from rosbags.highlevel import AnyReader
 from mount_twin.engine.batch import event_level
 from mount_twin.engine.health import INPUT, INTEGRATION
 from mount_twin.errors import BagError
+from mount_twin.io.bag import reader_paths
 from mount_twin.io.bag_info import require_existing
 from mount_twin.io.messages import DIAGNOSTICS, OUTPUTS, TYPESTORE, Readback, output_table
 from mount_twin.kinds.events import EVENT_IS_ERROR
@@ -55,7 +56,7 @@ def read_output_bag(path: str | Path) -> list[Table]:
     rank: dict[str, int] = {}
     require_existing(path)
     try:
-        with AnyReader([Path(path)], default_typestore=TYPESTORE) as reader:
+        with AnyReader(reader_paths(Path(path)), default_typestore=TYPESTORE) as reader:
             tables_of: dict[int, tuple[str, Readback | None]] = {}
             for c in reader.connections:
                 if c.msgtype == DIAGNOSTICS:
