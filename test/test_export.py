@@ -62,12 +62,22 @@ def test_a_bag_without_outputs_is_refused_naming_it(
     assert f"{bag}: no mount_twin output in the bag" in capsys.readouterr().err
 
 
+@pytest.fixture
+def unread(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Reading an output bag is a failure: a target is to be checked before the bag is read."""
+
+    def read(*_: object) -> None:
+        raise AssertionError("the bag was read before its target was checked")
+
+    monkeypatch.setattr("mount_twin.io.output_tables.read_output_bag", read)
+
+
+@pytest.mark.usefixtures("unread")
 @pytest.mark.parametrize("where", ["device", "file", "under_a_file"])
 def test_a_target_that_cannot_be_a_directory_is_refused_naming_the_option_before_reading(
     replayed: Path,
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
-    monkeypatch: pytest.MonkeyPatch,
     where: str,
 ) -> None:
     """`export BAG --csv /dev/full` read the whole bag, then said "mount-twin: error:
@@ -79,10 +89,6 @@ def test_a_target_that_cannot_be_a_directory_is_refused_naming_the_option_before
         pytest.skip("no /dev/full")
     target = {"device": Path("/dev/full"), "file": afile, "under_a_file": afile / "tables"}[where]
 
-    def unread(*_: object) -> None:
-        raise AssertionError("the bag was read before its target was checked")
-
-    monkeypatch.setattr("mount_twin.io.output_tables.read_output_bag", unread)
     assert main(["export", str(replayed), "--csv", str(target)]) == 2
     said = f"{afile} is not a directory" if where == "under_a_file" else "exists, not a directory"
     want = f"mount-twin: error: --csv {target}: {said}; export writes one file per table into "
@@ -90,12 +96,12 @@ def test_a_target_that_cannot_be_a_directory_is_refused_naming_the_option_before
     assert afile.read_text(encoding="utf-8") == "not a directory"
 
 
+@pytest.mark.usefixtures("unread")
 @pytest.mark.parametrize("where", ["at_the_target", "above_the_target"])
 def test_a_dangling_symlink_in_the_way_is_refused_naming_it_before_reading(
     replayed: Path,
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
-    monkeypatch: pytest.MonkeyPatch,
     where: str,
 ) -> None:
     """A symlink to a missing directory as the target (or above it) read as absent: the bag
@@ -105,10 +111,6 @@ def test_a_dangling_symlink_in_the_way_is_refused_naming_it_before_reading(
     link.symlink_to(tmp_path / "missing")
     target = link if where == "at_the_target" else link / "csv"
 
-    def unread(*_: object) -> None:
-        raise AssertionError("the bag was read before its target was checked")
-
-    monkeypatch.setattr("mount_twin.io.output_tables.read_output_bag", unread)
     assert main(["export", str(replayed), "--csv", str(target)]) == 2
     err = capsys.readouterr().err
     said = f"{link} is a symlink to {tmp_path / 'missing'}, which does not exist"

@@ -402,13 +402,18 @@ def test_an_input_axis_without_motion_shows_no_infinite_margin(genset_run, tmp_p
 PUMP = CONFIG / "pump_8_mounts.scene.yaml"
 
 
+def _pump_replayed(tmp_path_factory: pytest.TempPathFactory, bag: str) -> Path:
+    """The pump's output bag of the bundled `bag`, replayed by the command line."""
+    out = tmp_path_factory.mktemp(bag) / "out"
+    path = ROOT / "bags" / bag
+    assert main(["replay", str(path), "--scene", str(PUMP), "-o", str(out), "--no-progress"]) == 0
+    return out
+
+
 @pytest.fixture(scope="module")
 def pump_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The pump's output bag of the bundled half-sine shock, replayed by the command line."""
-    out = tmp_path_factory.mktemp("pump") / "out"
-    bag = ROOT / "bags" / "half_sine_shock_10khz"
-    assert main(["replay", str(bag), "--scene", str(PUMP), "-o", str(out), "--no-progress"]) == 0
-    return out
+    """The pump's output bag of the bundled half-sine shock."""
+    return _pump_replayed(tmp_path_factory, "half_sine_shock_10khz")
 
 
 def _table_rows(page: str, heading: str) -> list[list[str]]:
@@ -622,11 +627,8 @@ def test_a_run_replayed_with_frame_id_is_reported_with_the_frame_it_expected(
 
 @pytest.fixture(scope="module")
 def pump_ship_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The pump's output bag of the bundled ship motion, replayed by the command line."""
-    out = tmp_path_factory.mktemp("pump_ship") / "out"
-    bag = ROOT / "bags" / "ship_motion_1khz"
-    assert main(["replay", str(bag), "--scene", str(PUMP), "-o", str(out), "--no-progress"]) == 0
-    return out
+    """The pump's output bag of the bundled ship motion."""
+    return _pump_replayed(tmp_path_factory, "ship_motion_1khz")
 
 
 def test_without_its_scene_the_report_names_what_the_bag_records_of_the_input_and_solver(
