@@ -112,3 +112,26 @@ def test_the_graph_is_what_the_topic_table_says(tmp_path: Path) -> None:
         assert qos.reliability == ReliabilityPolicy.RELIABLE, topic
         latched = DurabilityPolicy.TRANSIENT_LOCAL if topic == "/tf_static" else None
         assert qos.durability == (latched or DurabilityPolicy.VOLATILE), topic
+
+
+def test_the_parameter_table_gives_each_node_options_default_and_declared_range() -> None:
+    """docs/node.md's table of the node's own parameters named defaults but no ranges, which
+    the node declares and refuses values past (`ros2 param describe` shows them)."""
+    from mount_twin.ros.parameters import _OPTIONS, NodeOptions
+
+    text = (ROOT / "docs" / "node.md").read_text(encoding="utf-8")
+    rows = {}
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 4 and cells[0].strip("`") in _OPTIONS:
+            rows[cells[0].strip("`")] = cells[1:3]
+    assert sorted(rows) == sorted(_OPTIONS)
+    for name, descriptor in _OPTIONS.items():
+        default, shown = rows[name]
+        assert default == f"`{getattr(NodeOptions(), name)}`", name
+        (bounds,) = descriptor.floating_point_range or descriptor.integer_range
+        ends = [  # as the pages write numbers: 1 000 000, 3600, 0
+            f"{int(v):,}".replace(",", " ") if v >= 10_000 else f"{v:g}"
+            for v in (bounds.from_value, bounds.to_value)
+        ]
+        assert shown.startswith(f"{ends[0]}–{ends[1]} "), (name, shown, ends)
