@@ -260,3 +260,24 @@ def test_units_the_header_does_not_give_are_said_to_be_assumed(
     ) in said
     stated = _write(tmp_path, "t [s],ax [g],ay [g],az [g]\n0,0,0,1.0\n", "stated.csv")
     assert "units: time s, accel g" in read_recorder_csv(stated).notes
+
+
+def test_quoted_cells_are_read_as_the_numbers_they_hold(tmp_path: Path) -> None:
+    """Spreadsheets quote cells: `"0"` had been refused ('"0"' is not a number)."""
+    path = _write(tmp_path, '"t [s]","ax","ay","az [g]"\n"0","0","0","1"\n"0.5",0,"-1.5","2"\n')
+    got = read_recorder_csv(path).signal
+    np.testing.assert_array_equal(got.t, [0.0, 0.5])
+    np.testing.assert_array_equal(got.accel, [[0, 0, G], [0, -1.5, 2 * G]])
+    out = tmp_path / "bag"
+    assert main(["import-csv", str(path), "-o", str(out), "--offset", "7"]) == 0
+    _, msgs = read_bag(out)
+    assert [stamp_ns(m) for _, m in msgs["/deck/imu"]] == [7, 7 + 500_000_000]
+
+
+@pytest.mark.parametrize("cell", ['"abc"', '""0""', '"', '"1" 2'])
+def test_a_quoted_cell_that_is_no_number_is_refused_naming_it(tmp_path: Path, cell: str) -> None:
+    """One pair of quotes around a number, no more: the cell is named as written."""
+    path = _write(tmp_path, f"t,ax,ay,az\n0,0,0,1\n0.1,0,{cell},1\n")
+    with pytest.raises(ValueError, match=None) as err:
+        read_recorder_csv(path)
+    assert str(err.value) == f"{path}: row 3, column ay: {cell!r} is not a number"

@@ -2,11 +2,12 @@
 
 Accepted: `,` `;` tab or whitespace between cells (sniffed from the header line), a decimal
 comma (with `;`, tab or whitespace delimiters), a UTF-8 byte-order mark (Excel's "CSV UTF-8"),
-comment lines (`#`) and blank lines, units in the header (`t [s]`, `AccZ (g)`, `wx[deg/s]`),
-quoted header cells and channels named by their range (enDAQ's `"X (100g)"`: g), common column
-names (`time`, `AccX`, `gyro_x`, `X`, ...) or an explicit mapping, files without gyro columns
-(Ω = 0), and single-axis records (`CsvFormat.axis`: one acceleration column along a stated
-sensor axis, the others 0). Units: time s, ms, us, ns; acceleration m/s², g (9.80665 m/s²), mm/s²;
+comment lines (`#`) and blank lines, cells in double quotes (`"0"`, as spreadsheets write
+them), units in the header (`t [s]`, `AccZ (g)`, `wx[deg/s]`), quoted header cells and
+channels named by their range (enDAQ's `"X (100g)"`: g), common column names (`time`, `AccX`,
+`gyro_x`, `X`, ...) or an explicit mapping, files without gyro columns (Ω = 0), and
+single-axis records (`CsvFormat.axis`: one acceleration column along a stated sensor axis, the
+others 0). Units: time s, ms, us, ns; acceleration m/s², g (9.80665 m/s²), mm/s²;
 angular rate rad/s, deg/s. Every error names the file, the row (its line number in the file)
 and the column. The values are specific force in the sensor frame, as an IMU reports them.
 """
@@ -154,11 +155,12 @@ def cell_value(
     path: Path, row: int, column: str, cell: str, factor: float = 1.0, decimal: str = "."
 ) -> float:
     """A data cell's number times `factor` (to SI units), with a decimal comma where `decimal`
-    is ','; ValueError naming the file, the row (its line number), the column and the cell
-    where it is not a number, not finite, or not finite once in SI units."""
-    text = cell.strip()
+    is ',' and within one pair of double quotes or none (`unquoted`); ValueError naming the
+    file, the row (its line number), the column and the cell as written where it is not a
+    number, not finite, or not finite once in SI units."""
+    text, number = cell.strip(), unquoted(cell)
     try:
-        v = float(text.replace(decimal, ".") if decimal == "," else text)
+        v = float(number.replace(decimal, ".") if decimal == "," else number)
     except ValueError:
         raise _cell_fail(path, row, column, f"{text!r} is not a number") from None
     if not math.isfinite(v):
@@ -167,6 +169,13 @@ def cell_value(
         what = f"{text!r} is beyond a float in SI units (×{factor:g})"
         raise _cell_fail(path, row, column, what)
     return v * factor
+
+
+def unquoted(cell: str) -> str:
+    """A cell's text without the spaces around it and one pair of double quotes around that,
+    if it has them: spreadsheets quote cells (`"0"`)."""
+    text = cell.strip()
+    return text[1:-1] if len(text) > 1 and text[0] == text[-1] == '"' else text
 
 
 def _cell_fail(path: Path, row: int, column: str, what: str) -> ValueError:
