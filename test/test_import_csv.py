@@ -262,6 +262,34 @@ def test_units_the_header_does_not_give_are_said_to_be_assumed(
     assert "units: time s, accel g" in read_recorder_csv(stated).notes
 
 
+@pytest.mark.parametrize(
+    ("options", "named"),
+    [
+        (
+            ["--columns", "t=Foo", "--time-unit", "ms", "--accel-unit", "g", "--decimal", ","],
+            "--decimal, --columns, --time-unit, --accel-unit",
+        ),
+        (["--single-axis", "z", "--delimiter", ";", "--gyro-unit", "rad/s"], None),
+    ],
+)
+def test_format_options_are_refused_for_an_xsens_export(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], options: list[str], named: str | None
+) -> None:
+    """A Movella/Xsens DOT export is read in its own layout: --columns, --time-unit,
+    --accel-unit, --decimal (...) had been ignored without a word, exit 0."""
+    path = DATA_DIR / "shake_table_1story/sine_2hz_trial1_top_excerpt.csv"
+    out = tmp_path / "bag"
+    assert main(["import-csv", str(path), "-o", str(out), *options]) == 2
+    err = capsys.readouterr().err
+    assert "Movella/Xsens DOT export" in err and "read as is" in err, err
+    for option in options:
+        if option.startswith("--"):
+            assert option in err, err
+    if named:
+        assert named in err, err
+    assert not out.exists()
+
+
 def test_quoted_cells_are_read_as_the_numbers_they_hold(tmp_path: Path) -> None:
     """Spreadsheets quote cells: `"0"` had been refused ('"0"' is not a number)."""
     path = _write(tmp_path, '"t [s]","ax","ay","az [g]"\n"0","0","0","1"\n"0.5",0,"-1.5","2"\n')

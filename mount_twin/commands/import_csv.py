@@ -77,6 +77,7 @@ def run(args: argparse.Namespace) -> int:
     delimiter = "\t" if args.delimiter in ("\\t", "tab") else args.delimiter
     fmt = CsvFormat(delimiter, args.decimal, columns, units, args.single_axis)
     if is_xsens_csv(args.csv):  # its own layout: the device clock, Acc_*, Gyr_* in deg/s
+        _refuse_format_options(args)
         signal, tag = read_xsens_csv(args.csv)
         notes = [f"a Movella/Xsens DOT export (device {tag or 'untagged'}): stamps on its clock"]
     else:
@@ -87,3 +88,28 @@ def run(args: argparse.Namespace) -> int:
     for note in notes:
         print(f"  {note}")
     return 0
+
+
+FORMAT_OPTIONS = (
+    "delimiter",
+    "decimal",
+    "columns",
+    "time_unit",
+    "accel_unit",
+    "gyro_unit",
+    "single_axis",
+)
+"""The options (argparse's names) saying how a recorder CSV is laid out (`CsvFormat`): none
+applies to a Movella/Xsens DOT export, whose layout is its own."""
+
+
+def _refuse_format_options(args: argparse.Namespace) -> None:
+    """ValueError (exit 2) naming the FORMAT_OPTIONS given for a Movella/Xsens DOT export:
+    they had been ignored without a word."""
+    given = ["--" + o.replace("_", "-") for o in FORMAT_OPTIONS if getattr(args, o) is not None]
+    if given:
+        msg = (
+            f"{args.csv}: a Movella/Xsens DOT export's layout is read as is (SampleTimeFine µs, "
+            f"Acc_* m/s², Gyr_* deg/s): {', '.join(given)} do not apply to it; leave them out"
+        )
+        raise ValueError(msg)
