@@ -11,7 +11,7 @@ import pytest
 from io_helpers import CONFIG, DATA_DIR, read_bag, stamp_ns
 
 from mount_twin.cli import main
-from mount_twin.io.csv_import import CsvFormat, read_recorder_csv
+from mount_twin.io.csv_import import CsvFormat, read_recorder_csv, time_ns
 from mount_twin.io.xsens_csv import read_xsens_csv
 
 G = 9.80665
@@ -260,6 +260,86 @@ def test_units_the_header_does_not_give_are_said_to_be_assumed(
     ) in said
     stated = _write(tmp_path, "t [s],ax [g],ay [g],az [g]\n0,0,0,1.0\n", "stated.csv")
     assert "units: time s, accel g" in read_recorder_csv(stated).notes
+
+
+def test_an_epoch_timed_10khz_record_is_stamped_to_the_nanosecond(tmp_path: Path) -> None:
+    """A time cell 1700000000.0001 s had been parsed as a float (which holds an epoch time to
+    ~240 ns) and stamped 1700000000000099840 ns; the 10 kHz steps jittered (99 840, 100 096
+    ns). Each stamp is the offset plus the cell's decimal time in ns, exactly."""
+    cells = [f"1700000000.{k:04d}" for k in range(20)]
+    path = _write(tmp_path, "t [s],ax,ay,az\n" + "".join(f"{c},0,0,9.8\n" for c in cells))
+    for offset in (0, 123):
+        out = tmp_path / f"bag{offset}"
+        assert main(["import-csv", str(path), "-o", str(out), "--offset", str(offset)]) == 0
+        _, msgs = read_bag(out)
+        stamps = [stamp_ns(m) for _, m in msgs["/deck/imu"]]
+        # "1700000000.0001" s: 17000000000001 units of 0.1 ms, each 100 000 ns
+        assert stamps == [offset + int(c.replace(".", "")) * 100_000 for c in cells]
+    assert stamps[1] == 123 + 1_700_000_000_000_100_000
+
+
+def test_time_in_ms_with_a_decimal_comma_is_exact_and_sub_ns_rounded_half_even(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The unit's factor is applied to the written decimal, not to a float: 0,0035005 ms is
+    3500.5 ns, rounded half to even (3500), 0,0045015 ms is 4501.5 ns (4502); said."""
+    times = ["1700000000000,0001", "1700000000000,0015", "1700000000000,0035005"]
+    times += ["1700000000000,0045015", "1700000000000,01"]
+    text = "Time [ms];AccX;AccY;AccZ\n" + "".join(f"{t};0;0;9,8\n" for t in times)
+    path = _write(tmp_path, text)
+    out = tmp_path / "bag"
+    assert main(["import-csv", str(path), "-o", str(out), "--offset", "0"]) == 0
+    said = capsys.readouterr().out
+    assert "time: 2 cells finer than 1 ns, rounded to the ns (half to even)" in said, said
+    _, msgs = read_bag(out)
+    base = 1_700_000_000_000 * 1_000_000  # ms → ns
+    expected = [base + 100, base + 1500, base + 3500, base + 4502, base + 10_000]
+    assert [stamp_ns(m) for _, m in msgs["/deck/imu"]] == expected
+
+
+@pytest.mark.parametrize(
+    ("cell", "ns_per_unit", "decimal", "expected"),
+    [
+        ("1700000000.0001", 10**9, ".", (1_700_000_000_000_100_000, False)),
+        ('"1700000000,0001"', 10**9, ",", (1_700_000_000_000_100_000, False)),
+        ("1.7e9", 10**9, ".", (1_700_000_000_000_000_000, False)),
+        ("-2.5E-3", 10**6, ".", (-2_500, False)),  # -2.5e-3 ms
+        ("0.0000000005", 10**9, ".", (0, True)),  # 0.5 ns: to the even 0
+        ("0.0000000015", 10**9, ".", (2, True)),  # 1.5 ns: to the even 2
+        ("-0.0000000025", 10**9, ".", (-2, True)),
+        ("-0.0000000015", 10**9, ".", (-2, True)),
+        ("-0.0000000014", 10**9, ".", (-1, True)),
+        ("1e-12", 10**9, ".", (0, True)),  # 0.001 ns
+        ("1." + "0" * 100_000 + "1", 10**9, ".", (10**9, True)),  # long, and quick
+        ("9223372036.854775807", 10**9, ".", (2**63 - 1, False)),  # the last int64 ns
+        ("0.00000000250001", 10**9, ".", (3, True)),  # above the half
+        ("1e-999999999", 10**9, ".", (0, True)),  # no 10**999999999 made
+        ("0e999999999", 10**9, ".", (0, False)),
+        ("1500", 10**3, ".", (1_500_000, False)),  # µs
+        ("7", 1, ".", (7, False)),
+    ],
+)
+def test_a_time_cell_is_read_exactly_in_ns(
+    cell: str, ns_per_unit: int, decimal: str, expected: tuple[int, bool]
+) -> None:
+    assert time_ns(cell, ns_per_unit, decimal) == expected
+
+
+@pytest.mark.parametrize(
+    ("times", "says"),
+    [
+        # distinct as written and as floats, both 1 ns once rounded: not increasing
+        (["0.0000000010", "0.0000000014"], "row 3, column t: time does not increase"),
+        (["0", "1e10"], "row 3, column t: '1e10' is beyond the ±2**63 ns (292 years)"),
+    ],
+)
+def test_times_not_increasing_in_ns_or_beyond_int64_are_refused(
+    tmp_path: Path, times: list[str], says: str
+) -> None:
+    path = _write(tmp_path, "t,ax,ay,az\n" + "".join(f"{t},0,0,1\n" for t in times))
+    with pytest.raises(ValueError, match=None) as err:
+        read_recorder_csv(path)
+    assert says in str(err.value), err.value
 
 
 @pytest.mark.parametrize(

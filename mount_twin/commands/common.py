@@ -257,11 +257,19 @@ def _remove_unfinished(out: Path, command: str) -> None:
 
 
 def write_signal(
-    sig: Signal, out: str, topic: str, frame_id: str, start_ns: int, storage: str
+    sig: Signal,
+    out: str,
+    topic: str,
+    frame_id: str,
+    start_ns: int,
+    storage: str,
+    stamps_ns: np.ndarray | None = None,
 ) -> int:
-    """Write `sig` as sensor_msgs/Imu messages stamped start_ns + t into a new bag; a topic
-    that is no ROS topic name, a frame id with whitespace, stamps a bag cannot hold and a
-    stamp of 0 (unset in ROS) are refused before it is created."""
+    """Write `sig` as sensor_msgs/Imu messages stamped start_ns + t into a new bag (+ the int
+    `stamps_ns` where given: a record's exact times, which sig.t as floats holds only to some
+    240 ns from the epoch on); a topic that is no ROS topic name, a frame id with whitespace,
+    stamps a bag cannot hold and a stamp of 0 (unset in ROS) are refused before it is
+    created."""
     import numpy as np
 
     from mount_twin.io.bag import check_stamp, write_bag
@@ -275,13 +283,14 @@ def write_signal(
         msg = f"--frame-id {frame_id!r} {problem}"
         raise ValueError(msg)
 
-    stamps = start_ns + np.rint(sig.t * 1e9).astype(np.int64)
-    try:
-        check_stamp(out, topic, int(stamps.min()))
-        check_stamp(out, topic, int(stamps.max()))
+    since = np.rint(sig.t * 1e9).astype(np.int64) if stamps_ns is None else stamps_ns
+    try:  # in Python's ints: start_ns + since could wrap in int64
+        check_stamp(out, topic, start_ns + int(since.min()))
+        check_stamp(out, topic, start_ns + int(since.max()))
     except BagError as err:  # the stamps are the options' doing: name them
         msg = f"{err}: start the stamps elsewhere (--start, --offset)"
         raise BagError(msg) from None
+    stamps = start_ns + since
     if (stamps == 0).any():
         msg = (
             f"{out}: {topic}: a sample would be stamped 0 ns, which ROS reads as unset (the twin "

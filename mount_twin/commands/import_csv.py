@@ -24,7 +24,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--offset",
         type=int,
         default=DEFAULT_START_NS,
-        help="added to t·1e9 for the header stamp, ns (a stamp of 0 means unset in ROS)",
+        help="added to the time in ns (a recorder CSV's exactly as written) for the header "
+        "stamp, ns (a stamp of 0 means unset in ROS)",
     )
     parser.add_argument("--delimiter", help="between cells (default: sniffed from the header)")
     parser.add_argument("--decimal", choices=[".", ","], help="decimal mark (default: sniffed)")
@@ -80,10 +81,13 @@ def run(args: argparse.Namespace) -> int:
         _refuse_format_options(args)
         signal, tag = read_xsens_csv(args.csv)
         notes = [f"a Movella/Xsens DOT export (device {tag or 'untagged'}): stamps on its clock"]
+        stamps = None  # whole µs: its float t holds them to the ns
     else:
         imported = read_recorder_csv(args.csv, fmt)
-        signal, notes = imported.signal, imported.notes
-    n = write_signal(signal, args.output, args.topic, args.frame_id, args.offset, args.storage)
+        signal, notes, stamps = imported.signal, imported.notes, imported.stamps_ns
+    n = write_signal(
+        signal, args.output, args.topic, args.frame_id, args.offset, args.storage, stamps
+    )
     print(f"wrote {n} sensor_msgs/msg/Imu messages on {args.topic} to {args.output}")
     for note in notes:
         print(f"  {note}")

@@ -18,6 +18,15 @@ import math
 import re
 import unicodedata
 from dataclasses import dataclass, field
+from decimal import (
+    MAX_EMAX,
+    MAX_PREC,
+    MIN_EMIN,
+    ROUND_HALF_EVEN,
+    Context,
+    Decimal,
+    InvalidOperation,
+)
 from pathlib import Path
 
 import numpy as np
@@ -41,8 +50,14 @@ ALIASES: dict[str, tuple[str, ...]] = {
 exports name their axes X, Y, Z)."""
 RANGE_UNIT = re.compile(r"^(\d+)g$")
 """An accelerometer channel named by its range, as enDAQ's exports do (`X (100g)`): in g."""
+TIME_NS = {"s": 10**9, "sec": 10**9, "ms": 10**6, "us": 10**3, "µs": 10**3, "ns": 1}
+"""Time unit → nanoseconds in one, exactly: a stamp is the time cell's decimal text times this
+(`time_ns`), never a float's approximation of it."""
+EXACT = Context(prec=MAX_PREC, Emax=MAX_EMAX, Emin=MIN_EMIN)
+"""Decimal arithmetic that rounds nothing (a product has the digits it needs)."""
+INT64_MAX = 2**63 - 1
 UNITS: dict[str, dict[str, float]] = {
-    "time": {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "ns": 1e-9},
+    "time": {u: 1 / (10**9 // ns) for u, ns in TIME_NS.items()},  # 1 / 1000 is the float 1e-3
     "accel": {"m/s^2": 1.0, "m/s2": 1.0, "m/s²": 1.0, "mps2": 1.0, "g": G, "mm/s^2": 1e-3},
     "gyro": {"rad/s": 1.0, "deg/s": math.pi / 180, "°/s": math.pi / 180, "dps": math.pi / 180},
 }
@@ -81,10 +96,19 @@ takes some 10 times its size in memory."""
 
 @dataclass(frozen=True)
 class Imported:
-    """The signal read, and what was assumed or found, to tell the user (`notes`)."""
+    """The signal read, and what was assumed or found, to tell the user (`notes`).
+
+    Attributes:
+        signal: the record; its `t` (s) a float per time cell, as near as a float holds it
+            (some 240 ns off from the epoch on).
+        notes: what was assumed or found.
+        stamps_ns: the time cells exactly, int64 ns (`time_ns`): what the header stamps are
+            made of, `signal.t` being too coarse for a record timed from the epoch.
+    """
 
     signal: Signal
     notes: list[str]
+    stamps_ns: np.ndarray
 
 
 def _fail(path: Path, where: str, what: str) -> ValueError:
@@ -119,18 +143,22 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     }
     scale, notes = _factors(path, header_row, names, roles, units)
     columns = [(col, scale[role]) for role, col in roles.items()]
-    values = _values(path, data, names, delimiter, decimal, columns)
-    t = values[:, 0]
-    check_increasing(path, t, [row for row, _ in data], names[roles["t"]])
+    values, time_cells = _values(path, data, names, delimiter, decimal, columns)
+    t, rows, t_name = values[:, 0], [row for row, _ in data], names[roles["t"]]
+    check_increasing(path, t, rows, t_name)
+    stamps_ns, rounded = _stamps_ns(path, rows, t_name, time_cells, units["t"], decimal)
+    check_increasing(path, stamps_ns, rows, t_name)  # two times within a ns of each other
     accel_role = f"a{fmt.axis or 'x'}"
     accel, gyro, found = _motion(values, fmt.axis, names[roles[accel_role]])
     notes += found
     shown = [r for r in ("t", accel_role, "wx") if r in roles]
     given = {r: bool(fmt.units.get(QUANTITY[r]) or header_units[roles[r]]) for r in shown}
     notes.append(_units_note({r: units[r] for r in shown}, given))
+    if rounded:
+        notes.append(f"time: {rounded} cells finer than 1 ns, rounded to the ns (half to even)")
     if decimal == ",":
         notes.append("decimal comma")
-    return Imported(Signal(t, accel, gyro), notes)
+    return Imported(Signal(t, accel, gyro), notes, stamps_ns)
 
 
 def _units_note(units: dict[str, str], given: dict[str, bool]) -> str:
@@ -178,13 +206,53 @@ def unquoted(cell: str) -> str:
     return text[1:-1] if len(text) > 1 and text[0] == text[-1] == '"' else text
 
 
+def time_ns(cell: str, ns_per_unit: int, decimal: str = ".") -> tuple[int, bool]:
+    """A time cell (as `cell_value` reads it: quoted or not, `decimal` its decimal mark) in
+    whole ns: its decimal text times `ns_per_unit`, exactly, rounded half to even where it is
+    finer than 1 ns; and whether it was rounded. ValueError where the text is no decimal
+    number, is not finite or is beyond an int64 of ns."""
+    number = unquoted(cell)
+    try:
+        value = Decimal(number.replace(",", ".") if decimal == "," else number)
+    except InvalidOperation:
+        msg = f"{cell.strip()!r} is not a decimal number"
+        raise ValueError(msg) from None
+    if not value.is_finite():
+        msg = f"{cell.strip()!r} is not finite"
+        raise ValueError(msg)
+    ns = EXACT.multiply(value, ns_per_unit)  # in base 10, however long: no float between
+    whole = ns.to_integral_value(ROUND_HALF_EVEN, EXACT)
+    if abs(whole) > INT64_MAX:  # compared as a decimal: no int of 10**huge is made
+        msg = f"{cell.strip()!r} is beyond the ±2**63 ns (292 years) a stamp holds"
+        raise ValueError(msg)
+    return int(whole), whole != ns
+
+
+def _stamps_ns(
+    path: Path, rows: list[int], column: str, cells: list[str], unit: str, decimal: str
+) -> tuple[np.ndarray, int]:
+    """The time `cells` (of the data `rows`, in `unit`) exactly in ns (`time_ns`), int64, and
+    how many of them were rounded to the ns; ValueError naming the file, row and column of
+    one that `time_ns` refuses."""
+    ns_per_unit = next(ns for u, ns in TIME_NS.items() if _same_unit(u, unit))
+    stamps = np.empty(len(cells), dtype=np.int64)
+    rounded = 0
+    for i, (row, cell) in enumerate(zip(rows, cells, strict=True)):
+        try:
+            stamps[i], finer = time_ns(cell, ns_per_unit, decimal)
+        except ValueError as err:
+            raise _cell_fail(path, row, column, str(err)) from None
+        rounded += finer
+    return stamps, rounded
+
+
 def _cell_fail(path: Path, row: int, column: str, what: str) -> ValueError:
     return _fail(path, f"row {row}, column {column}", what)
 
 
 def check_increasing(path: Path, t: np.ndarray, rows: list[int], column: str) -> None:
     """ValueError naming the file, the first row (of `rows`, the line numbers of t's samples)
-    whose time `t` (s) is not after the one before, and the time's column."""
+    whose time `t` (s, or int ns) is not after the one before, and the time's column."""
     back = np.flatnonzero(np.diff(t) <= 0.0)
     if back.size:
         raise _cell_fail(path, rows[int(back[0]) + 1], column, "time does not increase")
@@ -249,16 +317,19 @@ def _values(
     delimiter: str | None,
     decimal: str,
     columns: list[tuple[int, float]],
-) -> np.ndarray:
+) -> tuple[np.ndarray, list[str]]:
     """The data rows' (line number, text) cells of `columns` (index, factor to SI), in SI
-    units, (rows, columns); every cell checked to be a finite number, in SI units too."""
+    units, (rows, columns), every cell checked to be a finite number, in SI units too; and
+    the first column's cells as written (time's, for its exact stamps)."""
     values = np.empty((len(data), len(columns)))
+    first = []
     for i, (row, line) in enumerate(data):
         cells = line.split(delimiter) if delimiter else line.split()
         check_width(path, row, cells, names)
         for j, (col, factor) in enumerate(columns):
             values[i, j] = cell_value(path, row, names[col], cells[col], factor, decimal)
-    return values
+        first.append(cells[columns[0][0]])
+    return values, first
 
 
 def _motion(
