@@ -691,3 +691,29 @@ def test_a_run_shorter_than_a_diagnostics_period_draws_one_point_per_mount(
         assert len(x) == len(y) == 1, name
         assert float(x[0]) == pytest.approx(0.049, abs=1e-9)
         assert float(y[0]) == float(utilisation[name][1][0])
+
+
+def test_without_its_scene_a_run_that_accepted_no_sample_names_the_method_set_as_recorded(
+    tmp_path: Path,
+) -> None:
+    """A run whose every input sample was rejected (the record's frame is hull_imu, the pump's
+    scene expects deck_imu) never chose a method: its integration status names the method the
+    scene set (the pump's `auto`) until one runs. The page without --scene printed it and then
+    sent the reader to --scene for "the method the scene set", which it had just printed: it
+    says the method is the one set, that none ran and why, and needs no --scene for it."""
+    import yaml
+
+    bag, out, page = tmp_path / "hull_bag", tmp_path / "out", tmp_path / "page.html"
+    generate = ["generate", "half-sine", "-o", str(bag), "--peak", "150", "--pulse", "0.008"]
+    assert main([*generate, "--frame-id", "hull_imu"]) == 0
+    replay_args = ["replay", str(bag), "--scene", str(PUMP), "-o", str(out), "--no-progress"]
+    assert main(replay_args) == 3  # no input sample accepted
+    assert main(["report", str(out), "-o", str(page)]) == 3  # no input sample accepted
+    rows = dict(_table_rows(html.unescape(page.read_text(encoding="utf-8")), "Verdict"))
+    integ = yaml.safe_load(PUMP.read_text(encoding="utf-8"))["integration"]
+    assert integ["method"] == "auto"
+    assert rows["solver"] == (
+        f"auto (the method set; no method ran: no input sample was accepted), "
+        f"rtol {integ['rtol']:g}, atol {integ['atol']:g}, error estimate on "
+        "(as the run's integration status records them)"
+    )

@@ -356,8 +356,9 @@ def _recorded_settings(
     """The input and solver rows of a page without the scene: what the output bag records,
     the topic the run read and the frame it expected (`recorded`: the last input status'
     values), the method and tolerances (`integration`: the last integration status' values;
-    `ran`: what ran), and that the rest (message type, input conditioning, the method set)
-    needs --scene. A row the bag records nothing of is left out, not guessed."""
+    `ran`: what ran), and that the rest (message type, input conditioning, the method set
+    where one ran: the status then names it) needs --scene. A row the bag records nothing of
+    is left out, not guessed."""
     rows = []
     if recorded and "topic" in recorded:
         frame = recorded.get("frame_id")
@@ -371,15 +372,15 @@ def _recorded_settings(
         )
     if "rtol" in integration:
         estimate = ", error estimate on" if "est_force_error_rel" in integration else ""
-        method = integration.get("method", "?")
+        # until one runs the status names the method set, which then needs no --scene
+        method, none_ran = integration.get("method", "?"), not ran.startswith("ran")
         rows.append(
             [
                 "solver",
-                # until one runs the status names the method set (`ran`: no method ran)
-                f"{ran if ran.startswith('ran') else f'{method} ({ran})'}, "
+                f"{f'{method} (the method set; {ran})' if none_ran else ran}, "
                 f"rtol {integration['rtol']}, "
                 f"atol {integration.get('atol', '?')}{estimate} (as the run's integration "
-                "status records them; the method the scene set: --scene)",
+                f"status records them{'' if none_ran else '; the method the scene set: --scene'})",
             ]
         )
     return rows
