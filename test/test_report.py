@@ -9,6 +9,7 @@ import html
 import json
 import re
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -717,3 +718,92 @@ def test_without_its_scene_a_run_that_accepted_no_sample_names_the_method_set_as
         f"rtol {integ['rtol']:g}, atol {integ['atol']:g}, error estimate on "
         "(as the run's integration status records them)"
     )
+
+
+def _utilisation_drawn(
+    monkeypatch: pytest.MonkeyPatch, report_args: list[str]
+) -> tuple[dict[str, tuple[np.ndarray, np.ndarray, list[int]]], str]:
+    """The utilisation figure `report_args` draws, per mount: the line's x (s) and y, and the
+    indices of the points it marks; and the page's text."""
+    from mount_twin.analysis import report
+
+    drawn: dict[str, tuple[np.ndarray, np.ndarray, list[int]]] = {}
+    draw = report._draw_utilisation
+
+    def keep(fig: Any, *args: Any, **kwargs: Any) -> None:
+        draw(fig, *args, **kwargs)
+        for line in fig.axes[0].get_lines():
+            x, y = np.asarray(line.get_xdata()), np.asarray(line.get_ydata())
+            marked = line.get_markevery()
+            indices = list(range(len(x)))
+            if isinstance(marked, slice):
+                indices = indices[marked]
+            drawn[str(line.get_label()).split(" ")[0]] = (x, y, indices)
+
+    monkeypatch.setattr(report, "_draw_utilisation", keep)
+    assert main(report_args) == 0
+    page = Path(report_args[report_args.index("-o") + 1])
+    return drawn, html.unescape(page.read_text(encoding="utf-8"))
+
+
+def test_with_its_scene_the_first_utilisation_report_steps_over_its_period(
+    pump_ship_run: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each report holds the peak of the diagnostics period ending at its stamp: the figure
+    drew the step into each from the report before, but the first as a marker alone. With the
+    scene its period is known (the pump's diagnostics_period_s 1 s): the ship record's first
+    sample is the first output (t 0), its first report is due one period later, at 1 s, and
+    its step spans 0 to 1 s. Only the reports are marked, not the step's start."""
+    import yaml
+
+    period = yaml.safe_load(PUMP.read_text(encoding="utf-8"))["outputs"]["diagnostics_period_s"]
+    assert period == 1.0
+    page = tmp_path / "page.html"
+    args = ["report", str(pump_ship_run), "--scene", str(PUMP), "-o", str(page)]
+    drawn, _ = _utilisation_drawn(monkeypatch, args)
+    mounts = yaml.safe_load(PUMP.read_text(encoding="utf-8"))["mounts"]
+    assert sorted(n for n in drawn if not n.startswith("rated")) == sorted(
+        m["name"] for m in mounts
+    )
+    for name, (x, y, marked) in drawn.items():
+        if name.startswith("rated"):
+            continue
+        # 5 s at 1 kHz: reports at 1, 2, 3, 4 s and at the last sample, 4.999 s
+        assert x.tolist() == pytest.approx([0.0, 1.0, 2.0, 3.0, 4.0, 4.999], abs=1e-9), name
+        assert y[0] == y[1], name  # the first period's peak, held from its start
+        assert marked == [1, 2, 3, 4, 5], name
+
+
+def test_without_its_scene_the_first_utilisation_report_is_a_marker_said_so(
+    pump_ship_run: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Without the scene the first period's length is not known: the first report stays a
+    marker at its stamp, and the page says why its step is not drawn."""
+    page = tmp_path / "page.html"
+    drawn, text = _utilisation_drawn(monkeypatch, ["report", str(pump_ship_run), "-o", str(page)])
+    x, _, marked = drawn["fl"]
+    assert x.tolist() == pytest.approx([1.0, 2.0, 3.0, 4.0, 4.999], abs=1e-9)
+    assert marked == [0, 1, 2, 3, 4]
+    note = text[text.index("<h2>Utilisation</h2>") :]
+    note = note[: note.index("<h2>", 4)]
+    assert "the first report's period is not drawn" in note and "--scene" in note
+
+
+def test_the_first_utilisation_step_starts_a_period_before_its_report_or_at_the_first_output() -> (
+    None
+):
+    """The first step spans the period before the first report, clipped at the first output
+    (t 0): a report at 2.5 s of a 1 s period starts at 1.5 s, one at 0.049 s at 0."""
+    from mount_twin.analysis.report import utilisation_lines
+
+    series = {
+        "late": (np.array([2.5, 3.5]), np.array([0.3, 0.4])),
+        "short": (np.array([0.049]), np.array([0.7])),
+    }
+    lines = utilisation_lines(series, 1.0)
+    assert lines["late"][0].tolist() == pytest.approx([1.5, 2.5, 3.5])
+    assert lines["late"][1].tolist() == [0.3, 0.3, 0.4]
+    assert lines["short"][0].tolist() == pytest.approx([0.0, 0.049])
+    assert lines["short"][1].tolist() == [0.7, 0.7]
+    unknown = utilisation_lines(series, None)
+    assert unknown["late"][0].tolist() == [2.5, 3.5]

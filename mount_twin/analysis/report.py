@@ -445,10 +445,17 @@ def write_report(
         ]
     sections += _forces_sections(mounts, events)
     if utilisation and not nothing:  # a run without motion: its 0 would read as at rest
+        period_s = scene.outputs.diagnostics_period_s if scene else None
         sections += [
             "<h2>Utilisation</h2>",
-            png(lambda fig: _draw_utilisation(fig, utilisation, kinds), (10, 4)),
+            png(lambda fig: _draw_utilisation(fig, utilisation, kinds, period_s), (10, 4)),
         ]
+        if period_s is None:
+            sections.append(
+                "<p>the first report's period is not drawn, only its marker: its length is the "
+                "scene's outputs.diagnostics_period_s, which the bag does not record (--scene "
+                "draws it)</p>"
+            )
     design_passed = None
     if input_samples is not None:
         srs_sections, design_passed = _srs_section(
@@ -576,22 +583,41 @@ def _forces_sections(mounts: dict[str, Table], events: list[Event]) -> list[str]
     return out
 
 
+def utilisation_lines(
+    utilisation: dict[str, tuple[np.ndarray, np.ndarray]], period_s: float | None
+) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each mount's utilisation figure line (`utilisation_of`: report times s from the first
+    output, peaks), drawn as steps into each report's stamp: from the report before, and for
+    the first, where the diagnostics period (`period_s`, the scene's) is known, from one period
+    before its stamp or from the first output (t 0), whichever is later, the point prepended
+    holding the first peak. Without the period the first report is its point alone."""
+    if period_s is None:
+        return dict(utilisation)
+    return {
+        name: (np.insert(t, 0, max(float(t[0]) - period_s, 0.0)), np.insert(u, 0, u[0]))
+        for name, (t, u) in utilisation.items()
+    }
+
+
 def _draw_utilisation(
-    fig: Any, utilisation: dict[str, tuple[np.ndarray, np.ndarray]], kinds: dict[str, str]
+    fig: Any,
+    utilisation: dict[str, tuple[np.ndarray, np.ndarray]],
+    kinds: dict[str, str],
+    period_s: float | None = None,
 ) -> None:
     """Each rated mount's peak utilisation per diagnostics period (-) against time from the
     first output (s), and the rating (1): one marker per report, at its stamp, holding the peak
-    of the period that ends there, the step into it spanning that period from the report
-    before. The first period's peak was held from the run's start, and a run shorter than one
-    period drew flat lines across the whole run, as if measured all along."""
+    of the period that ends there, the step into it spanning that period (`utilisation_lines`:
+    the first's only where `period_s` is known; a step's start prepended is not marked)."""
     ax = fig.subplots()
-    for name, (t, u) in utilisation.items():
+    for name, (t, u) in utilisation_lines(utilisation, period_s).items():
         ax.plot(
             t,
             u,
             drawstyle="steps-pre",
             marker="o",
             markersize=3,
+            markevery=None if period_s is None else slice(1, None),
             label=f"{name} ({kinds[name]})" if name in kinds else name,  # kinds: with a scene
         )
     ax.axhline(1.0, color="red", linestyle="--", label="rated (1)")
