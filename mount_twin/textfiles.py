@@ -119,6 +119,25 @@ def new_directory_refusal(path: str | Path) -> str:
     return "" if there is None else no_directory(there)
 
 
+@contextmanager
+def directories_above(path: str | Path) -> Iterator[Path]:
+    """`path`, with the directories missing above it made (`mkdir -p` of its parent, as `ros2
+    bag record -o` and rosbags' Writer make them) for the block to make `path` in. If the block
+    raises, those made here are removed again, nearest first, each if empty: an output the
+    block left at `path` keeps them, one it removed (or never began) leaves none behind, where
+    they had been left empty, made by a run that wrote nothing."""
+    target = Path(path)
+    made = [p for p in target.parents if not os.path.lexists(p)]  # nearest first
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        yield target
+    except BaseException:
+        for directory in made:
+            with suppress(OSError):  # not empty (an output kept), or never made
+                directory.rmdir()
+        raise
+
+
 def _cannot_write(path: Path, err: OSError) -> OSError:
     """`err` as an OSError of the same errno naming `path` as the file that was not written."""
     return OSError(err.errno, f"cannot write: {err.strerror or err}", str(path))

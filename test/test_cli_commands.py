@@ -651,3 +651,56 @@ def test_bags_in_directories_named_dot_bag_are_read_like_any_other(
     with (tmp_path / "tables" / "pose.csv").open(encoding="utf-8") as fh:
         assert sum(1 for _ in fh) == 1 + 400
     assert main(["report", str(out), "-o", str(tmp_path / "r.html")]) == 0
+
+
+def test_replay_makes_the_directories_missing_above_its_output_bag(tmp_path: Path) -> None:
+    """`ros2 bag record -o a/b/c` and rosbags' Writer (which generate and import-csv write
+    with) make the directories missing above a new bag, as `mkdir -p` does; replay refused
+    them ("cannot create the bag"). It makes them; a replay refused before its bag is begun
+    (a topic the input does not have) leaves none of them behind."""
+    bag = ROOT / "bags" / "half_sine_shock_10khz"
+    out = tmp_path / "a" / "b" / "out"
+    replay = ["replay", str(bag), "--scene", str(SCENE_FILE), "-o", str(out), "--no-progress"]
+    assert main([*replay, "--topic", "/no/such/topic"]) == 2
+    assert not (tmp_path / "a").exists()
+    assert main(replay) == 0
+    assert read_bag(out)  # a readable bag, where it was asked for
+
+
+def test_generate_failing_before_its_first_message_leaves_no_directory_it_made(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A generate whose first message cannot be written (a full disk) left the bag it had
+    begun, empty, and the directories it made above it: a rerun was refused ("output bag
+    exists") for a bag holding nothing. Having written nothing, it removes all it made."""
+    import errno
+
+    from rosbags.rosbag2 import Writer
+
+    def full(*_: object) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(Writer, "write", full)
+    out = tmp_path / "a" / "b" / "out"
+    assert main(["generate", "half-sine", "-o", str(out)]) == 2
+    assert "No space left on device, after 0 messages" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_synthesize_stopped_removes_the_directories_it_made_above_its_output(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A synthesize that stops before its end removes its unfinished output directory; the
+    directories it had made above it (it makes them, `mkdir -p`) stayed, empty."""
+    from mount_twin.commands import synthesize
+
+    def stopped(*_: object) -> None:
+        raise ValueError("stopped before the first seed")
+
+    monkeypatch.setattr(synthesize, "synthesized", stopped)
+    (tmp_path / "kept").mkdir()
+    out = tmp_path / "kept" / "a" / "b" / "out"
+    spectrum = ROOT / "config" / "shock_spectrum_vertical.csv"
+    assert main(["synthesize", "--spectrum", str(spectrum), "-o", str(out)]) == 2
+    assert list(tmp_path.iterdir()) == [tmp_path / "kept"]  # what was there stays
+    assert list((tmp_path / "kept").iterdir()) == []

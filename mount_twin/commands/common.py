@@ -215,20 +215,22 @@ def new_directory(path: str | Path, command: str) -> Iterator[Path]:
     what the command put in it if the command stops before its end (an error, a signal): an
     empty one blocked the rerun, and one holding the outputs so far (the first seeds of
     synthesize, half a qualification without its verdict) read as a finished result and
-    blocked the rerun too. It holds nothing else: it is new, made by this run."""
-    from mount_twin.textfiles import new_directory_refusal
+    blocked the rerun too. It holds nothing else: it is new, made by this run. The directories
+    missing above it are made, and removed with it (`textfiles.directories_above`)."""
+    from mount_twin.textfiles import directories_above, new_directory_refusal
 
     out = Path(path)
     if why := new_directory_refusal(out):
         said = f"exists; {command} writes a new directory" if why == "exists" else why
         msg = f"{out}: {said}"
         raise ValueError(msg)
-    out.mkdir(parents=True)
-    try:
-        yield out
-    except BaseException:
-        _remove_unfinished(out, command)
-        raise
+    with directories_above(out):  # removed too if it is
+        out.mkdir()
+        try:
+            yield out
+        except BaseException:
+            _remove_unfinished(out, command)
+            raise
 
 
 def _remove_unfinished(out: Path, command: str) -> None:

@@ -34,7 +34,7 @@ from mount_twin.io.mcap_salvage import Salvage, salvage
 from mount_twin.io.mcap_writer import McapBagWriter
 from mount_twin.io.messages import TYPESTORE, Encoded, RowBlock
 from mount_twin.io.raw_rows import joined, nbytes
-from mount_twin.textfiles import new_directory_refusal
+from mount_twin.textfiles import directories_above, new_directory_refusal
 
 _INFINITE = QosTime(9223372036, 854775807)
 """RMW_DURATION_INFINITE (sec, nsec), as a Jazzy recording stores a default deadline/lifespan."""
@@ -431,7 +431,8 @@ class OutputBag:
     = the message's stamp.
 
     Args:
-        path: new bag directory (must not exist: an output bag is never overwritten).
+        path: new bag directory (must not exist: an output bag is never overwritten); the
+            directories missing above it are made (`textfiles.directories_above`).
         topics: resolved topic → message type.
         offered_qos: resolved topic → QoS profiles its publisher offered (recorded in the bag's
             metadata, replayed by `ros2 bag play`); topics not listed record none (the player's
@@ -448,7 +449,8 @@ class OutputBag:
         check_new_bag(self.path)
         qos = {topic: list(profiles) for topic, profiles in (offered_qos or {}).items()}
         try:
-            self._writer = McapBagWriter(self.path, topics, qos)
+            with directories_above(self.path):
+                self._writer = McapBagWriter(self.path, topics, qos)
         except OSError as err:
             msg = f"{self.path}: cannot create the bag: {err.strerror or err}"
             raise BagError(msg) from err
@@ -575,18 +577,28 @@ def write_bag(
     storage: str = "mcap",
 ) -> int:
     """Write one topic's (stamp ns, CDR bytes) messages into a new bag; return the count. An
-    existing `path` (`check_new_bag`) and a failed write (a full disk) name the bag."""
+    existing `path` (`check_new_bag`) and a failed write (a full disk) name the bag. The
+    directories missing above it are made; a write stopped before its first message removes
+    the bag it began and them (`textfiles.directories_above`): an empty bag only blocked the
+    rerun. One stopped later leaves the bag of the messages before, as rosbags closes it."""
     check_new_bag(path)
     plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
-    n = 0
-    try:
-        with Writer(Path(path), version=Writer.VERSION_LATEST, storage_plugin=plugin) as writer:
-            conn = writer.add_connection(topic, msgtype, typestore=TYPESTORE)
-            for stamp, raw in messages:
-                check_stamp(path, topic, stamp)
-                writer.write(conn, stamp, raw)
-                n += 1
-    except OSError as err:
-        msg = f"{path}: cannot write: {err.strerror or err}, after {n} messages"
-        raise BagError(msg) from err
+    n, begun = 0, False
+    with directories_above(path):
+        try:
+            with Writer(Path(path), version=Writer.VERSION_LATEST, storage_plugin=plugin) as w:
+                begun = True  # the directory is this run's: Writer refuses one already there
+                conn = w.add_connection(topic, msgtype, typestore=TYPESTORE)
+                for stamp, raw in messages:
+                    check_stamp(path, topic, stamp)
+                    w.write(conn, stamp, raw)
+                    n += 1
+        except BaseException as err:
+            removed = begun and n == 0
+            if removed:
+                shutil.rmtree(path, ignore_errors=True)
+            if isinstance(err, OSError):
+                msg = f"{path}: cannot write: {err.strerror or err}, after {n} messages"
+                raise BagError(msg + ("; the bag begun is removed" if removed else "")) from err
+            raise
     return n
