@@ -235,8 +235,7 @@ class TwinStream:
         assert self.ageing is not None and self.base is not None
         accel, gyro = provided(decoded.accel, decoded.gyro, decoded.unprovided)
         good = np.isfinite(np.hstack([accel, gyro])).all(axis=1)
-        reads_rate = self.scene.input.gyro_filter != "ignore"
-        good &= ~disregarded(decoded.unprovided, good.shape[0], reads_rate)
+        good &= ~disregarded(decoded.unprovided, good.shape[0], self.scene.input.reads_rate)
         expected = self.scene.input.frame_id
         if expected:
             good &= np.array([f == expected for f in decoded.frame_ids], bool)
@@ -257,7 +256,7 @@ class TwinStream:
     def _foundation_rate(self, decoded: Decoded) -> np.ndarray:
         """The foundation's rate Ω_F (rad/s, F) of each decoded sample: its gyro in F, or
         zeros where the scene ignores it (input.gyro_filter: ignore)."""
-        if self.scene.input.gyro_filter == "ignore":
+        if not self.scene.input.reads_rate:
             return np.zeros((decoded.stamps_ns.shape[0], 3))
         with np.errstate(invalid="ignore", over="ignore"):  # a rejected sample's inf: unused
             return rotated(decoded.gyro, self.engine.model.sensor_rotation)

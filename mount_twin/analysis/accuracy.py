@@ -143,7 +143,7 @@ def conditioned(scene: Scene, samples: SampleBatch) -> SampleBatch:
         gaps = np.diff(samples.stamps) > spec.max_gap_s
         restarts = (np.flatnonzero(gaps) + 1).tolist() if spec.gap_policy == "reset" else []
         gyro = conditioned_rates(bands, samples.stamps, samples.gyro, restarts)
-    elif spec.gyro_filter == "ignore":
+    elif not spec.reads_rate:
         gyro = np.zeros_like(samples.gyro)
     else:
         return samples

@@ -200,7 +200,7 @@ def predict(scene: Scene, foundation: Signal) -> tuple[np.ndarray, np.ndarray]:
     batch = SampleBatch(foundation.t, foundation.accel, foundation.gyro, frames)
     model, out = followed(scene, batch, "the foundation record")
     rate = np.zeros((len(out), 3))  # the foundation's Ω at the rows, rad/s in F
-    if scene.input.gyro_filter != "ignore":
+    if scene.input.reads_rate:
         gyro = np.stack([np.interp(out.stamps, foundation.t, w) for w in foundation.gyro.T], 1)
         rate = rotated(gyro, model.sensor_rotation)
     sensor = scene.body_sensor or BodySensor()

@@ -116,9 +116,8 @@ def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
         msg = f"{args.scene}: no body_sensor: where is the body's IMU and how is it turned?"
         raise ValueError(msg)
     spec = scene.input
-    reads_rate = spec.gyro_filter != "ignore"  # the twin's run reads the deck's rate
     foundation, base = _read_record(
-        args.foundation, spec.topic, spec.msg_type, None, FOUNDATION_KEYS, reads_rate
+        args.foundation, spec.topic, spec.msg_type, None, FOUNDATION_KEYS, spec.reads_rate
     )
     body, _ = _read_record(args.body, scene.body_sensor.topic, IMU, base, BODY_KEYS)
     named = (f"--body {args.body}", f"--foundation {args.foundation}'s")

@@ -56,8 +56,6 @@ NEVER_STARTED = "the twin never started"
 """What a run that accepted samples but ended before a start says (`HealthWindow.never_started`):
 fewer samples than `initial_state.gravity_samples` (it had written no report at all, and its
 replay read OK)."""
-
-
 NOT_DESIGNED = (
     "the gyro filter was never designed: no two input samples were accepted without a restart "
     "between them"

@@ -299,7 +299,7 @@ class Intake:
         f = self._into_f(accel)
         if not self.spec.includes_gravity:
             f = f + self._gravity_up
-        if self.spec.gyro_filter == "ignore":  # the foundation's rotation neglected
+        if not self.spec.reads_rate:  # the foundation's rotation neglected
             return f, np.zeros_like(f), finite
         return f, self._into_f(gyro), finite
 
@@ -400,7 +400,7 @@ class Intake:
         if batch.unprovided is not None:  # REP-145: a reading to disregard
             if batch.unprovided[i, 0]:
                 return "no_acceleration"
-            if batch.unprovided[i, 1] and self.spec.gyro_filter != "ignore":
+            if batch.unprovided[i, 1] and self.spec.reads_rate:
                 return "no_angular_velocity"
         if self.last_stamp is None:
             return START

@@ -81,8 +81,7 @@ def provided_input(bag: str | Path, spec: InputSpec) -> tuple[Decoded, str]:
     what the twin's replay takes. The twin's outputs are those of the whole record: it skips
     such a sample without leaving a hole."""
     decoded = read_input(bag, spec)
-    reads_rate = spec.gyro_filter != "ignore"
-    marked = disregarded(decoded.unprovided, len(decoded.stamps_ns), reads_rate)
+    marked = disregarded(decoded.unprovided, len(decoded.stamps_ns), spec.reads_rate)
     note = ""
     if marked.any():
         note = (

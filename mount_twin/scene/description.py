@@ -123,6 +123,12 @@ class InputSpec:
     gyro_range_rad_s: float = 0.0
 
     @property
+    def reads_rate(self) -> bool:
+        """Whether the twin reads the gyro (Ω and Ω′ from it): every `gyro_filter` but
+        'ignore', which neglects the foundation's rotation (Ω = 0)."""
+        return self.gyro_filter != "ignore"
+
+    @property
     def g_scale(self) -> float:
         """The acceleration (m/s²) the checks scaled by g take as their unit: g, or standard
         gravity in a scene without gravity (a start check then asks for |f₀| within the
