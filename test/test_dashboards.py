@@ -12,12 +12,14 @@ from xml.etree import ElementTree as ET
 import pytest
 import yaml
 from io_helpers import CONFIG, ROOT
+from matplotlib import colormaps
+from matplotlib.colors import to_hex
 
 from mount_twin.analysis.dashboards import foxglove_layout, plotjuggler_layout
 from mount_twin.cli import main
 from mount_twin.io.messages import IMU, TYPESTORE, output_streams, output_types, resolve
 from mount_twin.replay import NODE_NAME
-from mount_twin.scene.description import BodySensor
+from mount_twin.scene.description import BodySensor, Scene
 from mount_twin.scene.loader import load_scene_file
 
 SCENES = ("pump_8_mounts", "genset_bolted_keyed")
@@ -184,3 +186,46 @@ def test_foxglove_shows_each_plot_and_series_with_its_unit(scene_name: str, body
         topics = {next(t for t in units if _as_readme_writes(c).startswith(t)) for c in curves}
         (unit,) = {units[t] for t in topics}
         assert area.get("name", "").endswith(f"[{unit}]")
+
+
+def _with_mounts(count: int) -> Scene:
+    """The pump with `count` mounts: copies of its first, named m00, m01, ..."""
+    pump = load_scene_file(CONFIG / "pump_8_mounts.scene.yaml")
+    mounts = tuple(dataclasses.replace(pump.mounts[0], name=f"m{k:02d}") for k in range(count))
+    return dataclasses.replace(pump, mounts=mounts)
+
+
+FORCE = re.compile(r"/mounts/([^/]+)/wrench[/.]wrench[/.]force[/.]([xyz])$")
+"""A mount force curve (PlotJuggler's `/` or Foxglove's `.` after the topic): mount, axis."""
+
+
+@pytest.mark.parametrize("count", [8, 11, 20, 21, 41])
+def test_no_two_curves_of_a_panel_look_alike(count: int) -> None:
+    """Curves took 8 colours in turn: in a force panel of 11 mounts the 9th mount's curve was
+    drawn as the 1st's; Foxglove's series named none, so it cycled its own 7 (in the bundled
+    layouts mount 8 looked like mount 1). Each panel's curves now take colours of matplotlib's
+    tab20, each a different one (a curve's colour is all PlotJuggler styles it by, and
+    Foxglove has no dash pattern either): a force panel holds at most 20 mounts, more go into
+    further panels, each mount's force plotted once per axis."""
+    scene = _with_mounts(count)
+    tab20 = {to_hex(c) for c in colormaps["tab20"].colors}
+    root = ET.fromstring(plotjuggler_layout(scene))
+    fox = json.loads(foxglove_layout(scene))["configById"].values()
+    layouts = {
+        "plotjuggler": [
+            [(c.get("name", ""), c.get("color")) for c in area.iter("curve")]
+            for area in root.iter("DockArea")
+        ],
+        "foxglove": [[(p["value"], p.get("color")) for p in panel["paths"]] for panel in fox],
+    }
+    for tool, panels in layouts.items():
+        for curves in panels:
+            colours = [colour for _, colour in curves]
+            assert len(set(colours)) == len(colours), (tool, curves)
+            assert set(colours) <= tab20, (tool, curves)
+        names = [name for curves in panels for name, _ in curves]
+        forces = [m.groups() for name in names if (m := FORCE.search(name))]
+        for axis in "xyz":
+            plotted = [mount for mount, a in forces if a == axis]
+            assert plotted == [m.name for m in scene.mounts], (tool, axis)
+        assert len(panels) == 2 + 3 * -(-count // 20), tool

@@ -6,7 +6,7 @@
 Series are named the way each tool names message fields: PlotJuggler `/topic/field/sub`,
 Foxglove message paths `/topic.field.sub` (plotted against the header stamp). Each plot's title
 carries its unit; Foxglove also labels each series with it (PlotJuggler names a curve by its
-series only).
+series only). No two curves of a panel share a colour (`PALETTE`).
 """
 
 from __future__ import annotations
@@ -26,7 +26,17 @@ from mount_twin.io.messages import (
 from mount_twin.replay import NODE_NAME
 from mount_twin.scene.description import Scene
 
-COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f")
+PALETTE = (
+    *("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd"),
+    *("#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"),
+    *("#aec7e8", "#ffbb78", "#98df8a", "#ff9896", "#c5b0d5"),
+    *("#c49c94", "#f7b6d2", "#c7c7c7", "#dbdb8d", "#9edae5"),
+)
+"""matplotlib's tab20: its ten strong colours (tab10's, in order), then their light companions.
+A panel's curves take one each, in order, and a panel holds at most this many curves (more
+mounts go into further force panels): a curve's colour is all PlotJuggler styles it by (line
+style and width are the plot's), and Foxglove has no dash pattern either, so a repeated colour
+would draw two curves alike."""
 
 
 Series = list[tuple[str, tuple[str, ...], str]]
@@ -35,9 +45,10 @@ Series = list[tuple[str, tuple[str, ...], str]]
 
 def panels(scene: Scene) -> list[tuple[str, Series]]:
     """(panel title, [(topic, field path, series label)]) of each plot of what the scene
-    publishes: pose, angles, force x, y, z, and with a body_sensor the body IMU's predicted and
-    residual specific force; titles and labels end with the unit. ValueError where it
-    publishes none of them."""
+    publishes: pose, angles, force x, y, z (each over as few panels as hold at most
+    len(PALETTE) mounts, in even shares, each titled with its first and last mount where there
+    are several), and with a body_sensor the body IMU's predicted and residual specific
+    force; titles and labels end with the unit. ValueError where it publishes none of them."""
     published = scene.outputs
     pose = resolve(POSE_OUTPUT.topic, NODE_NAME)
     angles = resolve(ANGLES_OUTPUT.topic, NODE_NAME)
@@ -51,10 +62,15 @@ def panels(scene: Scene) -> list[tuple[str, Series]]:
     if published.wrenches:
         streams = zip(WRENCHES_OUTPUT.streams(scene), scene.mounts, strict=True)
         topics = [(resolve(st.topic, NODE_NAME), m.name) for st, m in streams]
+        shares = -(-len(topics) // len(PALETTE))
+        size = -(-len(topics) // shares)
+        groups = [topics[i : i + size] for i in range(0, len(topics), size)]
         for k, axis in enumerate("xyz"):
             force = _path(WRENCHES_OUTPUT, k)
-            series = [(t, force, f"{name} [N]") for t, name in topics]
-            out.append((f"mount force along mount {axis} [N]", series))
+            for group in groups:
+                which = f", {group[0][1]} … {group[-1][1]}" if shares > 1 else ""
+                series = [(t, force, f"{name} [N]") for t, name in group]
+                out.append((f"mount force along mount {axis}{which} [N]", series))
     if scene.body_sensor is not None:  # the body IMU against the twin (its axes)
         for topic, what in (
             (BODY_PREDICTED_TOPIC, "predicted"),
@@ -98,7 +114,7 @@ def plotjuggler_layout(scene: Scene) -> str:
         ET.SubElement(plot, "limitY")
         for k, (topic, field, _label) in enumerate(series):
             name = "/".join([topic, *field])
-            ET.SubElement(plot, "curve", {"name": name, "color": COLOURS[k % len(COLOURS)]})
+            ET.SubElement(plot, "curve", {"name": name, "color": PALETTE[k]})
     ET.indent(root)
     return (
         "<?xml version='1.0' encoding='UTF-8'?>\n" + ET.tostring(root, encoding="unicode") + "\n"
@@ -121,8 +137,9 @@ def foxglove_layout(scene: Scene) -> str:
                     "enabled": True,
                     "timestampMethod": "headerStamp",
                     "label": label,
+                    "color": PALETTE[k],
                 }
-                for topic, field, label in series
+                for k, (topic, field, label) in enumerate(series)
             ],
             "showLegend": True,
             "isSynced": True,
