@@ -229,3 +229,96 @@ def test_no_two_curves_of_a_panel_look_alike(count: int) -> None:
             plotted = [mount for mount, a in forces if a == axis]
             assert plotted == [m.name for m in scene.mounts], (tool, axis)
         assert len(panels) == 2 + 3 * -(-count // 20), tool
+
+
+def _layout_curves(xml: str, json_text: str) -> tuple[list[str], list[str]]:
+    """The curves of a PlotJuggler layout and the series of a Foxglove one, in order."""
+    fox = json.loads(json_text)["configById"].values()
+    return (
+        [c.get("name", "") for c in ET.fromstring(xml).iter("curve")],
+        [p["value"] for panel in fox for p in panel["paths"]],
+    )
+
+
+def test_a_namespaced_renamed_node_is_plotted_on_its_topics(tmp_path: Path) -> None:
+    """`ros2 run mount_twin mount_twin_node --ros-args -r __ns:=/pump1 -r __node:=twin`
+    publishes `~/pose` on /pump1/twin/pose (rcl: a private name is the namespace, the node's
+    name, then the rest); the layouts plotted /mount_twin/pose, and every panel stayed empty.
+    `--namespace /pump1 --node-name twin`, as the remaps, plots the topics named here by
+    hand."""
+    pj, fox = tmp_path / "l.xml", tmp_path / "l.json"
+    scene_file = CONFIG / "pump_8_mounts.scene.yaml"
+    args = ["dashboard", str(scene_file), "--plotjuggler", str(pj), "--foxglove", str(fox)]
+    assert main([*args, "--namespace", "/pump1", "--node-name", "twin"]) == 0
+    mounts = [m.name for m in load_scene_file(scene_file).mounts]
+    assert mounts[:2] == ["fl", "fr"]
+    fields = [
+        *(("/pump1/twin/pose", f"pose.position.{a}") for a in "xyz"),
+        *(("/pump1/twin/angles", f"vector.{a}") for a in "xyz"),
+        *((f"/pump1/twin/mounts/{m}/wrench", f"wrench.force.{a}") for a in "xyz" for m in mounts),
+    ]
+    curves, paths = _layout_curves(pj.read_text("utf-8"), fox.read_text("utf-8"))
+    assert curves == [f"{t}/{f.replace('.', '/')}" for t, f in fields]
+    assert paths == [f"{t}.{f}" for t, f in fields]
+
+
+def test_a_body_imu_under_a_nested_namespace() -> None:
+    """`-r __ns:=/plant/pump1 -r __node:=twin`: `~/body_imu/residual` is
+    /plant/pump1/twin/body_imu/residual."""
+    pump = load_scene_file(CONFIG / "pump_8_mounts.scene.yaml")
+    scene = dataclasses.replace(pump, body_sensor=BodySensor(position=(0.8, 0.3, 1.0)))
+    node = {"namespace": "/plant/pump1", "node_name": "twin"}
+    curves, paths = _layout_curves(
+        plotjuggler_layout(scene, **node), foxglove_layout(scene, **node)
+    )
+    for what in ("predicted", "residual"):
+        topic = f"/plant/pump1/twin/body_imu/{what}"
+        assert [c for c in curves if c.startswith(f"{topic}/")] == [
+            f"{topic}/linear_acceleration/{a}" for a in "xyz"
+        ]
+        assert [p for p in paths if p.startswith(f"{topic}.")] == [
+            f"{topic}.linear_acceleration.{a}" for a in "xyz"
+        ]
+    assert all(c.startswith("/plant/pump1/twin/") for c in curves + paths)
+
+
+@pytest.mark.parametrize("scene_name", SCENES)
+def test_the_default_node_name_and_namespace_write_the_bundled_layouts(
+    scene_name: str, tmp_path: Path
+) -> None:
+    """`--namespace /` (no namespace, as `ros2 run` gives) and `--node-name mount_twin`, the
+    defaults, are the layouts in config/."""
+    pj, fox = tmp_path / "l.xml", tmp_path / "l.json"
+    scene = str(CONFIG / f"{scene_name}.scene.yaml")
+    node = ["--namespace", "/", "--node-name", "mount_twin"]
+    assert main(["dashboard", scene, "--plotjuggler", str(pj), "--foxglove", str(fox), *node]) == 0
+    assert pj.read_text("utf-8") == (CONFIG / f"{scene_name}.plotjuggler.xml").read_text("utf-8")
+    assert fox.read_text("utf-8") == (CONFIG / f"{scene_name}.foxglove.json").read_text("utf-8")
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "said"),
+    [
+        ("--namespace", "pump1", "absolute"),  # rcl: `__ns:=pump1` is no remap rule
+        ("--namespace", "/pump1/", "ends with '/'"),
+        ("--namespace", "/a//b", "empty token"),
+        ("--namespace", "/1pump", "starts with a digit"),
+        ("--namespace", "/a-b", "only ASCII letters"),
+        ("--node-name", "1twin", "not a ROS node name"),
+        ("--node-name", "a/b", "not a ROS node name"),
+        ("--node-name", "~twin", "not a ROS node name"),
+        ("--node-name", "", "not a ROS node name"),
+    ],
+)
+def test_a_name_ros_refuses_is_refused_naming_the_option(
+    option: str, value: str, said: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Each is a remap rcl refuses (`-r __ns:=pump1`, `-r __node:=1twin` end the node at
+    its start): no layout for a node that cannot run."""
+    args = ["dashboard", str(CONFIG / "pump_8_mounts.scene.yaml"), "--plotjuggler"]
+    with pytest.raises(SystemExit, match="2"):
+        main([*args, str(tmp_path / "l.xml"), f"{option}={value}"])
+    err = capsys.readouterr().err
+    assert f"argument {option}: {value!r}" in err
+    assert said in err
+    assert not (tmp_path / "l.xml").exists()

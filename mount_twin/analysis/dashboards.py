@@ -1,7 +1,10 @@
 """Ready dashboards for a scene's outputs: a PlotJuggler layout (XML) and a Foxglove layout
 (JSON), each plotting the CG position, the attitude angles and every mount's force components
 (with a body IMU, its predicted specific force and the residual too) from the node's topics
-(live) or an output bag (the same topics).
+(live) or an output bag (the same topics). The topics are the node's private (`~/`) names,
+resolved as rcl does for the node's namespace and name (`-r __ns:=/pump1 -r __node:=twin`:
+/pump1/twin/pose); by default the node's own name, no namespace, as `ros2 run`, the bundled
+launch file and `mount-twin replay` have it.
 
 Series are named the way each tool names message fields: PlotJuggler `/topic/field/sub`,
 Foxglove message paths `/topic.field.sub` (plotted against the header stamp). Each plot's title
@@ -43,15 +46,18 @@ Series = list[tuple[str, tuple[str, ...], str]]
 """A plot's series: (topic, field path, label with its unit)."""
 
 
-def panels(scene: Scene) -> list[tuple[str, Series]]:
+def panels(
+    scene: Scene, namespace: str = "/", node_name: str = NODE_NAME
+) -> list[tuple[str, Series]]:
     """(panel title, [(topic, field path, series label)]) of each plot of what the scene
     publishes: pose, angles, force x, y, z (each over as few panels as hold at most
     len(PALETTE) mounts, in even shares, each titled with its first and last mount where there
     are several), and with a body_sensor the body IMU's predicted and residual specific
-    force; titles and labels end with the unit. ValueError where it publishes none of them."""
+    force; titles and labels end with the unit; topics those of the node `node_name` in
+    `namespace`. ValueError where it publishes none of them."""
     published = scene.outputs
-    pose = resolve(POSE_OUTPUT.topic, NODE_NAME)
-    angles = resolve(ANGLES_OUTPUT.topic, NODE_NAME)
+    pose = resolve(POSE_OUTPUT.topic, node_name, namespace)
+    angles = resolve(ANGLES_OUTPUT.topic, node_name, namespace)
     out: list[tuple[str, Series]] = []
     if published.pose:
         series = [(pose, _path(POSE_OUTPUT, k), f"{a} [m]") for k, a in enumerate("xyz")]
@@ -61,7 +67,7 @@ def panels(scene: Scene) -> list[tuple[str, Series]]:
         out.append(("α (x), γ (y), δ (z) [rad]", series))
     if published.wrenches:
         streams = zip(WRENCHES_OUTPUT.streams(scene), scene.mounts, strict=True)
-        topics = [(resolve(st.topic, NODE_NAME), m.name) for st, m in streams]
+        topics = [(resolve(st.topic, node_name, namespace), m.name) for st, m in streams]
         shares = -(-len(topics) // len(PALETTE))
         size = -(-len(topics) // shares)
         groups = [topics[i : i + size] for i in range(0, len(topics), size)]
@@ -76,7 +82,7 @@ def panels(scene: Scene) -> list[tuple[str, Series]]:
             (BODY_PREDICTED_TOPIC, "predicted"),
             (BODY_RESIDUAL_TOPIC, "residual"),
         ):
-            resolved = resolve(topic, NODE_NAME)
+            resolved = resolve(topic, node_name, namespace)
             series = [(resolved, ("linear_acceleration", a), f"{a} [m/s²]") for a in "xyz"]
             out.append((f"body IMU specific force, {what} [m/s²]", series))
     if not out:
@@ -93,13 +99,14 @@ def _path(output: Output, column: int) -> tuple[str, ...]:
     return tuple(output.fields[column].split("."))
 
 
-def plotjuggler_layout(scene: Scene) -> str:
-    """A PlotJuggler layout: one tab, the panels stacked."""
+def plotjuggler_layout(scene: Scene, namespace: str = "/", node_name: str = NODE_NAME) -> str:
+    """A PlotJuggler layout: one tab, the panels stacked (`panels`: of the node `node_name` in
+    `namespace`)."""
     root = ET.Element("root")
     tabs = ET.SubElement(root, "tabbed_widget", {"parent": "main_window", "name": "Main Window"})
     tab = ET.SubElement(tabs, "Tab", {"tab_name": scene.name, "containers": "1"})
     container = ET.SubElement(tab, "Container")
-    items = panels(scene)
+    items = panels(scene, namespace, node_name)
     share = ";".join([f"{1 / len(items):.6f}"] * len(items))
     split = ET.SubElement(
         container, "DockSplitter", {"orientation": "-", "sizes": share, "count": str(len(items))}
@@ -121,11 +128,12 @@ def plotjuggler_layout(scene: Scene) -> str:
     )
 
 
-def foxglove_layout(scene: Scene) -> str:
-    """A Foxglove layout: the panels in one column."""
+def foxglove_layout(scene: Scene, namespace: str = "/", node_name: str = NODE_NAME) -> str:
+    """A Foxglove layout: the panels in one column (`panels`: of the node `node_name` in
+    `namespace`)."""
     config: dict[str, object] = {}
     ids = []
-    for k, (title, series) in enumerate(panels(scene)):
+    for k, (title, series) in enumerate(panels(scene, namespace, node_name)):
         panel = f"Plot!mt{k}"
         ids.append(panel)
         config[panel] = {

@@ -554,7 +554,8 @@ def output_table(topic: str, msgtype: str) -> tuple[str, Readback] | None:
 
 
 def resolve(name: str, node_name: str, namespace: str = "/") -> str:
-    """Resolve a private (~) or relative topic name as rclpy would, for a node without remaps."""
+    """Resolve a private (~) or relative topic name as rclpy would for the node `node_name` in
+    `namespace` (what `-r __node:=` and `-r __ns:=` set; no topic remaps)."""
     ns = "/" + namespace.strip("/") if namespace.strip("/") else ""
     if name.startswith("~"):
         return f"{ns}/{node_name}{name[1:]}"
