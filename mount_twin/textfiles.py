@@ -7,8 +7,8 @@ from __future__ import annotations
 import os
 import secrets
 import stat
-from collections.abc import Iterator
-from contextlib import contextmanager, suppress
+from collections.abc import Callable, Iterator
+from contextlib import ExitStack, contextmanager, suppress
 from pathlib import Path
 from typing import TextIO
 
@@ -37,42 +37,80 @@ def replacing(path: str | Path) -> Iterator[Path]:
     when written and synced, removed if anything fails. A failure to write is an OSError
     naming `path` (its filename; its strerror says "cannot write: ..."): a bare errno had not
     said which file, and a full disk had left a truncated file. An existing file keeps its
-    permissions; a new one gets the umask's. A target that is no regular file (a FIFO,
-    /dev/full) or is named under /dev or /proc (/dev/stdout, even redirected to a file: the
-    rename would put a new file in place of the shell's) is written directly."""
-    given = Path(path)
-    try:
-        mode = os.stat(given).st_mode
-    except FileNotFoundError:
-        mode = None
-    except OSError as err:
-        raise _cannot_write(given, err) from err
-    device = Path(os.path.abspath(given)).parts[1:2] in (("dev",), ("proc",))
-    if device or (mode is not None and not stat.S_ISREG(mode)):
+    permissions; a new one gets the umask's. The directories missing above a new one are
+    made, and removed again if it is not written (`directories_above`). A target that is no
+    regular file (a FIFO, /dev/full) or is named under /dev or /proc (/dev/stdout, even
+    redirected to a file: the rename would put a new file in place of the shell's) is written
+    directly."""
+    with replacing_all() as replace:
+        yield replace(path)
+
+
+@contextmanager
+def replacing_all() -> Iterator[Callable[[str | Path], Path]]:
+    """`replace(path)`, which gives the path to write the new content of `path` at (each as
+    `replacing` gives it), for files put in place together when the block ends: every one
+    written and synced before the first is renamed into place, so that a failure while any is
+    written (a full disk, a signal) leaves none of them, not the first few looking finished,
+    and the files that were there as they were. A rename failing after others (a race) removes
+    the files those made new; those they replaced stay replaced, each whole. A failure is an
+    OSError naming the file: the one last given out while the block ran, the one synced or
+    renamed after it."""
+    stack = ExitStack()
+    pending: list[tuple[Path, Path, Path, bool]] = []  # given, tmp, target, target was there
+    current: list[Path] = []  # the file a failure is named after
+
+    def replace(path: str | Path) -> Path:
+        given = Path(path)
+        current[:] = [given]
         try:
-            yield given
-        except OSError as err:
-            raise _cannot_write(given, err) from err
-        return
-    target = Path(os.path.realpath(given))
-    tmp = target.with_name(f".{target.stem}.partial-{secrets.token_hex(4)}{target.suffix}")
-    try:
+            mode = os.stat(given).st_mode
+        except FileNotFoundError:
+            mode = None
+        device = Path(os.path.abspath(given)).parts[1:2] in (("dev",), ("proc",))
+        if device or (mode is not None and not stat.S_ISREG(mode)):
+            return given
+        target = Path(os.path.realpath(given))
+        stack.enter_context(directories_above(target))
+        tmp = target.with_name(f".{target.stem}.partial-{secrets.token_hex(4)}{target.suffix}")
         os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+        stack.callback(_remove, tmp)  # gone once renamed into place
         if mode is not None:
             os.chmod(tmp, stat.S_IMODE(mode))
-        yield tmp
-        fd = os.open(tmp, os.O_RDONLY)
-        try:
-            os.fsync(fd)  # a delayed allocation's ENOSPC comes here, before the rename
-        finally:
-            os.close(fd)
-        os.replace(tmp, target)
-    except BaseException as err:
-        with suppress(OSError):
-            tmp.unlink()
-        if isinstance(err, OSError):
-            raise _cannot_write(given, err) from err
-        raise
+        pending.append((given, tmp, target, mode is not None))
+        return tmp
+
+    try:
+        with stack:
+            yield replace
+            for given, tmp, _, _ in pending:
+                current[:] = [given]
+                fd = os.open(tmp, os.O_RDONLY)
+                try:
+                    os.fsync(fd)  # a delayed allocation's ENOSPC comes here, before the rename
+                finally:
+                    os.close(fd)
+            renamed: list[tuple[Path, bool]] = []
+            try:
+                for given, tmp, target, there in pending:
+                    current[:] = [given]
+                    os.replace(tmp, target)
+                    renamed.append((target, there))
+            except OSError:
+                for target, there in renamed:
+                    if not there:
+                        _remove(target)
+                raise
+    except OSError as err:
+        if not current:  # not one of the files: the block's own
+            raise
+        raise _cannot_write(current[0], err) from err
+
+
+def _remove(path: Path) -> None:
+    """Remove the file `path` if it is there."""
+    with suppress(OSError):
+        path.unlink()
 
 
 @contextmanager
@@ -112,10 +150,15 @@ def new_directory_refusal(path: str | Path) -> str:
     can; "exists" if a directory or file is there; else what is in the way at or above it
     (`no_directory`: a dangling symlink, or a file where a directory goes). Checked before
     long work: the write at its end had failed with "File exists" or rosbags' traceback."""
-    target = Path(path)
-    if target.exists():
-        return "exists"
-    there = on_disk(target)
+    return "exists" if Path(path).exists() else directory_refusal(path)
+
+
+def directory_refusal(path: str | Path) -> str:
+    """Why `path` can be no directory to write into, the one there or one made with the
+    missing ones above it (as `directories_above` makes them): '' if it can be; else what is
+    in the way at or above it (`no_directory`): checked before the work, for a directory of
+    outputs and for an output file's directory alike."""
+    there = on_disk(Path(path))
     return "" if there is None else no_directory(there)
 
 

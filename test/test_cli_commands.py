@@ -423,23 +423,26 @@ CALIBRATE = (
     ],
     ids=lambda c: c.split()[0],
 )
-@pytest.mark.parametrize("through", [False, True], ids=["path", "symlink"])
+@pytest.mark.parametrize("where", ["under_a_file", "under_a_dangling_symlink", "symlink"])
 def test_a_target_no_file_can_be_written_at_is_refused_before_the_work(
     tmp_path: Path,
     command: str,
-    through: bool,
+    where: str,
     shock_out: Path,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """A --json in a missing directory: the replay ran to its end, then exit 2 (its verdict's
-    exit status lost). So did one through a symlink into a missing directory (the link's own
-    directory was checked, not its target's), and `report -o` anywhere: it read the bags
-    first."""
-    missing = tmp_path / "missing" / "x"
-    target = tmp_path / "link" if through else missing
-    if through:
-        target.symlink_to(missing)
+    """A --json under a file (where its directory goes, or one above it: no directory can be
+    made there) or under a symlink to a missing directory: the replay ran to its end, then
+    exit 2 (its verdict's exit status lost). So did one through a symlink into a missing
+    directory (the link's own directory was checked, not its target's), and `report -o`
+    anywhere: it read the bags first."""
+    afile, link, missing = tmp_path / "afile", tmp_path / "link", tmp_path / "missing" / "x"
+    afile.write_text("not a directory", encoding="utf-8")
+    link.symlink_to(missing if where == "symlink" else missing.parent)
+    target = {"under_a_file": afile / "a" / "x", "under_a_dangling_symlink": link / "x"}.get(
+        where, link
+    )
 
     def unread(*_: object) -> None:
         raise AssertionError("the bag was read before the target was checked")
@@ -447,11 +450,15 @@ def test_a_target_no_file_can_be_written_at_is_refused_before_the_work(
     monkeypatch.setattr("mount_twin.io.output_tables.read_output_bag", unread)
     flag = _refused(command, target, tmp_path / "out", shock_out)
     err = capsys.readouterr().err
-    said = f"a symlink to {missing}: " if through else ""
-    assert (
-        f"mount-twin: error: {flag} {target}: {said}there is no directory {missing.parent}" in err
-    )
-    assert not (tmp_path / "out").exists()
+    said = {
+        "under_a_file": f"{afile} is not a directory",
+        "under_a_dangling_symlink": f"{link} is a symlink to {missing.parent}, which does not "
+        "exist",
+        "symlink": f"a symlink to {missing}: there is no directory {missing.parent}",
+    }[where]
+    assert f"mount-twin: error: {flag} {target}: {said}\n" in err
+    assert sorted(tmp_path.iterdir()) == [afile, link]
+    assert afile.read_text(encoding="utf-8") == "not a directory"
 
 
 @pytest.mark.parametrize("name", ["figure.txt", "figure"])
@@ -573,6 +580,61 @@ def test_a_figure_the_disk_cannot_take_is_named_and_leaves_no_part_of_it(
     assert done.returncode == 2, done.stderr
     assert done.stderr.endswith(f"mount-twin: error: {png}: cannot write: File too large\n")
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        "replay bags/half_sine_shock_10khz --scene config/pump_8_mounts.scene.yaml -o OUT "
+        "--no-progress --json X",
+        "srs bags/genset_shock_10khz --csv X",
+        "srs bags/genset_shock_10khz --plot X",
+        "report BAG -o X",
+        "show config/pump_8_mounts.scene.yaml -o X",
+        "dashboard config/pump_8_mounts.scene.yaml --foxglove X",
+    ],
+    ids=["replay-json", "srs-csv", "srs-plot", "report", "show", "foxglove"],
+)
+def test_a_file_output_is_written_in_the_directories_it_makes_above_it(
+    tmp_path: Path, shock_out: Path, command: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Output directories get the directories missing above them made (`ros2 bag record -o
+    a/b/c`), and so does an output file now: `--json a/b/s.json` was refused, "there is no
+    directory a/b"."""
+    monkeypatch.chdir(ROOT)
+    target = tmp_path / "a" / "b" / ("x.png" if "-plot" in command or "show" in command else "x")
+    args = [
+        {"X": str(target), "OUT": str(tmp_path / "out"), "BAG": str(shock_out)}.get(a, a)
+        for a in command.split()
+    ]
+    assert main(args) == 0
+    assert list((tmp_path / "a" / "b").iterdir()) == [target]
+    assert target.stat().st_size > 0
+
+
+@pytest.mark.parametrize(
+    ("command", "written"),
+    [
+        (["report", "BAG", "-o", "X"], "X"),
+        (["show", str(SCENE_FILE), "-o", "X.png"], "X.png"),
+        (["export", "BAG", "--csv", "X"], "X/pose.csv"),
+    ],
+    ids=["report", "show", "export"],
+)
+def test_an_output_the_disk_cannot_take_leaves_no_directory_it_made(
+    tmp_path: Path, shock_out: Path, command: list[str], written: str
+) -> None:
+    """An output in directories missing above it, which the disk cannot take (RLIMIT_FSIZE,
+    as a full disk): the error names the file, and the directories made for it are removed
+    with it; those that were there stay."""
+    (tmp_path / "kept").mkdir()
+    target = tmp_path / "kept" / "a" / "b" / "x"
+    args = [a.replace("X", str(target)) if "X" in a else a for a in command]
+    done = run_python("-c", LIMITED, *[str(shock_out) if a == "BAG" else a for a in args])
+    assert done.returncode == 2, done.stderr
+    failed = written.replace("X", str(target))
+    assert done.stderr.endswith(f"mount-twin: error: {failed}: cannot write: File too large\n")
+    assert list(tmp_path.rglob("*")) == [tmp_path / "kept"]
 
 
 def test_an_output_replaced_keeps_its_mode_and_a_symlink_to_it(

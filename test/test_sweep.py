@@ -175,7 +175,7 @@ def test_results_that_are_no_regular_file_are_an_error_before_any_case_runs(
     assert "/dev/full: the results CSV is no regular file" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("where", ["other_csv", "the_sweep_file", "missing_directory"])
+@pytest.mark.parametrize("where", ["other_csv", "the_sweep_file", "under_a_file"])
 def test_results_no_sweep_can_append_to_are_an_error_naming_them_before_any_case_runs(
     tmp_path: Path,
     where: str,
@@ -183,13 +183,13 @@ def test_results_no_sweep_can_append_to_are_an_error_naming_them_before_any_case
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     """-o of a CSV without a `case` column (or the sweep file itself) died with a KeyError
-    traceback (exit 1); -o into a missing directory started the cluster, then said only
-    "FILE: No such file or directory". Each is refused before the cluster starts, naming the
-    file; what is there is left as it was."""
+    traceback (exit 1); -o under a file (no directory can be made there) started the cluster,
+    then said only "FILE: Not a directory". Each is refused before the cluster starts, naming
+    the file; what is there is left as it was."""
     sweep = _sweep_file(tmp_path)
     other = tmp_path / "other.csv"
     other.write_text("time,az\n0.0,1.0\n", encoding="utf-8")
-    out = {"other_csv": other, "the_sweep_file": sweep}.get(where, tmp_path / "no" / "r.csv")
+    out = {"other_csv": other, "the_sweep_file": sweep}.get(where, other / "no" / "r.csv")
     before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
 
     def no_cluster(*_: object) -> None:
@@ -200,10 +200,41 @@ def test_results_no_sweep_can_append_to_are_an_error_naming_them_before_any_case
     said = {
         "other_csv": f"{out}: its columns are not this sweep's",
         "the_sweep_file": f"--output {out}: would replace {sweep}, which this command reads",
-        "missing_directory": f"--output {out}: there is no directory {out.parent}",
+        "under_a_file": f"--output {out}: {other} is not a directory",
     }[where]
     assert said in capsys.readouterr().err
     assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
+
+
+@pytest.mark.parametrize("rows", [0, 1])
+def test_results_in_directories_it_makes_are_removed_with_them_if_stopped_before_a_row(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, rows: int
+) -> None:
+    """-o a/b/r.csv makes the directories missing above the results, as every output does. A
+    sweep stopped (Ctrl-C) before its first row leaves neither the results CSV, which would
+    hold only its header, nor them; one stopped after a row keeps the row, for the rerun."""
+    from contextlib import contextmanager
+
+    from mount_twin.sweeps import runner
+
+    @contextmanager
+    def cluster(*_: object):
+        yield type("Client", (), {"scheduler_info": lambda _: {"workers": {"w": None}}})()
+
+    def stopped(*_: object):
+        yield from [[{"case": "c0"}]][:rows]
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner, "dask_client", cluster)
+    monkeypatch.setattr(runner, "results_as_completed", stopped)
+    (tmp_path / "kept").mkdir()
+    results = tmp_path / "kept" / "a" / "b" / "r.csv"
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(load_sweep(_sweep_file(tmp_path / "kept")), results, workers=1)
+    if rows:
+        assert [r["case"] for r in read_results(results)] == ["c0"]
+    else:
+        assert sorted(tmp_path.rglob("*")) == [tmp_path / "kept", tmp_path / "kept" / "sweep.yaml"]
 
 
 @pytest.fixture(scope="module")

@@ -121,12 +121,15 @@ def check_targets(
     **targets: str | None,
 ) -> None:
     """ValueError naming the option (`--json` for json=...) of the first given path a file
-    cannot be written at (its directory missing, or a directory there; through a symlink, its
-    target's directory missing: the file is written there; for the options named in
-    `figures`, a name not ending in one of FIGURE_FORMATS), or whose file would replace one
-    the command reads (`reads`: its input files and bags; None where not given): checked
-    before long work, which had run to its end to fail there with exit 2, its own exit status
-    lost, or to replace the recording or scene it had read (exit 0)."""
+    cannot be written at (a directory there; a file or a dangling symlink in place of its
+    directory or one above it, which is made if missing: `textfiles.directory_refusal`;
+    through a symlink, its target's directory missing: the file is written there; for the
+    options named in `figures`, a name not ending in one of FIGURE_FORMATS), or whose file
+    would replace one the command reads (`reads`: its input files and bags; None where not
+    given): checked before long work, which had run to its end to fail there with exit 2, its
+    own exit status lost, or to replace the recording or scene it had read (exit 0)."""
+    from mount_twin.textfiles import directory_refusal
+
     for option, path in targets.items():
         if path is None:
             continue
@@ -134,11 +137,14 @@ def check_targets(
         if target.is_dir():
             msg = f"{flag} {path}: is a directory"
             raise ValueError(msg)
-        link = target.is_symlink()
-        directory = Path(os.path.realpath(target)).parent if link else target.parent
-        if not directory.is_dir():
-            via = f"a symlink to {os.readlink(target)}: " if link else ""
-            msg = f"{flag} {path}: {via}there is no directory {directory}"
+        if target.is_symlink():
+            directory = Path(os.path.realpath(target)).parent
+            if not directory.is_dir():
+                via = f"a symlink to {os.readlink(target)}"
+                msg = f"{flag} {path}: {via}: there is no directory {directory}"
+                raise ValueError(msg)
+        elif why := directory_refusal(target.parent):
+            msg = f"{flag} {path}: {why}"
             raise ValueError(msg)
         if option in figures and target.suffix.lower().lstrip(".") not in FIGURE_FORMATS:
             msg = (

@@ -80,7 +80,10 @@ def run(args: argparse.Namespace) -> int:
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        pq.write_table(pa.Table.from_pylist(rows), args.parquet)
+        from mount_twin.textfiles import replacing
+
+        with replacing(args.parquet) as tmp:
+            pq.write_table(pa.Table.from_pylist(rows), tmp)
         print(f"parquet: {args.parquet}")
     if args.plot:
         from mount_twin.sweeps.plot import plot_sweep

@@ -39,6 +39,7 @@ from mount_twin.scene.loader import scene_from_dict
 from mount_twin.sweeps.cases import Case, apply, expand
 from mount_twin.sweeps.cluster import dask_client, results_as_completed
 from mount_twin.sweeps.spec import InputCase, SweepSpec
+from mount_twin.textfiles import directories_above
 
 UTILISATION = "utilisation"
 """The result table's per-mount utilisation columns are UTILISATION.<mount> (NaN: unrated)."""
@@ -219,18 +220,29 @@ def run_sweep(
 @contextmanager
 def _appender(path: Path, head: list[str]) -> Iterator[Callable[[dict[str, Any]], None]]:
     """Append rows to a CSV (header written if the file is new), flushed row by row; its
-    columns were checked by `finished_cases`."""
+    columns were checked by `finished_cases`. The directories missing above a new one are
+    made; one that a sweep stopped before its first row leaves is removed with them
+    (`textfiles.directories_above`): it held only the header this run wrote."""
     new = not path.exists() or path.stat().st_size == 0
-    with path.open("a", encoding="utf-8", newline="") as fh:
-        writer = csv.DictWriter(fh, head, extrasaction="raise")
-        if new:
-            writer.writeheader()
+    appended = 0
+    with directories_above(path):
+        try:
+            with path.open("a", encoding="utf-8", newline="") as fh:
+                writer = csv.DictWriter(fh, head, extrasaction="raise")
+                if new:
+                    writer.writeheader()
 
-        def append(row: dict[str, Any]) -> None:
-            writer.writerow({k: _cell(row.get(k, "")) for k in head})
-            fh.flush()
+                def append(row: dict[str, Any]) -> None:
+                    nonlocal appended
+                    writer.writerow({k: _cell(row.get(k, "")) for k in head})
+                    fh.flush()
+                    appended += 1
 
-        yield append
+                yield append
+        except BaseException:
+            if new and not appended:
+                path.unlink(missing_ok=True)
+            raise
 
 
 def _cell(value: Any) -> Any:
