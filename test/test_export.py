@@ -118,6 +118,92 @@ def test_a_dangling_symlink_in_the_way_is_refused_naming_it_before_reading(
     assert link.is_symlink() and not (tmp_path / "missing").exists()
 
 
+def _files(root: Path) -> dict[Path, bytes]:
+    """Every file under `root` and its bytes."""
+    return {p: p.read_bytes() for p in root.rglob("*") if p.is_file()}
+
+
+def test_an_export_that_fails_part_way_leaves_the_directory_as_it_was(
+    replayed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`export --csv DIR` into a directory holding a table's name as a directory (the last
+    table's, events.csv): the tables before it were left in DIR, each looking finished (and
+    the last export's pose.csv replaced), then exit 2. Now none of them is put in place until
+    every one is written: DIR is left as it was, its own files untouched."""
+    tables = tmp_path / "tables"
+    tables.mkdir()
+    (tables / "pose.csv").write_text("the last pose\n", encoding="utf-8")
+    (tables / "notes.txt").write_text("mine\n", encoding="utf-8")
+    (tables / "events.csv").mkdir()
+    before = _files(tmp_path)
+
+    assert main(["export", str(replayed), "--csv", str(tables)]) == 2
+    err = capsys.readouterr().err
+    assert err.endswith(
+        f"mount-twin: error: {tables / 'events.csv'}: cannot write: Is a directory\n"
+    )
+    assert _files(tmp_path) == before
+    assert sorted(p.name for p in tables.iterdir()) == ["events.csv", "notes.txt", "pose.csv"]
+
+
+def test_an_export_whose_rename_fails_removes_the_tables_it_made_new(
+    replayed: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every table is written before the first is renamed into place; a rename failing after
+    others (a race: here the third) removes the tables those renames made new, and leaves no
+    file being written; a table that was there before is replaced whole (the new pose)."""
+    import errno
+    import os
+
+    tables = tmp_path / "tables"
+    tables.mkdir()
+    (tables / "pose.csv").write_text("the last pose\n", encoding="utf-8")
+    rename, calls = os.replace, []
+
+    def third_fails(src: str | Path, dst: str | Path) -> None:
+        calls.append(dst)
+        if len(calls) == 3:
+            raise OSError(errno.EIO, "Input/output error")
+        rename(src, dst)
+
+    monkeypatch.setattr(os, "replace", third_fails)
+    assert main(["export", str(replayed), "--csv", str(tables)]) == 2
+    assert [Path(c).name for c in calls] == ["pose.csv", "angles.csv", "mount_fl.csv"]
+    assert sorted(p.name for p in tables.iterdir()) == ["pose.csv"]
+    _, msgs = read_bag(replayed)
+    assert len(_csv(tables / "pose.csv")) == len(msgs["/mount_twin/pose"])
+
+
+def test_an_export_into_a_new_directory_that_fails_leaves_nothing_it_made(
+    replayed: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`export --csv a/b/tables` makes tables and the directories above it; one that fails
+    on a table after the first (a full disk) removes the tables written so far and the
+    directories it made, leaving what was there."""
+    import errno
+
+    from mount_twin.io import output_tables
+
+    write, written = output_tables._write_csv, []
+
+    def full_at_the_second(table: Table, path: Path) -> None:
+        if written:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        write(table, path)
+        written.append(path)
+
+    monkeypatch.setattr(output_tables, "_write_csv", full_at_the_second)
+    (tmp_path / "kept").mkdir()
+    tables = tmp_path / "kept" / "a" / "b" / "tables"
+    assert main(["export", str(replayed), "--csv", str(tables)]) == 2
+    assert written  # the first table was written before the failure
+    assert list(tmp_path.rglob("*")) == [tmp_path / "kept"]
+
+    monkeypatch.setattr(output_tables, "_write_csv", write)
+    assert main(["export", str(replayed), "--csv", str(tables)]) == 0
+    assert (tables / "pose.csv").is_file()
+
+
 def test_replay_json_summary_times_events_from_the_first_output(tmp_path: Path) -> None:
     import json
 

@@ -40,14 +40,12 @@ def run(args: argparse.Namespace) -> int:
 def _check_directory(flag: str, path: str) -> None:
     """ValueError naming `flag` where no directory of tables can be at `path` (export creates it
     or writes into it): a file there, or in place of a directory above it, or a dangling
-    symlink at or above it. Checked before the bag is read, which had been read whole to fail
-    there ("/dev/full: File exists", "LINK: File exists")."""
-    from mount_twin.textfiles import no_directory, on_disk
+    symlink at or above it (`textfiles.directory_refusal`). Checked before the bag is read,
+    which had been read whole to fail there ("/dev/full: File exists", "LINK: File exists")."""
+    from mount_twin.textfiles import directory_refusal
 
-    target = Path(path)
-    existing = on_disk(target)
-    if existing is None or not (why := no_directory(existing)):
+    if not (why := directory_refusal(path)):
         return
-    said = "exists, not a directory" if target.exists() else why
+    said = "exists, not a directory" if Path(path).exists() else why
     msg = f"{flag} {path}: {said}; export writes one file per table into a directory"
     raise ValueError(msg)

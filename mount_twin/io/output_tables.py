@@ -27,7 +27,7 @@ from mount_twin.io.bag import reader_paths
 from mount_twin.io.bag_info import require_existing
 from mount_twin.io.messages import DIAGNOSTICS, OUTPUTS, TYPESTORE, Readback, output_table
 from mount_twin.kinds.events import EVENT_IS_ERROR
-from mount_twin.textfiles import replacing, text_output
+from mount_twin.textfiles import replacing_all
 
 LEVELS = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
 EVENT = re.compile(r"(\w+) ×(\d+) \(first (\d+\.\d+) s, \|F\| max ([\d.e+-]+) N\)")
@@ -200,22 +200,28 @@ def events_table(diagnostics: Table, origin_ns: int) -> Table:
 
 def write_tables(tables: list[Table], directory: str | Path, fmt: str = "csv") -> list[Path]:
     """Write each table as DIRECTORY/<name>.csv (or .parquet, with pyarrow); returns the
-    files. The directory is created; existing files of the same names are replaced."""
+    files. All or none (`textfiles.replacing_all`): each is written beside its place and all
+    are put in place once every one is written, replacing the files of the same names; a
+    failure (a full disk, a directory where a table goes, a signal) leaves the directory as it
+    was, not the first tables looking finished. The directory is made, with those missing
+    above it, and removed with them if no table is written."""
     out_dir = Path(directory)
-    out_dir.mkdir(parents=True, exist_ok=True)
     files = []
-    for table in tables:
-        path = out_dir / f"{table.name}.{fmt}"
-        if fmt == "parquet":
-            import pyarrow as pa
-            import pyarrow.parquet as pq
+    with replacing_all() as replace:
+        for table in tables:
+            path = out_dir / f"{table.name}.{fmt}"
+            tmp = replace(path)
+            if fmt == "parquet":
+                import pyarrow as pa
+                import pyarrow.parquet as pq
 
-            columns = {k: v.tolist() if v.dtype == object else v for k, v in table.columns.items()}
-            with replacing(path) as tmp:
+                columns = {
+                    k: v.tolist() if v.dtype == object else v for k, v in table.columns.items()
+                }
                 pq.write_table(pa.table(columns), tmp)
-        else:
-            _write_csv(table, path)
-        files.append(path)
+            else:
+                _write_csv(table, tmp)
+            files.append(path)
     return files
 
 
@@ -223,7 +229,7 @@ def _write_csv(table: Table, path: Path) -> None:
     import csv
 
     names = list(table.columns)
-    with text_output(path, newline="") as fh:
+    with path.open("w", encoding="utf-8", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(names)
         for row in zip(*(table.columns[n].tolist() for n in names), strict=True):
