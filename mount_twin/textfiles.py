@@ -52,10 +52,10 @@ def replacing_all() -> Iterator[Callable[[str | Path], Path]]:
     `replacing` gives it), for files put in place together when the block ends: every one
     written and synced before the first is renamed into place, so that a failure while any is
     written (a full disk, a signal) leaves none of them, not the first few looking finished,
-    and the files that were there as they were. A rename failing after others (a race) removes
-    the files those made new; those they replaced stay replaced, each whole. A failure is an
-    OSError naming the file: the one last given out while the block ran, the one synced or
-    renamed after it."""
+    and the files that were there as they were. A rename failing after others (a race, a
+    signal) removes the files those made new; those they replaced stay replaced, each whole.
+    A failure is an OSError naming the file: the one last given out while the block ran, the
+    one synced or renamed after it."""
     stack = ExitStack()
     pending: list[tuple[Path, Path, Path, bool]] = []  # given, tmp, target, target was there
     current: list[Path] = []  # the file a failure is named after
@@ -96,7 +96,7 @@ def replacing_all() -> Iterator[Callable[[str | Path], Path]]:
                     current[:] = [given]
                     os.replace(tmp, target)
                     renamed.append((target, there))
-            except OSError:
+            except BaseException:  # an error, or a signal between two renames
                 for target, there in renamed:
                     if not there:
                         _remove(target)

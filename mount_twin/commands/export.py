@@ -14,7 +14,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "bag", help="output bag of `mount-twin replay` (or a recording of the node)"
     )
     target = parser.add_mutually_exclusive_group(required=True)
-    target.add_argument("--csv", metavar="DIR", help="one CSV per table into DIR")
+    target.add_argument(
+        "--csv", metavar="DIR", help="one CSV per table into DIR (made if missing); all or none"
+    )
     target.add_argument(
         "--parquet", metavar="DIR", help="one Parquet file per table into DIR (needs pyarrow)"
     )
