@@ -146,13 +146,22 @@ def test_an_export_that_fails_part_way_leaves_the_directory_as_it_was(
     assert sorted(p.name for p in tables.iterdir()) == ["events.csv", "notes.txt", "pose.csv"]
 
 
+@pytest.mark.parametrize(
+    ("stop", "status"),
+    [(OSError(5, "Input/output error"), 2), (KeyboardInterrupt(), 130)],
+    ids=["error", "ctrl-c"],
+)
 def test_an_export_whose_rename_fails_removes_the_tables_it_made_new(
-    replayed: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    replayed: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    stop: BaseException,
+    status: int,
 ) -> None:
     """Every table is written before the first is renamed into place; a rename failing after
-    others (a race: here the third) removes the tables those renames made new, and leaves no
-    file being written; a table that was there before is replaced whole (the new pose)."""
-    import errno
+    others (a race, or a Ctrl-C between two: here at the third) removes the tables those
+    renames made new, and leaves no file being written; a table that was there before is
+    replaced whole (the new pose)."""
     import os
 
     tables = tmp_path / "tables"
@@ -163,11 +172,11 @@ def test_an_export_whose_rename_fails_removes_the_tables_it_made_new(
     def third_fails(src: str | Path, dst: str | Path) -> None:
         calls.append(dst)
         if len(calls) == 3:
-            raise OSError(errno.EIO, "Input/output error")
+            raise stop
         rename(src, dst)
 
     monkeypatch.setattr(os, "replace", third_fails)
-    assert main(["export", str(replayed), "--csv", str(tables)]) == 2
+    assert main(["export", str(replayed), "--csv", str(tables)]) == status
     assert [Path(c).name for c in calls] == ["pose.csv", "angles.csv", "mount_fl.csv"]
     assert sorted(p.name for p in tables.iterdir()) == ["pose.csv"]
     _, msgs = read_bag(replayed)
