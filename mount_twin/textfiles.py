@@ -70,8 +70,8 @@ def replacing_all() -> Iterator[Callable[[str | Path], Path]]:
         device = Path(os.path.abspath(given)).parts[1:2] in (("dev",), ("proc",))
         if device or (mode is not None and not stat.S_ISREG(mode)):
             return given
+        stack.enter_context(directories_above(given))  # not through a symlink's target
         target = Path(os.path.realpath(given))
-        stack.enter_context(directories_above(target))
         tmp = target.with_name(f".{target.stem}.partial-{secrets.token_hex(4)}{target.suffix}")
         os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
         stack.callback(_remove, tmp)  # gone once renamed into place

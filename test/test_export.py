@@ -213,6 +213,23 @@ def test_an_export_into_a_new_directory_that_fails_leaves_nothing_it_made(
     assert (tables / "pose.csv").is_file()
 
 
+def test_a_table_that_is_a_dangling_symlink_makes_no_directory_where_it_points(
+    replayed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The directories missing above an output are made above the path given, not through a
+    symlink at it: DIR/pose.csv linked into a missing directory is refused as it was, naming
+    it, and nothing is made where it points."""
+    tables = tmp_path / "tables"
+    tables.mkdir()
+    (tables / "pose.csv").symlink_to(tmp_path / "elsewhere" / "pose.csv")
+
+    assert main(["export", str(replayed), "--csv", str(tables)]) == 2
+    err = capsys.readouterr().err
+    pose = tables / "pose.csv"
+    assert err.endswith(f"mount-twin: error: {pose}: cannot write: No such file or directory\n")
+    assert sorted(tmp_path.rglob("*")) == [tables, pose]
+
+
 def test_replay_json_summary_times_events_from_the_first_output(tmp_path: Path) -> None:
     import json
 

@@ -221,9 +221,10 @@ def run_sweep(
 def _appender(path: Path, head: list[str]) -> Iterator[Callable[[dict[str, Any]], None]]:
     """Append rows to a CSV (header written if the file is new), flushed row by row; its
     columns were checked by `finished_cases`. The directories missing above a new one are
-    made; one that a sweep stopped before its first row leaves is removed with them
+    made; a new one that a sweep stopped before its first row leaves is removed with them
     (`textfiles.directories_above`): it held only the header this run wrote."""
-    new = not path.exists() or path.stat().st_size == 0
+    made = not (path.exists() or path.is_symlink())  # nor a dangling symlink
+    new = made or path.stat().st_size == 0
     appended = 0
     with directories_above(path):
         try:
@@ -240,7 +241,7 @@ def _appender(path: Path, head: list[str]) -> Iterator[Callable[[dict[str, Any]]
 
                 yield append
         except BaseException:
-            if new and not appended:
+            if made and not appended:
                 path.unlink(missing_ok=True)
             raise
 
