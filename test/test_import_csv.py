@@ -389,3 +389,45 @@ def test_a_quoted_cell_that_is_no_number_is_refused_naming_it(tmp_path: Path, ce
     with pytest.raises(ValueError, match=None) as err:
         read_recorder_csv(path)
     assert str(err.value) == f"{path}: row 3, column ay: {cell!r} is not a number"
+
+
+def test_quoted_decimal_commas_between_commas_are_read_or_refused_naming_the_option(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A spreadsheet in a decimal-comma locale, saving with commas between cells, quotes its
+    numbers: `"0,001","0,12",...`. Each such row had been split at every comma and refused as
+    "row 2: 8 cells where the header has 4", naming neither a cell nor an option. The quotes
+    keep a cell whole; the decimal comma is sniffed (or given with --decimal ,); where it is not
+    (or `"1,234"`, a thousands separator as much as a decimal comma, is all there is), the cell
+    is refused naming the file, row, column, cell and the option."""
+    text = (
+        '"t [s]","ax","ay","az"\n'
+        '"1700000000,0001","0,12","-0,5","9,81"\n'
+        '"1700000000,001","1,5e1","0","9,8"\n'
+    )
+    path = _write(tmp_path, text)
+    for options in ([], ["--decimal", ","]):
+        got = read_recorder_csv(path, CsvFormat(decimal=(options or [None, None])[1]))
+        np.testing.assert_array_equal(got.signal.accel, [[0.12, -0.5, 9.81], [15.0, 0, 9.8]])
+        assert "decimal comma" in got.notes
+        out = tmp_path / f"bag{len(options)}"
+        args = ["import-csv", str(path), "-o", str(out), "--offset", "0", *options]
+        assert main(args) == 0
+        _, msgs = read_bag(out)
+        stamps = [stamp_ns(m) for _, m in msgs["/deck/imu"]]
+        assert stamps == [1_700_000_000_000_100_000, 1_700_000_000_001_000_000]
+    option = "`mount-twin import-csv --decimal ,`"
+    with pytest.raises(ValueError, match=None) as err:
+        read_recorder_csv(path, CsvFormat(decimal="."))
+    assert str(err.value).startswith(
+        f"{path}: row 2, column t: '\"1700000000,0001\"' is not a number: a decimal comma? "
+        f"say {option}"
+    ), err.value
+    ambiguous = _write(tmp_path, 't,ax,ay,az\n"1,250",0,0,"9,810"\n"2,500",0,0,"9,810"\n', "a.csv")
+    assert main(["import-csv", str(ambiguous), "-o", str(tmp_path / "bag")]) == 2
+    said = capsys.readouterr().err
+    assert f"{ambiguous}: row 2, column t: '\"1,250\"' is not a number" in said, said
+    assert option in said and "thousands separators are not read" in said, said
+    assert not (tmp_path / "bag").exists()
+    got = read_recorder_csv(ambiguous, CsvFormat(decimal=","))
+    np.testing.assert_array_equal(got.signal.t, [1.25, 2.5])

@@ -1,9 +1,10 @@
 """Accelerometer (and gyro) CSV files as recorders write them, read into a `Signal`.
 
 Accepted: `,` `;` tab or whitespace between cells (sniffed from the header line), a decimal
-comma (with `;`, tab or whitespace delimiters), a UTF-8 byte-order mark (Excel's "CSV UTF-8"),
-comment lines (`#`) and blank lines, cells in double quotes (`"0"`, as spreadsheets write
-them), units in the header (`t [s]`, `AccZ (g)`, `wx[deg/s]`), quoted header cells and
+comma (with `;`, tab or whitespace delimiters; with `,` in quoted cells, `"0,12"`), a UTF-8
+byte-order mark (Excel's "CSV UTF-8"), comment lines (`#`) and blank lines, cells in double
+quotes (`"0"`, as spreadsheets write them; a delimiter within them is no cell's end), units
+in the header (`t [s]`, `AccZ (g)`, `wx[deg/s]`), quoted header cells and
 channels named by their range (enDAQ's `"X (100g)"`: g), common column names (`time`, `AccX`,
 `gyro_x`, `X`, ...) or an explicit mapping, files without gyro columns (Ω = 0), and
 single-axis records (`CsvFormat.axis`: one acceleration column along a stated sensor axis, the
@@ -66,6 +67,11 @@ QUANTITY = {"t": "time", **dict.fromkeys(ROLES[1:4], "accel"), **dict.fromkeys(R
 UNIT_APART = re.compile(r"\s+(?![\[(])")
 """Whitespace between header cells: not that before a bracketed unit (`Time [ms]`)."""
 HEADER_CELL = re.compile(r"^\s*(.*?)\s*(?:[\[(]\s*(.*?)\s*[\])])?\s*$")
+DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+(?:[eE][+-]?\d+)?$")
+"""A number written with a decimal comma (`0,12`, `-1,5e3`)."""
+THOUSANDS = re.compile(r"^[+-]?[1-9]\d{0,2}(?:,\d{3})+$")
+"""A whole number with commas between groups of three digits (`1,234`), as a spreadsheet
+with thousands separators quotes it: a decimal comma or not, the text does not say."""
 
 
 @dataclass(frozen=True)
@@ -74,7 +80,7 @@ class CsvFormat:
 
     Attributes:
         delimiter: between cells; None: `;`, tab or `,` as the header has them, else spaces.
-        decimal: '.' or ','; None: ',' if the delimiter is not ',' and the numbers have one.
+        decimal: '.' or ','; None: ',' if the numbers have one (`_sniffed_decimal`).
         columns: role (t, ax, ay, az, wx, wy, wz) → header name, for names not recognised.
         units: quantity (time, accel, gyro) → unit, overriding the header's.
         axis: 'x', 'y' or 'z' for a single-axis record: its one acceleration column (mapped
@@ -135,9 +141,7 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     data = lines[1:]
     if not data:
         raise _fail(path, f"row {header_row}", "a header but no data rows")
-    decimal = fmt.decimal or (
-        "," if delimiter != "," and any("," in line for _, line in data[:50]) else "."
-    )
+    decimal = fmt.decimal or _sniffed_decimal([line for _, line in data[:50]], delimiter)
     units = {
         role: _unit(QUANTITY[role], header_units[col], fmt.units) for role, col in roles.items()
     }
@@ -170,6 +174,38 @@ def _units_note(units: dict[str, str], given: dict[str, bool]) -> str:
         options = ", ".join(f"--{q}-unit" for q in assumed)
         text += f" ({', '.join(assumed)} assumed: the header gives no unit; say it with {options})"
     return text
+
+
+def split_cells(line: str, delimiter: str | None) -> list[str]:
+    """A line's cells as written (quotes kept): split at `delimiter` outside double quotes
+    (`"0,12","9,81"`: two cells), or at runs of whitespace where it is None. A line whose
+    quotes do not pair is split at every delimiter, its cells then named as written."""
+    if delimiter is None:
+        return line.split()
+    parts = line.split('"')
+    if len(parts) % 2 == 0:  # an odd number of quotes: none is taken as quoting
+        return line.split(delimiter)
+    cells = [""]
+    for k, part in enumerate(parts):
+        if k % 2:  # within quotes
+            cells[-1] += f'"{part}"'
+        else:
+            first, *rest = part.split(delimiter)
+            cells[-1] += first
+            cells.extend(rest)
+    return cells
+
+
+def _sniffed_decimal(lines: list[str], delimiter: str | None) -> str:
+    """',' where the data `lines` (the first ones) write numbers with a decimal comma, else
+    '.'. Between `;`, tabs or spaces: any comma. Between commas, a comma can only be in a
+    quoted cell, and decides only where it is no thousands separator (`"0,12"`, `"0,001"`,
+    `"12,5"`; `"1,234"` may be either: a cell that is no number then, named with the option)."""
+    if delimiter != ",":
+        return "," if any("," in line for line in lines) else "."
+    cells = (unquoted(cell) for line in lines for cell in split_cells(line, ","))
+    decimal_comma = (c for c in cells if DECIMAL_COMMA.match(c) and not THOUSANDS.match(c))
+    return "," if next(decimal_comma, None) is not None else "."
 
 
 def check_width(path: Path, row: int, cells: list[str], header: list[str]) -> None:
@@ -324,10 +360,19 @@ def _values(
     values = np.empty((len(data), len(columns)))
     first = []
     for i, (row, line) in enumerate(data):
-        cells = line.split(delimiter) if delimiter else line.split()
+        cells = split_cells(line, delimiter)
         check_width(path, row, cells, names)
         for j, (col, factor) in enumerate(columns):
-            values[i, j] = cell_value(path, row, names[col], cells[col], factor, decimal)
+            try:
+                values[i, j] = cell_value(path, row, names[col], cells[col], factor, decimal)
+            except ValueError as err:
+                if decimal == "," or "," not in cells[col]:
+                    raise
+                hint = (
+                    "a decimal comma? say `mount-twin import-csv --decimal ,` (thousands "
+                    "separators are not read)"
+                )
+                raise ValueError(f"{err}: {hint}") from None
         first.append(cells[columns[0][0]])
     return values, first
 
@@ -357,7 +402,7 @@ def _header(line: str, delimiter: str | None) -> tuple[list[str], list[str]]:
     """Column names (lower case, spaces as _) and units ('' where none) of the header line;
     between spaces, a unit in brackets stays with the name before it (`Time [ms]  AccZ [g]`)."""
     names, units = [], []
-    for raw in line.split(delimiter) if delimiter else UNIT_APART.split(line.strip()):
+    for raw in split_cells(line, delimiter) if delimiter else UNIT_APART.split(line.strip()):
         cell = raw.strip().strip('"')  # quoted cells: enDAQ's "X (100g)"
         match = HEADER_CELL.match(cell)
         name, unit = (match.group(1), match.group(2) or "") if match else (cell, "")
