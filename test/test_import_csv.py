@@ -431,3 +431,26 @@ def test_quoted_decimal_commas_between_commas_are_read_or_refused_naming_the_opt
     assert not (tmp_path / "bag").exists()
     got = read_recorder_csv(ambiguous, CsvFormat(decimal=","))
     np.testing.assert_array_equal(got.signal.t, [1.25, 2.5])
+
+
+@pytest.mark.parametrize(
+    ("text", "cell"),
+    [
+        ('t,ax,ay,az\n"1.000","0,12",0,"9,81"\n', '"1.000"'),  # sniffed from "0,12"
+        ("t;ax;ay;az\n0;0,5;0;9,81\n0,5;1.250;0;9,81\n", "1.250"),
+    ],
+)
+def test_a_point_where_the_numbers_have_a_decimal_comma_is_refused(
+    tmp_path: Path, text: str, cell: str
+) -> None:
+    """Where `0,5` is a half, `1.000` is a thousand (a thousands separator): it had been read
+    as 1, silently. It is refused naming the cell and what to say if the point is a decimal
+    point."""
+    path = _write(tmp_path, text)
+    with pytest.raises(ValueError, match=None) as err:
+        read_recorder_csv(path)
+    assert str(err.value).startswith(f"{path}: row ")
+    assert f"{cell!r} has a '.' where the decimal mark is ','" in str(err.value), err.value
+    assert "`mount-twin import-csv --decimal .`" in str(err.value)
+    with pytest.raises(ValueError, match=r"has a '\.' where the decimal mark is ','"):
+        time_ns('"1.000,5"', 10**9, ",")

@@ -215,14 +215,25 @@ def check_width(path: Path, row: int, cells: list[str], header: list[str]) -> No
         raise _fail(path, f"row {row}", f"{len(cells)} cells where the header has {len(header)}")
 
 
+POINT_WITH_COMMA = (
+    "has a '.' where the decimal mark is ',': a thousands separator (not read), or a decimal "
+    "point (say `mount-twin import-csv --decimal .`)?"
+)
+"""Why a number with a '.' is refused where the numbers have a decimal comma: `1.000` is a
+thousand in the locales that write `0,5`, not one."""
+
+
 def cell_value(
     path: Path, row: int, column: str, cell: str, factor: float = 1.0, decimal: str = "."
 ) -> float:
     """A data cell's number times `factor` (to SI units), with a decimal comma where `decimal`
     is ',' and within one pair of double quotes or none (`unquoted`); ValueError naming the
     file, the row (its line number), the column and the cell as written where it is not a
-    number, not finite, or not finite once in SI units."""
+    number (or has a '.' besides a decimal comma), not finite, or not finite once in SI
+    units."""
     text, number = cell.strip(), unquoted(cell)
+    if decimal == "," and "." in number:
+        raise _cell_fail(path, row, column, f"{text!r} {POINT_WITH_COMMA}")
     try:
         v = float(number.replace(decimal, ".") if decimal == "," else number)
     except ValueError:
@@ -246,8 +257,12 @@ def time_ns(cell: str, ns_per_unit: int, decimal: str = ".") -> tuple[int, bool]
     """A time cell (as `cell_value` reads it: quoted or not, `decimal` its decimal mark) in
     whole ns: its decimal text times `ns_per_unit`, exactly, rounded half to even where it is
     finer than 1 ns; and whether it was rounded. ValueError where the text is no decimal
-    number, is not finite or is beyond an int64 of ns."""
+    number (or has a '.' besides a decimal comma), is not finite or is beyond an int64 of
+    ns."""
     number = unquoted(cell)
+    if decimal == "," and "." in number:
+        msg = f"{cell.strip()!r} {POINT_WITH_COMMA}"
+        raise ValueError(msg)
     try:
         value = Decimal(number.replace(",", ".") if decimal == "," else number)
     except InvalidOperation:
