@@ -35,7 +35,7 @@ def main() -> None:
     for run in RUNS:
         files = [args.data / f"{run}_{side}{args.suffix}.csv" for side in ("ground", "top")]
         if all(f.exists() for f in files):
-            pairs[run] = tuple(read_xsens_csv(f)[0] for f in files)
+            pairs[run] = tuple(read_xsens_csv(f).signal for f in files)
     t0 = time.process_time()
     cal = calibrate(scene, *pairs[args.fit_on])
     print(f"calibrated on {args.fit_on} in {time.process_time() - t0:.1f} s CPU:")

@@ -216,7 +216,7 @@ def test_the_real_shake_table_pair_is_calibrated_on_one_run_and_predicts_the_oth
     calibrated = load_scene_file(out)
     assert calibrated.mounts[0].stiffness[0] != load_scene_file(scene_path).mounts[0].stiffness[0]
     held_out = tuple(
-        read_xsens_csv(SHAKE / f"sine_2hz_trial2_{side}_excerpt.csv")[0]
+        read_xsens_csv(SHAKE / f"sine_2hz_trial2_{side}_excerpt.csv").signal
         for side in ("ground", "top")
     )
     nominal = load_scene_file(scene_path)
@@ -239,7 +239,7 @@ def test_the_stiffness_is_found_where_the_record_puts_the_mode_not_near_the_nomi
         lines = (SHAKE / f"sine_2hz_trial1_{side}_excerpt.csv").read_text().splitlines()
         cut[side] = tmp_path / f"{side}.csv"
         cut[side].write_text("\n".join(lines[:1449]) + "\n")
-    table, block = (read_xsens_csv(cut[side])[0] for side in ("ground", "top"))
+    table, block = (read_xsens_csv(cut[side]).signal for side in ("ground", "top"))
     f, pxy = csd(table.accel[:, 0], block.accel[:, 0], fs=120.0, nperseg=256)
     _, pxx = welch(table.accel[:, 0], fs=120.0, nperseg=256)
     band = (f > 10.0) & (f < 40.0)

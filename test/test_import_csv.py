@@ -454,3 +454,38 @@ def test_a_point_where_the_numbers_have_a_decimal_comma_is_refused(
     assert "`mount-twin import-csv --decimal .`" in str(err.value)
     with pytest.raises(ValueError, match=r"has a '\.' where the decimal mark is ','"):
         time_ns('"1.000,5"', 10**9, ",")
+
+
+def test_an_xsens_export_is_stamped_with_its_clock_exactly_over_many_wraps(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """SampleTimeFine is a 32-bit µs counter, unwrapped into the device's time. It had been
+    read as a float and stamped round(t · 1e9) with t = µs · 1e-6: from some 50 days of clock
+    on, a float's seconds are coarser than the ns, and stamps came out 1–2 ns off. Each stamp
+    is the offset plus the cell's µs and the whole wraps before it (2**32 µs each), exactly:
+    here 5 000 samples 2 100 s (and a few µs) apart, 121 days, every ~2 wraps (unwrapped when
+    a step back is more than half the period)."""
+    wrap = 2**32
+    clock_us = [2_528_763_256 + k * 2_100_000_000 + (k * k) % 997 for k in range(5_000)]
+    cells = [us % wrap for us in clock_us]
+    assert cells != sorted(cells) and clock_us[-1] > 120 * 86_400 * 10**6  # wrapped, 121 days
+    head = ["PacketCounter,SampleTimeFine,Euler_X,Euler_Y,Euler_Z"]
+    head += ["Acc_X,Acc_Y,Acc_Z,Gyr_X,Gyr_Y,Gyr_Z"]
+    text = "sep=,\nDeviceTag:,left leg\nFirmwareVersion:,2.2.1\nAppVersion:,2023.6.0\n"
+    text += "StartTime: ,2025-04-02_17:17:54_000 PDT\n© Movella Technologies B. V. 2005-2025\n\n"
+    text += ",".join(head) + "\n" + "0," + ",".join(["0"] * 10) + "\n"  # the all-zero row
+    text += "".join(f"{k + 1},{c},0,0,0,0.1,0,9.81,1.5,0,0\n" for k, c in enumerate(cells))
+    path = _write(tmp_path, text, "dot.csv")
+    float_ns = np.rint(np.unwrap(np.array(cells, float), period=wrap) * 1e-6 * 1e9)
+    off = float_ns - np.array(clock_us, float) * 1e3  # exact: both below 2**53
+    assert np.abs(off).max() >= 1.0  # what the float would stamp, for this test's worth
+    out = tmp_path / "bag"
+    assert main(["import-csv", str(path), "-o", str(out), "--offset", "123"]) == 0
+    said = capsys.readouterr().out
+    assert "a Movella/Xsens DOT export (device left leg): stamps on its clock" in said, said
+    _, msgs = read_bag(out)
+    assert [stamp_ns(m) for _, m in msgs["/deck/imu"]] == [123 + us * 1000 for us in clock_us]
+    imported = read_xsens_csv(path)
+    assert imported.stamps_ns.tolist() == [us * 1000 for us in clock_us]
+    np.testing.assert_allclose(imported.signal.t, np.array(clock_us) / 1e6, rtol=2**-52, atol=0)
+    np.testing.assert_allclose(imported.signal.gyro[0], [1.5 * math.pi / 180, 0, 0], rtol=1e-15)

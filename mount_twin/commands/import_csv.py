@@ -24,7 +24,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--offset",
         type=int,
         default=DEFAULT_START_NS,
-        help="added to the time in ns (a recorder CSV's exactly as written) for the header "
+        help="added to the time in ns (the CSV's time cells exactly as written) for the header "
         "stamp, ns (a stamp of 0 means unset in ROS)",
     )
     parser.add_argument("--delimiter", help="between cells (default: sniffed from the header)")
@@ -79,17 +79,20 @@ def run(args: argparse.Namespace) -> int:
     fmt = CsvFormat(delimiter, args.decimal, columns, units, args.single_axis)
     if is_xsens_csv(args.csv):  # its own layout: the device clock, Acc_*, Gyr_* in deg/s
         _refuse_format_options(args)
-        signal, tag = read_xsens_csv(args.csv)
-        notes = [f"a Movella/Xsens DOT export (device {tag or 'untagged'}): stamps on its clock"]
-        stamps = None  # whole µs: its float t holds them to the ns
+        imported = read_xsens_csv(args.csv)
     else:
         imported = read_recorder_csv(args.csv, fmt)
-        signal, notes, stamps = imported.signal, imported.notes, imported.stamps_ns
     n = write_signal(
-        signal, args.output, args.topic, args.frame_id, args.offset, args.storage, stamps
+        imported.signal,
+        args.output,
+        args.topic,
+        args.frame_id,
+        args.offset,
+        args.storage,
+        imported.stamps_ns,
     )
     print(f"wrote {n} sensor_msgs/msg/Imu messages on {args.topic} to {args.output}")
-    for note in notes:
+    for note in imported.notes:
         print(f"  {note}")
     return 0
 

@@ -150,7 +150,7 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     values, time_cells = _values(path, data, names, delimiter, decimal, columns)
     t, rows, t_name = values[:, 0], [row for row, _ in data], names[roles["t"]]
     check_increasing(path, t, rows, t_name)
-    stamps_ns, rounded = _stamps_ns(path, rows, t_name, time_cells, units["t"], decimal)
+    stamps_ns, rounding = time_cells_ns(path, rows, t_name, time_cells, units["t"], decimal)
     check_increasing(path, stamps_ns, rows, t_name)  # two times within a ns of each other
     accel_role = f"a{fmt.axis or 'x'}"
     accel, gyro, found = _motion(values, fmt.axis, names[roles[accel_role]])
@@ -158,8 +158,7 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
     shown = [r for r in ("t", accel_role, "wx") if r in roles]
     given = {r: bool(fmt.units.get(QUANTITY[r]) or header_units[roles[r]]) for r in shown}
     notes.append(_units_note({r: units[r] for r in shown}, given))
-    if rounded:
-        notes.append(f"time: {rounded} cells finer than 1 ns, rounded to the ns (half to even)")
+    notes += rounding
     if decimal == ",":
         notes.append("decimal comma")
     return Imported(Signal(t, accel, gyro), notes, stamps_ns)
@@ -279,12 +278,12 @@ def time_ns(cell: str, ns_per_unit: int, decimal: str = ".") -> tuple[int, bool]
     return int(whole), whole != ns
 
 
-def _stamps_ns(
-    path: Path, rows: list[int], column: str, cells: list[str], unit: str, decimal: str
-) -> tuple[np.ndarray, int]:
+def time_cells_ns(
+    path: Path, rows: list[int], column: str, cells: list[str], unit: str, decimal: str = "."
+) -> tuple[np.ndarray, list[str]]:
     """The time `cells` (of the data `rows`, in `unit`) exactly in ns (`time_ns`), int64, and
-    how many of them were rounded to the ns; ValueError naming the file, row and column of
-    one that `time_ns` refuses."""
+    the note saying how many of them were rounded to the ns, if any was; ValueError naming the
+    file, row and column of one that `time_ns` refuses. Any importer's stamps are read so."""
     ns_per_unit = next(ns for u, ns in TIME_NS.items() if _same_unit(u, unit))
     stamps = np.empty(len(cells), dtype=np.int64)
     rounded = 0
@@ -294,7 +293,9 @@ def _stamps_ns(
         except ValueError as err:
             raise _cell_fail(path, row, column, str(err)) from None
         rounded += finer
-    return stamps, rounded
+    if not rounded:
+        return stamps, []
+    return stamps, [f"time: {rounded} cells finer than 1 ns, rounded to the ns (half to even)"]
 
 
 def _cell_fail(path: Path, row: int, column: str, what: str) -> ValueError:

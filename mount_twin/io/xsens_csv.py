@@ -4,6 +4,8 @@ Layout: a preamble (`sep=,`, `DeviceTag:`, versions, `StartTime:`, a copyright l
 line), then `PacketCounter,SampleTimeFine,...` with `SampleTimeFine` the device clock in µs
 (32-bit, wrapping), `Acc_X/Y/Z` specific force in m/s² (+g on z at rest) and `Gyr_X/Y/Z` in
 deg/s, in the sensor's frame. The export's first data row is all zeros (no sample): dropped.
+Stamps are read as a recorder CSV's are (`csv_import.time_cells_ns`): each SampleTimeFine
+cell exactly in ns, plus the whole wraps of the clock before it, in integers.
 """
 
 from __future__ import annotations
@@ -16,15 +18,19 @@ import numpy as np
 
 from mount_twin.io.csv_import import (
     CSV_MAX_BYTES,
+    TIME_NS,
+    Imported,
     cell_value,
     check_increasing,
     check_width,
     read_recorder_csv,
+    time_cells_ns,
 )
 from mount_twin.io.signals import Signal
 from mount_twin.textfiles import FileTooLargeError, read_limited
 
 CLOCK_WRAP_US = 2**32
+"""SampleTimeFine's period, µs (a 32-bit counter): 71.6 min."""
 ACCEL = ("Acc_X", "Acc_Y", "Acc_Z")
 GYRO = ("Gyr_X", "Gyr_Y", "Gyr_Z")
 
@@ -37,11 +43,12 @@ def is_xsens_csv(path: str | Path) -> bool:
     return len(head) > 1 and head[0].strip().startswith("sep=") and head[1].startswith("DeviceTag")
 
 
-def read_xsens_csv(path: str | Path) -> tuple[Signal, str]:
-    """The record (stamps s on the device clock, SampleTimeFine: two synchronised sensors'
-    records share it; specific force m/s², rate rad/s, sensor frame) and its device tag;
-    errors name the file, the row (its line number) and the column, as a recorder CSV's do
-    (`csv_import.cell_value`, `check_width`, `check_increasing`)."""
+def read_xsens_csv(path: str | Path) -> Imported:
+    """The record (on the device clock, SampleTimeFine: two synchronised sensors' records
+    share it; specific force m/s², rate rad/s, sensor frame), its stamps exactly in int64 ns
+    (`Imported.stamps_ns`) and a note naming its device; errors name the file, the row (its
+    line number) and the column, as a recorder CSV's do (`csv_import.cell_value`,
+    `check_width`, `check_increasing`, `time_cells_ns`)."""
     path = Path(path)
     try:
         lines = read_limited(path, CSV_MAX_BYTES, "CSV_MAX_BYTES", "utf-8-sig").splitlines()
@@ -62,7 +69,7 @@ def read_xsens_csv(path: str | Path) -> tuple[Signal, str]:
         msg = f"{path}: row {start + 1}: no column {', '.join(missing)}"
         raise ValueError(msg)
     read = [(c, header.index(c), f) for c, f in zip(columns, factors, strict=True)]
-    rows, values = [], []
+    rows, values, times = [], [], []
     for cells in reader:
         row = start + reader.line_num  # the file's line number (the reader's are from 1)
         if not cells:
@@ -71,17 +78,21 @@ def read_xsens_csv(path: str | Path) -> tuple[Signal, str]:
         parsed = [cell_value(path, row, c, cells[i], f) for c, i, f in read]
         if any(v != 0.0 for v in parsed[1:]):  # the export's first row is all zeros
             rows.append(row)
-            values.append(parsed)
+            values.append(parsed[1:])
+            times.append(cells[read[0][1]])
     if not values:
         msg = f"{path}: no data rows after the header (row {start + 1})"
         raise ValueError(msg)
+    on_clock, notes = time_cells_ns(path, rows, "SampleTimeFine", times, "us")
+    stamps = np.unwrap(on_clock, period=CLOCK_WRAP_US * TIME_NS["us"])  # int64: exact
+    check_increasing(path, stamps, rows, "SampleTimeFine")
     data = np.array(values)
-    t = np.unwrap(data[:, 0], period=CLOCK_WRAP_US) * 1e-6
-    check_increasing(path, t, rows, "SampleTimeFine")
-    return Signal(t, data[:, 1:4].copy(), data[:, 4:7].copy()), tag
+    signal = Signal(stamps / 1e9, data[:, :3].copy(), data[:, 3:].copy())
+    device = f"a Movella/Xsens DOT export (device {tag or 'untagged'}): stamps on its clock"
+    return Imported(signal, [device, *notes], stamps)
 
 
 def read_csv_record(path: str | Path) -> Signal:
     """A CSV record, whichever of the two it is: an Xsens DOT export (stamps on its device
     clock) or a recorder CSV (`csv_import`: its stamps as written, units from its header)."""
-    return read_xsens_csv(path)[0] if is_xsens_csv(path) else read_recorder_csv(path).signal
+    return (read_xsens_csv if is_xsens_csv(path) else read_recorder_csv)(path).signal
