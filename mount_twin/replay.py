@@ -48,7 +48,14 @@ from mount_twin.engine.health import (
     why_none,
 )
 from mount_twin.errors import BagError, DamagedBagError, require
-from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
+from mount_twin.io.bag import (
+    LATCHED_QOS,
+    SCENE_DIGEST_KEY,
+    SCENE_KEY,
+    InputBag,
+    OutputBag,
+    check_new_bag,
+)
 from mount_twin.io.messages import (
     DIAGNOSTICS_TOPIC,
     IMU,
@@ -62,7 +69,7 @@ from mount_twin.io.messages import (
     static_transforms,
 )
 from mount_twin.physics.rotations import quaternion_matrices
-from mount_twin.scene.description import Scene
+from mount_twin.scene.description import Scene, scene_digest
 from mount_twin.stream import TwinStream
 
 NODE_NAME = "mount_twin"
@@ -473,7 +480,9 @@ def replay(
     The output holds what the node publishes: the scene's outputs (`output_types`), and the mount
     frames on /tf_static once, before anything else, stamped with the first output's stamp (that
     of the first input sample the stream took: never an unset or pre-1970 one) and offered
-    latched (`LATCHED_QOS`) so `ros2 bag play` republishes it to late subscribers. Both bags are
+    latched (`LATCHED_QOS`) so `ros2 bag play` republishes it to late subscribers; its metadata
+    records the scene (`io.bag.SCENE_KEY`: where it came from; `SCENE_DIGEST_KEY`: its digest,
+    `scene_digest`), which `report --scene` checks its scene against. Both bags are
     checked before the twin is built. `checkpoint` is called once it is built and between
     chunks, where stopping is safe: it may raise to stop the replay (a signal noted by
     the command line); once the output bag exists, it is then finished and marked partial.
@@ -505,7 +514,12 @@ def replay(
     with (
         bag,
         body_bag or nullcontext(),
-        OutputBag(output_path, topics, {TF_STATIC_TOPIC: [LATCHED_QOS]}) as out,
+        OutputBag(
+            output_path,
+            topics,
+            {TF_STATIC_TOPIC: [LATCHED_QOS]},
+            {SCENE_KEY: scene.source, SCENE_DIGEST_KEY: scene_digest(scene)},
+        ) as out,
         tqdm(total=bag.count, unit="msg", disable=not progress, desc="replay", leave=False) as bar,
     ):
         # the chunks, then the end (also where a damaged bag ends): the outputs the gyro delay

@@ -807,3 +807,115 @@ def test_the_first_utilisation_step_starts_a_period_before_its_report_or_at_the_
     assert lines["short"][1].tolist() == [0.7, 0.7]
     unknown = utilisation_lines(series, None)
     assert unknown["late"][0].tolist() == [2.5, 3.5]
+
+
+def _pump_scene(path: Path, change: Any = None) -> Path:
+    """The pump's scene written to `path` by yaml (its comments, order and layout gone), with
+    `change(data)` applied to its mapping first."""
+    import yaml
+
+    data = yaml.safe_load(PUMP.read_text(encoding="utf-8"))
+    if change is not None:
+        change(data)
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    return path
+
+
+def _set(*keys: Any, value: Any) -> Any:
+    """A change setting data[keys[0]][keys[1]]... to `value`."""
+
+    def change(data: Any) -> None:
+        for key in keys[:-1]:
+            data = data[key]
+        data[keys[-1]] = value
+
+    return change
+
+
+OTHER_VALUES = {
+    "a mount's stiffness": _set("mounts", 0, "stiffness", 2, value=2.4e6),
+    "the mass": _set("body", "mass", value=1500.0),
+    "the diagnostics period": _set("outputs", "diagnostics_period_s", value=0.25),
+    "a rating": _set("mounts", 3, "rated_load", value=[6000.0, 6000.0, 4500.0]),
+}
+
+
+@pytest.mark.parametrize("what", OTHER_VALUES)
+def test_a_scene_with_the_runs_mounts_and_another_value_is_refused_naming_both(
+    pump_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], what: str
+) -> None:
+    """The pump's mounts, one value changed: only the mount names were compared, so another
+    scene's period drew the utilisation's first step, and its name, modes and scene table
+    headed the run's numbers, exit 0. The replay records its scene's digest in the output
+    bag's metadata: refused, exit 2, naming both scene files; --other-scene draws with it all
+    the same, and the page and stderr say it is not the run's."""
+    other = _pump_scene(tmp_path / "other.scene.yaml", OTHER_VALUES[what])
+    page = tmp_path / "r.html"
+    args = ["report", str(pump_run), "--scene", str(other), "-o", str(page)]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert (
+        f"{other}: scene pump_8_mounts is not the one {pump_run} was replayed with, {PUMP}" in err
+    )
+    assert not page.exists()
+    assert main([*args, "--other-scene"]) == 0
+    assert "NOT the run's, drawn with on request (--other-scene)" in capsys.readouterr().err
+    text = html.unescape(page.read_text(encoding="utf-8"))
+    assert f"NOT the run's, drawn with on request (--other-scene): {other}: scene" in text
+
+
+def test_the_runs_scene_rewritten_is_still_its_own(
+    pump_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The digest is of the scene's values, not of its file's bytes: the pump's scene written
+    out again without its comments, in another order, is the run's."""
+    same = _pump_scene(tmp_path / "same.scene.yaml")
+    assert same.read_text(encoding="utf-8") != PUMP.read_text(encoding="utf-8")
+    page = tmp_path / "r.html"
+    assert main(["report", str(pump_run), "--scene", str(same), "-o", str(page)]) == 0
+    assert "warning" not in capsys.readouterr().err
+    assert f"the run's: its digest is the one {pump_run} records" in html.unescape(
+        page.read_text(encoding="utf-8")
+    )
+
+
+def _recorded(pump_run: Path, tmp_path: Path) -> Path:
+    """The pump's run as a bag without mount_twin's custom_data, as `ros2 bag record` of the
+    node's topics writes one: nothing in it names or digests the scene."""
+    import shutil
+
+    import yaml
+
+    bag = tmp_path / "recorded"
+    shutil.copytree(pump_run, bag)
+    meta = yaml.safe_load((bag / "metadata.yaml").read_text(encoding="utf-8"))
+    assert meta["rosbag2_bagfile_information"].pop("custom_data")  # the replay's: the scene
+    (bag / "metadata.yaml").write_text(yaml.safe_dump(meta), encoding="utf-8")
+    return bag
+
+
+def test_without_a_digest_a_scene_is_checked_by_the_settings_the_bag_records(
+    pump_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A recording of the node's topics records no digest of its scene; its integration
+    status records the solver's rtol and atol. A scene with another atol is refused, naming
+    it and both values; one differing elsewhere cannot be told apart, and stderr and the page
+    say what it was checked by."""
+    bag = _recorded(pump_run, tmp_path)
+    page = tmp_path / "r.html"
+    loose = _pump_scene(tmp_path / "loose.scene.yaml", _set("integration", "atol", value=1e-7))
+    assert main(["report", str(bag), "--scene", str(loose), "-o", str(page)]) == 2
+    err = capsys.readouterr().err
+    assert (
+        f"{loose}: scene pump_8_mounts is not the one {bag} was run with: its integration.atol "
+        "is 1e-07, the run's 1e-09" in err
+    )
+    assert not page.exists()
+    heavy = _pump_scene(tmp_path / "heavy.scene.yaml", OTHER_VALUES["the mass"])
+    assert main(["report", str(bag), "--scene", str(heavy), "-o", str(page)]) == 0
+    said = (
+        "by its mount names, integration.rtol, integration.atol only: "
+        f"{bag} records no digest of its scene"
+    )
+    assert said in capsys.readouterr().err
+    assert said in html.unescape(page.read_text(encoding="utf-8"))

@@ -54,7 +54,7 @@ from mount_twin.engine.health import (
 )
 from mount_twin.engine.intake import nothing_accepted
 from mount_twin.errors import ModelError
-from mount_twin.io.bag import partial_marker
+from mount_twin.io.bag import SCENE_DIGEST_KEY, SCENE_KEY, custom_data, partial_marker
 from mount_twin.io.messages import WRENCHES_OUTPUT
 from mount_twin.io.output_tables import (
     Event,
@@ -63,7 +63,7 @@ from mount_twin.io.output_tables import (
     input_values,
     integration_values,
 )
-from mount_twin.scene.description import STANDARD_GRAVITY, Scene
+from mount_twin.scene.description import STANDARD_GRAVITY, Scene, scene_digest
 from mount_twin.textfiles import write_text
 
 if TYPE_CHECKING:
@@ -158,12 +158,14 @@ def _provenance_section(
     scene: Scene | None,
     input_note: str = "",
     recorded: dict[str, str] | None = None,
+    scene_check: str = "",
 ) -> list[str]:
     """The verdict, what produced the page from what (with `input_note` on the input bag:
     what of it was left out), the input and the solver's settings and estimated error
-    (`integration`: the last integration status' values), and the scene as loaded; without
-    the scene, what of the input and the solver the bag records (`recorded`: the last input
-    status' values; `_recorded_settings`)."""
+    (`integration`: the last integration status' values), and the scene as loaded with
+    whether it is the run's (`scene_check`: `check_scene`'s); without the scene, what of the
+    input and the solver the bag records (`recorded`: the last input status' values;
+    `_recorded_settings`)."""
     partial = partial_marker(output_bag)
     rows = [
         ["verdict (worst over the run)", verdict.text],
@@ -196,6 +198,7 @@ def _provenance_section(
         )
         rows += [
             ["scene", f"{scene.name} from {scene.source}"],
+            *([["scene checked", scene_check]] if scene_check else []),
             ["input", f"{spec.topic} ({spec.msg_type}), frame {spec.frame_id or 'any'}"],
             [
                 "input conditioning",
@@ -400,6 +403,7 @@ def write_report(
     design_axes: tuple[str, ...] = ("z",),
     tolerance_db: tuple[float, float] = TOLERANCE_DB,
     design_name: str = "",
+    other_scene: bool = False,
 ) -> ReportPage:
     """Write the report page of the output bag whose tables are `bag_tables` (`read_output_bag` of
     `output_bag`, which the page names, hashes and checks for a partial run). `input_samples`:
@@ -409,7 +413,9 @@ def write_report(
     the input's spectra along `design_axes` (of F; z, as `report --design` and `srs --design`
     judge by default) are judged against (within `tolerance_db`), named `design_name` (its file).
     The page opens with the verdict, what produced it and with what settings, and the scene as
-    loaded (every value with its meaning and unit)."""
+    loaded (every value with its meaning and unit). A scene that is not the run's
+    (`check_scene`) is a ValueError, or with `other_scene` drawn with all the same, the page
+    saying so."""
     tables = {t.name: t for t in bag_tables}
     mounts = {k.removeprefix("mount_"): t for k, t in tables.items() if k.startswith("mount_")}
     origin = min(int(t.columns["stamp_ns"][0]) for t in tables.values() if len(t))
@@ -417,8 +423,13 @@ def write_report(
     events = events_of(diagnostics, origin) if diagnostics else []
     utilisation = utilisation_of(diagnostics) if diagnostics else {}
     kinds = {m.name: m.kind for m in scene.mounts} if scene else {}
+    checked = None
     if scene:
         _check_scene_is_the_bags(scene, set(mounts) or set(utilisation), output_bag)
+        checked = check_scene(scene, output_bag, integration_values(diagnostics))
+        if checked.differs and not other_scene:
+            msg = f"{checked.text}: give the run's own scene (--other-scene: draw with this one)"
+            raise ValueError(msg)
         # the scene's order, as the replay's summary has them (else the bag's topics')
         mounts = {m.name: mounts[m.name] for m in scene.mounts if m.name in mounts} | mounts
     title = f"{scene.name if scene else 'mount_twin'} — {Path(output_bag).name}"
@@ -435,6 +446,7 @@ def write_report(
         scene,
         input_note,
         input_values(diagnostics),
+        "" if checked is None else checked.page_text,
     )
     if "pose" in tables and "angles" in tables:
         sections += [
@@ -479,16 +491,84 @@ def write_report(
     ]
     out = Path(html_path)
     write_text(out, page(title, sections))
-    return ReportPage(out, verdict, design_passed)
+    return ReportPage(out, verdict, design_passed, checked)
+
+
+class SceneCheck(NamedTuple):
+    """How far a scene was found to be its output bag's run's own (`check_scene`).
+
+    text: how it was checked and what was found; differs: it is not the run's; by_digest: the
+    bag recorded its scene's digest (else only the facts `text` names were compared)."""
+
+    text: str
+    differs: bool
+    by_digest: bool
+
+    @property
+    def page_text(self) -> str:
+        """The report page's line on it."""
+        if self.differs:
+            return f"NOT the run's, drawn with on request (--other-scene): {self.text}"
+        return self.text
 
 
 class ReportPage(NamedTuple):
-    """A report written: its file, the run's verdict, and whether the input's spectra passed
-    the design (None: no design judged them)."""
+    """A report written: its file, the run's verdict, whether the input's spectra passed the
+    design (None: no design judged them), and how far its scene was checked to be the run's
+    (None: no scene)."""
 
     path: Path
     verdict: RunVerdict
     design_passed: bool | None
+    scene_check: SceneCheck | None = None
+
+
+CHECKED_SETTINGS = ("rtol", "atol")
+"""The scene's integration settings its run's integration status records (`health`)."""
+
+
+def check_scene(scene: Scene, output_bag: str | Path, integration: dict[str, str]) -> SceneCheck:
+    """Whether `scene` (with the input topic and frame the run read, as `report` gives it) is
+    the one the run of `output_bag` ran (its mount names are checked before:
+    `_check_scene_is_the_bags`). By the digest its replay recorded in the bag's metadata
+    (`io.bag.SCENE_DIGEST_KEY`, `scene_digest`): any value differing (a mount's stiffness,
+    the mass, the diagnostics period, a rating) makes another. A bag that records none (a
+    recording of the node's topics by `ros2 bag record`, or a replay by a mount_twin that did
+    not record it) tells only some settings: the solver's tolerances its last integration
+    status records (`integration`: its values), compared, the first that differs named."""
+    meta = custom_data(output_bag)
+    if recorded := meta.get(SCENE_DIGEST_KEY):
+        digest = scene_digest(scene)
+        ran = meta.get(SCENE_KEY, "a scene it does not name")
+        if digest == recorded:
+            text = f"the run's: its digest is the one {output_bag} records (sha256 {digest})"
+            return SceneCheck(f"{text}, its replay's of {ran}", False, True)
+        text = (
+            f"{scene.source}: scene {scene.name} is not the one {output_bag} was replayed "
+            f"with, {ran}: its digest (sha256 {digest}) differs from the one the bag's "
+            f"metadata records ({SCENE_DIGEST_KEY}: {recorded}); a value differs (a mount's "
+            "stiffness or rating, the body, the diagnostics period, ...)"
+        )
+        return SceneCheck(text, True, True)
+    compared = [key for key in CHECKED_SETTINGS if key in integration]
+    for key in compared:
+        value = f"{getattr(scene.integration, key):g}"
+        if integration[key] != value:
+            text = (
+                f"{scene.source}: scene {scene.name} is not the one {output_bag} was run with: "
+                f"its integration.{key} is {value}, the run's {integration[key]} (as its "
+                "integration status records it)"
+            )
+            return SceneCheck(text, True, False)
+    facts = ", ".join(["its mount names", *(f"integration.{key}" for key in compared)])
+    text = (
+        f"by {facts} only: {output_bag} records no digest of its scene (a recording of the "
+        "node's topics, a replay by a mount_twin that did not record it, or a storage file "
+        "without its metadata.yaml), so a scene "
+        "differing in another value (a stiffness, the mass, the diagnostics period, a rating) "
+        "is not told apart"
+    )
+    return SceneCheck(text, False, False)
 
 
 def _check_scene_is_the_bags(scene: Scene, in_bag: set[str], output_bag: str | Path) -> None:

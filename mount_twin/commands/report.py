@@ -18,7 +18,8 @@ if TYPE_CHECKING:
 NAME = "report"
 HELP = "one HTML page of a replay: input and response, signed mount forces, utilisation, events"
 EXIT_STATUS = (
-    "exit status: 0 done; 2 bad input, a failed write (the message names the file), or "
+    "exit status: 0 done; 2 bad input, a failed write (the message names the file), a "
+    "--scene that is not the run's (without --other-scene), or "
     "--fail-on on a bag without diagnostics; 3 the run accepted no input sample; 4 the run's "
     "diagnostics reached --fail-on, or with --design a spectrum out of the design's "
     "tolerance somewhere; 6 the run FAILED (its integration failed), whatever --fail-on says. "
@@ -32,6 +33,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("bag", help="output bag of `mount-twin replay`")
     parser.add_argument("-o", "--output", default="report.html", help="HTML file to write")
     parser.add_argument("--scene", help="the replay's scene YAML (mount kinds, names)")
+    parser.add_argument(
+        "--other-scene",
+        action="store_true",
+        help="draw with --scene even where it is not the run's (its digest, which the replay "
+        "records in the output bag's metadata, differs): the page and stderr say so",
+    )
     parser.add_argument(
         "--input", metavar="BAG", help="the replay's input bag (plotted beside the response)"
     )
@@ -109,7 +116,10 @@ def run(args: argparse.Namespace) -> int:
         design_axes=axes_of(args),
         tolerance_db=tolerance,
         design_name=Path(args.design).name if args.design else "",
+        other_scene=args.other_scene,
     )
+    if (checked := out.scene_check) is not None and (checked.differs or not checked.by_digest):
+        print(f"mount-twin: warning: --scene {args.scene}: {checked.page_text}", file=sys.stderr)
     print(f"report: {out.path}")
     return _exit_status(out, args.fail_on)
 

@@ -410,20 +410,39 @@ def _as_ros2(value: Any) -> Any:
 
 PARTIAL_KEY = "mount_twin.partial"
 """custom_data key in an output bag's metadata.yaml present when the bag stops early."""
+SCENE_KEY = "mount_twin.scene"
+"""custom_data key in a replay's output bag's metadata.yaml: where its scene came from (the
+file, and the input settings the command line replaced: `Scene.source`)."""
+SCENE_DIGEST_KEY = "mount_twin.scene_sha256"
+"""custom_data key in a replay's output bag's metadata.yaml: its scene's digest
+(`scene.description.scene_digest`), which `report --scene` checks its scene against."""
+
+
+def custom_data(path: str | Path) -> dict[str, str]:
+    """The custom_data of a bag's metadata.yaml ({} if it has none, or no metadata.yaml: a
+    storage file given alone, or a bag a write failure left unfinished)."""
+    meta = Path(path) / "metadata.yaml"
+    if not meta.is_file():
+        return {}
+    try:
+        info = yaml.safe_load(meta.read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
+        return {str(k): str(v) for k, v in (info.get("custom_data") or {}).items()}
+    except (
+        OSError,
+        UnicodeDecodeError,
+        yaml.YAMLError,
+        TypeError,
+        KeyError,
+        AttributeError,
+    ) as err:
+        msg = f"{meta}: cannot read the bag's metadata: {err}"
+        raise BagError(msg) from err
 
 
 def partial_marker(path: str | Path) -> str:
     """Why an output bag stops early, from its metadata.yaml (`PARTIAL_KEY`): '' if it does
     not, or has no metadata.yaml to say so (a storage file given alone)."""
-    meta = Path(path) / "metadata.yaml"
-    if not meta.is_file():
-        return ""
-    try:
-        info = yaml.safe_load(meta.read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
-    except (OSError, UnicodeDecodeError, yaml.YAMLError, TypeError, KeyError) as err:
-        msg = f"{meta}: cannot read the bag's metadata: {err}"
-        raise BagError(msg) from err
-    return str((info.get("custom_data") or {}).get(PARTIAL_KEY, ""))
+    return custom_data(path).get(PARTIAL_KEY, "")
 
 
 class OutputBag:
@@ -437,6 +456,8 @@ class OutputBag:
         offered_qos: resolved topic → QoS profiles its publisher offered (recorded in the bag's
             metadata, replayed by `ros2 bag play`); topics not listed record none (the player's
             default, reliable and volatile).
+        custom_data: key → text recorded in the bag's metadata (`ros2 bag info` shows them;
+            a replay's scene, `SCENE_KEY` and `SCENE_DIGEST_KEY`).
     """
 
     def __init__(
@@ -444,6 +465,7 @@ class OutputBag:
         path: str | Path,
         topics: dict[str, str],
         offered_qos: Mapping[str, Sequence[Qos]] | None = None,
+        custom_data: Mapping[str, str] | None = None,
     ) -> None:
         self.path = Path(path)
         check_new_bag(self.path)
@@ -451,6 +473,7 @@ class OutputBag:
         try:
             with directories_above(self.path):
                 self._writer = McapBagWriter(self.path, topics, qos)
+            self._writer.custom_data.update(custom_data or {})
         except OSError as err:
             msg = f"{self.path}: cannot create the bag: {err.strerror or err}"
             raise BagError(msg) from err

@@ -7,7 +7,9 @@ scene are coordinates in F at the reference pose, in metres; angles are radians.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import hashlib
+import json
+from dataclasses import asdict, dataclass, field
 
 from mount_twin.kinds.bolted_joint import BoltedJoint
 from mount_twin.kinds.elastomer import Elastomer
@@ -346,3 +348,18 @@ class Scene:
         if len(self.mount_paths) == len(self.mounts):
             return self.mount_paths[i]
         return f"mounts[{i}]"
+
+
+NOT_THE_VALUE = ("source", "warnings", "mount_paths")
+"""Fields of a Scene that are not part of its value (`Scene`): left out of its digest."""
+
+
+def scene_digest(scene: Scene) -> str:
+    """sha256 (hex) of the scene's value: every field two scenes are compared by but the file
+    it came from (`source`), as sorted JSON (floats as Python writes them back exactly). Two
+    files that set the same values (however commented, ordered, or with defaults written out)
+    give the same digest; one value changed, another. A replay records it in its output bag's
+    metadata (`io.bag.SCENE_DIGEST_KEY`), for `report --scene` to check its scene against."""
+    value = {k: v for k, v in asdict(scene).items() if k not in NOT_THE_VALUE}
+    text = json.dumps(value, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()
