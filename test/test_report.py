@@ -260,12 +260,14 @@ def _pump_input(path: Path, n: int = 10_000, bad: slice = slice(0)) -> Path:
     return path
 
 
-def test_an_input_marking_accelerations_not_provided_is_refused_naming_the_bag(
+def test_an_input_marking_accelerations_not_provided_inside_is_refused_naming_the_bag(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """The replay disregards 3 samples whose acceleration the IMU marks not provided
     (covariance[0] = -1, REP-145, zeros in it); the input's spectra took their zeros as
-    readings, a hole in the shock. Refused, naming the bag, the topic and how many."""
+    readings, a hole in the shock. Between samples the replay takes, leaving them out would
+    join those around them: refused, as a sample not finite there is, naming the bag, the
+    topic, how many and the first."""
     from mount_twin.io.bag import write_bag
     from mount_twin.io.messages import IMU
 
@@ -300,8 +302,10 @@ def test_an_input_marking_accelerations_not_provided_is_refused_naming_the_bag(
     assert main(args) == 2
     err = capsys.readouterr().err
     assert (
-        f"{tmp_path / 'marked'}: /deck/imu: 3 of 2000 samples mark a reading not provided" in err
-    )
+        f"{tmp_path / 'marked'}: /deck/imu: 3 of 2000 samples the replay rejects "
+        "(no_acceleration 3); sample 1500 (t = 1.5 s from the first) marks its acceleration "
+        "not provided (covariance[0] = -1, REP-145), between samples it takes" in err
+    ), err
     assert not page.exists()
 
 
@@ -330,12 +334,58 @@ def test_an_inputs_samples_not_finite_after_the_others_are_skipped_as_the_replay
         args = ["report", str(out), "--scene", pump, "--input", str(bag), "-o", str(page)]
         assert main(args) == 0
         pages[bag.name] = page.read_text(encoding="utf-8")
-    said = f"{tail}: /deck/imu: 9000 of 10000 samples not finite, before or after the others"
+    said = (
+        f"{tail}: /deck/imu: 9000 of 10000 samples the replay rejects (non_finite 9000) left "
+        "out, as the replay skips them: 9000 after its last (samples 1000–9999)"
+    )
     assert said in capsys.readouterr().out
     assert "sample 1000 (t = 1 s from the first) has accel x nan" in pages["tail_nan"]
     assert "samples not finite" not in pages["first_second"]
     assert _spectra_table(pages["tail_nan"]) == _spectra_table(pages["first_second"])
     assert re.search(r"<td>[1-9][\d.]*</td>", _spectra_table(pages["tail_nan"]))  # the shock
+
+
+def test_an_inputs_samples_the_replay_rejects_at_its_ends_are_left_out_whatever_the_reason(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The input's first 5 samples NaN and its last 3 marking their acceleration not provided
+    (REP-145): the replay rejects both kinds and takes the rest. The report skipped the NaN
+    ones but refused the record for the marked ones (exit 2). It leaves both out now, saying
+    how many of each and at which end, and its spectra are those of a bag of samples 5–1996
+    alone."""
+    from mount_twin.io.bag import write_bag
+    from mount_twin.io.messages import IMU
+
+    pump = str(CONFIG / "pump_8_mounts.scene.yaml")
+    holed = _pump_input(tmp_path / "holed", 2000, bad=slice(0, 5))
+    (msgs,) = read_raw(holed, ["/deck/imu"]).values()
+    ns, raws = zip(*msgs[1997:], strict=True)
+    ends = tmp_path / "ends"
+    marked = zip(ns, unprovided_imu(list(raws), "linear_acceleration"), strict=True)
+    write_bag(ends, "/deck/imu", IMU, iter([*msgs[:1997], *marked]))
+    middle = tmp_path / "middle"
+    write_bag(middle, "/deck/imu", IMU, iter(msgs[5:1997]))
+    out = tmp_path / "out"
+    assert main(["replay", str(ends), "--scene", pump, "-o", str(out), "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    assert "non_finite 5" in printed and "no_acceleration 3" in printed  # what the twin took
+    pages = {}
+    for bag in (ends, middle):
+        page = tmp_path / f"{bag.name}.html"
+        args = ["report", str(out), "--scene", pump, "--input", str(bag), "-o", str(page)]
+        assert main(args) == 0
+        pages[bag.name] = html.unescape(page.read_text(encoding="utf-8"))
+    said = (
+        f"{ends}: /deck/imu: 8 of 2000 samples the replay rejects (non_finite 5, "
+        "no_acceleration 3) left out, as the replay skips them: 5 before the first it takes "
+        "(samples 0–4), 3 after its last (samples 1997–1999); the first: sample 0 (t = 0 s "
+        "from the first) has accel x nan; the input's plot and spectra are of the other 1992"
+    )
+    assert said in capsys.readouterr().out
+    assert said in pages["ends"]
+    assert "left out" not in pages["middle"]
+    assert _spectra_table(pages["ends"]) == _spectra_table(pages["middle"])
+    assert re.search(r"<td>[1-9][\d.]*</td>", _spectra_table(pages["ends"]))  # the shock
 
 
 def test_an_inputs_sample_not_finite_between_finite_ones_is_refused_naming_it(
@@ -354,8 +404,8 @@ def test_an_inputs_sample_not_finite_between_finite_ones_is_refused_naming_it(
     assert main(args) == 2
     err = capsys.readouterr().err
     assert (
-        f"{holed}: /deck/imu: 1 of 10000 samples not finite; sample 500 (t = 0.5 s from the "
-        "first) has accel x nan, between finite samples" in err
+        f"{holed}: /deck/imu: 1 of 10000 samples the replay rejects (non_finite 1); sample 500 "
+        "(t = 0.5 s from the first) has accel x nan, between samples it takes" in err
     ), err
     assert not page.exists()
 
@@ -919,3 +969,43 @@ def test_without_a_digest_a_scene_is_checked_by_the_settings_the_bag_records(
     )
     assert said in capsys.readouterr().err
     assert said in html.unescape(page.read_text(encoding="utf-8"))
+
+
+@pytest.mark.parametrize("gyro_filter", ["linear_phase", "ignore"])
+def test_the_readings_rejections_are_those_the_twin_counts(gyro_filter: str) -> None:
+    """What `report --input` leaves out is what the twin rejects: per reason, the twin's own
+    counters of the same samples (a NaN acceleration, an absurd rate, an acceleration marked
+    not provided with NaN in its place, a rate marked not provided, read or not)."""
+    from collections import Counter
+
+    from mount_twin.engine.batch import SampleBatch
+    from mount_twin.engine.engine import TwinEngine
+    from mount_twin.engine.intake import reading_rejections
+    from mount_twin.model.assemble import assemble
+
+    scene = load_scene_file(PUMP)
+    scene = dataclasses.replace(
+        scene, input=dataclasses.replace(scene.input, gyro_filter=gyro_filter, frame_id="")
+    )
+    n = 60
+    accel = np.tile([0.0, 0.0, 9.80665], (n, 1))
+    gyro = np.zeros((n, 3))
+    unprovided = np.zeros((n, 2), dtype=bool)
+    accel[10, 1] = np.nan
+    gyro[20, 2] = 1e200
+    unprovided[30, 0], accel[30] = True, np.nan
+    unprovided[40, 1], gyro[40] = True, np.nan
+    unprovided[50] = True
+    batch = SampleBatch(np.arange(n) * 1e-3 + 1.0, accel, gyro, ["imu"] * n, unprovided)
+    engine = TwinEngine(assemble(scene))
+    engine.run(batch)
+    reasons = reading_rejections(accel, gyro, unprovided, scene.input.reads_rate)
+    counted = {k.removeprefix("rejected_"): v for k, v in engine.counts.items() if v}
+    expected = Counter(r for r in reasons.tolist() if r)
+    assert {k: counted[k] for k in expected} == expected
+    assert counted["accepted"] == n - sum(expected.values())
+    assert (
+        reasons[[10, 20, 30, 50]].tolist()
+        == ["non_finite", "non_finite"] + ["no_acceleration"] * 2
+    )
+    assert reasons[40] == ("no_angular_velocity" if gyro_filter != "ignore" else "")

@@ -10,10 +10,12 @@ from mount_twin.commands.replay import EXIT_FAIL_ON, FAIL_ON, run_exit_status
 from mount_twin.commands.srs import add_axis_argument, add_design_arguments, axes_of, tolerance_of
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from mount_twin.analysis.report import ReportPage
     from mount_twin.io.messages import Decoded
     from mount_twin.io.output_tables import Table
-    from mount_twin.scene.description import Scene
+    from mount_twin.scene.description import InputSpec, Scene
 
 NAME = "report"
 HELP = "one HTML page of a replay: input and response, signed mount forces, utilisation, events"
@@ -87,14 +89,12 @@ def run(args: argparse.Namespace) -> int:
         if scene is None:
             msg = "--input needs --scene (its input topic, sensor frame and gravity convention)"
             raise ValueError(msg)
-        from mount_twin.io.input_samples import read_input, refuse_unprovided
+        from mount_twin.io.input_samples import read_input
         from mount_twin.physics.rotations import rpy_matrix
 
         keys = ("the topic the run read: is this its input bag?", "input.msg_type")
         decoded = read_input(args.input, scene.input, keys)
-        why = "the input's spectra take every sample's acceleration as a reading, evenly spaced"
-        refuse_unprovided(decoded, f"{args.input}: {scene.input.topic}:", False, why)
-        decoded, note = finite_input(args.input, scene.input.topic, decoded)
+        decoded, note = taken_input(args.input, scene.input, decoded)
         if note:
             print(note)
         f = decoded.accel @ rpy_matrix(*scene.input.sensor_rpy).T
@@ -153,41 +153,67 @@ def _exit_status(out: ReportPage, fail_on: str) -> int:
     return status
 
 
-def finite_input(path: str, topic: str, decoded: Decoded) -> tuple[Decoded, str]:
-    """The input's samples the replay takes as finite (`intake.readable`), and what was skipped
-    ('' if nothing). Samples not finite before or after the finite ones are skipped, as the
-    replay skips them; one between finite samples is refused (ValueError naming the bag, the
-    topic, the sample and its axis): the input's spectra take the samples as evenly spaced,
-    and would join those around the hole. So is a record with no finite sample."""
+def taken_input(path: str, spec: InputSpec, decoded: Decoded) -> tuple[Decoded, str]:
+    """The input's samples the replay takes as far as their readings tell, and what was left
+    out ('' if nothing). The intake rejects a sample with a reading not finite, or marked not
+    provided (REP-145: its acceleration, or the rate the twin reads), and goes on
+    (`intake.reading_rejections`): such samples before the first it takes or after its last
+    are left out here too, and said (how many for each reason, at which end, the first). One
+    between taken samples is refused (ValueError naming the bag, the topic, the sample and
+    what it lacks): the input's spectra take the samples as evenly spaced, and would join
+    those around the hole. So is a record the replay takes no sample of."""
+    from collections import Counter
+
     import numpy as np
 
-    from mount_twin.commands.common import not_finite
-    from mount_twin.engine.intake import READING_LIMIT, readable
+    from mount_twin.engine.intake import counted_text, reading_rejections
 
-    ok = readable(decoded.accel, decoded.gyro)
-    bad, count = not_finite(ok, "samples")
-    if not count:
+    reasons = reading_rejections(decoded.accel, decoded.gyro, decoded.unprovided, spec.reads_rate)
+    ok = reasons == ""
+    left = np.flatnonzero(~ok)
+    if not left.size:
         return decoded, ""
-    finite = np.flatnonzero(ok)
-    inside = bad[(bad > finite[0]) & (bad < finite[-1])] if finite.size else bad
-    first = int((inside if inside.size else bad)[0])
-    readings = np.concatenate([decoded.accel[first], decoded.gyro[first]]).tolist()
-    k = next(i for i, v in enumerate(readings) if not abs(v) <= READING_LIMIT)
-    t = (int(decoded.stamps_ns[first]) - int(decoded.stamps_ns[0])) * 1e-9
-    axis = f"{('accel', 'gyro')[k // 3]} {'xyz'[k % 3]}"
-    said = f"sample {first} (t = {t:.6g} s from the first) has {axis} {readings[k]!r}"
-    where = f"{path}: {topic}: {count}"
-    if not finite.size:
-        msg = f"{where}, none finite: {said}"
+    n, taken = ok.shape[0], np.flatnonzero(ok)
+    inside = left[(left > taken[0]) & (left < taken[-1])] if taken.size else left
+    where = (
+        f"{path}: {spec.topic}: {left.size} of {n} samples the replay rejects "
+        f"({counted_text(Counter(reasons[left].tolist()))})"
+    )
+    if not taken.size:
+        msg = f"{where}, every one: the first, {_sample_text(decoded, int(left[0]), reasons)}"
         raise ValueError(msg)
     if inside.size:
         msg = (
-            f"{where}; {said}, between finite samples: the input's spectra take its samples "
-            "as evenly spaced"
+            f"{where}; {_sample_text(decoded, int(inside[0]), reasons)}, between samples it "
+            "takes: the input's spectra take its samples as evenly spaced"
         )
         raise ValueError(msg)
+    ends = []
+    if before := int(taken[0]):
+        ends.append(f"{before} before the first it takes (samples 0–{before - 1})")
+    if after := n - 1 - int(taken[-1]):
+        ends.append(f"{after} after its last (samples {n - after}–{n - 1})")
     note = (
-        f"{where}, before or after the others (the first: {said}): skipped, as the replay "
-        f"skips them; the input's plot and spectra are of the other {finite.size}"
+        f"{where} left out, as the replay skips them: {', '.join(ends)}; the first: "
+        f"{_sample_text(decoded, int(left[0]), reasons)}; the input's plot and spectra are of "
+        f"the other {taken.size}"
     )
     return decoded.select(ok), note
+
+
+def _sample_text(decoded: Decoded, i: int, reasons: np.ndarray) -> str:
+    """What sample i of the record lacks for the intake (`reasons[i]`, its rejection), with its
+    place and time from the first sample: a reading not finite, with its axis and value, or
+    one its message marks not provided."""
+    from mount_twin.engine.intake import READING_LIMIT, provided
+
+    t = (int(decoded.stamps_ns[i]) - int(decoded.stamps_ns[0])) * 1e-9
+    at = f"sample {i} (t = {t:.6g} s from the first)"
+    if reasons[i] != "non_finite":
+        what = "acceleration" if reasons[i] == "no_acceleration" else "angular velocity"
+        return f"{at} marks its {what} not provided (covariance[0] = -1, REP-145)"
+    marked = None if decoded.unprovided is None else decoded.unprovided[i : i + 1]
+    accel, gyro = provided(decoded.accel[i : i + 1], decoded.gyro[i : i + 1], marked)
+    readings = [*accel[0].tolist(), *gyro[0].tolist()]  # a placeholder not provided is not read
+    k = next(j for j, v in enumerate(readings) if not abs(v) <= READING_LIMIT)
+    return f"{at} has {('accel', 'gyro')[k // 3]} {'xyz'[k % 3]} {readings[k]!r}"

@@ -179,6 +179,23 @@ def disregarded(unprovided: np.ndarray | None, n: int, reads_rate: bool = True) 
     return unprovided[:, 0] | (unprovided[:, 1] & reads_rate)
 
 
+def reading_rejections(
+    accel: np.ndarray, gyro: np.ndarray, unprovided: np.ndarray | None, reads_rate: bool
+) -> np.ndarray:
+    """(n,) the rejection each sample earns at the intake by its readings alone ('' none), as
+    `Intake` judges them, first first: non_finite (a reading not within ±READING_LIMIT, those
+    marked not provided disregarded: `provided`), no_acceleration, no_angular_velocity (where
+    the twin `reads_rate`; `unprovided` as `disregarded` takes it). For an analysis of a record
+    to leave out what the twin did not take."""
+    n = accel.shape[0]
+    reasons = np.full(n, "", dtype=object)
+    if unprovided is not None:
+        reasons[unprovided[:, 1] & reads_rate] = "no_angular_velocity"
+        reasons[unprovided[:, 0]] = "no_acceleration"
+    reasons[~readable(*provided(accel, gyro, unprovided))] = "non_finite"
+    return reasons
+
+
 def rising(stamps: np.ndarray, keep: np.ndarray, last: int) -> np.ndarray:
     """Of the samples `keep` marks, those (bool mask) whose integer stamp is after `last` and
     after every kept stamp before it (one going back is not after the others either, so the
