@@ -914,6 +914,13 @@ def test_a_scene_with_the_runs_mounts_and_another_value_is_refused_naming_both(
     assert f"NOT the run's, drawn with on request (--other-scene): {other}: scene" in text
 
 
+def test_other_scene_needs_a_scene(pump_run: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["report", str(pump_run), "--other-scene"]) == 2
+    assert "--other-scene draws with the scene --scene gives: it needs --scene" in (
+        capsys.readouterr().err
+    )
+
+
 def test_the_runs_scene_rewritten_is_still_its_own(
     pump_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

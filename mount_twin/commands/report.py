@@ -76,6 +76,9 @@ def run(args: argparse.Namespace) -> int:
 
     check_targets(output=args.output, reads=(args.bag, args.scene, args.input, args.design))
     tolerance = tolerance_of(args)
+    if args.other_scene and not args.scene:
+        msg = "--other-scene draws with the scene --scene gives: it needs --scene"
+        raise ValueError(msg)
     if args.design and not args.input:
         msg = "--design judges the input's spectra: it needs --input (and --scene)"
         raise ValueError(msg)
