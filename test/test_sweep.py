@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import math
 import shutil
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -571,3 +572,50 @@ def test_two_local_clusters_at_once_start_without_a_warning() -> None:
             assert one.submit(abs, -2).result() == 2 and two.submit(abs, -3).result() == 3
     said = [str(w.message) for w in caught if "already in use" in str(w.message)]
     assert not said, said
+
+
+def test_a_rerun_after_the_bag_was_recorded_again_runs_every_case_on_the_new_record(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A case's id hashed the bag's path, not its content: a bag recorded again at the same
+    path (here the same size, twice the shock) kept its ids, so a rerun skipped every case as
+    finished and summarised the old record. Its cases now run again, as single runs of the new
+    record (a copy elsewhere, read by no cache) do."""
+    bag = tmp_path / "shock"
+
+    def record(peak: str) -> None:
+        shutil.rmtree(bag, ignore_errors=True)
+        options = ["--peak", peak, "--pulse", "0.005", "--rate", "4000", "--duration", "0.15"]
+        assert main(["generate", "half-sine", "-o", str(bag), *options]) == 0
+
+    record("150")
+    text = SWEEP.replace(str(ROOT / "bags" / "half_sine_shock_10khz"), str(bag))
+    text = text.split("  - name: dhs", maxsplit=1)[0].replace("[1100.0, -5.0]", "[1100.0]")
+    sweep, results = _sweep_file(tmp_path, text), tmp_path / "r.csv"
+    args = ["sweep", str(sweep), "-o", str(results), "--workers", "1", "--no-progress"]
+    assert main(args) == 0
+    first = read_results(results)
+    old_spec = load_sweep(sweep)
+    old_single = [run_case(old_spec.base, old_spec.source, c) for c in check(old_spec)]
+    sizes = {f.name: f.stat().st_size for f in bag.iterdir()}
+    record("300")
+    assert {f.name: f.stat().st_size for f in bag.iterdir()} == sizes  # only the content
+    capsys.readouterr()
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"2 cases in {results} (and 2 of cases this sweep no longer has")
+    table = read_results(results)
+    assert len(table) == 4
+    copy = tmp_path / "copy"
+    shutil.copytree(bag, copy)
+    spec = load_sweep(sweep)
+    names = [m["name"] for m in spec.base["mounts"]]
+    for case, old in zip(check(spec), old_single, strict=True):
+        (row,) = (r for r in table if r["case"] == case.case_id)
+        assert case.case_id not in {r["case"] for r in first}
+        moved = replace(case, input=replace(case.input, bag=str(copy)))
+        for alone in (run_case(spec.base, spec.source, case), run_case(spec.base, "", moved)):
+            for n in names:
+                key = f"peak_force_magnitude_N.{n}"
+                assert row[key] == pytest.approx(alone[key], rel=1e-12)
+                assert row[key] > 1.1 * old[key], n  # twice the shock: not the old record's

@@ -33,10 +33,11 @@ class Case:
 
 def expand(spec: SweepSpec) -> list[Case]:
     """Every case of the sweep, in a stable order, each with a stable id: a hash of the base
-    scene's mapping, what the case sets and its input's definition (name, bag path, generate
-    options), so that a rerun recognises finished cases and only those. An id of what it sets
-    and its input's name alone had a rerun after an edit of the base scene (or of a generated
-    input) skip every case as finished, its table and summary the old design's."""
+    scene's mapping, what the case sets and its input's definition (name, bag path and the
+    digest of its files, generate options), so that a rerun recognises finished cases and only
+    those. An id of what it sets and its input's name alone had a rerun after an edit of the
+    base scene (or of a generated input) skip every case as finished, its table and summary the
+    old design's; one of the bag's path, after the bag was recorded again there."""
     columns = [[(v.key, v.op, x) for x in v.values] for v in spec.variations]
     combos = (
         itertools.product(*columns) if spec.combine == "product" else zip(*columns, strict=True)
@@ -44,7 +45,9 @@ def expand(spec: SweepSpec) -> list[Case]:
     cases = []
     for combo in combos:
         for inp in spec.inputs:
-            what = [spec.base, list(combo), [inp.name, inp.bag, list(inp.generate)]]
+            given = [inp.name, inp.bag, list(inp.generate)]
+            # (a generated input has no content: its ids stay those of its earlier results)
+            what = [spec.base, list(combo), [*given, inp.content] if inp.content else given]
             text = json.dumps(what, sort_keys=True, default=str)
             cases.append(Case(hashlib.sha1(text.encode()).hexdigest()[:12], tuple(combo), inp))
     return cases

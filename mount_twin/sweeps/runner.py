@@ -71,7 +71,8 @@ def columns(spec: SweepSpec) -> list[str]:
 
 @lru_cache(maxsize=8)
 def _input_samples(case: InputCase, spec: InputSpec) -> SampleBatch:
-    """The input of a case (read once per worker process, input and input spec)."""
+    """The input of a case (read once per worker process, input and input spec: a bag recorded
+    again is another input, `InputCase.content`, read anew by a worker that read the old)."""
     if case.bag:
         from mount_twin.io.input_samples import read_samples
 

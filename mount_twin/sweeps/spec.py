@@ -20,6 +20,7 @@ inputs:                               # each case runs against every input
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -50,6 +51,10 @@ class InputCase:
     name: str
     bag: str = ""
     generate: tuple[tuple[str, Any], ...] = ()
+    content: str = ""
+    """A bag's: the digest of its files when the sweep was loaded (`bag_digest`), so that a
+    bag recorded again at the same path is another input (its cases' ids, a worker's cache of
+    what it read)."""
 
 
 @dataclass(frozen=True)
@@ -89,8 +94,10 @@ def load_sweep(path: str | Path) -> SweepSpec:
     raw_inputs = top.raw("inputs")
     if not isinstance(raw_inputs, list) or not raw_inputs:
         raise top.error("inputs", f"expected a non-empty list of inputs, got {raw_inputs!r}")
+    digests: dict[tuple[str, int, int], str] = {}  # each file read once, named twice or not
     inputs = tuple(
-        _input(Reader(v, str(path), f"inputs[{i}]"), path.parent) for i, v in enumerate(raw_inputs)
+        _input(Reader(v, str(path), f"inputs[{i}]"), path.parent, digests)
+        for i, v in enumerate(raw_inputs)
     )
     if len({i.name for i in inputs}) != len(inputs):
         raise top.error("inputs", "input names must differ (give each a `name`)")
@@ -126,12 +133,16 @@ def _variation(r: Reader) -> Variation:
     return Variation(key, op, values)
 
 
-def _input(r: Reader, folder: Path) -> InputCase:
+def _input(r: Reader, folder: Path, digests: dict[tuple[str, int, int], str]) -> InputCase:
     if "bag" in r.data:
         bag = str((folder / r.string("bag")).resolve())
         if not Path(bag).exists():
             raise r.error("bag", f"no such file or directory: {bag}")
-        case = InputCase(r.string("name", Path(bag).name), bag=bag)
+        try:
+            content = bag_digest(Path(bag), digests)
+        except OSError as err:
+            raise r.error("bag", f"cannot read {err.filename or bag}: {err.strerror}") from err
+        case = InputCase(r.string("name", Path(bag).name), bag=bag, content=content)
     else:
         g = r.sub("generate", optional=False)
         kind = g.choice("kind", GENERATE_KINDS)
@@ -143,3 +154,23 @@ def _input(r: Reader, folder: Path) -> InputCase:
         case = InputCase(r.string("name", kind), generate=tuple(sorted(options.items())))
     r.finish()
     return case
+
+
+DIGEST_BLOCK = 1 << 20
+"""Bytes of a bag file read at a time for its digest (a bag is never read whole into memory)."""
+
+
+def bag_digest(bag: Path, digests: dict[tuple[str, int, int], str]) -> str:
+    """SHA-256 of the bag at `bag`: of the file, or of a directory's regular files (a rosbag2
+    directory: metadata.yaml and the storage files), each by its name and bytes, streamed.
+    `digests` caches a file's by (path, size, mtime_ns): a bag two inputs name is read once."""
+    files = sorted(f for f in bag.iterdir() if f.is_file()) if bag.is_dir() else [bag]
+    whole = hashlib.sha256()
+    for file in files:
+        st = file.stat()
+        key = (str(file), st.st_size, st.st_mtime_ns)
+        if key not in digests:
+            with file.open("rb") as fh:
+                digests[key] = hashlib.file_digest(fh, "sha256").hexdigest()
+        whole.update(f"{file.name}\0{digests[key]}\0".encode())
+    return whole.hexdigest()
