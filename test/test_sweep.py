@@ -619,3 +619,53 @@ def test_a_rerun_after_the_bag_was_recorded_again_runs_every_case_on_the_new_rec
                 key = f"peak_force_magnitude_N.{n}"
                 assert row[key] == pytest.approx(alone[key], rel=1e-12)
                 assert row[key] > 1.1 * old[key], n  # twice the shock: not the old record's
+
+
+def _fake_pyarrow(monkeypatch: pytest.MonkeyPatch, write: object) -> None:
+    """pyarrow (not installed here) as modules whose `parquet.write_table(table, where)` is
+    `write` and whose `Table.from_pylist` keeps the rows."""
+    import importlib.machinery
+    import sys
+    import types
+
+    pa = types.ModuleType("pyarrow")
+    pa.__spec__ = importlib.machinery.ModuleSpec("pyarrow", None)
+    pa.Table = types.SimpleNamespace(from_pylist=list)  # type: ignore[attr-defined]
+    pq = types.ModuleType("pyarrow.parquet")
+    pq.__spec__ = importlib.machinery.ModuleSpec("pyarrow.parquet", None)
+    pq.write_table = write  # type: ignore[attr-defined]
+    pa.parquet = pq  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "pyarrow", pa)
+    monkeypatch.setitem(sys.modules, "pyarrow.parquet", pq)
+
+
+def test_parquet_is_written_whole_or_not_at_all(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--parquet was written in place: a write that failed part-way (a full disk) left a
+    truncated file in place of the last good one. It is written beside it and renamed over it
+    when whole (as the CSV and PNG outputs are); a failure leaves the old file and no other."""
+    text = SWEEP.split("  - name: dhs", maxsplit=1)[0].replace("[1100.0, -5.0]", "[1100.0]")
+    sweep, results = _sweep_file(tmp_path, text), tmp_path / "r.csv"
+    parquet = tmp_path / "r.parquet"
+    parquet.write_bytes(b"the last good table")
+    args = ["sweep", str(sweep), "-o", str(results), "--parquet", str(parquet)]
+
+    def fails_part_way(rows: list[dict[str, object]], where: object) -> None:
+        Path(str(where)).write_bytes(b"PAR1 half a table")
+        raise OSError(28, "No space left on device", str(where))
+
+    _fake_pyarrow(monkeypatch, fails_part_way)
+    assert main([*args, "--workers", "1", "--no-progress"]) == 2
+    assert "No space left on device" in capsys.readouterr().err
+    assert parquet.read_bytes() == b"the last good table"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv", "r.parquet", "sweep.yaml"]
+
+    def writes(rows: list[dict[str, object]], where: object) -> None:
+        Path(str(where)).write_bytes(f"PAR1 {len(rows)} rows".encode())
+
+    _fake_pyarrow(monkeypatch, writes)
+    assert main([*args, "--workers", "1", "--no-progress"]) == 0
+    assert parquet.read_bytes() == b"PAR1 2 rows"
+    assert f"parquet: {parquet}" in capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv", "r.parquet", "sweep.yaml"]

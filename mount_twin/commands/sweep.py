@@ -82,8 +82,10 @@ def run(args: argparse.Namespace) -> int:
 
         from mount_twin.textfiles import replacing
 
+        # whole or not at all, as the CSV and PNG outputs: a write that failed part-way had
+        # left a truncated file in place of the last good one
         with replacing(args.parquet) as tmp:
-            pq.write_table(pa.Table.from_pylist(rows), tmp)
+            pq.write_table(pa.Table.from_pylist(rows), str(tmp))
         print(f"parquet: {args.parquet}")
     if args.plot:
         from mount_twin.sweeps.plot import plot_sweep
