@@ -468,13 +468,60 @@ def test_a_stopped_sweep_says_what_its_table_holds_and_a_rerun_runs_the_rest(
 def test_the_local_clusters_workers_leave_ctrl_c_to_the_command() -> None:
     """Ctrl-C reaches the terminal's whole process group: each local worker printed a
     KeyboardInterrupt traceback (30 lines of asyncio and multiprocessing) beside the command's
-    own "interrupted (SIGINT)" line, though the command stops them with its cluster."""
+    own "interrupted (SIGINT)" line, though the command stops them with its cluster. Their
+    SIGINT is blocked; this process's is as it was."""
     import signal
 
     with dask_client(workers=1) as client:
-        ignored = client.run(lambda: signal.getsignal(signal.SIGINT) is signal.SIG_IGN)
-    assert list(ignored.values()) == [True]
+        blocked = client.run(lambda: signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, []))
+    assert list(blocked.values()) == [True]
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # this process's own
+    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, [])
+
+
+@pytest.mark.parametrize("after_s", [0.0, 0.2, 0.5])
+def test_ctrl_c_as_the_workers_start_is_the_commands_line_alone(
+    tmp_path: Path, after_s: float
+) -> None:
+    """The workers ignored SIGINT from the cluster's first task on: a Ctrl-C in the second a
+    worker takes to start (its imports) printed its KeyboardInterrupt traceback, or "Fatal
+    Python error: init_import_site", and one while the cluster itself started an "AssertionError:
+    Status.init" at exit. The process group is sent SIGINT `after_s` after the first worker
+    process appears: the command says it was interrupted, and nothing else."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import psutil  # dask.distributed's own dependency
+
+    text = SWEEP.split("  - bag:", maxsplit=1)[0] + "  - name: dhs" + SWEEP.split("- name: dhs")[1]
+    sweep = _sweep_file(tmp_path, text)
+    command = [sys.executable, "-m", "mount_twin.cli", "sweep", str(sweep)]
+    options = ["-o", str(tmp_path / "r.csv"), "--workers", "2", "--no-progress"]
+    with subprocess.Popen(
+        [*command, *options],
+        cwd=ROOT,
+        start_new_session=True,  # its own process group, as a terminal's foreground job
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    ) as proc:
+        started = time.monotonic()
+        while not [
+            c
+            for c in psutil.Process(proc.pid).children(recursive=True)
+            if "resource_tracker" not in " ".join(c.cmdline())
+        ]:
+            assert proc.poll() is None and time.monotonic() - started < 60, "no worker started"
+            time.sleep(0.002)
+        time.sleep(after_s)
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130
+    lines = err.splitlines()  # (its one line names the rows held, had a case finished)
+    assert len(lines) == 1 and lines[0].startswith("mount-twin: interrupted (SIGINT)"), err
 
 
 def test_the_plot_says_how_many_failed_cases_it_leaves_out(

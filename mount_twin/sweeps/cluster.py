@@ -19,30 +19,48 @@ def dask_client(scheduler: str | None = None, workers: int | None = None) -> Ite
         raise ValueError(msg)
     from dask.distributed import Client, LocalCluster
 
-    cluster = None
-    if scheduler is None:
-        n = (os.cpu_count() or 1) if workers is None else workers
-        # ":0": its dashboard on a free port (None still took 8787, warning "Port 8787 is
-        # already in use" beside a second sweep or any other Dask cluster)
-        cluster = LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0"
-        )
-    client = Client(scheduler or cluster)
+    cluster = client = None
     try:
-        if cluster is not None:  # its workers, not a shared cluster's
-            client.run(_ignore_sigint)
+        if scheduler is None:
+            n = (os.cpu_count() or 1) if workers is None else workers
+            with _workers_deaf_to_ctrl_c():
+                # ":0": its dashboard on a free port (None still took 8787, warning "Port 8787
+                # is already in use" beside a second sweep or any other Dask cluster)
+                cluster = LocalCluster(
+                    n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0"
+                )
+        client = Client(scheduler or cluster)
         yield client
     finally:
-        client.close()
+        if client is not None:
+            client.close()
         if cluster is not None:
             cluster.close()
 
 
-def _ignore_sigint() -> None:
-    """Run in each worker process of a local cluster: Ctrl-C, which reaches the terminal's whole
-    process group, is the command's, which stops the workers with the cluster (each had printed
-    a KeyboardInterrupt traceback beside the command's own line)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+@contextmanager
+def _workers_deaf_to_ctrl_c() -> Iterator[None]:
+    """Start a local cluster within this: its worker processes have SIGINT blocked from their
+    first instruction to their end. Ctrl-C reaches the terminal's whole process group and is
+    the command's, which stops the workers with the cluster; a worker that took it printed a
+    KeyboardInterrupt traceback (or "Fatal Python error: init_import_site") beside the
+    command's own line, and ignoring it from the cluster's first task on still left the second
+    a worker takes to start.
+
+    A signal mask is inherited by the threads a thread starts and across fork and exec: this
+    thread's, blocked here, is the cluster's event-loop thread's, which spawns the workers (and
+    restarts one that dies) for the cluster's life. The multiprocessing resource tracker is
+    started first: its start, had the loop thread made it, unblocks SIGINT in that thread
+    afterwards (its own mask dance), and the workers spawned after it would take Ctrl-C again.
+    A Ctrl-C to this process meanwhile waits, pending, and is raised when this block ends."""
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def results_as_completed(
