@@ -382,7 +382,9 @@ def test_a_retried_case_that_succeeds_is_no_longer_counted_failed(
 ) -> None:
     """A bag still being copied when the sweep ran (its folder empty) fails its cases; rerun
     once it is in place, they succeed. Their first, FAILED rows stayed in the table the summary
-    and the exit status read: "4 cases" of a 2-case sweep, "ERROR 2, FAILED 2", exit 6."""
+    and the exit status read: "4 cases" of a 2-case sweep, "ERROR 2, FAILED 2", exit 6. (Its
+    files are now part of its cases' ids: the rerun's cases are new ones, and the FAILED rows
+    of the empty folder are left out, counted.)"""
     bag = tmp_path / "shock"
     bag.mkdir()  # there, but not yet its files
     text = SWEEP.replace(str(ROOT / "bags" / "half_sine_shock_10khz"), str(bag))
@@ -395,9 +397,27 @@ def test_a_retried_case_that_succeeds_is_no_longer_counted_failed(
     shutil.copytree(ROOT / "bags" / "half_sine_shock_10khz", bag)
     assert main(args) == 0  # each case's latest run succeeded
     out = capsys.readouterr().out
-    assert out.startswith(f"2 cases in {results}\n")
+    assert out.startswith(f"2 cases in {results} (and 2 of cases this sweep no longer has")
     assert "verdicts: ERROR 2\n" in out  # the bundled shock overloads the pump's mounts
-    assert [r["verdict"] for r in read_results(results)] == ["ERROR", "ERROR"]
+    ids = {c.case_id for c in check(load_sweep(sweep))}
+    assert [r["verdict"] for r in read_results(results) if r["case"] in ids] == ["ERROR", "ERROR"]
+
+
+def test_a_case_run_again_is_its_latest_row(tmp_path: Path) -> None:
+    """A rerun retries a FAILED case, appending its new row: the table is each case's latest
+    row, in its first row's place."""
+    results = tmp_path / "r.csv"
+    results.write_text(
+        "case,input,verdict,error,events\n"
+        "a,dhs,FAILED,OSError: no bag,\n"
+        "b,dhs,OK,,0\n"
+        "a,dhs,ERROR,,2\n",
+        encoding="utf-8",
+    )
+    assert [(r["case"], r["verdict"], r["events"]) for r in read_results(results)] == [
+        ("a", "ERROR", 2),
+        ("b", "OK", 0),
+    ]
 
 
 def test_the_plot_takes_a_first_varied_value_that_is_no_number_in_the_files_order(
