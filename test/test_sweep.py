@@ -316,7 +316,7 @@ def test_the_command_reports_and_exits_6_when_a_case_failed(
     # the failed cases named with their errors: a script's exit 6 says which and why
     named = [line for line in out.splitlines() if line.startswith("  FAILED case ")]
     assert len(named) == NAMED_FAILURES
-    assert all("body.mass = -5.0): SceneError: " in line for line in named)
+    assert all("body.mass = -5.0 kg): SceneError: " in line for line in named)
     assert "more FAILED (the table's error column)" in out
     # per input, the case of the lowest largest utilisation, from the table's own columns
     names = [m["name"] for m in spec.base["mounts"]]
@@ -347,7 +347,7 @@ def test_the_plot_draws_each_inputs_largest_force_and_utilisation_in_the_sweeps_
     spec, results, _ = swept
     rows = read_results(results)
     lines = trade_off(rows, spec)
-    assert list(lines) == ["half_sine_shock_10khz body.mass=1100.0", "dhs body.mass=1100.0"]
+    assert list(lines) == ["half_sine_shock_10khz body.mass=1100.0 kg", "dhs body.mass=1100.0 kg"]
     names = [m["name"] for m in spec.base["mounts"]]
     for label, points in lines.items():
         done = sorted(
@@ -440,7 +440,7 @@ def test_the_plot_takes_a_first_varied_value_that_is_no_number_in_the_files_orde
     assert png.stat().st_size > 10_000
     spec, rows = load_sweep(sweep), read_results(results)
     lines = trade_off(rows, spec)
-    assert list(lines) == ["half_sine_shock_10khz body.mass=1100.0", "dhs body.mass=1100.0"]
+    assert list(lines) == ["half_sine_shock_10khz body.mass=1100.0 kg", "dhs body.mass=1100.0 kg"]
     for label, points in lines.items():
         assert [p[0] for p in points] == [0.0, 1.0]
         for p in points:
@@ -736,3 +736,86 @@ def test_parquet_is_written_whole_or_not_at_all(
     assert parquet.read_bytes() == b"PAR1 2 rows"
     assert f"parquet: {parquet}" in capsys.readouterr().out
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv", "r.parquet", "sweep.yaml"]
+
+
+@pytest.mark.parametrize(
+    ("scene", "key", "unit"),
+    [
+        (PUMP, "body.mass", "kg"),
+        (PUMP, "body.inertia", "kg·m²"),
+        (PUMP, "mounts[fl].position", "m"),
+        (PUMP, "mounts[*].rated_load", "N"),
+        (PUMP, "input.gyro_stopband_hz", "Hz"),
+        (PUMP, "input.g", "m/s²"),
+        (PUMP, "body_sensor.lag_s", "s"),
+        (PUMP, "mounts[fl].stiffness", None),  # N/m along, N·m/rad about its axes
+        (PUMP, "integration.atol", None),  # m, rad, m/s, rad/s by state
+        (PUMP, "integration.rtol", None),  # a ratio
+        (PUMP, "outputs.angles", None),  # a switch whose description names rad
+        (PUMP, "input.frame_id", None),
+        (CONFIG / "genset_bolted_keyed.scene.yaml", "mounts[key_x].stiffness", "N/m"),
+        (CONFIG / "genset_bolted_keyed.scene.yaml", "mounts[foot_fl].preload", "N"),
+        (CONFIG / "genset_bolted_keyed.scene.yaml", "mounts[0].bolt_stiffness", "N/m"),
+        # a shear key's N/m, a bolted joint's none: not one unit
+        (CONFIG / "genset_bolted_keyed.scene.yaml", "mounts[*].stiffness", None),
+    ],
+)
+def test_a_key_paths_unit_is_the_one_the_scene_tables_state(
+    scene: Path, key: str, unit: str | None
+) -> None:
+    from mount_twin.sweeps.cases import key_unit
+
+    assert key_unit(key, read_scene_yaml(scene)) == unit
+
+
+def test_the_summary_and_the_plot_give_each_set_values_unit_where_the_scene_states_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The summary and the plot named key paths bare: "body.mass = 1100.0", an x axis
+    "body.mass". A set value has the unit the scene's tables state for its key (kg, m); a scale
+    is a factor, and a key of no one unit (a tolerance) stays bare."""
+    from mount_twin.sweeps.runner import summary
+
+    matplotlib = pytest.importorskip("matplotlib")
+    monkeypatch.setitem(matplotlib.rcParams, "svg.fonttype", "none")  # text kept as text
+    text = f"""\
+base: {PUMP}
+vary:
+  - key: body.mass
+    values: [1100.0, 1300.0]
+  - key: mounts[fl].position
+    values: [[1.0, 0.4, 0.0]]
+  - key: integration.rtol
+    values: [1.0e-8]
+  - key: mounts[*].stiffness
+    scale: [1.0]
+inputs:
+  - name: dhs
+    generate: {{kind: half-sine, peak: 300.0}}
+"""
+    spec = load_sweep(_sweep_file(tmp_path, text))
+    names = [m["name"] for m in spec.base["mounts"]]
+    rows = [
+        {
+            "case": f"c{k}",
+            "input": "dhs",
+            "body.mass": mass,
+            "mounts[fl].position": "[1.0, 0.4, 0.0]",
+            "integration.rtol": 1e-08,
+            "mounts[*].stiffness (scale)": 1.0,
+            "verdict": "OK",
+            **{f"peak_force_magnitude_N.{n}": force for n in names},
+            **{f"utilisation.{n}": 0.5 for n in names},
+        }
+        for k, (mass, force) in enumerate(((1100.0, 9000.0), (1300.0, 9500.0)))
+    ]
+    settings = (
+        "body.mass = 1100.0 kg, mounts[fl].position = [1.0, 0.4, 0.0] m, "
+        "integration.rtol = 1e-08, mounts[*].stiffness (scale) = 1.0"
+    )
+    assert f"lowest peak mount force: 9000.0 N, case c0 (dhs; {settings}) OK" in summary(
+        rows, spec
+    )
+    svg = plot_sweep(rows, spec, tmp_path / "sweep.svg").read_text(encoding="utf-8")
+    assert "body.mass [kg]" in svg
+    assert "dhs mounts[fl].position=[1.0, 0.4, 0.0] m integration.rtol=1e-08" in svg

@@ -8,6 +8,7 @@ scene loader validates, so a params YAML and a scene YAML go through one loader.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator, Mapping
 from typing import Any, NamedTuple
 
@@ -125,6 +126,22 @@ def parameter_description(name: str, effective: Mapping[str, Any]) -> str:
         return PARAMETERS[name][1]
     _, mount, key = name.split(".", 2)
     return mount_parameters(str(effective.get(f"mounts.{mount}.kind", "linear")))[key][1]
+
+
+UNIT = re.compile(
+    r"(?<![\w'/·])(?:1/)?(?:kg|rad|Hz|N|m|s)(?:[·/](?:kg|rad|Hz|N|m|s)|[²³ⁿᵖ])*(?![\w/·])"
+)
+"""An SI unit as the descriptions above write one: kg, m, N/m, N·m·s/rad, m/s², 1/mⁿ, Hz."""
+NUMERIC_TYPES = ("double", "double_array", "integer")
+
+
+def stated_unit(entry: tuple[str, str]) -> str | None:
+    """The unit a parameter's (type, description) states: the one SI unit its description
+    names, or None for no number (`outputs.angles`, a switch, names rad) or a description that
+    names none (a ratio, a count) or several (a linear mount's stiffness, N/m along its axes
+    and N·m/rad about them)."""
+    units = set(UNIT.findall(entry[1])) if entry[0] in NUMERIC_TYPES else set()
+    return units.pop() if len(units) == 1 else None
 
 
 def flatten(tree: Mapping[str, Any], prefix: str = "") -> Iterator[tuple[str, Any]]:

@@ -103,6 +103,27 @@ def _apply_one(data: dict[str, Any], key: str, op: str, value: Any) -> None:
             raise KeyError(f"{key}: {name} holds no number to scale")
 
 
+def key_unit(key: str, base: dict[str, Any]) -> str | None:
+    """The unit of the value a key path sets, as the scene's parameter tables state it
+    (`stated_unit`; a mount's key by its kind, one unit for every mount it selects), or None:
+    no number, no one unit stated, a key path the tables do not know."""
+    from mount_twin.scene.params import PARAMETERS, mount_parameters, stated_unit
+
+    first, _, rest = key.partition(".")
+    match = SEGMENT.match(first)
+    if match is None or match.group(2) is None:  # no selector: a flat parameter's name
+        return stated_unit(PARAMETERS[key]) if key in PARAMETERS else None
+    if match.group(1) != "mounts" or not rest:
+        return None
+    try:
+        mounts = [m for m, _ in _targets(base, [first, "kind"], key)]
+    except KeyError:
+        return None
+    entries = [mount_parameters(str(m.get("kind", "linear"))).get(rest) for m in mounts]
+    units = {stated_unit(e) if e else None for e in entries}
+    return units.pop() if len(units) == 1 else None
+
+
 def check(spec: SweepSpec) -> list[Case]:
     """The cases, after checking that every variation's key path names a key of the scene (in
     the base, or one its loader knows and the base leaves at its default; an error names the

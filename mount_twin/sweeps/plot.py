@@ -10,10 +10,12 @@ from typing import Any
 
 from mount_twin.sweeps.runner import (
     FAILED,
+    column_units,
     columns,
     largest_peak_force,
     largest_utilisation,
     setting_text,
+    value_text,
 )
 from mount_twin.sweeps.spec import SweepSpec
 
@@ -53,11 +55,12 @@ def trade_off(rows: list[dict[str, Any]], spec: SweepSpec) -> dict[str, list[Poi
         return (order.get(r["input"], len(order)), str(r["input"]), *others)
 
     at = places(rows, spec)
+    units = column_units(spec)
     lines: dict[str, list[Point]] = {}
     for r in sorted(rows, key=line_key):
         if r["verdict"] == FAILED or not varied:
             continue
-        label = " ".join([r["input"], *(f"{k}={r[k]}" for k in varied[1:])])
+        label = " ".join([r["input"], *(f"{k}={value_text(k, r[k], units)}" for k in varied[1:])])
         lines.setdefault(label, []).append(
             (
                 float(r[varied[0]]) if at is None else float(at[str(r[varied[0]])]),
@@ -110,7 +113,10 @@ def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> 
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
     varied = columns(spec)[2 : 2 + len(spec.variations)]
-    panels[-1].set_xlabel(varied[0] if varied else "case")
+    xlabel = varied[0] if varied else "case"
+    if (unit := column_units(spec).get(xlabel)) is not None:
+        xlabel += f" [{unit}]"
+    panels[-1].set_xlabel(xlabel)
     if (at := places(rows, spec)) is not None:
         panels[-1].set_xticks(list(at.values()), list(at), fontsize=8)
     failed = sum(r["verdict"] == FAILED for r in rows)  # no figures to draw

@@ -36,7 +36,7 @@ from mount_twin.model.assemble import assemble
 from mount_twin.physics import pose_row
 from mount_twin.scene.description import InputSpec, Scene
 from mount_twin.scene.loader import scene_from_dict
-from mount_twin.sweeps.cases import Case, apply, expand
+from mount_twin.sweeps.cases import Case, apply, expand, key_unit
 from mount_twin.sweeps.cluster import dask_client, results_as_completed
 from mount_twin.sweeps.spec import InputCase, SweepSpec
 from mount_twin.textfiles import directories_above
@@ -67,6 +67,18 @@ def columns(spec: SweepSpec) -> list[str]:
         "est_force_error_rel",
         "wall_s",
     ]
+
+
+def column_units(spec: SweepSpec) -> dict[str, str]:
+    """The unit of each varied column whose key's unit the scene's tables state (`key_unit`):
+    a set value's (a scale's column holds a factor)."""
+    units = {v.key: key_unit(v.key, spec.base) for v in spec.variations if v.op == "set"}
+    return {key: unit for key, unit in units.items() if unit is not None}
+
+
+def value_text(column: str, value: Any, units: dict[str, str]) -> str:
+    """A varied value as the summary and the plot give it: with its column's unit, if known."""
+    return f"{value} {units[column]}" if column in units else f"{value}"
 
 
 @lru_cache(maxsize=8)
@@ -306,9 +318,10 @@ def summary(rows: Iterable[dict[str, Any]], spec: SweepSpec) -> str:
     rows = list(rows)
     names = [m["name"] for m in spec.base["mounts"]]
     varied = columns(spec)[2 : 2 + len(spec.variations)]
+    units = column_units(spec)
 
     def setting(r: dict[str, Any]) -> str:
-        return ", ".join(f"{k} = {r[k]}" for k in varied)
+        return ", ".join(f"{k} = {value_text(k, r[k], units)}" for k in varied)
 
     counts: dict[str, int] = {}
     for r in rows:
