@@ -97,8 +97,12 @@ def test_a_key_the_base_leaves_at_its_default_can_be_set(tmp_path: Path) -> None
             r"inputs\[0\]\.bag: no such file or directory: .*no_such_bag",
         ),
         (("scale: [0.5, 2.0]", "scale: [true, 2.0]"), r"vary\[0\]\.scale: expected numbers"),
+        (  # its digest read it for ever
+            (str(ROOT / "bags" / "half_sine_shock_10khz"), "/dev/zero"),
+            r"inputs\[0\]\.bag: /dev/zero: no bag \(neither a directory nor a regular file\)",
+        ),
     ],
-    ids=["missing-bag", "boolean-scale"],
+    ids=["missing-bag", "boolean-scale", "device"],
 )
 def test_a_bad_input_or_scale_fails_at_load_naming_it(
     tmp_path: Path, edit: tuple[str, str], says: str

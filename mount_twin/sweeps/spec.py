@@ -138,6 +138,8 @@ def _input(r: Reader, folder: Path, digests: dict[tuple[str, int, int], str]) ->
         bag = str((folder / r.string("bag")).resolve())
         if not Path(bag).exists():
             raise r.error("bag", f"no such file or directory: {bag}")
+        if not (Path(bag).is_dir() or Path(bag).is_file()):  # /dev/zero: digested for ever
+            raise r.error("bag", f"{bag}: no bag (neither a directory nor a regular file)")
         try:
             content = bag_digest(Path(bag), digests)
         except OSError as err:
@@ -156,13 +158,10 @@ def _input(r: Reader, folder: Path, digests: dict[tuple[str, int, int], str]) ->
     return case
 
 
-DIGEST_BLOCK = 1 << 20
-"""Bytes of a bag file read at a time for its digest (a bag is never read whole into memory)."""
-
-
 def bag_digest(bag: Path, digests: dict[tuple[str, int, int], str]) -> str:
     """SHA-256 of the bag at `bag`: of the file, or of a directory's regular files (a rosbag2
-    directory: metadata.yaml and the storage files), each by its name and bytes, streamed.
+    directory: metadata.yaml and the storage files), each by its name and bytes, streamed
+    (`hashlib.file_digest`: never read whole into memory).
     `digests` caches a file's by (path, size, mtime_ns): a bag two inputs name is read once."""
     files = sorted(f for f in bag.iterdir() if f.is_file()) if bag.is_dir() else [bag]
     whole = hashlib.sha256()
