@@ -113,3 +113,27 @@ def test_link_anchors_name_headings_of_their_pages(page: Path) -> None:
         linked = page.parent / target if target else page
         if linked.suffix == ".md":
             assert anchor in _heading_anchors(linked), f"{page.name}: {target}#{anchor}"
+
+
+def test_the_sweep_case_ids_offline_md_prints_are_the_bundled_sweeps() -> None:
+    """A case id hashes the base scene: after an edit of the pump the printed summary named
+    ids (658cd7036e59, …) that `mount-twin sweep config/sweep_pump.yaml` no longer writes, so a
+    reader could not find its rows in the CSV. Each id printed is the case of its input and
+    stiffness scale."""
+    from mount_twin.sweeps.cases import expand
+    from mount_twin.sweeps.spec import load_sweep
+
+    text = (ROOT / "docs/offline.md").read_text(encoding="utf-8")
+    printed = []
+    for line in text.splitlines():
+        case = re.search(r"case ([0-9a-f]{12}) \(.*stiffness \(scale\) = ([\d.]+)\)", line)
+        name = re.search(r"half_sine_\d+", line)
+        if case and name:
+            printed.append((name[0], case[1], float(case[2])))
+    cases = {
+        (case.input.name, case.settings[0][2]): case.case_id
+        for case in expand(load_sweep(ROOT / "config/sweep_pump.yaml"))
+    }
+    assert len(printed) == 5
+    for name, case_id, scale in printed:
+        assert cases[(name, scale)] == case_id, (name, scale)
