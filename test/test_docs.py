@@ -137,3 +137,59 @@ def test_the_sweep_case_ids_offline_md_prints_are_the_bundled_sweeps() -> None:
     assert len(printed) == 5
     for name, case_id, scale in printed:
         assert cases[(name, scale)] == case_id, (name, scale)
+
+
+def _scene_rows() -> dict[str, str]:
+    """scene.md's key table: each key path of a row's first cell (`input.max_gap_s`,
+    `gap_policy` → input.gap_policy) mapped to its row."""
+    rows = {}
+    for line in (ROOT / "docs/scene.md").read_text(encoding="utf-8").splitlines():
+        keys = re.findall(r"`([\w.\[\]]+)`", line.split("|")[1]) if line.startswith("| `") else []
+        if not keys:
+            continue
+        first, *others = keys
+        section = first.rsplit(".", 1)[0]
+        for key in (first, *(f"{section}.{name}" for name in others)):
+            rows[key] = line
+    return rows
+
+
+def _default_texts(value: object) -> list[str]:
+    """How a page may write a default: `true`, `first_order`, empty, 0.5, 1e-6, 1.309."""
+    if isinstance(value, bool):
+        return [f"`{str(value).lower()}`"]
+    if isinstance(value, (int, float)):
+        return [f"{value:g}", f"{value:.4g}", re.sub(r"e-0(\d)", r"e-\1", f"{value:g}")]
+    return [f"`{value}`"] if value else ["empty"]
+
+
+def test_scene_md_gives_every_scalar_default() -> None:
+    """README promises every key's default in scene.md; the table gave no unit or default for
+    `outputs.diagnostics_period_s`, `input.max_gap_s`, `integration.rtol` … (20 of them)."""
+    import dataclasses
+
+    from mount_twin.scene.description import (
+        Frames,
+        InitialState,
+        InputSpec,
+        Integration,
+        Outputs,
+    )
+
+    rows = _scene_rows()
+    sections = {
+        "input": InputSpec,
+        "initial_state": InitialState,
+        "integration": Integration,
+        "outputs": Outputs,
+        "frames": Frames,
+    }
+    missing = []
+    for section, cls in sections.items():
+        for field in dataclasses.fields(cls):
+            if isinstance(field.default, tuple):  # vectors: their rows give the components
+                continue
+            row = rows.get(f"{section}.{field.name}", "")
+            if not any(text in row for text in _default_texts(field.default)):
+                missing.append(f"{section}.{field.name} = {field.default!r}")
+    assert not missing, missing
