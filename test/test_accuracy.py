@@ -26,7 +26,7 @@ from mount_twin.analysis.accuracy import (
     run_at,
 )
 from mount_twin.cli import main
-from mount_twin.commands.accuracy import _unresolved
+from mount_twin.commands.accuracy import _table, _unresolved
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.errors import MountTwinError
 from mount_twin.io.bag import write_bag
@@ -284,3 +284,23 @@ def test_the_command_refuses_a_setting_no_run_takes_naming_the_option(
     bag = str(ROOT / "bags" / "ship_motion_1khz")
     assert main(["accuracy", str(CONFIG / "pump_8_mounts.scene.yaml"), bag, *option]) == 2
     assert f"mount-twin: error: {named}" in capsys.readouterr().err
+
+
+def test_the_table_heads_each_column_with_its_unit() -> None:
+    """`force err 1.03e-09` read as newtons: the force errors are ratios (of the largest force,
+    of each mount's peak), and every column's unit stands under its name, aligned with its
+    figures."""
+    row = Accuracy(1e-6, 2e-3, 9e-5, 4.8e-7, 3.2e-7, 0.1, 1.23, 0, 1.9e-3, 4.4e-7, 1.7)
+    head, units, figures = _table([row]).splitlines()
+    expected = {
+        "force err": ("of max |F|", "2.00e-03"),
+        "peak err": ("of peaks", "9.00e-05"),
+        "attitude err": ("rad", "4.80e-07"),
+        "CG err": ("m", "3.20e-07"),
+        "wall": ("s/s", "0.1000"),
+        "substeps": ("per sample", "1.23"),
+    }
+    for name, (unit, figure) in expected.items():
+        end = head.index(name) + len(name)  # columns are right-aligned
+        assert units[:end].endswith(unit), (name, units)
+        assert figures[:end].endswith(figure), (name, figures)

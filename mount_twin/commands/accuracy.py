@@ -147,18 +147,26 @@ def _reference_text(
 
 
 def _table(rows: list[Accuracy]) -> str:
+    """The figures per rtol under a two-line head, each column's quantity over its unit: the
+    force errors are ratios (of the largest force, of each mount's peak), which a head of
+    `force err` alone let a reader take for newtons."""
     head = (
-        f"{'rtol':>8} {'force err':>10} {'estimated':>10} {'peak err':>10} "
-        f"{'attitude rad':>13} {'estimated':>10} {'CG m':>10} {'wall s/s':>9} "
-        f"{'substeps':>9} {'failures':>8} {'est cost':>8}"
+        f"{'rtol':>8} {'force err':>11} {'estimated':>11} {'peak err':>10} "
+        f"{'attitude err':>13} {'estimated':>10} {'CG err':>10} {'wall':>9} "
+        f"{'substeps':>10} {'failures':>8} {'est cost':>8}"
     )
-    lines = [head]
+    units = (
+        f"{'':>8} {'of max |F|':>11} {'of max |F|':>11} {'of peaks':>10} "
+        f"{'rad':>13} {'rad':>10} {'m':>10} {'s/s':>9} "
+        f"{'per sample':>10} {'':>8} {'×':>8}"
+    )
+    lines = [head, units]
     for r in rows:
         lines.append(
-            f"{r.rtol:>8.0e} {r.force_error:>10.2e} {r.est_force_error:>10.2e} "
+            f"{r.rtol:>8.0e} {r.force_error:>11.2e} {r.est_force_error:>11.2e} "
             f"{r.peak_force_error:>10.2e} {r.attitude_error_rad:>13.2e} "
             f"{r.est_attitude_error_rad:>10.2e} {r.position_error_m:>10.2e} "
-            f"{r.wall_s_per_sim_s:>9.4f} {r.substeps_per_sample:>9.2f} {r.failures:>8d} "
+            f"{r.wall_s_per_sim_s:>9.4f} {r.substeps_per_sample:>10.2f} {r.failures:>8d} "
             f"{r.estimate_cost:>7.2f}×"
         )
     return "\n".join(lines)
