@@ -249,7 +249,8 @@ class ReplaySummary:
             lines.append(f"    {name:>12}: " + " ".join(f"{peak_text(v):>10}" for v in peak))
         if self.utilisation_max:
             lines.append(
-                "  peak utilisation (bolt F/F_y, rubber deflection/rated, key F/allowable):"
+                "  peak utilisation (bolt F/F_y, rubber deflection/rated, key F/allowable, "
+                "linear travel/rated_travel or F/rated_load):"
             )
             lines += [
                 f"    {n:>12}: {utilisation_text(u)}" for n, u in self.utilisation_max.items()

@@ -13,6 +13,7 @@ from physics_helpers import base_scene, mount
 from mount_twin.engine.batch import ERROR, OK, WARN
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.model.assemble import assemble
+from mount_twin.replay import ReplaySummary
 from mount_twin.scene.loader import scene_from_dict
 
 G = 9.80665
@@ -123,18 +124,22 @@ def test_a_utilisation_just_under_1_does_not_read_as_1() -> None:
     assert said == pytest.approx(0.9998, abs=5e-5)
 
 
-def test_the_replay_summary_does_not_round_a_utilisation_under_1_up_to_1(tmp_path) -> None:
-    """The replay's summary printed the same mount's peak utilisation as "1.000"."""
+def _replayed_at_rest(engine: TwinEngine, tmp_path) -> ReplaySummary:
+    """The replay summary of `engine`'s scene on 0.5 s of a deck at rest (a 1e-4 m/s² pulse)."""
     from mount_twin.cli import main
     from mount_twin.replay import replay
 
-    load = MASS * G / 4
-    engine = _engine([0.0, 0.0, 0.0], [0.0, 0.0, load / 0.9998])
     bag = tmp_path / "still"
     quiet = ["--peak", "1e-4", "--pulse", "0.01", "--rate", "1000", "--duration", "0.5"]
     topic = ["--topic", engine.scene.input.topic]
     assert main(["generate", "half-sine", "-o", str(bag), *quiet, *topic]) == 0
-    summary = replay(engine.scene, bag, tmp_path / "out", progress=False)
+    return replay(engine.scene, bag, tmp_path / "out", progress=False)
+
+
+def test_the_replay_summary_does_not_round_a_utilisation_under_1_up_to_1(tmp_path) -> None:
+    """The replay's summary printed the same mount's peak utilisation as "1.000"."""
+    load = MASS * G / 4
+    summary = _replayed_at_rest(_engine([0.0, 0.0, 0.0], [0.0, 0.0, load / 0.9998]), tmp_path)
     assert summary.utilisation_max["m0"] == pytest.approx(0.9998, abs=2e-5)
     text = summary.text()
     peaks = text.split("peak utilisation")[1]
@@ -167,3 +172,16 @@ def test_a_load_a_hair_past_its_rating_never_reads_as_1_times_it(over: float, sa
     assert f"{load:.4g} N along local z, " in warning.message
     assert says.format(excess=load - rated) + f" {rated:.4g} N" in warning.message
     assert "is 1 times" not in warning.message
+
+
+def test_the_replay_summary_says_what_a_linear_mounts_utilisation_divides(tmp_path) -> None:
+    """A scene of linear mounts read `peak utilisation (bolt F/F_y, rubber deflection/rated,
+    key F/allowable)`: none of its mounts' ratios. Here the load alone is rated, 0.8 at rest."""
+    load = MASS * G / 4
+    text = _replayed_at_rest(_engine([0.0, 0.0, 0.0], [0.0, 0.0, load / 0.8]), tmp_path).text()
+    (head,) = [s for s in text.splitlines() if "peak utilisation" in s]
+    assert "linear travel/rated_travel or F/rated_load" in head
+    (line,) = [
+        s for s in text.split("peak utilisation")[1].splitlines() if s.strip().startswith("m0:")
+    ]
+    assert float(line.split(":")[1]) == pytest.approx(0.8, abs=1e-3)
