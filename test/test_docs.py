@@ -193,3 +193,23 @@ def test_scene_md_gives_every_scalar_default() -> None:
             if not any(text in row for text in _default_texts(field.default)):
                 missing.append(f"{section}.{field.name} = {field.default!r}")
     assert not missing, missing
+
+
+def test_the_resampling_offline_md_quotes_is_the_bundled_shocks() -> None:
+    """offline.md quoted `resampled: 206 of 19998 steps` from a record the repository no longer
+    holds; `srs` on the bundled water-entry shock says 34 of 4999, the off-median steps of its
+    time column counted here."""
+    import numpy as np
+
+    text = (ROOT / "docs/offline.md").read_text(encoding="utf-8")
+    ((off, steps),) = re.findall(r"`resampled: (\d+) of (\d+) steps are off the median", text)
+    t = np.loadtxt(
+        ROOT / "test/data/water_entry_shock_20khz_excerpt.csv",
+        delimiter=",",
+        skiprows=1,
+        usecols=0,
+    )
+    step = np.diff(t)
+    median = np.median(step)
+    off_median = int((np.abs(step - median) > 0.005 * median).sum())  # srs: 0.5 % of it
+    assert (int(off), int(steps)) == (off_median, step.size)
