@@ -14,7 +14,7 @@ from typing import Any
 
 import pytest
 import yaml
-from io_helpers import CONFIG, G
+from io_helpers import CONFIG, PARAMS_FILE, G
 from physics_helpers import base_scene, mount
 
 from mount_twin.errors import SceneError
@@ -552,3 +552,19 @@ def test_the_weight_is_the_scene_s_own() -> None:
         m["stiffness"] = [v / 1000.0 for v in m["stiffness"][:3]] + m["stiffness"][3:]
     data["input"]["g"] = G / 6.0
     assert "the CG sags 0.221 m" in _warnings(scene_from_dict(data, "moon"))["mounts"]
+
+
+def test_a_ros_parameters_file_given_as_a_scene_is_named_as_one(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """`mount-twin replay … --scene config/params.yaml` said `body: required key is missing`
+    of a file whose `/**: ros__parameters:` holds a body: it is the node's parameters file,
+    and the command says so, pointing at a scene file (exit 2, as any bad scene)."""
+    from mount_twin.cli import main
+
+    with pytest.raises(SceneError, match=r"params\.yaml: <file>: a ROS 2 parameters file \(/\*\*"):
+        load_scene_file(PARAMS_FILE)
+    assert main(["info", str(PARAMS_FILE)]) == 2
+    err = capsys.readouterr().err
+    assert "(--ros-args --params-file), not a scene file" in err
+    assert "required key" not in err

@@ -106,6 +106,7 @@ def scene_from_dict(
             instead of a warning: what scene files and parameter sets get. Off for scenes built
             in code, such as tests of a single mount's law.
     """
+    refuse_parameters_file(data, source)
     top = Reader(data, source, record=record)
     body = _body(top.sub("body", optional=False))
     dofs = _dofs(top)
@@ -140,6 +141,22 @@ def scene_from_dict(
     top.finish()
     warnings = check_scene(scene, paths, refuse_unheld=refuse_unheld)
     return dataclasses.replace(scene, warnings=warnings, mount_paths=tuple(paths))
+
+
+def refuse_parameters_file(data: Any, source: str) -> None:
+    """Raise SceneError where `data` is a ROS 2 parameters file (`NODE: ros__parameters: …`,
+    the node's --params-file), not a scene: read as one it failed on its first key, `body:
+    required key is missing`, which its `body` under `ros__parameters` contradicts."""
+    if not isinstance(data, dict):
+        return
+    for node, section in data.items():
+        if isinstance(section, dict) and "ros__parameters" in section:
+            msg = (
+                f"a ROS 2 parameters file ({node}: ros__parameters), which the node reads "
+                "(--ros-args --params-file), not a scene file: give a scene YAML such as "
+                "config/pump_8_mounts.scene.yaml, which the node also reads (-p scene_file:=PATH)"
+            )
+            raise SceneError(source, "<file>", msg)
 
 
 def _body(r: Reader) -> Body:
