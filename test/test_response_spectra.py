@@ -189,3 +189,17 @@ def test_the_plots_title_fits_in_the_figure(tmp_path: Path, monkeypatch) -> None
     box, page = title.get_window_extent(renderer), fig.bbox
     assert "foot_fl" in title.get_text()
     assert page.x0 <= box.x0 and box.x1 <= page.x1 and box.y1 <= page.y1
+
+
+def test_the_help_gives_a_mount_forces_spectra_in_newtons() -> None:
+    """`srs --help` said the --csv and --plot spectra are in g and m/s whatever --response
+    takes; a mount's force has its spectra in N and its pseudo-velocity in N·s."""
+    import argparse
+
+    from mount_twin.cli import build_parser
+
+    parser, _ = build_parser()
+    (sub,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    helps = {a.dest: a.help or "" for a in sub.choices["srs"]._actions}
+    assert "with --response mount:NAME, N and N·s" in helps["csv"]
+    assert "(N with --response mount:NAME)" in helps["plot"]

@@ -104,9 +104,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--csv",
         metavar="FILE",
         help="frequency_hz, then maximax, primary, residual (g), pseudo_velocity (m/s), "
-        "positive, negative (g); suffixed _x, _y, _z with --axis all",
+        "positive, negative (g); with --response mount:NAME, N and N·s; suffixed _x, _y, _z "
+        "with --axis all",
     )
-    parser.add_argument("--plot", metavar="PNG", help="the spectra in g against Hz, log-log")
+    parser.add_argument(
+        "--plot",
+        metavar="PNG",
+        help="the spectra against Hz, log-log, in g (N with --response mount:NAME)",
+    )
     parser.add_argument(
         "--response",
         metavar="WHAT",
