@@ -579,3 +579,28 @@ def test_a_record_marking_a_reading_the_fit_reads_not_provided_is_refused(
         else:
             with pytest.raises(ValueError, match=re.escape(said)):
                 _read_record(str(bag), "/machine/imu", IMU, None, BODY_KEYS, False)
+
+
+def test_the_plot_names_what_its_axes_hold(tmp_path: Path, monkeypatch) -> None:
+    """The panels read `x [m/s²]` over `time [s]`: neither said that they hold the body IMU's
+    specific force along its own axes, each about its mean, nor from when time counts."""
+    import matplotlib.pyplot as plt
+
+    from mount_twin.commands.calibrate import _plot
+
+    shown = []
+    close = plt.close
+    monkeypatch.setattr(plt, "close", lambda fig=None: shown.append(fig) or close(fig))
+    scene = load_scene_file(SHAKE / "block.scene.yaml")
+    ground, top = (
+        read_xsens_csv(SHAKE / f"sine_2hz_trial1_{side}_excerpt.csv")[0]
+        for side in ("ground", "top")
+    )
+    cal = cal_mod.Calibration({}, {}, {}, 1.0, 0.5, scene)  # the nominal scene, as fitted
+    _plot(str(tmp_path / "c.png"), scene, cal, ground, top)
+    (fig,) = shown
+    labels = [ax.get_ylabel() for ax in fig.axes]
+    assert labels == [
+        f"body IMU specific force\nalong its {a}, about its mean [m/s²]" for a in "xyz"
+    ]
+    assert fig.axes[-1].get_xlabel() == "time from the body record's first sample [s]"

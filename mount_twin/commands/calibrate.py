@@ -218,7 +218,8 @@ def _write_scene(source: str, out: Path, cal: Calibration, lines: list[str]) -> 
 
 
 def _plot(png: str, scene: Scene, cal: Calibration, foundation: Signal, body: Signal) -> None:
-    """The body record's axes against the prediction, nominal and calibrated."""
+    """The body record's axes against the prediction, nominal and calibrated, each about its
+    mean (the sensor's axes: its x is not F's where the body sensor is turned)."""
     from scipy.interpolate import CubicSpline
 
     from mount_twin.analysis.calibration import predict
@@ -241,12 +242,12 @@ def _plot(png: str, scene: Scene, cal: Calibration, foundation: Signal, body: Si
             lag = sc.body_sensor.lag_s if sc.body_sensor else 0.0
             p = CubicSpline(t, f[:, i])(body.t - lag)
             ax.plot(body.t - body.t[0], p - p.mean(), color=colour, lw=0.8, label=label)
-        ax.set_ylabel(f"{'xyz'[i]} [m/s²]")
+        ax.set_ylabel(f"body IMU specific force\nalong its {'xyz'[i]}, about its mean [m/s²]")
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8, loc="upper right")
     axes[0].set_title(
         f"body sensor: NRMS {cal.nrms_before:.3f} nominal, {cal.nrms_after:.3f} calibrated",
         fontsize=9,
     )
-    axes[-1].set_xlabel("time [s]")
+    axes[-1].set_xlabel("time from the body record's first sample [s]")
     save_png(fig, png, dpi=100)
