@@ -243,7 +243,8 @@ class ReplaySummary:
             f"  max CG displacement from the first published position "
             f"{self.displacement_max_m * 1e3:.3f} mm, max tilt "
             f"{np.degrees(self.tilt_max_rad):.4f} deg",
-            f"  peak mount loads ({peak_label(self.decimation)}): |F| [N]  |M| [N·m]",
+            f"  peak mount loads ({peak_label(self.decimation)}):",
+            f"{'':18}{'|F| [N]':>10} {'|M| [N·m]':>10}",  # over `{name:>12}: ` and the figures
         ]
         for name, peak in self.peaks.items():
             lines.append(f"    {name:>12}: " + " ".join(f"{peak_text(v):>10}" for v in peak))

@@ -185,3 +185,19 @@ def test_the_replay_summary_says_what_a_linear_mounts_utilisation_divides(tmp_pa
         s for s in text.split("peak utilisation")[1].splitlines() if s.strip().startswith("m0:")
     ]
     assert float(line.split(":")[1]) == pytest.approx(0.8, abs=1e-3)
+
+
+def test_the_summary_heads_the_peak_loads_over_their_columns(tmp_path) -> None:
+    """`|F| [N]  |M| [N·m]` trailed the title line, over no column. At rest each of the four
+    equal mounts about the CG carries a quarter of the weight and, with no rotational
+    stiffness, no couple: the figures under each head."""
+    text = _replayed_at_rest(_engine([0.0, 0.0, 0.0], [0.0, 0.0, 0.0]), tmp_path).text()
+    lines = text.splitlines()
+    at = next(i for i, s in enumerate(lines) if "peak mount loads" in s)
+    head, rows = lines[at + 1], lines[at + 2 : at + 6]
+    for name, column in (("|F| [N]", 0), ("|M| [N·m]", 1)):
+        end = head.index(name) + len(name)
+        for row in rows:
+            figure = row[:end].split()[-1]
+            assert row[:end].endswith(figure) and row.split()[1:][column] == figure
+            assert float(figure) == pytest.approx((MASS * G / 4, 0.0)[column], abs=0.1)
