@@ -593,7 +593,7 @@ def test_the_plot_names_what_its_axes_hold(tmp_path: Path, monkeypatch) -> None:
     monkeypatch.setattr(plt, "close", lambda fig=None: shown.append(fig) or close(fig))
     scene = load_scene_file(SHAKE / "block.scene.yaml")
     ground, top = (
-        read_xsens_csv(SHAKE / f"sine_2hz_trial1_{side}_excerpt.csv")[0]
+        read_xsens_csv(SHAKE / f"sine_2hz_trial1_{side}_excerpt.csv").signal
         for side in ("ground", "top")
     )
     cal = cal_mod.Calibration({}, {}, {}, 1.0, 0.5, scene)  # the nominal scene, as fitted
