@@ -791,13 +791,22 @@ def static_transforms(scene: Scene, stamp_ns: int) -> tuple[str, int, bytes]:
 
 
 def imu_messages(
-    stamps_ns: np.ndarray, accel: np.ndarray, gyro: np.ndarray, frame_id: str
+    stamps_ns: np.ndarray,
+    accel: np.ndarray,
+    gyro: np.ndarray,
+    frame_id: str,
+    unprovided: np.ndarray | None = None,
 ) -> list[tuple[int, bytes]]:
-    """sensor_msgs/Imu messages (no orientation estimate: orientation_covariance[0] = −1)."""
+    """sensor_msgs/Imu messages (no orientation estimate: orientation_covariance[0] = −1; the
+    acceleration, the angular velocity marked not provided alike where `unprovided`, (k, 2),
+    says so: REP-145)."""
     k = stamps_ns.shape[0]
     extra = np.zeros((k, 31))  # orientation (x, y, z, w), then three covariances
     extra[:, 3] = 1.0
-    extra[:, 4] = -1.0
+    extra[:, 4] = -1.0  # orientation_covariance[0]
+    if unprovided is not None:
+        extra[unprovided[:, 1], 13] = -1.0  # angular_velocity_covariance[0]
+        extra[unprovided[:, 0], 22] = -1.0  # linear_acceleration_covariance[0]
     sec, nsec = np.divmod(stamps_ns, 1_000_000_000)
     values = np.hstack([accel, gyro, extra])
     return list(zip(stamps_ns.tolist(), _pack(IMU, frame_id, sec, nsec, values), strict=True))
