@@ -59,14 +59,17 @@ def plot_output_bag(
                 + ", ".join(sorted({e.event for e in mine})),
             )
     if body:  # the body IMU: measured (the prediction plus the residual) against the twin,
-        # each about its mean (gravity and biases out, as the comparison takes them)
+        # each about its mean (gravity and biases out, as the comparison takes them); a sample
+        # that does not provide the specific force (its residual NaN) is a hole
         predicted = tables["body_imu_predicted"].columns
         residual = tables["body_imu_residual"].columns
         for axis in "xyz":
             twin = predicted[f"f{axis}_m_s2"]
             measured = twin + residual[f"f{axis}_m_s2"]
+            given = np.isfinite(measured)
+            centre = measured[given].mean() if given.any() else 0.0
             t = predicted["t_s"]
-            line = axes[3].plot(t, measured - measured.mean(), lw=0.8, label=f"measured {axis}")
+            line = axes[3].plot(t, measured - centre, lw=0.8, label=f"measured {axis}")
             colour = line[0].get_color()
             axes[3].plot(t, twin - twin.mean(), "--", color=colour, lw=0.8, label=f"twin {axis}")
         axes[3].set_ylabel("body IMU specific force\nabout its mean [m/s²]")

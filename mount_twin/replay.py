@@ -27,6 +27,7 @@ from mount_twin.analysis.figures import (
     utilisation_text,
 )
 from mount_twin.engine import intake
+from mount_twin.engine.agreement import FIELDS
 from mount_twin.engine.agreement import NAME as BODY_STATUS
 from mount_twin.engine.batch import (
     FAILED,
@@ -37,6 +38,7 @@ from mount_twin.engine.batch import (
     MountEvent,
     OutputBatch,
 )
+from mount_twin.engine.body_check import UNPROVIDED, not_compared
 from mount_twin.engine.estimate import NOT_INTEGRATED, ErrorEstimate
 from mount_twin.engine.health import (
     EVENTS_KEY,
@@ -265,11 +267,17 @@ class ReplaySummary:
             return []
         if not c.get("received", 0):
             return [f"  body IMU {self.body_topic}: no message (not in the bag; --body names one)"]
-        missed = {k: v for k, v in c.items() if k not in ("received", "accepted", "compared")}
+        compared = c.get("compared", 0)
+        fields = {f: c.get(f"compared_{f}", 0) for f in FIELDS}
+        marked = {k: c.get(k, 0) for k in UNPROVIDED}
+        on = ""
+        if any(marked.values()):  # which readings it was compared on, and the marks
+            on = " (" + ", ".join(f"{f.replace('_', ' ')} on {n}" for f, n in fields.items())
+            on += f"; marked not provided: {intake.counted_text(marked, 'unprovided_')})"
         return [
-            f"  body IMU {self.body_topic}: {c['received']} received, {c.get('compared', 0)} "
-            f"compared with the twin, not compared: {intake.counted_text(missed)} (its agreement: "
-            f"{BODY_STATUS} below)"
+            f"  body IMU {self.body_topic}: {c['received']} received, {compared} compared with "
+            f"the twin{on}, not compared: {intake.counted_text(not_compared(c))} (its "
+            f"agreement: {BODY_STATUS} below)"
         ]
 
     def to_dict(self) -> dict[str, object]:

@@ -266,8 +266,8 @@ class TwinStream:
         sample the twin has answered, and the windows judged (none without a body_sensor).
         A message that cannot be compared is counted (BodyCheck.counts) and skipped: not
         valid CDR, an unset or pre-1970 stamp, a stamp not after the last, a value not
-        finite, a header.frame_id other than body_sensor.frame_id, a reading marked not
-        provided (REP-145)."""
+        finite, a header.frame_id other than body_sensor.frame_id, both readings marked not
+        provided (REP-145; one marked so, the sample is compared on the other)."""
         if self.body is None:
             return []
         decoded = decode_inputs(raws, IMU)
@@ -292,14 +292,19 @@ class TwinStream:
         return out
 
     def _body_in(self, decoded: Decoded) -> list[tuple[str, int, bytes]]:
-        """Accepted body samples into the comparison, on the twin's time base."""
+        """Accepted body samples into the comparison, on the twin's time base (a reading
+        marked not provided zeroed, `provided`: never read as a value); into the ageing
+        tracker, whose fits read the specific force, those that provide it."""
         assert self.body is not None and self.base is not None
-        measured = np.hstack([decoded.accel, decoded.gyro])
+        accel, gyro = provided(decoded.accel, decoded.gyro, decoded.unprovided)
+        n = decoded.stamps_ns.shape[0]
+        present = ~(np.zeros((n, 2), bool) if decoded.unprovided is None else decoded.unprovided)
         t = self.base.seconds(decoded.stamps_ns)
         if self.ageing is not None:
-            jobs = self.ageing.add_body(decoded.stamps_ns, t, decoded.accel, decoded.gyro)
+            k = present[:, 0]
+            jobs = self.ageing.add_body(decoded.stamps_ns[k], t[k], accel[k], gyro[k])
             self._ageing_jobs += jobs
-        rows = self.body.add_body(decoded.stamps_ns, t, measured)
+        rows = self.body.add_body(decoded.stamps_ns, t, np.hstack([accel, gyro]), present)
         return self._encode_body(rows)
 
     def _encode_body(self, rows: BodyComparison) -> list[tuple[str, int, bytes]]:

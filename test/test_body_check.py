@@ -260,13 +260,14 @@ def test_bad_body_messages_are_counted_skipped_and_reported() -> None:
     assert first[0] == WARN and "rejected_wrong_frame_id 2" in first[1]
 
 
-def test_body_readings_marked_not_provided_are_counted_not_compared() -> None:
+def test_a_reading_marked_not_provided_is_never_compared_as_a_value() -> None:
     """REP-145: an Imu whose covariance[0] is -1 has no such reading. Every tenth body sample
     marked (alternately its acceleration, holding zeros, and its rate, holding 5 rad/s) was
-    compared as a value: a free fall, a spin. Now such a sample is counted
-    (rejected_no_acceleration, rejected_no_angular_velocity) and skipped: the residuals and
-    every window's figures are those of the stream without those samples, and each window
-    names them (a WARN, like any rejected body message)."""
+    compared as a value (a free fall, a spin), then skipped whole. Now such a sample is
+    compared on its other reading only: each field's figures are those of the stream without
+    the samples marking it, the residual's marked reading is NaN, and the marks are counted
+    (unprovided_acceleration, unprovided_angular_velocity) and said in each window, which they
+    do not make a WARN."""
     scene, deck = _pump(), _deck()
     ns, measured = _measured(scene, deck)
     raws = _body_raws(ns, measured)
@@ -275,31 +276,36 @@ def test_body_readings_marked_not_provided_are_counted_not_compared() -> None:
         unprovided_imu([raw], fields[i % 20])[0] if i % 20 in fields else raw
         for i, raw in enumerate(raws)
     ]
-    kept = [raw for i, raw in enumerate(raws) if i % 20 not in fields]
+    without = [[raw for i, raw in enumerate(raws) if i % 20 != k] for k in fields]
     deck_raws = _deck_raws(scene, deck)
-    runs = [_chunked(scene, deck_raws, body, 500, False) for body in (marked, kept)]
-    residuals = [_imu_values(out, BODY_RESIDUAL_TOPIC) for out in runs]
-    assert np.array_equal(residuals[0][0], residuals[1][0])
-    assert np.array_equal(residuals[0][1], residuals[1][1])
+    runs = [_chunked(scene, deck_raws, body, 500, False) for body in (marked, *without)]
+    (stamps, residual), *_ = (_imu_values(out, BODY_RESIDUAL_TOPIC) for out in runs)
+    _, truth = _imu_values(_chunked(scene, deck_raws, raws, 500, False), BODY_RESIDUAL_TOPIC)
+    assert np.array_equal(stamps, ns)
+    at = np.arange(ns.shape[0]) % 20
+    assert np.isnan(residual[at == 5, :3]).all() and np.isnan(residual[at == 15, 3:]).all()
+    given = np.ones(residual.shape, bool)
+    given[at == 5, :3] = given[at == 15, 3:] = False
+    assert np.array_equal(residual[given], truth[given])
     windows = [_windows(out) for out in runs]
-    assert len(windows[0]) == len(windows[1]) == 4
-    for (level, message, values), (level_kept, _, values_kept) in zip(*windows, strict=True):
-        figures = {k: v for k, v in values.items() if not k.startswith("body_")}
-        assert figures == {k: v for k, v in values_kept.items() if not k.startswith("body_")}
-        assert level_kept == OK and level == WARN and "rejected_no_acceleration" in message
-    named = [
-        sum(int(v[f"body_rejected_no_{r}"]) for _, _, v in windows[0])
-        for r in ("acceleration", "angular_velocity")
-    ]
-    assert named == [len(raws) // 20] * 2  # the last window's, after its last sample, too
+    assert len(windows[0]) == len(windows[1]) == len(windows[2]) == 4
+    for (level, message, values), *alone in zip(*windows, strict=True):
+        assert level == OK, message
+        for i, axes in enumerate(("f", "w")):  # without the samples marking that reading
+            assert {k: v for k, v in values.items() if k[:-1].endswith(f"_{axes}")} == {
+                k: v for k, v in alone[i][2].items() if k[:-1].endswith(f"_{axes}")
+            }
+            assert values[f"samples_{('specific_force', 'rate')[i]}"] == alone[i][2]["samples"]
+        assert "specific force judged on " in message and "rate judged on " in message
     stream = TwinStream(scene)
     stream.process(deck_raws)
     stream.process_body(marked)
     stream.finish()
     assert stream.body is not None
     counts = stream.body.counts
-    assert counts["rejected_no_acceleration"] == counts["rejected_no_angular_velocity"] == 199
-    assert counts["accepted"] == len(kept) and counts["received"] == len(raws)
+    assert counts["unprovided_acceleration"] == counts["unprovided_angular_velocity"] == 199
+    assert counts["accepted"] == counts["received"] == len(raws) == counts["compared"]
+    assert counts["compared_specific_force"] == counts["compared_rate"] == len(raws) - 199
 
 
 def test_a_body_imu_whose_every_message_is_rejected_is_reported_window_by_window() -> None:
@@ -450,3 +456,118 @@ def test_under_gyro_filter_ignore_the_ageing_tracker_takes_a_deck_sample_whose_r
         windows.append(job.records[0])
     assert np.array_equal(windows[1].t, windows[0].t)
     assert np.array_equal(windows[1].accel, windows[0].accel)
+
+
+def _gained(
+    machine: Scene, deck: Signal, gains: tuple[float, float]
+) -> tuple[np.ndarray, np.ndarray]:
+    """(stamps ns, (k, 6) readings) of a body IMU on `machine` at the deck's stamps (from the
+    21st), reading its true specific force × gains[0] and its true rate × gains[1], noiseless:
+    each residual is then (gain − 1) × the truth, so on any set of samples and in any band an
+    axis's normalised RMS error is (gain − 1) / gain exactly."""
+    _, truth = _whole_record(machine, deck)
+    ns = _stamps(deck)[20:]
+    return ns, truth[20:] * np.repeat(gains, 3)
+
+
+def _window_samples(ns: np.ndarray, provides: np.ndarray, window_s: float) -> list[list[int]]:
+    """Per window of `window_s` from the first stamp: [samples, of them providing the specific
+    force, the rate] (`provides`: (k, 2) bool), counted from the stamps."""
+    index = (ns - ns[0]) // round(window_s * 1e9)
+    return [
+        [int((index == i).sum()), *(int(v) for v in provides[index == i].sum(axis=0))]
+        for i in np.unique(index).tolist()
+    ]
+
+
+def test_an_accelerometer_only_body_imu_is_judged_on_its_specific_force() -> None:
+    """A body IMU marking its angular velocity not provided on every message (REP-145, an
+    accelerometer alone, holding 5 rad/s) had every sample rejected (no_angular_velocity): no
+    window was ever judged. Reading 1.5 × the true specific force, each window now judges fx, fy
+    and fz at (1.5 − 1) / 1.5 = 1/3 (a WARN past 0.3), its rate not judged and said so, on the
+    window's every sample; the residual's rate is marked not provided, NaN."""
+    scene, deck = _pump(), _deck()
+    ns, measured = _gained(scene, deck, (1.5, 1.0))
+    raws = unprovided_imu(_body_raws(ns, measured), "angular_velocity")
+    out = _chunked(scene, _deck_raws(scene, deck), raws, 500, False)
+    windows = _windows(out)
+    want = _window_samples(ns, np.tile([True, False], (ns.shape[0], 1)), 5.0)
+    assert len(windows) == len(want) == 4
+    for (level, message, values), (n, n_f, n_w) in zip(windows, want, strict=True):
+        assert level == WARN, message
+        for axis in ("fx", "fy", "fz"):  # the figures' 4 digits
+            assert values[f"nrms_{axis}"] == values[f"nrms_broadband_{axis}"] == "0.3333"
+        for axis in ("wx", "wy", "wz"):
+            assert values[f"nrms_{axis}"] == "not judged"
+        assert (values["samples"], values["samples_specific_force"]) == (str(n), str(n_f))
+        assert values["samples_rate"] == str(n_w) == "0"
+        assert f"rate not judged: not provided in {n} of {n} samples" in message
+        assert "body messages not compared" not in message
+    stamps, residual = _imu_values(out, BODY_RESIDUAL_TOPIC)
+    assert np.array_equal(stamps, ns)  # every sample compared, on its specific force
+    assert np.isnan(residual[:, 3:]).all()
+    np.testing.assert_allclose(residual[:, :3], 0.5 / 1.5 * measured[:, :3], rtol=1e-9, atol=1e-12)
+    marks = [
+        TYPESTORE.deserialize_cdr(raw, IMU).angular_velocity_covariance[0]
+        for topic, _, raw in out
+        if topic == BODY_RESIDUAL_TOPIC
+    ]
+    assert set(marks) == {-1.0}
+
+
+def test_a_body_imu_marking_either_reading_is_judged_field_by_field_in_any_batching() -> None:
+    """Every 7th body message marks its acceleration not provided, every 5th its rate (every
+    35th both: nothing to compare, rejected as no_reading); the IMU reads 1.5 × the true
+    specific force and 1.25 × the true rate. Each field is judged on the samples providing it,
+    at its own exact error (1/3, and 0.25 / 1.25 = 0.2), each window counting them; the marks
+    are counted; and the messages are the same bytes however the two streams come."""
+    scene, deck = _pump(), _deck()
+    ns, measured = _gained(scene, deck, (1.5, 1.25))
+    raws = _body_raws(ns, measured)
+    place = np.arange(ns.shape[0])
+    provides = np.column_stack([place % 7 != 3, place % 5 != 2])
+    fields = ("linear_acceleration", "angular_velocity")
+    for i in np.flatnonzero(~provides.all(axis=1)).tolist():
+        for field, given in zip(fields, provides[i], strict=True):
+            if not given:
+                raws[i] = unprovided_imu([raws[i]], field)[0]
+    deck_raws, deck_ns = _deck_raws(scene, deck), _stamps(deck)
+    runs = [
+        _interleaved(scene, deck_raws, deck_ns, (raws, ns)),
+        _chunked(scene, deck_raws, raws, 700, body_first=True),
+        _chunked(scene, deck_raws, raws, 333, body_first=False),
+    ]
+    kept = [[m for m in run if m[0] != DIAGNOSTICS_TOPIC or NAME.encode() in m[2]] for run in runs]
+    assert all(sorted(k) == sorted(kept[0]) for k in kept[1:])
+    windows = _windows(runs[0])
+    taken = provides.any(axis=1)
+    want = _window_samples(ns[taken], provides[taken], 5.0)
+    assert len(windows) == len(want) == 4
+    for (level, message, values), (n, n_f, n_w) in zip(windows, want, strict=True):
+        assert level == WARN, message  # the specific force's 1/3
+        exact = {"f": "0.3333", "w": "0.2"}  # the figures' 4 digits
+        for axis in ("fx", "fy", "fz", "wx", "wy", "wz"):
+            assert values[f"nrms_broadband_{axis}"] == exact[axis[0]]
+            # in the band, where the body moved past the floor (wz's yaw does not)
+            assert values[f"nrms_{axis}"] in (exact[axis[0]], "not judged")
+        assert (values["nrms_fx"], values["nrms_wx"]) == ("0.3333", "0.2")  # both judged
+        assert [values[f"samples{k}"] for k in ("", "_specific_force", "_rate")] == [
+            str(n),
+            str(n_f),
+            str(n_w),
+        ]
+        assert f"specific force judged on {n_f} of {n} samples" in message
+        assert f"rate judged on {n_w} of {n} samples" in message
+    assert sum(int(v["body_rejected_no_reading"]) for _, _, v in windows) == (~taken).sum()
+    stream = TwinStream(scene)
+    stream.process(deck_raws)
+    stream.process_body(raws)
+    stream.finish()
+    assert stream.body is not None
+    counts = stream.body.counts
+    assert counts["accepted"] == taken.sum() == counts["compared"]
+    assert counts["compared_specific_force"] == provides[:, 0].sum()
+    assert counts["compared_rate"] == provides[:, 1].sum()
+    assert counts["unprovided_acceleration"] == (taken & ~provides[:, 0]).sum()
+    assert counts["unprovided_angular_velocity"] == (taken & ~provides[:, 1]).sum()
+    assert counts["rejected_no_reading"] == (~taken).sum()

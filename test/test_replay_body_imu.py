@@ -90,35 +90,79 @@ def test_a_body_imu_in_the_bag_or_in_its_own_bag_is_compared_alike(
         assert got[0][topic] == got[1][topic]
 
 
+def _marked_bag(tmp: Path, name: str, marks: dict[str, slice]) -> None:
+    """`_streams` into bag `tmp/name`, the body messages `marks[field]` marking that reading
+    (linear_acceleration, angular_velocity) not provided (covariance[0] = -1, REP-145)."""
+    streams = _streams()
+    stamps, raws = (list(a) for a in zip(*streams[BODY_TOPIC], strict=True))
+    for field, where in marks.items():
+        raws[where] = unprovided_imu(raws[where], field)
+    streams[BODY_TOPIC] = list(zip(stamps, raws, strict=True))
+    with OutputBag(tmp / name, {"/deck/imu": IMU, BODY_TOPIC: IMU}) as bag:
+        bag.write(
+            sorted(((t, s, r) for t, m in streams.items() for s, r in m), key=lambda m: m[1])
+        )
+
+
 def test_body_readings_marked_not_provided_are_counted_in_the_summary(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """10 body messages whose acceleration and 20 whose rate the IMU marks not provided
-    (covariance[0] = -1, REP-145): the replay compares none of them and says so, in the
-    summary's line and its JSON counts, as it says the body's other rejected messages."""
-    streams = _streams()
-    stamps, raws = zip(*streams[BODY_TOPIC], strict=True)
-    body = [
-        *raws[:300],
-        *unprovided_imu(list(raws[300:310]), "linear_acceleration"),
-        *raws[310:700],
-        *unprovided_imu(list(raws[700:720]), "angular_velocity"),
-        *raws[720:],
-    ]
-    streams[BODY_TOPIC] = list(zip(stamps, body, strict=True))
-    with OutputBag(tmp_path / "marked", {"/deck/imu": IMU, BODY_TOPIC: IMU}) as bag:
-        bag.write(
-            sorted(((t, s, r) for t, m in streams.items() for s, r in m), key=lambda m: m[1])
-        )
+    (covariance[0] = -1, REP-145) were rejected, compared on neither reading. Each is now
+    compared on the other: the summary's line and its JSON counts say on how many samples each
+    reading was compared, and the marks."""
+    marks = {"linear_acceleration": slice(300, 310), "angular_velocity": slice(700, 720)}
+    _marked_bag(tmp_path, "marked", marks)
     code, summary = _replay(tmp_path, "marked")
     assert code == 0
     counts = summary["body_sensor"]["counts"]
-    assert (counts["rejected_no_acceleration"], counts["rejected_no_angular_velocity"]) == (10, 20)
-    assert counts["received"] == 1200 and counts["accepted"] == 1170
-    assert counts["compared"] + counts["unanswered"] == 1170
+    assert (counts["unprovided_acceleration"], counts["unprovided_angular_velocity"]) == (10, 20)
+    assert counts["received"] == counts["accepted"] == 1200
+    compared = counts["compared"]
+    assert compared + counts["unanswered"] == 1200
+    assert (counts["compared_specific_force"], counts["compared_rate"]) == (
+        compared - 10,
+        compared - 20,
+    )
     said = capsys.readouterr().out
-    assert "rejected_no_acceleration 10, rejected_no_angular_velocity 20" in said
-    assert len(read_raw(tmp_path / "out_marked")[BODY_OUT[1]]) == counts["compared"]
+    assert (
+        f"1200 received, {compared} compared with the twin (specific force on {compared - 10}, "
+        f"rate on {compared - 20}; marked not provided: acceleration 10, angular_velocity 20), "
+        "not compared: unanswered " in said
+    )
+    assert len(read_raw(tmp_path / "out_marked")[BODY_OUT[1]]) == compared
+
+
+def test_an_accelerometer_only_body_imu_is_judged_in_a_replay(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every body message marks its rate not provided (an accelerometer alone): every one was
+    rejected, no window judged, the run a WARN saying so. Now every window is judged on the
+    specific force on all its samples, its rate said not provided (in its values and message,
+    and the worst's in the JSON); the summary's line counts the marks."""
+    _marked_bag(tmp_path, "accel_only", {"angular_velocity": slice(None)})
+    code, summary = _replay(tmp_path, "accel_only")
+    assert code == 0
+    counts = summary["body_sensor"]["counts"]
+    assert counts["received"] == counts["accepted"] == counts["unprovided_angular_velocity"]
+    assert counts["compared_specific_force"] == counts["compared"] > 1150
+    assert counts["compared_rate"] == counts["rejected_no_reading"] == 0
+    windows = statuses_named(
+        [r for _, r in read_raw(tmp_path / "out_accel_only")["/diagnostics"]], NAME
+    )
+    assert len(windows) == 3  # of 2 s over 6 s
+    for _, _, message, values in windows:
+        n = values["samples"]
+        assert values["samples_specific_force"] == n and values["samples_rate"] == "0"
+        assert all(values[f"nrms_{a}"] == "not judged" for a in ("wx", "wy", "wz"))
+        assert all(values[f"nrms_broadband_{a}"] == "n/a" for a in ("wx", "wy", "wz"))
+        assert any(values[f"nrms_{a}"] != "not judged" for a in ("fx", "fy", "fz"))
+        assert f"; rate not judged: not provided in {n} of {n} samples" in message
+    assert sum(int(v["samples"]) for *_, v in windows) == counts["compared"]
+    worst = summary["diagnostics_worst"][NAME]["message"]
+    assert worst.startswith("model and machine ") and "rate not judged" in worst
+    said = capsys.readouterr().out
+    assert f"(specific force on {counts['compared']}, rate on 0; marked not provided: " in said
 
 
 def test_without_the_body_topic_the_summary_says_so(

@@ -14,9 +14,11 @@ batched, and whichever of the two streams comes first (live = replay), within `R
    `RETAIN_S` behind the prediction, or between rows farther apart than input.max_gap_s (a
    gap, a restart) is counted and not compared.
 3. `_Windows` judges the compared samples in windows of body_sensor.window_s of stamps
-   (`agreement`), on a grid from the first compared sample; the last, partial window at the
-   end of the stream if it spans half a window (and holds `agreement.MIN_SAMPLES`). Each
-   counts the body messages not compared in it by their place in the body stream.
+   (`agreement`), on a grid from the first compared sample, each field (specific force, rate)
+   on the samples that provide it (a message may mark one reading not provided, REP-145);
+   the last, partial window at the end of the stream if it spans half a window. A window
+   with fewer than `agreement.MIN_SAMPLES` samples providing either field is judged with the
+   next. Each counts the body messages not compared in it by their place in the body stream.
 
 Beside them, `_Refusals` watches the body messages themselves, in windows of the same length
 on their own stamps: a window in which every message was rejected (another frame_id, …) is a
@@ -27,12 +29,12 @@ the end of the stream. It depends on the body stream alone.
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, fields
 
 import numpy as np
 
-from mount_twin.engine.agreement import MIN_SAMPLES, NAME, agreement, window_status
+from mount_twin.engine.agreement import FIELDS, MIN_SAMPLES, NAME, agreement, window_status
 from mount_twin.engine.batch import WARN, HealthStatus
 from mount_twin.engine.intake import provided, rising
 from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
@@ -50,12 +52,15 @@ REJECTED = (
     "nonpositive_stamp",
     "nonfinite",
     "wrong_frame_id",
-    "no_acceleration",
-    "no_angular_velocity",
+    "no_reading",
     "stamp_back",
 )
-"""Why a body message was not taken (`BodyCheck.screen`, and undecodable): reported as
-body_rejected_<reason> in every window, zero included."""
+"""Why a body message was not taken (`BodyCheck.screen`, and undecodable; no_reading: both
+its readings marked not provided): reported as body_rejected_<reason> in every window, zero
+included."""
+UNPROVIDED = ("unprovided_acceleration", "unprovided_angular_velocity")
+"""The counts of accepted body messages that mark their acceleration, their angular velocity
+not provided (REP-145): compared on the other reading alone."""
 PROBLEMS = ("before_twin", "late", "in_gap", "unanswered", "dropped_waiting", "lost_middleware")
 """Why a body sample accepted was not compared: before the twin's first row, behind the kept
 predictions, inside a gap of the twin's rows, after its last row, or held too long."""
@@ -162,12 +167,14 @@ class _Series:
 @dataclass
 class _Taken:
     """Accepted body samples out of the matcher, in order: stamps (ns, s), measured (k, 6),
-    the prediction at each (where compared), why each was not compared ('' where it was:
-    `PROBLEMS`), and each one's place among the accepted samples."""
+    which readings each provides ((k, 2): specific force, rate), the prediction at each (where
+    compared), why each was not compared ('' where it was: `PROBLEMS`), and each one's place
+    among the accepted samples."""
 
     ns: np.ndarray
     t: np.ndarray
     measured: np.ndarray
+    present: np.ndarray
     predicted: np.ndarray
     why: np.ndarray
     place: np.ndarray
@@ -179,6 +186,7 @@ class _Taken:
             np.zeros(0, np.int64),
             np.zeros(0),
             empty,
+            np.zeros((0, 2), bool),
             empty,
             np.zeros(0, object),
             np.zeros(0, np.int64),
@@ -187,9 +195,7 @@ class _Taken:
     def compared(self) -> _Taken:
         """Those compared."""
         k = self.why == ""
-        return _Taken(
-            *(a[k] for a in (self.ns, self.t, self.measured, self.predicted, self.why, self.place))
-        )
+        return _Taken(*(getattr(self, f.name)[k] for f in fields(self)))
 
 
 class _Matcher:
@@ -199,8 +205,9 @@ class _Matcher:
         self._lag, self._max_gap, self._problems = lag_s, max_gap_s, problems
         self._pred = _Series()
         self._first: float | None = None
-        self._body: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
-        """Waiting body samples: (stamps ns, stamps s, measured (k, 6)) chunks."""
+        self._body: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        """Waiting body samples: (stamps ns, stamps s, measured (k, 6), readings provided
+        (k, 2)) chunks."""
         self.taken = 0
         """Accepted body samples taken out so far (compared, or counted not compared): the
         place among them of the first one waiting."""
@@ -210,15 +217,20 @@ class _Matcher:
             self._first = float(t[0]) if self._first is None else self._first
             self._pred.append(t, v)
 
-    def add_body(self, ns: np.ndarray, t: np.ndarray, v: np.ndarray) -> None:
-        self._body.append((ns, t, v))
+    def add_body(self, ns: np.ndarray, t: np.ndarray, v: np.ndarray, present: np.ndarray) -> None:
+        self._body.append((ns, t, v, present))
         waiting = sum(c[0].shape[0] for c in self._body)
         if waiting > PENDING_LIMIT:
-            ns, t, v = (np.concatenate(a) for a in zip(*self._body, strict=True))
             cut = waiting - PENDING_LIMIT
             self._problems["dropped_waiting"] += cut
             self.taken += cut
-            self._body = [(ns[cut:], t[cut:], v[cut:])]
+            ns, t, v, present = self._waiting()
+            self._body = [(ns[cut:], t[cut:], v[cut:], present[cut:])]
+
+    def _waiting(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The waiting body samples in one chunk."""
+        ns, t, v, present = (np.concatenate(a) for a in zip(*self._body, strict=True))
+        return ns, t, v, present
 
     def take(self, final: bool = False) -> _Taken:
         """The body samples the prediction now covers, in order (`final`: the end of the
@@ -232,15 +244,15 @@ class _Matcher:
                 self._body = []
             self._trim(None)
             return _Taken.none()
-        ns, t, v = (np.concatenate(a) for a in zip(*self._body, strict=True))
+        ns, t, v, present = self._waiting()
         ready = t - self._lag <= pt[-1]  # a prefix: accepted stamps rise
-        self._body = [] if final else [(ns[~ready], t[~ready], v[~ready])]
+        self._body = [] if final else [(ns[~ready], t[~ready], v[~ready], present[~ready])]
         first = self.taken
         self.taken += int(ready.sum())
         if final:
             self._problems["unanswered"] += int((~ready).sum())
             self.taken += int((~ready).sum())
-        ns, t, v = ns[ready], t[ready], v[ready]
+        ns, t, v, present = ns[ready], t[ready], v[ready], present[ready]
         tau = t - self._lag
         why = np.full(t.shape[0], "", dtype=object)
         why[tau < self._first] = "before_twin"
@@ -263,7 +275,7 @@ class _Matcher:
         for reason in ("before_twin", "late", "in_gap"):
             self._problems[reason] += int((why == reason).sum())
         self._trim(float(tau[kept][-1]) if kept.shape[0] else None)
-        return _Taken(ns, t, v, pred, why, first + np.arange(t.shape[0]))
+        return _Taken(ns, t, v, present, pred, why, first + np.arange(t.shape[0]))
 
     def _trim(self, last_tau: float | None) -> None:
         """Drop the predictions no future body sample needs: those before the one at or
@@ -277,7 +289,7 @@ class _Matcher:
         self._pred.drop_before(min(cut, pt.shape[0] - 1))
 
 
-def _not_compared(counts: Counter[str]) -> dict[str, int]:
+def not_compared(counts: Mapping[str, int]) -> dict[str, int]:
     """The counts of body messages not compared, by reason (`PROBLEMS`, rejected_<reason>)."""
     return {k: v for k, v in counts.items() if k in PROBLEMS or k.startswith("rejected_")}
 
@@ -285,10 +297,10 @@ def _not_compared(counts: Counter[str]) -> dict[str, int]:
 @dataclass
 class _Window:
     """The window being filled: chunks of its compared samples (stamps ns, seconds, measured,
-    residual), and the body messages not compared in it, by reason."""
+    residual, readings provided), and the body messages not compared in it, by reason."""
 
     index: int
-    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
+    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
     problems: Counter[str]
 
 
@@ -355,6 +367,7 @@ class _Windows:
                         taken.t[part & compared],
                         taken.measured[part & compared],
                         residual[k : k + n],
+                        taken.present[part & compared],
                     )
                 )
                 k += n
@@ -378,10 +391,11 @@ class _Windows:
         reports = self._close(final=True)
         if reports or self._judged or not counts["received"]:
             return reports
-        missed = ", ".join(f"{k} {v}" for k, v in _not_compared(counts).items() if v)
+        missed = ", ".join(f"{k} {v}" for k, v in not_compared(counts).items() if v)
         message = (
             f"no window of the body IMU was judged over the run: {counts['compared']} of "
-            f"{counts['received']} messages compared (a window needs {MIN_SAMPLES} over half "
+            f"{counts['received']} messages compared (a window needs {MIN_SAMPLES} providing "
+            "a reading over half "
             f"its {self._sensor.window_s:g} s)" + (f"; not compared: {missed}" if missed else "")
         )
         values = {f"body_{k}": str(v) for k, v in counts.items()}
@@ -394,8 +408,11 @@ class _Windows:
         if not window.chunks:
             self._carried.update(window.problems)
             return []
-        ns, t, measured, residual = (np.concatenate(a) for a in zip(*window.chunks, strict=True))
-        if t.shape[0] < MIN_SAMPLES or (final and t[-1] - t[0] < 0.5 * self._sensor.window_s):
+        ns, t, measured, residual, present = (
+            np.concatenate(a) for a in zip(*window.chunks, strict=True)
+        )
+        short = final and t[-1] - t[0] < 0.5 * self._sensor.window_s
+        if present.sum(axis=0).max() < MIN_SAMPLES or short:
             self._carried.update(window.problems)  # too short to judge: said with the next
             return []
         for key in LOOSE:
@@ -403,7 +420,7 @@ class _Windows:
             self._loose_reported[key] = self._totals[key]
         keys = (*(f"rejected_{r}" for r in REJECTED), *PROBLEMS)
         problems = {key: window.problems[key] for key in keys}
-        figures = agreement(t, measured, residual, self._sensor)
+        figures = agreement(t, measured, residual, self._sensor, present)
         span = (float(t[-1] - t[0]), int(t.shape[0]))
         status = window_status(figures, self._sensor, span, problems)
         if final:
@@ -475,13 +492,15 @@ class BodyComparison:
         stamps_ns: (k,) the compared body samples' header stamps, ns.
         predicted: (k, 6) the twin's prediction: specific force (m/s²), rate (rad/s), in the
             sensor's axes.
-        residual: (k, 6) measured − predicted.
+        residual: (k, 6) measured − predicted (nan for a reading the sample does not provide).
+        present: (k, 2) which readings (specific force, rate) each sample provides.
         reports: (stamp ns, status) of each window closed.
     """
 
     stamps_ns: np.ndarray
     predicted: np.ndarray
     residual: np.ndarray
+    present: np.ndarray
     reports: list[tuple[int, HealthStatus]]
 
 
@@ -489,13 +508,16 @@ class BodyCheck:
     """The body IMU against the twin (module docstring).
 
     Attributes:
-        counts: body messages received, accepted and compared, and why others were not
-            (`PROBLEMS`; the stream counts its rejections here too, as rejected_<reason>).
+        counts: body messages received, accepted and compared (and compared on each field,
+            compared_<field> of `agreement.FIELDS`), the accepted ones marking a reading not
+            provided (`UNPROVIDED`), and why others were not compared (`PROBLEMS`; the stream
+            counts its rejections here too, as rejected_<reason>).
     """
 
     def __init__(self, scene: Scene, sensor: BodySensor) -> None:
         self.sensor = sensor
         self.counts: Counter[str] = Counter({f"rejected_{r}": 0 for r in REJECTED})
+        self.counts.update(dict.fromkeys(UNPROVIDED, 0))
         self.last_ns = 0
         """The last accepted body stamp, ns (0: none yet)."""
         self.seen_ns = 0
@@ -526,10 +548,10 @@ class BodyCheck:
         readings (k, 2) its message marks not provided, `Decoded.unprovided`) cannot be
         compared ('' where it can; the caller counts the others with `reject`, at their place
         in the stream): an unset or pre-1970 stamp, a value not finite (a reading marked not
-        provided is not read), a frame_id other than body_sensor.frame_id ("": any), its
-        acceleration or its rate marked not provided (REP-145: to be disregarded; the
-        comparison's unit is the whole sample, so one without either is not compared), a
-        stamp not after every one accepted before it."""
+        provided is not read), a frame_id other than body_sensor.frame_id ("": any), both its
+        acceleration and its rate marked not provided (REP-145: to be disregarded; a sample
+        that provides one is compared on it), a stamp not after every one accepted before
+        it."""
         expected = self.sensor.frame_id
         accel, rate = provided(measured[:, :3], measured[:, 3:], unprovided)
         marked = np.zeros((stamps_ns.shape[0], 2), bool) if unprovided is None else unprovided
@@ -539,8 +561,7 @@ class BodyCheck:
             "wrong_frame_id": np.array(
                 [bool(expected) and f != expected for f in frame_ids], bool
             ),
-            "no_acceleration": marked[:, 0],
-            "no_angular_velocity": marked[:, 1],
+            "no_reading": marked[:, 0] & marked[:, 1],
         }
         why = np.full(stamps_ns.shape[0], "", dtype=object)
         for reason, bad in reasons.items():
@@ -563,7 +584,11 @@ class BodyCheck:
         self._accepted_screened += int(accepted.sum())
         empty = np.zeros((0, 6))
         return BodyComparison(
-            np.zeros(0, np.int64), empty, empty, self._refusals.add(stamps_ns, why)
+            np.zeros(0, np.int64),
+            empty,
+            empty,
+            np.zeros((0, 2), bool),
+            self._refusals.add(stamps_ns, why),
         )
 
     def reject(self, reason: str, n: int) -> None:
@@ -580,10 +605,16 @@ class BodyCheck:
         self._matcher.add_predictions(*self._lead.add(_Rows(t, pose, wrenches, rate)))
         return self._compared()
 
-    def add_body(self, ns: np.ndarray, t: np.ndarray, measured: np.ndarray) -> BodyComparison:
-        """Accepted body samples: stamps (ns and s on the twin's base), (k, 6) readings."""
+    def add_body(
+        self, ns: np.ndarray, t: np.ndarray, measured: np.ndarray, present: np.ndarray
+    ) -> BodyComparison:
+        """Accepted body samples: stamps (ns and s on the twin's base), (k, 6) readings, which
+        of them each provides ((k, 2): specific force, rate; `screen` takes none with
+        neither)."""
         self.counts["accepted"] += int(ns.shape[0])
-        self._matcher.add_body(ns, t, measured)
+        for key, given in zip(UNPROVIDED, present.T, strict=True):
+            self.counts[key] += int((~given).sum())
+        self._matcher.add_body(ns, t, measured, present)
         return self._compared()
 
     def finish(self) -> BodyComparison:
@@ -598,6 +629,9 @@ class BodyCheck:
         taken = self._matcher.take(final)
         compared = taken.compared()
         self.counts["compared"] += int(compared.ns.shape[0])
+        for field, given in zip(FIELDS, compared.present.T, strict=True):
+            self.counts[f"compared_{field}"] += int(given.sum())
         residual = compared.measured - compared.predicted
+        residual[~np.repeat(compared.present, 3, axis=1)] = np.nan
         reports = self._windows.add(taken, residual)
-        return BodyComparison(compared.ns, compared.predicted, residual, reports)
+        return BodyComparison(compared.ns, compared.predicted, residual, compared.present, reports)

@@ -727,14 +727,16 @@ def body_frame_id(scene: Scene) -> str:
 def encode_body(scene: Scene, rows: BodyComparison) -> list[tuple[str, int, bytes]]:
     """The body comparison as (unresolved topic, stamp ns, CDR bytes): per compared sample its
     prediction and residual (stamped as the sample; linear_acceleration the specific force,
-    m/s², angular_velocity the rate, rad/s, in the sensor's axes; no orientation), then each
+    m/s², angular_velocity the rate, rad/s, in the sensor's axes; no orientation; a reading
+    the sample does not provide marked so in the residual, REP-145, its value NaN), then each
     window's report on /diagnostics."""
     frame = body_frame_id(scene)
     msgs: list[tuple[str, int, bytes]] = []
     if rows.stamps_ns.shape[0]:
+        off = rows.residual
         pairs = zip(
             imu_messages(rows.stamps_ns, rows.predicted[:, :3], rows.predicted[:, 3:], frame),
-            imu_messages(rows.stamps_ns, rows.residual[:, :3], rows.residual[:, 3:], frame),
+            imu_messages(rows.stamps_ns, off[:, :3], off[:, 3:], frame, ~rows.present),
             strict=True,
         )
         for (stamp, predicted), (_, residual) in pairs:
