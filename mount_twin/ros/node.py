@@ -59,7 +59,12 @@ from mount_twin.io.messages import (
     output_types,
     static_transforms,
 )
-from mount_twin.ros.parameters import check_qos_overrides, configure
+from mount_twin.ros.parameters import (
+    check_command_line,
+    check_qos_overrides,
+    configure,
+    rcl_message,
+)
 from mount_twin.ros.rclpy_private import take_waiting
 from mount_twin.stream import TwinStream
 
@@ -399,14 +404,19 @@ def run(stop: threading.Event, args: list[str] | None = None) -> int:
     error exits 2 with one line. A stop before the node is made exits 0 at once."""
     if stop.is_set():
         return 0
+    argv = sys.argv if args is None else args
     try:
-        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    except Exception as err:  # rcl's argument and params-file errors (RCLError)
-        print(f"mount_twin_node: {str(err).splitlines()[0]}", file=sys.stderr)
+        check_command_line(argv)
+        rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    except MountTwinError as err:
+        print(f"mount_twin_node: {err}", file=sys.stderr)
+        return 2
+    except RuntimeError as err:  # rcl's others (RCLError), e.g. a bad ROS_DOMAIN_ID
+        print(f"mount_twin_node: {rcl_message(err)}", file=sys.stderr)
         return 2
     node = None
     try:
-        node = MountTwinNode(sys.argv if args is None else args)
+        node = MountTwinNode(argv)
         executor = SingleThreadedExecutor()
         executor.add_node(node)
         while not stop.is_set() and rclpy.ok():

@@ -11,6 +11,7 @@ double, and a `scene_file` is loaded with the other scene parameters overriding 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from itertools import pairwise
@@ -18,9 +19,11 @@ from typing import Any
 
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.exceptions import InvalidParameterValueException
+from rclpy.logging import LoggingSeverity, get_logger_level, set_logger_level
 from rclpy.node import Node
+from rclpy.utilities import remove_ros_args
 
-from mount_twin.errors import SceneError
+from mount_twin.errors import MountTwinError, SceneError
 from mount_twin.ros.rclpy_private import given_parameters
 from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import read_scene_yaml
@@ -117,6 +120,51 @@ def _ros_arguments(args: Sequence[str]) -> list[str]:
         elif inside:
             out.append(arg)
     return out
+
+
+RCL_WHERE = re.compile(r"(, at \S+:\d+)+$")
+"""The C source positions rcl appends to its error messages."""
+RCL_UNPARSED = re.compile(r"Couldn't parse (?P<what>.+?): '(?P<arg>.*)'\. Error: (?P<why>.*)")
+"""rcl's message for a command-line argument it cannot parse."""
+
+
+def rcl_message(err: Exception) -> str:
+    """rcl's error (an `RCLError` of rclpy) as one line for a user: without the C source
+    positions rcl appends (`, at /project/src/rcl/arguments.c:415`) nor rclpy's prefix, and
+    an argument rcl could not parse named first (`-r /a:=//b: not a valid remap rule`)."""
+    text = RCL_WHERE.sub("", " ".join(str(err).split()))
+    for prefix in ("failed to initialize rcl: ", "Failed to parse ROS arguments: "):
+        text = text.removeprefix(prefix)
+    unparsed = RCL_UNPARSED.fullmatch(text)
+    if unparsed is None:
+        return text
+    why = "" if unparsed["why"] == "error not set" else f": {unparsed['why']}"
+    return f"{unparsed['arg']}: not a valid {unparsed['what']}{why}"
+
+
+def check_command_line(args: Sequence[str]) -> None:
+    """Check the command line `args` before rclpy is initialised with it, so that a bad one
+    ends the node with one line: every `--params-file` is read by the scene files' rules (a
+    missing file, a YAML error and a key given twice are named with the file and line), then
+    rcl parses the ROS arguments with its own logger quiet (on an argument it cannot parse,
+    rcl logged `[ERROR] [rcl]: Failed to parse global arguments` before the node's line, and
+    its message ended in C source positions).
+
+    Raises:
+        SceneError: a params file cannot be read or breaks the scene files' YAML rules.
+        MountTwinError: rcl refuses an argument (`rcl_message`).
+    """
+    for flag, value in pairwise(_ros_arguments(args)):
+        if flag == "--params-file":
+            read_scene_yaml(value)
+    level = get_logger_level("rcl")
+    set_logger_level("rcl", LoggingSeverity.FATAL)
+    try:
+        remove_ros_args(list(args))
+    except RuntimeError as err:  # rclpy's RCLInvalidROSArgsError
+        raise MountTwinError(rcl_message(err)) from err
+    finally:
+        set_logger_level("rcl", level)
 
 
 def shadowed_command_line(args: Sequence[str], names: set[str]) -> dict[str, Any]:
