@@ -81,7 +81,23 @@ def read_scene_yaml(path: str | Path) -> Any:
     except SceneYamlError as err:
         raise SceneError(str(path), "<file>", str(err)) from err
     except yaml.YAMLError as err:
-        raise SceneError(str(path), "<file>", f"not valid YAML: {err}") from err
+        raise SceneError(str(path), "<file>", f"not valid YAML: {_yaml_problem(err)}") from err
+
+
+def _yaml_problem(err: yaml.YAMLError) -> str:
+    """PyYAML's error on one line, with 1-based positions in the file (its text spans five
+    lines, quoting the line with a caret, and names the file '<unicode string>'):
+    `line 3, column 1: expected ',' or ']', but got '<stream end>' (while parsing a flow
+    sequence from line 2, column 23)`."""
+    if not isinstance(err, yaml.MarkedYAMLError) or err.problem_mark is None:
+        return " ".join(str(err).split())
+    mark = err.problem_mark
+    text = f"line {mark.line + 1}, column {mark.column + 1}: {err.problem}"
+    if err.context:
+        where = err.context_mark
+        at = "" if where is None else f" from line {where.line + 1}, column {where.column + 1}"
+        text += f" ({err.context}{at})"
+    return text
 
 
 def scene_from_dict(
