@@ -130,7 +130,7 @@ class ReplaySummary:
     events: list[MountEvent] = field(default_factory=list)
     utilisation_max: dict[str, float] = field(default_factory=dict)
     origin_s: int = 0  # whole seconds to add to event stamps to get header stamps
-    wrong_frame_id: str | None = None  # the last header.frame_id rejected as wrong, if any
+    wrong_frame_id: str | None = None  # the last header.frame_id rejected as wrong (kept_text)
     start_s: float = 0.0  # engine seconds of the first output (event times count from it)
     error_estimate: ErrorEstimate | None = None  # the live estimate over the run (None: off)
     failure: str = ""  # how often the integration failed and why ('' if never)

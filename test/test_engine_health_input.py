@@ -8,7 +8,9 @@ engine.
 
 from __future__ import annotations
 
+import gc
 import math
+import tracemalloc
 import warnings
 from collections import Counter
 
@@ -18,7 +20,7 @@ from io_helpers import batch, default_model, default_scene, scene_with, split
 
 from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus, SampleBatch
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.engine.health import _median
+from mount_twin.engine.health import WRONG_FRAMES_COUNTED, _median
 from mount_twin.io.messages import DIAGNOSTICS_TOPIC, imu_messages
 from mount_twin.model.assemble import assemble
 from mount_twin.scene import Scene
@@ -436,6 +438,64 @@ def test_a_huge_wrong_frame_id_is_shortened_in_every_report() -> None:
     for report in reports:
         value = status(report).values["last_wrong_frame_id"]
         assert value.startswith("'xxx") and value.endswith("(shortened, 100000 characters)")
+
+
+def _wrong_frame_messages(frame_ids: list[str], t0_ns: int = 10**18) -> list[bytes]:
+    """Imu messages at rest at RATE, one per frame id, from `t0_ns`."""
+    rest = np.array([[0.0, 0.0, 9.80665]])
+    return [
+        raw
+        for i, frame_id in enumerate(frame_ids)
+        for _, raw in imu_messages(np.array([t0_ns + i * 10**6]), rest, np.zeros((1, 3)), frame_id)
+    ]
+
+
+def test_a_period_keeps_no_hostile_frame_id_whole() -> None:
+    """A period held every distinct wrong frame_id in full until its report, which names
+    three, shortened: 100 kB frame ids at 10 kHz held about a gigabyte a second. 200 distinct
+    ids of 50 000 characters (10 MB) through the node's path may leave no more than 1 MB held,
+    and the stall report still names three, shortened, and counts the others."""
+    stream = TwinStream(default_scene())
+    stream.process(_wrong_frame_messages(["warm_up"] * 10))  # the first push's allocations
+    ids = [f"{i:06d}" + "x" * 50_000 for i in range(200)]  # distinct in their shown head
+    raws = _wrong_frame_messages(ids, t0_ns=10**18 + 10**8)
+    gc.collect()
+    tracemalloc.start()
+    try:
+        before = tracemalloc.get_traced_memory()[0]
+        assert stream.process(raws) == []  # within the period: no report yet
+        gc.collect()
+        held = tracemalloc.get_traced_memory()[0] - before
+    finally:
+        tracemalloc.stop()
+    assert held < 1_000_000, f"{held} bytes held after the push"
+    report = stream.engine.report_stalled(1.0)
+    st = status(report)
+    assert st.message.startswith(
+        "no sample accepted for 1.0 s: 210 received, all rejected (wrong_frame 210: expected "
+        "frame_id 'deck_imu', got 'warm_up', '000000xxx"
+    )
+    assert st.message.count("(shortened, 50006 characters)") == 2
+    assert st.message.endswith(" and 198 more)")
+    value = st.values["last_wrong_frame_id"]
+    assert value.startswith("'000199xxx") and value.endswith("(shortened, 50006 characters)")
+
+
+def test_distinct_wrong_frame_ids_are_counted_up_to_a_bound() -> None:
+    """A period counts the distinct wrong frame_ids it names as 'N more' up to
+    WRONG_FRAMES_COUNTED of them, and past that says 'over'; however the samples are pushed."""
+    ids = [f"f{i:05d}" for i in range(WRONG_FRAMES_COUNTED + 200)]
+    b = batch(ramp(len(ids)) / 10.0, frame_ids=ids)  # 10 kHz: all within a period
+    more = WRONG_FRAMES_COUNTED - 3
+    for parts in ([b], split(b, [7] * (len(ids) // 7 + 1))):
+        eng = engine()
+        assert push_all(eng, parts) == []
+        said = status(eng.report_stalled(1.0)).message
+        assert said.endswith(f"got 'f00000', 'f00001', 'f00002' and over {more} more)")
+    eng = engine()
+    assert eng.push(batch(ramp(500) / 10.0, frame_ids=ids[:500])).health == []
+    said = status(eng.report_stalled(1.0)).message
+    assert said.endswith("got 'f00000', 'f00001', 'f00002' and 497 more)")
 
 
 # --------------------------------------------------------------------------- stalled input

@@ -93,7 +93,11 @@ ENDED = math.inf
 """`HealthWindow.report`'s `stalled_s` when the input ended with no sample accepted since the
 last report (`TwinEngine.flush`)."""
 NAMED_FRAMES = 3
-"""Wrong frame_ids named in a message (the rest are elided)."""
+"""Wrong frame_ids named in a message (the rest are counted)."""
+WRONG_FRAMES_COUNTED = 1000
+"""Distinct wrong frame_ids a period keeps (each as `kept_text` keeps it) to name and count; a
+period with more says 'over' that many. A hostile publisher varying its frame_id at every
+message cannot make a period hold more than these."""
 
 
 def ratio_text(value: float, spec: str = ".3g", limit: float = 1.0) -> str:
@@ -151,7 +155,8 @@ class HealthWindow:
         """(samples gathered, samples a start takes) while samples are gathered toward a start
         (`starts.Starts.gather`); None otherwise."""
         self.last_wrong_frame_id: str | None = None
-        """header.frame_id of the last sample rejected as wrong_frame (any period)."""
+        """header.frame_id of the last sample rejected as wrong_frame (any period), as
+        `kept_text` keeps it (a hostile one shortened, with its length)."""
         self.latency: tuple[int, float] | None = None if filter_bands(scene.input) else (0, 0.0)
         """Samples and seconds by which outputs follow their input (the gyro delay); None until
         the `linear_phase` filter is designed (NOT_DESIGNED), the others have none."""
@@ -177,6 +182,11 @@ class HealthWindow:
         self.skipped: list[tuple[int, int]] = []
         """(position among this window's steps, samples rejected within that interval)."""
         self.wrong_frames: dict[str, None] = {}
+        """The distinct wrong frame_ids of this window in arrival order, as `kept_text` keeps
+        them, at most WRONG_FRAMES_COUNTED: a 100 kB frame id kept whole until the report, at
+        10 kHz, held a gigabyte a second."""
+        self.wrong_frames_uncounted = False
+        """Whether this window saw distinct wrong frame_ids beyond those kept."""
         self.starts: list[tuple[float, float, float, list[tuple[int, str]]]] = []
         """(stamp s, |f0| m/s², tilt of f0 rad, findings (level, text)) per start."""
         self.notes: list[str] = []
@@ -264,10 +274,17 @@ class HealthWindow:
             self.n_steps += steps.shape[0]
 
     def add_wrong_frames(self, frame_ids: list[str]) -> None:
-        """header.frame_id of samples rejected as wrong_frame, in arrival order."""
-        self.wrong_frames.update(dict.fromkeys(frame_ids))
+        """header.frame_id of samples rejected as wrong_frame, in arrival order: kept as
+        published (`kept_text`), the distinct ones up to WRONG_FRAMES_COUNTED."""
+        for kept in map(kept_text, dict.fromkeys(frame_ids)):
+            if kept in self.wrong_frames:
+                continue
+            if len(self.wrong_frames) < WRONG_FRAMES_COUNTED:
+                self.wrong_frames[kept] = None
+            else:
+                self.wrong_frames_uncounted = True
         if frame_ids:
-            self.last_wrong_frame_id = frame_ids[-1]
+            self.last_wrong_frame_id = kept_text(frame_ids[-1])
 
     def lost_estimate(self) -> tuple[int, float]:
         """Samples lost in this window, estimated from its stamp intervals, and the nominal
@@ -772,7 +789,7 @@ class HealthWindow:
             },
         }
         if counts["rejected_wrong_frame"] and self.last_wrong_frame_id is not None:
-            values["last_wrong_frame_id"] = kept_text(self.last_wrong_frame_id)
+            values["last_wrong_frame_id"] = self.last_wrong_frame_id
         if stalled_s is not None and stalled_s != ENDED:
             values["since_last_report_s"] = f"{stalled_s:.6g}"
         if self.starts:
@@ -788,7 +805,8 @@ class HealthWindow:
         seen = list(self.wrong_frames)
         got = ", ".join(shown_text(f) for f in seen[:NAMED_FRAMES])  # a hostile one shortened
         if len(seen) > NAMED_FRAMES:
-            got += f" and {len(seen) - NAMED_FRAMES} more"
+            over = "over " if self.wrong_frames_uncounted else ""
+            got += f" and {over}{len(seen) - NAMED_FRAMES} more"
         expected = shown_text(self.scene.input.frame_id)
         return f"{reason} {n}: expected frame_id {expected}, got {got}"
 
