@@ -554,6 +554,12 @@ def test_parameters_are_all_set_described_and_read_only(tmp_path: Path) -> None:
             "-p body.mass:=[1: not a valid parameter override rule: Error parsing an event",
         ),
         (["-r", "/deck/imu:=//x"], "-r /deck/imu:=//x: not a valid remap rule"),
+        # rclpy's own parameters, of another type: a traceback from Node.__init__, exit 1
+        (["-p", "use_sim_time:=maybe"], "use_sim_time: expected true or false, got 'maybe'"),
+        (
+            ["-p", "start_type_description_service:=1"],
+            "start_type_description_service: expected true or false, got 1",
+        ),
     ],
     ids=[
         "unknown_key",
@@ -571,6 +577,8 @@ def test_parameters_are_all_set_described_and_read_only(tmp_path: Path) -> None:
         "scene_file_as_params_file",
         "bad_override_rule",
         "bad_remap_rule",
+        "bad_use_sim_time",
+        "bad_type_description_switch",
     ],
 )
 def test_configuration_errors_end_the_node_with_one_line_naming_the_parameter(

@@ -60,6 +60,7 @@ from mount_twin.io.messages import (
     static_transforms,
 )
 from mount_twin.ros.parameters import (
+    built_in_type_error,
     check_command_line,
     check_qos_overrides,
     configure,
@@ -110,7 +111,10 @@ class MountTwinNode(Node):
 
     def __init__(self, args: Sequence[str] = (), **kwargs: Any) -> None:
         """`args`: the process's command line (its `-p` outrank a params file's section)."""
-        super().__init__(NODE_NAME, **kwargs)
+        try:
+            super().__init__(NODE_NAME, **kwargs)
+        except InvalidParameterTypeException as err:  # raised from rclpy's own declarations
+            raise built_in_type_error(self, err) from err
         self.options, self.scene = configure(self, args)
         self.stream = TwinStream(self.scene)
         self._pubs = self._create_outputs()

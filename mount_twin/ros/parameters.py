@@ -105,7 +105,7 @@ _OPTIONS: dict[str, ParameterDescriptor] = {
     ),
 }
 BUILT_IN = frozenset({"use_sim_time", "start_type_description_service"})
-"""Parameters rclpy declares itself."""
+"""Parameters rclpy declares itself (in `Node.__init__`), both booleans."""
 QOS_OVERRIDES = "qos_overrides."
 """Prefix of ROS 2's QoS override parameters, which rclpy declares and checks itself (the node
 lets the input subscription's reliability be overridden)."""
@@ -227,6 +227,18 @@ def configure(node: Node, args: Sequence[str] = ()) -> tuple[NodeOptions, Scene]
 KNOWN_NAMES = frozenset({name.split(".")[0] for name in PARAMETERS} | {"mounts", *_OPTIONS})
 """The first part of every parameter name the node takes: the scene's sections and scene
 keys (`mount_names`, `scene_file`, ...), `mounts`, and the node's own options."""
+
+
+def built_in_type_error(node: Node, err: Exception) -> SceneError:
+    """The error for a parameter of BUILT_IN given a value of another type than bool, which
+    rclpy's `Node.__init__` raised (`err`) from its declaration, and which ended the node
+    with a traceback (`-p use_sim_time:=1`); rclpy's text where no such value was given."""
+    given = given_parameters(node)
+    source = f"parameters of {node.get_fully_qualified_name()}"
+    for name in sorted(BUILT_IN & given.keys()):
+        if not isinstance(given[name], bool):
+            return SceneError(source, name, f"expected true or false, got {given[name]!r}")
+    return SceneError(source, "<rclpy>", str(err))
 
 
 def _refuse_unknown_names(given: dict[str, Any], source: str) -> None:
