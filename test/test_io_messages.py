@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+from typing import Any
 
 import numpy as np
 import pytest
@@ -73,6 +74,77 @@ def test_imu_messages_decode_back_to_the_same_stamps_vectors_and_frames() -> Non
     np.testing.assert_array_equal(dec.accel, accel)  # float64 through CDR: bit exact
     np.testing.assert_array_equal(dec.gyro, gyro)
     assert dec.frame_ids == ["deck_imu"] * 50
+
+
+def _scans(monkeypatch: pytest.MonkeyPatch) -> dict[str, int]:
+    """Count the layouts probed and the rows their unpacks scan (FixedLayout's), from no
+    layout known (the messages to decode made before: their making probes layouts)."""
+    from mount_twin.io import fixed_layout, messages
+
+    seen = {"rows": 0, "probes": 0}
+    unpack, probe = fixed_layout.FixedLayout.unpack, fixed_layout.FixedLayout.probe.__func__
+
+    def counted_unpack(self: Any, raws: Any, want: Any) -> Any:
+        seen["rows"] += len(raws)
+        return unpack(self, raws, want)
+
+    def counted_probe(cls: Any, *args: Any) -> Any:
+        seen["probes"] += 1
+        return probe(cls, *args)
+
+    monkeypatch.setattr(fixed_layout.FixedLayout, "unpack", counted_unpack)
+    monkeypatch.setattr(fixed_layout.FixedLayout, "probe", classmethod(counted_probe))
+    messages._layout.cache_clear()
+    monkeypatch.setattr(messages, "_LAST_FRAME", {})
+    return seen
+
+
+def _one_frame_each(frame_ids: list[str]) -> tuple[np.ndarray, list[bytes]]:
+    """Imu messages at rest, 1 ms apart, one per frame id: their stamps (ns) and bytes."""
+    stamps = START_NS + np.arange(len(frame_ids), dtype=np.int64) * 1_000_000
+    raws = [
+        raw
+        for stamp, frame_id in zip(stamps, frame_ids, strict=True)
+        for _, raw in imu_messages(stamp[None], REST[None], np.zeros((1, 3)), frame_id)
+    ]
+    return stamps, raws
+
+
+def test_a_frame_id_in_every_message_decodes_in_linear_time(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Each new frame_id's layout scanned every message still pending: 1000 messages with
+    distinct ids of 100 000 characters took 57 s to decode (one batch of a live node). Now at
+    most 4 × the messages are scanned; every message still decodes to its own frame id."""
+    ids = [f"f{i:05d}" for i in range(3000)]
+    stamps, raws = _one_frame_each(ids)
+    seen = _scans(monkeypatch)
+    dec = decode_inputs(raws, IMU)
+    assert dec.frame_ids == ids and dec.undecodable == 0
+    np.testing.assert_array_equal(dec.stamps_ns, stamps)
+    assert seen["rows"] <= 4 * 3000
+    # three sensors interleaved on one topic still go through their layouts, one scan each
+    three = [("a", "bb", "ccc")[i % 3] for i in range(3000)]
+    stamps, raws = _one_frame_each(three)
+    seen = _scans(monkeypatch)
+    dec = decode_inputs(raws, IMU)
+    assert dec.frame_ids == three
+    np.testing.assert_array_equal(dec.stamps_ns, stamps)
+    assert seen["rows"] == 3000 + 2000 + 1000  # each layout scans its message and the rest
+
+
+def test_a_frame_id_no_sensor_has_is_decoded_without_a_layout(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A 100 000-character frame_id was probed (serialized twice) and its layout cached, 256
+    of them held; now such messages are decoded by rosbags alone, one by one or batched."""
+    ids = [f"{i:03d}" + "x" * 100_000 for i in range(20)]
+    _, raws = _one_frame_each(ids)
+    seen = _scans(monkeypatch)
+    for chunk in ([raws], [[r] for r in raws]):
+        frames = [f for part in chunk for f in decode_inputs(part, IMU).frame_ids]
+        assert frames == ids
+    assert seen["probes"] == 0
 
 
 def test_imu_messages_say_no_orientation_estimate() -> None:

@@ -115,6 +115,17 @@ class Decoded:
         return SampleBatch(seconds, self.accel, self.gyro, self.frame_ids, self.unprovided)
 
 
+LAYOUT_FRAME_MAX = 256
+"""Longest frame_id (characters) whose messages are read through a layout: a longer one (no
+sensor's; a hostile publisher's) is decoded by rosbags alone, neither probed (a probe
+serializes it twice) nor cached (`_layout` kept 256 of them: 100 kB ids held 25 MB)."""
+LAYOUT_SCANS = 4
+"""Most rows a decode of n messages scans against layouts, in units of n (each new frame_id's
+layout scans every message still pending): past it the rest is decoded one by one, in time
+linear in the messages. A publisher varying its frame_id at every message made it quadratic:
+1000 messages with ids of 100 000 characters took 57 s to decode, one batch of a live node."""
+
+
 def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
     """Decode sensor_msgs/Imu (linear_acceleration, angular_velocity) or
     geometry_msgs/AccelStamped (accel.linear; its accel.angular is an angular acceleration, not a
@@ -126,7 +137,8 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
     are read in one numpy pass (`FixedLayout`; rows of `RawRows` as they lie), the rest one by
     one through rosbags. A single
     message (the live node's usual call) is first tried against the layout of the frame_id
-    last seen, without rosbags or numpy (~200 → ~15 µs).
+    last seen, without rosbags or numpy (~200 → ~15 µs). Frame ids past LAYOUT_FRAME_MAX
+    characters, and every message once LAYOUT_SCANS is spent, go through rosbags alone.
     """
     n = len(raws)
     if n == 1 and msgtype in _LAST_FRAME:
@@ -144,6 +156,7 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
     ok = np.zeros(n, dtype=bool)
     pending = np.ones(n, dtype=bool)
     batched = True
+    scanned = 0
     while pending.any():
         i = int(np.argmax(pending))
         pending[i] = False
@@ -154,9 +167,13 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
         ok[i] = True
         frames[i] = msg.header.frame_id
         stamps[i], accel[i], gyro[i], covariance[i] = _input_values(msg, msgtype)
-        if not batched:
+        if not batched or len(msg.header.frame_id) > LAYOUT_FRAME_MAX:
             continue
         rest = np.flatnonzero(pending)
+        scanned += rest.shape[0]
+        if scanned > LAYOUT_SCANS * n:
+            batched = False
+            continue
         try:
             layout = _layout(msgtype, msg.header.frame_id)
         except ValueError:  # a frame_id holding a probe's sentinel bytes: rosbags, one by one
