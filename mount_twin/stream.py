@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from mount_twin.engine.batch import ERROR, HealthReport, OutputBatch
-from mount_twin.engine.body_check import BodyCheck, BodyComparison
+from mount_twin.engine.body_check import RESETS, BodyCheck, BodyComparison
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.health import ENDED, INPUT
 from mount_twin.engine.intake import disregarded, provided, rising, rotated
@@ -150,6 +150,9 @@ class TwinStream:
             self.ageing = AgeingTracker(scene)
         self._ageing_jobs: list[WindowJob] = []
         self._ageing_last_ns = 0
+        self._ageing_body_ns = 0
+        """The latest body stamp the ageing tracker took, ns: it takes rising stamps alone, as
+        of the deck (`_track_foundation`), where the body comparison restarts at a jump back."""
 
     def process(self, raws: Sequence[bytes]) -> list[Encoded]:
         """Outputs for raw input messages, as (unresolved topic, stamp ns, CDR bytes), or blocks
@@ -218,8 +221,12 @@ class TwinStream:
     @property
     def body_behind(self) -> bool:
         """Whether the body IMU's last accepted stamp is not past the foundation's last
-        received one (a replay feeds the body stream until it is)."""
-        return self.body is None or self.body.last_ns <= self._received_ns
+        received one, each after its stamps' jumps back (a replay feeds the body stream until
+        it is: a bag played with --loop, both its streams jumping back at each loop)."""
+        if self.body is None:
+            return True
+        body = (self.body.counts[RESETS], self.body.last_ns)
+        return body <= (self.engine.counts[RESETS], self._received_ns)
 
     def take_body_reports(self) -> list[HealthReport]:
         """The body comparison's window reports since the last call."""
@@ -294,14 +301,17 @@ class TwinStream:
     def _body_in(self, decoded: Decoded) -> list[tuple[str, int, bytes]]:
         """Accepted body samples into the comparison, on the twin's time base (a reading
         marked not provided zeroed, `provided`: never read as a value); into the ageing
-        tracker, whose fits read the specific force, those that provide it."""
+        tracker, whose fits read the specific force, those that provide it and whose stamps
+        rise (`_ageing_body_ns`)."""
         assert self.body is not None and self.base is not None
         accel, gyro = provided(decoded.accel, decoded.gyro, decoded.unprovided)
         n = decoded.stamps_ns.shape[0]
         present = ~(np.zeros((n, 2), bool) if decoded.unprovided is None else decoded.unprovided)
         t = self.base.seconds(decoded.stamps_ns)
         if self.ageing is not None:
-            k = present[:, 0]
+            k = rising(decoded.stamps_ns, np.ones(n, bool), self._ageing_body_ns)
+            self._ageing_body_ns = max(self._ageing_body_ns, int(decoded.stamps_ns.max(initial=0)))
+            k &= present[:, 0]
             jobs = self.ageing.add_body(decoded.stamps_ns[k], t[k], accel[k], gyro[k])
             self._ageing_jobs += jobs
         rows = self.body.add_body(decoded.stamps_ns, t, np.hstack([accel, gyro]), present)

@@ -65,11 +65,13 @@ def _stamps(deck: Signal) -> np.ndarray:
     return NS0 + np.round(deck.t * 1e9).astype(np.int64)
 
 
-def _whole_record(scene: Scene, deck: Signal) -> tuple[np.ndarray, np.ndarray]:
-    """(row stamps s, (k, 6) prediction) of the scene's twin on the whole deck record at once,
-    its stamps on the stream's time base."""
+def _whole_record(
+    scene: Scene, deck: Signal, ns: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """(row stamps s, (k, 6) prediction) of the scene's twin on the whole deck record at once
+    (stamped `ns`, by default `_stamps`), its stamps on the stream's time base."""
     frames = [scene.input.frame_id] * deck.t.shape[0]
-    t = TimeBase.at(NS0).seconds(_stamps(deck))
+    t = TimeBase.at(NS0).seconds(_stamps(deck) if ns is None else ns)
     model, out = followed(scene, SampleBatch(t, deck.accel, deck.gyro, frames), "deck")
     rate = rotated(deck.gyro, model.sensor_rotation)
     assert scene.body_sensor is not None
@@ -571,3 +573,49 @@ def test_a_body_imu_marking_either_reading_is_judged_field_by_field_in_any_batch
     assert counts["unprovided_acceleration"] == (taken & ~provides[:, 0]).sum()
     assert counts["unprovided_angular_velocity"] == (taken & ~provides[:, 1]).sum()
     assert counts["rejected_no_reading"] == (~taken).sum()
+
+
+def test_stamps_jumping_back_restart_the_comparison_in_any_batching() -> None:
+    """Both streams' stamps jump back 8 s at 6 s (a bag played with --loop, a recorder's clock
+    reset): the twin restarted, the body check did not. Every body message after the jump was
+    rejected stamp_back (its stamps behind the last accepted), and the prediction ran on rows
+    whose stamps went back. Now the body stream restarts as the deck's does: each body sample
+    (the twin's own reading on each run, from a twin on that run alone) is compared with its
+    exact prediction, the window before the jump is judged and the first one after it too
+    (NRMS ≈ 0, the restart counted in its values), the same however the streams come."""
+    scene, deck = _pump(), _deck(12.0)
+    jumped = deck.t >= 6.0
+    ns = _stamps(deck) - np.where(jumped, 8_000_000_000, 0)
+    truth = np.vstack(
+        [
+            _whole_record(scene, Signal(deck.t[k], deck.accel[k], deck.gyro[k]), ns[k])[1]
+            for k in (~jumped, jumped)
+        ]
+    )
+    body = _body_raws(ns, truth)
+    deck_raws = [r for _, r in imu_messages(ns, deck.accel, deck.gyro, "deck_imu")]
+    streams = [TwinStream(scene) for _ in range(2)]
+    runs = [
+        _interleaved(scene, deck_raws, ns, (body, ns)),
+        _chunked(scene, deck_raws, body, 700, body_first=True),
+        _chunked(scene, deck_raws, body, 333, body_first=False),
+        streams[0].process(deck_raws) + streams[0].process_body(body) + streams[0].finish(),
+        streams[1].process_body(body) + streams[1].process(deck_raws) + streams[1].finish(),
+    ]
+    kept = [[m for m in run if m[0] != DIAGNOSTICS_TOPIC or NAME.encode() in m[2]] for run in runs]
+    assert all(sorted(k) == sorted(kept[0]) for k in kept[1:])
+    for stream in streams:
+        assert stream.body is not None
+        counts = stream.body.counts
+        assert counts["rejected_stamp_back"] == 0 and counts["reset_stamp_jumped_back"] == 1
+        assert counts["accepted"] == counts["compared"] == ns.shape[0]
+    stamps, predicted = _imu_values(runs[0], BODY_PREDICTED_TOPIC)
+    assert np.array_equal(stamps, ns)
+    assert np.array_equal(predicted, truth)  # each run's ends by one-sided differences
+    windows = _windows(runs[0])  # 0–5 s, then -2–3 s (each run's last second: too short)
+    assert [v["body_reset_stamp_jumped_back"] for _, _, v in windows] == ["0", "1"]
+    for level, message, values in windows:
+        assert level == OK and "agree" in message, message
+        nrms = [float(values[f"nrms_broadband_{a}"]) for a in ("fx", "fy", "fz", "wx", "wy")]
+        assert max(nrms) < 1e-6, values
+        assert values["samples"] == str(1000)

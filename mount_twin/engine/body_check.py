@@ -28,15 +28,17 @@ the end of the stream. It depends on the body stream alone.
 
 from __future__ import annotations
 
+import math
 from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, fields
+from itertools import pairwise
 
 import numpy as np
 
 from mount_twin.engine.agreement import FIELDS, MIN_SAMPLES, NAME, agreement, window_status
 from mount_twin.engine.batch import WARN, HealthStatus
-from mount_twin.engine.intake import provided, rising
+from mount_twin.engine.intake import provided, rising_or_back
 from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.physics import pose_row
 from mount_twin.scene.description import BodySensor, Scene
@@ -58,6 +60,9 @@ REJECTED = (
 """Why a body message was not taken (`BodyCheck.screen`, and undecodable; no_reading: both
 its readings marked not provided): reported as body_rejected_<reason> in every window, zero
 included."""
+RESETS = "reset_stamp_jumped_back"
+"""The count of body messages whose stamp jumped back by more than input.back_jump_reset_s,
+each restarting the comparison (`BodyCheck.screen`)."""
 UNPROVIDED = ("unprovided_acceleration", "unprovided_angular_velocity")
 """The counts of accepted body messages that mark their acceleration, their angular velocity
 not provided (REP-145): compared on the other reading alone."""
@@ -85,6 +90,15 @@ class _Rows:
             np.concatenate([self.pose, later.pose]),
             np.concatenate([self.wrenches, later.wrenches]),
             np.concatenate([self.rate, later.rate]),
+        )
+
+    def part(self, start: int, stop: int) -> _Rows:
+        """Rows [start, stop) (views)."""
+        return _Rows(
+            self.t[start:stop],
+            self.pose[start:stop],
+            self.wrenches[start:stop],
+            self.rate[start:stop],
         )
 
     def tail(self, n: int) -> _Rows:
@@ -124,11 +138,13 @@ class _Lead:
 
     def finish(self) -> tuple[np.ndarray, np.ndarray]:
         """The rows still held, the last by one-sided differences (fewer than 3 rows in the
-        whole run: none)."""
+        whole run: none): the end of the stream, or of the twin's run (the rows after it
+        start afresh)."""
         window, self._held = self._held, None
+        first = 0 if self._at_start else 2
+        self._at_start = True
         if window is None or len(window) < 3:
             return _NO_PREDICTION
-        first = 0 if self._at_start else 2
         return window.t[first:], self._predict(window)[first:]
 
 
@@ -139,6 +155,8 @@ class _Series:
         self._t = np.zeros(1024)
         self._v = np.zeros((1024, 6))
         self._start = self._end = 0
+        self.first: float | None = None
+        """The first stamp ever appended (None: none yet)."""
 
     @property
     def t(self) -> np.ndarray:
@@ -150,6 +168,8 @@ class _Series:
 
     def append(self, t: np.ndarray, v: np.ndarray) -> None:
         k = t.shape[0]
+        if k and self.first is None:
+            self.first = float(t[0])
         if self._end + k > self._t.shape[0]:
             n = self._end - self._start
             size = max(2 * (n + k), 1024)
@@ -168,8 +188,9 @@ class _Series:
 class _Taken:
     """Accepted body samples out of the matcher, in order: stamps (ns, s), measured (k, 6),
     which readings each provides ((k, 2): specific force, rate), the prediction at each (where
-    compared), why each was not compared ('' where it was: `PROBLEMS`), and each one's place
-    among the accepted samples."""
+    compared), why each was not compared ('' where it was: `PROBLEMS`), each one's place
+    among the accepted samples, and the body stream's run it is in (its stamps' jumps back
+    before it)."""
 
     ns: np.ndarray
     t: np.ndarray
@@ -178,6 +199,7 @@ class _Taken:
     predicted: np.ndarray
     why: np.ndarray
     place: np.ndarray
+    run: np.ndarray
 
     @classmethod
     def none(cls) -> _Taken:
@@ -190,77 +212,139 @@ class _Taken:
             empty,
             np.zeros(0, object),
             np.zeros(0, np.int64),
+            np.zeros(0, np.int64),
         )
+
+    def select(self, k: np.ndarray | slice) -> _Taken:
+        """Those `k` selects."""
+        return _Taken(*(getattr(self, f.name)[k] for f in fields(self)))
 
     def compared(self) -> _Taken:
         """Those compared."""
-        k = self.why == ""
-        return _Taken(*(getattr(self, f.name)[k] for f in fields(self)))
+        return self.select(self.why == "")
+
+
+_Waiting = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+"""Body samples waiting for the twin: stamps ns, stamps s, measured (k, 6), readings provided
+(k, 2), the body stream's run of each."""
 
 
 class _Matcher:
-    """Body samples matched to the prediction at the motion they measured."""
+    """Body samples matched to the prediction at the motion they measured, run by run: the
+    twin restarts where its rows' stamps go back (`_Lead` finishes the run before), the body
+    stream where its stamps jump back (`BodyCheck.screen`), and the n-th run of the body
+    stream is matched with the n-th run of the twin's. A body sample past the last row of a
+    run the twin has ended is in_gap; one of a run the twin never had rows in, before_twin."""
 
     def __init__(self, lag_s: float, max_gap_s: float, problems: Counter[str]) -> None:
         self._lag, self._max_gap, self._problems = lag_s, max_gap_s, problems
-        self._pred = _Series()
-        self._first: float | None = None
-        self._body: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
-        """Waiting body samples: (stamps ns, stamps s, measured (k, 6), readings provided
-        (k, 2)) chunks."""
+        self._pred: dict[int, _Series] = {0: _Series()}
+        """The predictions of each of the twin's runs a body sample may still need."""
+        self._rows_run = 0
+        """The twin's run the rows come in."""
+        self._body_run = 0
+        """The body stream's run of the last body sample added."""
+        self._last_ns = 0
+        """The stamp of the last body sample added, ns."""
+        self._body: list[_Waiting] = []
         self.taken = 0
         """Accepted body samples taken out so far (compared, or counted not compared): the
         place among them of the first one waiting."""
 
     def add_predictions(self, t: np.ndarray, v: np.ndarray) -> None:
-        if t.shape[0]:
-            self._first = float(t[0]) if self._first is None else self._first
-            self._pred.append(t, v)
+        series = self._pred.get(self._rows_run)
+        if t.shape[0] and series is not None:  # None: the body stream is past this run
+            series.append(t, v)
+
+    def restart_rows(self) -> None:
+        """The twin's rows start a new run (their stamps went back)."""
+        self._rows_run += 1
+        if self._rows_run >= self._oldest():
+            self._pred[self._rows_run] = _Series()
 
     def add_body(self, ns: np.ndarray, t: np.ndarray, v: np.ndarray, present: np.ndarray) -> None:
-        self._body.append((ns, t, v, present))
+        """Accepted body samples, in order (a stamp before the last starts a new run)."""
+        if not ns.shape[0]:
+            return
+        back = ns < np.concatenate([[self._last_ns], ns[:-1]])
+        run = self._body_run + np.cumsum(back)
+        self._body_run, self._last_ns = int(run[-1]), int(ns[-1])
+        self._body.append((ns, t, v, present, run))
         waiting = sum(c[0].shape[0] for c in self._body)
         if waiting > PENDING_LIMIT:
             cut = waiting - PENDING_LIMIT
             self._problems["dropped_waiting"] += cut
             self.taken += cut
-            ns, t, v, present = self._waiting()
-            self._body = [(ns[cut:], t[cut:], v[cut:], present[cut:])]
+            ns, t, v, present, run = self._waiting()
+            self._body = [(ns[cut:], t[cut:], v[cut:], present[cut:], run[cut:])]
 
-    def _waiting(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def _waiting(self) -> _Waiting:
         """The waiting body samples in one chunk."""
-        ns, t, v, present = (np.concatenate(a) for a in zip(*self._body, strict=True))
-        return ns, t, v, present
+        ns, t, v, present, run = (np.concatenate(a) for a in zip(*self._body, strict=True))
+        return ns, t, v, present, run
 
     def take(self, final: bool = False) -> _Taken:
-        """The body samples the prediction now covers, in order (`final`: the end of the
+        """The body samples the predictions now decide, in order (`final`: the end of the
         stream, the rest are counted unanswered)."""
-        pt, pv = self._pred.t, self._pred.v
-        if not self._body or self._first is None:
-            if final:
-                left = sum(c[0].shape[0] for c in self._body)
-                self._problems["unanswered"] += left
-                self.taken += left
-                self._body = []
-            self._trim(None)
+        if not self._body:
+            self._forget()
             return _Taken.none()
-        ns, t, v, present = self._waiting()
-        ready = t - self._lag <= pt[-1]  # a prefix: accepted stamps rise
-        self._body = [] if final else [(ns[~ready], t[~ready], v[~ready], present[~ready])]
-        first = self.taken
-        self.taken += int(ready.sum())
-        if final:
-            self._problems["unanswered"] += int((~ready).sum())
-            self.taken += int((~ready).sum())
-        ns, t, v, present = ns[ready], t[ready], v[ready], present[ready]
+        ns, t, v, present, run = self._waiting()
         tau = t - self._lag
         why = np.full(t.shape[0], "", dtype=object)
-        why[tau < self._first] = "before_twin"
+        pred = np.zeros((t.shape[0], 6))
+        done = 0  # the samples decided: a prefix
+        for r in np.unique(run).tolist():
+            stop = done + int((run[done:] == r).sum())  # runs rise
+            series = self._pred.get(r) if r <= self._rows_run else None
+            ended = r < self._rows_run
+            if series is None or series.first is None:
+                if not ended:
+                    break
+                why[done:stop] = "before_twin"  # the twin had no row in that run
+                done = stop
+                continue
+            covered = done + int((tau[done:stop] <= series.t[-1]).sum())  # accepted stamps rise
+            self._match(series, tau[done:covered], why[done:covered], pred[done:covered])
+            if ended:
+                why[covered:stop] = "in_gap"  # the twin restarted before them
+                covered = stop
+            done = covered
+            if done < stop:
+                break
+        left = t.shape[0] - done
+        if final:
+            self._problems["unanswered"] += left
+        rest = (ns[done:], t[done:], v[done:], present[done:], run[done:])
+        self._body = [rest] if left and not final else []
+        first = self.taken
+        self.taken += done + (left if final else 0)
+        for reason in ("before_twin", "late", "in_gap"):
+            self._problems[reason] += int((why[:done] == reason).sum())
+        self._forget()
+        return _Taken(
+            ns[:done],
+            t[:done],
+            v[:done],
+            present[:done],
+            pred[:done],
+            why[:done],
+            first + np.arange(done),
+            run[:done],
+        )
+
+    def _match(self, series: _Series, tau: np.ndarray, why: np.ndarray, pred: np.ndarray) -> None:
+        """The predictions (into `pred`, (k, 6)) of body samples measuring the motion at `tau`
+        (s, rising, none past the run's last row), or why each is not compared (into `why`)."""
+        if not tau.shape[0]:
+            return
+        assert series.first is not None
+        pt, pv = series.t, series.v
+        why[tau < series.first] = "before_twin"
         why[(why == "") & (tau < pt[0])] = "late"
         kept = np.flatnonzero(why == "")
         after = np.searchsorted(pt, tau[kept], side="right")
         at_row = pt[after - 1] == tau[kept]  # (after ≥ 1: tau ≥ the first row)
-        pred = np.zeros((t.shape[0], 6))
         # A sample at a row takes that row's prediction whichever rows come after it (were it
         # interpolated toward the next row, the row after a gap would make it in_gap or not by
         # whether that row was already published: by how the two streams came interleaved).
@@ -272,21 +356,35 @@ class _Matcher:
             w = ((tau[between] - t0) / (t1 - t0))[:, None]
             pred[between] = (1.0 - w) * pv[j - 1] + w * pv[j]
             why[between[(t1 - t0) > self._max_gap]] = "in_gap"
-        for reason in ("before_twin", "late", "in_gap"):
-            self._problems[reason] += int((why == reason).sum())
-        self._trim(float(tau[kept][-1]) if kept.shape[0] else None)
-        return _Taken(ns, t, v, present, pred, why, first + np.arange(t.shape[0]))
+        if kept.shape[0]:
+            _trim(series, float(tau[kept][-1]))
 
-    def _trim(self, last_tau: float | None) -> None:
-        """Drop the predictions no future body sample needs: those before the one at or
-        before the last sample compared, and those more than RETAIN_S behind the newest."""
-        pt = self._pred.t
-        if not pt.shape[0]:
-            return
-        cut = int(np.searchsorted(pt, pt[-1] - RETAIN_S, side="left"))
-        if last_tau is not None:
-            cut = max(cut, int(np.searchsorted(pt, last_tau, side="right")) - 1)
-        self._pred.drop_before(min(cut, pt.shape[0] - 1))
+    def _oldest(self) -> int:
+        """The earliest run a body sample still to be matched may be in."""
+        return int(self._body[0][4][0]) if self._body else self._body_run
+
+    def _forget(self) -> None:
+        """Drop the predictions no future body sample needs: the runs before the first body
+        sample waiting (none waiting: before the last added), and in each run kept those
+        more than RETAIN_S behind its newest."""
+        oldest = self._oldest()
+        for r in [r for r in self._pred if r < oldest]:
+            del self._pred[r]
+        for series in self._pred.values():
+            _trim(series, None)
+
+
+def _trim(series: _Series, last_tau: float | None) -> None:
+    """Drop the predictions of `series` no future body sample needs: those before the one at
+    or before the last sample compared (`last_tau`, s), and those more than RETAIN_S behind
+    the newest."""
+    pt = series.t
+    if not pt.shape[0]:
+        return
+    cut = int(np.searchsorted(pt, pt[-1] - RETAIN_S, side="left"))
+    if last_tau is not None:
+        cut = max(cut, int(np.searchsorted(pt, last_tau, side="right")) - 1)
+    series.drop_before(min(cut, pt.shape[0] - 1))
 
 
 def not_compared(counts: Mapping[str, int]) -> dict[str, int]:
@@ -304,6 +402,9 @@ class _Window:
     problems: Counter[str]
 
 
+CUT_BY_END = "the last window, closed by the end of the stream"
+CUT_BY_JUMP = "the last window before the body IMU's stamps jumped back"
+"""How a window cut short is said (`_Windows._close`)."""
 LOOSE = ("dropped_waiting", "unanswered")
 """Not compared for the stream's sake, not at a place in it (held too long, or left at its
 end): reported in the window judged next."""
@@ -314,7 +415,9 @@ class _Windows:
     messages not compared in each: a sample where its stamp falls, a rejected message where the
     accepted sample after it does (its place in the body stream), so that neither depends on
     how the two streams come interleaved; before the first window, in the first; in a window
-    too short to judge, in the next."""
+    too short to judge, in the next. Where the body stream's stamps jump back (a new run,
+    `_Matcher`), the window open ends as the stream's last does, and the grid starts again
+    from the run's first compared sample."""
 
     def __init__(self, sensor: BodySensor, totals: Counter[str]) -> None:
         self._sensor, self._totals = sensor, totals
@@ -326,6 +429,8 @@ class _Windows:
         rejected message not yet in a window."""
         self._loose_reported: Counter[str] = Counter()
         self._judged = False
+        self._run = 0
+        """The body stream's run the windows are in (its stamps' jumps back so far)."""
 
     def mark(self, places: np.ndarray, reasons: np.ndarray) -> None:
         """Rejected messages (reasons of REJECTED), each before the accepted sample at its
@@ -337,6 +442,21 @@ class _Windows:
     def add(self, taken: _Taken, residual: np.ndarray) -> list[tuple[int, HealthStatus]]:
         """Reports (stamp ns, status) of the windows these samples (all taken out of the
         matcher, the compared ones' `residual` beside them) close."""
+        reports = []
+        start = k = 0  # into the samples, the compared ones
+        for run in np.unique(taken.run).tolist():
+            stop = start + int((taken.run[start:] == run).sum())  # runs rise
+            part = taken.select(slice(start, stop))
+            n = int((part.why == "").sum())
+            if run != self._run:
+                reports += self._close(CUT_BY_JUMP)
+                self._origin, self._run = None, run
+            reports += self._add_run(part, residual[k : k + n])
+            start, k = stop, k + n
+        return reports
+
+    def _add_run(self, taken: _Taken, residual: np.ndarray) -> list[tuple[int, HealthStatus]]:
+        """`add` of samples of the run the windows are in."""
         if not taken.t.shape[0]:
             return []
         compared = taken.why == ""
@@ -388,7 +508,7 @@ class _Windows:
         as a check passed."""
         if self._window is not None:
             self._attribute(np.iinfo(np.int64).max, self._window.problems)
-        reports = self._close(final=True)
+        reports = self._close(CUT_BY_END)
         if reports or self._judged or not counts["received"]:
             return reports
         missed = ", ".join(f"{k} {v}" for k, v in not_compared(counts).items() if v)
@@ -401,7 +521,9 @@ class _Windows:
         values = {f"body_{k}": str(v) for k, v in counts.items()}
         return [(stamp_ns, HealthStatus(NAME, WARN, message, values))]
 
-    def _close(self, final: bool = False) -> list[tuple[int, HealthStatus]]:
+    def _close(self, cut: str = "") -> list[tuple[int, HealthStatus]]:
+        """The window open closed by the next beginning, or cut short (`cut`: `CUT_BY_END`,
+        `CUT_BY_JUMP`; judged if it spans half a window, else its messages said with the next)."""
         window, self._window = self._window, None
         if window is None:
             return []
@@ -411,7 +533,7 @@ class _Windows:
         ns, t, measured, residual, present = (
             np.concatenate(a) for a in zip(*window.chunks, strict=True)
         )
-        short = final and t[-1] - t[0] < 0.5 * self._sensor.window_s
+        short = bool(cut) and t[-1] - t[0] < 0.5 * self._sensor.window_s
         if present.sum(axis=0).max() < MIN_SAMPLES or short:
             self._carried.update(window.problems)  # too short to judge: said with the next
             return []
@@ -423,20 +545,21 @@ class _Windows:
         figures = agreement(t, measured, residual, self._sensor, present)
         span = (float(t[-1] - t[0]), int(t.shape[0]))
         status = window_status(figures, self._sensor, span, problems)
-        if final:
-            status.message += " (the last window, closed by the end of the stream)"
+        status.values[f"body_{RESETS}"] = str(self._run)
+        if cut:
+            status.message += f" ({cut})"
         self._judged = True
         return [(int(ns[-1]), status)]
 
 
 class _Refusals:
     """Windows of body_sensor.window_s of the body messages' own stamps (a grid from the first
-    message with one; a message without, or stamped behind, counts in the window the stream
-    is in): each in which messages came and none was accepted is reported, when the next
-    begins."""
+    message with one, and afresh from one stamped more than `back_ns` before the latest; a
+    message without, or stamped behind, counts in the window the stream is in): each in which
+    messages came and none was accepted is reported, when the next begins."""
 
-    def __init__(self, sensor: BodySensor) -> None:
-        self._sensor = sensor
+    def __init__(self, sensor: BodySensor, back_ns: int) -> None:
+        self._sensor, self._back_ns = sensor, back_ns
         self._window_ns = sensor.window_s * 1e9
         self._origin: int | None = None
         self._index = 0
@@ -447,17 +570,14 @@ class _Refusals:
     def add(self, stamps_ns: np.ndarray, why: np.ndarray) -> list[tuple[int, HealthStatus]]:
         """Reports (stamp ns, status) of the windows these screened messages (stamps, and
         why each was rejected, '' where not) close."""
-        stamped = stamps_ns > 0
-        if self._origin is None and stamped.any():
-            self._origin = int(stamps_ns[stamped][0])
-        if self._origin is None:
-            index = np.zeros(stamps_ns.shape[0], np.int64)
-        else:
-            raw = np.floor((stamps_ns - self._origin) / self._window_ns).astype(np.int64)
-            index = np.maximum.accumulate(np.where(stamped, raw, self._index))
         reports = []
-        for i, reason, ns in zip(index.tolist(), why, stamps_ns.tolist(), strict=True):
-            if i > self._index:
+        for reason, ns in zip(why, stamps_ns.tolist(), strict=True):
+            if ns > 0 and (self._origin is None or ns < self._last_ns - self._back_ns):
+                if self._origin is not None:  # jumped back: the window ends, a grid afresh
+                    reports += self._close(self._last_ns)
+                self._origin, self._index, self._last_ns = ns, 0, ns
+            i = math.floor((ns - self._origin) / self._window_ns) if ns > 0 else 0
+            if self._origin is not None and i > self._index:
                 reports += self._close(self._last_ns)  # the latest stamp in the window
                 self._index = i
             if reason:
@@ -517,9 +637,12 @@ class BodyCheck:
     def __init__(self, scene: Scene, sensor: BodySensor) -> None:
         self.sensor = sensor
         self.counts: Counter[str] = Counter({f"rejected_{r}": 0 for r in REJECTED})
-        self.counts.update(dict.fromkeys(UNPROVIDED, 0))
+        self.counts.update(dict.fromkeys((*UNPROVIDED, RESETS), 0))
+        self._back_ns = round(scene.input.back_jump_reset_s * 1e9)
         self.last_ns = 0
         """The last accepted body stamp, ns (0: none yet)."""
+        self._last_row_t = -np.inf
+        """The stamp of the twin's last row, s."""
         self.seen_ns = 0
         """The latest stamp of any body message screened, ns (0: none with a stamp)."""
         self._accepted_screened = 0
@@ -535,7 +658,7 @@ class BodyCheck:
         self._lead = _Lead(predict)
         self._matcher = _Matcher(sensor.lag_s, scene.input.max_gap_s, self.counts)
         self._windows = _Windows(sensor, self.counts)
-        self._refusals = _Refusals(sensor)
+        self._refusals = _Refusals(sensor, self._back_ns)
 
     def screen(
         self,
@@ -551,7 +674,9 @@ class BodyCheck:
         provided is not read), a frame_id other than body_sensor.frame_id ("": any), both its
         acceleration and its rate marked not provided (REP-145: to be disregarded; a sample
         that provides one is compared on it), a stamp not after every one accepted before
-        it."""
+        it, unless it is more than input.back_jump_reset_s before them (the body stream's run
+        restarts, as the twin does where the deck's stamps jump back so: counted
+        reset_stamp_jumped_back)."""
         expected = self.sensor.frame_id
         accel, rate = provided(measured[:, :3], measured[:, 3:], unprovided)
         marked = np.zeros((stamps_ns.shape[0], 2), bool) if unprovided is None else unprovided
@@ -567,7 +692,9 @@ class BodyCheck:
         for reason, bad in reasons.items():
             why[bad & (why == "")] = reason
         keep = why == ""
-        why[keep & ~rising(stamps_ns, keep, self.last_ns)] = "stamp_back"
+        taken, jumped = rising_or_back(stamps_ns, keep, self.last_ns, self._back_ns)
+        why[keep & ~taken] = "stamp_back"
+        self.counts[RESETS] += int(jumped.sum())
         keep = why == ""
         if keep.any():
             self.last_ns = int(stamps_ns[keep][-1])
@@ -602,7 +729,15 @@ class BodyCheck:
     ) -> BodyComparison:
         """The twin's published rows: stamps (s), pose rows, wrenches and the foundation's
         rate (rad/s, F) at each."""
-        self._matcher.add_predictions(*self._lead.add(_Rows(t, pose, wrenches, rate)))
+        rows = _Rows(t, pose, wrenches, rate)
+        back = set(np.flatnonzero(t < np.concatenate([[self._last_row_t], t[:-1]])).tolist())
+        if t.shape[0]:
+            self._last_row_t = float(t[-1])
+        for start, stop in pairwise([*sorted({0, *back}), t.shape[0]]):
+            if start in back:  # the twin restarted (its stamps jumped back): its run ended
+                self._matcher.add_predictions(*self._lead.finish())
+                self._matcher.restart_rows()
+            self._matcher.add_predictions(*self._lead.add(rows.part(start, stop)))
         return self._compared()
 
     def add_body(

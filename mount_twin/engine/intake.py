@@ -200,9 +200,35 @@ def rising(stamps: np.ndarray, keep: np.ndarray, last: int) -> np.ndarray:
     """Of the samples `keep` marks, those (bool mask) whose integer stamp is after `last` and
     after every kept stamp before it (one going back is not after the others either, so the
     running maximum over all kept ones is the same as over the rising ones)."""
+    return keep & (stamps > _latest_before(stamps, keep, last))
+
+
+def _latest_before(stamps: np.ndarray, keep: np.ndarray, last: int) -> np.ndarray:
+    """Per sample, the latest of `last` and the stamps `keep` marks before it."""
     kept = np.where(keep, stamps, np.iinfo(np.int64).min)
-    before = np.maximum.accumulate(np.concatenate([[last], kept]))[:-1]
-    return keep & (stamps > before)
+    return np.maximum.accumulate(np.concatenate([[last], kept]))[:-1]
+
+
+def rising_or_back(
+    stamps: np.ndarray, keep: np.ndarray, last: int, reset: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """`rising`, except that a kept stamp more than `reset` before `last` and every kept stamp
+    before it starts afresh, as a stamp jumping back by more than input.back_jump_reset_s
+    restarts the twin (`stamp_verdict`'s JUMPED_BACK: a bag played with --loop): (taken, of
+    them those that jumped back) bool masks (`last`, `reset` and the stamps in one unit)."""
+    taken = np.zeros(stamps.shape[0], bool)
+    jumped = np.zeros(stamps.shape[0], bool)
+    start = 0
+    while True:
+        part, kept = stamps[start:], keep[start:]
+        before = _latest_before(part, kept, last)
+        back = np.flatnonzero(kept & (part < before - reset))
+        stop = int(back[0]) if back.shape[0] else part.shape[0]
+        taken[start : start + stop] = (kept & (part > before))[:stop]
+        if not back.shape[0]:
+            return taken, jumped
+        taken[start + stop] = jumped[start + stop] = True
+        last, start = int(part[stop]), start + stop + 1
 
 
 def runs(verdicts: list[str], start: int, stop: int) -> list[Run]:
