@@ -38,7 +38,7 @@ from mount_twin.engine.batch import (
     MountEvent,
     OutputBatch,
 )
-from mount_twin.engine.body_check import UNPROVIDED, not_compared
+from mount_twin.engine.body_check import RESETS, UNPROVIDED, not_compared
 from mount_twin.engine.estimate import NOT_INTEGRATED, ErrorEstimate
 from mount_twin.engine.health import (
     EVENTS_KEY,
@@ -274,10 +274,12 @@ class ReplaySummary:
         if any(marked.values()):  # which readings it was compared on, and the marks
             on = " (" + ", ".join(f"{f.replace('_', ' ')} on {n}" for f, n in fields.items())
             on += f"; marked not provided: {intake.counted_text(marked, 'unprovided_')})"
+        jumps = c.get(RESETS, 0)
+        restarted = f"; its stamps jumped back {jumps}×, the comparison restarted" if jumps else ""
         return [
             f"  body IMU {self.body_topic}: {c['received']} received, {compared} compared with "
-            f"the twin{on}, not compared: {intake.counted_text(not_compared(c))} (its "
-            f"agreement: {BODY_STATUS} below)"
+            f"the twin{on}, not compared: {intake.counted_text(not_compared(c))}{restarted} "
+            f"(its agreement: {BODY_STATUS} below)"
         ]
 
     def to_dict(self) -> dict[str, object]:

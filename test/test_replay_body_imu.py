@@ -287,3 +287,35 @@ def test_the_body_imu_comparison_is_exported_and_plotted(tmp_path: Path) -> None
             "wz_rad_s",
         ]
         assert len(lines) == 1 + compared
+
+
+def test_a_bag_played_in_a_loop_is_compared_on_every_loop(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A recording of `ros2 bag play --loop`: both streams' header stamps jump back 6 s after
+    the first 6 s (log times rising). The twin restarted, the body check did not: every body
+    message of the second loop was rejected stamp_back. Now the body comparison restarts with
+    the twin: the second loop's windows read the first's figures, and the restart is counted
+    (the summary's line and JSON, the windows' values)."""
+    streams = _streams()
+    loops = [(t, s + k * 6_005_000_000, r) for k in (0, 1) for t in streams for s, r in streams[t]]
+    with OutputBag(tmp_path / "looped", {"/deck/imu": IMU, BODY_TOPIC: IMU}) as bag:
+        bag.write(sorted(loops, key=lambda m: m[1]))
+    code, summary = _replay(tmp_path, "looped")
+    assert code == 0
+    counts = summary["body_sensor"]["counts"]
+    assert counts["received"] == counts["accepted"] == 2400
+    assert counts["rejected_stamp_back"] == 0 and counts["reset_stamp_jumped_back"] == 1
+    assert counts["compared"] + counts["unanswered"] == 2400 and counts["compared"] > 2350
+    said = capsys.readouterr().out
+    assert "; its stamps jumped back 1×, the comparison restarted (its agreement: " in said
+    raws = [raw for _, raw in read_raw(tmp_path / "out_looped")["/diagnostics"]]
+    reset = "body_reset_stamp_jumped_back"  # the loop, in the order of stamps
+    windows = sorted(statuses_named(raws, NAME), key=lambda w: (w[3][reset], w[0]))
+    assert len(windows) == 6  # of 2 s over each loop's 6 s
+    assert [v[reset] for *_, v in windows] == ["0"] * 3 + ["1"] * 3
+    for (_, level, _, first), (_, again, _, second) in zip(windows[:3], windows[3:], strict=True):
+        assert again == level == OK
+        assert {k: v for k, v in second.items() if k != reset} == {
+            k: v for k, v in first.items() if k != reset
+        }

@@ -234,7 +234,8 @@ class _Matcher:
     twin restarts where its rows' stamps go back (`_Lead` finishes the run before), the body
     stream where its stamps jump back (`BodyCheck.screen`), and the n-th run of the body
     stream is matched with the n-th run of the twin's. A body sample past the last row of a
-    run the twin has ended is in_gap; one of a run the twin never had rows in, before_twin."""
+    run the twin has ended is unanswered, as one past the stream's last row is (the two
+    recorders never stop together); one of a run the twin never had a row in, before_twin."""
 
     def __init__(self, lag_s: float, max_gap_s: float, problems: Counter[str]) -> None:
         self._lag, self._max_gap, self._problems = lag_s, max_gap_s, problems
@@ -307,7 +308,7 @@ class _Matcher:
             covered = done + int((tau[done:stop] <= series.t[-1]).sum())  # accepted stamps rise
             self._match(series, tau[done:covered], why[done:covered], pred[done:covered])
             if ended:
-                why[covered:stop] = "in_gap"  # the twin restarted before them
+                why[covered:stop] = "unanswered"  # the twin restarted before them
                 covered = stop
             done = covered
             if done < stop:
@@ -319,7 +320,7 @@ class _Matcher:
         self._body = [rest] if left and not final else []
         first = self.taken
         self.taken += done + (left if final else 0)
-        for reason in ("before_twin", "late", "in_gap"):
+        for reason in ("before_twin", "late", "in_gap", "unanswered"):
             self._problems[reason] += int((why[:done] == reason).sum())
         self._forget()
         return _Taken(
@@ -407,7 +408,8 @@ CUT_BY_JUMP = "the last window before the body IMU's stamps jumped back"
 """How a window cut short is said (`_Windows._close`)."""
 LOOSE = ("dropped_waiting", "unanswered")
 """Not compared for the stream's sake, not at a place in it (held too long, or left at its
-end): reported in the window judged next."""
+end): reported in the window judged next (unanswered at the end of a run the twin restarted
+after: at its place)."""
 
 
 class _Windows:
@@ -442,6 +444,8 @@ class _Windows:
     def add(self, taken: _Taken, residual: np.ndarray) -> list[tuple[int, HealthStatus]]:
         """Reports (stamp ns, status) of the windows these samples (all taken out of the
         matcher, the compared ones' `residual` beside them) close."""
+        for key in LOOSE:  # those at a place: said there
+            self._loose_reported[key] += int((taken.why == key).sum())
         reports = []
         start = k = 0  # into the samples, the compared ones
         for run in np.unique(taken.run).tolist():
