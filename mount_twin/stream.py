@@ -272,9 +272,10 @@ class TwinStream:
         """The body IMU's raw messages (sensor_msgs/Imu): the prediction and residual at each
         sample the twin has answered, and the windows judged (none without a body_sensor).
         A message that cannot be compared is counted (BodyCheck.counts) and skipped: not
-        valid CDR, an unset or pre-1970 stamp, a stamp not after the last, a value not
-        finite, a header.frame_id other than body_sensor.frame_id, both readings marked not
-        provided (REP-145; one marked so, the sample is compared on the other)."""
+        valid CDR, an unset or pre-1970 stamp, a stamp not after the last (one more than
+        input.back_jump_reset_s before it restarts the comparison), a value not finite, a
+        header.frame_id other than body_sensor.frame_id, both readings marked not provided
+        (REP-145; one marked so, the sample is compared on the other)."""
         if self.body is None:
             return []
         decoded = decode_inputs(raws, IMU)

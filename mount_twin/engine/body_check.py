@@ -20,6 +20,12 @@ batched, and whichever of the two streams comes first (live = replay), within `R
    with fewer than `agreement.MIN_SAMPLES` samples providing either field is judged with the
    next. Each counts the body messages not compared in it by their place in the body stream.
 
+Where the twin restarts because the deck's stamps jumped back (more than
+input.back_jump_reset_s: a bag played with --loop), its rows' stamps go back: the stages
+restart with it, the body stream at its own jump back (`BodyCheck.screen`), each of its runs
+matched with the twin's of the same rank (`_Matcher`), the window open at the jump closed as
+the stream's last is.
+
 Beside them, `_Refusals` watches the body messages themselves, in windows of the same length
 on their own stamps: a window in which every message was rejected (another frame_id, …) is a
 WARN when the next begins, so that a body IMU the twin never takes shows live, not only at
