@@ -619,3 +619,26 @@ def test_stamps_jumping_back_restart_the_comparison_in_any_batching() -> None:
         nrms = [float(values[f"nrms_broadband_{a}"]) for a in ("fx", "fy", "fz", "wx", "wy")]
         assert max(nrms) < 1e-6, values
         assert values["samples"] == str(1000)
+
+
+def test_a_body_imu_whose_every_message_is_rejected_is_reported_after_a_jump_back() -> None:
+    """Every body message of another frame_id, both streams' stamps jumping back 8 s at 6 s:
+    the windows of the body's own stamps stayed in the one open at the jump (5–10 s) until the
+    stamps passed 10 s again, so nothing more was said. Now the jump ends that window (5–6 s,
+    said) and a grid starts afresh from the first message after it (-2–3 s, said when 3–4 s
+    begins), the same in any batching."""
+    scene, deck = _pump(frame_id="pump_imu"), _deck(12.0)
+    ns = _stamps(deck) - np.where(deck.t >= 6.0, 8_000_000_000, 0)
+    body = _body_raws(ns, np.zeros((ns.shape[0], 6)), "other_imu")
+    deck_raws = [r for _, r in imu_messages(ns, deck.accel, deck.gyro, "deck_imu")]
+    runs = {}
+    for chunk in (1, 7, len(body)):
+        stream, out = TwinStream(scene), []
+        for k in range(0, len(body), chunk):
+            out += stream.process(deck_raws[k : k + chunk])
+            out += stream.process_body(body[k : k + chunk])
+        runs[chunk] = _windows(out)
+    assert runs[1] == runs[7] == runs[len(body)]
+    counted = [int(values["body_rejected_wrong_frame_id"]) for _, _, values in runs[1]]
+    assert counted == [1000, 200, 1000]  # 0–5 s, 5–6 s, -2–3 s at 200 Hz
+    assert all(level == WARN for level, _, _ in runs[1])
