@@ -738,7 +738,8 @@ class BodyCheck:
         self, t: np.ndarray, pose: np.ndarray, wrenches: np.ndarray, rate: np.ndarray
     ) -> BodyComparison:
         """The twin's published rows: stamps (s), pose rows, wrenches and the foundation's
-        rate (rad/s, F) at each."""
+        rate (rad/s, F) at each; a row stamped before the one before it starts a new run of
+        the twin (a restart where the deck's stamps jumped back)."""
         rows = _Rows(t, pose, wrenches, rate)
         back = set(np.flatnonzero(t < np.concatenate([[self._last_row_t], t[:-1]])).tolist())
         if t.shape[0]:
