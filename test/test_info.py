@@ -7,11 +7,12 @@ from pathlib import Path
 
 import pytest
 from io_helpers import CONFIG, ROOT
+from rosbags.rosbag2 import StoragePlugin, Writer
 
 from mount_twin.cli import main
 from mount_twin.io.bag import OutputBag
-from mount_twin.io.bag_info import bag_info
-from mount_twin.io.messages import IMU
+from mount_twin.io.bag_info import _bytes_text, bag_info
+from mount_twin.io.messages import IMU, TYPESTORE
 
 
 def test_a_bag_lists_its_topics_types_and_counts(capsys: pytest.CaptureFixture[str]) -> None:
@@ -104,3 +105,38 @@ def test_a_bags_start_is_printed_to_the_nanosecond_it_has(
     capsys.readouterr()
     assert main(["info", str(bag)]) == 0
     assert "start:     1432235498.025043042 s (log time)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("plugin", "storage", "suffix"),
+    [(StoragePlugin.SQLITE3, "sqlite3", ".db3"), (StoragePlugin.MCAP, "mcap", ".mcap")],
+)
+def test_a_bag_shows_its_files_size_storage_and_end_like_ros2_bag_info(
+    tmp_path: Path, plugin: StoragePlugin, storage: str, suffix: str
+) -> None:
+    """`ros2 bag info` prints Files, Bag size, Storage id, Start and End; info printed none
+    of files, size, storage or end. Three String messages at stamps chosen here."""
+    bag = tmp_path / "rec"
+    stamps = [5_000_000_000, 5_250_000_001, 7_000_000_123]
+    string = "std_msgs/msg/String"
+    with Writer(bag, version=9, storage_plugin=plugin) as writer:
+        conn = writer.add_connection("/chatter", string, typestore=TYPESTORE)
+        for ns in stamps:
+            msg = TYPESTORE.types[string](data="x")
+            writer.write(conn, ns, TYPESTORE.serialize_cdr(msg, string))
+    (file,) = [f for f in bag.iterdir() if f.suffix == suffix]
+    size = file.stat().st_size
+    text = bag_info(bag).text()
+    assert f"files:     {file.name}\n" in text
+    assert f"storage:   {storage}\n" in text
+    assert f"({size} B)" in text or f"size:      {size} B" in text
+    assert "start:     5.000000000 s (log time)" in text
+    assert "end:       7.000000123 s (log time)" in text
+    assert "duration:  2.000000 s" in text
+    assert re.search(r"^  /chatter  std_msgs/msg/String +3$", text, re.MULTILINE)
+
+
+def test_a_bag_size_is_given_in_binary_units() -> None:
+    """`ros2 bag info` gives the size in KiB/MiB; 3 MiB + 512 KiB is 3.5 MiB."""
+    assert _bytes_text(3 * 2**20 + 2**19) == f"3.5 MiB ({3 * 2**20 + 2**19} B)"
+    assert _bytes_text(1023) == "1023 B"

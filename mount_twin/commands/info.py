@@ -10,7 +10,10 @@ if TYPE_CHECKING:
     from mount_twin.scene.description import Scene
 
 NAME = "info"
-HELP = "show a bag's topics (like `ros2 bag info`) or a scene's body, mounts, input and outputs"
+HELP = (
+    "show a bag's files, storage, span and topics (like `ros2 bag info`), or a scene's body, "
+    "mounts, input and outputs"
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -82,7 +82,7 @@ class InputBag:
         try:
             self._reader = _open_reader(reader_paths(self.path))
         except Exception as err:
-            files = _storage_files(self.path)
+            files = storage_files(self.path)
             if not files:
                 raise _not_a_bag(self.path, err) from err
             try:  # the storage files of a directory without (a readable) metadata.yaml
@@ -181,7 +181,7 @@ class InputBag:
         """The topic's log times and raw messages in log-time order, in batches: a chunk's from
         a bag of one plain mcap file (`io.mcap_reader`), one at a time from rosbags
         otherwise."""
-        files = _storage_files(self.path)
+        files = storage_files(self.path)
         if not self.ros1 and len(files) == 1 and files[0].suffix == ".mcap":
             with suppress(ValueError, struct.error, UnicodeDecodeError, OSError):
                 plain = plain_messages(files[0], self.topic)
@@ -194,7 +194,7 @@ class InputBag:
         the order rosbags read them in) that the mcap files hold before a damage found record
         by record (rosbags reads an mcap chunk whole, so a damaged record loses the chunk's
         messages before it), or None if no damage is found that way."""
-        files = [f for f in _storage_files(self.path) if f.suffix == ".mcap"]
+        files = [f for f in storage_files(self.path) if f.suffix == ".mcap"]
         found = _salvage(files, self.topic)
         if not found.damage or len(found.messages) <= read:
             return None
@@ -242,7 +242,7 @@ def reader_paths(path: Path) -> list[Path]:
     directory whose name ends in .bag (`ros2 bag record -o run.bag` makes one), its storage
     files: AnyReader takes any name ending in .bag for a ROS 1 file ("Is a directory")."""
     if path.suffix == ".bag" and path.is_dir():
-        return _storage_files(path) or [path]
+        return storage_files(path) or [path]
     return [path]
 
 
@@ -266,8 +266,10 @@ def _up_to(log_time_ns: int | None) -> str:
 
 CHUNK_MAX_BYTES = 32 << 20
 """Most bytes of raw messages in one chunk (2000 Imu messages with short frame ids: 0.7 MB)."""
-STORAGE_SUFFIXES = (".mcap", ".db3")
-"""rosbag2 storage files that can be read without the bag's metadata.yaml."""
+STORAGE_IDS = {".mcap": "mcap", ".db3": "sqlite3"}
+"""rosbag2 storage files that can be read without the bag's metadata.yaml, by suffix: their
+storage identifier (metadata.yaml's `storage_identifier`, `ros2 bag info`'s "Storage id")."""
+STORAGE_SUFFIXES = tuple(STORAGE_IDS)
 
 
 def _pieces(
@@ -286,7 +288,7 @@ def _pieces(
     return pending[at:]
 
 
-def _storage_files(path: Path) -> list[Path]:
+def storage_files(path: Path) -> list[Path]:
     """The rosbag2 storage files of the bag at `path` (itself, if it is one) in recording order:
     rosbag2 numbers split files NAME_0, NAME_1, ..."""
     if path.is_dir():
