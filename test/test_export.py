@@ -13,7 +13,8 @@ import pytest
 from io_helpers import CONFIG, ROOT, read_bag
 
 from mount_twin.cli import main
-from mount_twin.io.output_tables import Table, events_of
+from mount_twin.commands import export
+from mount_twin.io.output_tables import Table, events_of, table_names
 from mount_twin.replay import replay
 from mount_twin.scene import load_scene_file
 
@@ -331,3 +332,23 @@ def test_decimated_peaks_are_said_to_be_an_upper_bound_and_are_one(tmp_path: Pat
     )
     for name, peak in full.peaks.items():
         assert (decimated.peaks[name] >= peak).all()
+
+
+def test_export_help_names_every_table_it_writes(
+    replayed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The help listed pose, angles, wrenches and diagnostics, not events.csv nor the body
+    IMU's tables (written with a body_sensor: test_replay_body_imu)."""
+    with pytest.raises(SystemExit):
+        main(["export", "--help"])
+    helped = " ".join(capsys.readouterr().out.split())
+    for name in ("pose", "angles", "mount_<mount>", "diagnostics", "events"):
+        assert name in helped
+    for name in ("body_imu_predicted", "body_imu_residual"):
+        assert name in helped
+    assert main(["export", str(replayed), "--csv", str(tmp_path)]) == 0
+    written = {p.stem for p in tmp_path.iterdir()}
+    assert "events" in written
+    for stem in written:
+        assert (stem if not stem.startswith("mount_") else "mount_<mount>") in helped
+    assert list(export.TABLES) == table_names()

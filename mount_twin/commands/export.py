@@ -6,7 +6,18 @@ import argparse
 from pathlib import Path
 
 NAME = "export"
-HELP = "write an output bag's pose, angles, mount wrenches and diagnostics as CSV (or Parquet)"
+TABLES = (
+    "pose",
+    "angles",
+    "mount_<mount>",
+    "body_imu_predicted",
+    "body_imu_residual",
+    "diagnostics",
+    "events",
+)
+"""The tables export can write (`io.output_tables.table_names`: a test holds them equal; it is
+not imported to build the command line)."""
+HELP = f"write an output bag's tables as CSV (or Parquet), each it holds of: {', '.join(TABLES)}"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

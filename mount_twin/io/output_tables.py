@@ -25,11 +25,19 @@ from mount_twin.engine.health import INPUT, INTEGRATION
 from mount_twin.errors import BagError
 from mount_twin.io.bag import reader_paths
 from mount_twin.io.bag_info import require_existing
-from mount_twin.io.messages import DIAGNOSTICS, OUTPUTS, TYPESTORE, Readback, output_table
+from mount_twin.io.messages import (
+    BODY_READBACKS,
+    DIAGNOSTICS,
+    OUTPUTS,
+    TYPESTORE,
+    Readback,
+    output_table,
+)
 from mount_twin.kinds.events import EVENT_IS_ERROR
 from mount_twin.textfiles import replacing_all
 
 LEVELS = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
+DIAGNOSTICS_TABLE, EVENTS_TABLE = "diagnostics", "events"
 EVENT = re.compile(r"(\w+) ×(\d+) \(first (\d+\.\d+) s, \|F\| max ([\d.e+-]+) N\)")
 """An event group in a mount status message (engine.health._events_text)."""
 
@@ -60,7 +68,7 @@ def read_output_bag(path: str | Path) -> list[Table]:
             tables_of: dict[int, tuple[str, Readback | None]] = {}
             for c in reader.connections:
                 if c.msgtype == DIAGNOSTICS:
-                    tables_of[c.id] = ("diagnostics", None)
+                    tables_of[c.id] = (DIAGNOSTICS_TABLE, None)
                 elif (found := output_table(c.topic, c.msgtype)) is not None:
                     tables_of[c.id] = found
                 else:
@@ -105,6 +113,14 @@ def read_output_bag(path: str | Path) -> list[Table]:
         if output is None:
             tables.append(events_table(tables[-1], origin))
     return tables
+
+
+def table_names() -> list[str]:
+    """Every table `read_output_bag` can return, in its order; `<mount>` stands for each
+    mount's name (`export --help` lists them: a test holds its list equal)."""
+    readbacks = (*OUTPUTS, *BODY_READBACKS)
+    named = [r.table.format(mount="<mount>") for r in readbacks if r.table is not None]
+    return [*named, DIAGNOSTICS_TABLE, EVENTS_TABLE]
 
 
 def _rank(msgtype: str, topic: str) -> int:
@@ -185,7 +201,7 @@ def events_table(diagnostics: Table, origin_ns: int) -> Table:
     events = events_of(diagnostics, origin_ns)
     first_ns = np.array([origin_ns + round(e.t_s * 1e9) for e in events], dtype=np.int64)
     return Table(
-        "events",
+        EVENTS_TABLE,
         {
             "stamp_ns": first_ns,
             "t_s": np.array([e.t_s for e in events]),
