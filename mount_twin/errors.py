@@ -8,13 +8,14 @@ class MountTwinError(Exception):
 
 
 class SceneError(MountTwinError):
-    """A scene or parameter set is invalid; the message names the source and key path."""
+    """A scene or parameter set is invalid; the message names the source and key path, or the
+    source alone where the error is the file's as a whole (`path` "": unreadable, not YAML)."""
 
     def __init__(self, source: str, path: str, msg: str) -> None:
         self.source = source
         self.path = path
         self.message = msg
-        super().__init__(f"{source}: {path}: {msg}")
+        super().__init__(f"{source}: {path}: {msg}" if path else f"{source}: {msg}")
 
 
 class ModelError(MountTwinError):

@@ -230,7 +230,7 @@ def test_replay_with_a_bad_scene_path_exits_2_naming_it(
     )
     assert rc == 2
     err = capsys.readouterr().err
-    assert err.startswith(f"mount-twin: error: {missing}: <file>: cannot read")
+    assert err.startswith(f"mount-twin: error: {missing}: cannot read")
     assert not (tmp_path / "out").exists()
 
 

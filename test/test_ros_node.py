@@ -521,7 +521,7 @@ def test_parameters_are_all_set_described_and_read_only(tmp_path: Path) -> None:
             "batch_perod_s: unknown parameter (known: ageing, batch_period_s, body,",
         ),
         ([], "mount_names: required parameter is missing"),
-        (["-p", "scene_file:=/nonexistent.yaml"], "/nonexistent.yaml: <file>: cannot read"),
+        (["-p", "scene_file:=/nonexistent.yaml"], "/nonexistent.yaml: cannot read"),
         (["-p", "input.topic:=/deck//imu"], "input.topic: '/deck//imu' is not a ROS topic name"),
         (["-p", "batch_period_s:=-1.0"], "batch_period_s: must be in [0.0, 1.0]"),
         (["-p", "input_queue_depth:=10.5"], "input_queue_depth: expected an integer, got 10.5"),
@@ -542,7 +542,7 @@ def test_parameters_are_all_set_described_and_read_only(tmp_path: Path) -> None:
         # arguments" first, and its message ended in C source positions
         (
             ["--params-file", "/nonexistent.yaml"],
-            "/nonexistent.yaml: <file>: cannot read: No such file or directory",
+            "/nonexistent.yaml: cannot read: No such file or directory",
         ),
         (
             ["--params-file", str(GENSET)],  # a scene file where a params file goes
@@ -628,7 +628,7 @@ def test_a_params_file_key_given_twice_ends_the_node_naming_the_file_and_lines(
     code = node.wait(60.0)
     assert code == 2, node.stderr
     (line,) = node.stderr.splitlines()
-    assert f"{params}: <file>: line " in line, node.stderr
+    assert f"{params}: line " in line, node.stderr
     assert "key 'mass' given twice in one mapping" in line
 
 

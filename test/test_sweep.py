@@ -114,7 +114,7 @@ def test_a_bad_input_or_scale_fails_at_load_naming_it(
 @pytest.mark.parametrize(
     ("edit", "says"),
     [
-        ((f"base: {PUMP}", "base: /dev/zero"), "/dev/zero: <file>: cannot read: larger than"),
+        ((f"base: {PUMP}", "base: /dev/zero"), "/dev/zero: cannot read: larger than"),
         (
             ("values: [1100.0, -5.0]", "range: {start: 1.0, stop: 2.0, num: 1000000000}"),
             "vary[1].range.num: must be in [1, 100000], got 1000000000",

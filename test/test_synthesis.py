@@ -111,7 +111,7 @@ def test_a_design_spectrum_that_is_no_text_is_an_error_naming_it(
     (mcap,) = (root / "bags" / "ship_motion_1khz").glob("*.mcap")
     long_field = tmp_path / "long_field.csv"
     long_field.write_text("frequency_hz,accel_g\n10," + "9" * 200_000 + "\n", encoding="utf-8")
-    for design, said in ((mcap, "<file>: not UTF-8 text"), (long_field, "not a CSV table")):
+    for design, said in ((mcap, "not UTF-8 text"), (long_field, "not a CSV table")):
         if command == "synthesize":
             args = ["synthesize", "--spectrum", str(design), "-o", str(tmp_path / "out")]
         else:

@@ -118,7 +118,8 @@ class Imported:
 
 
 def _fail(path: Path, where: str, what: str) -> ValueError:
-    return ValueError(f"{path}: {where}: {what}")
+    """A ValueError naming the file, then `where` in it (none: the file as a whole)."""
+    return ValueError(f"{path}: {where}: {what}" if where else f"{path}: {what}")
 
 
 def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Imported:
@@ -130,7 +131,7 @@ def read_recorder_csv(path: str | Path, fmt: CsvFormat = CsvFormat()) -> Importe
         if line.strip() and not line.lstrip().startswith("#")
     ]
     if not lines:
-        raise _fail(path, "<file>", "no header line (the file is empty or only comments)")
+        raise _fail(path, "", "no header line (the file is empty or only comments)")
     header_row, header = lines[0]
     delimiter = fmt.delimiter or next((d for d in (";", "\t", ",") if d in header), None)
     names, header_units = _header(header, delimiter)
@@ -312,16 +313,16 @@ def check_increasing(path: Path, t: np.ndarray, rows: list[int], column: str) ->
 
 def read_csv_text(path: Path) -> str:
     """The file's text (at most CSV_MAX_BYTES, UTF-8, a byte-order mark dropped); errors name
-    the file (ValueError "FILE: <file>: ..."). Any CSV a command reads is read so."""
+    the file (ValueError "FILE: ..."). Any CSV a command reads is read so."""
     try:
         # utf-8-sig drops a byte-order mark
         return read_limited(path, CSV_MAX_BYTES, "CSV_MAX_BYTES", "utf-8-sig")
     except FileTooLargeError as err:
-        raise _fail(path, "<file>", f"cannot read: {err}") from err
+        raise _fail(path, "", f"cannot read: {err}") from err
     except OSError as err:
-        raise _fail(path, "<file>", f"cannot read: {err.strerror}") from err
+        raise _fail(path, "", f"cannot read: {err.strerror}") from err
     except UnicodeDecodeError as err:
-        raise _fail(path, "<file>", f"not UTF-8 text ({err.reason} at byte {err.start})") from err
+        raise _fail(path, "", f"not UTF-8 text ({err.reason} at byte {err.start})") from err
 
 
 def _unit(quantity: str, header_unit: str, overrides: dict[str, str]) -> str:

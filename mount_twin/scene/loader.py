@@ -72,16 +72,16 @@ def read_scene_yaml(path: str | Path) -> Any:
     try:
         return load_yaml(read_limited(path, SCENE_MAX_BYTES, "SCENE_MAX_BYTES"))
     except FileTooLargeError as err:
-        raise SceneError(str(path), "<file>", f"cannot read: {err}") from err
+        raise SceneError(str(path), "", f"cannot read: {err}") from err
     except OSError as err:
-        raise SceneError(str(path), "<file>", f"cannot read: {err.strerror}") from err
+        raise SceneError(str(path), "", f"cannot read: {err.strerror}") from err
     except UnicodeDecodeError as err:
         msg = f"not UTF-8 text: byte {err.start} is {err.object[err.start : err.start + 1]!r}"
-        raise SceneError(str(path), "<file>", msg) from err
+        raise SceneError(str(path), "", msg) from err
     except SceneYamlError as err:
-        raise SceneError(str(path), "<file>", str(err)) from err
+        raise SceneError(str(path), "", str(err)) from err
     except yaml.YAMLError as err:
-        raise SceneError(str(path), "<file>", f"not valid YAML: {_yaml_problem(err)}") from err
+        raise SceneError(str(path), "", f"not valid YAML: {_yaml_problem(err)}") from err
 
 
 def _yaml_problem(err: yaml.YAMLError) -> str:
@@ -172,7 +172,7 @@ def refuse_parameters_file(data: Any, source: str) -> None:
                 "(--ros-args --params-file), not a scene file: give a scene YAML such as "
                 "config/pump_8_mounts.scene.yaml, which the node also reads (-p scene_file:=PATH)"
             )
-            raise SceneError(source, "<file>", msg)
+            raise SceneError(source, "", msg)
 
 
 def _body(r: Reader) -> Body:
