@@ -35,7 +35,8 @@ class Command(Protocol):
 
     NAME: str
     HELP: str
-    # optional: STOPS_AT_CHECKPOINTS (bool), STOPPED_OUTPUT (str), read with getattr
+    # optional: EXIT_STATUS (str), STOPS_AT_CHECKPOINTS (bool), STOPPED_OUTPUT (str), read with
+    # getattr
 
     def add_arguments(self, parser: argparse.ArgumentParser) -> None: ...
 
@@ -68,6 +69,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, Command]]:
                 module.NAME,
                 help=module.HELP,
                 description=module.HELP,
+                epilog=exit_statuses(module),
                 formatter_class=DefaultsShown,
             )
         )
@@ -80,6 +82,22 @@ EXIT_DAMAGED, EXIT_SIGINT, EXIT_SIGPIPE, EXIT_SIGTERM = 5, 130, 141, 143
 input damaged part-way (what came before it was processed), 128 + the signal's number when
 stopped by SIGINT (Ctrl-C) or SIGTERM (output bags are finished and marked partial), or when
 the reader of the output closed it (SIGPIPE: `| head`), silently, as a Unix tool is."""
+
+
+EXIT_STATUS = "exit status: 0 done; 2 bad input (the message names the option, file or key)"
+"""The exit statuses of a command that has none of its own (no EXIT_STATUS)."""
+
+
+def exit_statuses(module: Command) -> str:
+    """A command's exit statuses for its --help: its own (its EXIT_STATUS, each code leading a
+    clause after "; "), then those `main` gives every command on a signal."""
+    held = getattr(module, "STOPPED_OUTPUT", "")
+    stopped = f"; on either, -o {held}" if held else ""
+    return (
+        f"{getattr(module, 'EXIT_STATUS', EXIT_STATUS)}; {EXIT_SIGINT} SIGINT (Ctrl-C); "
+        f"{EXIT_SIGTERM} SIGTERM{stopped}; {EXIT_SIGPIPE} SIGPIPE: the reader of the output "
+        "closed it (`| head`), quietly"
+    )
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from io_helpers import run_python
 
-from mount_twin.cli import main
+from mount_twin.cli import build_parser, main
 
 ROOT = Path(__file__).resolve().parents[1]
 HEAVY = re.compile(r"\|\s*(mount_twin\._core|numpy|scipy|rosbags|yaml)(\.|$)")
@@ -139,3 +139,33 @@ def test_a_reader_that_closes_the_pipe_ends_the_command_quietly_with_141() -> No
     err = child.stderr.read().decode()
     assert child.wait(timeout=60) == 141
     assert err == ""
+
+
+SIGNALS = {130, 141, 143}
+"""SIGINT, SIGPIPE, SIGTERM: 128 + the signal's number (signal(7)), from any command."""
+OWN_EXIT_STATUSES = {
+    "replay": {0, 2, 3, 4, 5, 6},
+    "demo": {0, 2, 3, 5, 6},
+    "report": {0, 2, 3, 4, 6},
+    "srs": {0, 2, 4},
+    "qualify": {0, 2, 4, 6},
+    "calibrate": {0, 2},
+    "track": {0, 1, 2, 4},
+    "sweep": {0, 2, 6},
+}
+"""What each command's `run` can return (read from its code: `verdict`, `run_exit_status`, the
+verdict maps; 5 where an input bag is replayed up to a damage); any other command 0 or 2."""
+
+
+@pytest.mark.parametrize("command", sorted(build_parser()[1]))
+def test_every_commands_help_lists_the_exit_statuses_it_returns(
+    command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`replay --help` left out 141 (a reader that closed the pipe: the test above), and most
+    commands listed no exit status, or not the signals'."""
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    helped = " ".join(capsys.readouterr().out.split())
+    listed = helped[helped.index("exit status: ") :]
+    codes = {int(c) for c in re.findall(r"(?:^exit status: |; )(\d+) ", listed)}
+    assert codes == OWN_EXIT_STATUSES.get(command, {0, 2}) | SIGNALS

@@ -7,7 +7,9 @@ the standard library and `mount_twin.errors`: numpy, scipy and rosbags take a se
 - ``NAME``: the subcommand, as typed;
 - ``HELP``: one line for `mount-twin --help`;
 - ``add_arguments(parser)``: its options;
-- ``run(args) -> int``: carry it out, importing what it needs; returns the exit status.
+- ``run(args) -> int``: carry it out, importing what it needs; returns the exit status;
+- optionally ``EXIT_STATUS``: the statuses `run` returns, "exit status: 0 ...; 2 ...", each code
+  leading a clause (default: 0 and 2); `--help` lists them with the signals' (mount_twin.cli).
 
 A new command is a new module here and one entry in `COMMANDS`.
 """

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
 
 NAME = "calibrate"
 HELP = "fit mount stiffness and damping scales, the body IMU's yaw and lag to a recorded pair"
+EXIT_STATUS = "exit status: 0 calibrated; 2 bad input (a refused parameter is said, not an error)"
 
 
 FITTED = ("stiffness", "damping", "yaw", "lag")
@@ -46,9 +47,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "mounts apart",
     )
     parser.add_argument("--plot", metavar="PNG", help="the body record against the prediction")
-    parser.epilog = (
-        "exit status: 0 calibrated; 2 bad input (a refused parameter is said, not an error)"
-    )
 
 
 FOUNDATION_KEYS = ("input.topic", "input.msg_type")

@@ -13,6 +13,12 @@ HELP = "replay the bundled bag through the bundled default scene"
 STOPS_AT_CHECKPOINTS = True
 STOPPED_OUTPUT = REPLAY_STOPPED_OUTPUT
 """A stopped demo's output bag is the replay's: finished and marked partial."""
+EXIT_STATUS = (
+    "exit status: 0 done; 2 bad input or a failed write (the message names the file); 3 no "
+    "input sample accepted; 5 the bundled bag damaged part-way (the output bag is finished and "
+    "marked partial); 6 FAILED: the integration failed at least once (the summary says why)"
+)
+"""The replay's statuses (`replay.EXIT_STATUS`) but 4: the demo never fails on diagnostics."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -27,6 +27,10 @@ if TYPE_CHECKING:
 NAME = "qualify"
 HELP = "qualify the scene's machine against a shock spectrum: synthesise, run, judge each mount"
 EXIT_FAIL, EXIT_FAILED = 4, 6
+EXIT_STATUS = (
+    f"exit status: 0 PASS; 2 bad input; {EXIT_FAIL} FAIL (a criterion broken in some run); "
+    f"{EXIT_FAILED} FAILED (an integration failed: not judged)"
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -54,10 +58,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="local Dask workers (default: one per core, at most one per input; 1: no cluster)",
     )
     parser.add_argument("--scheduler", help="a Dask scheduler's address (bags on shared disk)")
-    parser.epilog = (
-        f"exit status: 0 PASS; 2 bad input; {EXIT_FAIL} FAIL (a criterion broken in some run); "
-        f"{EXIT_FAILED} FAILED (an integration failed: not judged)"
-    )
 
 
 def plan_of(args: argparse.Namespace) -> Plan:

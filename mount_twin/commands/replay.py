@@ -25,20 +25,18 @@ EXIT_STATUS = (
     "exit status: 0 done; 2 bad input or configuration, or a failed write (the message names "
     "the file; a run that failed too, 3 to 6, says so before it); 3 no input sample "
     "accepted, or too few to start the twin (initial_state.gravity_samples); 4 diagnostics "
-    "reached --fail-on; 6 FAILED: the "
-    "integration failed at least once (the summary says how often and why), whatever "
-    "--fail-on says: after a failure the twin restarts at an equilibrium or stops following, "
-    "so its figures are no longer the motion the record drove; 5 input bag "
-    "damaged part-way (the messages before the damage are replayed; a failure before it is "
-    "said on stderr too); 130 SIGINT (Ctrl-C), 143 "
-    "SIGTERM. On 5, 130 and 143 the output bag is finished and marked partial in its metadata "
-    "(custom_data mount_twin.partial: why, and up to which stamp)."
+    "reached --fail-on; 5 input bag damaged part-way: the messages before the damage are "
+    "replayed (a failure before it is said on stderr too), and the output bag is finished and "
+    "marked partial in its metadata (custom_data mount_twin.partial: why, and up to which "
+    "stamp); 6 FAILED: the integration failed at least once (the summary says how often and "
+    "why), whatever --fail-on says: after a failure the twin restarts at an equilibrium or "
+    "stops following, so its figures are no longer the motion the record drove"
 )
-"""The replay's exit statuses (mount_twin.cli's EXIT_* and `verdict`), in its --help."""
+"""The replay's own exit statuses (`verdict`, mount_twin.cli's EXIT_DAMAGED; the cli adds the
+signals'), in its --help."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.epilog = EXIT_STATUS
     parser.add_argument(
         "input",
         help="input bag: a rosbag2 directory (mcap or sqlite3), one .mcap or .db3 file, or a "

@@ -31,7 +31,6 @@ EXIT_STATUS = (
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.epilog = EXIT_STATUS
     parser.add_argument("bag", help="output bag of `mount-twin replay`")
     parser.add_argument("-o", "--output", default="report.html", help="HTML file to write")
     parser.add_argument("--scene", help="the replay's scene YAML (mount kinds, names)")

@@ -126,7 +126,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "a PASS/FAIL line, exit 4 on FAIL",
     )
     parser.add_argument("--json", metavar="FILE", help="the spectra, margins and verdict as JSON")
-    parser.epilog = EXIT_STATUS
 
 
 def add_axis_argument(parser: argparse.ArgumentParser, what: str) -> None:

@@ -15,13 +15,11 @@ STOPPED_OUTPUT = (
 """What the results CSV holds when a signal stopped the sweep (mount_twin.cli)."""
 EXIT_STATUS = (
     "exit status: 0 every case ran (whatever its verdict); 6 a case FAILED (its row and the "
-    "summary say why); 2 bad input or configuration; 130 SIGINT (Ctrl-C), 143 SIGTERM: the "
-    "results CSV holds the cases finished before the stop, and a rerun runs the rest"
+    "summary say why); 2 bad input or configuration"
 )
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.epilog = EXIT_STATUS
     parser.add_argument("sweep", help="sweep YAML (see mount_twin.sweeps.spec)")
     parser.add_argument(
         "-o", "--output", required=True, help="results CSV (appended; a rerun skips done cases)"

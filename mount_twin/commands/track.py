@@ -14,6 +14,7 @@ import argparse
 NAME = "track"
 HELP = "re-fit the mounts' stiffness and damping window by window: flag mounts that age"
 EXIT_WARN, EXIT_ERROR = 1, 4
+EXIT_STATUS = f"exit status: 0 OK; {EXIT_WARN} WARN; 2 bad input; {EXIT_ERROR} ERROR"
 BANDS = {"warn": (0.85, 1.15), "error": (0.75, 1.25)}
 """--warn and --error's defaults: `analysis.ageing.Band`'s (a test holds them equal; numpy is
 not imported to build the command line)."""
@@ -42,7 +43,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
             help=f"scale band outside which a window is judged {level.upper()} (default: the "
             f"scene's ageing.{level}, else {band[0]:g} {band[1]:g})",
         )
-    parser.epilog = f"exit status: 0 OK; {EXIT_WARN} WARN; {EXIT_ERROR} ERROR; 2 bad input"
 
 
 def run(args: argparse.Namespace) -> int:
