@@ -141,6 +141,13 @@ def test_a_reader_that_closes_the_pipe_ends_the_command_quietly_with_141() -> No
     assert err == ""
 
 
+def _help(capsys: pytest.CaptureFixture[str], *args: str) -> str:
+    """`mount-twin ARGS --help`, its whitespace made single spaces."""
+    with pytest.raises(SystemExit):
+        main([*args, "--help"])
+    return " ".join(capsys.readouterr().out.split())
+
+
 SIGNALS = {130, 141, 143}
 """SIGINT, SIGPIPE, SIGTERM: 128 + the signal's number (signal(7)), from any command."""
 OWN_EXIT_STATUSES = {
@@ -163,9 +170,27 @@ def test_every_commands_help_lists_the_exit_statuses_it_returns(
 ) -> None:
     """`replay --help` left out 141 (a reader that closed the pipe: the test above), and most
     commands listed no exit status, or not the signals'."""
-    with pytest.raises(SystemExit):
-        main([command, "--help"])
-    helped = " ".join(capsys.readouterr().out.split())
+    helped = _help(capsys, command)
     listed = helped[helped.index("exit status: ") :]
     codes = {int(c) for c in re.findall(r"(?:^exit status: |; )(\d+) ", listed)}
     assert codes == OWN_EXIT_STATUSES.get(command, {0, 2}) | SIGNALS
+
+
+def test_qualify_help_shows_the_synthesis_defaults(capsys: pytest.CaptureFixture[str]) -> None:
+    """qualify parses --seeds, --rate, --axis to None (to see one given beside --plan), so its
+    help showed no default; they are synthesize's: 3 seeds at 20 kHz along z."""
+    helped = _help(capsys, "qualify")
+    for said in ("one per seed (default: 3;", "Hz (default: 20000.0;", "shock (default: z;"):
+        assert said in helped
+    synth = _help(capsys, "synthesize")
+    for said in ("one per seed (default: 3)", "Hz (default: 20000.0)", "shock (default: z)"):
+        assert said in synth
+
+
+def test_import_csv_offset_help_says_the_stamp_in_one_formula(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """It read "added to the time in ns (the CSV's time cells exactly as written) for the
+    header stamp, ns (a stamp of 0 means unset in ROS)"."""
+    helped = _help(capsys, "import-csv")
+    assert "--offset NS header stamp = NS + the CSV's time, ns" in helped

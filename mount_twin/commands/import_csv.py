@@ -23,9 +23,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--offset",
         type=int,
+        metavar="NS",
         default=DEFAULT_START_NS,
-        help="added to the time in ns (the CSV's time cells exactly as written) for the header "
-        "stamp, ns (a stamp of 0 means unset in ROS)",
+        help="header stamp = NS + the CSV's time, ns (0 if that time is since the epoch)",
     )
     parser.add_argument("--delimiter", help="between cells (default: sniffed from the header)")
     parser.add_argument("--decimal", choices=[".", ","], help="decimal mark (default: sniffed)")

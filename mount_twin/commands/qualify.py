@@ -45,6 +45,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_synthesis_arguments(alone, required=False)
     defaults = {k: v for k, v in vars(alone.parse_args([])).items() if k != "spectrum"}
     parser.set_defaults(synthesis_defaults=defaults, **dict.fromkeys(defaults))
+    for action in parser._actions:  # their help says the defaults set aside
+        if defaults.get(action.dest) is not None and "default" not in (action.help or ""):
+            action.help = (
+                f"{action.help} (default: {defaults[action.dest]}; with --plan, the plan's)"
+            )
     parser.add_argument(
         "--plan",
         metavar="YAML",
