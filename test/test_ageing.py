@@ -15,7 +15,7 @@ from scipy.signal import butter, sosfiltfilt
 
 from mount_twin import load_scene_file
 from mount_twin.analysis import calibration as cal_mod
-from mount_twin.analysis.ageing import track
+from mount_twin.analysis.ageing import WindowFit, track, window_table
 from mount_twin.cli import main
 from mount_twin.errors import SceneError
 from mount_twin.io.signals import Signal, ship_motion
@@ -225,3 +225,21 @@ def test_a_part_window_left_at_the_end_is_said(
         "mount-twin: warning: the last 8 s of the records, 32–40 s, are in no window: less "
         "than one of 30 s\n"
     )
+
+
+def test_the_window_table_heading_stands_over_its_columns_and_refusals_read_plainly() -> None:
+    """The heading was "window s" padded to 19 over spans right-aligned in 9 + 1 + 9, with
+    no heading over why; a refusal read "damping refused (1σ is 80 % of its value (the
+    record barely moves it))", parentheses nested."""
+    why = "1σ is 80% of its value (the record barely moves it)"
+    fits = [
+        WindowFit(2.0, 32.0, {"stiffness": 1.0}, {"stiffness": 0.004}),
+        WindowFit(1022.0, 1052.0, {}, {}, {"damping": why}, "WARN", "not judged"),
+    ]
+    head, ok, warn = window_table(fits)
+    assert head.split() == ["window", "s", "level", "fit:", "scale", "×value", "±", "1σ", "why"]
+    assert head.index("s ") + 1 == ok.index("32.0") + 4 == warn.index("1052.0") + 6
+    assert head.index("level") == ok.index("OK") == warn.index("WARN")
+    assert head.index("fit:") == ok.index("stiffness") == warn.index("-  ")
+    assert head.index("why") == warn.index("not judged")
+    assert warn.endswith(f"not judged; damping refused: {why}")

@@ -166,12 +166,27 @@ def left_over(fits: list[WindowFit], foundation: Signal, body: Signal, window_s:
     )
 
 
+WINDOW_HEADING = ("window s", "level", "fit: scale ×value ± 1σ", "why")
+"""`window_table`'s column headings."""
+
+
 def window_table(fits: list[WindowFit]) -> list[str]:
-    """One line per window: span, values ± 1σ, refused, level and why."""
-    lines = []
-    for f in fits:
-        shown = ", ".join(f"{n} ×{v:.3f} ± {f.sigma[n]:.2g}" for n, v in f.values.items())
-        refused = "; ".join(f"{n} refused ({w})" for n, w in f.refused.items())
-        tail = " — ".join(x for x in (refused, f.why) if x)
-        lines.append(f"{f.start_s:9.1f}–{f.end_s:<9.1f} {f.level:<5} {shown}  {tail}".rstrip())
-    return lines
+    """A heading, then one line per window: span, level, values ± 1σ, then why it is not OK
+    and each refused parameter ("NAME refused: WHY"); each column as wide as its widest
+    cell, the span right-aligned."""
+    rows = [
+        (
+            f"{f.start_s:.1f}–{f.end_s:.1f}",
+            f.level,
+            ", ".join(f"{n} ×{v:.3f} ± {f.sigma[n]:.2g}" for n, v in f.values.items()) or "-",
+            "; ".join(
+                [*filter(None, [f.why]), *(f"{n} refused: {w}" for n, w in f.refused.items())]
+            ),
+        )
+        for f in fits
+    ]
+    widths = [max(len(r[k]) for r in (WINDOW_HEADING, *rows)) for k in range(3)]
+    return [
+        f"{span:>{widths[0]}}  {level:<{widths[1]}}  {shown:<{widths[2]}}  {why}".rstrip()
+        for span, level, shown, why in (WINDOW_HEADING, *rows)
+    ]

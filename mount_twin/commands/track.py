@@ -58,7 +58,6 @@ def run(args: argparse.Namespace) -> int:
     fit = tuple(args.fit or ageing.fit)
     window = ageing.window_s if args.window is None else args.window  # 0 is refused
     fits = track(scene, foundation, body, window, fit, band)
-    print(f"{'window s':<19} level fit")
     print("\n".join(window_table(fits)))
     if dropped := left_over(fits, foundation, body, window):
         print(f"mount-twin: warning: {dropped}", file=sys.stderr)
