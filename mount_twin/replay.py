@@ -211,11 +211,17 @@ class ReplaySummary:
             lines.append(f"  motion and mount loads: none, {why_none(self.followed_nothing())}")
         else:
             lines += self._figure_lines()
-        lines.append(f"  mount events: {len(self.events) or 'none'}")
+        lines.append(
+            f"  mount events: {len(self.events)} (times from the first output, as the plots'; "
+            "stamp: the header stamp)"
+            if self.events
+            else "  mount events: none"
+        )
         for (mount, event), same in _grouped(self.events).items():
             lines.append(
                 f"    {same[0].level:5} {mount:>12} {event:<16} ×{len(same):<5} "
-                f"first {self.origin_s + same[0].stamp:.6f} s  "
+                f"first {same[0].stamp - self.start_s:.6f} s "
+                f"(stamp {self.origin_s + same[0].stamp:.6f} s)  "
                 f"|F| max {max(e.force for e in same):.4g} N"
             )
         lines += self._body_lines()

@@ -231,13 +231,20 @@ def test_a_table_that_is_a_dangling_symlink_makes_no_directory_where_it_points(
     assert sorted(tmp_path.rglob("*")) == [tables, pose]
 
 
-def test_replay_json_summary_times_events_from_the_first_output(tmp_path: Path) -> None:
+def test_replay_summary_times_events_from_the_first_output(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The JSON's events and the printed summary's event lines: time from the first output
+    (the plots' and the report's), with the header stamp beside it (the printed lines gave
+    the stamp alone: "first 1700000000.051878 s")."""
     import json
+    import re
 
     out, summary_file = tmp_path / "g", tmp_path / "g.json"
     args = ["replay", str(ROOT / "bags" / "genset_shock_10khz"), "--scene"]
     args += [str(CONFIG / "genset_bolted_keyed.scene.yaml"), "-o", str(out), "--no-progress"]
     assert main([*args, "--json", str(summary_file)]) == 0
+    printed = capsys.readouterr().out
     doc = json.loads(summary_file.read_text(encoding="utf-8"))
     _, msgs = read_bag(out)
     first = msgs["/mount_twin/pose"][0][1].header.stamp
@@ -245,6 +252,12 @@ def test_replay_json_summary_times_events_from_the_first_output(tmp_path: Path) 
     assert doc["verdict"] == "ERROR" and doc["events"]
     for e in doc["events"]:
         assert e["t_s"] == pytest.approx(e["stamp_s"] - first_s, abs=1e-6)
+    lines = re.findall(r"×\d+ +first (\d+\.\d+) s \(stamp (\d+\.\d+) s\)", printed)
+    assert lines
+    for t, stamp in lines:
+        assert 0.0 <= float(t) < 1.0 and float(t) == pytest.approx(
+            float(stamp) - first_s, abs=2e-6
+        )
     assert doc["counts"]["accepted"] == 2500
     f = max(
         math.hypot(m.wrench.force.x, m.wrench.force.y, m.wrench.force.z)
