@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 from io_helpers import CONFIG, ROOT
-from rosbags.rosbag2 import StoragePlugin, Writer
+from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
 
 from mount_twin.cli import main
 from mount_twin.io.bag import OutputBag
@@ -134,6 +134,24 @@ def test_a_bag_shows_its_files_size_storage_and_end_like_ros2_bag_info(
     assert "end:       7.000000123 s (log time)" in text
     assert "duration:  2.000000 s" in text
     assert re.search(r"^  /chatter  std_msgs/msg/String +3$", text, re.MULTILINE)
+    alone = bag_info(file)  # the storage file given alone: no metadata.yaml to say either
+    assert (alone.files, alone.storage, alone.size) == ([file], storage, size)
+
+
+def test_a_file_compressed_bag_shows_its_metadatas_files_and_storage(tmp_path: Path) -> None:
+    """A bag compressed file by file (`ros2 bag record --compression-mode file`): its files
+    end in .zstd, which no storage suffix matches; its metadata.yaml names them."""
+    bag = tmp_path / "packed"
+    string = "std_msgs/msg/String"
+    writer = Writer(bag, version=9, storage_plugin=StoragePlugin.SQLITE3)
+    writer.set_compression(CompressionMode.FILE, CompressionFormat.ZSTD)
+    with writer:
+        conn = writer.add_connection("/chatter", string, typestore=TYPESTORE)
+        msg = TYPESTORE.serialize_cdr(TYPESTORE.types[string](data="x"), string)
+        writer.write(conn, 5_000_000_000, msg)
+    (packed,) = [f for f in bag.iterdir() if f.name.endswith(".zstd")]
+    info = bag_info(bag)
+    assert (info.files, info.storage, info.size) == ([packed], "sqlite3", packed.stat().st_size)
 
 
 def test_a_bag_size_is_given_in_binary_units() -> None:

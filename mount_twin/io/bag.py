@@ -423,12 +423,26 @@ SCENE_DIGEST_KEY = "mount_twin.scene_sha256"
 def custom_data(path: str | Path) -> dict[str, str]:
     """The custom_data of a bag's metadata.yaml ({} if it has none, or no metadata.yaml: a
     storage file given alone, or a bag a write failure left unfinished)."""
+    custom = bag_metadata(path).get("custom_data") or {}
+    if not isinstance(custom, dict):
+        msg = f"{Path(path) / 'metadata.yaml'}: cannot read the bag's metadata: custom_data is "
+        msg += f"not a mapping: {custom!r}"
+        raise BagError(msg)
+    return {str(k): str(v) for k, v in custom.items()}
+
+
+def bag_metadata(path: str | Path) -> dict[str, Any]:
+    """The rosbag2_bagfile_information of a bag's metadata.yaml ({} if it has no
+    metadata.yaml: a storage file given alone, or a bag a write failure left unfinished);
+    BagError naming the file if it cannot be read."""
     meta = Path(path) / "metadata.yaml"
     if not meta.is_file():
         return {}
     try:
         info = yaml.safe_load(meta.read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
-        return {str(k): str(v) for k, v in (info.get("custom_data") or {}).items()}
+        if not isinstance(info, dict):
+            raise TypeError(f"rosbag2_bagfile_information is not a mapping: {info!r}")
+        return info
     except (
         OSError,
         UnicodeDecodeError,

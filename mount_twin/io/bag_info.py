@@ -9,7 +9,7 @@ from pathlib import Path
 from rosbags.highlevel import AnyReader
 
 from mount_twin.errors import BagError
-from mount_twin.io.bag import STORAGE_IDS, reader_paths, storage_files
+from mount_twin.io.bag import STORAGE_IDS, bag_metadata, reader_paths, storage_files
 from mount_twin.io.messages import TYPESTORE
 
 
@@ -91,10 +91,13 @@ def _bytes_text(n: int) -> str:
 
 
 def _storage(path: Path) -> tuple[list[Path], str]:
-    """The bag's files and storage identifier: rosbag2's storage files (mcap or sqlite3), or a
-    ROS 1 .bag file."""
-    files = storage_files(path)
-    if files:
+    """The bag's files and storage identifier, as its metadata.yaml gives them (a compressed
+    bag's files too), else as the storage files' suffixes say (mcap or sqlite3), else a ROS 1
+    .bag file."""
+    meta = bag_metadata(path) if path.is_dir() else {}
+    if storage := meta.get("storage_identifier"):
+        return [path / f for f in meta.get("relative_file_paths") or []], str(storage)
+    if files := storage_files(path):
         return files, "/".join(sorted({STORAGE_IDS[f.suffix] for f in files}))
     return ([path], ROS1_STORAGE) if path.is_file() else ([], "unknown")
 
