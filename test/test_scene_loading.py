@@ -446,7 +446,7 @@ def test_directory_instead_of_scene_file_fails_naming_it(tmp_path: Path) -> None
 def test_yaml_that_is_not_a_mapping_fails_at_the_top(tmp_path: Path, text: str) -> None:
     path = tmp_path / "odd.scene.yaml"
     path.write_text(text, encoding="utf-8")
-    with pytest.raises(SceneError, match=re.escape(f"{path}: <top>: expected a mapping")):
+    with pytest.raises(SceneError, match=re.escape(f"{path}: expected a mapping at the top")):
         load_scene_file(path)
 
 
@@ -523,7 +523,7 @@ def test_a_mount_namespace_that_is_a_value_fails_naming_it() -> None:
 
 def test_a_parameter_set_that_is_no_mapping_fails_naming_it() -> None:
     """An AttributeError's traceback: 'list' object has no attribute 'get'."""
-    with pytest.raises(SceneError, match=re.escape("P: <top>: expected a mapping of parameter")):
+    with pytest.raises(SceneError, match=re.escape("P: expected a mapping of parameter")):
         scene_from_params([1], "P")  # type: ignore[arg-type]
 
 

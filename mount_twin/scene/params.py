@@ -211,7 +211,7 @@ def effective_parameters(flat: Mapping[str, Any], source: str) -> Effective:
     """
     if not isinstance(flat, Mapping):
         raise SceneError(
-            source, "<top>", f"expected a mapping of parameter names to values, got {shown(flat)}"
+            source, "", f"expected a mapping of parameter names to values, got {shown(flat)}"
         )
     scene_file = flat.get("scene_file", "")
     if not isinstance(scene_file, str):

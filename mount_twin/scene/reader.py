@@ -94,7 +94,8 @@ class Reader:
         record: Used | None = None,
     ) -> None:
         if not isinstance(data, Mapping):
-            raise SceneError(source, path or "<top>", f"expected a mapping, got {shown(data)}")
+            top = "" if path else " at the top level"
+            raise SceneError(source, path, f"expected a mapping{top}, got {shown(data)}")
         self.data = data
         self.source = source
         self.path = path
