@@ -17,7 +17,7 @@ TABLES = (
 )
 """The tables export can write (`io.output_tables.table_names`: a test holds them equal; it is
 not imported to build the command line)."""
-HELP = f"write an output bag's tables as CSV (or Parquet), each it holds of: {', '.join(TABLES)}"
+HELP = f"write the tables an output bag holds as CSV (or Parquet): {', '.join(TABLES)}"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
