@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import os
 import signal
 from collections.abc import Callable, Iterator
@@ -25,9 +26,17 @@ def dask_client(scheduler: str | None = None, workers: int | None = None) -> Ite
             n = (os.cpu_count() or 1) if workers is None else workers
             with _workers_deaf_to_ctrl_c():
                 # ":0": its dashboard on a free port (None still took 8787, warning "Port 8787
-                # is already in use" beside a second sweep or any other Dask cluster)
+                # is already in use" beside a second sweep or any other Dask cluster);
+                # silence_logs: the workers' own warnings, at ERROR: a Ctrl-C closing the
+                # cluster under running cases printed "Async instruction ... ended with
+                # CancelledError" per case beside the command's line (a case that fails is
+                # its own FAILED row, a lost worker the command's error)
                 cluster = LocalCluster(
-                    n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0"
+                    n_workers=n,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=":0",
+                    silence_logs=logging.ERROR,
                 )
         client = Client(scheduler or cluster)
         yield client
