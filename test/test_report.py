@@ -17,7 +17,7 @@ from io_helpers import CONFIG, ROOT, read_bag, read_raw, unprovided_imu
 
 from mount_twin.analysis.report import events_of
 from mount_twin.cli import main
-from mount_twin.io.output_tables import input_values, read_output_bag
+from mount_twin.io.output_tables import Table, input_values, read_output_bag
 from mount_twin.replay import replay
 from mount_twin.scene.loader import load_scene_file
 
@@ -1016,3 +1016,104 @@ def test_the_readings_rejections_are_those_the_twin_counts(gyro_filter: str) -> 
         == ["non_finite", "non_finite"] + ["no_acceleration"] * 2
     )
     assert reasons[40] == ("no_angular_velocity" if gyro_filter != "ignore" else "")
+
+
+def _figure() -> Any:
+    """A matplotlib Figure on the Agg canvas, drawn into as the page's `png` does."""
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=(10, 4))
+
+
+def _legend_texts(ax: Any) -> list[str]:
+    legend = ax.get_legend()
+    return [] if legend is None else [t.get_text() for t in legend.get_texts()]
+
+
+def test_the_srs_figures_legend_gives_the_damping() -> None:
+    """The spectra's damping was in the section heading only: a figure copied out of the page
+    did not say which ζ its curves are of. Its legend says ζ."""
+    from mount_twin.analysis.report import _draw_srs
+    from mount_twin.analysis.srs import srs
+
+    rate, freqs = 1000.0, np.array([10.0, 20.0, 40.0])
+    pulse = np.sin(np.pi * np.arange(20) / 20.0)  # a 20 ms half-sine
+    spectra = {"z": srs(pulse, rate, freqs, 0.1)}
+    fig = _figure()
+    _draw_srs(fig, spectra, 0.1, None)
+    legend = fig.axes[0].get_legend()
+    assert legend.get_title().get_text() == "ζ = 0.1 (10 %)"
+
+
+def test_the_event_windows_line_colours_are_named_in_a_legend() -> None:
+    """The window around the first event marks WARN events orange and ERROR events red, and
+    nothing said so. A legend names each level drawn, in its line's colour."""
+    from matplotlib.colors import to_rgba
+
+    from mount_twin.analysis.report import _draw_forces
+    from mount_twin.io.output_tables import Event
+
+    t = np.linspace(0.0, 0.2, 201)
+    zero = np.zeros_like(t)
+    mount = Table(
+        "a",
+        {"stamp_ns": (t * 1e9).astype(np.int64), "t_s": t, "fx_N": zero, "fy_N": zero, "fz_N": t},
+    )
+    events = [
+        Event("a", "joint_slipped", 1, 0.10, 1.0, "WARN"),
+        Event("a", "joint_opened", 1, 0.12, 1.0, "ERROR"),
+    ]
+    fig = _figure()
+    _draw_forces(fig, {"a": mount}, events, (0.05, 0.15))
+    named = {}
+    for ax in fig.axes:
+        legend = ax.get_legend()
+        if legend is not None:
+            for text, handle in zip(legend.get_texts(), legend.legend_handles, strict=True):
+                named[text.get_text()] = to_rgba(handle.get_color(), 1.0)
+    vertical = {  # the events' lines: x constant, by their time
+        float(line.get_xdata()[0]): to_rgba(line.get_color(), 1.0)
+        for line in fig.axes[0].get_lines()
+        if len(set(line.get_xdata())) == 1
+    }
+    assert vertical[0.10] == named["WARN event"]
+    assert vertical[0.12] == named["ERROR event"]
+    assert named["WARN event"] != named["ERROR event"]
+
+
+def test_the_utilisation_legend_is_beside_the_plot_not_over_its_rating_line() -> None:
+    """Inside the axes the legend sat over the "rated (1)" line and the peaks near it. It is
+    beside them: its box and the plotting area's do not meet."""
+    from mount_twin.analysis.report import _draw_utilisation
+
+    t = np.array([0.1, 0.2, 0.3])
+    utilisation = {f"m{k}": (t, np.array([0.95, 1.0, 0.9])) for k in range(8)}
+    fig = _figure()
+    _draw_utilisation(fig, utilisation, {}, 0.1)
+    fig.tight_layout()
+    fig.canvas.draw()
+    (ax,) = fig.axes
+    legend = ax.get_legend().get_window_extent()
+    assert "rated (1)" in _legend_texts(ax)
+    assert not legend.overlaps(ax.get_window_extent())
+
+
+def test_the_attitude_is_drawn_in_radians_as_the_bag_records_it() -> None:
+    """The guide gives angles in rad everywhere, the bag and the JSON too; the report drew the
+    attitude in degrees. Its axis is in rad, each curve the bag's angle as it is."""
+    from mount_twin.analysis.report import _draw_response
+
+    t = np.linspace(0.0, 1.0, 11)
+    stamps = (t * 1e9).astype(np.int64)
+    pose = {"stamp_ns": stamps, "t_s": t, **{f"{a}_m": 0.0 * t for a in "xyz"}}
+    angles = {"stamp_ns": stamps, "t_s": t}
+    angles |= {f"{n}_rad": k * 0.01 * t for k, n in enumerate(("alpha", "gamma", "delta"), 1)}
+    fig = _figure()
+    tables = {"pose": Table("pose", pose), "angles": Table("angles", angles)}
+    _draw_response(fig, tables, None, 0, "")
+    attitude = fig.axes[-1]
+    assert attitude.get_ylabel() == "attitude [rad]"
+    for line in attitude.get_lines():
+        assert np.array_equal(line.get_ydata(), angles[f"{line.get_label()}_rad"])

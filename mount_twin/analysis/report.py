@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import html
 import json
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -71,6 +72,8 @@ if TYPE_CHECKING:
 
 WINDOW_S = 0.05
 """Half-width of the zoom around the first event, s."""
+LEGEND_ROWS = 16
+"""The most rows of the utilisation figure's legend before it takes another column."""
 
 
 def utilisation_of(diagnostics: Table) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -241,7 +244,12 @@ def _srs_section(
     spectrum (Hz, g), the design on the plot, and for each of `design_axes` its margin (dB) in
     the table and its PASS/FAIL line (`analysis.design_margin`, as `mount-twin srs --design
     --axis`). Also whether every axis judged passed (None: nothing judged)."""
-    from mount_twin.analysis.srs import gravity_offset, octave_frequencies, srs
+    from mount_twin.analysis.srs import (
+        DEFAULT_DAMPING,
+        gravity_offset,
+        octave_frequencies,
+        srs,
+    )
 
     t = (stamps_ns - stamps_ns[0]) * 1e-9
     rate = (len(t) - 1) / float(t[-1]) if len(t) > 1 and t[-1] > 0 else 0.0
@@ -249,7 +257,10 @@ def _srs_section(
         return [], None
     freqs = octave_frequencies(5.0, min(2000.0, rate / 10.0), 6)
     offset, removed = gravity_offset(t, f)
-    spectra = {axis: srs(f[:, k] - offset[k], rate, freqs, 0.05) for k, axis in enumerate("xyz")}
+    spectra = {
+        axis: srs(f[:, k] - offset[k], rate, freqs, DEFAULT_DAMPING)
+        for k, axis in enumerate("xyz")
+    }
     checks = (
         {
             a: check_design(freqs, spectra[a].maximax / STANDARD_GRAVITY, *design, tolerance_db)
@@ -265,9 +276,10 @@ def _srs_section(
         for a, c in checks.items()
     ]
     sections = [
-        f"<h2>Shock response spectra of the input (ζ = 5 %, {html.escape(removed)} removed)</h2>",
+        f"<h2>Shock response spectra of the input (ζ = {DEFAULT_DAMPING * 100:g} %, "
+        f"{html.escape(removed)} removed)</h2>",
         *verdicts,
-        png(lambda fig: _draw_srs(fig, spectra, design, tuple(checks)), (9, 4.5)),
+        png(lambda fig: _draw_srs(fig, spectra, DEFAULT_DAMPING, design, tuple(checks)), (9, 4.5)),
         html_table(head, _srs_rows(freqs, spectra, checks)),
     ]
     return sections, (all(c.passed for c in checks.values()) if checks else None)
@@ -276,11 +288,13 @@ def _srs_section(
 def _draw_srs(
     fig: Any,
     spectra: dict[str, Spectrum],
+    damping: float,
     design: tuple[list[float], list[float]] | None,
     judged: tuple[str, ...] = (),
 ) -> None:
     """The maximax spectra (g) of the axes with any response, and the design (Hz, g) if any,
-    named with the axes it judges (`judged`), log-log against natural frequency (Hz)."""
+    named with the axes it judges (`judged`), log-log against natural frequency (Hz); the
+    legend gives the oscillators' damping ratio `damping`, as the page's heading does."""
     ax = fig.subplots()
     for axis, s in spectra.items():
         if s.maximax.max() > 0.0:
@@ -291,7 +305,7 @@ def _draw_srs(
     ax.set_ylabel("peak absolute acceleration [g]")
     plain_log_labels(ax, "y")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, title=f"ζ = {damping:g} ({damping * 100:g} %)", title_fontsize=7)
 
 
 def _srs_rows(
@@ -591,7 +605,7 @@ def _draw_response(
     input_name: str,
 ) -> None:
     """The input's specific force (g; with `input_samples`), the CG's displacement from its
-    first published position (mm) and the attitude (deg), against time from the first output
+    first published position (mm) and the attitude (rad), against time from the first output
     (s; it is at `origin_ns`)."""
     n = 3 if input_samples is not None else 2
     axes = fig.subplots(n, 1, sharex=True)
@@ -611,8 +625,8 @@ def _draw_response(
     axes[k].set_ylabel("CG displacement from its\nfirst published position [mm]")
     ang = tables["angles"].columns
     for name in ("alpha", "gamma", "delta"):
-        axes[k + 1].plot(ang["t_s"], np.degrees(ang[f"{name}_rad"]), label=name)
-    axes[k + 1].set_ylabel("attitude [deg]")
+        axes[k + 1].plot(ang["t_s"], ang[f"{name}_rad"], label=name)
+    axes[k + 1].set_ylabel("attitude [rad]")
     axes[-1].set_xlabel("time from the first output [s]")
     for ax in axes:
         ax.grid(True, alpha=0.3)
@@ -626,7 +640,10 @@ def _draw_forces(
     window: tuple[float, float] | None = None,
 ) -> None:
     """Each mount's force components (kN, mount axes) against time from the first output (s):
-    all of it, or within `window` (s) with the events there as lines."""
+    all of it, or within `window` (s) with the events there as lines, coloured by level
+    (EVENT_COLOURS) and named so in a legend."""
+    import matplotlib.lines
+
     axes = fig.subplots(3, 1, sharex=True)
     for name, table in mounts.items():
         c = table.columns
@@ -637,11 +654,37 @@ def _draw_forces(
         axes[i].set_ylabel(f"force along mount {comp} [kN]")
         axes[i].grid(True, alpha=0.3)
     if window is not None:
-        for e in (e for e in events if window[0] <= e.t_s <= window[1]):
+        shown = [e for e in events if window[0] <= e.t_s <= window[1]]
+        for e in shown:
             for ax in axes:
-                ax.axvline(e.t_s, color="red" if e.level == "ERROR" else "orange", alpha=0.4)
+                ax.axvline(e.t_s, color=_event_colour(e.level), alpha=0.4)
+        axes[1].legend(  # what the lines' colours mean, the levels there
+            handles=[
+                matplotlib.lines.Line2D([], [], color=_event_colour(level), alpha=0.4)
+                for level in _levels(shown)
+            ],
+            labels=[f"{level} event" for level in _levels(shown)],
+            fontsize=7,
+            loc="upper right",
+            title="lines",
+            title_fontsize=7,
+        )
     axes[0].legend(fontsize=7, ncol=4, loc="upper right")
     axes[-1].set_xlabel("time from the first output [s]")
+
+
+EVENT_COLOURS = {"ERROR": "red", "WARN": "orange"}
+"""An event's line by its level (any other level: gray)."""
+
+
+def _event_colour(level: str) -> str:
+    return EVENT_COLOURS.get(level, "gray")
+
+
+def _levels(events: list[Event]) -> list[str]:
+    """The levels of `events`, worst first."""
+    rank = {name: k for k, name in enumerate(LEVEL_NAMES)}
+    return sorted({e.level for e in events}, key=lambda v: -rank.get(v, len(rank)))
 
 
 def _forces_sections(mounts: dict[str, Table], events: list[Event]) -> list[str]:
@@ -705,7 +748,13 @@ def _draw_utilisation(
     ax.set_ylabel("peak utilisation of the\ndiagnostics period ending at • [-]")
     ax.set_xlabel("time from the first output [s]")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, ncol=3)
+    # beside the plot, not in it: inside, it covered the rating line and the peaks near it
+    ax.legend(
+        fontsize=7,
+        loc="upper left",
+        bbox_to_anchor=(1.01, 1.0),
+        ncol=math.ceil((len(utilisation) + 1) / LEGEND_ROWS),
+    )
 
 
 def _displacement_line(pose: Table) -> str:
