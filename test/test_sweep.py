@@ -823,3 +823,49 @@ inputs:
     svg = plot_sweep(rows, spec, tmp_path / "sweep.svg").read_text(encoding="utf-8")
     assert "body.mass [kg]" in svg
     assert "dhs mounts[fl].position=[1.0, 0.4, 0.0] m integration.rtol=1e-08" in svg
+
+
+def test_the_plots_legend_shows_each_verdicts_marker(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The title read "markers o OK, s WARN, v ERROR": matplotlib's marker codes, not what a
+    reader sees. Each panel's legend shows the marker drawn for each verdict, by its name."""
+    pytest.importorskip("matplotlib")
+    from mount_twin import figure_files
+
+    drawn: list = []
+    monkeypatch.setattr(figure_files, "save_png", lambda fig, png: drawn.append(fig) or png)
+    spec = load_sweep(_sweep_file(tmp_path, SWEEP.replace("[1100.0, -5.0]", "[1100.0]")))
+    names = [m["name"] for m in spec.base["mounts"]]
+    verdicts = ("OK", "WARN", "ERROR")
+    rows = [
+        {
+            "case": f"c{k}",
+            "input": "dhs",
+            "mounts[*].stiffness (scale)": 0.5 * (k + 1),
+            "body.mass": 1100.0,
+            "verdict": verdict,
+            **{f"peak_force_magnitude_N.{n}": 1000.0 * (k + 1) for n in names},
+            **{f"utilisation.{n}": 0.5 * (k + 1) for n in names},
+        }
+        for k, verdict in enumerate(verdicts)
+    ]
+    plot_sweep(rows, spec, tmp_path / "sweep.png")
+    (fig,) = drawn
+    assert len(fig.axes) == 2
+    for ax in fig.axes:
+        # the marker of each case's point, at its x (the points drawn without a line)
+        marker_at = {
+            float(line.get_xdata()[0]): line.get_marker()
+            for line in ax.get_lines()
+            if len(line.get_xdata()) == 1
+        }
+        legend = ax.get_legend()
+        shown = {
+            text.get_text(): handle.get_marker()
+            for text, handle in zip(legend.get_texts(), legend.legend_handles, strict=True)
+        }
+        for r in rows:
+            assert shown[r["verdict"]] == marker_at[r["mounts[*].stiffness (scale)"]], r
+        assert len({shown[v] for v in verdicts}) == 3
+    assert "markers" not in fig.axes[0].get_title()

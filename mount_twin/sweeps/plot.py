@@ -21,6 +21,8 @@ from mount_twin.sweeps.spec import SweepSpec
 
 MARKS = {"OK": "o", "WARN": "s", "ERROR": "v"}
 """A case's marker by its verdict."""
+OTHER_MARK = "x"
+"""The marker of a case whose verdict MARKS does not name."""
 
 
 Point = tuple[float, float, float, str]
@@ -74,6 +76,12 @@ def trade_off(rows: list[dict[str, Any]], spec: SweepSpec) -> dict[str, list[Poi
     return lines
 
 
+def _verdict_order(verdict: str) -> tuple[int, str]:
+    """A verdict as a sort key: those of MARKS in its order (OK, WARN, ERROR), then any other."""
+    order = list(MARKS)
+    return (order.index(verdict) if verdict in order else len(order), verdict)
+
+
 def _is_number(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
@@ -89,10 +97,11 @@ def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> 
     """Write the plot of `trade_off`: the force above, the utilisation below (its limit, 1,
     dashed; that panel only where a mount is rated); its title counts the FAILED cases left
     out."""
+    import matplotlib.lines
+
     from mount_twin.figure_files import pyplot, save_png
 
     plt = pyplot()
-
     lines = trade_off(rows, spec)
     rated = any(not math.isnan(p[2]) for points in lines.values() for p in points)
     fig, axes = plt.subplots(2 if rated else 1, 1, figsize=(8, 8 if rated else 5), sharex=True)
@@ -101,7 +110,13 @@ def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> 
         for ax, column in zip(panels, (1, 2), strict=False):
             line = ax.plot([p[0] for p in points], [p[column] for p in points], label=label)[0]
             for p in points:
-                ax.plot(p[0], p[column], MARKS.get(p[3], "x"), color=line.get_color())
+                ax.plot(p[0], p[column], MARKS.get(p[3], OTHER_MARK), color=line.get_color())
+    verdicts = [  # the markers' shapes by verdict, of the verdicts drawn
+        matplotlib.lines.Line2D(
+            [], [], color="0.3", linestyle="", marker=MARKS.get(v, OTHER_MARK), label=v
+        )
+        for v in sorted({p[3] for points in lines.values() for p in points}, key=_verdict_order)
+    ]
     if rated:
         panels[1].axhline(1.0, color="0.4", lw=1, ls="--")
     ylabels = ("largest peak mount force [kN]", "largest utilisation [-]")
@@ -111,7 +126,8 @@ def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> 
         # "1e−6+7.8535"), which reads as 54 kN
         ax.ticklabel_format(axis="y", useOffset=False)
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=7)
+        handles, _ = ax.get_legend_handles_labels()
+        ax.legend(handles=handles + verdicts, fontsize=7)  # the lines, then the markers' shapes
     varied = columns(spec)[2 : 2 + len(spec.variations)]
     xlabel = varied[0] if varied else "case"
     if (unit := column_units(spec).get(xlabel)) is not None:
@@ -121,7 +137,5 @@ def plot_sweep(rows: list[dict[str, Any]], spec: SweepSpec, png: str | Path) -> 
         panels[-1].set_xticks(list(at.values()), list(at), fontsize=8)
     failed = sum(r["verdict"] == FAILED for r in rows)  # no figures to draw
     left_out = f"; {failed} FAILED case{'s' * (failed != 1)} not drawn" if failed else ""
-    panels[0].set_title(
-        f"{Path(spec.source).name}: markers o OK, s WARN, v ERROR{left_out}", fontsize=9
-    )
+    panels[0].set_title(f"{Path(spec.source).name}{left_out}", fontsize=9)
     return save_png(fig, png)
