@@ -8,6 +8,7 @@ import json
 import math
 import re
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -705,3 +706,67 @@ def test_frequencies_given_beside_a_spacing_are_refused_naming_the_options(
     assert said.out == "" and not table.exists()
     assert main(["srs", str(GENSET), "--freqs", "50", "100", "--csv", str(table)]) == 0
     assert [float(r["frequency_hz"]) for r in _rows(table)] == [50.0, 100.0]
+
+
+def _spectra_drawn(
+    monkeypatch: pytest.MonkeyPatch, spectra: dict, unit: str = "m/s²"
+) -> tuple[object, str]:
+    """The figure `srs --plot` draws of `spectra` (values in m/s²), and what it says it left
+    out."""
+    pytest.importorskip("matplotlib")
+    from mount_twin import figure_files
+    from mount_twin.commands.srs import _plot
+
+    drawn: list = []
+    monkeypatch.setattr(figure_files, "save_png", lambda fig, png: drawn.append(fig) or png)
+    clipped = _plot("unused.png", spectra, None, None, "title", 1e9, unit)
+    return drawn[0], clipped
+
+
+def _spectrum(f: np.ndarray, maximax: np.ndarray, residual: np.ndarray) -> Any:
+    from mount_twin.analysis.srs import Spectrum
+
+    return Spectrum(f, maximax, maximax, residual, maximax, maximax, maximax, f > 0.0)
+
+
+def test_the_plots_y_axis_takes_in_every_curve_four_decades_down(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The floor was 1e-3 of the top: the CG's x spectrum, 0.01 g below 15 Hz under a z of
+    75 g, was cut off. Every positive value of every curve drawn is now within the y limits
+    when they span less than DECADES_MAX decades, and nothing is said to be left out."""
+    f = np.array([5.0, 10.0, 100.0, 1000.0])
+    g = 9.80665
+    spectra = {
+        "x": _spectrum(f, g * np.array([0.01, 0.03, 1.0, 2.0]), np.zeros(4)),
+        "z": _spectrum(f, g * np.array([1.5, 5.0, 60.0, 75.0]), np.zeros(4)),
+    }
+    fig, clipped = _spectra_drawn(monkeypatch, spectra)
+    (ax,) = fig.axes
+    low, high = ax.get_ylim()
+    for line in ax.get_lines():
+        y = np.asarray(line.get_ydata(), dtype=float)
+        assert ((y[y > 0.0] >= low) & (y[y > 0.0] <= high)).all(), line.get_label()
+    assert low <= 0.01 and high >= 75.0
+    assert clipped == ""
+
+
+def test_a_residual_at_round_off_is_clipped_and_said_so(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A residual falling to round-off (1e-16 g) would squash the curves into the top: the axis
+    spans at most DECADES_MAX decades under its top, and the plot says which curve goes below
+    it and how far."""
+    from mount_twin.analysis.log_labels import DECADES_MAX
+
+    f = np.array([5.0, 100.0, 1000.0])
+    g = 9.80665
+    spectra = {
+        "z": _spectrum(f, g * np.array([1.0, 50.0, 40.0]), g * np.array([1.0, 1e-3, 1e-16]))
+    }
+    fig, clipped = _spectra_drawn(monkeypatch, spectra)
+    (ax,) = fig.axes
+    low, high = ax.get_ylim()
+    assert high == pytest.approx(100.0)  # twice the top
+    assert low == pytest.approx(100.0 * 10.0**-DECADES_MAX)
+    assert "residual, z down to 1e-16 g" in clipped
+    assert "maximax" not in clipped and "primary" not in clipped
+    assert clipped in ax.get_title().replace("\n", " ")  # the title says so

@@ -248,8 +248,8 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         title = f"SRS of {name}, ζ = {zeta:g}, {removed} taken out"
         band = (low, high) if design is not None else None
-        _plot(args.plot, spectra, design, band, title, ACCURATE_SHARE * rate, unit)
-        print(f"plot: {args.plot}")
+        clipped = _plot(args.plot, spectra, design, band, title, ACCURATE_SHARE * rate, unit)
+        print(f"plot: {args.plot}" + (f" ({clipped})" if clipped else ""))
     return EXIT_OUT_OF_TOLERANCE if any(not c.passed for c in checks.values()) else 0
 
 
@@ -536,11 +536,13 @@ def _plot(
     title: str,
     accurate_hz: float,
     unit: str,
-) -> None:
+) -> str:
     """Maximax, primary and residual of one axis (maximax of each with all) in g (a force's in
-    its `unit`), log-log, against the design spectrum; the frequencies above fs/10 shaded."""
+    its `unit`), log-log, against the design spectrum; the frequencies above fs/10 shaded; the
+    y axis takes in every curve (`fit_log_y`). What it leaves out, in words ("" if nothing)."""
     import textwrap
 
+    from mount_twin.analysis.log_labels import fit_log_y
     from mount_twin.figure_files import pyplot, save_png
     from mount_twin.io.csv_import import G
 
@@ -563,23 +565,22 @@ def _plot(
             ax.loglog(
                 s.frequency_hz, getattr(s, kind) / scale, label=f"{kind}, {axis}", **styles[kind]
             )
-    top = max(float(s.maximax.max()) for s in spectra.values()) / scale
     if design is not None:
         ax.loglog(*design, "k--", label="design")
-        top = max(top, *design[1])
         if band_db is not None:
             low, high = (10.0 ** (db / 20.0) for db in band_db)
             band = f"tolerance {band_db[0]:+g}/{band_db[1]:+g} dB"
             ax.loglog(design[0], [v * low for v in design[1]], "k:", lw=1.0, label=band)
             ax.loglog(design[0], [v * high for v in design[1]], "k:", lw=1.0)
-            top = max(top, max(design[1]) * high)
     f_top = float(max(s.frequency_hz.max() for s in spectra.values()))
     if f_top > accurate_hz:
         ax.axvspan(accurate_hz, f_top, color="0.9", label="f > fs/10: less accurate")
-    ax.set_ylim(top * 1e-3, top * 2.0)  # the residual of a short record falls off to nothing
+    clipped = fit_log_y(ax, "g" if unit == "m/s²" else unit)
     ax.set_xlabel("natural frequency [Hz]")
     ax.set_ylabel(ylabel)
-    ax.set_title(textwrap.fill(title, 90), fontsize=9)  # a long bag or mount name: two lines
+    # a long bag or mount name: two lines; what the y axis leaves out, under it
+    ax.set_title("\n".join(textwrap.wrap(title, 90) + textwrap.wrap(clipped, 90)), fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     save_png(fig, png)
+    return clipped
