@@ -38,7 +38,7 @@ def plot_output_bag(
     if "angles" in tables:
         angles = tables["angles"].columns
         for name in ("alpha", "gamma", "delta"):
-            axes[1].plot(angles["t_s"], np.degrees(angles[f"{name}_rad"]), label=name)
+            axes[1].plot(angles["t_s"], angles[f"{name}_rad"], label=name)
     for name, table in tables.items():
         if name.startswith("mount_"):
             c = table.columns
@@ -74,7 +74,7 @@ def plot_output_bag(
             axes[3].plot(t, twin - twin.mean(), "--", color=colour, lw=0.8, label=f"twin {axis}")
         axes[3].set_ylabel("body IMU specific force\nabout its mean [m/s²]")
     axes[0].set_ylabel("displacement [mm]")
-    axes[1].set_ylabel("angle [deg]")
+    axes[1].set_ylabel("attitude angle [rad]")
     axes[2].set_ylabel("|mount force| [N]")
     axes[-1].set_xlabel("time from first output [s]")
     for ax in axes:

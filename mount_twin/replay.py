@@ -250,7 +250,7 @@ class ReplaySummary:
         lines = [
             f"  max CG displacement from the first published position "
             f"{self.displacement_max_m * 1e3:.3f} mm, max tilt "
-            f"{np.degrees(self.tilt_max_rad):.4f} deg",
+            f"{self.tilt_max_rad:.4g} rad ({np.degrees(self.tilt_max_rad):.4f} deg)",
             f"  peak mount loads ({peak_label(self.decimation)}):",
             f"{'':18}{'|F| [N]':>10} {'|M| [N·m]':>10}",  # over `{name:>12}: ` and the figures
         ]

@@ -626,3 +626,34 @@ def test_a_summary_that_cannot_be_written_hides_not_the_runs_own_failure(
     err = capsys.readouterr().err
     assert f"{own}\n" in err, err
     assert err.endswith(f"mount-twin: error: {FULL}: cannot write: No space left on device\n")
+
+
+def test_the_summary_and_plot_give_the_attitude_in_radians(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Angles are in rad everywhere (the guide, the bag, the JSON's max_tilt_rad), yet the
+    summary printed "max tilt 0.0987 deg" and the replay's plot drew the attitude in degrees.
+    The summary gives the tilt in rad first, degrees beside it, both the output bag's own: the
+    largest angle of the body's z from F's, from its pose quaternions; the plot's attitude axis
+    is in rad, each curve the bag's angle."""
+    pytest.importorskip("matplotlib")
+    from mount_twin import figure_files
+
+    drawn: list = []
+    monkeypatch.setattr(figure_files, "save_png", lambda fig, png: drawn.append(fig) or png)
+    bag, png = ROOT / "bags" / "half_sine_shock_10khz", str(tmp_path / "p.png")
+    code, doc, out = _replay(tmp_path, CONFIG / "pump_8_mounts.scene.yaml", bag, "--plot", png)
+    assert code == 0 and len(drawn) == 1
+    tables = {t.name: t.columns for t in read_output_bag(out)}
+    q = tables["pose"]
+    tilt = float(np.arccos(np.clip(1.0 - 2.0 * (q["qx"] ** 2 + q["qy"] ** 2), -1.0, 1.0)).max())
+    said = re.search(r"max tilt (\S+) rad \((\S+) deg\)", capsys.readouterr().out)
+    assert said is not None
+    assert float(said[1]) == pytest.approx(tilt, rel=1e-3)  # 4 significant figures
+    assert float(said[2]) == pytest.approx(np.degrees(tilt), rel=1e-3)
+    assert doc["max_tilt_rad"] == pytest.approx(tilt, rel=1e-9)
+    attitude = next(ax for ax in drawn[0].axes if "angle" in ax.get_ylabel())
+    assert attitude.get_ylabel().endswith("[rad]")
+    for line in attitude.get_lines():
+        name = str(line.get_label())
+        assert np.array_equal(line.get_ydata(), tables["angles"][f"{name}_rad"]), name
