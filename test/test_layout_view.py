@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -115,3 +116,40 @@ def test_a_shear_keys_line_of_action_is_along_its_stiff_axis_not_z() -> None:
     assert dashed_through(end, 0.0, 0.0) == [(1.0, 0.0)]  # key_y, on the centre line: along y
     assert dashed_through(side, 1.1, 0.0) == [(0.0, 1.0)] * 2  # foot_fl, foot_fr: the bolts
     plt.close(fig)
+
+
+@pytest.mark.parametrize("scene_file", ["pump_8_mounts", "genset_bolted_keyed"])
+def test_no_label_runs_into_another(scene_file: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The pump's side view wrote "F (deck), foundation IMU" across the labels of ml1 and mr1
+    0.3 m on, and the 3-D view its F and IMU labels over each other. In every view, as saved,
+    no two labels' boxes meet."""
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg")
+    from matplotlib.text import Text
+
+    from mount_twin import figure_files
+    from mount_twin.analysis.layout_view import draw_layout
+    from mount_twin.scene import load_scene_file
+
+    saved: list = []
+
+    def keep(fig: Any, png: Any) -> Any:  # as save_png lays the figure out, without the file
+        fig.tight_layout()
+        fig.canvas.draw()
+        saved.append(fig)
+        return png
+
+    monkeypatch.setattr(figure_files, "save_png", keep)
+    draw_layout(load_scene_file(CONFIG / f"{scene_file}.scene.yaml"), "unused.png")
+    (fig,) = saved
+    renderer = fig.canvas.get_renderer()
+    for ax in fig.axes:
+        boxes = [
+            (t.get_text(), Text.get_window_extent(t, renderer))  # the text, not its leader
+            for t in ax.texts
+            if t.get_text().strip()
+        ]
+        assert len(boxes) >= 4, ax.get_title()
+        for k, (a, box_a) in enumerate(boxes):
+            for b, box_b in boxes[k + 1 :]:
+                assert not box_a.overlaps(box_b), f"{ax.get_title()}: {a!r} meets {b!r}"

@@ -68,9 +68,10 @@ def draw_layout(scene: Scene, png: str | Path) -> Path:
     ax3 = fig.add_subplot(1, 3, 1, projection="3d")
     views = _Views(ax3, [fig.add_subplot(1, 3, 2 + k) for k in range(2)])
     _draw_scene(views, scene)
-    views.annotate()
     kinds = sorted({m.kind for m in scene.mounts})
     _dress(views, kinds)
+    fig.tight_layout()  # the axes where they are drawn: labels are placed apart on the page
+    views.annotate(fig.canvas.get_renderer())
     fig.suptitle(
         f"{scene.name}: {scene.body.mass:g} kg, {len(scene.mounts)} mounts "
         f"({', '.join(kinds)}), "
@@ -88,6 +89,8 @@ class _Views:
         self.flat = flat
         self.labels: list[dict[tuple[float, float], list[str]]] = [{} for _ in VIEWS]
         """Per 2-D view: the labels of the points at each position (rounded to 1 µm)."""
+        self.labels3: dict[tuple[float, float, float], list[str]] = {}
+        """The 3-D view's, likewise."""
 
     def segment(self, a: np.ndarray, b: np.ndarray, **style: Any) -> None:
         """A line from `a` to `b` in every view."""
@@ -96,12 +99,12 @@ class _Views:
             ax.plot([a[i], b[i]], [a[j], b[j]], **style)
 
     def point(self, p: np.ndarray, label: str, **style: Any) -> None:
-        """A marker at `p` in every view, labelled at once in 3-D and by `annotate` in 2-D."""
+        """A marker at `p` in every view, labelled by `annotate`."""
         self.ax3.scatter(*p, **style)
-        self.ax3.text(*p, f" {label}", fontsize=7)
+        # Points that fall on one another in a view share one label.
+        self.labels3.setdefault((round(p[0], 6), round(p[1], 6), round(p[2], 6)), []).append(label)
         for ax, (_, i, j), named in zip(self.flat, VIEWS, self.labels, strict=True):
             ax.scatter(p[i], p[j], **style)
-            # Points that fall on one another in a view share one label.
             named.setdefault((round(p[i], 6), round(p[j], 6)), []).append(label)
 
     def frame(self, origin: np.ndarray, rot: np.ndarray, length: float, width: float) -> None:
@@ -111,19 +114,66 @@ class _Views:
                 origin, origin + length * rot[:, k], color=AXIS_COLOURS[k], linewidth=width
             )
 
-    def annotate(self) -> None:
-        """The 2-D views' point labels, one per position."""
-        for ax, named in zip(self.flat, self.labels, strict=True):
-            for (u, v), names in named.items():
-                ax.annotate(  # slanted: labels of points side by side do not run together
+    def annotate(self, renderer: Any) -> None:
+        """Every view's point labels, one per position, none on another nor on another point
+        (`_place_apart`); in 3-D at the points' projections onto the page, so call it once the
+        views' limits and layout are final."""
+        from mpl_toolkits.mplot3d import proj3d
+
+        proj = self.ax3.get_proj()
+        flat3 = {
+            proj3d.proj_transform(*p, proj)[:2]: names  # type: ignore[no-untyped-call]
+            for p, names in self.labels3.items()
+        }
+        for ax, named in ((self.ax3, flat3), *zip(self.flat, self.labels, strict=True)):
+            labels = [
+                ax.annotate(
                     ", ".join(names),
                     (u, v),
                     fontsize=7,
-                    xytext=(3, 3),
+                    xytext=LABEL_OFFSET,
                     textcoords="offset points",
-                    rotation=40,
-                    rotation_mode="anchor",
+                    arrowprops={"arrowstyle": "-", "color": "0.5", "lw": 0.5, "shrinkA": 0},
+                    bbox={"boxstyle": "square,pad=0.1", "fc": "white", "ec": "none", "alpha": 0.7},
                 )
+                for (u, v), names in sorted(named.items())
+            ]
+            for label in labels:  # placed for this layout: the figure's saving keeps it
+                label.set_in_layout(False)
+            _place_apart(ax, labels, renderer)
+
+
+LABEL_OFFSET = (4.0, 4.0)
+"""A point label's place from its point, points (1/72 in): up and to the right."""
+LABEL_GAP = 2.0
+"""The least space between two labels, or a label and a labelled point, points."""
+
+
+def _place_apart(ax: Any, labels: list[Any], renderer: Any) -> None:
+    """Move each of `labels` (annotations in offset points) up, in turn, until its box meets no
+    label placed before it nor any labelled point (a LABEL_GAP square around it), a grey line
+    leading back to its point: labels of points close on the page (the pump's F, its IMU and
+    the mounts 0.3 m on in the side view) ran into one another."""
+    from matplotlib.text import Text
+    from matplotlib.transforms import Bbox
+
+    def text_box(label: Any) -> Bbox:  # the text's alone, not with its leading line
+        label.update_positions(renderer)  # where its offset now puts it
+        return Text.get_window_extent(label, renderer)
+
+    scale = renderer.points_to_pixels(1.0)
+    gap = LABEL_GAP * scale
+    points = [ax.transData.transform(label.xy) for label in labels]
+    taken = [Bbox.from_extents(x - gap, y - gap, x + gap, y + gap) for x, y in points]
+    for label in labels:
+        for _ in range(len(labels) + 1):  # each step clears one box at least
+            box = text_box(label).padded(gap / 2.0)
+            hit = [b for b in taken if box.overlaps(b)]
+            if not hit:
+                break
+            dx, dy = label.xyann
+            label.xyann = (dx, dy + (max(b.y1 for b in hit) - box.y0) / scale + LABEL_GAP / 2.0)
+        taken.append(text_box(label))
 
 
 def _draw_scene(views: _Views, scene: Scene) -> None:
