@@ -121,10 +121,7 @@ class _Views:
         from mpl_toolkits.mplot3d import proj3d
 
         proj = self.ax3.get_proj()
-        flat3 = {
-            proj3d.proj_transform(*p, proj)[:2]: names  # type: ignore[no-untyped-call]
-            for p, names in self.labels3.items()
-        }
+        flat3 = {proj3d.proj_transform(*p, proj)[:2]: names for p, names in self.labels3.items()}
         for ax, named in ((self.ax3, flat3), *zip(self.flat, self.labels, strict=True)):
             labels = [
                 ax.annotate(
