@@ -996,3 +996,56 @@ def test_a_diagnostics_period_longer_than_a_timer_can_wait_runs_the_node() -> No
     assert code == 0, node.stderr
     assert "Traceback" not in node.stderr, node.stderr
     assert len(peer.got["/mount_twin/pose"]) == 100
+
+
+SILENT_SUBSCRIBER = """
+import sys, time
+sys.path.insert(0, "test")
+from ros_harness import Peer, wait_for
+peer = Peer(int(sys.argv[1]), "silent_subscriber")
+peer.record({"/diagnostics": "diagnostic_msgs/msg/DiagnosticArray"})
+assert wait_for(lambda: peer.connected("/diagnostics"), 120.0)
+print("connected", flush=True)
+time.sleep(3600.0)
+"""
+"""A reliable subscriber of /diagnostics in a process of its own: stopped (SIGSTOP), it
+acknowledges nothing, and the node's shutdown waits for it."""
+
+
+@pytest.mark.parametrize(("again", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_second_stop_ends_the_shutdown_at_once_saying_what_it_dropped(
+    again: int, code: int
+) -> None:
+    """SIGINT, then, while the node waits for a subscriber that never acknowledges its last
+    diagnostics, SIGINT again (Ctrl-C pressed twice) or SIGTERM: the node exits at once
+    (here: within 5 s of the second signal; the wait lasts 10 s) with 128 + that signal,
+    naming the topic whose last outputs it dropped. It ignored the second signal and waited
+    the 10 s out, then exited 0."""
+    domain = fresh_domain()
+    node = NodeProcess(domain, ["--params-file", str(PARAMS_FILE)])
+    silent = subprocess.Popen(
+        [sys.executable, "-c", SILENT_SUBSCRIBER, str(domain)],
+        env={**os.environ, "ROS_DOMAIN_ID": str(domain)},
+        stdout=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    try:
+        assert silent.stdout is not None and silent.stdout.readline() == "connected\n"
+        time.sleep(1.0)  # the node's writer matches the reader too
+        assert node.alive, node.failed()
+        silent.send_signal(signal.SIGSTOP)
+        node.proc.send_signal(signal.SIGINT)
+        time.sleep(2.0)
+        assert node.alive, node.failed()  # waiting for the acknowledgement
+        sent = time.monotonic()
+        assert node.stop(again) == code, node.stderr
+        took = time.monotonic() - sent
+    finally:
+        node.stop(signal.SIGKILL)
+        silent.kill()
+        silent.communicate()
+    assert took < 5.0, node.stderr
+    said = "stopped again: the last outputs not acknowledged by every subscriber were dropped on "
+    assert f"{said}/diagnostics (subscribers matched: 1)" in node.stderr, node.stderr
+    assert "Traceback" not in node.stderr, node.stderr

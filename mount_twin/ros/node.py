@@ -17,7 +17,6 @@ from __future__ import annotations
 import importlib
 import math
 import sys
-import threading
 import time
 from collections.abc import Callable, Sequence
 from functools import partial
@@ -73,6 +72,7 @@ if TYPE_CHECKING:
     from rclpy.parameter import Parameter
 
     from mount_twin.ros.ageing_fits import AgeingFits
+    from mount_twin.ros.start import StopRequests
 
 T = TypeVar("T")
 NODE_NAME = "mount_twin"
@@ -82,6 +82,10 @@ SHUTDOWN_ACK_S = 10.0
 """At shutdown, how long (s, steady clock) the node waits for every reliable subscriber to
 acknowledge what it published last (the final, partial diagnostics period among it) before it
 destroys its publishers; what is still unacknowledged then is named in a warning."""
+ACK_POLL_S = 0.05
+"""Slice (s) of that wait per publisher, between which a second stop is seen."""
+SHUTDOWN_CHUNK = 1000
+"""Input messages processed in one call at shutdown, between which a second stop is seen."""
 FIT_POLL_S = 0.2
 """Steady-clock period at which finished ageing fits are published."""
 NO_EVENTS = PublisherEventCallbacks(use_default_callbacks=False)
@@ -368,14 +372,30 @@ class MountTwinNode(Node):
         self._publish([encode_report(self.scene, report, self.get_clock().now().nanoseconds)])
         self._reported = found
 
-    def finish(self) -> None:
+    def finish(self, stops: StopRequests) -> bool:
         """Take what is still waiting, process the queue, publish the last, partial
         diagnostics period (where no input message ever came, a last report saying so, on
         which topic, at ERROR: a run that produced nothing never reads as fine), and wait (up
         to SHUTDOWN_ACK_S) until every reliable subscriber has acknowledged it all; a topic
-        still unacknowledged then is named in a warning."""
-        self._pending.extend(take_waiting(self._sub, TAKE_LIMIT))
-        self._drain()
+        still unacknowledged then is named in a warning.
+
+        A second stop (`stops.hurried`) skips what is left: the input messages not yet
+        processed (counted `lost_unprocessed_at_stop` in the last report, which still goes
+        out with the gyro filter's delayed samples) and the wait for acknowledgements, each
+        said in a warning. True where it skipped any."""
+        raws = [*self._pending, *take_waiting(self._sub, TAKE_LIMIT)]
+        self._pending = []
+        unprocessed = 0
+        for start in range(0, len(raws), SHUTDOWN_CHUNK):
+            if stops.hurried:
+                unprocessed = len(raws) - start
+                self.stream.engine.count("lost_unprocessed_at_stop", unprocessed)
+                self.get_logger().warning(
+                    f"shutdown: stopped again: {unprocessed} input messages waiting on "
+                    f"{self._sub.topic_name} were not processed"
+                )
+                break
+            self._process(raws[start : start + SHUTDOWN_CHUNK])
         if self._body_sub is not None:
             self._publish(self.stream.process_body(take_waiting(self._body_sub, TAKE_LIMIT)))
         self._publish(messages_of(self.stream.finish()))
@@ -389,24 +409,42 @@ class MountTwinNode(Node):
             self._publish(self.stream.ended_without_input(source, now))
         self._submit_fits()
         self._publish_fits(wait=True)
+        return self._wait_for_acks(stops) or unprocessed > 0
+
+    def _wait_for_acks(self, stops: StopRequests) -> bool:
+        """Wait up to SHUTDOWN_ACK_S until every reliable subscriber has acknowledged every
+        output, or until a second stop; a warning names the topics still unacknowledged. True
+        where the second stop cut the wait short."""
         deadline = time.monotonic() + SHUTDOWN_ACK_S
-        unacked = [
-            pub.topic_name
-            for pub in self._pubs.values()
-            if not pub.wait_for_all_acked(Duration(seconds=max(0.0, deadline - time.monotonic())))
-        ]
-        if unacked:
+        waiting = list(self._pubs.values())
+        slice_s = Duration(seconds=ACK_POLL_S)  # a signal's handler runs only between them
+        while waiting and not stops.hurried and time.monotonic() < deadline:
+            waiting = [p for p in waiting if not p.wait_for_all_acked(slice_s)]
+        if not waiting:
+            return False
+        topics = ", ".join(
+            f"{p.topic_name} (subscribers matched: {p.get_subscription_count()})" for p in waiting
+        )
+        if stops.hurried:
             self.get_logger().warning(
-                f"shutdown: not acknowledged by every subscriber within {SHUTDOWN_ACK_S} s, "
-                f"the last messages may be lost on {', '.join(unacked)}"
+                f"shutdown: stopped again: the last outputs not acknowledged by every "
+                f"subscriber were dropped on {topics}"
             )
+            return True
+        self.get_logger().warning(
+            f"shutdown: not acknowledged by every subscriber within {SHUTDOWN_ACK_S} s, "
+            f"the last messages may be lost on {topics}"
+        )
+        return False
 
 
-def run(stop: threading.Event, args: list[str] | None = None) -> int:
-    """The node's process (`mount_twin.ros.start`, which sets `stop` on SIGINT or SIGTERM):
-    spin until `stop`, then publish the last diagnostics period and exit 0; a configuration
-    error exits 2 with one line. A stop before the node is made exits 0 at once."""
-    if stop.is_set():
+def run(stops: StopRequests, args: list[str] | None = None) -> int:
+    """The node's process (`mount_twin.ros.start`, whose handler of SIGINT and SIGTERM takes
+    `stops`): spin until the first stop, then publish the last diagnostics period and exit 0;
+    a second stop that cut the shutdown short exits 128 + its signal (130 SIGINT, 143 SIGTERM,
+    as the shell reports a process a signal ended). A configuration error exits 2 with one
+    line. A stop before the node is made exits 0 at once."""
+    if stops.first.is_set():
         return 0
     argv = sys.argv if args is None else args
     try:
@@ -419,11 +457,12 @@ def run(stop: threading.Event, args: list[str] | None = None) -> int:
         print(f"mount_twin_node: {rcl_message(err)}", file=sys.stderr)
         return 2
     node = None
+    cut_short = False
     try:
         node = MountTwinNode(argv)
         executor = SingleThreadedExecutor()
         executor.add_node(node)
-        while not stop.is_set() and rclpy.ok():
+        while not stops.first.is_set() and rclpy.ok():
             executor.spin_once(timeout_sec=0.1)
     except MountTwinError as err:
         print(f"mount_twin_node: {err}", file=sys.stderr)
@@ -433,7 +472,7 @@ def run(stop: threading.Event, args: list[str] | None = None) -> int:
     finally:
         if node is not None:
             if rclpy.ok():
-                node.finish()
+                cut_short = node.finish(stops)
             node.destroy_node()
         rclpy.try_shutdown()
-    return 0
+    return 128 + stops.again if cut_short and stops.again is not None else 0
