@@ -1049,3 +1049,61 @@ def test_a_second_stop_ends_the_shutdown_at_once_saying_what_it_dropped(
     said = "stopped again: the last outputs not acknowledged by every subscriber were dropped on "
     assert f"{said}/diagnostics (subscribers matched: 1)" in node.stderr, node.stderr
     assert "Traceback" not in node.stderr, node.stderr
+
+
+def test_a_second_stop_leaves_the_backlog_unprocessed_and_the_last_report_counts_it() -> None:
+    """The node's shutdown after a second stop (`StopRequests` taking SIGINT twice), in this
+    process: of 200 samples processed and 3000 still waiting in the input's queue, the 3000
+    are not processed; the last report still goes out, its period's 200 samples all answered
+    (the gyro filter's delayed ones flushed), counting the 3000 `lost_unprocessed_at_stop`
+    (ERROR: 94 % of the samples due). Before, the shutdown processed the whole backlog, however
+    long it took."""
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.duration import Duration
+    from rclpy.executors import SingleThreadedExecutor
+
+    from mount_twin.ros.node import MountTwinNode
+    from mount_twin.ros.start import StopRequests
+
+    domain = fresh_domain()
+    context = Context()
+    args = ["mount_twin_node", "--ros-args", "--params-file", str(PARAMS_FILE), *LOSSLESS]
+    rclpy.init(args=args, context=context, domain_id=domain)
+    node = MountTwinNode(args, context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    peer = Peer(domain)
+    peer.record({"/diagnostics": DIAGNOSTICS, "/mount_twin/pose": POSE})
+    stops = StopRequests()
+    try:
+        pub = peer.publisher(IMU, "/deck/imu")
+        assert wait_for(lambda: pub.get_subscription_count() > 0, 30.0)
+        assert wait_for(lambda: peer.connected("/diagnostics"), 30.0)
+        stamps, accel = _at_rest(3200)
+        for raw in _imu(stamps[:200], accel[:200]):
+            pub.publish(raw)
+        counts = node.stream.engine.counts
+        deadline = time.monotonic() + 30.0
+        while counts["accepted"] < 200 and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.01)
+        assert counts["accepted"] == 200
+        for raw in _imu(stamps[200:], accel[200:]):
+            pub.publish(raw)
+        assert pub.wait_for_all_acked(Duration(seconds=30.0))  # all in the node's queue
+        stops.take(signal.SIGINT)
+        stops.take(signal.SIGINT)
+        assert node.finish(stops)
+        peer.take_until(lambda: len(peer.got["/diagnostics"]) >= 1, 30.0)
+        peer.take_until(lambda: False, 0.5)
+    finally:
+        peer.close()
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+    assert (counts["received"], counts["lost_unprocessed_at_stop"]) == (200, 3000)
+    assert len(peer.got["/mount_twin/pose"]) == 200
+    (_, statuses), *_ = diagnostics(peer.got["/diagnostics"][-1:])
+    level, msg, values = {n: (lv, m, v) for n, lv, m, v in statuses}["mount_twin: input"]
+    assert (values["received"], values["lost_unprocessed_at_stop"]) == ("200", "3000")
+    assert level == ERROR and "reported lost_unprocessed_at_stop 3000" in msg, msg

@@ -405,6 +405,8 @@ class MountTwinNode(Node):
                 f"{self._sub.topic_name} ({self.scene.input.msg_type}) over the node's life "
                 f"({life:.1f} s)"
             )
+            if unprocessed:
+                source += f", {unprocessed} waiting at the second stop were not processed"
             now = self.get_clock().now().nanoseconds
             self._publish(self.stream.ended_without_input(source, now))
         self._submit_fits()
@@ -418,8 +420,10 @@ class MountTwinNode(Node):
         deadline = time.monotonic() + SHUTDOWN_ACK_S
         waiting = list(self._pubs.values())
         slice_s = Duration(seconds=ACK_POLL_S)  # a signal's handler runs only between them
-        while waiting and not stops.hurried and time.monotonic() < deadline:
+        while True:  # once at least, even after a second stop: what is acknowledged is not lost
             waiting = [p for p in waiting if not p.wait_for_all_acked(slice_s)]
+            if not waiting or stops.hurried or time.monotonic() >= deadline:
+                break
         if not waiting:
             return False
         topics = ", ".join(
