@@ -192,12 +192,13 @@ them (a best-effort input under load lost 36 % of a 10 kHz stream)."""
 
 
 def stop_and_take(
-    node: NodeProcess, peer: Peer, done: Callable[[], bool], sig: int = signal.SIGINT
+    node: NodeProcess, peer: Peer, done: Callable[[], bool], sig: int | None = signal.SIGINT
 ) -> int:
-    """Signal the node, take its outputs while it shuts down (it waits for its reliable
-    subscribers' acknowledgements before it exits), then until `done()` (e.g. the final
-    diagnostics period has arrived) or 30 s; the node's exit code."""
-    if node.alive:
+    """Signal the node (`sig`; None: the caller has), take its outputs while it shuts down
+    (it waits for its reliable subscribers' acknowledgements before it exits), then until
+    `done()` (e.g. the final diagnostics period has arrived) or 30 s; the node's exit code.
+    A signal sent while the node shuts down is a second stop, which cuts the shutdown short."""
+    if sig is not None and node.alive:
         node.proc.send_signal(sig)
     peer.take_until(lambda: not node.alive, 60.0)
     code = node.wait()

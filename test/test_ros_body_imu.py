@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import signal
+import time
 from pathlib import Path
 
 import numpy as np
@@ -221,16 +222,31 @@ def _children(pid: int) -> list[int]:
     return found
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def _gone(pid: int) -> bool:
+    """Whether process `pid` has ended (a zombie nobody reaped counts as ended)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return True
+    return state == "Z"
+
+
+@pytest.mark.parametrize(
+    ("sig", "again"),
+    [(signal.SIGINT, None), (signal.SIGTERM, None), (signal.SIGINT, signal.SIGINT)],
+    ids=["SIGINT", "SIGTERM", "SIGINT_twice"],
+)
 def test_a_stop_sent_to_the_process_group_finishes_the_ageing_fit_in_flight(
-    tmp_path: Path, sig: int
+    tmp_path: Path, sig: int, again: int | None
 ) -> None:
     """SIGINT or SIGTERM to the node's whole process group (a terminal's Ctrl-C, systemd's
     stop) while an ageing fit runs in the worker process: the worker finishes it, the node
     publishes its report and exits 0. The worker took the signal too: a KeyboardInterrupt
     raised out of the fit's result into the node's shutdown (a traceback, killed by SIGINT,
     the fit's report and the acknowledgement wait lost), or the worker died at SIGTERM and
-    the window read as a failed fit."""
+    the window read as a failed fit. Ctrl-C pressed again (`again`) while the node waits for
+    the fit: the node does not wait, the window's report says so (ERROR), the worker is
+    ended, exit 130; the second Ctrl-C was ignored and the node waited the fit out."""
     scene_path = pump_scene_file(tmp_path, **AGEING_PUMP)
     inputs = ageing_bag(tmp_path / "in", load_scene_file(scene_path), 24.0, 30.0, BODY_TOPIC)
     domain = fresh_domain()
@@ -242,12 +258,25 @@ def test_a_stop_sent_to_the_process_group_finishes_the_ageing_fit_in_flight(
         # the window 2-22 s is due: its fit starts in a worker (beside the resource tracker)
         assert wait_for(lambda: len(_children(node.proc.pid)) >= 2, 60.0), node.failed()
         assert not statuses_named(peer.got["/diagnostics"], AGEING)  # still fitting
+        children = _children(node.proc.pid)
         os.killpg(node.proc.pid, sig)
-        code = stop_and_take(node, peer, lambda: True)
+        if again is not None:
+            time.sleep(0.3)  # a separate signal: two at once are one to Python's handler
+            os.killpg(node.proc.pid, again)
+        code = stop_and_take(node, peer, lambda: True, None)
     finally:
         node.stop(signal.SIGKILL)
         peer.close()
-    assert code == 0, node.stderr
     assert "Traceback" not in node.stderr, node.stderr
     ((_, level, message, _),) = statuses_named(peer.got["/diagnostics"], AGEING)
-    assert level == OK, message
+    if again is None:
+        assert code == 0, node.stderr
+        assert level == OK, message
+        return
+    assert code == 128 + again, node.stderr
+    assert (level, message) == (
+        ERROR,
+        "the ageing fit was not waited for: the node was stopped again",
+    ), node.stderr
+    assert "1 ageing fits were not waited for" in node.stderr, node.stderr
+    assert wait_for(lambda: all(_gone(pid) for pid in children), 10.0)

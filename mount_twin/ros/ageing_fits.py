@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import multiprocessing
 import signal
+import time
 from collections import deque
+from collections.abc import Callable
+from concurrent import futures
 from concurrent.futures import Future, ProcessPoolExecutor
 
 from mount_twin.analysis.ageing_live import NAME, WindowJob, run_job
@@ -18,6 +21,8 @@ from mount_twin.scene.description import Scene
 
 FIT_WAIT_S = 120.0
 """At shutdown, how long (s) the node waits for each ageing fit still running."""
+POLL_S = 0.1
+"""Slice (s) of that wait, between which a second stop is seen."""
 STOP_SIGNALS = frozenset({signal.SIGINT, signal.SIGTERM})
 """The signals that stop the node, blocked in its worker (see `AgeingFits.submit`)."""
 
@@ -29,6 +34,8 @@ class AgeingFits:
         self.scene = scene
         self._pool: ProcessPoolExecutor | None = None
         self._pending: deque[tuple[int, Future[HealthReport]]] = deque()
+        self.not_waited_for = 0
+        """Fits a second stop left unfinished (`done`)."""
 
     def submit(self, job: WindowJob) -> None:
         """Fit `job` in the worker process (started at the first: a fresh interpreter, not a
@@ -51,22 +58,37 @@ class AgeingFits:
             signal.pthread_sigmask(signal.SIG_SETMASK, mask)
         self._pending.append((job.stamp_ns, future))
 
-    def done(self, wait: bool = False) -> list[tuple[str, int, bytes]]:
+    def done(
+        self, wait: bool = False, give_up: Callable[[], bool] = lambda: False
+    ) -> list[tuple[str, int, bytes]]:
         """The reports of the fits finished in order (`wait`: all, each within FIT_WAIT_S,
         then the worker stops), as /diagnostics messages; a fit that raised or did not finish
-        in time is an ERROR saying so."""
+        in time is an ERROR saying so. Once `give_up()` (the node stopped again), the fits
+        still running are not waited for: each an ERROR saying so, the worker ended."""
         msgs = []
         hung = False
         while self._pending and (wait or self._pending[0][1].done()):
             stamp_ns, future = self._pending.popleft()
-            try:
-                report = future.result(timeout=FIT_WAIT_S)
-            except Exception as err:  # the worker died, the fit raised or hung: said, not lost
-                hung = hung or not future.done()
-                status = HealthStatus(NAME, ERROR, f"the ageing fit failed: {err!r}", {})
-                report = HealthReport(stamp_ns * 1e-9, -1, [status])
+            deadline = time.monotonic() + FIT_WAIT_S
+            while wait and not future.done() and not give_up() and time.monotonic() < deadline:
+                futures.wait([future], timeout=POLL_S)  # a stop's handler runs in between
+            if not future.done() and give_up():
+                hung = True
+                self.not_waited_for += 1
+                text = "the ageing fit was not waited for: the node was stopped again"
+                report = HealthReport(stamp_ns * 1e-9, -1, [HealthStatus(NAME, ERROR, text, {})])
+            else:
+                try:
+                    report = future.result(timeout=0.0)
+                except Exception as err:  # the worker died, the fit raised or hung: said
+                    hung = hung or not future.done()
+                    status = HealthStatus(NAME, ERROR, f"the ageing fit failed: {err!r}", {})
+                    report = HealthReport(stamp_ns * 1e-9, -1, [status])
             msgs.append(encode_report(self.scene, report, stamp_ns))
         if wait and self._pool is not None:
+            if hung:  # its fit would hold the interpreter's exit (it joins the pool's thread)
+                for worker in self._pool._processes.values():  # no public way before 3.14
+                    worker.kill()
             # Joined where every fit is done: left running (wait=False), the pool's thread
             # closed its wake-up pipe under the interpreter's exit hook, which then printed
             # "OSError: Bad file descriptor" after a clean shutdown (CPython gh-83279).

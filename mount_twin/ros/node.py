@@ -299,10 +299,10 @@ class MountTwinNode(Node):
             for job in self.stream.take_ageing_jobs():
                 self._fits.submit(job)
 
-    def _publish_fits(self, wait: bool = False) -> None:
-        """The ageing reports whose fits are done (`wait`: all of them), in window order."""
+    def _publish_fits(self) -> None:
+        """The ageing reports whose fits are done, in window order."""
         if self._fits is not None:
-            self._publish(self._fits.done(wait))
+            self._publish(self._fits.done())
 
     def _publish(self, messages: list[tuple[str, int, bytes]]) -> None:
         for topic, _stamp, data in messages:
@@ -410,8 +410,16 @@ class MountTwinNode(Node):
             now = self.get_clock().now().nanoseconds
             self._publish(self.stream.ended_without_input(source, now))
         self._submit_fits()
-        self._publish_fits(wait=True)
-        return self._wait_for_acks(stops) or unprocessed > 0
+        fits_cut = False
+        if self._fits is not None:
+            self._publish(self._fits.done(wait=True, give_up=lambda: stops.hurried))
+            fits_cut = self._fits.not_waited_for > 0
+            if fits_cut:
+                self.get_logger().warning(
+                    f"shutdown: stopped again: {self._fits.not_waited_for} ageing fits were not "
+                    "waited for (their reports say so, ERROR)"
+                )
+        return self._wait_for_acks(stops) or unprocessed > 0 or fits_cut
 
     def _wait_for_acks(self, stops: StopRequests) -> bool:
         """Wait up to SHUTDOWN_ACK_S until every reliable subscriber has acknowledged every
