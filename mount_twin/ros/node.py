@@ -381,8 +381,8 @@ class MountTwinNode(Node):
 
         A second stop (`stops.hurried`) skips what is left: the input messages not yet
         processed (counted `lost_unprocessed_at_stop` in the last report, which still goes
-        out with the gyro filter's delayed samples) and the wait for acknowledgements, each
-        said in a warning. True where it skipped any."""
+        out with the gyro filter's delayed samples), the ageing fits still running and the
+        wait for acknowledgements, each said in a warning. True where it skipped any."""
         raws = [*self._pending, *take_waiting(self._sub, TAKE_LIMIT)]
         self._pending = []
         unprocessed = 0
