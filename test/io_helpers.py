@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import subprocess
 import sys
@@ -212,15 +213,33 @@ def comparable_diagnostics(raw: bytes) -> list[tuple[str, int, str, list[tuple[s
 def ageing_bag(
     path: Path, scene: Scene, total_s: float, change_s: float, body_topic: str
 ) -> list[tuple[str, int, bytes]]:
-    """A bag at `path` of the deck IMU (/deck/imu, 200 Hz of ship motion with 1-40 Hz
-    machinery vibration at 0.3 m/s² RMS) and the body IMU (`body_topic`) of the scene's
-    machine whose mounts all lose 30 % of their stiffness at `change_s`; 0.01 m/s² of noise on
-    both. Returns its (topic, stamp ns, raw) messages in stamp order."""
+    """A bag at `path` of `ageing_messages`. Returns its (topic, stamp ns, raw) messages in
+    stamp order."""
+    from mount_twin.io.bag import OutputBag
+    from mount_twin.io.messages import IMU
+
+    msgs = ageing_messages(scene, total_s, change_s, body_topic)
+    with OutputBag(path, {"/deck/imu": IMU, body_topic: IMU}) as bag:
+        bag.write(msgs)
+    return msgs
+
+
+def ageing_messages(
+    scene: Scene,
+    total_s: float,
+    change_s: float,
+    body_topic: str,
+    jump: tuple[float, float] | None = None,
+) -> list[tuple[str, int, bytes]]:
+    """The deck IMU (/deck/imu, 200 Hz of ship motion with 1-40 Hz machinery vibration at
+    0.3 m/s² RMS) and the body IMU (`body_topic`) of the scene's machine whose mounts all lose
+    30 % of their stiffness at `change_s`; 0.01 m/s² of noise on both: (topic, stamp ns, raw)
+    messages in the order of the record's time. `jump` (at s, by s): the stamps of both from
+    `at` on are `by` earlier (a recorder's clock set back)."""
     from scipy.signal import butter, sosfiltfilt
 
     from mount_twin.analysis.calibration import calibrated_scene, predict
-    from mount_twin.io.bag import OutputBag
-    from mount_twin.io.messages import IMU, imu_messages
+    from mount_twin.io.messages import imu_messages
     from mount_twin.io.signals import Signal, ship_motion
 
     rate, stamp0 = 200.0, 1_700_000_000_000_000_000
@@ -233,16 +252,17 @@ def ageing_bag(
     rng = np.random.default_rng(1)
     body = np.where((t >= change_s)[:, None], aged, intact) + rng.normal(0, 0.01, intact.shape)
     noisy = deck.accel + rng.normal(0, 0.01, deck.accel.shape)
-    ns = stamp0 + np.round(deck.t * 1e9).astype(np.int64)
-    body_ns = stamp0 + np.round(t * 1e9).astype(np.int64)
-    msgs = sorted(
-        [("/deck/imu", s, r) for s, r in imu_messages(ns, noisy, deck.gyro, "deck_imu")]
-        + [(body_topic, s, r) for s, r in imu_messages(body_ns, body, np.zeros_like(body), "")],
-        key=lambda m: (m[1], m[0]),
+    at, by = jump or (math.inf, 0.0)
+    ns = stamp0 + np.round(np.where(deck.t >= at, deck.t - by, deck.t) * 1e9).astype(np.int64)
+    body_ns = stamp0 + np.round(np.where(t >= at, t - by, t) * 1e9).astype(np.int64)
+    deck_msgs = imu_messages(ns, noisy, deck.gyro, "deck_imu")
+    body_msgs = imu_messages(body_ns, body, np.zeros_like(body), "")
+    timed = sorted(
+        [(float(u), "/deck/imu", m) for u, m in zip(deck.t, deck_msgs, strict=True)]
+        + [(float(u), body_topic, m) for u, m in zip(t, body_msgs, strict=True)],
+        key=lambda m: (m[0], m[1]),
     )
-    with OutputBag(path, {"/deck/imu": IMU, body_topic: IMU}) as bag:
-        bag.write(msgs)
-    return msgs
+    return [(topic, s, r) for _, topic, (s, r) in timed]
 
 
 def statuses_named(raws: list[bytes], name: str) -> list[tuple[int, int, str, dict[str, str]]]:
