@@ -17,7 +17,7 @@ from mount_twin.engine.batch import ERROR, HealthReport, OutputBatch
 from mount_twin.engine.body_check import RESETS, BodyCheck, BodyComparison
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.health import ENDED, INPUT
-from mount_twin.engine.intake import disregarded, provided, rising, rotated
+from mount_twin.engine.intake import disregarded, provided, rising_or_back, rotated
 from mount_twin.errors import require
 from mount_twin.io.messages import (
     IMU,
@@ -150,9 +150,8 @@ class TwinStream:
             self.ageing = AgeingTracker(scene)
         self._ageing_jobs: list[WindowJob] = []
         self._ageing_last_ns = 0
-        self._ageing_body_ns = 0
-        """The latest body stamp the ageing tracker took, ns: it takes rising stamps alone, as
-        of the deck (`_track_foundation`), where the body comparison restarts at a jump back."""
+        """The stamp of the last deck sample the ageing tracker took, ns."""
+        self._back_ns = round(scene.input.back_jump_reset_s * 1e9)
 
     def process(self, raws: Sequence[bytes]) -> list[Encoded]:
         """Outputs for raw input messages, as (unresolved topic, stamp ns, CDR bytes), or blocks
@@ -238,7 +237,8 @@ class TwinStream:
         values, no reading the twin reads marked not provided (a rate marked so under
         input.gyro_filter: ignore is zeroed, not dropped: `intake.disregarded`, `provided`;
         it had been dropped, the tracker's window then short of the twin's samples), the
-        input's frame_id (if it names one) and rising stamps."""
+        input's frame_id (if it names one) and rising stamps, or one more than
+        input.back_jump_reset_s back (the twin restarts there, and the tracker with it)."""
         assert self.ageing is not None and self.base is not None
         accel, gyro = provided(decoded.accel, decoded.gyro, decoded.unprovided)
         good = np.isfinite(np.hstack([accel, gyro])).all(axis=1)
@@ -246,7 +246,7 @@ class TwinStream:
         expected = self.scene.input.frame_id
         if expected:
             good &= np.array([f == expected for f in decoded.frame_ids], bool)
-        keep = rising(decoded.stamps_ns, good, self._ageing_last_ns)
+        keep, _ = rising_or_back(decoded.stamps_ns, good, self._ageing_last_ns, self._back_ns)
         if keep.any():
             ns = decoded.stamps_ns[keep]
             self._ageing_last_ns = int(ns[-1])
@@ -302,18 +302,15 @@ class TwinStream:
     def _body_in(self, decoded: Decoded) -> list[tuple[str, int, bytes]]:
         """Accepted body samples into the comparison, on the twin's time base (a reading
         marked not provided zeroed, `provided`: never read as a value); into the ageing
-        tracker, whose fits read the specific force, those that provide it and whose stamps
-        rise (`_ageing_body_ns`)."""
+        tracker, whose fits read the specific force, those that provide it (the others tell
+        it where the stamps jumped back: `BodyCheck.screen` took them)."""
         assert self.body is not None and self.base is not None
         accel, gyro = provided(decoded.accel, decoded.gyro, decoded.unprovided)
         n = decoded.stamps_ns.shape[0]
         present = ~(np.zeros((n, 2), bool) if decoded.unprovided is None else decoded.unprovided)
         t = self.base.seconds(decoded.stamps_ns)
         if self.ageing is not None:
-            k = rising(decoded.stamps_ns, np.ones(n, bool), self._ageing_body_ns)
-            self._ageing_body_ns = max(self._ageing_body_ns, int(decoded.stamps_ns.max(initial=0)))
-            k &= present[:, 0]
-            jobs = self.ageing.add_body(decoded.stamps_ns[k], t[k], accel[k], gyro[k])
+            jobs = self.ageing.add_body(decoded.stamps_ns, t, accel, gyro, present[:, 0])
             self._ageing_jobs += jobs
         rows = self.body.add_body(decoded.stamps_ns, t, np.hstack([accel, gyro]), present)
         return self._encode_body(rows)

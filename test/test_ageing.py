@@ -5,21 +5,27 @@ not before."""
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
-from io_helpers import ROOT
+from io_helpers import AGEING_PUMP, ROOT, ageing_messages, pump_scene_file
 from scipy.signal import butter, sosfiltfilt
 
 from mount_twin import load_scene_file
 from mount_twin.analysis import calibration as cal_mod
 from mount_twin.analysis.ageing import WindowFit, track, window_table
+from mount_twin.analysis.ageing_live import CUT_BY_JUMP, DROPPED, WindowJob, run_job
 from mount_twin.cli import main
+from mount_twin.engine.batch import LEVEL_NAMES
+from mount_twin.engine.body_check import RESETS
 from mount_twin.errors import SceneError
 from mount_twin.io.signals import Signal, ship_motion
+from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
+from mount_twin.stream import TwinStream
 
 RATE, TOTAL, CHANGE = 200.0, 92.5, 45.0
 
@@ -243,3 +249,121 @@ def test_the_window_table_heading_stands_over_its_columns_and_refusals_read_plai
     assert head.index("fit:") == ok.index("stiffness") == warn.index("-  ")
     assert head.index("why") == warn.index("not judged")
     assert warn.endswith(f"not judged; damping refused: {why}")
+
+
+JUMP_AT, JUMP_BY = 34.0, 8.0
+"""The loop test's record: its stamps go back by JUMP_BY s at JUMP_AT s of the record, where
+its mounts lose 30 % of their stiffness."""
+
+
+@pytest.fixture(scope="module")
+def jumping(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[tuple[str, int, bytes]]]:
+    """The pump (AGEING_PUMP: windows of 20 s) under 56.5 s of ship motion, deck and body IMU,
+    both streams' stamps jumping back 8 s at 34 s, where every mount loses 30 % of its
+    stiffness: stamps 0–34 s, then 26–48.5 s (from the first deck stamp)."""
+    path = pump_scene_file(tmp_path_factory.mktemp("jump"), **AGEING_PUMP)
+    messages = ageing_messages(
+        load_scene_file(path), 56.5, JUMP_AT, "/machine/imu", (JUMP_AT, JUMP_BY)
+    )
+    return path, messages
+
+
+def _jobs(scene: Scene, messages: list[tuple[str, int, bytes]], feed: str) -> list[WindowJob]:
+    """The ageing jobs of a TwinStream fed `messages` (in their order) as `feed` says: 'replay'
+    (deck chunks of 97, body chunks of 13 while the body is behind, as a replay feeds them),
+    'body first' (every body message, then the deck in one), 'deck first' (the deck in one,
+    then the body in chunks of 7), 'one by one' (each message as it comes, as live)."""
+    deck = [raw for topic, _, raw in messages if topic == "/deck/imu"]
+    body = [raw for topic, _, raw in messages if topic != "/deck/imu"]
+    stream = TwinStream(scene)
+    if feed == "replay":
+        bodies = iter([body[i : i + 13] for i in range(0, len(body), 13)])
+        for i in range(0, len(deck), 97):
+            stream.process(deck[i : i + 97])
+            while stream.body_behind and (chunk := next(bodies, None)) is not None:
+                stream.process_body(chunk)
+        for chunk in bodies:
+            stream.process_body(chunk)
+    elif feed == "body first":
+        stream.process_body(body)
+        stream.process(deck)
+    elif feed == "deck first":
+        stream.process(deck)
+        for i in range(0, len(body), 7):
+            stream.process_body(body[i : i + 7])
+    else:
+        for topic, _, raw in messages:
+            if topic == "/deck/imu":
+                stream.process([raw])
+            else:
+                stream.process_body([raw])
+    stream.finish()
+    return stream.take_ageing_jobs()
+
+
+def _same(a: list[WindowJob], b: list[WindowJob]) -> bool:
+    """Whether two lists of jobs cut the same windows of the same samples."""
+    fields = [(j.span, j.stamp_ns, j.restarts, j.dropped, j.cut) for j in (*a, *b)]
+    records = [np.hstack([r.t[:, None], r.accel, r.gyro]) for j in (*a, *b) for r in j.records]
+    n = 2 * len(a)
+    return (
+        len(a) == len(b)
+        and fields[: len(a)] == fields[len(a) :]
+        and all(np.array_equal(x, y) for x, y in zip(records[:n], records[n:], strict=True))
+    )
+
+
+FEEDS = ("replay", "body first", "deck first", "one by one")
+
+
+def test_the_live_tracker_restarts_where_both_streams_stamps_jump_back(
+    jumping: tuple[Path, list[tuple[str, int, bytes]]],
+) -> None:
+    """Stamps 0–34 s, then 26–48.5 s (a recorder's clock set back 8 s, a bag played with
+    --loop), the mounts at 0.7× stiffness from the jump on. The tracker took only stamps past
+    34 s after the jump: it fitted 2–22 s and nothing more, silently. Now it restarts with the
+    twin: 2–22 s, the window open at the jump (22–34 s, more than half a window) cut there,
+    both at ×1.00, then 28–48 s (the new run's first body stamp plus the 2 s lead) at ×0.70
+    (within 2 %), its values saying one jump back; the same windows of the same samples
+    however the two streams come batched and interleaved."""
+    path, messages = jumping
+    scene = load_scene_file(path)
+    jobs = {feed: _jobs(scene, messages, feed) for feed in FEEDS}
+    assert [round(j.span[0], 6) for j in jobs["replay"]] == [2.0, 22.0, 28.0]
+    assert [round(j.span[1], 2) for j in jobs["replay"]] == [22.0, 34.0, 48.0]
+    for feed in FEEDS[1:]:
+        assert _same(jobs[feed], jobs["replay"]), feed
+    statuses = [run_job(job).statuses[0] for job in jobs["replay"]]
+    assert [float(s.values["stiffness"]) for s in statuses] == [
+        pytest.approx(1.0, abs=0.01),
+        pytest.approx(1.0, abs=0.01),
+        pytest.approx(0.7, rel=0.02),
+    ]
+    assert [s.values[RESETS] for s in statuses] == ["0", "0", "1"]
+    assert [s.values[DROPPED] for s in statuses] == ["0", "0", "0"]
+    assert [CUT_BY_JUMP in s.message for s in statuses] == [False, True, False]
+    assert [LEVEL_NAMES[s.level] for s in statuses] == ["OK", "OK", "ERROR"]
+
+
+def test_a_window_open_at_a_jump_back_too_short_to_fit_is_dropped_and_said(
+    jumping: tuple[Path, list[tuple[str, int, bytes]]],
+) -> None:
+    """Windows of 14 s on the same record: 2–16 and 16–30 s, then 30–34 s open at the jump
+    (4 s, less than half a window) is dropped, and the next window, 28–42 s (after the
+    jump), says so; the same in any batching."""
+    path, messages = jumping
+    scene = load_scene_file(path)
+    scene = replace(scene, ageing=replace(scene.ageing, window_s=14.0))
+    jobs = {feed: _jobs(scene, messages, feed) for feed in FEEDS}
+    assert [tuple(round(x, 6) for x in j.span) for j in jobs["replay"]] == [
+        (2.0, 16.0),
+        (16.0, 30.0),
+        (28.0, 42.0),
+    ]
+    assert [(j.restarts, j.dropped, j.cut) for j in jobs["replay"]] == [
+        (0, 0, False),
+        (0, 0, False),
+        (1, 1, False),
+    ]
+    for feed in FEEDS[1:]:
+        assert _same(jobs[feed], jobs["replay"]), feed

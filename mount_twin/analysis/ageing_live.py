@@ -7,6 +7,13 @@ record taken from `LEAD_S` before each window's start. A window is cut by stamps
 its fit is the same live and in a replay; a fit takes seconds, so the node runs the jobs
 (`WindowJob`, `run_job`) in a worker process and publishes each report when it is done,
 stamped with the window's last body stamp.
+
+Where the stamps jump back by more than input.back_jump_reset_s (a bag played with --loop, a
+recorder's clock set back), the twin restarts, and so does the tracker: each stream's n-th
+run is paired with the other's, the window open at the jump is fitted (up to the last sample
+both streams have in the run) if it spans half a window, else dropped and counted, and the
+windows start again from the new run's first body sample plus the lead. Each report says the
+jumps before its window and the windows dropped so far (`run_job`).
 """
 
 from __future__ import annotations
@@ -18,21 +25,32 @@ import numpy as np
 
 from mount_twin.analysis.ageing import LEAD_S, Band, WindowFit, fit_window
 from mount_twin.engine.batch import LEVEL_NAMES, WARN, HealthReport, HealthStatus
+from mount_twin.engine.body_check import RESETS
 from mount_twin.io.signals import Signal
 from mount_twin.scene.description import Scene
 
 NAME = "mount_twin: ageing"
+DROPPED = "windows_dropped_at_jump_back"
+"""The count of windows open where the stamps jumped back that held less than half a window
+(not fitted), in every report's values beside RESETS (the jumps back before its window)."""
+CUT_BY_JUMP = "the last window before the stamps jumped back"
+"""How a window cut short by a jump back is said."""
 
 
 @dataclass(frozen=True)
 class WindowJob:
     """One window to re-fit: the scene (with its `ageing`), the (foundation, body) records
-    (s on the twin's time base), the window's span (s) and its last body stamp (ns)."""
+    (s on the twin's time base), the window's span (s) and its last body stamp (ns); the
+    stamps' jumps back before it (the tracker restarted at each), the windows dropped so far
+    (open at a jump, too short to fit), and whether it is one cut short by a jump."""
 
     scene: Scene
     records: tuple[Signal, Signal]
     span: tuple[float, float]
     stamp_ns: int
+    restarts: int = 0
+    dropped: int = 0
+    cut: bool = False
 
 
 def _status(fit: WindowFit) -> HealthStatus:
@@ -52,7 +70,8 @@ def _status(fit: WindowFit) -> HealthStatus:
 
 def run_job(job: WindowJob) -> HealthReport:
     """The window's fit as a diagnostics report (a plain function of plain data: it runs in a
-    worker process live). A window the twin cannot follow is a WARN saying why."""
+    worker process live). A window the twin cannot follow is a WARN saying why. Its values
+    say the stamps' jumps back so far (RESETS) and the windows dropped at them (DROPPED)."""
     ageing = job.scene.ageing
     assert ageing is not None
     band = Band(ageing.warn, ageing.error)
@@ -61,19 +80,30 @@ def run_job(job: WindowJob) -> HealthReport:
     except ValueError as err:
         span = f"{job.span[0]:.1f}–{job.span[1]:.1f} s"
         status = HealthStatus(NAME, WARN, f"{span}: not fitted: {err}", {})
+    if job.cut:
+        status.message += f" ({CUT_BY_JUMP})"
+    if job.dropped:
+        status.message += (
+            f"; {job.dropped} window(s) open where the stamps jumped back held less than half "
+            "a window: not fitted"
+        )
+    status.values.update({RESETS: str(job.restarts), DROPPED: str(job.dropped)})
     return HealthReport(job.stamp_ns * 1e-9, -1, [status])
 
 
-class _Record:
-    """A growing record (stamps ns and s, accel, gyro), its oldest part dropped as it goes."""
+class _Run:
+    """A stream's samples of one run (stamps ns and s, accel, gyro), its oldest part dropped
+    as it goes."""
 
     def __init__(self) -> None:
         self.parts: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        self.first_t: float | None = None
         self.last_t = -math.inf
 
     def add(self, ns: np.ndarray, t: np.ndarray, accel: np.ndarray, gyro: np.ndarray) -> None:
         if t.shape[0]:
             self.parts.append((ns, t, accel, gyro))
+            self.first_t = float(t[0]) if self.first_t is None else self.first_t
             self.last_t = float(t[-1])
 
     def cut(self, start: float, end: float) -> tuple[Signal, int]:
@@ -86,15 +116,58 @@ class _Record:
         return Signal(t[keep], accel[keep], gyro[keep]), last
 
 
+class _Record:
+    """A stream's samples, by run: a stamp before the last one added starts a new run (the
+    stream gives rising stamps but where they jump back by more than input.back_jump_reset_s,
+    `intake.rising_or_back`: a bag played with --loop)."""
+
+    def __init__(self) -> None:
+        self.runs: dict[int, _Run] = {}
+        self.run = 0
+        """The run of the last sample added."""
+        self._last_ns = 0
+
+    def add(
+        self,
+        ns: np.ndarray,
+        t: np.ndarray,
+        accel: np.ndarray,
+        gyro: np.ndarray,
+        use: np.ndarray | None = None,
+    ) -> None:
+        """Samples (stamps ns and s, accel, gyro); of them, those `use` marks kept (all where
+        None; the others only tell where a run starts)."""
+        if not ns.shape[0]:
+            return
+        run = self.run + np.cumsum(ns < np.concatenate([[self._last_ns], ns[:-1]]))
+        self.run, self._last_ns = int(run[-1]), int(ns[-1])
+        if use is not None:
+            ns, t, accel, gyro, run = ns[use], t[use], accel[use], gyro[use], run[use]
+        for r in np.unique(run).tolist():
+            k = run == r
+            self.runs.setdefault(r, _Run()).add(ns[k], t[k], accel[k], gyro[k])
+
+    def of(self, run: int) -> _Run:
+        """The samples of `run` (none yet: empty)."""
+        return self.runs.setdefault(run, _Run())
+
+
 class AgeingTracker:
-    """The windows of the deck and body IMU streams, due once both pass their end."""
+    """The windows of the deck and body IMU streams, due once both pass their end; where the
+    stamps jump back (each stream's n-th run paired with the other's n-th), the window open is
+    fitted once both streams have left the run if it spans half a window, else dropped
+    (counted), and the windows start again from the new run's first body sample."""
 
     def __init__(self, scene: Scene) -> None:
         assert scene.ageing is not None
         self.scene = scene
         self._window_s = scene.ageing.window_s
         self._foundation, self._body = _Record(), _Record()
+        self._run = 0
+        """The run the windows are in."""
         self._start: float | None = None
+        self.dropped = 0
+        """Windows open at a jump back, too short to fit."""
 
     def add_foundation(
         self, ns: np.ndarray, t: np.ndarray, accel: np.ndarray, gyro: np.ndarray
@@ -105,24 +178,54 @@ class AgeingTracker:
         return self._due()
 
     def add_body(
-        self, ns: np.ndarray, t: np.ndarray, accel: np.ndarray, gyro: np.ndarray
+        self,
+        ns: np.ndarray,
+        t: np.ndarray,
+        accel: np.ndarray,
+        gyro: np.ndarray,
+        use: np.ndarray | None = None,
     ) -> list[WindowJob]:
-        """Body IMU samples, as `add_foundation`'s."""
-        if self._start is None and t.shape[0]:
-            self._start = float(t[0]) + LEAD_S
-        self._body.add(ns, t, accel, gyro)
+        """Body IMU samples, as `add_foundation`'s; of them, those `use` marks fitted (all
+        where None: the others, whose specific force is not provided, only tell where a run
+        starts)."""
+        self._body.add(ns, t, accel, gyro, use)
         return self._due()
 
     def _due(self) -> list[WindowJob]:
         jobs = []
-        while (
-            self._start is not None
-            and min(self._foundation.last_t, self._body.last_t) >= self._start + self._window_s
-        ):
-            start, end = self._start, self._start + self._window_s
-            foundation, _ = self._foundation.cut(start - LEAD_S, end)
-            body, stamp_ns = self._body.cut(start, end)
-            self._start = end
-            if foundation.t.shape[0] > 2 and body.t.shape[0] > 2:
-                jobs.append(WindowJob(self.scene, (foundation, body), (start, end), stamp_ns))
-        return jobs
+        while True:
+            foundation, body = self._foundation.of(self._run), self._body.of(self._run)
+            if self._start is None and body.first_t is not None:
+                self._start = body.first_t + LEAD_S
+            while (
+                self._start is not None
+                and min(foundation.last_t, body.last_t) >= self._start + self._window_s
+            ):
+                start, end = self._start, self._start + self._window_s
+                self._start = end
+                jobs += self._job(foundation, body, (start, end))
+            if min(self._foundation.run, self._body.run) <= self._run:
+                return jobs  # the run goes on in a stream
+            stop = min(foundation.last_t, body.last_t)
+            if self._start is not None and stop > self._start:  # a window open at the jump
+                if stop - self._start >= 0.5 * self._window_s:
+                    jobs += self._job(foundation, body, (self._start, stop), cut=True)
+                else:
+                    self.dropped += 1
+            del self._foundation.runs[self._run], self._body.runs[self._run]
+            self._run, self._start = self._run + 1, None
+
+    def _job(
+        self, foundation: _Run, body: _Run, span: tuple[float, float], cut: bool = False
+    ) -> list[WindowJob]:
+        """The job of the window `span` (s; `cut`: one cut short, its end the last sample
+        both streams have), if both records hold more than 2 samples in it."""
+        start, end = span
+        stop = math.nextafter(end, math.inf) if cut else end
+        deck, _ = foundation.cut(start - LEAD_S, stop)
+        measured, stamp_ns = body.cut(start, stop)
+        if deck.t.shape[0] <= 2 or measured.t.shape[0] <= 2:
+            return []
+        return [
+            WindowJob(self.scene, (deck, measured), span, stamp_ns, self._run, self.dropped, cut)
+        ]
