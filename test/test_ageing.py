@@ -342,6 +342,9 @@ def test_the_live_tracker_restarts_where_both_streams_stamps_jump_back(
     assert [s.values[RESETS] for s in statuses] == ["0", "0", "1"]
     assert [s.values[DROPPED] for s in statuses] == ["0", "0", "0"]
     assert [CUT_BY_JUMP in s.message for s in statuses] == [False, True, False]
+    assert statuses[2].message.endswith(
+        "; the stamps jumped back 1× before it, the tracker restarted"
+    )
     assert [LEVEL_NAMES[s.level] for s in statuses] == ["OK", "OK", "ERROR"]
 
 
@@ -350,7 +353,7 @@ def test_a_window_open_at_a_jump_back_too_short_to_fit_is_dropped_and_said(
 ) -> None:
     """Windows of 14 s on the same record: 2–16 and 16–30 s, then 30–34 s open at the jump
     (4 s, less than half a window) is dropped, and the next window, 28–42 s (after the
-    jump), says so; the same in any batching."""
+    jump, ×0.70 within 2 %), says so; the same in any batching."""
     path, messages = jumping
     scene = load_scene_file(path)
     scene = replace(scene, ageing=replace(scene.ageing, window_s=14.0))
@@ -367,3 +370,9 @@ def test_a_window_open_at_a_jump_back_too_short_to_fit_is_dropped_and_said(
     ]
     for feed in FEEDS[1:]:
         assert _same(jobs[feed], jobs["replay"]), feed
+    status = run_job(jobs["replay"][2]).statuses[0]
+    assert float(status.values["stiffness"]) == pytest.approx(0.7, rel=0.02)
+    assert (status.values[RESETS], status.values[DROPPED]) == ("1", "1")
+    assert (
+        "; 1 window(s) open at a jump held less than half a window: not fitted" in status.message
+    )

@@ -71,7 +71,8 @@ def _status(fit: WindowFit) -> HealthStatus:
 def run_job(job: WindowJob) -> HealthReport:
     """The window's fit as a diagnostics report (a plain function of plain data: it runs in a
     worker process live). A window the twin cannot follow is a WARN saying why. Its values
-    say the stamps' jumps back so far (RESETS) and the windows dropped at them (DROPPED)."""
+    say the stamps' jumps back before the window (RESETS) and the windows dropped at them so
+    far (DROPPED), its message too where not 0."""
     ageing = job.scene.ageing
     assert ageing is not None
     band = Band(ageing.warn, ageing.error)
@@ -82,10 +83,13 @@ def run_job(job: WindowJob) -> HealthReport:
         status = HealthStatus(NAME, WARN, f"{span}: not fitted: {err}", {})
     if job.cut:
         status.message += f" ({CUT_BY_JUMP})"
+    if job.restarts:
+        status.message += (
+            f"; the stamps jumped back {job.restarts}× before it, the tracker restarted"
+        )
     if job.dropped:
         status.message += (
-            f"; {job.dropped} window(s) open where the stamps jumped back held less than half "
-            "a window: not fitted"
+            f"; {job.dropped} window(s) open at a jump held less than half a window: not fitted"
         )
     status.values.update({RESETS: str(job.restarts), DROPPED: str(job.dropped)})
     return HealthReport(job.stamp_ns * 1e-9, -1, [status])
