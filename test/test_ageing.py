@@ -376,3 +376,24 @@ def test_a_window_open_at_a_jump_back_too_short_to_fit_is_dropped_and_said(
     assert (
         "; 1 window(s) open at a jump held less than half a window: not fitted" in status.message
     )
+
+
+def test_where_only_the_decks_stamps_jump_back_the_window_open_is_cut_there(
+    jumping: tuple[Path, list[tuple[str, int, bytes]]],
+) -> None:
+    """The deck's stamps jump back at 34 s, the body IMU's go on (another clock): the deck's
+    second run has no body run to pair with. The window open at the jump, 22–34 s, is fitted
+    once the body passes the deck's last stamp before the jump (its later samples belong to no
+    run of the deck's: not kept), and nothing after; the same in any batching."""
+    path, messages = jumping
+    scene = load_scene_file(path)
+    steady = ageing_messages(scene, 56.5, JUMP_AT, "/machine/imu")
+    jumped = iter(m for m in messages if m[0] == "/deck/imu")  # in the record's order
+    mixed = [next(jumped) if m[0] == "/deck/imu" else m for m in steady]
+    jobs = {feed: _jobs(scene, mixed, feed) for feed in FEEDS}
+    assert [(round(j.span[0], 6), round(j.span[1], 2), j.cut) for j in jobs["replay"]] == [
+        (2.0, 22.0, False),
+        (22.0, 34.0, True),
+    ]
+    for feed in FEEDS[1:]:
+        assert _same(jobs[feed], jobs["replay"]), feed

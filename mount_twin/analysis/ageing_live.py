@@ -11,8 +11,10 @@ stamped with the window's last body stamp.
 Where the stamps jump back by more than input.back_jump_reset_s (a bag played with --loop, a
 recorder's clock set back), the twin restarts, and so does the tracker: each stream's n-th
 run is paired with the other's, the window open at the jump is fitted (up to the last sample
-both streams have in the run) if it spans half a window, else dropped and counted, and the
-windows start again from the new run's first body sample plus the lead. Each report says the
+both streams have in the run, known once one stream has left it and the other has reached
+that stamp) if it spans half a window, else dropped and counted, and the windows start again
+from the new run's first body sample plus the lead; a stream's samples of a run the tracker
+is done with (the other stream jumped back, it did not) are not kept. Each report says the
 jumps before its window and the windows dropped so far (`run_job`).
 """
 
@@ -129,6 +131,8 @@ class _Record:
         self.runs: dict[int, _Run] = {}
         self.run = 0
         """The run of the last sample added."""
+        self.floor = 0
+        """The first run kept (the tracker is done with those before)."""
         self._last_ns = 0
 
     def add(
@@ -147,7 +151,7 @@ class _Record:
         self.run, self._last_ns = int(run[-1]), int(ns[-1])
         if use is not None:
             ns, t, accel, gyro, run = ns[use], t[use], accel[use], gyro[use], run[use]
-        for r in np.unique(run).tolist():
+        for r in np.unique(run[run >= self.floor]).tolist():
             k = run == r
             self.runs.setdefault(r, _Run()).add(ns[k], t[k], accel[k], gyro[k])
 
@@ -159,8 +163,9 @@ class _Record:
 class AgeingTracker:
     """The windows of the deck and body IMU streams, due once both pass their end; where the
     stamps jump back (each stream's n-th run paired with the other's n-th), the window open is
-    fitted once both streams have left the run if it spans half a window, else dropped
-    (counted), and the windows start again from the new run's first body sample."""
+    fitted, up to the last sample both streams have in the run, once that is known (a stream
+    has left the run, and the other reached its last stamp there), if it spans half a window,
+    else dropped (counted); the windows start again from the new run's first body sample."""
 
     def __init__(self, scene: Scene) -> None:
         assert scene.ageing is not None
@@ -208,16 +213,20 @@ class AgeingTracker:
                 start, end = self._start, self._start + self._window_s
                 self._start = end
                 jobs += self._job(foundation, body, (start, end))
-            if min(self._foundation.run, self._body.run) <= self._run:
-                return jobs  # the run goes on in a stream
+            records = ((self._foundation, foundation), (self._body, body))
+            ended = [run.last_t for record, run in records if record.run > self._run]
             stop = min(foundation.last_t, body.last_t)
+            if not ended or stop < min(ended):
+                return jobs  # the run goes on in both streams, or in one behind the other
             if self._start is not None and stop > self._start:  # a window open at the jump
                 if stop - self._start >= 0.5 * self._window_s:
                     jobs += self._job(foundation, body, (self._start, stop), cut=True)
                 else:
                     self.dropped += 1
-            del self._foundation.runs[self._run], self._body.runs[self._run]
             self._run, self._start = self._run + 1, None
+            for record, _ in records:
+                record.runs.pop(self._run - 1)
+                record.floor = self._run
 
     def _job(
         self, foundation: _Run, body: _Run, span: tuple[float, float], cut: bool = False
