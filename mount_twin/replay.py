@@ -70,7 +70,7 @@ from mount_twin.io.messages import (
     resolve,
     static_transforms,
 )
-from mount_twin.physics.rotations import quaternion_matrices
+from mount_twin.physics.rotations import angle_text, quaternion_matrices
 from mount_twin.scene.description import Scene, scene_digest
 from mount_twin.stream import TwinStream
 
@@ -249,8 +249,7 @@ class ReplaySummary:
         """The run's motion, peak mount loads and utilisations (a run that accepted samples)."""
         lines = [
             f"  max CG displacement from the first published position "
-            f"{self.displacement_max_m * 1e3:.3f} mm, max tilt "
-            f"{self.tilt_max_rad:.4g} rad ({np.degrees(self.tilt_max_rad):.4f} deg)",
+            f"{self.displacement_max_m * 1e3:.3f} mm, max tilt {angle_text(self.tilt_max_rad)}",
             f"  peak mount loads ({peak_label(self.decimation)}):",
             f"{'':18}{'|F| [N]':>10} {'|M| [N·m]':>10}",  # over `{name:>12}: ` and the figures
         ]

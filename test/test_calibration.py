@@ -524,7 +524,8 @@ def test_records_too_short_to_compare_are_refused_for_that_not_for_their_clocks(
 
 def test_every_figure_calibrate_prints_carries_its_unit() -> None:
     """It printed "lag: 18.89 ms ± 0.29 (1σ)": the 1σ without its unit. A lag of 18.89 ms is
-    0.01889 s; an angle of 1.672° is 0.02918 rad; 12.3 mm is 0.0123 m; scales are factors."""
+    0.01889 s; an angle of 1.672° is 0.02918 rad (printed in rad, degrees beside: "-1.672°" gave
+    no rad), its 1σ 0.62° is 0.0108 rad; 12.3 mm is 0.0123 m; scales are factors."""
     from mount_twin.analysis.calibration import Calibration
     from mount_twin.commands.calibrate import describe
 
@@ -539,7 +540,7 @@ def test_every_figure_calibrate_prints_carries_its_unit() -> None:
     assert describe(cal)[:4] == [
         "stiffness: ×1.23 ± 0.0024 (1σ)",
         "lag: 18.89 ms ± 0.29 ms (1σ)",
-        "yaw: -1.672° ± 0.62° (1σ)",
+        "yaw: -0.02918 rad (-1.672 deg) ± 0.011 rad (0.62 deg) (1σ)",
         "sensor_x: 12.3 mm ± 0.4 mm (1σ)",
     ]
 
@@ -604,3 +605,11 @@ def test_the_plot_names_what_its_axes_hold(tmp_path: Path, monkeypatch) -> None:
         f"body IMU specific force\nalong its {a}, about its mean [m/s²]" for a in "xyz"
     ]
     assert fig.axes[-1].get_xlabel() == "time from the body record's first sample [s]"
+
+
+def test_an_angle_refused_as_too_uncertain_gives_its_1_sigma_in_rad() -> None:
+    """The refusal read "1σ is 12.0°": the angle in degrees only. 12° is 0.2094 rad."""
+    from mount_twin.analysis.calibration import _too_uncertain
+
+    why = _too_uncertain("yaw", math.radians(12.0), 0.1, 0.005)
+    assert why == "1σ is 0.2094 rad (12 deg): the motion has no direction to tell it by"

@@ -4,6 +4,7 @@ of F, rest over the start samples) and the start gravity as the mean of N sample
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -28,6 +29,13 @@ def _steady(f0: np.ndarray, n: int = 20) -> np.ndarray:
     return np.tile(f0, (n, 1))
 
 
+def _said_tilt(message: str) -> tuple[float, float]:
+    """The start tilt a message gives, rad and the degrees beside: "0.5 rad (28.65 deg)"."""
+    said = re.search(r"is (\S+) rad \((\S+) deg\) from \+z of F", message)
+    assert said, message
+    return float(said[1]), float(said[2])
+
+
 def test_a_start_at_rest_passes_and_reports_its_figures() -> None:
     status = _input_status(_steady(REST))
     assert (status.level, status.message) == (OK, "ok")
@@ -38,7 +46,7 @@ def test_a_start_at_rest_passes_and_reports_its_figures() -> None:
 def test_a_sensor_frame_turned_90_degrees_is_an_error_naming_sensor_rpy() -> None:
     status = _input_status(_steady(np.array([G, 0.0, 0.0])))
     assert status.level == ERROR
-    assert "90.0° from +z of F (is input.sensor_rpy right?)" in status.message
+    assert "1.571 rad (90 deg) from +z of F (is input.sensor_rpy right?)" in status.message
     assert float(status.values["start_tilt_rad"]) == pytest.approx(math.pi / 2, rel=1e-5)
 
 
@@ -46,7 +54,7 @@ def test_a_moderate_tilt_is_a_warning() -> None:
     tilt = 0.5  # rad: past the 0.35 rad tolerance, within three times it
     status = _input_status(_steady(G * np.array([0.0, math.sin(tilt), math.cos(tilt)])))
     assert status.level == WARN
-    assert f"{math.degrees(tilt):.1f}° from +z of F" in status.message
+    assert _said_tilt(status.message) == pytest.approx((tilt, math.degrees(tilt)), rel=1e-3)
 
 
 def test_a_start_on_a_shock_pulse_is_an_error() -> None:
@@ -61,14 +69,16 @@ def test_a_start_on_a_shock_pulse_is_an_error() -> None:
 def test_free_fall_read_through_a_bias_is_a_warning_and_a_tilted_bias_an_error() -> None:
     """A record that starts in free fall (true specific force 0) read through a bias: 7.7 m/s²
     on z is 0.785 g (21 % short of g: WARN); the water-entry record's bias (6.0, −4.6, 1.7) m/s²
-    is 0.790 g and 77.3° from +z (ERROR)."""
+    is 0.790 g and 1.35 rad (77.3 deg) from +z (ERROR)."""
     status = _input_status(_steady(np.array([0.0, 0.0, 7.7])))
     assert status.level == WARN
     assert "|f0| = 7.7 m/s² is 0.785 g" in status.message
     status = _input_status(_steady(np.array([6.0, -4.6, 1.7])))
     assert status.level == ERROR
     assert "is 0.79 g" in status.message
-    assert "77.3° from +z of F" in status.message
+    tilt = math.atan2(math.hypot(6.0, -4.6), 1.7)
+    assert _said_tilt(status.message) == pytest.approx((tilt, math.degrees(tilt)), rel=1e-3)
+    assert math.degrees(tilt) == pytest.approx(77.3, abs=0.05)
 
 
 def test_gravity_added_twice_is_named() -> None:

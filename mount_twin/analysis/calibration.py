@@ -47,6 +47,7 @@ from mount_twin.engine.batch import SampleBatch
 from mount_twin.engine.intake import rotated
 from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.io.signals import Signal
+from mount_twin.physics.rotations import angle_text
 from mount_twin.scene.description import BodySensor, LinearMount, Scene, Vec3, Vec6
 
 PARAMETERS = ("stiffness", "damping", "yaw", "lag")
@@ -374,7 +375,7 @@ def _too_uncertain(name: str, sigma: float, value: float, step_s: float) -> str 
     if is_scale(name) and sigma > MAX_REL_SIGMA * value:
         return f"1σ is {sigma / value:.0%} of its value (the record barely moves it)"
     if name in ANGLES and sigma > MAX_YAW_SIGMA_RAD:
-        return f"1σ is {math.degrees(sigma):.1f}° (the motion has no direction to tell it by)"
+        return f"1σ is {angle_text(sigma)}: the motion has no direction to tell it by"
     if name in (*OFFSETS, *CG_OFFSETS) and sigma > MAX_POSITION_SIGMA_M:
         return f"1σ is {sigma * 1e3:.0f} mm (the body barely turns: its point hardly matters)"
     if name == "lag" and sigma > step_s:

@@ -160,20 +160,16 @@ def describe(cal: Calibration) -> list[str]:
     """Each parameter with its 1σ or why it is refused, and the residual before and after;
     every figure in its unit (a scale factor as ×value, its 1σ a plain number): the 1σ had
     none ("lag: 18.89 ms ± 0.29 (1σ)")."""
-    degrees = ("°", 57.29577951308232)
-    millimetres = ("mm", 1e3)
-    units = {"roll": degrees, "pitch": degrees, "yaw": degrees, "lag": ("ms", 1e3)}
-    offsets = ("sensor_x", "sensor_y", "sensor_z", "cg_x", "cg_y", "cg_z")
-    units.update(dict.fromkeys(offsets, millimetres))
+    from mount_twin.analysis.calibration import is_scale
+
     lines = []
     for name, value in cal.values.items():
-        unit, k = units.get(name, ("×", 1.0))  # the rest are scale factors
         if name in cal.sigma:
-            sigma = k * cal.sigma[name]
-            spread = f"{sigma:.2g}" if unit == "×" else _in_unit(sigma, ".2g", unit)
-            lines.append(f"{name}: {_in_unit(k * value, '.4g', unit)} ± {spread} (1σ)")
+            sigma = cal.sigma[name]
+            spread = f"{sigma:.2g}" if is_scale(name) else _in_unit(name, sigma, ".2g")
+            lines.append(f"{name}: {_in_unit(name, value, '.4g')} ± {spread} (1σ)")
         elif name in cal.refused:
-            kept = _in_unit(k * value, "g", unit)
+            kept = _in_unit(name, value, "g")
             lines.append(f"{name}: refused, {cal.refused[name]}; kept at {kept}")
     lines.append(
         f"body sensor, normalised RMS error: {cal.nrms_before:.3f} before, {cal.nrms_after:.3f}"
@@ -182,12 +178,17 @@ def describe(cal: Calibration) -> list[str]:
     return lines
 
 
-def _in_unit(value: float, spec: str, unit: str) -> str:
-    """`value` formatted by `spec` in `unit`: 18.89 ms, -1.672°, or a scale factor ×1.23."""
-    text = format(value, spec)
-    if unit == "×":
-        return f"×{text}"
-    return f"{text}{'' if unit == '°' else ' '}{unit}"
+def _in_unit(name: str, value: float, spec: str) -> str:
+    """Parameter `name`'s `value` (SI) formatted by `spec` in its unit: an angle in
+    rad with degrees beside, a lag in ms, an offset in mm, or a scale factor ×1.23."""
+    from mount_twin.analysis.calibration import ANGLES, is_scale
+    from mount_twin.physics.rotations import angle_text
+
+    if name in ANGLES:
+        return angle_text(value, spec)
+    if is_scale(name):
+        return f"×{value:{spec}}"
+    return f"{value * 1e3:{spec}} {'ms' if name == 'lag' else 'mm'}"  # the rest: s and m
 
 
 def _write_scene(source: str, out: Path, cal: Calibration, lines: list[str]) -> None:

@@ -18,6 +18,7 @@ from mount_twin.engine.estimate import (
 )
 from mount_twin.engine.gyro_filter import Design
 from mount_twin.physics import pose_row
+from mount_twin.physics.rotations import angle_text
 from mount_twin.scene.description import Scene
 from mount_twin.scene.reader import kept_text, shown_text
 
@@ -568,8 +569,8 @@ class HealthWindow:
         return HealthStatus(
             ATTITUDE,
             WARN if self.tilt_max > warn else OK,
-            f"tilt {self.tilt_max:.4g} rad ({math.degrees(self.tilt_max):.3g}°) past "
-            f"outputs.tilt_warn_rad {warn:.4g}: the α/γ/δ chart degrades toward 90°"
+            f"tilt {angle_text(self.tilt_max)} past outputs.tilt_warn_rad {warn:.4g}: the α/γ/δ "
+            f"chart degrades toward {angle_text(math.pi / 2)}"
             if self.tilt_max > warn
             else "ok",
             {TILT_KEY: f"{self.tilt_max:.6g}"},

@@ -22,6 +22,7 @@ from mount_twin.engine.health import HealthWindow
 from mount_twin.engine.restart import start_state
 from mount_twin.engine.rows import BatchRows, Part
 from mount_twin.model.assemble import Model
+from mount_twin.physics.rotations import angle_text
 from mount_twin.scene.description import STANDARD_GRAVITY, InitialState, InputSpec
 
 
@@ -64,7 +65,7 @@ def start_notes(
         notes.append(
             (
                 ERROR if tilt > 3.0 * init.tilt_tolerance_rad else WARN,
-                f"start specific force is {math.degrees(tilt):.1f}° from +z of F "
+                f"start specific force is {angle_text(tilt)} from +z of F "
                 "(is input.sensor_rpy right?)",
             )
         )

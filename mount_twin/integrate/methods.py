@@ -16,7 +16,10 @@ method is dispatched, test/test_core_contract.py that the core has the same ids.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+
+from mount_twin.physics.rotations import angle_text
 
 SUCCESS = 0
 TOO_MANY_STEPS = 1
@@ -29,7 +32,7 @@ STATUS_TEXT: dict[int, str] = {
     SUCCESS: "ok",
     TOO_MANY_STEPS: "too many substeps in one input interval",
     STEP_TOO_SMALL: "step size underflow",
-    LEFT_CHART: "attitude left the α/γ/δ chart (tilt reached 90°)",
+    LEFT_CHART: f"attitude left the α/γ/δ chart: tilt reached {angle_text(math.pi / 2)}",
     NOT_FINITE: "the right-hand side stayed non-finite (NaN/inf) down to the smallest step",
     UNKNOWN_METHOD: "unknown stepper",
 }

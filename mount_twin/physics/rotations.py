@@ -8,6 +8,12 @@ import math
 import numpy as np
 
 
+def angle_text(rad: float, spec: str = ".4g") -> str:
+    """An angle for a human: rad first, degrees beside to read ("0.001723 rad (0.09872 deg)"),
+    both by `spec`."""
+    return f"{rad:{spec}} rad ({math.degrees(rad):{spec}} deg)"
+
+
 def rpy_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
     """Rotation Rz(yaw)·Ry(pitch)·Rx(roll), rad (REP-103 fixed-axis roll, pitch, yaw)."""
     cr, sr = math.cos(roll), math.sin(roll)
