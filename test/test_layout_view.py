@@ -119,13 +119,18 @@ def test_a_shear_keys_line_of_action_is_along_its_stiff_axis_not_z() -> None:
 
 
 @pytest.mark.parametrize("scene_file", ["pump_8_mounts", "genset_bolted_keyed"])
-def test_no_label_runs_into_another(scene_file: str, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_every_label_is_readable(scene_file: str, monkeypatch: pytest.MonkeyPatch) -> None:
     """The pump's side view wrote "F (deck), foundation IMU" across the labels of ml1 and mr1
-    0.3 m on, and the 3-D view its F and IMU labels over each other. In every view, as saved,
-    no two labels' boxes meet."""
+    0.3 m on, and the 3-D view its F and IMU labels over each other; then the pump's end view
+    drew that label's leader over "fl, ml1, ml2, rl", and the genset's side view ran "F (deck),
+    foot_ml, foot_mr, foundation IMU" out past the axes' right edge. In every view, as saved,
+    each label's box lies inside its axes and meets no other label, no other label's leader
+    and no marker (a disc of the marker's size) but its own point's."""
     matplotlib = pytest.importorskip("matplotlib")
     matplotlib.use("Agg")
+    from matplotlib.path import Path as MplPath
     from matplotlib.text import Text
+    from matplotlib.transforms import Bbox
 
     from mount_twin import figure_files
     from mount_twin.analysis.layout_view import draw_layout
@@ -143,13 +148,39 @@ def test_no_label_runs_into_another(scene_file: str, monkeypatch: pytest.MonkeyP
     draw_layout(load_scene_file(CONFIG / f"{scene_file}.scene.yaml"), "unused.png")
     (fig,) = saved
     renderer = fig.canvas.get_renderer()
+    page = fig.bbox
     for ax in fig.axes:
-        boxes = [
-            (t.get_text(), Text.get_window_extent(t, renderer))  # the text, not its leader
-            for t in ax.texts
-            if t.get_text().strip()
+        view, frame = ax.get_title(), ax.get_window_extent(renderer)
+        labels = [t for t in ax.texts if t.get_text().strip()]
+        assert len(labels) >= 4, view
+        boxes = [Text.get_window_extent(t, renderer) for t in labels]  # the text alone
+        leaders = [  # as drawn, in pixels
+            t.arrow_patch.get_transform().transform_path(t.arrow_patch.get_path()) for t in labels
         ]
-        assert len(boxes) >= 4, ax.get_title()
-        for k, (a, box_a) in enumerate(boxes):
-            for b, box_b in boxes[k + 1 :]:
-                assert not box_a.overlaps(box_b), f"{ax.get_title()}: {a!r} meets {b!r}"
+        markers = [  # (centre, radius) in pixels, of every scatter marker as drawn
+            (centre, np.sqrt(size) / 2.0 * renderer.points_to_pixels(1.0))
+            for c in ax.collections
+            for centre, size in zip(
+                c.get_offset_transform().transform(c.get_offsets()),
+                np.broadcast_to(c.get_sizes(), len(c.get_offsets())),
+                strict=True,
+            )
+        ]
+        for label, box in zip(labels, boxes, strict=True):
+            name = f"{view}: {label.get_text()!r}"
+            assert page.x0 <= box.x0 and box.x1 <= page.x1, f"{name} leaves the figure"
+            assert frame.x0 <= box.x0 and box.x1 <= frame.x1, f"{name} leaves the axes"
+            assert frame.y0 <= box.y0 and box.y1 <= frame.y1, f"{name} leaves the axes"
+            own = ax.transData.transform(label.xy)  # its point's pixels
+            for other, other_box, leader in zip(labels, boxes, leaders, strict=True):
+                if other is label:
+                    continue
+                assert not box.overlaps(other_box), f"{name} meets {other.get_text()!r}"
+                assert not MplPath(leader.vertices).intersects_bbox(box), (
+                    f"{name} is crossed by the leader of {other.get_text()!r}"
+                )
+            for centre, radius in markers:
+                if np.hypot(*(centre - own)) < 1.0:
+                    continue  # its own point's marker, which its leader starts at
+                disc = Bbox.from_extents(*(centre - radius), *(centre + radius))
+                assert not box.overlaps(disc), f"{name} covers the marker at {centre}"

@@ -70,14 +70,17 @@ def draw_layout(scene: Scene, png: str | Path) -> Path:
     _draw_scene(views, scene)
     kinds = sorted({m.kind for m in scene.mounts})
     _dress(views, kinds)
-    fig.tight_layout()  # the axes where they are drawn: labels are placed apart on the page
-    views.annotate(fig.canvas.get_renderer())
     fig.suptitle(
         f"{scene.name}: {scene.body.mass:g} kg, {len(scene.mounts)} mounts "
         f"({', '.join(kinds)}), "
         f"DOFs {', '.join(scene.dofs)} — {scene.source}",
         fontsize=10,
     )
+    # The axes where save_png's layout draws them (the title too takes its room) and their tick
+    # labels where drawing puts them: labels are placed apart on the page.
+    fig.tight_layout()
+    fig.canvas.draw()
+    views.annotate(fig.canvas.get_renderer())
     return save_png(fig, png)
 
 
@@ -115,9 +118,10 @@ class _Views:
             )
 
     def annotate(self, renderer: Any) -> None:
-        """Every view's point labels, one per position, none on another nor on another point
-        (`_place_apart`); in 3-D at the points' projections onto the page, so call it once the
-        views' limits and layout are final."""
+        """Every view's point labels, one per position, each where it meets no other label, no
+        leader, no labelled point and stays inside its axes (`_place_apart`); in 3-D at the
+        points' projections onto the page, so call it once the views' limits and layout are
+        final."""
         from mpl_toolkits.mplot3d import proj3d
 
         proj = self.ax3.get_proj()
@@ -125,10 +129,10 @@ class _Views:
         for ax, named in ((self.ax3, flat3), *zip(self.flat, self.labels, strict=True)):
             labels = [
                 ax.annotate(
-                    ", ".join(names),
+                    label_text(names),
                     (u, v),
                     fontsize=7,
-                    xytext=LABEL_OFFSET,
+                    xytext=(0.0, 0.0),  # placed by _place_apart
                     textcoords="offset points",
                     arrowprops={"arrowstyle": "-", "color": "0.5", "lw": 0.5, "shrinkA": 0},
                     bbox={"boxstyle": "square,pad=0.1", "fc": "white", "ec": "none", "alpha": 0.7},
@@ -140,37 +144,104 @@ class _Views:
             _place_apart(ax, labels, renderer)
 
 
-LABEL_OFFSET = (4.0, 4.0)
-"""A point label's place from its point, points (1/72 in): up and to the right."""
-LABEL_GAP = 2.0
+LABEL_LINE = 24
+"""A point label's longest line, characters: the names of the points at one place are wrapped
+onto lines of at most this (a name longer than it has a line of its own)."""
+LABEL_GAP = 5.0
 """The least space between two labels, or a label and a labelled point, points."""
+LABEL_OFFSETS = (4.0, 10.0, 18.0, 30.0, 45.0, 65.0, 90.0, 120.0)
+"""A point label's distances from its point tried in turn, points (1/72 in)."""
+LABEL_SIDES = ((1, 1), (1, -1), (-1, 1), (-1, -1), (0, 1), (0, -1), (1, 0), (-1, 0))
+"""The sides of its point a label is tried on at each distance, in turn: up right, down right,
+up left, down left, above, below, right, left."""
+
+
+def label_text(names: list[str]) -> str:
+    """The label of the points named `names`: the names, comma separated, wrapped onto lines of
+    at most LABEL_LINE characters, never within a name."""
+    lines = [names[0]]
+    for name in names[1:]:
+        if len(lines[-1]) + len(name) + 2 > LABEL_LINE:
+            lines[-1] += ","
+            lines.append(name)
+        else:
+            lines[-1] += f", {name}"
+    return "\n".join(lines)
 
 
 def _place_apart(ax: Any, labels: list[Any], renderer: Any) -> None:
-    """Move each of `labels` (annotations in offset points) up, in turn, until its box meets no
-    label placed before it nor any labelled point (a LABEL_GAP square around it), a grey line
-    leading back to its point: labels of points close on the page (the pump's F, its IMU and
-    the mounts 0.3 m on in the side view) ran into one another."""
+    """Place each of `labels` (annotations in offset points) in turn at the first of the
+    LABEL_OFFSETS × LABEL_SIDES places where its box lies inside `ax`, meets no label placed
+    before it, no labelled point (a LABEL_GAP square around it) and no leader of another label,
+    and its own leader (the grey line back to its point) crosses no other label nor passes
+    through another point; where none is free, at the place with the fewest such conflicts.
+    Labels of points close on the page (the pump's F, its IMU and the mounts 0.3 m on; the
+    genset's feet and keys) ran into one another, their leaders through other labels, or out
+    of the axes."""
+    from matplotlib.path import Path as MplPath
     from matplotlib.text import Text
     from matplotlib.transforms import Bbox
 
-    def text_box(label: Any) -> Bbox:  # the text's alone, not with its leading line
-        label.update_positions(renderer)  # where its offset now puts it
-        return Text.get_window_extent(label, renderer)
-
     scale = renderer.points_to_pixels(1.0)
     gap = LABEL_GAP * scale
+    frame = ax.get_window_extent(renderer)
     points = [ax.transData.transform(label.xy) for label in labels]
-    taken = [Bbox.from_extents(x - gap, y - gap, x + gap, y + gap) for x, y in points]
-    for label in labels:
-        for _ in range(len(labels) + 1):  # each step clears one box at least
-            box = text_box(label).padded(gap / 2.0)
-            hit = [b for b in taken if box.overlaps(b)]
-            if not hit:
+    marks = [Bbox.from_extents(x - gap, y - gap, x + gap, y + gap) for x, y in points]
+    # A leader may pass near another point, not through it (as if it led there).
+    dots = [Bbox.from_extents(x, y, x, y).padded(gap / 2.0) for x, y in points]
+    marks += [  # the axes' ticks and tick labels too: the 3-D view's lie within its axes
+        box.padded(gap / 2.0)
+        for axis in (ax.xaxis, ax.yaxis, getattr(ax, "zaxis", ax.xaxis))
+        if (box := axis.get_tightbbox(renderer)) is not None
+    ]
+    boxes: list[Any] = []  # the labels placed so far, padded
+    leaders: list[Any] = []  # and their leaders
+
+    def conflicts(k: int, box: Any, leader: Any) -> int:
+        inside = frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0
+        inside = inside and box.y1 <= frame.y1
+        others = marks[:k] + marks[k + 1 :]  # its own point's square excepted
+        return (
+            (not inside)
+            + sum(box.overlaps(b) for b in (*others, *boxes))
+            + sum(line.intersects_bbox(box) for line in leaders)
+            + sum(leader.intersects_bbox(b) for b in (*dots[:k], *dots[k + 1 :], *boxes))
+        )
+
+    for k, (label, (x, y)) in enumerate(zip(labels, points, strict=True)):
+        best: tuple[int, Any, Any, tuple[float, float, str, str]] | None = None
+        for offset in LABEL_OFFSETS:
+            for sx, sy in LABEL_SIDES:
+                place = (
+                    sx * offset,
+                    sy * offset,
+                    ("center", "left", "right")[sx],
+                    ("center", "bottom", "top")[sy],
+                )
+                _put(label, place)
+                label.update_positions(renderer)  # where this place puts it
+                box = Text.get_window_extent(label, renderer).padded(gap / 2.0)
+                leader = MplPath([(x, y), ((box.x0 + box.x1) / 2, (box.y0 + box.y1) / 2)])
+                n = conflicts(k, box, leader)
+                if best is None or n < best[0]:
+                    best = (n, box, leader, place)
+                if n == 0:
+                    break
+            if best is not None and best[0] == 0:
                 break
-            dx, dy = label.xyann
-            label.xyann = (dx, dy + (max(b.y1 for b in hit) - box.y0) / scale + LABEL_GAP / 2.0)
-        taken.append(text_box(label))
+        assert best is not None  # LABEL_OFFSETS and LABEL_SIDES are not empty
+        _, box, leader, place = best
+        _put(label, place)
+        boxes.append(box)
+        leaders.append(leader)
+
+
+def _put(label: Any, place: tuple[float, float, str, str]) -> None:
+    """Move `label` (an annotation in offset points) to `place`: its offset from its point,
+    points, and its horizontal and vertical alignment there."""
+    label.xyann = place[:2]
+    label.set_horizontalalignment(place[2])
+    label.set_verticalalignment(place[3])
 
 
 def _draw_scene(views: _Views, scene: Scene) -> None:
