@@ -107,7 +107,7 @@ class FixedLayout:
     def pack(self, columns: Sequence[np.ndarray]) -> list[bytes]:
         """One message per row of the columns (`pack_rows`), each its own bytes."""
         if len(columns[0]) == 1:  # a live sample: struct beats numpy's per-call overhead
-            return [self._pack_one([v for c in columns for v in c.reshape(-1).tolist()])]
+            return [self.pack_one([v for c in columns for v in c.reshape(-1).tolist()])]
         return split_rows(self.pack_rows(columns))
 
     def pack_rows(self, columns: Sequence[np.ndarray]) -> np.ndarray:
@@ -130,8 +130,8 @@ class FixedLayout:
             f += m
         return rows
 
-    def _pack_one(self, values: list[float | int]) -> bytes:
-        """One message of its field values, in field order."""
+    def pack_one(self, values: list[float | int]) -> bytes:
+        """One message of its field values (Python numbers), in field order."""
         buf = bytearray(self._template_bytes)
         for start, end, packer in self._runs:
             packer.pack_into(buf, self.fields[start][0], *values[start:end])
