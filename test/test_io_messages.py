@@ -76,6 +76,44 @@ def test_imu_messages_decode_back_to_the_same_stamps_vectors_and_frames() -> Non
     assert dec.frame_ids == ["deck_imu"] * 50
 
 
+@pytest.mark.parametrize("n", [1, 2, 5, 8, 9])
+def test_a_wake_ups_few_messages_decode_as_rosbags_reads_them(n: int) -> None:
+    """A live wake-up's few messages are read one by one against the last layout: each must
+    give what rosbags reads from it, a reading marked not provided (-1) marked so, and a
+    message of another frame_id among them decoded too."""
+    stamps, accel, gyro = rng_signal(n)
+    unprovided = np.zeros((n, 2), bool)
+    unprovided[-1, 1] = True
+    decode_inputs(
+        [raw for _, raw in imu_messages(stamps[:1], accel[:1], gyro[:1], "deck_imu")], IMU
+    )
+    for frames in (["deck_imu"] * n, ["deck_imu"] * (n - 1) + ["other"]):
+        raws = [
+            raw
+            for i, frame in enumerate(frames)
+            for _, raw in imu_messages(
+                stamps[i : i + 1], accel[i : i + 1], gyro[i : i + 1], frame, unprovided[i : i + 1]
+            )
+        ]
+        truth = [TYPESTORE.deserialize_cdr(raw, IMU) for raw in raws]
+        dec = decode_inputs(raws, IMU)
+        assert dec.undecodable == 0 and dec.frame_ids == [m.header.frame_id for m in truth]
+        np.testing.assert_array_equal(
+            dec.stamps_ns, [m.header.stamp.sec * 10**9 + m.header.stamp.nanosec for m in truth]
+        )
+        a = [
+            [m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z]
+            for m in truth
+        ]
+        w = [[m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z] for m in truth]
+        np.testing.assert_array_equal(dec.accel, a)
+        np.testing.assert_array_equal(dec.gyro, w)
+        np.testing.assert_array_equal(dec.stamps_ns, stamps)
+        assert dec.unprovided is not None
+        np.testing.assert_array_equal(dec.unprovided, unprovided)
+        assert dec.accel.flags.c_contiguous and dec.gyro.flags.c_contiguous
+
+
 def _scans(monkeypatch: pytest.MonkeyPatch) -> dict[str, int]:
     """Count the layouts probed and the rows their unpacks scan (FixedLayout's), from no
     layout known (the messages to decode made before: their making probes layouts)."""
