@@ -340,15 +340,26 @@ def _one_row_batch(scene, stamp_s: float = 0.25, health=None) -> OutputBatch:
     return OutputBatch(np.array([stamp_s]), np.array([0]), pose, wrenches, health or [])
 
 
-def test_encoded_outputs_have_the_right_topics_types_frames_and_values() -> None:
+@pytest.mark.parametrize("n_rows", [1, 3, 9])  # a live sample, a live wake-up's few, a block
+def test_encoded_outputs_have_the_right_topics_types_frames_and_values(n_rows: int) -> None:
     scene = default_scene()
-    want_ns = START_NS + 123_456_789
-    out = _one_row_batch(scene, stamp_s=0.123456789)
-    msgs = encode_outputs(scene, out, np.array([want_ns]))
+    one = _one_row_batch(scene, stamp_s=0.123456789)
+    k = np.arange(n_rows)
+    want = START_NS + 123_456_789 + k * 1_000_001
+    out = OutputBatch(
+        one.stamps + k * 1.000001e-3,
+        k,
+        one.pose + k[:, None] * 1e-3,
+        one.wrenches - k[:, None, None] * 3.0,
+        [],
+    )
+    msgs = encode_outputs(scene, out, want)
     wrench_topics = [f"~/mounts/{m.name}/wrench" for m in scene.mounts]
     types = output_types(scene)
-    assert [t for t, _, _ in msgs] == ["~/pose", "~/angles", *wrench_topics, "/tf"]
-    for topic, stamp, raw in msgs:
+    assert [t for t, _, _ in msgs] == ["~/pose", "~/angles", *wrench_topics, "/tf"] * n_rows
+    for j, (topic, stamp, raw) in enumerate(msgs):
+        row = j // (len(wrench_topics) + 3)
+        want_ns = int(want[row])
         msg = TYPESTORE.deserialize_cdr(raw, types[topic])
         stamped = msg.transforms[0] if types[topic] == TF else msg
         assert stamp == want_ns and stamp_ns(stamped) == want_ns
@@ -357,21 +368,21 @@ def test_encoded_outputs_have_the_right_topics_types_frames_and_values() -> None
                 types[topic] == POSE and msg.header.frame_id == scene.frames.foundation == "deck"
             )
             p, q = msg.pose.position, msg.pose.orientation
-            assert [p.x, p.y, p.z, q.x, q.y, q.z, q.w] == out.pose[0, :7].tolist()
+            assert [p.x, p.y, p.z, q.x, q.y, q.z, q.w] == out.pose[row, :7].tolist()
         elif topic == "~/angles":
             assert types[topic] == VECTOR3 and msg.header.frame_id == "deck"
-            assert [msg.vector.x, msg.vector.y, msg.vector.z] == out.pose[0, 7:].tolist()
+            assert [msg.vector.x, msg.vector.y, msg.vector.z] == out.pose[row, 7:].tolist()
         elif topic == "/tf":
             assert types[topic] == TF and len(msg.transforms) == 1
             tf = msg.transforms[0]
             assert (tf.header.frame_id, tf.child_frame_id) == ("deck", "pump")
             p, q = tf.transform.translation, tf.transform.rotation
-            assert [p.x, p.y, p.z, q.x, q.y, q.z, q.w] == out.pose[0, :7].tolist()
+            assert [p.x, p.y, p.z, q.x, q.y, q.z, q.w] == out.pose[row, :7].tolist()
         else:
             i = wrench_topics.index(topic)
             assert types[topic] == WRENCH and msg.header.frame_id == scene.mounts[i].name
             f, c = msg.wrench.force, msg.wrench.torque
-            assert [f.x, f.y, f.z, c.x, c.y, c.z] == out.wrenches[0, i].tolist()
+            assert [f.x, f.y, f.z, c.x, c.y, c.z] == out.wrenches[row, i].tolist()
 
 
 def test_the_output_registry_has_one_entry_per_output_flag_of_a_scene() -> None:
