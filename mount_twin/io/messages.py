@@ -149,9 +149,10 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
     if 0 < n <= ONE_BY_ONE_MAX and msgtype in _LAST_FRAME:
         frame = _LAST_FRAME[msgtype]
         layout, want = _layout(msgtype, frame), _INPUT_WANT[msgtype]
-        rows = [layout.unpack_one(raw, want) for raw in raws]
-        if all(row is not None for row in rows):
-            return _decoded_rows(rows, msgtype, frame)  # type: ignore[arg-type]
+        ones = [layout.unpack_one(raw, want) for raw in raws]
+        read = [one for one in ones if one is not None]
+        if len(read) == n:
+            return _decoded_rows(read, msgtype, frame)
     stamps = np.zeros(n, dtype=np.int64)
     accel, gyro, covariance = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 2))
     frames = np.full(n, "", dtype=object)
