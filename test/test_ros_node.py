@@ -14,6 +14,7 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -932,15 +933,13 @@ def test_the_node_wakes_its_executor_only_for_work() -> None:
         for raw in _imu(*_at_rest(50)):
             pub.publish(raw)
         counts = node.stream.engine.counts
-        deadline = time.monotonic() + 30.0
-        while counts["accepted"] < 50 and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.01)
-        assert counts["accepted"] == 50
+        _spin_until_accepted(executor, counts, 50)
         for _ in range(10):  # input has stopped: the next period finds nothing and stops it
             executor.spin_once(timeout_sec=0.01)
         assert timer.is_canceled() and not node._pending
         for raw in _imu(*_at_rest(5, STAMP0 + 50_000_000)):  # input again: running again
             pub.publish(raw)
+        deadline = time.monotonic() + 30.0
         while not node._pending and time.monotonic() < deadline:
             executor.spin_once(timeout_sec=0.01)
         assert node._pending and not timer.is_canceled()
@@ -1087,10 +1086,7 @@ def test_a_second_stop_leaves_the_backlog_unprocessed_and_the_last_report_counts
         for raw in _imu(stamps[:200], accel[:200]):
             pub.publish(raw)
         counts = node.stream.engine.counts
-        deadline = time.monotonic() + 30.0
-        while counts["accepted"] < 200 and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.01)
-        assert counts["accepted"] == 200
+        _spin_until_accepted(executor, counts, 200)
         for raw in _imu(stamps[200:], accel[200:]):
             pub.publish(raw)
         assert pub.wait_for_all_acked(Duration(seconds=30.0))  # all in the node's queue
@@ -1110,3 +1106,12 @@ def test_a_second_stop_leaves_the_backlog_unprocessed_and_the_last_report_counts
     level, msg, values = {n: (lv, m, v) for n, lv, m, v in statuses}["mount_twin: input"]
     assert (values["received"], values["lost_unprocessed_at_stop"]) == ("200", "3000")
     assert level == ERROR and "reported lost_unprocessed_at_stop 3000" in msg, msg
+
+
+def _spin_until_accepted(executor: Any, counts: Mapping[str, int], n: int) -> None:
+    """Spin the node's executor (in this process) until its engine has accepted `n` input
+    samples (30 s at most): they are all in the twin."""
+    deadline = time.monotonic() + 30.0
+    while counts["accepted"] < n and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.01)
+    assert counts["accepted"] == n
