@@ -642,3 +642,50 @@ def test_a_body_imu_whose_every_message_is_rejected_is_reported_after_a_jump_bac
     counted = [int(values["body_rejected_wrong_frame_id"]) for _, _, values in runs[1]]
     assert counted == [1000, 200, 1000]  # 0–5 s, 5–6 s, -2–3 s at 200 Hz
     assert all(level == WARN for level, _, _ in runs[1])
+
+
+@pytest.mark.parametrize("first", ["deck", "body"])
+def test_stamps_jumping_back_apart_are_said_and_not_held(first: str) -> None:
+    """One stream's stamps jump back 8 s at 6 s, the other's go on to 12 s (a body IMU on
+    another clock, a recorder restarted): the runs never pair again. Every later body sample
+    was counted unanswered (the deck jumped) or held waiting for a twin run that never came
+    (the body jumped), and nothing said why. Now, once the other stream's stamps pass the
+    jump by more than input.back_jump_reset_s (1 s), a WARN says which stream jumped back and
+    when, and the body samples past that pairing are counted jumped_back_apart, held no more;
+    the same however the streams come."""
+    scene, deck = _pump(), _deck(12.0)
+    steady = _stamps(deck)
+    jumped = steady - np.where(deck.t >= 6.0, 8_000_000_000, 0)
+    deck_ns, body_ns = (jumped, steady) if first == "deck" else (steady, jumped)
+    body = _body_raws(body_ns, np.zeros((steady.shape[0], 6)))
+    deck_raws = [r for _, r in imu_messages(deck_ns, deck.accel, deck.gyro, "deck_imu")]
+    streams = [TwinStream(scene) for _ in range(2)]
+    runs = [
+        _interleaved(scene, deck_raws, deck_ns, (body, body_ns)),
+        _chunked(scene, deck_raws, body, 700, body_first=True),
+        _chunked(scene, deck_raws, body, 333, body_first=False),
+        streams[0].process(deck_raws) + streams[0].process_body(body) + streams[0].finish(),
+        streams[1].process_body(body) + streams[1].process(deck_raws) + streams[1].finish(),
+    ]
+    kept = [[m for m in run if m[0] != DIAGNOSTICS_TOPIC or NAME.encode() in m[2]] for run in runs]
+    assert all(sorted(k) == sorted(kept[0]) for k in kept[1:])
+    # the last stamp before the jump on the twin's time base (from the first deck stamp's
+    # whole second)
+    end = 6.0 - 1 / RATE + NS0 % 10**9 * 1e-9
+    apart = [w for w in _windows(runs[0]) if "jumped back apart" in w[1]]
+    assert len(apart) == 1
+    level, message, values = apart[0]
+    assert level == WARN
+    assert values == {"jumped_back_first": first, "jumped_back_at_s": f"{end:.3f}"}
+    name = {"deck": "the deck's", "body": "the body IMU's"}[first]
+    assert f"{name} jumped back at {end:.3f} s" in message
+    # the deck jumped: body samples up to its last stamp compared, those within 1 s after it
+    # unanswered, the rest apart; the body jumped: those before its jump compared, not after
+    t = deck.t
+    within = (t > 6.0 - 1e-9) & (t <= 7.0 - 1 / RATE + 1e-9) if first == "deck" else t < 0
+    for stream in streams:
+        assert stream.body is not None
+        counts = stream.body.counts
+        assert counts["compared"] == (t < 6.0).sum()
+        assert counts["unanswered"] == within.sum()
+        assert counts["jumped_back_apart"] == (t >= 6.0).sum() - within.sum()

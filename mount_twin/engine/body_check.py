@@ -24,7 +24,9 @@ Where the twin restarts because the deck's stamps jumped back (more than
 input.back_jump_reset_s: a bag played with --loop), its rows' stamps go back: the stages
 restart with it, the body stream at its own jump back (`BodyCheck.screen`), each of its runs
 matched with the twin's of the same rank (`_Matcher`), the window open at the jump closed as
-the stream's last is.
+the stream's last is. Where only one of them jumps back (`Apart`: the other's stamps went
+on past the jump by more than back_jump_reset_s), the runs never pair again: a WARN says so
+once, and the body samples past the pairing are counted `APART`, not held.
 
 Beside them, `_Refusals` watches the body messages themselves, in windows of the same length
 on their own stamps: a window in which every message was rejected (another frame_id, …) is a
@@ -72,9 +74,92 @@ each restarting the comparison (`BodyCheck.screen`)."""
 UNPROVIDED = ("unprovided_acceleration", "unprovided_angular_velocity")
 """The counts of accepted body messages that mark their acceleration, their angular velocity
 not provided (REP-145): compared on the other reading alone."""
-PROBLEMS = ("before_twin", "late", "in_gap", "unanswered", "dropped_waiting", "lost_middleware")
+APART = "jumped_back_apart"
+PROBLEMS = (
+    "before_twin",
+    "late",
+    "in_gap",
+    "unanswered",
+    "dropped_waiting",
+    "lost_middleware",
+    APART,
+)
 """Why a body sample accepted was not compared: before the twin's first row, behind the kept
-predictions, inside a gap of the twin's rows, after its last row, or held too long."""
+predictions, inside a gap of the twin's rows, after its last row, held too long, or after the
+body IMU's and the deck's stamps jumped back apart (`Apart`)."""
+
+
+class Apart:
+    """Whether the deck's and the body IMU's stamps jumped back apart: the n-th runs of the
+    two streams (their stamps split where they go back) are paired, and they are out of step
+    once one stream has left run n (jumped back) and the other's stamps of run n have gone
+    more than input.back_jump_reset_s past its last one there (a body IMU on another clock
+    than the deck, a recorder restarted). In a bag played with --loop both streams jump back
+    within a few ms of stamps of each other: in step. Stamps alone decide, so the answer is
+    the same however the streams come batched or interleaved. The body's stamps are taken
+    less body_sensor.lag_s (the motion they measured)."""
+
+    def __init__(self, reset_s: float, lag_s: float) -> None:
+        self._reset, self._lag = reset_s, lag_s
+        self._run = {"deck": 0, "body": 0}
+        self._ends: dict[str, dict[int, float]] = {"deck": {}, "body": {}}
+        """Per stream, the latest stamp (s) of each run not yet found in step."""
+        self._paired = 0
+        """The first run not yet found in step."""
+        self.found: tuple[str, int, float] | None = None
+        """(the stream that jumped back first, 'deck' or 'body'; the run it left; its last
+        stamp there, s) once out of step (None: in step so far)."""
+
+    def add(self, stream: str, t: np.ndarray) -> None:
+        """Stamps (s, on the twin's time base) of `stream` ('deck', 'body'), in its order: a
+        stamp before the one before it starts a new run."""
+        if not t.shape[0] or self.found is not None:
+            return
+        t = t - self._lag if stream == "body" else t
+        ends, last = self._ends[stream], self._ends[stream].get(self._run[stream], -math.inf)
+        run = self._run[stream] + np.cumsum(t < np.concatenate([[last], t[:-1]]))
+        for r in np.unique(run).tolist():
+            ends[r] = float(t[run == r][-1])
+        self._run[stream] = int(run[-1])
+        self._check()
+
+    def _check(self) -> None:
+        run = self._paired
+        while self.found is None:
+            left = {s: self._run[s] > run for s in self._run}
+            for first, other in (("deck", "body"), ("body", "deck")):
+                end, beyond = self._ends[first].get(run), self._ends[other].get(run)
+                known = left[first] and end is not None and beyond is not None
+                if known and beyond > end + self._reset:
+                    self.found = (first, run, end)
+            if self.found is not None or not all(left.values()):
+                break
+            for ends in self._ends.values():
+                ends.pop(run, None)
+            run = self._paired = run + 1
+
+    def beyond(self, t: np.ndarray, run: np.ndarray) -> np.ndarray:
+        """Of body samples (stamps s, runs), those (bool) past the pairing: in a run after the
+        one the streams went apart at, or in it more than back_jump_reset_s past the deck's
+        last stamp there (all False while in step)."""
+        if self.found is None:
+            return np.zeros(t.shape[0], bool)
+        _, n, _ = self.found
+        deck = self._ends["deck"].get(n, math.inf)
+        return (run > n) | ((run == n) & (t - self._lag > deck + self._reset))
+
+    def message(self) -> str:
+        """What the streams did, once out of step."""
+        assert self.found is not None
+        first, run, end = self.found
+        names = {"deck": "the deck's", "body": "the body IMU's"}
+        other = names["body" if first == "deck" else "deck"]
+        return (
+            f"the body IMU's and the deck's stamps jumped back apart: {names[first]} jumped "
+            f"back at {end:.3f} s (after its run {run}), {other} went on past "
+            f"{end + self._reset:.3f} s (input.back_jump_reset_s later; the body's less "
+            f"body_sensor.lag_s, s of the twin's time base): their runs no longer pair"
+        )
 
 
 @dataclass
@@ -243,8 +328,13 @@ class _Matcher:
     run the twin has ended is unanswered, as one past the stream's last row is (the two
     recorders never stop together); one of a run the twin never had a row in, before_twin."""
 
-    def __init__(self, lag_s: float, max_gap_s: float, problems: Counter[str]) -> None:
+    def __init__(
+        self, lag_s: float, max_gap_s: float, problems: Counter[str], apart: Apart
+    ) -> None:
         self._lag, self._max_gap, self._problems = lag_s, max_gap_s, problems
+        self._apart = apart
+        self.first_apart_ns: int | None = None
+        """The stamp of the first body sample counted APART, ns (None: none yet)."""
         self._pred: dict[int, _Series] = {0: _Series()}
         """The predictions of each of the twin's runs a body sample may still need."""
         self._rows_run = 0
@@ -260,7 +350,8 @@ class _Matcher:
 
     def add_predictions(self, t: np.ndarray, v: np.ndarray) -> None:
         series = self._pred.get(self._rows_run)
-        if t.shape[0] and series is not None:  # None: the body stream is past this run
+        if t.shape[0] and series is not None and self._apart.found is None:
+            # (None: the body stream is past this run; apart: no body sample will need it)
             series.append(t, v)
 
     def restart_rows(self) -> None:
@@ -300,9 +391,10 @@ class _Matcher:
         tau = t - self._lag
         why = np.full(t.shape[0], "", dtype=object)
         pred = np.zeros((t.shape[0], 6))
+        paired = int(np.argmax(beyond)) if (beyond := self._apart.beyond(t, run)).any() else None
         done = 0  # the samples decided: a prefix
-        for r in np.unique(run).tolist():
-            stop = done + int((run[done:] == r).sum())  # runs rise
+        for r in np.unique(run[:paired]).tolist():
+            stop = done + int((run[done:paired] == r).sum())  # runs rise
             series = self._pred.get(r) if r <= self._rows_run else None
             ended = r < self._rows_run
             if series is None or series.first is None:
@@ -319,6 +411,11 @@ class _Matcher:
             done = covered
             if done < stop:
                 break
+        if paired is not None and done == paired:  # the rest (a suffix) will never pair
+            why[paired:] = APART
+            done = t.shape[0]
+            if self.first_apart_ns is None:
+                self.first_apart_ns = int(ns[paired])
         left = t.shape[0] - done
         if final:
             self._problems["unanswered"] += left
@@ -326,7 +423,7 @@ class _Matcher:
         self._body = [rest] if left and not final else []
         first = self.taken
         self.taken += done + (left if final else 0)
-        for reason in ("before_twin", "late", "in_gap", "unanswered"):
+        for reason in ("before_twin", "late", "in_gap", "unanswered", APART):
             self._problems[reason] += int((why[:done] == reason).sum())
         self._forget()
         return _Taken(
@@ -374,7 +471,7 @@ class _Matcher:
         """Drop the predictions no future body sample needs: the runs before the first body
         sample waiting (none waiting: before the last added), and in each run kept those
         more than RETAIN_S behind its newest."""
-        oldest = self._oldest()
+        oldest = math.inf if self._apart.found is not None else self._oldest()
         for r in [r for r in self._pred if r < oldest]:
             del self._pred[r]
         for series in self._pred.values():
@@ -666,7 +763,9 @@ class BodyCheck:
             return np.hstack([f, w])
 
         self._lead = _Lead(predict)
-        self._matcher = _Matcher(sensor.lag_s, scene.input.max_gap_s, self.counts)
+        self._apart = Apart(scene.input.back_jump_reset_s, sensor.lag_s)
+        self._said_apart = False
+        self._matcher = _Matcher(sensor.lag_s, scene.input.max_gap_s, self.counts, self._apart)
         self._windows = _Windows(sensor, self.counts)
         self._refusals = _Refusals(sensor, self._back_ns)
 
@@ -741,6 +840,7 @@ class BodyCheck:
         rate (rad/s, F) at each; a row stamped before the one before it starts a new run of
         the twin (a restart where the deck's stamps jumped back)."""
         rows = _Rows(t, pose, wrenches, rate)
+        self._apart.add("deck", t)
         back = set(np.flatnonzero(t < np.concatenate([[self._last_row_t], t[:-1]])).tolist())
         if t.shape[0]:
             self._last_row_t = float(t[-1])
@@ -760,6 +860,7 @@ class BodyCheck:
         self.counts["accepted"] += int(ns.shape[0])
         for key, given in zip(UNPROVIDED, present.T, strict=True):
             self.counts[key] += int((~given).sum())
+        self._apart.add("body", t)
         self._matcher.add_body(ns, t, measured, present)
         return self._compared()
 
@@ -780,4 +881,14 @@ class BodyCheck:
         residual = compared.measured - compared.predicted
         residual[~np.repeat(compared.present, 3, axis=1)] = np.nan
         reports = self._windows.add(taken, residual)
+        stamp_ns = self._matcher.first_apart_ns
+        if stamp_ns is not None and not self._said_apart:
+            self._said_apart = True
+            message = self._apart.message() + (
+                f": the body IMU is not compared from there on (counted {APART})"
+            )
+            assert self._apart.found is not None
+            first, _, end = self._apart.found
+            values = {"jumped_back_first": first, "jumped_back_at_s": f"{end:.3f}"}
+            reports.append((stamp_ns, HealthStatus(NAME, WARN, message, values)))
         return BodyComparison(compared.ns, compared.predicted, residual, compared.present, reports)
