@@ -128,9 +128,8 @@ class Apart:
         while self.found is None:
             left = {s: self._run[s] > run for s in self._run}
             for first, other in (("deck", "body"), ("body", "deck")):
-                end, beyond = self._ends[first].get(run), self._ends[other].get(run)
-                known = left[first] and end is not None and beyond is not None
-                if known and beyond > end + self._reset:
+                end = self._ends[first].get(run, math.inf) if left[first] else math.inf
+                if self._ends[other].get(run, -math.inf) > end + self._reset:
                     self.found = (first, run, end)
             if self.found is not None or not all(left.values()):
                 break
