@@ -378,22 +378,40 @@ def test_a_window_open_at_a_jump_back_too_short_to_fit_is_dropped_and_said(
     )
 
 
-def test_where_only_the_decks_stamps_jump_back_the_window_open_is_cut_there(
-    jumping: tuple[Path, list[tuple[str, int, bytes]]],
+@pytest.mark.parametrize("first", ["/deck/imu", "/machine/imu"])
+def test_where_only_one_streams_stamps_jump_back_the_window_is_cut_and_that_said(
+    jumping: tuple[Path, list[tuple[str, int, bytes]]], first: str
 ) -> None:
-    """The deck's stamps jump back at 34 s, the body IMU's go on (another clock): the deck's
-    second run has no body run to pair with. The window open at the jump, 22–34 s, is fitted
-    once the body passes the deck's last stamp before the jump (its later samples belong to no
-    run of the deck's: not kept), and nothing after; the same in any batching."""
+    """One stream's stamps jump back at 34 s, the other's go on (a body IMU on another clock,
+    a recorder restarted): its second run has no run of the other's to pair with. The window
+    open at the jump, 22–34 s, is fitted once the other passes the jump's last stamp (its
+    later samples belong to no run of the first's: not kept). The first stream's second run
+    was then kept for good (memory growing, nothing said). Now, once the other's stamps pass
+    the jump by more than input.back_jump_reset_s (1 s), a WARN says which stream jumped back
+    and when, and no sample of a later run is kept (counted); the same in any batching."""
     path, messages = jumping
     scene = load_scene_file(path)
     steady = ageing_messages(scene, 56.5, JUMP_AT, "/machine/imu")
-    jumped = iter(m for m in messages if m[0] == "/deck/imu")  # in the record's order
-    mixed = [next(jumped) if m[0] == "/deck/imu" else m for m in steady]
+    jumped = iter(m for m in messages if m[0] == first)  # in the record's order
+    mixed = [next(jumped) if m[0] == first else m for m in steady]
     jobs = {feed: _jobs(scene, mixed, feed) for feed in FEEDS}
     assert [(round(j.span[0], 6), round(j.span[1], 2), j.cut) for j in jobs["replay"]] == [
         (2.0, 22.0, False),
         (22.0, 34.0, True),
+        (33.995, 34.0, False),  # the WARN (its end rounded), at the last stamp before the jump
     ]
     for feed in FEEDS[1:]:
         assert _same(jobs[feed], jobs["replay"]), feed
+        assert [j.apart for j in jobs[feed]] == [j.apart for j in jobs["replay"]], feed
+    status = run_job(jobs["replay"][2]).statuses[0]
+    assert LEVEL_NAMES[status.level] == "WARN"
+    name = {"/deck/imu": "the deck's", "/machine/imu": "the body IMU's"}[first]
+    assert f"stamps jumped back apart: {name} jumped back at 33.995 s" in status.message
+    assert status.message.endswith("not tracked from there on")
+    stream = TwinStream(scene)  # fed as it comes, without finish: what it holds
+    for topic, _, raw in mixed:
+        (stream.process if topic == "/deck/imu" else stream.process_body)([raw])
+    assert stream.ageing is not None
+    stamps = np.array([m[1] for m in mixed if m[0] == first])
+    n_after = stamps.shape[0] - int(np.flatnonzero(np.diff(stamps) < 0)[0]) - 1
+    assert stream.ageing.unpaired == n_after

@@ -14,8 +14,12 @@ run is paired with the other's, the window open at the jump is fitted (up to the
 both streams have in the run, known once one stream has left it and the other has reached
 that stamp) if it spans half a window, else dropped and counted, and the windows start again
 from the new run's first body sample plus the lead; a stream's samples of a run the tracker
-is done with (the other stream jumped back, it did not) are not kept. Each report says the
-jumps before its window and the windows dropped so far (`run_job`).
+is done with (the other stream jumped back, it did not) are not kept. Where the other stream
+never jumps back with it (`body_check.Apart`: its stamps went on past the jump by more than
+back_jump_reset_s), the runs never pair again: once the run is done, a WARN says which stream
+jumped back and when (a `WindowJob` with `apart`), and no sample of a later run is kept
+(`AgeingTracker.unpaired`). Each report says the jumps before its window and the windows
+dropped so far (`run_job`).
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ import numpy as np
 
 from mount_twin.analysis.ageing import LEAD_S, Band, WindowFit, fit_window
 from mount_twin.engine.batch import LEVEL_NAMES, WARN, HealthReport, HealthStatus
-from mount_twin.engine.body_check import RESETS
+from mount_twin.engine.body_check import RESETS, Apart
 from mount_twin.io.signals import Signal
 from mount_twin.scene.description import Scene
 
@@ -53,6 +57,8 @@ class WindowJob:
     restarts: int = 0
     dropped: int = 0
     cut: bool = False
+    apart: str = ""
+    """Not a window: the streams' stamps jumped back apart (`Apart`), said as a WARN."""
 
 
 def _status(fit: WindowFit) -> HealthStatus:
@@ -79,7 +85,10 @@ def run_job(job: WindowJob) -> HealthReport:
     assert ageing is not None
     band = Band(ageing.warn, ageing.error)
     try:
-        status = _status(fit_window(job.scene, job.records, job.span, ageing.fit, band))
+        if job.apart:
+            status = HealthStatus(NAME, WARN, job.apart, {})
+        else:
+            status = _status(fit_window(job.scene, job.records, job.span, ageing.fit, band))
     except ValueError as err:
         span = f"{job.span[0]:.1f}–{job.span[1]:.1f} s"
         status = HealthStatus(NAME, WARN, f"{span}: not fitted: {err}", {})
@@ -133,6 +142,10 @@ class _Record:
         """The run of the last sample added."""
         self.floor = 0
         """The first run kept (the tracker is done with those before)."""
+        self.ceiling: int | None = None
+        """The last run kept (None: all; the streams jumped back apart after it)."""
+        self.unpaired = 0
+        """Samples of runs after the ceiling, not kept."""
         self._last_ns = 0
 
     def add(
@@ -151,9 +164,18 @@ class _Record:
         self.run, self._last_ns = int(run[-1]), int(ns[-1])
         if use is not None:
             ns, t, accel, gyro, run = ns[use], t[use], accel[use], gyro[use], run[use]
+        if self.ceiling is not None:
+            self.unpaired += int((run > self.ceiling).sum())
+            run = np.where(run > self.ceiling, -1, run)
         for r in np.unique(run[run >= self.floor]).tolist():
             k = run == r
             self.runs.setdefault(r, _Run()).add(ns[k], t[k], accel[k], gyro[k])
+
+    def close_after(self, run: int) -> None:
+        """Keep no sample of a run after `run`: those held dropped, counted `unpaired`."""
+        self.ceiling = run
+        for r in [r for r in self.runs if r > run]:
+            self.unpaired += sum(p[0].shape[0] for p in self.runs.pop(r).parts)
 
     def of(self, run: int) -> _Run:
         """The samples of `run` (none yet: empty)."""
@@ -177,14 +199,24 @@ class AgeingTracker:
         self._start: float | None = None
         self.dropped = 0
         """Windows open at a jump back, too short to fit."""
+        sensor = scene.body_sensor
+        self._apart = Apart(scene.input.back_jump_reset_s, 0.0 if sensor is None else sensor.lag_s)
+        self._origin_ns: int | None = None
+        """The twin's time base's origin, ns (stamp ns − its seconds)."""
+
+    @property
+    def unpaired(self) -> int:
+        """Samples of either stream not kept because the stamps jumped back apart."""
+        return self._foundation.unpaired + self._body.unpaired
 
     def add_foundation(
         self, ns: np.ndarray, t: np.ndarray, accel: np.ndarray, gyro: np.ndarray
     ) -> list[WindowJob]:
         """Deck samples (stamps ns and s, sensor-frame accel m/s², gyro rad/s); the windows
         they complete."""
+        self._apart.add("deck", t)
         self._foundation.add(ns, t, accel, gyro)
-        return self._due()
+        return self._due(ns, t)
 
     def add_body(
         self,
@@ -197,12 +229,21 @@ class AgeingTracker:
         """Body IMU samples, as `add_foundation`'s; of them, those `use` marks fitted (all
         where None: the others, whose specific force is not provided, only tell where a run
         starts)."""
+        self._apart.add("body", t)
         self._body.add(ns, t, accel, gyro, use)
-        return self._due()
+        return self._due(ns, t)
 
-    def _due(self) -> list[WindowJob]:
+    def _due(self, ns: np.ndarray, t: np.ndarray) -> list[WindowJob]:
+        """The windows due, after samples stamped `ns`, `t` (s) came."""
+        if self._origin_ns is None and ns.shape[0]:
+            self._origin_ns = int(ns[0]) - round(float(t[0]) * 1e9)
         jobs = []
         while True:
+            found = self._apart.found
+            if found is not None and self._run > found[1] and self._body.ceiling is None:
+                jobs.append(self._apart_job())
+            if self._body.ceiling is not None:
+                return jobs
             foundation, body = self._foundation.of(self._run), self._body.of(self._run)
             if self._start is None and body.first_t is not None:
                 self._start = body.first_t + LEAD_S
@@ -227,6 +268,20 @@ class AgeingTracker:
             for record, _ in records:
                 record.runs.pop(self._run - 1)
                 record.floor = self._run
+
+    def _apart_job(self) -> WindowJob:
+        """The streams jumped back apart and the run they paired last is done: nothing after
+        it is kept (counted `unpaired`); the WARN saying so, as a job."""
+        assert self._apart.found is not None and self._origin_ns is not None
+        _, run, end = self._apart.found
+        for record in (self._foundation, self._body):
+            record.close_after(run)
+        empty = Signal(np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)))
+        message = self._apart.message() + ": not tracked from there on"
+        stamp_ns = self._origin_ns + round(end * 1e9)
+        return WindowJob(
+            self.scene, (empty, empty), (end, end), stamp_ns, run, self.dropped, apart=message
+        )
 
     def _job(
         self, foundation: _Run, body: _Run, span: tuple[float, float], cut: bool = False
