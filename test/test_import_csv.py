@@ -489,3 +489,60 @@ def test_an_xsens_export_is_stamped_with_its_clock_exactly_over_many_wraps(
     assert imported.stamps_ns.tolist() == [us * 1000 for us in clock_us]
     np.testing.assert_allclose(imported.signal.t, np.array(clock_us) / 1e6, rtol=2**-52, atol=0)
     np.testing.assert_allclose(imported.signal.gyro[0], [1.5 * math.pi / 180, 0, 0], rtol=1e-15)
+
+
+SPLIT_HINT = (
+    "decimal commas between commas? A comma-separated file cannot hold an unquoted decimal "
+    "comma unambiguously (`0,12` is two cells); export with ';' as the separator (or quote "
+    'the cells, "0,12"), then `mount-twin import-csv --decimal ,`'
+)
+
+
+@pytest.mark.parametrize("before", [0, 60])
+def test_unquoted_decimal_commas_between_commas_are_refused_naming_the_cause_and_fix(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], before: int
+) -> None:
+    """A European export saved with ',' between cells and unquoted decimal commas,
+    `0,001,0,12,9,81,...`: each number is split in two. It had been refused only as "row 2:
+    8 cells where the header has 4", naming neither cause nor fix; the numbers are not guessed.
+    A row past the 50 the decimal mark is sniffed from is refused alike."""
+    rows = "".join(f"{k}.5,0,0,9.5\n" for k in range(before))
+    text = f"t,ax,ay,az\n{rows}0,001,0,12,-0,5,9,81\n"
+    path = _write(tmp_path, text)
+    out = tmp_path / "bag"
+    assert main(["import-csv", str(path), "-o", str(out)]) == 2
+    said = capsys.readouterr().err
+    row = 2 + before
+    assert f"{path}: row {row}: 8 cells where the header has 4: {SPLIT_HINT}" in said, said
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "line",
+    ["0.1,1,2,3,4", "0,1,2,3,4,5,6,7,8", "0,a,b,1,2", "0,1,,2,3"],
+)
+def test_a_row_too_long_for_another_cause_is_refused_without_the_decimal_comma_hint(
+    tmp_path: Path, line: str
+) -> None:
+    """A point in a piece, more than two pieces per cell, a piece that is no digits or an
+    empty one: no decimal comma split, no hint."""
+    path = _write(tmp_path, f"t,ax,ay,az\n{line}\n")
+    with pytest.raises(ValueError, match=None) as err:
+        read_recorder_csv(path)
+    cells = line.count(",") + 1
+    assert str(err.value) == f"{path}: row 2: {cells} cells where the header has 4"
+
+
+def test_a_decimal_comma_past_the_sniffed_rows_names_the_option(tmp_path: Path) -> None:
+    """The decimal mark is sniffed from the first 50 data rows; a decimal comma after them
+    (between ';') is refused naming its cell and `--decimal ,`, and read with it."""
+    rows = "".join(f"{k};0;0;9\n" for k in range(60))
+    path = _write(tmp_path, f"t;ax;ay;az\n{rows}60;0,5;0;9\n")
+    with pytest.raises(ValueError, match=None) as err:
+        read_recorder_csv(path)
+    assert str(err.value) == (
+        f"{path}: row 62, column ax: '0,5' is not a number: a decimal comma? say "
+        "`mount-twin import-csv --decimal ,` (thousands separators are not read)"
+    )
+    got = read_recorder_csv(path, CsvFormat(decimal=","))
+    assert got.signal.accel[-1, 0] == 0.5

@@ -208,11 +208,31 @@ def _sniffed_decimal(lines: list[str], delimiter: str | None) -> str:
     return "," if next(decimal_comma, None) is not None else "."
 
 
-def check_width(path: Path, row: int, cells: list[str], header: list[str]) -> None:
+SPLIT_PIECE = re.compile(r"^[+-]?\d+(?:[eE][+-]?\d+)?$")
+"""Half of a number split at an unquoted decimal comma (`-0` and `5`, `1` and `5e1`)."""
+SPLIT_DECIMAL_COMMA = (
+    "decimal commas between commas? A comma-separated file cannot hold an unquoted decimal "
+    "comma unambiguously (`0,12` is two cells); export with ';' as the separator (or quote "
+    'the cells, "0,12"), then `mount-twin import-csv --decimal ,`'
+)
+"""Why a comma-separated row of digits has too many cells: its numbers' decimal commas split
+each in two; which comma is which, the text does not say (nor is it guessed)."""
+
+
+def check_width(
+    path: Path, row: int, cells: list[str], header: list[str], delimiter: str | None = None
+) -> None:
     """ValueError naming the file and the row (its line number) where the row's `cells` are
-    not as many as the `header`'s (a cell split by a stray delimiter shifts the rest)."""
-    if len(cells) != len(header):
-        raise _fail(path, f"row {row}", f"{len(cells)} cells where the header has {len(header)}")
+    not as many as the `header`'s (a cell split by a stray delimiter shifts the rest); with
+    `SPLIT_DECIMAL_COMMA` where the `delimiter` is ',' and the cells, up to twice as many as
+    the header's, are all digits: numbers split at their decimal commas."""
+    if len(cells) == len(header):
+        return
+    what = f"{len(cells)} cells where the header has {len(header)}"
+    split = len(header) < len(cells) <= 2 * len(header)
+    if delimiter == "," and split and all(SPLIT_PIECE.match(unquoted(c)) for c in cells):
+        what += f": {SPLIT_DECIMAL_COMMA}"
+    raise _fail(path, f"row {row}", what)
 
 
 POINT_WITH_COMMA = (
@@ -378,7 +398,7 @@ def _values(
     first = []
     for i, (row, line) in enumerate(data):
         cells = split_cells(line, delimiter)
-        check_width(path, row, cells, names)
+        check_width(path, row, cells, names, delimiter)
         for j, (col, factor) in enumerate(columns):
             try:
                 values[i, j] = cell_value(path, row, names[col], cells[col], factor, decimal)
