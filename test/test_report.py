@@ -914,6 +914,51 @@ def test_a_scene_with_the_runs_mounts_and_another_value_is_refused_naming_both(
     assert f"NOT the run's, drawn with on request (--other-scene): {other}: scene" in text
 
 
+def _run_scene_named(pump_run: Path, tmp_path: Path, scene: str) -> Path:
+    """The pump's run, its metadata naming `scene` as the file it was replayed with."""
+    import shutil
+
+    import yaml
+
+    bag = tmp_path / "renamed"
+    shutil.copytree(pump_run, bag)
+    meta = yaml.safe_load((bag / "metadata.yaml").read_text(encoding="utf-8"))
+    meta["rosbag2_bagfile_information"]["custom_data"]["mount_twin.scene"] = scene
+    (bag / "metadata.yaml").write_text(yaml.safe_dump(meta), encoding="utf-8")
+    return bag
+
+
+def test_a_refused_scene_names_the_values_it_differs_in_where_the_runs_file_tells(
+    pump_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A refused scene said only that "a value differs". Where the run's scene file still
+    loads to the recorded digest, the message names each value that differs, with both
+    values (mount fl's z stiffness: the file's 1.2e6, 2.4e6 here); read past the input
+    settings the command line replaced; else it says why it cannot."""
+    other = _pump_scene(tmp_path / "other.scene.yaml", OTHER_VALUES["a mount's stiffness"])
+    args = ["report", str(pump_run), "--scene", str(other), "-o", str(tmp_path / "r.html")]
+    assert main(args) == 2
+    differs = "it differs in mounts[0].stiffness[2]: 2400000.0 here, 1200000.0 in the run's scene"
+    assert differs in capsys.readouterr().err
+    # the run's file named as a replay with --topic names it (its topic is the run's)
+    copy = _pump_scene(tmp_path / "copy.scene.yaml")
+    bag = _run_scene_named(pump_run, tmp_path, f"{copy} (with input topic from the command line)")
+    assert main(["report", str(bag), *args[2:]]) == 2
+    assert differs in capsys.readouterr().err
+    _pump_scene(copy, _set("body", "mass", value=1500.0))
+    assert main(["report", str(bag), *args[2:]]) == 2
+    assert (
+        f"the run's scene file {copy} has changed since: cannot say which value differs"
+        in capsys.readouterr().err
+    )
+    copy.unlink()
+    assert main(["report", str(bag), *args[2:]]) == 2
+    assert (
+        f"the run's scene file {copy} is not found (from here): cannot say which value differs"
+        in capsys.readouterr().err
+    )
+
+
 def test_other_scene_needs_a_scene(pump_run: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["report", str(pump_run), "--other-scene"]) == 2
     assert "--other-scene draws with the scene --scene gives: it needs --scene" in (

@@ -11,6 +11,7 @@ from __future__ import annotations
 import html
 import json
 import math
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -54,7 +55,7 @@ from mount_twin.engine.health import (
     why_none,
 )
 from mount_twin.engine.intake import nothing_accepted
-from mount_twin.errors import ModelError
+from mount_twin.errors import ModelError, MountTwinError
 from mount_twin.io.bag import SCENE_DIGEST_KEY, SCENE_KEY, custom_data, partial_marker
 from mount_twin.io.messages import WRENCHES_OUTPUT
 from mount_twin.io.output_tables import (
@@ -64,7 +65,12 @@ from mount_twin.io.output_tables import (
     input_values,
     integration_values,
 )
-from mount_twin.scene.description import STANDARD_GRAVITY, Scene, scene_digest
+from mount_twin.scene.description import (
+    STANDARD_GRAVITY,
+    Scene,
+    scene_differences,
+    scene_digest,
+)
 from mount_twin.textfiles import write_text
 
 if TYPE_CHECKING:
@@ -560,8 +566,8 @@ def check_scene(scene: Scene, output_bag: str | Path, integration: dict[str, str
         text = (
             f"{scene.source}: scene {scene.name} is not the one {output_bag} was replayed "
             f"with, {ran}: its digest (sha256 {digest}) differs from the one the bag's "
-            f"metadata records ({SCENE_DIGEST_KEY}: {recorded}); a value differs (a mount's "
-            "stiffness or rating, the body, the diagnostics period, ...)"
+            f"metadata records ({SCENE_DIGEST_KEY}: {recorded}); "
+            f"{_differing(scene, ran, recorded)}"
         )
         return SceneCheck(text, True, True)
     compared = [key for key in CHECKED_SETTINGS if key in integration]
@@ -583,6 +589,37 @@ def check_scene(scene: Scene, output_bag: str | Path, integration: dict[str, str
         "is not told apart"
     )
     return SceneCheck(text, False, False)
+
+
+SHOWN_DIFFERENCES = 3
+"""How many of the values a scene differs from its run's in `check_scene` names."""
+
+
+def _differing(scene: Scene, ran: str, recorded: str) -> str:
+    """Which values `scene` differs in from the run's (`SHOWN_DIFFERENCES` of them, by key
+    path: `scene_differences`), where the run's scene file (`ran`: `SCENE_KEY`'s value, the
+    input fields the command line replaced named after it, here taken from `scene`, which has
+    the run's) still loads to a scene of the `recorded` digest; else why that cannot be said."""
+    from mount_twin.commands.common import load_scene
+
+    replaced = re.fullmatch(r"(.*) \(with input ([\w, ]+) from the command line\)", ran)
+    path, keys = (replaced[1], replaced[2].split(", ")) if replaced else (ran, [])
+    cannot = "cannot say which value differs"
+    if not Path(path).is_file():
+        return f"the run's scene file {path} is not found (from here): {cannot}"
+    try:
+        run = load_scene(path, {k: getattr(scene.input, k) for k in keys}, warn=False)
+    except (MountTwinError, ValueError, OSError) as err:
+        return f"the run's scene file no longer loads ({err}): {cannot}"
+    if scene_digest(run) != recorded:
+        return f"the run's scene file {path} has changed since: {cannot}"
+    found = scene_differences(scene, run)
+    shown = "; ".join(
+        f"{key}: {here!r} here, {there!r} in the run's scene"
+        for key, here, there in found[:SHOWN_DIFFERENCES]
+    )
+    more = len(found) - SHOWN_DIFFERENCES
+    return f"it differs in {shown}" + (f" (and {more} more values)" if more > 0 else "")
 
 
 def _check_scene_is_the_bags(scene: Scene, in_bag: set[str], output_bag: str | Path) -> None:

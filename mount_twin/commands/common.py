@@ -178,10 +178,13 @@ INPUT_OPTIONS = {"input.topic": "replay --topic", "input.frame_id": "replay --fr
 or the report names it where it did."""
 
 
-def load_scene(path: str | Path, input_overrides: Mapping[str, str] | None = None) -> Scene:
+def load_scene(
+    path: str | Path, input_overrides: Mapping[str, str] | None = None, *, warn: bool = True
+) -> Scene:
     """The scene file at `path`, with `input` fields replaced by `input_overrides` (checked like
     the file's own); each of its warnings (units? a message type's convention?) is printed on
-    stderr, so that no command runs a scene it found implausible without saying so. A scene
+    stderr (unless not `warn`: a scene only compared with, not run), so that no command runs a
+    scene it found implausible without saying so. A scene
     whose ratings or force limits are judged at the start the twin uses
     (`scene.checks.rated_at_start`) is assembled for them: its start is solved here, and again
     where the command assembles it."""
@@ -198,7 +201,7 @@ def load_scene(path: str | Path, input_overrides: Mapping[str, str] | None = Non
         from mount_twin.model.assemble import assemble
 
         scene = assemble(scene).scene
-    for warning in scene.warnings:
+    for warning in scene.warnings if warn else ():
         print(f"mount-twin: warning: {warning}", file=sys.stderr)
     return scene
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import hashlib
 import json
 from dataclasses import asdict, dataclass, field
+from typing import Any
 
 from mount_twin.kinds.bolted_joint import BoltedJoint
 from mount_twin.kinds.elastomer import Elastomer
@@ -360,6 +361,48 @@ def scene_digest(scene: Scene) -> str:
     files that set the same values (however commented, ordered, or with defaults written out)
     give the same digest; one value changed, another. A replay records it in its output bag's
     metadata (`io.bag.SCENE_DIGEST_KEY`), for `report --scene` to check its scene against."""
-    value = {k: v for k, v in asdict(scene).items() if k not in NOT_THE_VALUE}
-    text = json.dumps(value, sort_keys=True, separators=(",", ":"))
+    text = json.dumps(scene_value(scene), sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
+
+
+def scene_value(scene: Scene) -> dict[str, Any]:
+    """The scene's value as `scene_digest` hashes it: its fields (nested dataclasses as dicts)
+    but those `NOT_THE_VALUE`."""
+    return {k: v for k, v in asdict(scene).items() if k not in NOT_THE_VALUE}
+
+
+def value_differences(here: Any, there: Any, path: str = "") -> list[tuple[str, Any, Any]]:
+    """Where two values (dicts, lists or tuples of them, leaves) differ: (key path, value
+    here, value there) of each differing leaf, in `here`'s key order (then `there`'s extra
+    keys), a dict's key as `.key`, an item as `[i]`. A key one lacks is `None` on that side;
+    sequences of unequal length, or values of another shape, differ as a whole at `path`."""
+    if isinstance(here, dict) and isinstance(there, dict):
+        keys = [*here, *(k for k in there if k not in here)]
+        return [
+            d
+            for k in keys
+            for d in value_differences(here.get(k), there.get(k), f"{path}.{k}" if path else k)
+        ]
+    sequences = (list, tuple)
+    if isinstance(here, sequences) and isinstance(there, sequences) and len(here) == len(there):
+        return [
+            d
+            for i, (a, b) in enumerate(zip(here, there, strict=True))
+            for d in value_differences(a, b, f"{path}[{i}]")
+        ]
+    return [] if here == there else [(path, here, there)]
+
+
+def scene_differences(here: Scene, there: Scene) -> list[tuple[str, Any, Any]]:
+    """`value_differences` of two scenes' values (`scene_value`), a mount's key path as
+    `here` names it (`Scene.mount_path`: `mounts.<name>` in a parameter set)."""
+    found = value_differences(scene_value(here), scene_value(there))
+    return [(_named(here, path), a, b) for path, a, b in found]
+
+
+def _named(scene: Scene, path: str) -> str:
+    """`path` with a mount's `mounts[i]` as the scene names it (`Scene.mount_path`)."""
+    head, sep, rest = path.partition("]")
+    if head.startswith("mounts[") and sep:
+        return scene.mount_path(int(head.removeprefix("mounts["))) + rest
+    return path
