@@ -552,7 +552,8 @@ def check_scene(scene: Scene, output_bag: str | Path, integration: dict[str, str
     the one the run of `output_bag` ran (its mount names are checked before:
     `_check_scene_is_the_bags`). By the digest its replay recorded in the bag's metadata
     (`io.bag.SCENE_DIGEST_KEY`, `scene_digest`): any value differing (a mount's stiffness,
-    the mass, the diagnostics period, a rating) makes another. A bag that records none (a
+    the mass, the diagnostics period, a rating) makes another, the values named where the
+    run's scene file still tells them (`_differing`). A bag that records none (a
     recording of the node's topics by `ros2 bag record`, or a replay by a mount_twin that did
     not record it) tells only some settings: the solver's tolerances its last integration
     status records (`integration`: its values), compared, the first that differs named."""
