@@ -7,6 +7,7 @@ import dataclasses
 import hashlib
 import html
 import json
+import math
 import re
 from pathlib import Path
 from typing import Any
@@ -1162,3 +1163,19 @@ def test_the_attitude_is_drawn_in_radians_as_the_bag_records_it() -> None:
     assert attitude.get_ylabel() == "attitude [rad]"
     for line in attitude.get_lines():
         assert np.array_equal(line.get_ydata(), angles[f"{line.get_label()}_rad"])
+
+
+def test_a_scene_equal_to_the_runs_but_for_a_zeros_sign_says_so() -> None:
+    """Digests hash the values' JSON text, where -0.0 is not 0.0 though the numbers are equal:
+    the list of differences was empty and the message ended in "it differs in "."""
+    from mount_twin.analysis.report import _differing
+    from mount_twin.scene.description import scene_digest
+
+    path = CONFIG / "pump_8_mounts.scene.yaml"
+    run = load_scene_file(path)
+    x, y, z = run.body.cg
+    assert y == 0.0 and math.copysign(1.0, y) > 0  # the bundled pump's cg y is +0.0
+    here = dataclasses.replace(run, body=dataclasses.replace(run.body, cg=(x, -0.0, z)))
+    assert scene_digest(here) != scene_digest(run)
+    text = _differing(here, str(path), scene_digest(run))
+    assert "differ only as the digest writes them" in text, text

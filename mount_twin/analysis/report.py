@@ -615,6 +615,11 @@ def _differing(scene: Scene, ran: str, recorded: str) -> str:
     if scene_digest(run) != recorded:
         return f"the run's scene file {path} has changed since: {cannot}"
     found = scene_differences(scene, run)
+    if not found:  # equal as numbers, not as the digest's JSON text
+        return (
+            "its values equal the run's as numbers and differ only as the digest writes them "
+            "(-0.0 against 0.0, 1 against 1.0)"
+        )
     shown = "; ".join(
         f"{key}: {here!r} here, {there!r} in the run's scene"
         for key, here, there in found[:SHOWN_DIFFERENCES]
