@@ -594,16 +594,7 @@ def test_stamps_jumping_back_restart_the_comparison_in_any_batching() -> None:
     )
     body = _body_raws(ns, truth)
     deck_raws = [r for _, r in imu_messages(ns, deck.accel, deck.gyro, "deck_imu")]
-    streams = [TwinStream(scene) for _ in range(2)]
-    runs = [
-        _interleaved(scene, deck_raws, ns, (body, ns)),
-        _chunked(scene, deck_raws, body, 700, body_first=True),
-        _chunked(scene, deck_raws, body, 333, body_first=False),
-        streams[0].process(deck_raws) + streams[0].process_body(body) + streams[0].finish(),
-        streams[1].process_body(body) + streams[1].process(deck_raws) + streams[1].finish(),
-    ]
-    kept = [[m for m in run if m[0] != DIAGNOSTICS_TOPIC or NAME.encode() in m[2]] for run in runs]
-    assert all(sorted(k) == sorted(kept[0]) for k in kept[1:])
+    runs, streams = _fed_five_ways(scene, deck_raws, ns, body, ns)
     for stream in streams:
         assert stream.body is not None
         counts = stream.body.counts
@@ -659,16 +650,7 @@ def test_stamps_jumping_back_apart_are_said_and_not_held(first: str) -> None:
     deck_ns, body_ns = (jumped, steady) if first == "deck" else (steady, jumped)
     body = _body_raws(body_ns, np.zeros((steady.shape[0], 6)))
     deck_raws = [r for _, r in imu_messages(deck_ns, deck.accel, deck.gyro, "deck_imu")]
-    streams = [TwinStream(scene) for _ in range(2)]
-    runs = [
-        _interleaved(scene, deck_raws, deck_ns, (body, body_ns)),
-        _chunked(scene, deck_raws, body, 700, body_first=True),
-        _chunked(scene, deck_raws, body, 333, body_first=False),
-        streams[0].process(deck_raws) + streams[0].process_body(body) + streams[0].finish(),
-        streams[1].process_body(body) + streams[1].process(deck_raws) + streams[1].finish(),
-    ]
-    kept = [[m for m in run if m[0] != DIAGNOSTICS_TOPIC or NAME.encode() in m[2]] for run in runs]
-    assert all(sorted(k) == sorted(kept[0]) for k in kept[1:])
+    runs, streams = _fed_five_ways(scene, deck_raws, deck_ns, body, body_ns)
     # the last stamp before the jump on the twin's time base (from the first deck stamp's
     # whole second)
     end = 6.0 - 1 / RATE + NS0 % 10**9 * 1e-9
@@ -689,3 +671,27 @@ def test_stamps_jumping_back_apart_are_said_and_not_held(first: str) -> None:
         assert counts["compared"] == (t < 6.0).sum()
         assert counts["unanswered"] == within.sum()
         assert counts["jumped_back_apart"] == (t >= 6.0).sum() - within.sum()
+
+
+def _fed_five_ways(
+    scene: Scene,
+    deck_raws: list[bytes],
+    deck_ns: np.ndarray,
+    body: list[bytes],
+    body_ns: np.ndarray,
+) -> tuple[list[Messages], list[TwinStream]]:
+    """The outputs of the deck and body streams fed five ways (interleaved by stamp; chunks of
+    700 body first, of 333 deck first; all deck then all body, and the reverse), checked to
+    be the same messages (the body sensor's statuses among /diagnostics); and the two streams
+    fed whole, for their counts."""
+    streams = [TwinStream(scene) for _ in range(2)]
+    runs = [
+        _interleaved(scene, deck_raws, deck_ns, (body, body_ns)),
+        _chunked(scene, deck_raws, body, 700, body_first=True),
+        _chunked(scene, deck_raws, body, 333, body_first=False),
+        streams[0].process(deck_raws) + streams[0].process_body(body) + streams[0].finish(),
+        streams[1].process_body(body) + streams[1].process(deck_raws) + streams[1].finish(),
+    ]
+    kept = [[m for m in run if m[0] != DIAGNOSTICS_TOPIC or NAME.encode() in m[2]] for run in runs]
+    assert all(sorted(k) == sorted(kept[0]) for k in kept[1:])
+    return runs, streams
