@@ -18,6 +18,7 @@ from io_helpers import CONFIG, ROOT, read_bag, read_raw, unprovided_imu
 
 from mount_twin.analysis.report import events_of
 from mount_twin.cli import main
+from mount_twin.commands.common import OVERRIDDEN
 from mount_twin.io.output_tables import Table, input_values, read_output_bag
 from mount_twin.replay import replay
 from mount_twin.scene.loader import load_scene_file
@@ -943,7 +944,7 @@ def test_a_refused_scene_names_the_values_it_differs_in_where_the_runs_file_tell
     assert differs in capsys.readouterr().err
     # the run's file named as a replay with --topic names it (its topic is the run's)
     copy = _pump_scene(tmp_path / "copy.scene.yaml")
-    bag = _run_scene_named(pump_run, tmp_path, f"{copy} (with input topic from the command line)")
+    bag = _run_scene_named(pump_run, tmp_path, str(copy) + OVERRIDDEN.format("topic"))
     assert main(["report", str(bag), *args[2:]]) == 2
     assert differs in capsys.readouterr().err
     _pump_scene(copy, _set("body", "mass", value=1500.0))

@@ -11,7 +11,6 @@ from __future__ import annotations
 import html
 import json
 import math
-import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -601,10 +600,9 @@ def _differing(scene: Scene, ran: str, recorded: str) -> str:
     path: `scene_differences`), where the run's scene file (`ran`: `SCENE_KEY`'s value, the
     input fields the command line replaced named after it, here taken from `scene`, which has
     the run's) still loads to a scene of the `recorded` digest; else why that cannot be said."""
-    from mount_twin.commands.common import load_scene
+    from mount_twin.commands.common import load_scene, scene_file_of
 
-    replaced = re.fullmatch(r"(.*) \(with input ([\w, ]+) from the command line\)", ran)
-    path, keys = (replaced[1], replaced[2].split(", ")) if replaced else (ran, [])
+    path, keys = scene_file_of(ran)
     cannot = "cannot say which value differs"
     if not Path(path).is_file():
         return f"the run's scene file {path} is not found (from here): {cannot}"

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
@@ -178,6 +179,19 @@ INPUT_OPTIONS = {"input.topic": "replay --topic", "input.frame_id": "replay --fr
 or the report names it where it did."""
 
 
+OVERRIDDEN = " (with input {} from the command line)"
+"""What `load_scene` appends to a scene's source where the command line replaced `input`
+fields (their names, comma-separated): read back by `scene_file_of`."""
+
+
+def scene_file_of(source: str) -> tuple[str, list[str]]:
+    """The scene file and the `input` fields the command line replaced of a scene's source as
+    `load_scene` gives it (recorded by a replay in its output bag's metadata)."""
+    before, _, after = OVERRIDDEN.partition("{}")
+    found = re.fullmatch(f"(.*){re.escape(before)}([\\w, ]+){re.escape(after)}", source)
+    return (found[1], found[2].split(", ")) if found else (source, [])
+
+
 def load_scene(
     path: str | Path, input_overrides: Mapping[str, str] | None = None, *, warn: bool = True
 ) -> Scene:
@@ -195,7 +209,7 @@ def load_scene(
     source = str(path)
     if input_overrides and isinstance(data, dict) and isinstance(data.get("input", {}), dict):
         data["input"] = {**data.get("input", {}), **input_overrides}
-        source += f" (with input {', '.join(sorted(input_overrides))} from the command line)"
+        source += OVERRIDDEN.format(", ".join(sorted(input_overrides)))
     scene = scene_from_dict(data, source, refuse_unheld=True)
     if rated_at_start(scene):
         from mount_twin.model.assemble import assemble
