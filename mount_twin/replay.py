@@ -61,6 +61,7 @@ from mount_twin.io.bag import (
 from mount_twin.io.messages import (
     DIAGNOSTICS_TOPIC,
     IMU,
+    NODE_NAME,
     TF,
     TF_STATIC_TOPIC,
     Encoded,
@@ -73,9 +74,6 @@ from mount_twin.io.messages import (
 from mount_twin.physics.rotations import angle_text, quaternion_matrices
 from mount_twin.scene.description import Scene, scene_digest
 from mount_twin.stream import TwinStream
-
-NODE_NAME = "mount_twin"
-"""The node name output topics resolve against, as with `ros2 run` and the default launch."""
 
 
 def _estimate_text(est: ErrorEstimate | None) -> str:

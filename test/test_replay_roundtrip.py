@@ -16,6 +16,7 @@ from mount_twin.errors import BagError
 from mount_twin.io.messages import (
     DIAGNOSTICS,
     IMU,
+    NODE_NAME,
     POSE,
     TF,
     VECTOR3,
@@ -23,7 +24,7 @@ from mount_twin.io.messages import (
     decode_inputs,
     resolve,
 )
-from mount_twin.replay import NODE_NAME, replay
+from mount_twin.replay import replay
 from mount_twin.stream import TwinStream
 
 DURATION = 0.5

@@ -46,11 +46,12 @@ from mount_twin.io.messages import (
     BODY_RESIDUAL_TOPIC,
     DIAGNOSTICS,
     IMU,
+    NODE_NAME,
     imu_messages,
     resolve,
 )
 from mount_twin.io.signals import ship_motion
-from mount_twin.replay import NODE_NAME, replay
+from mount_twin.replay import replay
 from mount_twin.scene import load_scene_file
 
 RATE = 500.0

@@ -47,6 +47,7 @@ from mount_twin.io.messages import (
     ACCEL,
     DIAGNOSTICS,
     IMU,
+    NODE_NAME,
     POSE,
     TF,
     TF_STATIC_TOPIC,
@@ -58,7 +59,7 @@ from mount_twin.io.messages import (
     stamp_ns,
     static_transforms,
 )
-from mount_twin.replay import NODE_NAME, replay
+from mount_twin.replay import replay
 from mount_twin.scene import load_scene_file, scene_from_params
 from mount_twin.scene.description import InputSpec
 from mount_twin.scene.params import flatten

@@ -25,6 +25,7 @@ from mount_twin.errors import SceneError
 from mount_twin.io.bag import write_bag
 from mount_twin.io.messages import (
     IMU,
+    NODE_NAME,
     TF,
     TF_STATIC_TOPIC,
     TF_TOPIC,
@@ -34,7 +35,7 @@ from mount_twin.io.messages import (
     output_types,
     static_transforms,
 )
-from mount_twin.replay import NODE_NAME, replay
+from mount_twin.replay import replay
 from mount_twin.scene import load_scene_file, scene_from_params
 from mount_twin.scene.description import Scene
 

@@ -21,12 +21,12 @@ from mount_twin.io.messages import (
     ANGLES_OUTPUT,
     BODY_PREDICTED_TOPIC,
     BODY_RESIDUAL_TOPIC,
+    NODE_NAME,
     POSE_OUTPUT,
     WRENCHES_OUTPUT,
     Output,
     resolve,
 )
-from mount_twin.replay import NODE_NAME
 from mount_twin.scene.description import Scene
 
 PALETTE = (

@@ -59,7 +59,7 @@ def run(args: argparse.Namespace) -> int:
 
     from mount_twin.analysis.dashboards import foxglove_layout, plotjuggler_layout
     from mount_twin.commands.common import check_targets, load_scene
-    from mount_twin.replay import NODE_NAME
+    from mount_twin.io.messages import NODE_NAME
     from mount_twin.textfiles import write_text
 
     if not (args.plotjuggler or args.foxglove):

@@ -36,8 +36,14 @@ def run(args: argparse.Namespace) -> int:
 def scene_text(scene: Scene) -> str:
     """A scene in a few lines: body, DOFs, each mount, input (and the body IMU), integration,
     and every topic the node publishes with its type."""
-    from mount_twin.io.messages import IMU, TF, TF_STATIC_TOPIC, output_types, resolve
-    from mount_twin.replay import NODE_NAME
+    from mount_twin.io.messages import (
+        IMU,
+        NODE_NAME,
+        TF,
+        TF_STATIC_TOPIC,
+        output_types,
+        resolve,
+    )
 
     b, i, g = scene.body, scene.input, scene.integration
     lines = [

@@ -586,6 +586,11 @@ def output_table(topic: str, msgtype: str) -> tuple[str, Readback] | None:
     return None
 
 
+NODE_NAME = "mount_twin"
+"""The node's name, which its private (~) output topics resolve against: the live node's, as
+with `ros2 run` and the default launch, and a replay's bag's."""
+
+
 def resolve(name: str, node_name: str, namespace: str = "/") -> str:
     """Resolve a private (~) or relative topic name as rclpy would for the node `node_name` in
     `namespace` (what `-r __node:=` and `-r __ns:=` set; no topic remaps)."""

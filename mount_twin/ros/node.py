@@ -51,6 +51,7 @@ from mount_twin.errors import MountTwinError
 from mount_twin.io.messages import (
     DIAGNOSTICS_TOPIC,
     IMU,
+    NODE_NAME,
     TF,
     TF_STATIC_TOPIC,
     encode_report,
@@ -75,7 +76,6 @@ if TYPE_CHECKING:
     from mount_twin.ros.start import StopRequests
 
 T = TypeVar("T")
-NODE_NAME = "mount_twin"
 TAKE_LIMIT = 100_000
 """Most input messages taken in one wake-up."""
 SHUTDOWN_ACK_S = 10.0
