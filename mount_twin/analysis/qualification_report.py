@@ -13,6 +13,7 @@ from typing import Any
 from mount_twin.analysis.html_page import fingerprint, page, png, produced_by, scene_section, table
 from mount_twin.analysis.log_labels import plain_log_labels
 from mount_twin.analysis.qualification import InputRun, Plan
+from mount_twin.io.design_spectrum import read_design_table
 from mount_twin.scene.description import Scene
 from mount_twin.textfiles import write_text
 
@@ -83,7 +84,6 @@ def _verdict_section(scene: Scene, plan: Plan, doc: dict[str, Any]) -> list[str]
 
 def _spectra_section(plan: Plan, runs: list[InputRun]) -> list[str]:
     """Per axis, each input's maximax against the design and its tolerance band."""
-    from mount_twin.commands.common import read_design_table
 
     def draw(fig: Any) -> None:
         axes = fig.subplots(1, len(plan.spectra), squeeze=False)[0]

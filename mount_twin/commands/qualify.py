@@ -106,9 +106,10 @@ def run_input(scene_path: str, plan: Plan, axis: str, seed: int, out: str) -> In
 
     from mount_twin.analysis.qualification import InputRun
     from mount_twin.analysis.synthesis import imu_record
-    from mount_twin.commands.common import load_scene, read_design_table, write_signal
+    from mount_twin.commands.common import load_scene, write_signal
     from mount_twin.commands.synthesize import synthesis_of
     from mount_twin.engine.batch import LEVEL_NAMES
+    from mount_twin.io.design_spectrum import read_design_table
     from mount_twin.io.epoch import DEFAULT_START_NS
     from mount_twin.replay import replay
 

@@ -65,12 +65,8 @@ def run(args: argparse.Namespace) -> int:
 
     require("matplotlib", "mount-twin report")
     from mount_twin.analysis.report import write_report
-    from mount_twin.commands.common import (
-        check_targets,
-        load_scene,
-        read_design_table,
-        warn_if_partial,
-    )
+    from mount_twin.commands.common import check_targets, load_scene, warn_if_partial
+    from mount_twin.io.design_spectrum import read_design_table
     from mount_twin.io.output_tables import read_output_bag
 
     check_targets(output=args.output, reads=(args.bag, args.scene, args.input, args.design))

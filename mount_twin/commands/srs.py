@@ -180,7 +180,8 @@ def run(args: argparse.Namespace) -> int:
 
     from mount_twin.analysis.sampling import uniform
     from mount_twin.analysis.srs import ACCURATE_SHARE, damping_ratio, gravity_offset, srs
-    from mount_twin.commands.common import check_targets, read_design_table
+    from mount_twin.commands.common import check_targets
+    from mount_twin.io.design_spectrum import read_design_table
 
     check_targets(
         plot=args.plot,

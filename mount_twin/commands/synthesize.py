@@ -91,7 +91,7 @@ def synthesized(args: argparse.Namespace) -> Iterator[tuple[int, Synthesis, Sign
     the design spectrum and the plan printed first."""
     from mount_twin.analysis.srs import damping_ratio
     from mount_twin.analysis.synthesis import imu_record
-    from mount_twin.commands.common import read_design_table
+    from mount_twin.io.design_spectrum import read_design_table
 
     low, high = tolerance_of(args)
     design = read_design_table(args.spectrum)
