@@ -18,8 +18,8 @@ from io_helpers import CONFIG, ROOT, read_bag, read_raw, unprovided_imu
 
 from mount_twin.analysis.report import events_of
 from mount_twin.cli import main
-from mount_twin.commands.common import OVERRIDDEN
 from mount_twin.io.output_tables import Table, input_values, read_output_bag
+from mount_twin.model.scene_file import OVERRIDDEN
 from mount_twin.replay import replay
 from mount_twin.scene.loader import load_scene_file
 

@@ -13,6 +13,7 @@ from importlib.metadata import version as package_version
 from pathlib import Path
 from typing import Any
 
+from mount_twin.model.scene_file import INPUT_OPTIONS
 from mount_twin.scene.description import Scene
 from mount_twin.scene.params import effective_parameters, parameter_description
 
@@ -85,8 +86,6 @@ def _replaced(scene: Scene, in_file: dict[str, Any]) -> dict[str, tuple[str, str
     """Of `scene`'s input settings, those whose value differs from the file's (`in_file`), each
     with the option that replaced it (`replay --topic`, `--frame-id`) and the run's value
     (`report` gives the scene those its run read and expected, as its output bag recorded)."""
-    from mount_twin.commands.common import INPUT_OPTIONS
-
     ran = {"input.topic": scene.input.topic, "input.frame_id": scene.input.frame_id}
     return {
         key: (option, ran[key])
@@ -103,7 +102,6 @@ def frame_id_setting(scene: Scene | None, expected: str | None = None) -> str:
     both, and the frame expected where the bag has it."""
     key = "input.frame_id"
     if scene is None:
-        from mount_twin.commands.common import INPUT_OPTIONS
         from mount_twin.scene.reader import shown  # a 1 MB frame id, shortened
 
         frame = "the one" if expected is None else f"the {shown(expected)}"

@@ -64,6 +64,7 @@ from mount_twin.io.output_tables import (
     input_values,
     integration_values,
 )
+from mount_twin.model.scene_file import read_scene, scene_file_of
 from mount_twin.scene.description import (
     STANDARD_GRAVITY,
     Scene,
@@ -600,14 +601,12 @@ def _differing(scene: Scene, ran: str, recorded: str) -> str:
     path: `scene_differences`), where the run's scene file (`ran`: `SCENE_KEY`'s value, the
     input fields the command line replaced named after it, here taken from `scene`, which has
     the run's) still loads to a scene of the `recorded` digest; else why that cannot be said."""
-    from mount_twin.commands.common import load_scene, scene_file_of
-
     path, keys = scene_file_of(ran)
     cannot = "cannot say which value differs"
     if not Path(path).is_file():
         return f"the run's scene file {path} is not found (from here): {cannot}"
     try:
-        run = load_scene(path, {k: getattr(scene.input, k) for k in keys}, warn=False)
+        run = read_scene(path, {k: getattr(scene.input, k) for k in keys})
     except (MountTwinError, ValueError, OSError) as err:
         return f"the run's scene file no longer loads ({err}): {cannot}"
     if scene_digest(run) != recorded:

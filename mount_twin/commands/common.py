@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 import sys
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
@@ -173,48 +172,15 @@ def _input_replaced(target: Path, reads: Iterable[str | Path | None]) -> str:
     return ""
 
 
-INPUT_OPTIONS = {"input.topic": "replay --topic", "input.frame_id": "replay --frame-id"}
-"""The scene's input settings that --topic and --frame-id replace, and the option as a message
-or the report names it where it did."""
+def load_scene(path: str | Path, input_overrides: Mapping[str, str] | None = None) -> Scene:
+    """The scene file at `path` as a run uses it (`model.scene_file.read_scene`: its `input`
+    fields replaced by `input_overrides`, its start solved where its ratings are judged there);
+    each of its warnings (units? a message type's convention?) is printed on stderr, so that no
+    command runs a scene it found implausible without saying so."""
+    from mount_twin.model.scene_file import read_scene
 
-
-OVERRIDDEN = " (with input {} from the command line)"
-"""What `load_scene` appends to a scene's source where the command line replaced `input`
-fields (their names, comma-separated): read back by `scene_file_of`."""
-
-
-def scene_file_of(source: str) -> tuple[str, list[str]]:
-    """The scene file and the `input` fields the command line replaced of a scene's source as
-    `load_scene` gives it (recorded by a replay in its output bag's metadata)."""
-    before, _, after = OVERRIDDEN.partition("{}")
-    found = re.fullmatch(f"(.*){re.escape(before)}([\\w, ]+){re.escape(after)}", source)
-    return (found[1], found[2].split(", ")) if found else (source, [])
-
-
-def load_scene(
-    path: str | Path, input_overrides: Mapping[str, str] | None = None, *, warn: bool = True
-) -> Scene:
-    """The scene file at `path`, with `input` fields replaced by `input_overrides` (checked like
-    the file's own); each of its warnings (units? a message type's convention?) is printed on
-    stderr (unless not `warn`: a scene only compared with, not run), so that no command runs a
-    scene it found implausible without saying so. A scene
-    whose ratings or force limits are judged at the start the twin uses
-    (`scene.checks.rated_at_start`) is assembled for them: its start is solved here, and again
-    where the command assembles it."""
-    from mount_twin.scene.checks import rated_at_start
-    from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
-
-    data = read_scene_yaml(path)
-    source = str(path)
-    if input_overrides and isinstance(data, dict) and isinstance(data.get("input", {}), dict):
-        data["input"] = {**data.get("input", {}), **input_overrides}
-        source += OVERRIDDEN.format(", ".join(sorted(input_overrides)))
-    scene = scene_from_dict(data, source, refuse_unheld=True)
-    if rated_at_start(scene):
-        from mount_twin.model.assemble import assemble
-
-        scene = assemble(scene).scene
-    for warning in scene.warnings if warn else ():
+    scene = read_scene(path, input_overrides)
+    for warning in scene.warnings:
         print(f"mount-twin: warning: {warning}", file=sys.stderr)
     return scene
 

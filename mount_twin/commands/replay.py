@@ -8,7 +8,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mount_twin.commands.common import INPUT_OPTIONS, positive_int
+from mount_twin.commands.common import positive_int
 
 if TYPE_CHECKING:
     from mount_twin.replay import ReplaySummary
@@ -151,6 +151,8 @@ def replay_and_report(
 def _as_set(summary: ReplaySummary, input_overrides: dict[str, str] | None) -> ReplaySummary:
     """The summary pointing at what the user set: `replay --frame-id` where it replaced the
     scene's input.frame_id (a wrong frame id was set there, not in the scene)."""
+    from mount_twin.model.scene_file import INPUT_OPTIONS
+
     if not input_overrides or "frame_id" not in input_overrides:
         return summary
     return replace(summary, frame_id_setting=INPUT_OPTIONS["input.frame_id"])
