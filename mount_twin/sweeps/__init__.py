@@ -1,2 +1,3 @@
-"""Design sweeps: many scene variants × many inputs, run on a Dask cluster (an adapter: it uses
-the core, the core never imports it)."""
+"""Design sweeps: many scene variants × many inputs, run on a Dask cluster (in the analysis
+layer, docs/design.md: it uses the layers below, and only the command line and
+the package's names (`mount_twin.__init__`) import it)."""
