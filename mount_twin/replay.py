@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from mount_twin.analysis.ageing_live import WindowJob, run_job
+from mount_twin.analysis.ageing_live import DROPPED, UNPAIRED, WindowJob, run_job
+from mount_twin.analysis.ageing_live import NAME as AGEING_STATUS
 from mount_twin.analysis.figures import (
     DISPLACEMENT,
     PEAK_COUPLE,
@@ -141,6 +142,7 @@ class ReplaySummary:
     decimation: int = 1  # outputs.decimation: what the peaks are (`figures.peak_label`)
     frame_id_setting: str = "input.frame_id"  # what set the frame id expected, to point at
     never_started: str = ""  # why the twin never started (`HealthWindow.never_started`)
+    ageing_counts: dict[str, int] | None = None  # the ageing tracker's (None: no ageing)
 
     @property
     def worst_level(self) -> int:
@@ -223,6 +225,7 @@ class ReplaySummary:
                 f"|F| max {max(e.force for e in same):.4g} N"
             )
         lines += self._body_lines()
+        lines += self._ageing_lines()
         lines.append(f"  diagnostics, worst over the run: {LEVEL_NAMES[self.worst_level]}")
         lines += [
             f"    {LEVEL_NAMES[s.level]:5} {s.name}: {s.message}" for s in self.worst.values()
@@ -285,6 +288,19 @@ class ReplaySummary:
             f"(its agreement: {BODY_STATUS} below)"
         ]
 
+    def _ageing_lines(self) -> list[str]:
+        """The ageing tracker's counts (none without an ageing section)."""
+        c = self.ageing_counts
+        if c is None:
+            return []
+        deck, body = (c[k] for k in UNPAIRED)
+        return [
+            f"  ageing tracker: restarted at {c[RESETS]} jumps back of the stamps, "
+            f"{c[DROPPED]} windows open at one dropped (under half a window), samples paired "
+            f"with none of the other stream's: deck {deck}, body IMU {body} "
+            f"(its windows: {AGEING_STATUS} below)"
+        ]
+
     def to_dict(self) -> dict[str, object]:
         """The summary as JSON-ready data, units in the key names; event times `t_s` count
         from the first output, `stamp_s` are header stamps."""
@@ -312,6 +328,7 @@ class ReplaySummary:
             "body_sensor": None
             if self.body_counts is None
             else {"topic": self.body_topic, "counts": dict(self.body_counts)},
+            "ageing": None if self.ageing_counts is None else {"counts": dict(self.ageing_counts)},
             "mounts": {
                 name: {
                     PEAK_FORCE: float(peak[0]) if known else None,
@@ -624,4 +641,5 @@ def _summary(
         scene.body_sensor.topic if scene.body_sensor else "",
         decimation=scene.outputs.decimation,
         never_started=engine.health.never_started(engine.counts),
+        ageing_counts=None if stream.ageing is None else stream.ageing.counts,
     )

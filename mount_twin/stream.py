@@ -360,7 +360,8 @@ class TwinStream:
         still holds, then the last, partial diagnostics period, stamped with the last input
         stamp answered (none answered: the last received; none with a stamp: 0), or the last
         stall report's if later (input not stamped by the clock: /diagnostics never goes
-        back); no report if that period is empty."""
+        back); no report if that period is empty. The ageing tracker's end (the samples it
+        could not pair, `AgeingTracker.finish`) comes with `take_ageing_jobs`."""
         out = self.engine.flush()
         reports, out.health = out.health, []
         kept, self._kept = self._kept, _Kept()
@@ -374,6 +375,8 @@ class TwinStream:
             self.body.counts["unanswered"] += sum(len(d.stamps_ns) for d in self._body_waiting)
             self._body_waiting = []
             msgs += self._encode_body(self.body.finish())
+        if self.ageing is not None:  # the samples it could not pair, where any
+            self._ageing_jobs += self.ageing.finish()
         self.last_outputs = out
         self.final_report = reports[0] if reports else None
         stamp_ns = max(self._last_ns or self._received_ns, self._stalled_ns)

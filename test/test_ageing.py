@@ -11,18 +11,28 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from io_helpers import AGEING_PUMP, ROOT, ageing_messages, pump_scene_file
+from io_helpers import (
+    AGEING_PUMP,
+    ROOT,
+    ageing_messages,
+    pump_scene_file,
+    read_raw,
+    statuses_named,
+)
 from scipy.signal import butter, sosfiltfilt
 
 from mount_twin import load_scene_file
 from mount_twin.analysis import calibration as cal_mod
 from mount_twin.analysis.ageing import WindowFit, track, window_table
-from mount_twin.analysis.ageing_live import CUT_BY_JUMP, DROPPED, WindowJob, run_job
+from mount_twin.analysis.ageing_live import CUT_BY_JUMP, DROPPED, NAME, WindowJob, run_job
 from mount_twin.cli import main
 from mount_twin.engine.batch import LEVEL_NAMES
 from mount_twin.engine.body_check import RESETS
 from mount_twin.errors import SceneError
+from mount_twin.io.bag import OutputBag
+from mount_twin.io.messages import IMU
 from mount_twin.io.signals import Signal, ship_motion
+from mount_twin.replay import replay
 from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
 from mount_twin.stream import TwinStream
@@ -388,17 +398,17 @@ def test_where_only_one_streams_stamps_jump_back_the_window_is_cut_and_that_said
     later samples belong to no run of the first's: not kept). The first stream's second run
     was then kept for good (memory growing, nothing said). Now, once the other's stamps pass
     the jump by more than input.back_jump_reset_s (1 s), a WARN says which stream jumped back
-    and when, and no sample of a later run is kept (counted); the same in any batching."""
+    and when, and no sample of a later run is kept (counted: the end of the stream's report,
+    `test_the_samples_that_pair_with_none_are_counted_at_the_end`); the same in any batching."""
     path, messages = jumping
     scene = load_scene_file(path)
-    steady = ageing_messages(scene, 56.5, JUMP_AT, "/machine/imu")
-    jumped = iter(m for m in messages if m[0] == first)  # in the record's order
-    mixed = [next(jumped) if m[0] == first else m for m in steady]
+    mixed = _one_stream_jumping(messages, scene, first)
     jobs = {feed: _jobs(scene, mixed, feed) for feed in FEEDS}
     assert [(round(j.span[0], 6), round(j.span[1], 2), j.cut) for j in jobs["replay"]] == [
         (2.0, 22.0, False),
         (22.0, 34.0, True),
         (33.995, 34.0, False),  # the WARN (its end rounded), at the last stamp before the jump
+        (56.495, 56.5, False),  # the end of the stream: the samples not paired
     ]
     for feed in FEEDS[1:]:
         assert _same(jobs[feed], jobs["replay"]), feed
@@ -408,10 +418,65 @@ def test_where_only_one_streams_stamps_jump_back_the_window_is_cut_and_that_said
     name = {"/deck/imu": "the deck's", "/machine/imu": "the body IMU's"}[first]
     assert f"stamps jumped back apart: {name} jumped back at 33.995 s" in status.message
     assert status.message.endswith("not tracked from there on")
-    stream = TwinStream(scene)  # fed as it comes, without finish: what it holds
-    for topic, _, raw in mixed:
-        (stream.process if topic == "/deck/imu" else stream.process_body)([raw])
-    assert stream.ageing is not None
-    stamps = np.array([m[1] for m in mixed if m[0] == first])
-    n_after = stamps.shape[0] - int(np.flatnonzero(np.diff(stamps) < 0)[0]) - 1
-    assert stream.ageing.unpaired == n_after
+
+
+def _one_stream_jumping(
+    messages: list[tuple[str, int, bytes]], scene: Scene, first: str
+) -> list[tuple[str, int, bytes]]:
+    """56.5 s of both streams, `first`'s stamps jumping back 8 s at 34 s (those of
+    `messages`), the other's going on."""
+    steady = ageing_messages(scene, 56.5, JUMP_AT, "/machine/imu")
+    jumped = iter(m for m in messages if m[0] == first)  # in the record's order
+    return [next(jumped) if m[0] == first else m for m in steady]
+
+
+@pytest.mark.parametrize("first", ["/deck/imu", "/machine/imu"])
+def test_the_samples_that_pair_with_none_are_counted_at_the_end(
+    jumping: tuple[Path, list[tuple[str, int, bytes]]], first: str, tmp_path: Path
+) -> None:
+    """One stream's stamps jump back at 34 s, the other's go on to 56.5 s: the jumping
+    stream's samples after its jump pair with none of the other's (no second run comes), nor
+    do the other's stamped after the jumping one's last before it. The tracker counted the
+    first in a value no report carried, and the second nowhere: its fits stopped with no
+    count saying what was left out. The end of the stream's report (WARN: the streams jumped
+    back apart) counts both, per stream: by hand from the stamps fed, the same in any
+    batching, and in a replay's summary."""
+    path, messages = jumping
+    scene = load_scene_file(path)
+    mixed = _one_stream_jumping(messages, scene, first)
+    stamps = {t: np.array([s for topic, s, _ in mixed if topic == t]) for t in TOPICS}
+    jump = int(np.flatnonzero(np.diff(stamps[first]) < 0)[0])  # the last sample before it
+    other = next(t for t in TOPICS if t != first)
+    want = {
+        first: stamps[first].shape[0] - jump - 1,
+        other: int((stamps[other] > stamps[first][jump]).sum()),
+    }
+    assert want[first] == want[other] == 4500  # 22.5 s at 200 Hz each: a sanity check
+    want_values = {
+        "deck_samples_unpaired": want[TOPICS[0]],
+        "body_samples_unpaired": want[TOPICS[1]],
+    }
+    for feed in FEEDS:
+        end = _jobs(scene, mixed, feed)[-1]
+        status = run_job(end).statuses[0]
+        assert {k: int(status.values[k]) for k in want_values} == want_values, feed
+        assert LEVEL_NAMES[status.level] == "WARN", feed
+        deck, body = want[TOPICS[0]], want[TOPICS[1]]
+        said = f"at the end of the stream: {deck} deck and {body} body IMU samples paired with no"
+        assert status.message.startswith(said), status.message
+        assert "stamps jumped back apart" in status.message
+        assert end.stamp_ns == max(stamps[TOPICS[0]][-1], stamps[TOPICS[1]][-1])
+    with OutputBag(tmp_path / "in", dict.fromkeys(TOPICS, IMU)) as bag:  # log times rise
+        bag.write([(topic, 1 + i, raw) for i, (topic, _, raw) in enumerate(mixed)])
+    summary = replay(scene, tmp_path / "in", tmp_path / "out", progress=False)
+    assert summary.ageing_counts == {RESETS: 1, DROPPED: 0, **want_values}
+    assert summary.to_dict()["ageing"] == {"counts": summary.ageing_counts}
+    said = f"samples paired with none of the other stream's: deck {deck}, body IMU {body}"
+    assert said in summary.text()
+    raws = [raw for _, raw in read_raw(tmp_path / "out")["/diagnostics"]]
+    _, level, message, values = statuses_named(raws, NAME)[-1]  # the end's, as the node's
+    assert (LEVEL_NAMES[level], message) == ("WARN", status.message)
+    assert {k: int(values[k]) for k in want_values} == want_values
+
+
+TOPICS = ("/deck/imu", "/machine/imu")

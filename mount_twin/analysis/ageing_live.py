@@ -17,9 +17,15 @@ from the new run's first body sample plus the lead; a stream's samples of a run 
 is done with (the other stream jumped back, it did not) are not kept. Where the other stream
 never jumps back with it (`body_check.Apart`: its stamps went on past the jump by more than
 back_jump_reset_s), the runs never pair again: once the run is done, a WARN says which stream
-jumped back and when (a `WindowJob` with `apart`), and no sample of a later run is kept
-(`AgeingTracker.unpaired`). Each report says the jumps before its window and the windows
-dropped so far (`run_job`).
+jumped back and when (a `WindowJob` with `apart`), and no sample of a later run is kept. Each
+report says the jumps before its window and the windows dropped so far (`run_job`).
+
+The samples that pair with no sample of the other stream (`AgeingTracker.counts`: a stream's
+samples of a run past the last stamp the other has in it, and those of a run after the streams
+went apart) are counted per stream; the end of the stream (`AgeingTracker.finish`) reports
+them, where there are any. Only there: the count of a run is complete once its samples stop
+coming, which depends on how the two streams come interleaved, and every report must be the
+same live and in a replay.
 """
 
 from __future__ import annotations
@@ -30,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mount_twin.analysis.ageing import LEAD_S, Band, WindowFit, fit_window
-from mount_twin.engine.batch import LEVEL_NAMES, WARN, HealthReport, HealthStatus
+from mount_twin.engine.batch import LEVEL_NAMES, OK, WARN, HealthReport, HealthStatus
 from mount_twin.engine.body_check import RESETS, Apart
 from mount_twin.io.signals import Signal
 from mount_twin.scene.description import Scene
@@ -41,6 +47,10 @@ DROPPED = "windows_dropped_at_jump_back"
 (not fitted), in every report's values beside RESETS (the jumps back before its window)."""
 CUT_BY_JUMP = "the last window before the stamps jumped back"
 """How a window cut short by a jump back is said."""
+UNPAIRED = ("deck_samples_unpaired", "body_samples_unpaired")
+"""The counts of the deck's and of the body IMU's samples that paired with no sample of the
+other stream (`AgeingTracker.counts`), in the end of the stream's report and a replay's
+summary."""
 
 
 @dataclass(frozen=True)
@@ -59,6 +69,10 @@ class WindowJob:
     cut: bool = False
     apart: str = ""
     """Not a window: the streams' stamps jumped back apart (`Apart`), said as a WARN."""
+    unpaired: tuple[int, int] | None = None
+    """Not a window: the end of the stream, the samples of the deck and of the body IMU
+    that paired with no sample of the other stream (`UNPAIRED`); said with `apart` (a WARN)
+    where the streams jumped back apart, else at OK."""
 
 
 def _status(fit: WindowFit) -> HealthStatus:
@@ -80,12 +94,15 @@ def run_job(job: WindowJob) -> HealthReport:
     """The window's fit as a diagnostics report (a plain function of plain data: it runs in a
     worker process live). A window the twin cannot follow is a WARN saying why. Its values
     say the stamps' jumps back before the window (RESETS) and the windows dropped at them so
-    far (DROPPED), its message too where not 0."""
+    far (DROPPED), its message too where not 0; the end of the stream's, the samples that
+    paired with none of the other stream's (UNPAIRED)."""
     ageing = job.scene.ageing
     assert ageing is not None
     band = Band(ageing.warn, ageing.error)
     try:
-        if job.apart:
+        if job.unpaired is not None:
+            status = _unpaired_status(job.unpaired, job.apart)
+        elif job.apart:
             status = HealthStatus(NAME, WARN, job.apart, {})
         else:
             status = _status(fit_window(job.scene, job.records, job.span, ageing.fit, band))
@@ -106,6 +123,26 @@ def run_job(job: WindowJob) -> HealthReport:
     return HealthReport(job.stamp_ns * 1e-9, -1, [status])
 
 
+_NONE = Signal(np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)))
+_NO_RECORDS = (_NONE, _NONE)
+"""The records of a job that is not a window (`WindowJob.apart`, `unpaired`)."""
+
+
+def _unpaired_status(unpaired: tuple[int, int], apart: str) -> HealthStatus:
+    """The end of the stream's report: the deck's and the body's samples that paired with
+    none of the other stream's (`apart`: where the streams jumped back apart, said, WARN)."""
+    deck, body = unpaired
+    message = (
+        f"at the end of the stream: {deck} deck and {body} body IMU samples paired with no "
+        "sample of the other stream (one stream's stamps jumped back, the other's not): "
+        "not fitted"
+    )
+    if apart:
+        message += f"; {apart}"
+    values = {key: str(n) for key, n in zip(UNPAIRED, unpaired, strict=True)}
+    return HealthStatus(NAME, WARN if apart else OK, message, values)
+
+
 class _Run:
     """A stream's samples of one run (stamps ns and s, accel, gyro), its oldest part dropped
     as it goes."""
@@ -120,6 +157,10 @@ class _Run:
             self.parts.append((ns, t, accel, gyro))
             self.first_t = float(t[0]) if self.first_t is None else self.first_t
             self.last_t = float(t[-1])
+
+    def after(self, t: float) -> int:
+        """How many of its samples are stamped after `t` (s)."""
+        return sum(int((p[1] > t).sum()) for p in self.parts)
 
     def cut(self, start: float, end: float) -> tuple[Signal, int]:
         """The samples in [start, end) and the last one's stamp (ns); those before `start`
@@ -145,8 +186,11 @@ class _Record:
         self.ceiling: int | None = None
         """The last run kept (None: all; the streams jumped back apart after it)."""
         self.unpaired = 0
-        """Samples of runs after the ceiling, not kept."""
-        self._last_ns = 0
+        """Samples that pair with none of the other stream's, not kept: of runs before the
+        floor, after the ceiling, or past the other stream's last stamp in their run
+        (`AgeingTracker`)."""
+        self.last_ns = 0
+        """The stamp of the last sample added, ns."""
 
     def add(
         self,
@@ -160,14 +204,15 @@ class _Record:
         None; the others only tell where a run starts)."""
         if not ns.shape[0]:
             return
-        run = self.run + np.cumsum(ns < np.concatenate([[self._last_ns], ns[:-1]]))
-        self.run, self._last_ns = int(run[-1]), int(ns[-1])
+        run = self.run + np.cumsum(ns < np.concatenate([[self.last_ns], ns[:-1]]))
+        self.run, self.last_ns = int(run[-1]), int(ns[-1])
         if use is not None:
             ns, t, accel, gyro, run = ns[use], t[use], accel[use], gyro[use], run[use]
+        unpaired = run < self.floor
         if self.ceiling is not None:
-            self.unpaired += int((run > self.ceiling).sum())
-            run = np.where(run > self.ceiling, -1, run)
-        for r in np.unique(run[run >= self.floor]).tolist():
+            unpaired |= run > self.ceiling
+        self.unpaired += int(unpaired.sum())
+        for r in np.unique(run[~unpaired]).tolist():
             k = run == r
             self.runs.setdefault(r, _Run()).add(ns[k], t[k], accel[k], gyro[k])
 
@@ -205,9 +250,42 @@ class AgeingTracker:
         """The twin's time base's origin, ns (stamp ns − its seconds)."""
 
     @property
-    def unpaired(self) -> int:
-        """Samples of either stream not kept because the stamps jumped back apart."""
-        return self._foundation.unpaired + self._body.unpaired
+    def counts(self) -> dict[str, int]:
+        """The stamps' jumps back the tracker restarted at (RESETS), the windows dropped at
+        them (DROPPED), and the samples of the deck and of the body IMU that paired with no
+        sample of the other stream (UNPAIRED): a stream's samples of a run stamped after the
+        other's last sample in it (one stream jumped back, the other not yet or never), and
+        every sample of a run after the streams jumped back apart."""
+        deck, body = UNPAIRED
+        return {
+            RESETS: self._run,
+            DROPPED: self.dropped,
+            deck: self._foundation.unpaired,
+            body: self._body.unpaired,
+        }
+
+    def finish(self) -> list[WindowJob]:
+        """The end of both streams: where samples paired with none of the other stream's, a
+        report saying how many (with the streams' jumping back apart, where they did), as a
+        job; the last, partial window is not fitted."""
+        unpaired = (self._foundation.unpaired, self._body.unpaired)
+        if not sum(unpaired) or self._origin_ns is None:
+            return []
+        stamp_ns = max(self._foundation.last_ns, self._body.last_ns)
+        end = (stamp_ns - self._origin_ns) * 1e-9
+        apart = "" if self._apart.found is None else self._apart_message()
+        return [
+            WindowJob(
+                self.scene,
+                _NO_RECORDS,
+                (end, end),
+                stamp_ns,
+                self._run,
+                self.dropped,
+                apart=apart,
+                unpaired=unpaired,
+            )
+        ]
 
     def add_foundation(
         self, ns: np.ndarray, t: np.ndarray, accel: np.ndarray, gyro: np.ndarray
@@ -265,23 +343,32 @@ class AgeingTracker:
                 else:
                     self.dropped += 1
             self._run, self._start = self._run + 1, None
-            for record, _ in records:
+            for record, run in records:  # its samples past the other's last: unpaired
+                record.unpaired += run.after(stop)
                 record.runs.pop(self._run - 1)
                 record.floor = self._run
 
     def _apart_job(self) -> WindowJob:
         """The streams jumped back apart and the run they paired last is done: nothing after
-        it is kept (counted `unpaired`); the WARN saying so, as a job."""
+        it is kept (counted, `counts`); the WARN saying so, as a job."""
         assert self._apart.found is not None and self._origin_ns is not None
         _, run, end = self._apart.found
         for record in (self._foundation, self._body):
             record.close_after(run)
-        empty = Signal(np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)))
-        message = self._apart.message() + ": not tracked from there on"
         stamp_ns = self._origin_ns + round(end * 1e9)
         return WindowJob(
-            self.scene, (empty, empty), (end, end), stamp_ns, run, self.dropped, apart=message
+            self.scene,
+            _NO_RECORDS,
+            (end, end),
+            stamp_ns,
+            run,
+            self.dropped,
+            apart=self._apart_message(),
         )
+
+    def _apart_message(self) -> str:
+        """How the streams jumped back apart, and what became of the tracking."""
+        return self._apart.message() + ": not tracked from there on"
 
     def _job(
         self, foundation: _Run, body: _Run, span: tuple[float, float], cut: bool = False
