@@ -38,7 +38,7 @@ from ros_harness import (
 
 from mount_twin.analysis.ageing_live import NAME as AGEING
 from mount_twin.engine.agreement import NAME
-from mount_twin.engine.batch import ERROR, OK
+from mount_twin.engine.batch import ERROR, OK, WARN
 from mount_twin.engine.delay_line import delay_samples
 from mount_twin.io.bag import OutputBag
 from mount_twin.io.messages import (
@@ -281,3 +281,94 @@ def test_a_stop_sent_to_the_process_group_finishes_the_ageing_fit_in_flight(
     ), node.stderr
     assert "1 ageing fits were not waited for" in node.stderr, node.stderr
     assert wait_for(lambda: all(_gone(pid) for pid in children), 10.0)
+
+
+@pytest.mark.parametrize(
+    ("stops_sent", "first"),
+    [(1, 1000), (2, 1000), (2, 700)],
+    ids=["one_stop", "twice_last_window_judged", "twice_last_window_short"],
+)
+def test_a_second_stop_leaves_the_body_imu_backlog_unprocessed_and_counts_it(
+    tmp_path: Path, stops_sent: int, first: int
+) -> None:
+    """The node's shutdown in this process (`StopRequests`), `first` of the 1500 deck and
+    1500 body messages processed and the other 500 of each waiting in the node's queues.
+    Stopped twice, it processes neither backlog: the input's 500 are counted
+    `lost_unprocessed_at_stop` as before, and so now are the body IMU's 500 (its own counts,
+    and the body sensor's last status on /diagnostics, a WARN: the last, partial window where
+    it spans half a window (the 1000: 1–2 s of windows of 1 s), else a status of its own (the
+    700: 1–1.4 s)). The body backlog had been processed in full at a second stop, however
+    long it took. Stopped once, both backlogs are processed in full, as before (nothing
+    counted lost)."""
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.duration import Duration
+    from rclpy.executors import SingleThreadedExecutor
+
+    from mount_twin.ros.node import MountTwinNode
+    from mount_twin.ros.start import StopRequests
+
+    scene_path = _scene_file(tmp_path)
+    inputs = _inputs()
+    raws = {t: [r for topic, _, r in inputs if topic == t] for t in ("/deck/imu", BODY_TOPIC)}
+    assert [len(r) for r in raws.values()] == [1500, 1500]
+    domain = fresh_domain()
+    context = Context()
+    reliable_body = ["-p", f"qos_overrides.{BODY_TOPIC}.subscription.reliability:=reliable"]
+    args = ["mount_twin_node", "--ros-args", "-p", f"scene_file:={scene_path}"]
+    args += ["-p", "stall_period_s:=3600.0", *LOSSLESS, *reliable_body]
+    rclpy.init(args=args, context=context, domain_id=domain)
+    node = MountTwinNode(args, context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    peer = Peer(domain)
+    peer.record({"/diagnostics": DIAGNOSTICS})
+    stops = StopRequests()
+    assert node.stream.body is not None
+    counts, body_counts = node.stream.engine.counts, node.stream.body.counts
+    try:
+        pubs = {t: peer.publisher(IMU, t) for t in raws}
+        assert wait_for(lambda: all(p.get_subscription_count() > 0 for p in pubs.values()), 30.0)
+        # matched on both sides before any window closes (a report published before the
+        # node's writer matched the peer's reader is not sent to it)
+        assert wait_for(lambda: peer.connected("/diagnostics"), 30.0)
+        diagnostics_pub = node._pubs["/diagnostics"]
+        assert wait_for(lambda: diagnostics_pub.get_subscription_count() > 0, 30.0)
+        for topic, pub in pubs.items():
+            for raw in raws[topic][:first]:
+                pub.publish(raw)
+        deadline = time.monotonic() + 60.0
+        while (counts["received"], body_counts["received"]) != (first, first):
+            assert time.monotonic() < deadline, (counts["received"], body_counts["received"])
+            executor.spin_once(timeout_sec=0.01)
+        for topic, pub in pubs.items():
+            for raw in raws[topic][first:]:
+                pub.publish(raw)
+        assert all(p.wait_for_all_acked(Duration(seconds=30.0)) for p in pubs.values())
+        for _ in range(stops_sent):
+            stops.take(signal.SIGINT)
+        cut_short = node.finish(stops)
+        assert all(p.wait_for_all_acked(Duration(seconds=30.0)) for p in node._pubs.values())
+        peer.take_until(lambda: False, 0.5)
+    finally:
+        peer.close()
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+    lost = 1500 - first if stops_sent == 2 else 0
+    assert cut_short == (lost > 0)
+    assert (counts["received"], counts["lost_unprocessed_at_stop"]) == (1500 - lost, lost)
+    assert (body_counts["received"], body_counts["lost_unprocessed_at_stop"]) == (
+        1500 - lost,
+        lost,
+    )
+    _, level, message, values = _statuses(peer.got["/diagnostics"])[-1]  # the last published
+    assert values["body_lost_unprocessed_at_stop"] == str(lost), message
+    if not lost:
+        return
+    assert level >= WARN, message
+    if first == 1000:  # the last window, 1–2 s, judged: it says them
+        assert "nrms_fx" in values and f"lost_unprocessed_at_stop {lost}" in message, message
+    else:  # the last, 1–1.4 s, too short to judge: a status of their own
+        said = f"{lost} body IMU messages waiting when the node was stopped again were not"
+        assert "nrms_fx" not in values and message.startswith(said), message

@@ -75,6 +75,7 @@ UNPROVIDED = ("unprovided_acceleration", "unprovided_angular_velocity")
 """The counts of accepted body messages that mark their acceleration, their angular velocity
 not provided (REP-145): compared on the other reading alone."""
 APART = "jumped_back_apart"
+STOPPED = "lost_unprocessed_at_stop"
 PROBLEMS = (
     "before_twin",
     "late",
@@ -82,11 +83,14 @@ PROBLEMS = (
     "unanswered",
     "dropped_waiting",
     "lost_middleware",
+    STOPPED,
     APART,
 )
 """Why a body sample accepted was not compared: before the twin's first row, behind the kept
 predictions, inside a gap of the twin's rows, after its last row, held too long, or after the
-body IMU's and the deck's stamps jumped back apart (`Apart`)."""
+body IMU's and the deck's stamps jumped back apart (`Apart`); and why a body message was
+never received: lost by the middleware, or waiting unprocessed in the node's queue when it
+was stopped a second time (STOPPED, `ros.node`)."""
 
 
 class Apart:
@@ -508,10 +512,11 @@ class _Window:
 CUT_BY_END = "the last window, closed by the end of the stream"
 CUT_BY_JUMP = "the last window before the body IMU's stamps jumped back"
 """How a window cut short is said (`_Windows._close`)."""
-LOOSE = ("dropped_waiting", "unanswered")
-"""Not compared for the stream's sake, not at a place in it (held too long, or left at its
-end): reported in the window judged next (unanswered at the end of a run the twin restarted
-after: at its place)."""
+LOOSE = ("dropped_waiting", "unanswered", STOPPED)
+"""Not compared for the stream's sake, not at a place in it (held too long, left at its end,
+never processed at a second stop): reported in the window judged next (unanswered at the end
+of a run the twin restarted after: at its place; those of a second stop that no window
+reports: in a WARN of their own, `_Windows.finish`)."""
 
 
 class _Windows:
@@ -611,21 +616,29 @@ class _Windows:
         """The last, partial window's report, if it spans half a window (with the rejected
         messages after its last sample); if no window was judged over the run although body
         messages came (`counts`), a WARN saying why, stamped `stamp_ns`: silence would read
-        as a check passed."""
+        as a check passed. Where messages were left unprocessed at a second stop (STOPPED)
+        and no window reports them, a WARN saying how many."""
         if self._window is not None:
             self._attribute(np.iinfo(np.int64).max, self._window.problems)
         reports = self._close(CUT_BY_END)
-        if reports or self._judged or not counts["received"]:
-            return reports
-        missed = ", ".join(f"{k} {v}" for k, v in not_compared(counts).items() if v)
-        message = (
-            f"no window of the body IMU was judged over the run: {counts['compared']} of "
-            f"{counts['received']} messages compared (a window needs {MIN_SAMPLES} providing "
-            "a reading over half "
-            f"its {self._sensor.window_s:g} s)" + (f"; not compared: {missed}" if missed else "")
-        )
         values = {f"body_{k}": str(v) for k, v in counts.items()}
-        return [(stamp_ns, HealthStatus(NAME, WARN, message, values))]
+        if not (reports or self._judged or not counts["received"]):
+            missed = ", ".join(f"{k} {v}" for k, v in not_compared(counts).items() if v)
+            message = (
+                f"no window of the body IMU was judged over the run: {counts['compared']} of "
+                f"{counts['received']} messages compared (a window needs {MIN_SAMPLES} "
+                f"providing a reading over half its {self._sensor.window_s:g} s)"
+                + (f"; not compared: {missed}" if missed else "")
+            )
+            return [*reports, (stamp_ns, HealthStatus(NAME, WARN, message, values))]
+        stopped = counts[STOPPED] - self._loose_reported[STOPPED]
+        if stopped:
+            message = (
+                f"{stopped} body IMU messages waiting when the node was stopped again were not "
+                f"processed (counted {STOPPED})"
+            )
+            reports.append((stamp_ns, HealthStatus(NAME, WARN, message, values)))
+        return reports
 
     def _close(self, cut: str = "") -> list[tuple[int, HealthStatus]]:
         """The window open closed by the next beginning, or cut short (`cut`: `CUT_BY_END`,

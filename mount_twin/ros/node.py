@@ -47,6 +47,7 @@ from rclpy.subscription import Subscription
 from rclpy.timer import Timer
 
 from mount_twin.engine.batch import ERROR, OK, HealthReport, HealthStatus
+from mount_twin.engine.body_check import STOPPED
 from mount_twin.errors import MountTwinError
 from mount_twin.io.messages import (
     DIAGNOSTICS_TOPIC,
@@ -273,7 +274,11 @@ class MountTwinNode(Node):
 
     def _on_body(self, raw: bytes) -> None:
         assert self._body_sub is not None
-        self._publish(self.stream.process_body([raw, *take_waiting(self._body_sub, TAKE_LIMIT)]))
+        self._process_body([raw, *take_waiting(self._body_sub, TAKE_LIMIT)])
+
+    def _process_body(self, raws: list[bytes]) -> None:
+        """Body IMU messages through the comparison; its outputs published."""
+        self._publish(self.stream.process_body(raws))
         self._submit_fits()
 
     def _drain(self) -> None:
@@ -379,25 +384,23 @@ class MountTwinNode(Node):
         to SHUTDOWN_ACK_S) until every reliable subscriber has acknowledged it all; a topic
         still unacknowledged then is named in a warning.
 
-        A second stop (`stops.hurried`) skips what is left: the input messages not yet
-        processed (counted `lost_unprocessed_at_stop` in the last report, which still goes
-        out with the gyro filter's delayed samples), the ageing fits still running and the
-        wait for acknowledgements, each said in a warning. True where it skipped any."""
+        A second stop (`stops.hurried`) skips what is left: the input and body IMU messages
+        not yet processed (counted `lost_unprocessed_at_stop` in the last report, which still
+        goes out with the gyro filter's delayed samples, and in the body comparison's last
+        status), the ageing fits still running and the wait for acknowledgements, each said in
+        a warning. True where it skipped any."""
         raws = [*self._pending, *take_waiting(self._sub, TAKE_LIMIT)]
         self._pending = []
-        unprocessed = 0
-        for start in range(0, len(raws), SHUTDOWN_CHUNK):
-            if stops.hurried:
-                unprocessed = len(raws) - start
-                self.stream.engine.count("lost_unprocessed_at_stop", unprocessed)
-                self.get_logger().warning(
-                    f"shutdown: stopped again: {unprocessed} input messages waiting on "
-                    f"{self._sub.topic_name} were not processed"
-                )
-                break
-            self._process(raws[start : start + SHUTDOWN_CHUNK])
-        if self._body_sub is not None:
-            self._publish(self.stream.process_body(take_waiting(self._body_sub, TAKE_LIMIT)))
+        unprocessed = self._until_stopped(raws, self._process, stops, "input", self._sub)
+        if unprocessed:
+            self.stream.engine.count(STOPPED, unprocessed)
+        body_unprocessed = 0
+        if self._body_sub is not None and self.stream.body is not None:
+            body = take_waiting(self._body_sub, TAKE_LIMIT)
+            body_unprocessed = self._until_stopped(
+                body, self._process_body, stops, "body IMU", self._body_sub
+            )
+            self.stream.body.counts[STOPPED] += body_unprocessed
         self._publish(messages_of(self.stream.finish()))
         if not self.stream.engine.counts["received"]:  # nothing to report on: say so, ERROR
             life = time.monotonic() - self._started
@@ -419,7 +422,30 @@ class MountTwinNode(Node):
                     f"shutdown: stopped again: {self._fits.not_waited_for} ageing fits were not "
                     "waited for (their reports say so, ERROR)"
                 )
-        return self._wait_for_acks(stops) or unprocessed > 0 or fits_cut
+        skipped = unprocessed > 0 or body_unprocessed > 0 or fits_cut
+        return self._wait_for_acks(stops) or skipped
+
+    def _until_stopped(
+        self,
+        raws: list[bytes],
+        process: Callable[[list[bytes]], None],
+        stops: StopRequests,
+        what: str,
+        sub: Subscription,
+    ) -> int:
+        """`process` the messages `raws` waiting at shutdown on `sub` (`what`: whose), in
+        chunks of SHUTDOWN_CHUNK, until a second stop; how many were left unprocessed (said
+        in a warning)."""
+        for start in range(0, len(raws), SHUTDOWN_CHUNK):
+            if stops.hurried:
+                unprocessed = len(raws) - start
+                self.get_logger().warning(
+                    f"shutdown: stopped again: {unprocessed} {what} messages waiting on "
+                    f"{sub.topic_name} were not processed"
+                )
+                return unprocessed
+            process(raws[start : start + SHUTDOWN_CHUNK])
+        return 0
 
     def _wait_for_acks(self, stops: StopRequests) -> bool:
         """Wait up to SHUTDOWN_ACK_S until every reliable subscriber has acknowledged every
