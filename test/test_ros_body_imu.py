@@ -5,6 +5,7 @@ for the same messages of both topics. In CI rclpy must be importable (see test_r
 
 from __future__ import annotations
 
+import math
 import os
 import signal
 import time
@@ -21,6 +22,7 @@ else:
 from io_helpers import (
     AGEING_PUMP,
     ageing_bag,
+    ageing_messages,
     pump_scene_file,
     read_raw,
     statuses_named,
@@ -372,3 +374,55 @@ def test_a_second_stop_leaves_the_body_imu_backlog_unprocessed_and_counts_it(
     else:  # the last, 1–1.4 s, too short to judge: a status of their own
         said = f"{lost} body IMU messages waiting when the node was stopped again were not"
         assert "nrms_fx" not in values and message.startswith(said), message
+
+
+def test_the_node_publishes_the_ageing_samples_it_could_not_pair(tmp_path: Path) -> None:
+    """The deck's stamps jump back 2 s at 3 s of a 6 s record, the body IMU's go on (a deck
+    recorder restarted): the deck's 600 samples after the jump (3 s at 200 Hz) and the body
+    IMU's stamped after the deck's last before it pair with nothing. The node said the
+    streams went apart and that tracking stopped, and published no count of what it left
+    out (it held the deck's alone). Now, stopped, its last `mount_twin: ageing` status counts
+    both, by hand from the stamps fed, a WARN, as the replay of the same messages does."""
+    scene_path = pump_scene_file(tmp_path, **AGEING_PUMP)
+    scene = load_scene_file(scene_path)
+    jumping = ageing_messages(scene, 6.0, math.inf, BODY_TOPIC, (3.0, 2.0))
+    steady = ageing_messages(scene, 6.0, math.inf, BODY_TOPIC)
+    deck = iter(m for m in jumping if m[0] == "/deck/imu")
+    inputs = [next(deck) if m[0] == "/deck/imu" else m for m in steady]
+    stamps = {t: np.array([s for topic, s, _ in inputs if topic == t]) for t in TOPICS}
+    jump = int(np.flatnonzero(np.diff(stamps["/deck/imu"]) < 0)[0])
+    want = {
+        "deck_samples_unpaired": str(stamps["/deck/imu"].shape[0] - jump - 1),
+        "body_samples_unpaired": str(int((stamps[BODY_TOPIC] > stamps["/deck/imu"][jump]).sum())),
+    }
+    assert want == {"deck_samples_unpaired": "600", "body_samples_unpaired": "600"}
+    with OutputBag(tmp_path / "in", dict.fromkeys(TOPICS, IMU)) as bag:  # log times rise
+        bag.write([(topic, 1 + i, raw) for i, (topic, _, raw) in enumerate(inputs)])
+    replay(scene, tmp_path / "in", tmp_path / "out", progress=False)
+    replayed = statuses_named([r for _, r in read_raw(tmp_path / "out")["/diagnostics"]], AGEING)
+
+    domain = fresh_domain()
+    peer = Peer(domain)
+    peer.record({"/diagnostics": DIAGNOSTICS})
+    node = _ageing_node(domain, scene_path)
+    try:
+        _send_when_connected(node, peer, inputs)
+
+        def got() -> list[tuple[int, int, str, dict[str, str]]]:
+            return statuses_named(peer.got["/diagnostics"], AGEING)
+
+        assert peer.take_until(lambda: len(got()) == 1, 120.0), node.failed()  # the apart WARN
+        code = stop_and_take(node, peer, lambda: len(got()) == 2)
+    finally:
+        node.stop()
+        peer.close()
+    assert code == 0, node.stderr
+    assert "Traceback" not in node.stderr, node.stderr
+    _, level, message, values = got()[-1]
+    assert level == WARN, message
+    assert {k: values[k] for k in want} == want, message
+    assert "stamps jumped back apart" in message and "not tracked from there on" in message
+    assert got() == replayed
+
+
+TOPICS = ("/deck/imu", BODY_TOPIC)
