@@ -409,6 +409,18 @@ def _until_damage(
         damage.append(err)
 
 
+def _checked(
+    chunks: Iterator[Sequence[bytes]], checkpoint: Callable[[], None] | None
+) -> Iterator[Sequence[bytes]]:
+    """The chunks, `checkpoint` called before each (a stop noted ends the replay there: a
+    body IMU's bag, however much of it is left past the input's end, is not read to its end
+    first)."""
+    for chunk in chunks:
+        if checkpoint is not None:
+            checkpoint()
+        yield chunk
+
+
 @dataclass
 class _Figures:
     """Figures of the published rows so far: per mount peak |F| (N) and |M| (N·m) and travel
@@ -516,8 +528,9 @@ def replay(
     records the scene (`io.bag.SCENE_KEY`: where it came from; `SCENE_DIGEST_KEY`: its digest,
     `scene_digest`), which `report --scene` checks its scene against. Both bags are
     checked before the twin is built. `checkpoint` is called once it is built and between
-    chunks, where stopping is safe: it may raise to stop the replay (a signal noted by
-    the command line); once the output bag exists, it is then finished and marked partial.
+    chunks (the input's and the body IMU's), where stopping is safe: it may raise to stop the
+    replay (a signal noted by the command line); once the output bag exists, it is then
+    finished and marked partial.
 
     With a body_sensor, its IMU (body_sensor.topic of `body_path`, else of the input bag if it
     has it) is compared with the twin as the node compares it live (`TwinStream.process_body`):
@@ -557,7 +570,11 @@ def replay(
         # the chunks, then the end (also where a damaged bag ends): the outputs the gyro delay
         # holds and the last, partial diagnostics period
         damage: list[DamagedBagError] = []
-        body_chunks = _until_damage(body_bag.chunks(chunk), damage) if body_bag else iter(())
+        body_chunks = (
+            _checked(_until_damage(body_bag.chunks(chunk), damage), checkpoint)
+            if body_bag
+            else iter(())
+        )
         for raws in chain(_until_damage(bag.chunks(chunk), damage), [None]):
             if checkpoint is not None:
                 checkpoint()

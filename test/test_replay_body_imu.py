@@ -319,3 +319,49 @@ def test_a_bag_played_in_a_loop_is_compared_on_every_loop(
         assert {k: v for k, v in second.items() if k != reset} == {
             k: v for k, v in first.items() if k != reset
         }
+
+
+def test_a_stop_while_the_body_imus_rest_is_replayed_ends_it_at_the_next_chunk(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A body IMU bag running 5 s past the input's 1 s, replayed in chunks of 100 messages:
+    the body's first two chunks (to 0.997 s) go in beside the input's, its ten others after
+    the input's end. A stop (Ctrl-C, noted by the command line) while the first of those is
+    compared ended the replay only once all ten were read and compared (no stop was looked
+    at between them: a long body bag held a Ctrl-C for its whole length). Now the replay
+    stops before the next: three body chunks taken in all, KeyboardInterrupt, the output
+    bag marked partial."""
+    from mount_twin.io.bag import partial_marker
+    from mount_twin.replay import replay
+    from mount_twin.stream import TwinStream
+
+    streams = _streams()
+    with OutputBag(tmp_path / "deck", {"/deck/imu": IMU}) as bag:
+        bag.write([("/deck/imu", s, r) for s, r in streams["/deck/imu"][:200]])  # 0–0.995 s
+    with OutputBag(tmp_path / "body", {BODY_TOPIC: IMU}) as bag:
+        bag.write([(BODY_TOPIC, s, r) for s, r in streams[BODY_TOPIC]])  # 1200: 0.002–5.997 s
+    calls = []
+    process_body = TwinStream.process_body
+
+    def counted(stream: TwinStream, raws: list[bytes]) -> list[tuple[str, int, bytes]]:
+        calls.append(len(raws))
+        return process_body(stream, raws)
+
+    def checkpoint() -> None:
+        if len(calls) >= 3:  # a stop noted while the third body chunk was compared
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(TwinStream, "process_body", counted)
+    scene = load_scene_file(_scene(tmp_path))
+    with pytest.raises(KeyboardInterrupt):
+        replay(
+            scene,
+            tmp_path / "deck",
+            tmp_path / "out",
+            chunk=100,
+            progress=False,
+            checkpoint=checkpoint,
+            body_path=tmp_path / "body",
+        )
+    assert calls == [100, 100, 100]
+    assert partial_marker(tmp_path / "out").startswith("stopped by KeyboardInterrupt")
