@@ -295,9 +295,9 @@ class ReplaySummary:
             return []
         deck, body = (c[k] for k in UNPAIRED)
         return [
-            f"  ageing tracker: restarted at {c[RESETS]} jumps back of the stamps, "
-            f"{c[DROPPED]} windows open at one dropped (under half a window), samples paired "
-            f"with none of the other stream's: deck {deck}, body IMU {body} "
+            f"  ageing tracker: the stamps jumped back {c[RESETS]}× (it restarted), "
+            f"{c[DROPPED]} windows open at a jump dropped (under half a window), samples "
+            f"paired with none of the other stream's: deck {deck}, body IMU {body} "
             f"(its windows: {AGEING_STATUS} below)"
         ]
 
