@@ -630,7 +630,7 @@ class _Windows:
                 f"providing a reading over half its {self._sensor.window_s:g} s)"
                 + (f"; not compared: {missed}" if missed else "")
             )
-            return [*reports, (stamp_ns, HealthStatus(NAME, WARN, message, values))]
+            return [(stamp_ns, HealthStatus(NAME, WARN, message, values))]
         stopped = counts[STOPPED] - self._loose_reported[STOPPED]
         if stopped:
             message = (

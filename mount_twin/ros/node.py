@@ -392,7 +392,7 @@ class MountTwinNode(Node):
         raws = [*self._pending, *take_waiting(self._sub, TAKE_LIMIT)]
         self._pending = []
         unprocessed = self._until_stopped(raws, self._process, stops, "input", self._sub)
-        if unprocessed:
+        if unprocessed:  # the input's count named as the body's
             self.stream.engine.count(STOPPED, unprocessed)
         body_unprocessed = 0
         if self._body_sub is not None and self.stream.body is not None:
