@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -322,11 +323,29 @@ class SceneWarning:
 
 
 @dataclass(frozen=True)
+class SceneOrigin:
+    """Where a scene came from, as separate fields (a replay records them in its output bag,
+    the node publishes them on ~/scene: `io.scene_record`).
+
+    Attributes:
+        file: the scene file's absolute path; None: no file (a parameter set alone, a scene
+            built in code).
+        overrides: what was put over the file's values, by flat parameter name
+            (`input.topic`: `replay --topic`, `--frame-id`; the node's parameters given beside
+            `scene_file`); empty without a file.
+    """
+
+    file: str | None = None
+    overrides: Mapping[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
 class Scene:
-    """A complete scene; `source` names the file or parameter set it came from, `warnings` what
-    the loader found implausible in it, and the assembly at its start (`model.ratings`), and
-    `mount_paths` the key path of each mount in messages, as the loader named them (neither is
-    part of its value: two scenes that differ only in them are equal)."""
+    """A complete scene; `source` names the file or parameter set it came from (a text for
+    messages; `origin` the same as fields), `warnings` what the loader found implausible in it,
+    and the assembly at its start (`model.ratings`), and `mount_paths` the key path of each
+    mount in messages, as the loader named them (none of these is part of its value: two
+    scenes that differ only in them are equal)."""
 
     name: str
     body: Body
@@ -342,6 +361,7 @@ class Scene:
     source: str = "<memory>"
     warnings: tuple[SceneWarning, ...] = field(default=(), compare=False)
     mount_paths: tuple[str, ...] = field(default=(), compare=False)
+    origin: SceneOrigin = field(default_factory=SceneOrigin, compare=False)
 
     def mount_path(self, i: int) -> str:
         """Key path of mount i in messages: as its loader named it (mounts.<name> in a
@@ -351,7 +371,7 @@ class Scene:
         return f"mounts[{i}]"
 
 
-NOT_THE_VALUE = ("source", "warnings", "mount_paths")
+NOT_THE_VALUE = ("source", "warnings", "mount_paths", "origin")
 """Fields of a Scene that are not part of its value (`Scene`): left out of its digest."""
 
 
@@ -359,9 +379,16 @@ def scene_digest(scene: Scene) -> str:
     """sha256 (hex) of the scene's value: every field two scenes are compared by but the file
     it came from (`source`), as sorted JSON (floats as Python writes them back exactly). Two
     files that set the same values (however commented, ordered, or with defaults written out)
-    give the same digest; one value changed, another. A replay records it in its output bag's
-    metadata (`io.bag.SCENE_DIGEST_KEY`), for `report --scene` to check its scene against."""
-    text = json.dumps(scene_value(scene), sort_keys=True, separators=(",", ":"))
+    give the same digest; one value changed, another. The node publishes it on ~/scene and a
+    replay records it in its output bag (`io.scene_record`), for `report --scene` to check its
+    scene against."""
+    return value_digest(scene_value(scene))
+
+
+def value_digest(value: Mapping[str, Any]) -> str:
+    """sha256 (hex) of a scene's value (`scene_value`, or the same read back from JSON: the
+    text hashed is the same), as `scene_digest` gives it."""
+    text = json.dumps(value, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
 
 
@@ -393,10 +420,12 @@ def value_differences(here: Any, there: Any, path: str = "") -> list[tuple[str, 
     return [] if here == there else [(path, here, there)]
 
 
-def scene_differences(here: Scene, there: Scene) -> list[tuple[str, Any, Any]]:
-    """`value_differences` of two scenes' values (`scene_value`), a mount's key path as
-    `here` names it (`Scene.mount_path`: `mounts.<name>` in a parameter set)."""
-    found = value_differences(scene_value(here), scene_value(there))
+def scene_differences(here: Scene, there: Scene | Mapping[str, Any]) -> list[tuple[str, Any, Any]]:
+    """`value_differences` of two scenes' values (`scene_value`; `there` may be a value as
+    read back from JSON, its tuples lists), a mount's key path as `here` names it
+    (`Scene.mount_path`: `mounts.<name>` in a parameter set)."""
+    value = scene_value(there) if isinstance(there, Scene) else there
+    found = value_differences(scene_value(here), value)
     return [(_named(here, path), a, b) for path, a, b in found]
 
 

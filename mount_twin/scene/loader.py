@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import re
 from pathlib import Path
 from typing import Any
@@ -30,6 +31,7 @@ from mount_twin.scene.description import (
     Mount,
     Outputs,
     Scene,
+    SceneOrigin,
     Vec3,
     Vec6,
     ageing_bands_problem,
@@ -62,8 +64,9 @@ SCENE_MAX_BYTES = 16 * MIB
 
 def load_scene_file(path: str | Path) -> Scene:
     """Read and validate a scene YAML file; errors name the file and key path, and what looks
-    mistaken is in the Scene's `warnings`."""
-    return scene_from_dict(read_scene_yaml(path), str(path), refuse_unheld=True)
+    mistaken is in the Scene's `warnings`; its `origin` is the file's absolute path."""
+    origin = SceneOrigin(os.path.abspath(path))
+    return scene_from_dict(read_scene_yaml(path), str(path), refuse_unheld=True, origin=origin)
 
 
 def read_scene_yaml(path: str | Path) -> Any:
@@ -107,6 +110,7 @@ def scene_from_dict(
     mount_paths: list[str] | None = None,
     record: Used | None = None,
     refuse_unheld: bool = False,
+    origin: SceneOrigin | None = None,
 ) -> Scene:
     """Validate a scene mapping (the layout of config/*.scene.yaml), then the scene as a whole
     (`mount_twin.scene.checks`): what cannot work is a SceneError, what looks mistaken is in
@@ -121,6 +125,7 @@ def scene_from_dict(
         refuse_unheld: a free DOF no mount holds is a SceneError (for a start at equilibrium)
             instead of a warning: what scene files and parameter sets get. Off for scenes built
             in code, such as tests of a single mount's law.
+        origin: where it came from, as fields (default: no file, nothing put over it).
     """
     refuse_parameters_file(data, source)
     top = Reader(data, source, record=record)
@@ -156,7 +161,9 @@ def scene_from_dict(
     )
     top.finish()
     warnings = check_scene(scene, paths, refuse_unheld=refuse_unheld)
-    return dataclasses.replace(scene, warnings=warnings, mount_paths=tuple(paths))
+    return dataclasses.replace(
+        scene, warnings=warnings, mount_paths=tuple(paths), origin=origin or SceneOrigin()
+    )
 
 
 def refuse_parameters_file(data: Any, source: str) -> None:

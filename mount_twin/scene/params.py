@@ -8,6 +8,7 @@ scene loader validates, so a params YAML and a scene YAML go through one loader.
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Iterator, Mapping
 from typing import Any, NamedTuple
@@ -15,7 +16,7 @@ from typing import Any, NamedTuple
 from mount_twin.errors import SceneError
 from mount_twin.integrate.methods import METHODS
 from mount_twin.kinds import KINDS
-from mount_twin.scene.description import Scene
+from mount_twin.scene.description import Scene, SceneOrigin
 from mount_twin.scene.loader import load_scene_file, read_scene_yaml, scene_from_dict
 from mount_twin.scene.reader import Used, shown
 
@@ -217,6 +218,7 @@ def effective_parameters(flat: Mapping[str, Any], source: str) -> Effective:
     if not isinstance(scene_file, str):
         raise SceneError(source, "scene_file", f"expected a string, got {scene_file!r}")
     given = {k: v for k, v in flat.items() if k != "scene_file"}
+    overrides = as_declared_types(given)  # what the file's values are overridden with
     if scene_file:
         from_file = load_scene_file(scene_file)
         source = f"{source} over {scene_file}" if given else str(scene_file)
@@ -248,6 +250,7 @@ def effective_parameters(flat: Mapping[str, Any], source: str) -> Effective:
         mount_paths=[f"mounts.{n}" for n in names],
         record=used,
         refuse_unheld=True,
+        origin=SceneOrigin(os.path.abspath(scene_file), overrides) if scene_file else None,
     )
     types = parameter_types({**used.values, "mount_names": names})
     effective: dict[str, Any] = {"scene_file": str(scene_file), "mount_names": list(names)}
