@@ -51,14 +51,7 @@ from mount_twin.engine.health import (
     why_none,
 )
 from mount_twin.errors import BagError, DamagedBagError, require
-from mount_twin.io.bag import (
-    LATCHED_QOS,
-    SCENE_DIGEST_KEY,
-    SCENE_KEY,
-    InputBag,
-    OutputBag,
-    check_new_bag,
-)
+from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import (
     DIAGNOSTICS_TOPIC,
     IMU,
@@ -72,8 +65,9 @@ from mount_twin.io.messages import (
     resolve,
     static_transforms,
 )
+from mount_twin.io.scene_record import SCENE_TOPIC, STRING, scene_message, scene_metadata
 from mount_twin.physics.rotations import angle_text, quaternion_matrices
-from mount_twin.scene.description import Scene, scene_digest
+from mount_twin.scene.description import Scene
 from mount_twin.stream import TwinStream
 
 
@@ -522,11 +516,11 @@ def replay(
     """Replay `input_path`'s scene.input.topic into a new mcap bag at `output_path`.
 
     The output holds what the node publishes: the scene's outputs (`output_types`), and the mount
-    frames on /tf_static once, before anything else, stamped with the first output's stamp (that
-    of the first input sample the stream took: never an unset or pre-1970 one) and offered
-    latched (`LATCHED_QOS`) so `ros2 bag play` republishes it to late subscribers; its metadata
-    records the scene (`io.bag.SCENE_KEY`: where it came from; `SCENE_DIGEST_KEY`: its digest,
-    `scene_digest`), which `report --scene` checks its scene against. Both bags are
+    frames on /tf_static and the scene on ~/scene (`io.scene_record`) once, before anything else,
+    stamped with the first output's stamp (that of the first input sample the stream took: never
+    an unset or pre-1970 one) and offered latched (`LATCHED_QOS`) so `ros2 bag play` republishes
+    them to late subscribers; its metadata records the scene too (`scene_metadata`: its source,
+    file, overrides and digest), which `report --scene` checks its scene against. Both bags are
     checked before the twin is built. `checkpoint` is called once it is built and between
     chunks (the input's and the body IMU's), where stopping is safe: it may raise to stop the
     replay (a signal noted by the command line); once the output bag exists, it is then
@@ -547,9 +541,9 @@ def replay(
     except BaseException:
         bag.close()
         raise
-    resolved = {t: resolve(t, NODE_NAME) for t in output_types(scene)}
-    topics = {resolved[t]: msgtype for t, msgtype in output_types(scene).items()}
-    topics[TF_STATIC_TOPIC] = TF
+    types = output_types(scene) | {TF_STATIC_TOPIC: TF, SCENE_TOPIC: STRING}
+    resolved = {t: resolve(t, NODE_NAME) for t in types}
+    topics = {resolved[t]: msgtype for t, msgtype in types.items()}
     static_due = True
     n = len(scene.mounts)
     points = np.array([m.position for m in scene.mounts]).reshape(-1, 3)
@@ -562,8 +556,8 @@ def replay(
         OutputBag(
             output_path,
             topics,
-            {TF_STATIC_TOPIC: [LATCHED_QOS]},
-            {SCENE_KEY: scene.source, SCENE_DIGEST_KEY: scene_digest(scene)},
+            {resolved[t]: [LATCHED_QOS] for t in (TF_STATIC_TOPIC, SCENE_TOPIC)},
+            scene_metadata(scene),
         ) as out,
         tqdm(total=bag.count, unit="msg", disable=not progress, desc="replay", leave=False) as bar,
     ):
@@ -589,7 +583,8 @@ def replay(
             if static_due and outputs:
                 first = outputs[0]
                 stamp = int(first.stamps_ns[0]) if isinstance(first, RowBlock) else first[1]
-                out.write([static_transforms(scene, stamp)])
+                once = (static_transforms(scene, stamp), scene_message(scene, stamp))
+                out.write([(resolved[topic], at, data) for topic, at, data in once])
                 static_due = False
             out.write(
                 [

@@ -24,6 +24,7 @@ from mount_twin.io.messages import (
     decode_inputs,
     resolve,
 )
+from mount_twin.io.scene_record import STRING
 from mount_twin.replay import replay
 from mount_twin.stream import TwinStream
 
@@ -81,6 +82,7 @@ def expected_types() -> dict[str, str]:
         "/diagnostics": DIAGNOSTICS,
         "/tf": TF,
         "/tf_static": TF,
+        f"/{NODE_NAME}/scene": STRING,
     }
     types.update({f"/{NODE_NAME}/mounts/{m.name}/wrench": WRENCH for m in scene.mounts})
     return types
@@ -122,6 +124,10 @@ def test_each_output_topic_carries_the_input_stamps(
             ((log_time, static),) = msgs[topic]
             assert log_time == input_stamps[0]
             assert set(header_stamps(static)) == {input_stamps[0]}
+            continue
+        if topic == f"/{NODE_NAME}/scene":  # the same, with no header
+            ((log_time, _),) = msgs[topic]
+            assert log_time == input_stamps[0]
             continue
         got = [s for _, m in msgs[topic] for s in header_stamps(m)]
         assert [t for t, _ in msgs[topic]] == got, f"{topic}: log time must equal header.stamp"
@@ -199,7 +205,7 @@ def test_live_one_message_at_a_time_equals_the_chunked_replay(bags: dict[str, Pa
     pose_bag = decode_poses([d for _, d in replayed[f"/{NODE_NAME}/pose"]])
     np.testing.assert_allclose(pose_live, pose_bag, rtol=0, atol=1e-12)
     for topic in expected_types():
-        if topic in ("/diagnostics", "/tf_static"):  # the node sends /tf_static on its own
+        if topic in ("/diagnostics", "/tf_static", f"/{NODE_NAME}/scene"):  # the node's own
             continue
         live_topic = [(s, d) for t, s, d in live if t == topic]
         assert live_topic == replayed[topic], f"{topic}: live bytes differ from the replayed bag"
@@ -247,7 +253,7 @@ def test_replay_summary_reports_counts_and_real_time_factor(
 ) -> None:
     summary = replay(_scene(), bags["in_sqlite3"], tmp_path / "out", progress=False)
     assert summary.counts["received"] == summary.counts["accepted"] == 500
-    assert summary.written == 500 * (3 + 8) + 1 + len(
+    assert summary.written == 500 * (3 + 8) + 2 + len(  # 2: /tf_static, ~/scene
         read_raw(tmp_path / "out", ["/diagnostics"]).get("/diagnostics", [])
     )
     assert summary.stamp_span_s == pytest.approx(0.499, abs=1e-9)

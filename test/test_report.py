@@ -916,49 +916,138 @@ def test_a_scene_with_the_runs_mounts_and_another_value_is_refused_naming_both(
     assert f"NOT the run's, drawn with on request (--other-scene): {other}: scene" in text
 
 
-def _run_scene_named(pump_run: Path, tmp_path: Path, scene: str) -> Path:
-    """The pump's run, its metadata naming `scene` as the file it was replayed with."""
-    import shutil
+def _without_scene_topic(bag: Path, out: Path, custom: dict[str, str]) -> Path:
+    """`bag` rewritten at `out` without its ~/scene topic, its metadata's custom_data
+    `custom`: a replay's bag as a mount_twin wrote it before it wrote the scene's topic and
+    keys (`custom`: the one text naming the file, and the digest), or a recording of the
+    node's topics by one that did not publish its scene (`custom` empty)."""
+    from rosbags.highlevel import AnyReader
+    from rosbags.rosbag2 import StoragePlugin, Writer
 
-    import yaml
+    from mount_twin.io.messages import TYPESTORE
 
-    bag = tmp_path / "renamed"
-    shutil.copytree(pump_run, bag)
-    meta = yaml.safe_load((bag / "metadata.yaml").read_text(encoding="utf-8"))
-    meta["rosbag2_bagfile_information"]["custom_data"]["mount_twin.scene"] = scene
-    (bag / "metadata.yaml").write_text(yaml.safe_dump(meta), encoding="utf-8")
-    return bag
+    with (
+        AnyReader([bag], default_typestore=TYPESTORE) as reader,
+        Writer(out, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP) as writer,
+    ):
+        kept = [c for c in reader.connections if c.topic != "/mount_twin/scene"]
+        assert len(kept) == len(reader.connections) - 1
+        conns = {
+            c.id: writer.add_connection(
+                c.topic,
+                c.msgtype,
+                typestore=TYPESTORE,
+                offered_qos_profiles=c.ext.offered_qos_profiles,
+            )
+            for c in kept
+        }
+        for conn, t, raw in reader.messages(connections=kept):
+            writer.write(conns[conn.id], t, raw)
+        for key, value in custom.items():
+            writer.set_custom_data(key, value)
+    return out
 
 
-def test_a_refused_scene_names_the_values_it_differs_in_where_the_runs_file_tells(
+def _old_bag(pump_run: Path, out: Path, scene: str) -> Path:
+    """The pump's run as a replay wrote it before the scene's topic and separate keys: its
+    metadata naming `scene` as the one text (file and overrides) it was replayed with."""
+    from mount_twin.io.bag import SCENE_DIGEST_KEY, SCENE_KEY, custom_data
+
+    digest = custom_data(pump_run)[SCENE_DIGEST_KEY]
+    return _without_scene_topic(pump_run, out, {SCENE_KEY: scene, SCENE_DIGEST_KEY: digest})
+
+
+STIFFER_DIFFERS = (
+    "it differs in mounts[0].stiffness[2]: 2400000.0 here, 1200000.0 in the run's scene"
+)
+"""What a refused scene with mount fl's z stiffness doubled says (the pump's is 1.2e6)."""
+
+
+def test_a_refused_scene_names_the_values_it_differs_in_where_an_old_bags_file_tells(
     pump_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """A refused scene said only that "a value differs". Where the run's scene file still
-    loads to the recorded digest, the message names each value that differs, with both
-    values (mount fl's z stiffness: the file's 1.2e6, 2.4e6 here); read past the input
-    settings the command line replaced; else it says why it cannot."""
+    """A refused scene said only that "a value differs". In a bag written before the replay
+    recorded its scene's value, where the run's scene file still loads to the recorded
+    digest, the message names each value that differs, with both values (mount fl's z
+    stiffness: the file's 1.2e6, 2.4e6 here); read past the input settings the command line
+    replaced; else it says why it cannot."""
     other = _pump_scene(tmp_path / "other.scene.yaml", OTHER_VALUES["a mount's stiffness"])
-    args = ["report", str(pump_run), "--scene", str(other), "-o", str(tmp_path / "r.html")]
-    assert main(args) == 2
-    differs = "it differs in mounts[0].stiffness[2]: 2400000.0 here, 1200000.0 in the run's scene"
-    assert differs in capsys.readouterr().err
-    # the run's file named as a replay with --topic names it (its topic is the run's)
+    args = ["--scene", str(other), "-o", str(tmp_path / "r.html")]
     copy = _pump_scene(tmp_path / "copy.scene.yaml")
-    bag = _run_scene_named(pump_run, tmp_path, str(copy) + OVERRIDDEN.format("topic"))
-    assert main(["report", str(bag), *args[2:]]) == 2
-    assert differs in capsys.readouterr().err
+    # the run's file named as a replay with --topic names it (its topic is the run's)
+    bag = _old_bag(pump_run, tmp_path / "old", str(copy) + OVERRIDDEN.format("topic"))
+    assert main(["report", str(bag), *args]) == 2
+    assert f"{STIFFER_DIFFERS} (the run's scene as its file {copy} loads it)" in (
+        capsys.readouterr().err
+    )
     _pump_scene(copy, _set("body", "mass", value=1500.0))
-    assert main(["report", str(bag), *args[2:]]) == 2
+    assert main(["report", str(bag), *args]) == 2
     assert (
         f"the run's scene file {copy} has changed since: cannot say which value differs"
         in capsys.readouterr().err
     )
     copy.unlink()
-    assert main(["report", str(bag), *args[2:]]) == 2
+    assert main(["report", str(bag), *args]) == 2
     assert (
-        f"the run's scene file {copy} is not found (from here): cannot say which value differs"
+        f"the run's scene file {copy} is not found: cannot say which value differs"
         in capsys.readouterr().err
     )
+
+
+def test_an_old_bags_relative_scene_file_is_found_from_the_bags_directory(
+    pump_run: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """An old bag records the scene file as the replay was given it, relative to where it
+    ran: `report` run from another directory said the file was not found. Not found from
+    here, it is looked for from the bag's directory, and the message says so."""
+    ran, elsewhere = tmp_path / "ran", tmp_path / "elsewhere"
+    (ran / "config").mkdir(parents=True)
+    elsewhere.mkdir()
+    _pump_scene(ran / "config" / "run.scene.yaml")
+    bag = _old_bag(pump_run, ran / "out", "config/run.scene.yaml")
+    other = _pump_scene(tmp_path / "other.scene.yaml", OTHER_VALUES["a mount's stiffness"])
+    monkeypatch.chdir(elsewhere)
+    args = ["report", str(bag), "--scene", str(other), "-o", str(tmp_path / "r.html")]
+    assert main(args) == 2
+    found = ran / "config" / "run.scene.yaml"
+    assert (
+        f"{STIFFER_DIFFERS} (the run's scene as its file {found}, config/run.scene.yaml "
+        "found from the bag's directory loads it)" in capsys.readouterr().err
+    )
+    found.unlink()
+    assert main(args) == 2
+    assert (
+        f"the run's scene file config/run.scene.yaml is not found from here ({elsewhere}) nor "
+        f"from the bag's directory ({ran}): cannot say which value differs"
+        in capsys.readouterr().err
+    )
+
+
+def test_a_refused_scene_names_its_differences_from_the_bags_scene_with_the_file_gone(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The replay writes its scene's value into its bag (~/scene): a refused scene's
+    differences are named from it, the run's scene file moved away and `report` run from
+    another directory (which had said the file was not found, and nothing of the values)."""
+    ran, elsewhere = tmp_path / "ran", tmp_path / "elsewhere"
+    ran.mkdir()
+    elsewhere.mkdir()
+    _pump_scene(ran / "run.scene.yaml")
+    monkeypatch.chdir(ran)
+    bag = ROOT / "bags" / "half_sine_shock_10khz"
+    replayed = ["replay", str(bag), "--scene", "run.scene.yaml", "-o", "out", "--no-progress"]
+    assert main(replayed) == 0
+    (ran / "run.scene.yaml").unlink()
+    monkeypatch.chdir(elsewhere)
+    other = _pump_scene(tmp_path / "other.scene.yaml", OTHER_VALUES["a mount's stiffness"])
+    args = ["report", "../ran/out", "--scene", str(other), "-o", "r.html"]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "is not the one ../ran/out was replayed with, run.scene.yaml" in err
+    assert f"{STIFFER_DIFFERS} (the run's scene as its /mount_twin/scene topic records it)" in err
 
 
 def test_other_scene_needs_a_scene(pump_run: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -985,7 +1074,7 @@ def test_the_runs_scene_rewritten_is_still_its_own(
 
 def _recorded(pump_run: Path, tmp_path: Path) -> Path:
     """The pump's run as a bag without mount_twin's custom_data, as `ros2 bag record` of the
-    node's topics writes one: nothing in it names or digests the scene."""
+    node's topics writes one: its ~/scene topic the node's only record of its scene."""
     import shutil
 
     import yaml
@@ -998,6 +1087,26 @@ def _recorded(pump_run: Path, tmp_path: Path) -> Path:
     return bag
 
 
+def test_a_recording_of_the_nodes_topics_is_checked_by_its_scene_topics_digest(
+    pump_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A recording of the node's topics was checked by its mount names, rtol and atol only:
+    a scene of another mass passed. The node's ~/scene (as the replay writes it) gives the
+    digest and the value: refused, naming the mass (the pump's 1200 kg, 1500 here)."""
+    bag = _recorded(pump_run, tmp_path)
+    heavy = _pump_scene(tmp_path / "heavy.scene.yaml", OTHER_VALUES["the mass"])
+    page = tmp_path / "r.html"
+    assert main(["report", str(bag), "--scene", str(heavy), "-o", str(page)]) == 2
+    err = capsys.readouterr().err
+    assert f"is not the one {bag} was run with, {PUMP}: its digest" in err
+    assert "differs from the one its /mount_twin/scene topic records" in err
+    assert "it differs in body.mass: 1500.0 here, 1200.0 in the run's scene" in err
+    assert main(["report", str(bag), "--scene", str(PUMP), "-o", str(page)]) == 0
+    assert f"the run's: its digest is the one {bag} records" in html.unescape(
+        page.read_text(encoding="utf-8")
+    )
+
+
 def test_without_a_digest_a_scene_is_checked_by_the_settings_the_bag_records(
     pump_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -1005,7 +1114,7 @@ def test_without_a_digest_a_scene_is_checked_by_the_settings_the_bag_records(
     status records the solver's rtol and atol. A scene with another atol is refused, naming
     it and both values; one differing elsewhere cannot be told apart, and stderr and the page
     say what it was checked by."""
-    bag = _recorded(pump_run, tmp_path)
+    bag = _without_scene_topic(pump_run, tmp_path / "recorded", {})
     page = tmp_path / "r.html"
     loose = _pump_scene(tmp_path / "loose.scene.yaml", _set("integration", "atol", value=1e-7))
     assert main(["report", str(bag), "--scene", str(loose), "-o", str(page)]) == 2
@@ -1019,7 +1128,8 @@ def test_without_a_digest_a_scene_is_checked_by_the_settings_the_bag_records(
     assert main(["report", str(bag), "--scene", str(heavy), "-o", str(page)]) == 0
     said = (
         "by its mount names, integration.rtol, integration.atol only: "
-        f"{bag} records no digest of its scene"
+        f"{bag} records no digest of its scene (a recording of the node's topics without its "
+        "~/scene"
     )
     assert said in capsys.readouterr().err
     assert said in html.unescape(page.read_text(encoding="utf-8"))
@@ -1168,8 +1278,10 @@ def test_the_attitude_is_drawn_in_radians_as_the_bag_records_it() -> None:
 
 def test_a_scene_equal_to_the_runs_but_for_a_zeros_sign_says_so() -> None:
     """Digests hash the values' JSON text, where -0.0 is not 0.0 though the numbers are equal:
-    the list of differences was empty and the message ended in "it differs in "."""
+    the list of differences was empty and the message ended in "it differs in ". So from
+    the run's file, and from its value as the bag's ~/scene carries it (JSON)."""
     from mount_twin.analysis.report import _differing
+    from mount_twin.io.scene_record import RecordedScene, scene_text
     from mount_twin.scene.description import scene_digest
 
     path = CONFIG / "pump_8_mounts.scene.yaml"
@@ -1178,5 +1290,10 @@ def test_a_scene_equal_to_the_runs_but_for_a_zeros_sign_says_so() -> None:
     assert y == 0.0 and math.copysign(1.0, y) > 0  # the bundled pump's cg y is +0.0
     here = dataclasses.replace(run, body=dataclasses.replace(run.body, cg=(x, -0.0, z)))
     assert scene_digest(here) != scene_digest(run)
-    text = _differing(here, str(path), scene_digest(run))
-    assert "differ only as the digest writes them" in text, text
+    digest, value = scene_digest(run), json.loads(scene_text(run))["value"]
+    for recorded in (
+        RecordedScene(digest, "its metadata", str(path), str(path)),
+        RecordedScene(digest, "its /mount_twin/scene topic", str(path), value=value),
+    ):
+        text = _differing(here, recorded, "out")
+        assert "differ only as the digest writes them" in text, text

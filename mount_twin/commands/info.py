@@ -44,6 +44,7 @@ def scene_text(scene: Scene) -> str:
         output_types,
         resolve,
     )
+    from mount_twin.io.scene_record import SCENE_TOPIC, STRING
 
     b, i, g = scene.body, scene.input, scene.integration
     lines = [
@@ -85,5 +86,6 @@ def scene_text(scene: Scene) -> str:
         f"outputs (node named {NODE_NAME}):",
         *(f"  {resolve(t, NODE_NAME):<40} {m}" for t, m in output_types(scene).items()),
         f"  {TF_STATIC_TOPIC:<40} {TF} (latched: the mount frames)",
+        f"  {resolve(SCENE_TOPIC, NODE_NAME):<40} {STRING} (latched: the scene, its sha256)",
     ]
     return "\n".join(lines)

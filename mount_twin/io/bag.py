@@ -413,8 +413,14 @@ def _as_ros2(value: Any) -> Any:
 PARTIAL_KEY = "mount_twin.partial"
 """custom_data key in an output bag's metadata.yaml present when the bag stops early."""
 SCENE_KEY = "mount_twin.scene"
-"""custom_data key in a replay's output bag's metadata.yaml: where its scene came from (the
-file, and the input settings the command line replaced: `Scene.source`)."""
+"""custom_data key in a replay's output bag's metadata.yaml: where its scene came from, as
+text (the file as given, and the input settings the command line replaced: `Scene.source`)."""
+SCENE_FILE_KEY = "mount_twin.scene_file"
+"""custom_data key in a replay's output bag's metadata.yaml: its scene file's absolute path
+(`Scene.origin`; '' for none)."""
+SCENE_OVERRIDES_KEY = "mount_twin.scene_overrides"
+"""custom_data key in a replay's output bag's metadata.yaml: what the command line put over
+its scene file's values, a JSON object of flat parameter name → value (`Scene.origin`)."""
 SCENE_DIGEST_KEY = "mount_twin.scene_sha256"
 """custom_data key in a replay's output bag's metadata.yaml: its scene's digest
 (`scene.description.scene_digest`), which `report --scene` checks its scene against."""
@@ -473,7 +479,7 @@ class OutputBag:
             metadata, replayed by `ros2 bag play`); topics not listed record none (the player's
             default, reliable and volatile).
         custom_data: key → text recorded in the bag's metadata (`ros2 bag info` shows them;
-            a replay's scene, `SCENE_KEY` and `SCENE_DIGEST_KEY`).
+            a replay's scene: `io.scene_record.scene_metadata`).
     """
 
     def __init__(

@@ -4,12 +4,13 @@ as a replay records it in its output bag (a report reloads the run's scene from 
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Mapping
 from pathlib import Path
 
 from mount_twin.scene.checks import rated_at_start
-from mount_twin.scene.description import Scene
+from mount_twin.scene.description import Scene, SceneOrigin
 from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
 
 INPUT_OPTIONS = {"input.topic": "replay --topic", "input.frame_id": "replay --frame-id"}
@@ -19,12 +20,15 @@ or the report names it where it did."""
 
 OVERRIDDEN = " (with input {} from the command line)"
 """What `read_scene` appends to a scene's source where the command line replaced `input`
-fields (their names, comma-separated): read back by `scene_file_of`."""
+fields (their names, comma-separated); `scene_file_of` reads it back from the one text
+(`io.bag.SCENE_KEY`) a replay recorded before it recorded the file and the overrides apart
+(`Scene.origin`)."""
 
 
 def scene_file_of(source: str) -> tuple[str, list[str]]:
     """The scene file and the `input` fields the command line replaced of a scene's source as
-    `read_scene` gives it (recorded by a replay in its output bag's metadata)."""
+    `read_scene` gives it (recorded by a replay in its output bag's metadata, alone in bags
+    written before `io.bag.SCENE_FILE_KEY`)."""
     before, _, after = OVERRIDDEN.partition("{}")
     found = re.fullmatch(f"(.*){re.escape(before)}([\\w, ]+){re.escape(after)}", source)
     return (found[1], found[2].split(", ")) if found else (source, [])
@@ -32,7 +36,8 @@ def scene_file_of(source: str) -> tuple[str, list[str]]:
 
 def read_scene(path: str | Path, input_overrides: Mapping[str, str] | None = None) -> Scene:
     """The scene file at `path`, with `input` fields replaced by `input_overrides` (checked like
-    the file's own). A scene whose ratings or force limits are judged at the start the twin uses
+    the file's own); its `origin` the file's absolute path and those fields (`input.topic`). A
+    scene whose ratings or force limits are judged at the start the twin uses
     (`scene.checks.rated_at_start`) is assembled for them: its start is solved here, and again
     where the caller assembles it."""
     data = read_scene_yaml(path)
@@ -40,7 +45,9 @@ def read_scene(path: str | Path, input_overrides: Mapping[str, str] | None = Non
     if input_overrides and isinstance(data, dict) and isinstance(data.get("input", {}), dict):
         data["input"] = {**data.get("input", {}), **input_overrides}
         source += OVERRIDDEN.format(", ".join(sorted(input_overrides)))
-    scene = scene_from_dict(data, source, refuse_unheld=True)
+    overrides = {f"input.{k}": v for k, v in sorted((input_overrides or {}).items())}
+    origin = SceneOrigin(os.path.abspath(path), overrides)
+    scene = scene_from_dict(data, source, refuse_unheld=True, origin=origin)
     if rated_at_start(scene):
         from mount_twin.model.assemble import assemble
 

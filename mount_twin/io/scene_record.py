@@ -1,0 +1,205 @@
+"""The scene a run ran, recorded beside its outputs, and read back.
+
+The node publishes it on `~/scene` (std_msgs/String, latched: reliable, transient local, depth
+1, once at its start), as robot_state_publisher does /robot_description, and a replay writes
+the same message into its output bag (offered latched like /tf_static); its data is one JSON
+object (`scene_text`): the scene's digest (`sha256`, `scene.description.scene_digest`), its
+file (`file`, an absolute path, or null), what was put over the file's values (`overrides`,
+by flat parameter name) and its value (`value`, `scene_value`), which hashes to the digest.
+A replay also records the digest, the file and the overrides apart in its output bag's
+metadata (`io.bag`'s SCENE_*_KEY), for a bag whose topic was left out. `recorded_scene`
+reads back whichever a bag holds, for `report --scene`.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from rosbags.highlevel import AnyReader
+
+from mount_twin.errors import BagError
+from mount_twin.io.bag import (
+    SCENE_DIGEST_KEY,
+    SCENE_FILE_KEY,
+    SCENE_KEY,
+    SCENE_OVERRIDES_KEY,
+    custom_data,
+    reader_paths,
+)
+from mount_twin.io.messages import TYPESTORE
+from mount_twin.model.scene_file import scene_file_of
+from mount_twin.scene.description import Scene, scene_digest, scene_value, value_digest
+
+SCENE_TOPIC = "~/scene"
+"""The run's scene (std_msgs/String of `scene_text`); publish it latched (`io.bag.LATCHED_QOS`)."""
+STRING = "std_msgs/msg/String"
+
+
+def scene_text(scene: Scene) -> str:
+    """The `~/scene` message's data: the JSON object of the scene's digest (`sha256`), file
+    (`file`: absolute path, or null), overrides (`overrides`: flat parameter name → value) and
+    value (`value`); one line."""
+    origin = scene.origin
+    record = {
+        "sha256": scene_digest(scene),
+        "file": origin.file,
+        "overrides": dict(origin.overrides),
+        "value": scene_value(scene),
+    }
+    return json.dumps(record, default=list)  # default: rclpy's arrays of a parameter
+
+
+def scene_message(scene: Scene, stamp_ns: int) -> tuple[str, int, bytes]:
+    """The `~/scene` message, as (unresolved topic, stamp ns: its log time in a bag, CDR)."""
+    msg = TYPESTORE.types[STRING](data=scene_text(scene))
+    return SCENE_TOPIC, int(stamp_ns), bytes(TYPESTORE.serialize_cdr(msg, STRING))
+
+
+def scene_metadata(scene: Scene) -> dict[str, str]:
+    """What a replay records of its scene in its output bag's metadata: its source as text
+    (`SCENE_KEY`), its file's absolute path (`SCENE_FILE_KEY`, '' for none), the overrides
+    as JSON (`SCENE_OVERRIDES_KEY`) and its digest (`SCENE_DIGEST_KEY`)."""
+    return {
+        SCENE_KEY: scene.source,
+        SCENE_FILE_KEY: scene.origin.file or "",
+        SCENE_OVERRIDES_KEY: json.dumps(dict(scene.origin.overrides), default=list),
+        SCENE_DIGEST_KEY: scene_digest(scene),
+    }
+
+
+@dataclass(frozen=True)
+class RecordedScene:
+    """The scene a bag records its run ran (`recorded_scene`).
+
+    Attributes:
+        sha256: its digest.
+        where: what in the bag records it, for messages ("its /mount_twin/scene topic").
+        named: the run's scene as the bag names it, for messages (a replay's `SCENE_KEY`).
+        file: its scene file as recorded (None: none; relative in bags written before
+            `SCENE_FILE_KEY`: from the replay's directory).
+        overrides: what was put over the file's values, flat parameter name → value (None: a
+            value the bag does not hold: one written before `SCENE_OVERRIDES_KEY` names the
+            input fields only; the run's, its input status records).
+        value: its value (`scene_value`, read back from JSON), or None: only the metadata
+            records it.
+        replayed: a replay recorded it (its metadata names the scene), else a recording of
+            the node's topics.
+    """
+
+    sha256: str
+    where: str
+    named: str
+    file: str | None = None
+    overrides: Mapping[str, Any] = field(default_factory=dict)
+    value: dict[str, Any] | None = None
+    replayed: bool = False
+
+
+def recorded_scene(bag: str | Path) -> RecordedScene | None:
+    """The scene a bag records: from its `~/scene` topic (a std_msgs/String topic named
+    `…/scene` whose data is `scene_text`'s: a replay's, or the node's recorded), else from
+    its metadata; None where neither records one. A message whose value does not hash to its
+    digest, or messages of two scenes, are a BagError naming the topic."""
+    meta = custom_data(bag)
+    found = _from_topic(Path(bag))
+    return _metadata_scene(bag, meta) if found is None else _topic_scene(*found, meta)
+
+
+def _topic_scene(topic: str, record: dict[str, Any], meta: dict[str, str]) -> RecordedScene:
+    """The scene a `~/scene` message on `topic` records (`record`: its JSON object), named
+    as a replay's metadata (`meta`) names it, else by its file and overrides."""
+    named, file, overrides = meta.get(SCENE_KEY), record.get("file"), record.get("overrides")
+    text = named or file or "a parameter set without a scene file"
+    if file and not named and overrides:
+        text += f" with {', '.join(overrides)} over it"
+    return RecordedScene(
+        record["sha256"],
+        f"its {topic} topic",
+        text,
+        file,
+        overrides or {},
+        record["value"],
+        named is not None,
+    )
+
+
+def _metadata_scene(bag: str | Path, meta: dict[str, str]) -> RecordedScene | None:
+    """The scene a replay's metadata (`meta`) records, or None where it records none."""
+    digest = meta.get(SCENE_DIGEST_KEY)
+    if not digest:
+        return None
+    named = meta.get(SCENE_KEY)
+    file: str | None = None
+    overrides: dict[str, Any] = {}
+    if SCENE_FILE_KEY in meta:
+        file = meta[SCENE_FILE_KEY] or None
+        overrides = _overrides(bag, meta.get(SCENE_OVERRIDES_KEY) or "{}")
+    elif named:  # a bag written before the file and the overrides were recorded apart
+        file, keys = scene_file_of(named)
+        overrides = {f"input.{k}": None for k in keys}
+    where = f"its metadata ({SCENE_DIGEST_KEY})"
+    return RecordedScene(
+        digest, where, named or "a scene it does not name", file, overrides, replayed=True
+    )
+
+
+def _overrides(bag: str | Path, text: str) -> dict[str, Any]:
+    """The overrides a bag's metadata records (`SCENE_OVERRIDES_KEY`'s JSON object)."""
+    try:
+        overrides = json.loads(text)
+    except ValueError as err:
+        overrides = err
+    if not isinstance(overrides, dict):
+        msg = f"{bag}: {SCENE_OVERRIDES_KEY} in its metadata is no JSON object: {text!r}"
+        raise BagError(msg)
+    return overrides
+
+
+def _from_topic(bag: Path) -> tuple[str, dict[str, Any]] | None:
+    """(topic, record: the JSON object) of the bag's `~/scene` messages, or None where it has
+    none."""
+    try:
+        with AnyReader(reader_paths(bag), default_typestore=TYPESTORE) as reader:
+            conns = [
+                c for c in reader.connections if c.msgtype == STRING and c.topic.endswith("/scene")
+            ]
+            messages = []
+            for c, _, raw in reader.messages(connections=conns) if conns else ():
+                msg: Any = reader.deserialize(raw, STRING)
+                messages.append((c.topic, str(msg.data)))
+    except Exception as err:  # rosbags raises its own types for unreadable bags
+        msg = f"{bag}: cannot read the output bag: {err}"
+        raise BagError(msg) from err
+    found: dict[str, tuple[str, dict[str, Any]]] = {}
+    for topic, data in messages:
+        record = _record(data)
+        if record is None:  # another node's /scene
+            continue
+        if value_digest(record["value"]) != record["sha256"]:
+            msg = (
+                f"{bag}: {topic}: the scene's value does not hash to the sha256 it gives "
+                f"({record['sha256']}): the message is damaged"
+            )
+            raise BagError(msg)
+        found.setdefault(record["sha256"], (topic, record))
+    if len(found) > 1:
+        msg = (
+            f"{bag}: {', '.join(sorted({t for t, _ in found.values()}))}: records "
+            f"{len(found)} scenes (sha256 {', '.join(found)}): the bag holds more than one run"
+        )
+        raise BagError(msg)
+    return next(iter(found.values()), None)
+
+
+def _record(data: str) -> dict[str, Any] | None:
+    """A `~/scene` message's JSON object, or None where `data` is none (another node's)."""
+    try:
+        record = json.loads(data)
+    except ValueError:
+        return None
+    ours = isinstance(record, dict) and isinstance(record.get("sha256"), str)
+    return record if ours and isinstance(record.get("value"), dict) else None

@@ -1,0 +1,94 @@
+"""The scene a replay ran, written into its output bag as the node publishes it (`~/scene`,
+latched) and in its metadata as separate keys; read back with rosbags and PyYAML, held to the
+scene file loaded on its own."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+from io_helpers import CONFIG, ROOT
+from rosbags.highlevel import AnyReader
+from rosbags.interfaces import QosDurability, QosReliability
+
+from mount_twin.cli import main
+from mount_twin.io.messages import TYPESTORE
+from mount_twin.scene.description import scene_digest
+from mount_twin.scene.loader import load_scene_file
+
+PUMP = CONFIG / "pump_8_mounts.scene.yaml"
+TOPIC = "/mount_twin/scene"
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """(the run's scene file, its output bag): the pump replayed from its own directory with
+    the scene given relative and --topic given (the scene's own /deck/imu)."""
+    d = tmp_path_factory.mktemp("scene_record")
+    (d / "run.scene.yaml").write_text(PUMP.read_text(encoding="utf-8"), encoding="utf-8")
+    bag = ROOT / "bags" / "half_sine_shock_10khz"
+    args = ["replay", str(bag), "--scene", "run.scene.yaml", "--topic", "/deck/imu"]
+    with pytest.MonkeyPatch.context() as patch:
+        patch.chdir(d)
+        assert main([*args, "-o", "out", "--no-progress"]) == 0
+    return d / "run.scene.yaml", d / "out"
+
+
+def test_the_replay_writes_its_scene_on_the_scene_topic_once_latched(
+    run: tuple[Path, Path],
+) -> None:
+    """One std_msgs/String on /mount_twin/scene, offered reliable, transient local, depth 1
+    (as /tf_static), its JSON the scene's digest (that of the file loaded here), its file's
+    absolute path, the --topic given and a value that hashes to the digest and holds the
+    file's mass (1200 kg)."""
+    scene_file, bag = run
+    with AnyReader([bag], default_typestore=TYPESTORE) as reader:
+        (conn,) = [c for c in reader.connections if c.topic == TOPIC]
+        messages = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages([conn])]
+    assert conn.msgtype == "std_msgs/msg/String"
+    (qos,) = conn.ext.offered_qos_profiles
+    assert qos.durability == QosDurability.TRANSIENT_LOCAL
+    assert qos.reliability == QosReliability.RELIABLE and qos.depth == 1
+    (msg,) = messages
+    record = json.loads(msg.data)
+    assert set(record) == {"sha256", "file", "overrides", "value"}
+    assert record["sha256"] == scene_digest(load_scene_file(PUMP))
+    assert record["file"] == str(scene_file) and Path(record["file"]).is_absolute()
+    assert record["overrides"] == {"input.topic": "/deck/imu"}
+    text = json.dumps(record["value"], sort_keys=True, separators=(",", ":"))
+    assert hashlib.sha256(text.encode()).hexdigest() == record["sha256"]
+    assert record["value"]["body"]["mass"] == 1200.0
+    assert [m["name"] for m in record["value"]["mounts"]][:2] == ["fl", "fr"]
+
+
+def test_the_replays_metadata_records_file_overrides_and_digest_apart(
+    run: tuple[Path, Path],
+) -> None:
+    """The scene file and what the command line put over it were one text, which `report`
+    parsed back; they are separate keys (with the text kept), the file absolute."""
+    scene_file, bag = run
+    meta = yaml.safe_load((bag / "metadata.yaml").read_text(encoding="utf-8"))
+    custom = meta["rosbag2_bagfile_information"]["custom_data"]
+    assert custom["mount_twin.scene_file"] == str(scene_file)
+    assert json.loads(custom["mount_twin.scene_overrides"]) == {"input.topic": "/deck/imu"}
+    assert custom["mount_twin.scene_sha256"] == scene_digest(load_scene_file(PUMP))
+    assert custom["mount_twin.scene"] == "run.scene.yaml (with input topic from the command line)"
+
+
+def test_a_scene_message_whose_value_does_not_hash_to_its_digest_is_refused(
+    run: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """A ~/scene whose value was changed after it was hashed is no record of the run."""
+    from mount_twin.errors import BagError
+    from mount_twin.io.bag import write_bag
+    from mount_twin.io.scene_record import STRING, recorded_scene, scene_text
+
+    record = json.loads(scene_text(load_scene_file(PUMP)))
+    record["value"]["body"]["mass"] = 1500.0
+    raw = TYPESTORE.serialize_cdr(TYPESTORE.types[STRING](data=json.dumps(record)), STRING)
+    write_bag(tmp_path / "bag", TOPIC, STRING, iter([(1, bytes(raw))]))
+    with pytest.raises(BagError, match=f"{TOPIC}: the scene's value does not hash to the sha256"):
+        recorded_scene(tmp_path / "bag")
