@@ -26,6 +26,8 @@ NODE = "mount_twin"
 MOUNTS = params_yaml()["mount_names"]
 GRAPH_ONLY = {"/rosout", "/parameter_events"}
 """What every rclpy node publishes."""
+LATCHED = {"/tf_static", f"/{NODE}/scene"}
+"""The outputs published once, transient local (the mount frames, the scene)."""
 
 
 def _table() -> list[tuple[str, list[str], list[str]]]:
@@ -89,7 +91,8 @@ def _graph(params: Path) -> tuple[dict[str, Any], dict[str, Any]]:
 def test_the_graph_is_what_the_topic_table_says(tmp_path: Path) -> None:
     """config/params.yaml without `input.topic`: the node subscribes to the table's default
     for it (the page gave the bundled params' /deck/imu as the default, which is /imu/data) and
-    publishes exactly the table's outputs, reliable, /tf_static alone transient local."""
+    publishes exactly the table's outputs, reliable, /tf_static and ~/scene alone transient
+    local."""
     from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
 
     tree = yaml.safe_load((ROOT / "config" / "params.yaml").read_text(encoding="utf-8"))
@@ -110,7 +113,7 @@ def test_the_graph_is_what_the_topic_table_says(tmp_path: Path) -> None:
         qos = published[topic].qos_profile
         assert published[topic].topic_type == msgtype, topic
         assert qos.reliability == ReliabilityPolicy.RELIABLE, topic
-        latched = DurabilityPolicy.TRANSIENT_LOCAL if topic == "/tf_static" else None
+        latched = DurabilityPolicy.TRANSIENT_LOCAL if topic in LATCHED else None
         assert qos.durability == (latched or DurabilityPolicy.VOLATILE), topic
 
 

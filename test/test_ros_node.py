@@ -836,6 +836,54 @@ def test_tf_static_is_latched_for_a_late_subscriber_and_tf_carries_the_pose() ->
         assert (t.x, t.y, t.z, q.x, q.y, q.z, q.w) == (x.x, x.y, x.z, o.x, o.y, o.z, o.w)
 
 
+def test_the_node_publishes_its_scene_latched_for_a_late_subscriber(tmp_path: Path) -> None:
+    """A recording of the node's topics could be checked against a scene by its mount names,
+    rtol and atol only. The node publishes its scene on ~/scene once at its start, latched:
+    a subscriber joining seconds later (reliable, transient local) gets it, once; its digest
+    is that of the scene file loaded here with the parameter given over it written into it
+    (outputs.decimation 10), its value hashes to it, its file is the scene_file given and its
+    overrides the parameter given; a volatile subscriber joining then gets nothing."""
+    import hashlib
+    import json
+
+    from mount_twin.io.scene_record import STRING
+    from mount_twin.scene.description import scene_digest
+
+    data = yaml.safe_load(GENSET.read_text(encoding="utf-8"))
+    data["outputs"]["decimation"] = 10
+    written = tmp_path / "decimated.scene.yaml"
+    written.write_text(yaml.safe_dump(data), encoding="utf-8")
+    topic = resolve("~/scene", NODE_NAME)
+    domain = fresh_domain()
+    waiting, late, volatile = (Peer(domain, f"{n}_peer") for n in ("waiting", "late", "volatile"))
+    args = ["-p", f"scene_file:={GENSET}", "-p", "outputs.decimation:=10"]
+    node = NodeProcess(domain, args)
+    pub = waiting.publisher(IMU, "/deck/imu")
+    try:
+        assert wait_for_node(pub, node), node.stop()
+        wait_for(lambda: False, 2.0)  # the node published its scene seconds ago
+        late.record({topic: STRING}, latched=True)
+        volatile.record({topic: STRING})
+        assert late.take_until(lambda: len(late.got[topic]) >= 1, 10.0)
+        assert wait_for(lambda: volatile.connected(topic), 10.0)
+        late.take_until(lambda: False, 0.5)
+        volatile.take()
+        code = node.stop()
+    finally:
+        node.stop(signal.SIGKILL)
+        for p in (waiting, late, volatile):
+            p.close()
+    assert code == 0, node.stderr
+    assert len(late.got[topic]) == 1 and volatile.got[topic] == []
+    record = json.loads(TYPESTORE.deserialize_cdr(late.got[topic][0], STRING).data)
+    assert record["sha256"] == scene_digest(load_scene_file(written))
+    assert record["sha256"] != scene_digest(load_scene_file(GENSET))
+    text = json.dumps(record["value"], sort_keys=True, separators=(",", ":"))
+    assert hashlib.sha256(text.encode()).hexdigest() == record["sha256"]
+    assert record["file"] == str(GENSET) and record["overrides"] == {"outputs.decimation": 10}
+    assert record["value"]["outputs"]["decimation"] == 10
+
+
 def test_building_tf2_msgs_again_finds_the_build() -> None:
     """`mount-twin build-tf2-msgs` run again (.ci/run ran it before the tests) rebuilds
     nothing, needs no export, and the interpreter it checks with imports this tf2_msgs."""
@@ -924,9 +972,9 @@ def test_the_node_wakes_its_executor_only_for_work() -> None:
     executor.add_node(node)
     peer = Peer(domain)
     try:
-        outputs = [*node._pubs.values(), getattr(node, "_static", None)]  # /tf_static: tf2_msgs
-        outputs = [p for p in outputs if p is not None]
-        assert len(outputs) >= 11 and all(not p.event_handlers for p in outputs)  # 8 mounts
+        outputs = [*node._pubs.values(), node._scene_pub, getattr(node, "_static", None)]
+        outputs = [p for p in outputs if p is not None]  # /tf_static: with tf2_msgs
+        assert len(outputs) >= 12 and all(not p.event_handlers for p in outputs)  # 8 mounts
         timer = node._batch_timer
         assert timer is not None and timer.is_canceled()  # no input yet: not running
         pub = peer.publisher(IMU, "/deck/imu")

@@ -60,6 +60,7 @@ from mount_twin.io.messages import (
     output_types,
     static_transforms,
 )
+from mount_twin.io.scene_record import STRING, scene_message
 from mount_twin.ros.parameters import (
     built_in_type_error,
     check_command_line,
@@ -123,6 +124,7 @@ class MountTwinNode(Node):
         self.options, self.scene = configure(self, args)
         self.stream = TwinStream(self.scene)
         self._pubs = self._create_outputs()
+        self._scene_pub = self._publish_scene()
         self._pending: list[bytes] = []
         self._sub = self._create_input()
         self._body_sub = self._create_body_input()
@@ -169,7 +171,8 @@ class MountTwinNode(Node):
 
     def _create_outputs(self) -> dict[str, Publisher]:
         """A reliable publisher per output (unresolved topic → publisher); the mount frames on
-        latched /tf_static. Without tf2_msgs (not on the package registry) no TF, said once."""
+        latched /tf_static (`_latched`). Without tf2_msgs (not on the package registry) no TF,
+        said once."""
         reliable = QoSProfile(
             depth=self.options.output_queue_depth,
             reliability=ReliabilityPolicy.RELIABLE,
@@ -192,17 +195,30 @@ class MountTwinNode(Node):
                 "outputs",
                 partial(self.create_publisher, cls, topic, reliable, event_callbacks=NO_EVENTS),
             )
-        if tf_class is None:
-            return pubs
+        if tf_class is not None:
+            now = self.get_clock().now().nanoseconds
+            self._static = self._latched(tf_class, static_transforms(self.scene, now))
+        return pubs
+
+    def _publish_scene(self) -> Publisher:
+        """The scene the node runs, once, latched on ~/scene (`io.scene_record`: its digest,
+        file, overrides and value), as robot_state_publisher gives /robot_description; the
+        scene is read-only (a change restarts the node), so once is all."""
+        message = scene_message(self.scene, self.get_clock().now().nanoseconds)
+        return self._latched(message_class(STRING), message)
+
+    def _latched(self, cls: type, message: tuple[str, int, bytes]) -> Publisher:
+        """A latched publisher (reliable, transient local, depth 1: tf2_ros' static
+        broadcaster) of `message`'s topic, which it publishes once."""
         latched = QoSProfile(
             depth=1,
             reliability=ReliabilityPolicy.RELIABLE,
             durability=DurabilityPolicy.TRANSIENT_LOCAL,
         )
-        topic, _, data = static_transforms(self.scene, self.get_clock().now().nanoseconds)
-        self._static = self.create_publisher(tf_class, topic, latched, event_callbacks=NO_EVENTS)
-        self._static.publish(bytes(data))
-        return pubs
+        topic, _, data = message
+        pub = self.create_publisher(cls, topic, latched, event_callbacks=NO_EVENTS)
+        pub.publish(bytes(data))
+        return pub
 
     def _create_input(self) -> Subscription:
         """The foundation IMU's raw subscription, with its message-lost and type events."""
