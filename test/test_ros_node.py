@@ -8,6 +8,7 @@ collection instead of skipping. Elsewhere the module skips without rclpy. Likewi
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import signal
@@ -59,6 +60,7 @@ from mount_twin.io.messages import (
     stamp_ns,
     static_transforms,
 )
+from mount_twin.io.scene_record import STRING
 from mount_twin.replay import replay
 from mount_twin.scene import load_scene_file, scene_from_params
 from mount_twin.scene.description import InputSpec
@@ -70,6 +72,7 @@ GENSET = ROOT / "config" / "genset_bolted_keyed.scene.yaml"
 GYRO_DELAY = delay_samples(InputSpec(), 1000.0)
 """The shipped default's delay at 1 kHz (38 samples)."""
 STAMP0 = 1_700_000_000_000_000_000
+SCENE = resolve("~/scene", NODE_NAME)
 WALL_FIGURES = {"real_time_factor"}
 """Diagnostic values that measure wall time: they differ between any two runs."""
 
@@ -149,6 +152,7 @@ def run_live(
     peer = Peer(domain)
     topics = live_topics(scene)
     peer.record(topics)
+    peer.record({SCENE: STRING}, latched=True)  # published once, at the node's start
     node = NodeProcess(domain, [*ros_args, *LOSSLESS])
     pub = peer.publisher(IMU, "/deck/imu")
     pose = resolve("~/pose", NODE_NAME)
@@ -183,7 +187,8 @@ def test_live_node_over_dds_equals_the_replay_of_the_same_messages(
     tmp_path: Path, bag: str, params: Path | None, extra: list[str], n: int, batch_period_s: float
 ) -> None:
     """Every pose, angle, wrench (and /tf where tf2_msgs exists) message is byte-equal to the
-    replay's; diagnostics are equal in stamp, level, message and every value except the
+    replay's, and so is the scene on ~/scene (the same file, or parameter set, and nothing
+    over it); diagnostics are equal in stamp, level, message and every value except the
     real-time factor (wall time). The last one is the partial period published on SIGINT."""
     if params is None:
         scene = load_scene_file(GENSET)
@@ -209,6 +214,7 @@ def test_live_node_over_dds_equals_the_replay_of_the_same_messages(
             continue
         assert len(got) == len(want[topic]) == n, topic
         assert got == want[topic], f"{topic}: live bytes differ from the replay's"
+    assert len(want[SCENE]) == 1 and _records(peer.got[SCENE]) == _records(want[SCENE])
     # the live error estimate travels on /diagnostics (equal to the replay's, compared above)
     integration = [
         values
@@ -217,6 +223,11 @@ def test_live_node_over_dds_equals_the_replay_of_the_same_messages(
         if name == "mount_twin: integration"
     ]
     assert integration and all(0.0 <= float(v["est_force_error_rel"]) < 0.01 for v in integration)
+
+
+def _records(raws: list[bytes]) -> list[dict[str, Any]]:
+    """The JSON objects of ~/scene messages."""
+    return [json.loads(TYPESTORE.deserialize_cdr(raw, STRING).data) for raw in raws]
 
 
 def _stamp(raw: bytes) -> int:
@@ -844,16 +855,13 @@ def test_the_node_publishes_its_scene_latched_for_a_late_subscriber(tmp_path: Pa
     (outputs.decimation 10), its value hashes to it, its file is the scene_file given and its
     overrides the parameter given; a volatile subscriber joining then gets nothing."""
     import hashlib
-    import json
 
-    from mount_twin.io.scene_record import STRING
     from mount_twin.scene.description import scene_digest
 
     data = yaml.safe_load(GENSET.read_text(encoding="utf-8"))
     data["outputs"]["decimation"] = 10
     written = tmp_path / "decimated.scene.yaml"
     written.write_text(yaml.safe_dump(data), encoding="utf-8")
-    topic = resolve("~/scene", NODE_NAME)
     domain = fresh_domain()
     waiting, late, volatile = (Peer(domain, f"{n}_peer") for n in ("waiting", "late", "volatile"))
     args = ["-p", f"scene_file:={GENSET}", "-p", "outputs.decimation:=10"]
@@ -862,10 +870,10 @@ def test_the_node_publishes_its_scene_latched_for_a_late_subscriber(tmp_path: Pa
     try:
         assert wait_for_node(pub, node), node.stop()
         wait_for(lambda: False, 2.0)  # the node published its scene seconds ago
-        late.record({topic: STRING}, latched=True)
-        volatile.record({topic: STRING})
-        assert late.take_until(lambda: len(late.got[topic]) >= 1, 10.0)
-        assert wait_for(lambda: volatile.connected(topic), 10.0)
+        late.record({SCENE: STRING}, latched=True)
+        volatile.record({SCENE: STRING})
+        assert late.take_until(lambda: len(late.got[SCENE]) >= 1, 10.0)
+        assert wait_for(lambda: volatile.connected(SCENE), 10.0)
         late.take_until(lambda: False, 0.5)
         volatile.take()
         code = node.stop()
@@ -874,8 +882,8 @@ def test_the_node_publishes_its_scene_latched_for_a_late_subscriber(tmp_path: Pa
         for p in (waiting, late, volatile):
             p.close()
     assert code == 0, node.stderr
-    assert len(late.got[topic]) == 1 and volatile.got[topic] == []
-    record = json.loads(TYPESTORE.deserialize_cdr(late.got[topic][0], STRING).data)
+    assert len(late.got[SCENE]) == 1 and volatile.got[SCENE] == []
+    record = json.loads(TYPESTORE.deserialize_cdr(late.got[SCENE][0], STRING).data)
     assert record["sha256"] == scene_digest(load_scene_file(written))
     assert record["sha256"] != scene_digest(load_scene_file(GENSET))
     text = json.dumps(record["value"], sort_keys=True, separators=(",", ":"))

@@ -151,8 +151,8 @@ def _overrides(bag: str | Path, text: str) -> dict[str, Any]:
     """The overrides a bag's metadata records (`SCENE_OVERRIDES_KEY`'s JSON object)."""
     try:
         overrides = json.loads(text)
-    except ValueError as err:
-        overrides = err
+    except ValueError:
+        overrides = None
     if not isinstance(overrides, dict):
         msg = f"{bag}: {SCENE_OVERRIDES_KEY} in its metadata is no JSON object: {text!r}"
         raise BagError(msg)
@@ -169,8 +169,8 @@ def _from_topic(bag: Path) -> tuple[str, dict[str, Any]] | None:
             ]
             messages = []
             for c, _, raw in reader.messages(connections=conns) if conns else ():
-                msg: Any = reader.deserialize(raw, STRING)
-                messages.append((c.topic, str(msg.data)))
+                string: Any = reader.deserialize(raw, STRING)
+                messages.append((c.topic, str(string.data)))
     except Exception as err:  # rosbags raises its own types for unreadable bags
         msg = f"{bag}: cannot read the output bag: {err}"
         raise BagError(msg) from err
