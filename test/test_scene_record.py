@@ -92,3 +92,21 @@ def test_a_scene_message_whose_value_does_not_hash_to_its_digest_is_refused(
     write_bag(tmp_path / "bag", TOPIC, STRING, iter([(1, bytes(raw))]))
     with pytest.raises(BagError, match=f"{TOPIC}: the scene's value does not hash to the sha256"):
         recorded_scene(tmp_path / "bag")
+
+
+def test_a_recording_of_two_scenes_is_refused_naming_the_topic(tmp_path: Path) -> None:
+    """A recording over two runs of the node (restarted with another scene) holds two
+    ~/scene messages of different digests: no one scene is the run's."""
+    from mount_twin.errors import BagError
+    from mount_twin.io.bag import write_bag
+    from mount_twin.io.scene_record import STRING, recorded_scene, scene_text
+
+    texts = [
+        scene_text(load_scene_file(f)) for f in (PUMP, CONFIG / "genset_bolted_keyed.scene.yaml")
+    ]
+    raws = [TYPESTORE.serialize_cdr(TYPESTORE.types[STRING](data=t), STRING) for t in texts]
+    write_bag(
+        tmp_path / "bag", TOPIC, STRING, iter([(k + 1, bytes(r)) for k, r in enumerate(raws)])
+    )
+    with pytest.raises(BagError, match=f"{TOPIC}: records 2 scenes .*more than one run"):
+        recorded_scene(tmp_path / "bag")
