@@ -391,6 +391,12 @@ class Stream:
     values: Callable[[OutputBatch], np.ndarray]
     table: str | None
 
+    @cached_property
+    def layout(self) -> FixedLayout:
+        """Its messages' layout (`_layout`), looked up once: a live sample encodes each
+        topic's one message on its own."""
+        return _layout(self.msgtype, *self.frames)
+
 
 @dataclass(frozen=True)
 class Readback:
@@ -686,23 +692,19 @@ def encode_output_blocks(
         streams = output_streams(scene)
     topics = tuple(st.topic for st in streams)
     if len(stamps) <= PACK_ONE_MAX:  # a live wake-up's few samples: struct, not numpy
-        layouts = [_layout(st.msgtype, *st.frames) for st in streams]
         values = [st.values(out).tolist() for st in streams]  # (k, m) each
         per_row: list[list[Encoded]] = []
         for r, stamp in enumerate(stamps.tolist()):
             head = divmod(stamp, 1_000_000_000)
             per_row.append(
                 [
-                    (st.topic, stamp, layout.pack_one([*head, *v[r]]))
-                    for st, layout, v in zip(streams, layouts, values, strict=True)
+                    (st.topic, stamp, st.layout.pack_one([*head, *v[r]]))
+                    for st, v in zip(streams, values, strict=True)
                 ]
             )
     else:
         sec, nsec = np.divmod(stamps, 1_000_000_000)
-        rows = tuple(
-            _layout(st.msgtype, *st.frames).pack_rows([sec, nsec, st.values(out)])
-            for st in streams
-        )
+        rows = tuple(st.layout.pack_rows([sec, nsec, st.values(out)]) for st in streams)
 
     def block(a: int, b: int) -> list[Encoded]:
         if b <= a or not topics:
