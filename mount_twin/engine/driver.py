@@ -318,11 +318,10 @@ class CoreDriver:
         )
         done, status = run_samples(self._bound(), segment, buf)
         events = self._drain_events()
-        self._health.add_steps(buf.step_log[1 : done + 1])
+        self._counts["substeps"] += self._health.add_steps(buf.step_log[1 : done + 1])
         if self.estimator is not None:
             self._health.add_estimate(self.estimator.figures)
             self.estimator.figures[:] = 0.0
-        self._counts["substeps"] += int(buf.step_log[1 : done + 1, 1:3].sum())
         if done > 0:
             self.last = (float(segment.t[done]), segment.f[done], segment.w[done])
             if self._counter[0]:

@@ -121,6 +121,8 @@ def tilt_from_quaternions(quat: np.ndarray) -> np.ndarray:
 
 def tilt_from_cos(cos_tilt: np.ndarray | float) -> np.ndarray:
     """Tilt θ, rad, from cos θ = R₃₃ (clipped to [−1, 1]: rounding may step past it)."""
+    if isinstance(cos_tilt, float):  # a live push's one figure: np.clip of a float takes 2 µs
+        return np.arccos(min(max(cos_tilt, -1.0), 1.0))  # NaN stays NaN, as np.clip keeps it
     return np.arccos(np.clip(cos_tilt, -1.0, 1.0))
 
 
@@ -227,13 +229,17 @@ class HealthWindow:
         if design.note:
             self.notes.append(f"{self.origin_s + stamp:.6f} s: {design.note}")
 
-    def add_steps(self, step_log: np.ndarray) -> None:
-        """Per-sample stepper figures: (error norm, accepted, rejected substeps)."""
-        if step_log.shape[0]:
-            self.err_max = max(self.err_max, float(step_log[:, 0].max()))
-            self.substeps += int(step_log[:, 1].sum() + step_log[:, 2].sum())
-            self.samples += step_log.shape[0]
-            self.intervals_run += step_log.shape[0]
+    def add_steps(self, step_log: np.ndarray) -> int:
+        """Per-sample stepper figures: (error norm, accepted, rejected substeps); returns the
+        substeps they took (the engine counts them too)."""
+        if not step_log.shape[0]:
+            return 0
+        substeps = int(step_log[:, 1:].sum())
+        self.err_max = max(self.err_max, float(step_log[:, 0].max()))
+        self.substeps += substeps
+        self.samples += step_log.shape[0]
+        self.intervals_run += step_log.shape[0]
+        return substeps
 
     def add_estimate(self, figures: np.ndarray) -> None:
         """The error estimate's figures since the last call (`engine.estimator`)."""
