@@ -314,10 +314,10 @@ class Intake:
         """Count the verdicts and flags of samples [start, stop) and hand their stamp
         intervals and wrong frames to the health window."""
         for what, flags in judged.suspect.items():
-            if n_flagged := int(flags[start:stop].sum()):
+            if n_flagged := int(np.count_nonzero(flags[start:stop])):  # a quarter of .sum()'s
                 self._counts[what] += n_flagged
         verdicts = judged.verdicts
-        if self._count(verdicts[start:stop]).get("wrong_frame"):
+        if self._count(verdicts[start:stop]):
             self._health.add_wrong_frames(
                 [batch.frame_ids[i] for i in range(start, stop) if verdicts[i] == "wrong_frame"]
             )
@@ -370,13 +370,12 @@ class Intake:
             with np.errstate(invalid="ignore", over="ignore"):
                 beyond = np.linalg.norm(accel[plateau], axis=1) > PLATEAU_G * spec.g_scale
             plateau[plateau] = beyond
-        taken = np.ones(n, dtype=bool)
-        if self.held is not None:  # HOLD is only ever the last sample
-            taken[-1] = False
-        kept = np.flatnonzero(taken)
-        if kept.shape[0]:
-            self._last_reading = accel[kept[-1]].copy()
-        return {"saturated": saturated & taken, "plateau": plateau & taken}
+        taken = n - (self.held is not None)  # HOLD is only ever the last sample
+        if taken:
+            self._last_reading = accel[taken - 1].copy()
+        saturated[taken:] = False
+        plateau[taken:] = False
+        return {"saturated": saturated, "plateau": plateau}
 
     def _classify(
         self, batch: SampleBatch, finite: np.ndarray
@@ -484,14 +483,18 @@ class Intake:
         plain = verdicts.count(ACCEPT) == n
         return verdicts, due, Intervals(into, skipped, plain)
 
-    def _count(self, verdicts: list[str]) -> Counter[str]:
-        """Count the verdicts of samples processed; return how many of each there were. A held
+    def _count(self, verdicts: list[str]) -> int:
+        """Count the verdicts of samples processed; return how many were wrong_frame. A held
         sample is counted when the next push decides on it."""
         counts = self._counts
+        if verdicts and verdicts.count(ACCEPT) == len(verdicts):  # the usual: no Counter (2 µs)
+            counts["received"] += len(verdicts)
+            counts["accepted"] += len(verdicts)
+            return 0
         tally = Counter(verdicts)
         tally.pop(HOLD, None)
         counts["received"] += tally.total()
         for verdict, n in tally.items():
             for key in _COUNTS.get(verdict, (f"rejected_{verdict}",)):
                 counts[key] += n
-        return tally
+        return tally["wrong_frame"]
