@@ -403,18 +403,20 @@ class Intake:
         before[0] = batch.stamps[0] if first else last_t
         before[1:] = batch.stamps[:-1]
         steps = batch.stamps - before
-        prev = np.empty(n)
-        prev[0] = math.inf if self._last_step is None else self._last_step
-        prev[1:] = steps[:-1]
-        if first:
-            prev[1] = math.inf  # the start has no interval before it
+        if n - first > 1:  # the interval into the last sample's predecessor
+            prev = float(steps[-2])
+        elif first:  # the start has no interval before it
+            prev = math.inf
+        else:
+            prev = math.inf if self._last_step is None else self._last_step
         checked = steps[first:]
         # With every stamp later than the one before, no sample is a glitch (its next one
-        # would fall back): only a jump into the last sample is one to hold.
+        # would fall back): only a jump into the last sample is one to hold. (The stamps are
+        # finite: min and max judge them as the comparisons did, in two reductions not four.)
         if not (
-            (checked > 0.0).all()
-            and (checked <= spec.max_gap_s).all()
-            and steps[-1] <= JUMP_FACTOR * prev[-1]
+            checked.min() > 0.0
+            and checked.max() <= spec.max_gap_s
+            and steps[-1] <= JUMP_FACTOR * prev
         ):
             return None
         self.last_stamp = float(batch.stamps[-1])
