@@ -62,3 +62,20 @@ def test_the_counts_do_not_depend_on_batching(sizes: list[int]) -> None:
     whole, _ = _run(accel, accel_range_m_s2=300.0)
     parted, _ = _run(accel, sizes, accel_range_m_s2=300.0)
     assert (parted["saturated"], parted["plateau"]) == (whole["saturated"], whole["plateau"])
+
+
+def test_a_saturated_sample_held_back_at_a_stamp_jump_counts_once() -> None:
+    """The one clipped sample arrives last in its push after a 10 ms stamp jump, so it is held
+    until the next push confirms the jump: it is one sample at the full scale, counted once
+    (not also in the push that held it)."""
+    stamps = 1.0 + np.arange(20) / RATE
+    stamps[10:] += 0.01  # a jump into sample 10, which the next samples confirm
+    accel = np.tile([0.0, 0.0, G], (20, 1))
+    accel[10, 2] = 300.0
+    engine = engine_for(scene_with(input={"accel_range_m_s2": 300.0}))
+    first, rest = split(batch(stamps, accel), [11])
+    engine.push(first)
+    assert engine.holding  # the jump to confirm: the clipped sample waits
+    engine.push(rest)
+    engine.flush()
+    assert engine.counts["saturated"] == 1

@@ -13,7 +13,7 @@ from io_helpers import scene_with
 
 from mount_twin.analysis.accuracy import raw_gyro
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.engine.health import tilt_from_quaternions
+from mount_twin.engine.health import tilt_from_cos, tilt_from_quaternions
 from mount_twin.io.input_samples import read_samples
 from mount_twin.model.assemble import assemble
 from mount_twin.scene.loader import load_scene_file
@@ -45,3 +45,20 @@ def test_the_window_peaks_are_those_of_the_published_rows(case: str, decimation:
     # by an ulp or two, which arccos near 1 turns into eps/θ of θ (3e-8 of a 6e-5 rad tilt).
     assert window.tilt_max == pytest.approx(tilt, rel=1e-9, abs=8 * np.finfo(float).eps / tilt)
     assert window.published
+
+
+@pytest.mark.parametrize("as_array", [False, True], ids=["float", "array"])
+def test_a_cosine_rounded_past_one_is_no_tilt_and_past_minus_one_upside_down(
+    as_array: bool,
+) -> None:
+    """cos θ = R₃₃ may round one unit past ±1: θ is 0 and π there, not NaN; cos θ = ½ is 60°;
+    a NaN stays NaN (a live push's one float and a batch's array alike)."""
+    cosines = [1.0 + 2.0**-52, -1.0 - 2.0**-52, 0.5, float("nan")]
+    got = (
+        tilt_from_cos(np.array(cosines)).tolist()
+        if as_array
+        else [float(tilt_from_cos(c)) for c in cosines]
+    )
+    assert got[:2] == [0.0, np.pi]
+    assert got[2] == pytest.approx(np.pi / 3, rel=1e-15)
+    assert np.isnan(got[3])
