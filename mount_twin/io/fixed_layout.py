@@ -138,7 +138,9 @@ class FixedLayout:
         among the struct's arguments, bytes) of each stretch of the template's other bytes,
         and the struct of the whole message (each field its code, each stretch `Ns`)."""
         order = sorted(range(len(self.fields)), key=lambda f: self.fields[f][0])
-        template, codes, fixed, at = self._template_bytes, [], [], 0
+        template, at = self._template_bytes, 0
+        codes: list[str] = []
+        fixed: list[tuple[int, bytes]] = []
         for k, f in enumerate(order):
             offset, dtype = self.fields[f]
             if offset > at:
