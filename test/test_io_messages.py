@@ -79,11 +79,12 @@ def test_imu_messages_decode_back_to_the_same_stamps_vectors_and_frames() -> Non
 @pytest.mark.parametrize("n", [1, 2, 5, 8, 9])
 def test_a_wake_ups_few_messages_decode_as_rosbags_reads_them(n: int) -> None:
     """A live wake-up's few messages are read one by one against the last layout: each must
-    give what rosbags reads from it, a reading marked not provided (-1) marked so, and a
-    message of another frame_id among them decoded too."""
+    give what rosbags reads from it, each reading marked not provided (-1: the first's
+    acceleration, the last's angular velocity) marked so, and a message of another frame_id
+    among them decoded too."""
     stamps, accel, gyro = rng_signal(n)
     unprovided = np.zeros((n, 2), bool)
-    unprovided[-1, 1] = True
+    unprovided[0, 0] = unprovided[-1, 1] = True
     decode_inputs(
         [raw for _, raw in imu_messages(stamps[:1], accel[:1], gyro[:1], "deck_imu")], IMU
     )

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from functools import cached_property
 from operator import itemgetter
 from struct import Struct
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -40,6 +40,18 @@ def split_rows(rows: np.ndarray) -> list[bytes]:
     """Each row of a (k, L) uint8 array as its own bytes."""
     data, size = rows.tobytes(), rows.shape[1]
     return [data[i * size : (i + 1) * size] for i in range(rows.shape[0])]
+
+
+class _Whole(NamedTuple):
+    """A message as one struct: `in_order` takes its field values (builder order) in message
+    order (by offset); `fixed` (position among the struct's values, bytes) of each stretch of
+    the template's other bytes, in order; `struct` the whole message, each field its code and
+    each stretch `Ns`; `slots` each field's position among the struct's values."""
+
+    in_order: Callable[[Sequence[float | int]], tuple]
+    fixed: tuple[tuple[int, bytes], ...]
+    struct: Struct
+    slots: tuple[int, ...]
 
 
 @dataclass(frozen=True)
@@ -126,54 +138,50 @@ class FixedLayout:
         over the whole message, the template's other bytes passed in among the values (0.3
         µs a message against 1.0 µs for packing each run of fields into a copy of the
         template; a live sample publishes 10 or more)."""
-        in_order, fixed, packer = self._whole
-        args = list(in_order(values))
-        for at, data in fixed:
+        plan = self._whole
+        args = list(plan.in_order(values))
+        for at, data in plan.fixed:
             args.insert(at, data)
-        return packer.pack(*args)
+        return plan.struct.pack(*args)
 
     @cached_property
-    def _whole(self) -> tuple[Callable[[list], tuple], tuple[tuple[int, bytes], ...], Struct]:
-        """`pack_one`'s plan: the values in message order (fields sorted by offset), (position
-        among the struct's arguments, bytes) of each stretch of the template's other bytes,
-        and the struct of the whole message (each field its code, each stretch `Ns`)."""
+    def _whole(self) -> _Whole:
+        """The message as one struct (`_Whole`): `pack_one`'s and `unpack_one`'s plan."""
         order = sorted(range(len(self.fields)), key=lambda f: self.fields[f][0])
         template, at = self._template_bytes, 0
         codes: list[str] = []
         fixed: list[tuple[int, bytes]] = []
+        slots = [0] * len(order)
         for k, f in enumerate(order):
             offset, dtype = self.fields[f]
             if offset > at:
                 fixed.append((k + len(fixed), template[at:offset]))
                 codes.append(f"{offset - at}s")
+            slots[f] = k + len(fixed)
             codes.append(_FORMATS[dtype][1])
             at = offset + np.dtype(dtype).itemsize
         if at < self.size:
             fixed.append((len(order) + len(fixed), template[at:]))
             codes.append(f"{self.size - at}s")
-        return itemgetter(*order), tuple(fixed), Struct("<" + "".join(codes))
+        whole = Struct("<" + "".join(codes))
+        return _Whole(itemgetter(*order), tuple(fixed), whole, tuple(slots))
 
     @cached_property
     def _template_bytes(self) -> bytes:
         return self.template.tobytes()
 
-    @cached_property
-    def _fixed_spans(self) -> tuple[tuple[int, int], ...]:
-        """[start, stop) of each stretch of bytes no numeric field covers."""
-        edges = np.flatnonzero(np.diff(np.concatenate([[0], self.fixed.view(np.int8), [0]])))
-        return tuple(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
-
     def unpack_one(self, raw: bytes | memoryview, want: Sequence[int]) -> list | None:
-        """`unpack` of one message: its fields `want`, or None if it has another layout."""
+        """`unpack` of one message: its fields `want`, or None if it has another layout (one
+        struct call over the whole message, its other bytes compared as strings: 1.2 µs an
+        Imu against 4.5 µs field by field)."""
         if len(raw) != self.size:
             return None
-        raw, template = bytes(raw), self._template_bytes
-        if any(raw[a:b] != template[a:b] for a, b in self._fixed_spans):
+        plan = self._whole
+        values = plan.struct.unpack(raw)
+        if any(values[at] != data for at, data in plan.fixed):
             return None
-        return [
-            struct.unpack_from(_FORMATS[self.fields[f][1]], raw, self.fields[f][0])[0]
-            for f in want
-        ]
+        slots = plan.slots
+        return [values[slots[f]] for f in want]
 
     def unpack(
         self, raws: Sequence[bytes | memoryview], want: Sequence[int]
