@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
+from operator import is_not
 from typing import NamedTuple
 
 import numpy as np
@@ -297,7 +298,7 @@ class CoreDriver:
             self.estimator,
         )
         bound = self._loop
-        if bound is None or any(a is not b for a, b in zip(arrays, bound[0], strict=True)):
+        if bound is None or any(map(is_not, arrays, bound[0])):
             self._loop = bound = (arrays, Loop(*arrays))
         return bound[1]
 
@@ -327,11 +328,12 @@ class CoreDriver:
             if self._counter[0]:
                 self._tail_pose[:] = buf.pose[done]
         peaks = buf.wrench_abs_max, float(buf.cos_tilt_min[0])
-        keep = np.flatnonzero(buf.publish[: done + 1])  # never row 0: the previous sample
-        if keep.shape[0] == done:  # every sample published: views of this run's buffers
-            done_rows = slice(1, done + 1)
+        publish = buf.publish[: done + 1]  # never row 0: the previous sample
+        if np.count_nonzero(publish) == done:  # every sample published: views of this run's
+            done_rows = slice(1, done + 1)  # buffers
             published = Rows(index[:done], buf.pose[done_rows], buf.wrenches[done_rows], peaks)
         else:
+            keep = np.flatnonzero(publish)
             published = Rows(index[keep - 1], buf.pose[keep], buf.wrenches[keep], peaks)
         return Stepped(done, status, published, events)
 
