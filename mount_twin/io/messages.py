@@ -122,8 +122,8 @@ serializes it twice) nor cached (`_layout` kept 256 of them: 100 kB ids held 25 
 ONE_BY_ONE_MAX = 8
 """Most messages a decode first tries one by one against the layout of the frame_id last seen
 (`FixedLayout.unpack_one`): a live node's wake-up takes one message or a few. Measured
-2026-11-27 (Imu): 2 messages 9 µs, 8 messages 25 µs this way, ~47 µs either through rosbags
-(the first message) and the numpy pass, which 16 messages take about as long one by one."""
+2026-11-27 (Imu, best of 5 timeit runs, a loaded machine): 1, 2 and 8 messages 5.6, 7.7 and
+18.8 µs this way, 43-49 µs through rosbags (the first message) and the numpy pass."""
 LAYOUT_SCANS = 4
 """Most rows a decode of n messages scans against layouts, in units of n (each new frame_id's
 layout scans every message still pending): past it the rest is decoded one by one, in time
