@@ -87,10 +87,16 @@ def _body_raws(stamps_ns: np.ndarray, values: np.ndarray, frame: str = "") -> li
 
 
 def _interleaved(
-    scene: Scene, deck_raws: list[bytes], deck_ns: np.ndarray, body: tuple[list[bytes], np.ndarray]
+    scene: Scene,
+    deck_raws: list[bytes],
+    deck_ns: np.ndarray,
+    body: tuple[list[bytes], np.ndarray],
+    stream: TwinStream | None = None,
 ) -> Messages:
-    """Message by message, each body sample once the deck sample at or after its stamp went."""
-    stream, out, j = TwinStream(scene), [], 0
+    """Message by message, each body sample once the deck sample at or after its stamp went
+    (into `stream`, by default a new one)."""
+    stream = TwinStream(scene) if stream is None else stream
+    out, j = [], 0
     for raw, ns in zip(deck_raws, deck_ns.tolist(), strict=True):
         out += stream.process([raw])
         while j < len(body[0]) and body[1][j] <= ns:
@@ -100,10 +106,17 @@ def _interleaved(
 
 
 def _chunked(
-    scene: Scene, deck_raws: list[bytes], body_raws: list[bytes], size: int, body_first: bool
+    scene: Scene,
+    deck_raws: list[bytes],
+    body_raws: list[bytes],
+    size: int,
+    body_first: bool,
+    stream: TwinStream | None = None,
 ) -> Messages:
-    """In chunks of `size` of each stream, the body's chunk before or after the deck's."""
-    stream, out = TwinStream(scene), []
+    """In chunks of `size` of each stream, the body's chunk before or after the deck's (into
+    `stream`, by default a new one)."""
+    stream = TwinStream(scene) if stream is None else stream
+    out: Messages = []
     for i in range(0, max(len(deck_raws), len(body_raws)), size):
         steps: list[Callable[[], Messages]] = [
             lambda i=i: stream.process(deck_raws[i : i + size]),
@@ -673,6 +686,29 @@ def test_stamps_jumping_back_apart_are_said_and_not_held(first: str) -> None:
         assert counts["jumped_back_apart"] == (t >= 6.0).sum() - within.sum()
 
 
+def _five_ways(
+    scene: Scene,
+    deck_raws: list[bytes],
+    deck_ns: np.ndarray,
+    body: list[bytes],
+    body_ns: np.ndarray,
+    make: Callable[[Scene], TwinStream] = TwinStream,
+) -> tuple[list[Messages], list[TwinStream]]:
+    """The outputs of the deck and body streams fed five ways into streams `make` gives
+    (interleaved by stamp; chunks of 700 body first, of 333 deck first; all deck then all
+    body, and the reverse); and the streams, the last two fed whole, for their counts."""
+    streams = [make(scene) for _ in range(5)]
+    whole = streams[3:]
+    runs = [
+        _interleaved(scene, deck_raws, deck_ns, (body, body_ns), streams[0]),
+        _chunked(scene, deck_raws, body, 700, body_first=True, stream=streams[1]),
+        _chunked(scene, deck_raws, body, 333, body_first=False, stream=streams[2]),
+        whole[0].process(deck_raws) + whole[0].process_body(body) + whole[0].finish(),
+        whole[1].process_body(body) + whole[1].process(deck_raws) + whole[1].finish(),
+    ]
+    return runs, streams
+
+
 def _fed_five_ways(
     scene: Scene,
     deck_raws: list[bytes],
@@ -680,18 +716,9 @@ def _fed_five_ways(
     body: list[bytes],
     body_ns: np.ndarray,
 ) -> tuple[list[Messages], list[TwinStream]]:
-    """The outputs of the deck and body streams fed five ways (interleaved by stamp; chunks of
-    700 body first, of 333 deck first; all deck then all body, and the reverse), checked to
-    be the same messages (the body sensor's statuses among /diagnostics); and the two streams
-    fed whole, for their counts."""
-    streams = [TwinStream(scene) for _ in range(2)]
-    runs = [
-        _interleaved(scene, deck_raws, deck_ns, (body, body_ns)),
-        _chunked(scene, deck_raws, body, 700, body_first=True),
-        _chunked(scene, deck_raws, body, 333, body_first=False),
-        streams[0].process(deck_raws) + streams[0].process_body(body) + streams[0].finish(),
-        streams[1].process_body(body) + streams[1].process(deck_raws) + streams[1].finish(),
-    ]
+    """`_five_ways`, checked to be the same messages (the body sensor's statuses among
+    /diagnostics); and the two streams fed whole, for their counts."""
+    runs, streams = _five_ways(scene, deck_raws, deck_ns, body, body_ns)
     kept = [[m for m in run if m[0] != DIAGNOSTICS_TOPIC or NAME.encode() in m[2]] for run in runs]
     assert all(sorted(k) == sorted(kept[0]) for k in kept[1:])
-    return runs, streams
+    return runs, streams[3:]
