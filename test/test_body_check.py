@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +32,7 @@ from mount_twin.io.messages import (
     DIAGNOSTICS_TOPIC,
     IMU,
     TYPESTORE,
+    Encoded,
     TimeBase,
     imu_messages,
 )
@@ -722,3 +723,73 @@ def _fed_five_ways(
     kept = [[m for m in run if m[0] != DIAGNOSTICS_TOPIC or NAME.encode() in m[2]] for run in runs]
     assert all(sorted(k) == sorted(kept[0]) for k in kept[1:])
     return runs, streams[3:]
+
+
+LOSS = "(the middleware reported body messages lost)"
+"""The topic of the mark `_Losing` puts in its outputs where the loss was counted."""
+
+
+class _Losing(TwinStream):
+    """A stream whose body IMU's subscription reports `lost` messages lost by the middleware
+    before the call that brings body message `before` (None: before `finish`), counted as the
+    node counts them (`MountTwinNode._on_body_lost`, between its wake-ups); a LOSS message
+    marks the place in its outputs."""
+
+    def __init__(self, scene: Scene, lost: int, before: int | None) -> None:
+        super().__init__(scene)
+        self._lost, self._before = lost, before
+
+    def _lose(self) -> Messages:
+        assert self.body is not None
+        self.body.counts["lost_middleware"] += self._lost
+        return [(LOSS, 0, b"")]
+
+    def process_body(self, raws: Sequence[bytes]) -> Messages:
+        assert self.body is not None
+        received, before = self.body.counts["received"], self._before
+        lose = before is not None and received <= before < received + len(raws)
+        return (self._lose() if lose else []) + super().process_body(raws)
+
+    def finish(self) -> list[Encoded]:
+        return [*(self._lose() if self._before is None else []), *super().finish()]
+
+
+@pytest.mark.parametrize(
+    ("total", "before"),
+    [(12.0, 1100), (13.5, None), (12.0, None)],
+    ids=["mid_stream", "at_the_end_last_window_judged", "at_the_end_last_window_short"],
+)
+def test_body_messages_lost_by_the_middleware_are_reported_in_the_window_judged_next(
+    total: float, before: int | None
+) -> None:
+    """37 body IMU messages reported lost by the middleware (DDS message-lost events on the
+    body subscription, counted by the node between wake-ups) went into the run's counts and
+    no window: every window's body_lost_middleware read 0 live. Now the window judged next
+    after the count says all 37, every other 0, in every feeding order: counted mid-stream
+    (before body message 1100, 5.5 s), or at the end, in the last window where it is judged
+    (10–13.5 s of windows of 5 s), else in a WARN of their own (10–12 s: too short)."""
+    scene, deck = _pump(), _deck(total)
+    _, whole = _whole_record(scene, deck)
+    ns = _stamps(deck)
+    runs, streams = _five_ways(
+        scene,
+        _deck_raws(scene, deck),
+        ns,
+        _body_raws(ns, whole),
+        ns,
+        lambda s: _Losing(s, 37, before),
+    )
+    for run, stream in zip(runs, streams, strict=True):
+        assert stream.body is not None and stream.body.counts["lost_middleware"] == 37
+        at = [m[0] for m in run].index(LOSS)
+        earlier, later = _windows(run[:at]), _windows(run[at:])
+        assert all(v["body_lost_middleware"] == "0" for _, _, v in earlier), earlier
+        assert later, "no body sensor status after the loss"
+        (level, message, values), rest = later[0], later[1:]
+        assert values["body_lost_middleware"] == "37" and level >= WARN, message
+        assert all(v["body_lost_middleware"] == "0" for _, _, v in rest), rest
+        if total == 12.0 and before is None:  # no window after it: a status of its own
+            said = "37 body IMU messages lost by the middleware"
+            assert "nrms_fx" not in values and message.startswith(said), message
+        else:
+            assert "nrms_fx" in values and "lost_middleware 37" in message, message

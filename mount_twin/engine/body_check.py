@@ -75,6 +75,7 @@ UNPROVIDED = ("unprovided_acceleration", "unprovided_angular_velocity")
 """The counts of accepted body messages that mark their acceleration, their angular velocity
 not provided (REP-145): compared on the other reading alone."""
 APART = "jumped_back_apart"
+MIDDLEWARE = "lost_middleware"
 STOPPED = "lost_unprocessed_at_stop"
 PROBLEMS = (
     "before_twin",
@@ -82,7 +83,7 @@ PROBLEMS = (
     "in_gap",
     "unanswered",
     "dropped_waiting",
-    "lost_middleware",
+    MIDDLEWARE,
     STOPPED,
     APART,
 )
@@ -91,6 +92,13 @@ predictions, inside a gap of the twin's rows, after its last row, held too long,
 body IMU's and the deck's stamps jumped back apart (`Apart`); and why a body message was
 never received: lost by the middleware, or waiting unprocessed in the node's queue when it
 was stopped a second time (STOPPED, `ros.node`)."""
+NEVER_READ = {
+    MIDDLEWARE: "{} body IMU messages lost by the middleware (counted {})",
+    STOPPED: "{} body IMU messages waiting when the node was stopped again were not processed "
+    "(counted {})",
+}
+"""The body messages the node never read, by count: how a WARN at the end of the stream says
+those no window reported (`_Windows.finish`)."""
 
 
 class Apart:
@@ -512,11 +520,12 @@ class _Window:
 CUT_BY_END = "the last window, closed by the end of the stream"
 CUT_BY_JUMP = "the last window before the body IMU's stamps jumped back"
 """How a window cut short is said (`_Windows._close`)."""
-LOOSE = ("dropped_waiting", "unanswered", STOPPED)
+LOOSE = ("dropped_waiting", "unanswered", *NEVER_READ)
 """Not compared for the stream's sake, not at a place in it (held too long, left at its end,
-never processed at a second stop): reported in the window judged next (unanswered at the end
-of a run the twin restarted after: at its place; those of a second stop that no window
-reports: in a WARN of their own, `_Windows.finish`)."""
+lost by the middleware, never processed at a second stop; the node counts the last two as it
+learns of them): reported in the window judged next (unanswered at the end of a run the twin
+restarted after: at its place; those never read, NEVER_READ, that no window reports: in a
+WARN of their own, `_Windows.finish`)."""
 
 
 class _Windows:
@@ -616,8 +625,9 @@ class _Windows:
         """The last, partial window's report, if it spans half a window (with the rejected
         messages after its last sample); if no window was judged over the run although body
         messages came (`counts`), a WARN saying why, stamped `stamp_ns`: silence would read
-        as a check passed. Where messages were left unprocessed at a second stop (STOPPED)
-        and no window reports them, a WARN saying how many."""
+        as a check passed. Where messages the node never read (NEVER_READ: lost by the
+        middleware, left unprocessed at a second stop) are not in a window reported, a WARN
+        saying how many."""
         if self._window is not None:
             self._attribute(np.iinfo(np.int64).max, self._window.problems)
         reports = self._close(CUT_BY_END)
@@ -631,12 +641,9 @@ class _Windows:
                 + (f"; not compared: {missed}" if missed else "")
             )
             return [(stamp_ns, HealthStatus(NAME, WARN, message, values))]
-        stopped = counts[STOPPED] - self._loose_reported[STOPPED]
-        if stopped:
-            message = (
-                f"{stopped} body IMU messages waiting when the node was stopped again were not "
-                f"processed (counted {STOPPED})"
-            )
+        unsaid = {k: counts[k] - self._loose_reported[k] for k in NEVER_READ}
+        if any(unsaid.values()):
+            message = "; ".join(NEVER_READ[k].format(n, k) for k, n in unsaid.items() if n)
             reports.append((stamp_ns, HealthStatus(NAME, WARN, message, values)))
         return reports
 
