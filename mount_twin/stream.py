@@ -371,7 +371,9 @@ class TwinStream:
         stamp answered (none answered: the last received; none with a stamp: 0), or the last
         stall report's if later (input not stamped by the clock: /diagnostics never goes
         back); no report if that period is empty. The ageing tracker's end (the samples it
-        could not pair, `AgeingTracker.finish`) comes with `take_ageing_jobs`."""
+        could not pair, `AgeingTracker.finish`) comes with `take_ageing_jobs`. The body
+        comparison's reports of the end that have no body stamp to take (every body message
+        lost) take that stamp too."""
         out = self.engine.flush()
         reports, out.health = out.health, []
         kept, self._kept = self._kept, _Kept()
@@ -384,13 +386,18 @@ class TwinStream:
             )
             self.body.counts["unanswered"] += sum(len(d.stamps_ns) for d in self._body_waiting)
             self._body_waiting = []
-            msgs += self._encode_body(self.body.finish())
+            msgs += self._encode_body(self.body.finish(self._end_ns()))
         if self.ageing is not None:  # the samples it could not pair, where any
             self._ageing_jobs += self.ageing.finish()
         self.last_outputs = out
         self.final_report = reports[0] if reports else None
-        stamp_ns = max(self._last_ns or self._received_ns, self._stalled_ns)
-        return msgs + [encode_report(self.scene, r, stamp_ns) for r in reports]
+        return msgs + [encode_report(self.scene, r, self._end_ns()) for r in reports]
+
+    def _end_ns(self) -> int:
+        """The stamp (ns) of the reports at the end of the stream: the last input stamp
+        answered (none answered: the last received; none with a stamp: 0), or the last stall
+        report's if later (/diagnostics never goes back)."""
+        return max(self._last_ns or self._received_ns, self._stalled_ns)
 
 
 def _runs(values: np.ndarray) -> list[tuple[int, int]]:

@@ -14,7 +14,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_helpers import AGEING_PUMP, SCENE_FILE, ageing_bag, pump_scene_file, unprovided_imu
+from io_helpers import (
+    AGEING_PUMP,
+    SCENE_FILE,
+    ageing_bag,
+    pump_scene_file,
+    statuses_named,
+    unprovided_imu,
+)
 from scipy.signal import butter, sosfiltfilt
 
 from mount_twin import load_scene_file
@@ -793,3 +800,24 @@ def test_body_messages_lost_by_the_middleware_are_reported_in_the_window_judged_
             assert "nrms_fx" not in values and message.startswith(said), message
         else:
             assert "nrms_fx" in values and "lost_middleware 37" in message, message
+
+
+@pytest.mark.parametrize("reason", ["lost_unprocessed_at_stop", "lost_middleware"])
+def test_body_messages_never_read_are_said_at_the_twins_last_stamp(reason: str) -> None:
+    """Every one of 500 body IMU messages lost before it was read (waiting in the node's queue
+    at a second stop, or lost by the middleware) while the deck's 6 s went through the twin:
+    the body check has no stamp of its own, and its WARN of them was stamped 0 (1970), or (lost
+    by the middleware) there was none. Now a WARN says them, stamped with the twin's last input
+    stamp, the deck's last message's, as the input's last report is."""
+    scene, deck = _pump(), _deck(6.0)
+    stream = TwinStream(scene)
+    out = stream.process(_deck_raws(scene, deck))
+    assert stream.body is not None
+    stream.body.counts[reason] += 500  # as the node counts them (`MountTwinNode`)
+    out += stream.finish()
+    said = statuses_named([raw for topic, _, raw in out if topic == DIAGNOSTICS_TOPIC], NAME)
+    assert len(said) == 1, said
+    stamp, level, message, values = said[0]
+    assert stamp == int(_stamps(deck)[-1])
+    assert level == WARN and message.startswith("500 body IMU messages"), message
+    assert values[f"body_{reason}"] == "500", values

@@ -883,12 +883,14 @@ class BodyCheck:
         self._matcher.add_body(ns, t, measured, present)
         return self._compared()
 
-    def finish(self) -> BodyComparison:
+    def finish(self, stamp_ns: int) -> BodyComparison:
         """The end of both streams: the last rows predicted, every sample left compared or
-        counted, the last window judged."""
+        counted, the last window judged. A WARN of the end (`_Windows.finish`) is stamped with
+        the latest body stamp seen, else (no body message read with a stamp: every one lost,
+        say) `stamp_ns`, the twin's end (ns)."""
         self._matcher.add_predictions(*self._lead.finish())
         out = self._compared(final=True)
-        out.reports += self._windows.finish(self.counts, self.seen_ns)
+        out.reports += self._windows.finish(self.counts, self.seen_ns or stamp_ns)
         return out
 
     def _compared(self, final: bool = False) -> BodyComparison:
