@@ -286,20 +286,22 @@ def test_a_stop_sent_to_the_process_group_finishes_the_ageing_fit_in_flight(
 
 
 @pytest.mark.parametrize(
-    ("stops_sent", "first"),
-    [(1, 1000), (2, 1000), (2, 700)],
-    ids=["one_stop", "twice_last_window_judged", "twice_last_window_short"],
+    ("stops_sent", "first", "body_first"),
+    [(1, 1000, 1000), (2, 1000, 1000), (2, 700, 700), (2, 1000, 0)],
+    ids=["one_stop", "twice_last_window_judged", "twice_last_window_short", "twice_no_body_read"],
 )
 def test_a_second_stop_leaves_the_body_imu_backlog_unprocessed_and_counts_it(
-    tmp_path: Path, stops_sent: int, first: int
+    tmp_path: Path, stops_sent: int, first: int, body_first: int
 ) -> None:
     """The node's shutdown in this process (`StopRequests`), `first` of the 1500 deck and
-    1500 body messages processed and the other 500 of each waiting in the node's queues.
-    Stopped twice, it processes neither backlog: the input's 500 are counted
-    `lost_unprocessed_at_stop` as before, and so now are the body IMU's 500 (its own counts,
+    `body_first` of the 1500 body messages processed and the others waiting in the node's
+    queues.
+    Stopped twice, it processes neither backlog: the input's are counted
+    `lost_unprocessed_at_stop` as before, and so now are the body IMU's (its own counts,
     and the body sensor's last status on /diagnostics, a WARN: the last, partial window where
     it spans half a window (the 1000: 1–2 s of windows of 1 s), else a status of its own (the
-    700: 1–1.4 s)). The body backlog had been processed in full at a second stop, however
+    700: 1–1.4 s; none read: stamped with the last deck message processed, where it had been
+    stamped 0, 1970)). The body backlog had been processed in full at a second stop, however
     long it took. Stopped once, both backlogs are processed in full, as before (nothing
     counted lost)."""
     import rclpy
@@ -336,15 +338,16 @@ def test_a_second_stop_leaves_the_body_imu_backlog_unprocessed_and_counts_it(
         assert wait_for(lambda: peer.connected("/diagnostics"), 30.0)
         diagnostics_pub = node._pubs["/diagnostics"]
         assert wait_for(lambda: diagnostics_pub.get_subscription_count() > 0, 30.0)
+        read = {"/deck/imu": first, BODY_TOPIC: body_first}
         for topic, pub in pubs.items():
-            for raw in raws[topic][:first]:
+            for raw in raws[topic][: read[topic]]:
                 pub.publish(raw)
         deadline = time.monotonic() + 60.0
-        while (counts["received"], body_counts["received"]) != (first, first):
+        while (counts["received"], body_counts["received"]) != (first, body_first):
             assert time.monotonic() < deadline, (counts["received"], body_counts["received"])
             executor.spin_once(timeout_sec=0.01)
         for topic, pub in pubs.items():
-            for raw in raws[topic][first:]:
+            for raw in raws[topic][read[topic] :]:
                 pub.publish(raw)
         assert all(p.wait_for_all_acked(Duration(seconds=30.0)) for p in pubs.values())
         for _ in range(stops_sent):
@@ -357,23 +360,26 @@ def test_a_second_stop_leaves_the_body_imu_backlog_unprocessed_and_counts_it(
         executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown(context=context)
-    lost = 1500 - first if stops_sent == 2 else 0
+    twice = stops_sent == 2
+    lost, body_lost = (1500 - first, 1500 - body_first) if twice else (0, 0)
     assert cut_short == (lost > 0)
     assert (counts["received"], counts["lost_unprocessed_at_stop"]) == (1500 - lost, lost)
     assert (body_counts["received"], body_counts["lost_unprocessed_at_stop"]) == (
-        1500 - lost,
-        lost,
+        1500 - body_lost,
+        body_lost,
     )
-    _, level, message, values = _statuses(peer.got["/diagnostics"])[-1]  # the last published
-    assert values["body_lost_unprocessed_at_stop"] == str(lost), message
-    if not lost:
+    stamp, level, message, values = _statuses(peer.got["/diagnostics"])[-1]  # the last one
+    assert values["body_lost_unprocessed_at_stop"] == str(body_lost), message
+    if not body_lost:
         return
     assert level >= WARN, message
-    if first == 1000:  # the last window, 1–2 s, judged: it says them
-        assert "nrms_fx" in values and f"lost_unprocessed_at_stop {lost}" in message, message
-    else:  # the last, 1–1.4 s, too short to judge: a status of their own
-        said = f"{lost} body IMU messages waiting when the node was stopped again were not"
+    if body_first == 1000:  # the last window, 1–2 s, judged: it says them
+        assert "nrms_fx" in values and f"lost_unprocessed_at_stop {body_lost}" in message
+    else:  # the last, 1–1.4 s, too short to judge, or none: a status of their own
+        said = f"{body_lost} body IMU messages waiting when the node was stopped again were not"
         assert "nrms_fx" not in values and message.startswith(said), message
+    if not body_first:  # no body stamp read: the last deck message's (processed: 1000)
+        assert stamp == inputs[2 * (first - 1)][1], stamp
 
 
 def test_the_node_publishes_the_ageing_samples_it_could_not_pair(tmp_path: Path) -> None:
