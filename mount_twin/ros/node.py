@@ -47,7 +47,7 @@ from rclpy.subscription import Subscription
 from rclpy.timer import Timer
 
 from mount_twin.engine.batch import ERROR, OK, HealthReport, HealthStatus
-from mount_twin.engine.body_check import STOPPED
+from mount_twin.engine.body_check import MIDDLEWARE, STOPPED
 from mount_twin.errors import MountTwinError
 from mount_twin.io.messages import (
     DIAGNOSTICS_TOPIC,
@@ -347,7 +347,7 @@ class MountTwinNode(Node):
 
     def _on_body_lost(self, info: QoSMessageLostInfo) -> None:
         if self.stream.body is not None:
-            self.stream.body.counts["lost_middleware"] += int(info.total_count_change)
+            self.stream.body.counts[MIDDLEWARE] += int(info.total_count_change)
 
     def _on_incompatible_type(self, _info: object) -> None:
         self._problems["incompatible_type"] = (
