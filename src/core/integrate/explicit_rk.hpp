@@ -20,6 +20,44 @@
 
 namespace mt::integrate::explicit_rk {
 
+/// The stage state y_new = y + Σⱼ (step·A[S][j])·k[j] over j < S in order, a state at a time
+/// (its sum in a register, the table's zeros skipped at compile time: the operations on each
+/// state are those of adding the rows one after another, so the same bits, without storing
+/// and reloading y_new once per row). A nonzero weight times a step never rounds to zero
+/// (steps are at least MIN_STEP_FRACTION of an interval).
+template <class T, int S>
+inline void stage_state(Vec y, double step, Mat k, Vec y_new) {
+  double a[S];
+  const double* rows[S];
+  for (int j = 0; j < S; ++j) {
+    a[j] = step * T::A[S][j];
+    rows[j] = k.row(j).d;
+  }
+  const double* __restrict from = y.d;
+  double* __restrict to = y_new.d;
+  for (idx i = 0; i < y.n; ++i) {
+    double sum = from[i];
+    for (int j = 0; j < S; ++j) {
+      if (T::A[S][j] != 0.0) sum += a[j] * rows[j][i];
+    }
+    to[i] = sum;
+  }
+}
+
+/// Stages S.. of a step of `step` s from (t, y): each stage state into y_new and its rate into
+/// k[S]; false as soon as a right-hand side fails (y_new then holds that stage's state).
+template <class T, int S>
+inline bool stages(Vec y, double t, double step, const Model& m, Scratch& s, Vec u, Mat k,
+                   Vec y_new) {
+  stage_state<T, S>(y, step, k, y_new);
+  if (physics::rhs(t + T::C[S] * step, y_new, m, s, u, k.row(S)) != 0) return false;
+  if constexpr (S + 1 < T::STAGES) {
+    return stages<T, S + 1>(y, t, step, m, s, u, k, y_new);
+  } else {
+    return true;
+  }
+}
+
 /// Advance y (in place) from t0 to t1 s with input u held over the interval.
 ///
 /// settings: the slots of constants.hpp Setting (STEP: first trial step s, 0 for the whole
@@ -56,21 +94,7 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
     const Trial trial = trial_step(t, t1, h, h_max, span);
     const double step = trial.step;
     const bool last = trial.last;
-    bool ok = true;
-    for (int stage = 1; stage < T::STAGES; ++stage) {
-      for (idx i = 0; i < n; ++i) y_new[i] = y[i];
-      for (int j = 0; j < stage; ++j) {  // row by row: the inner loop runs along k[j]
-        const double a = step * T::A[stage][j];
-        if (a != 0.0) {
-          const Vec kj = k.row(j);
-          for (idx i = 0; i < n; ++i) y_new[i] += a * kj[i];
-        }
-      }
-      if (physics::rhs(t + T::C[stage] * step, y_new, m, s, u, k.row(stage)) != 0) {
-        ok = false;
-        break;
-      }
-    }
+    const bool ok = stages<T, 1>(y, t, step, m, s, u, k, y_new);
     rhs_failed = !ok;
     if (rhs_failed) {
       // a NaN stage state also reads as off the chart: tell them apart (only on failure)
