@@ -257,10 +257,11 @@ inline void fir_rows(Mat raw, Vec half, Mat out) {
     idx k = 0;
     for (; k + 8 <= m; k += 8) {
       const double* c = r + k;
-      Pair s0 = h[0] * load_pair(c), s1 = h[0] * load_pair(c + 2), s2 = h[0] * load_pair(c + 4),
-           s3 = h[0] * load_pair(c + 6);
+      const Pair h0 = {h[0], h[0]};  // pairs of pairs: no scalar operands (clang, GCC alike)
+      Pair s0 = h0 * load_pair(c), s1 = h0 * load_pair(c + 2), s2 = h0 * load_pair(c + 4),
+           s3 = h0 * load_pair(c + 6);
       for (idx j = 1; j <= n; ++j) {
-        const double hj = h[j];
+        const Pair hj = {h[j], h[j]};
         const double *lo = c - j, *hi = c + j;
         s0 += hj * (load_pair(lo) + load_pair(hi));
         s1 += hj * (load_pair(lo + 2) + load_pair(hi + 2));
