@@ -16,9 +16,8 @@ import numpy as np
 import pytest
 from io_helpers import CONFIG, ROOT, read_bag, read_raw, unprovided_imu
 
-from mount_twin.analysis.report import events_of
 from mount_twin.cli import main
-from mount_twin.io.output_tables import Table, input_values, read_output_bag
+from mount_twin.io.output_tables import Table, events_of, input_values, read_output_bag
 from mount_twin.model.scene_file import OVERRIDDEN
 from mount_twin.replay import replay
 from mount_twin.scene.loader import load_scene_file
@@ -109,7 +108,7 @@ def test_input_without_scene_is_refused(genset_run, capsys: pytest.CaptureFixtur
 
 
 def test_utilisation_series_come_from_the_diagnostics(genset_run) -> None:
-    from mount_twin.analysis.report import utilisation_of
+    from mount_twin.analysis.report_plots import utilisation_of
 
     out, summary = genset_run
     tables = {t.name: t for t in read_output_bag(out)}
@@ -718,7 +717,7 @@ def test_a_run_shorter_than_a_diagnostics_period_draws_one_point_per_mount(
     matplotlib.use("Agg")
     from matplotlib.figure import Figure
 
-    from mount_twin.analysis.report import _draw_utilisation, utilisation_of
+    from mount_twin.analysis.report_plots import draw_utilisation, utilisation_of
 
     bag, out = tmp_path / "in", tmp_path / "out"
     generate = ["generate", "ship-motion", "-o", str(bag), "--rate", "1000"]
@@ -730,7 +729,7 @@ def test_a_run_shorter_than_a_diagnostics_period_draws_one_point_per_mount(
     utilisation = utilisation_of(diagnostics)
     assert sorted(utilisation) == sorted(m.name for m in scene.mounts)
     fig = Figure()
-    _draw_utilisation(fig, utilisation, {})
+    draw_utilisation(fig, utilisation, {})
     (ax,) = fig.axes
     drawn = {
         str(line.get_label()): (line.get_xdata(), line.get_ydata())
@@ -780,7 +779,7 @@ def _utilisation_drawn(
     from mount_twin.analysis import report
 
     drawn: dict[str, tuple[np.ndarray, np.ndarray, list[int]]] = {}
-    draw = report._draw_utilisation
+    draw = report.draw_utilisation
 
     def keep(fig: Any, *args: Any, **kwargs: Any) -> None:
         draw(fig, *args, **kwargs)
@@ -792,7 +791,7 @@ def _utilisation_drawn(
                 indices = indices[marked]
             drawn[str(line.get_label()).split(" ")[0]] = (x, y, indices)
 
-    monkeypatch.setattr(report, "_draw_utilisation", keep)
+    monkeypatch.setattr(report, "draw_utilisation", keep)
     assert main(report_args) == 0
     page = Path(report_args[report_args.index("-o") + 1])
     return drawn, html.unescape(page.read_text(encoding="utf-8"))
@@ -846,7 +845,7 @@ def test_the_first_utilisation_step_starts_a_period_before_its_report_or_at_the_
 ):
     """The first step spans the period before the first report, clipped at the first output
     (t 0): a report at 2.5 s of a 1 s period starts at 1.5 s, one at 0.049 s at 0."""
-    from mount_twin.analysis.report import utilisation_lines
+    from mount_twin.analysis.report_plots import utilisation_lines
 
     series = {
         "late": (np.array([2.5, 3.5]), np.array([0.3, 0.4])),
@@ -1192,14 +1191,14 @@ def _legend_texts(ax: Any) -> list[str]:
 def test_the_srs_figures_legend_gives_the_damping() -> None:
     """The spectra's damping was in the section heading only: a figure copied out of the page
     did not say which ζ its curves are of. Its legend says ζ."""
-    from mount_twin.analysis.report import _draw_srs
+    from mount_twin.analysis.report_plots import draw_srs
     from mount_twin.analysis.srs import srs
 
     rate, freqs = 1000.0, np.array([10.0, 20.0, 40.0])
     pulse = np.sin(np.pi * np.arange(20) / 20.0)  # a 20 ms half-sine
     spectra = {"z": srs(pulse, rate, freqs, 0.1)}
     fig = _figure()
-    _draw_srs(fig, spectra, 0.1, None)
+    draw_srs(fig, spectra, 0.1, None)
     legend = fig.axes[0].get_legend()
     assert legend.get_title().get_text() == "ζ = 0.1 (10 %)"
 
@@ -1209,7 +1208,7 @@ def test_the_event_windows_line_colours_are_named_in_a_legend() -> None:
     nothing said so. A legend names each level drawn, in its line's colour."""
     from matplotlib.colors import to_rgba
 
-    from mount_twin.analysis.report import _draw_forces
+    from mount_twin.analysis.report_plots import draw_forces
     from mount_twin.io.output_tables import Event
 
     t = np.linspace(0.0, 0.2, 201)
@@ -1223,7 +1222,7 @@ def test_the_event_windows_line_colours_are_named_in_a_legend() -> None:
         Event("a", "joint_opened", 1, 0.12, 1.0, "ERROR"),
     ]
     fig = _figure()
-    _draw_forces(fig, {"a": mount}, events, (0.05, 0.15))
+    draw_forces(fig, {"a": mount}, events, (0.05, 0.15))
     named = {}
     for ax in fig.axes:
         legend = ax.get_legend()
@@ -1243,12 +1242,12 @@ def test_the_event_windows_line_colours_are_named_in_a_legend() -> None:
 def test_the_utilisation_legend_is_beside_the_plot_not_over_its_rating_line() -> None:
     """Inside the axes the legend sat over the "rated (1)" line and the peaks near it. It is
     beside them: its box and the plotting area's do not meet."""
-    from mount_twin.analysis.report import _draw_utilisation
+    from mount_twin.analysis.report_plots import draw_utilisation
 
     t = np.array([0.1, 0.2, 0.3])
     utilisation = {f"m{k}": (t, np.array([0.95, 1.0, 0.9])) for k in range(8)}
     fig = _figure()
-    _draw_utilisation(fig, utilisation, {}, 0.1)
+    draw_utilisation(fig, utilisation, {}, 0.1)
     fig.tight_layout()
     fig.canvas.draw()
     (ax,) = fig.axes
@@ -1260,7 +1259,7 @@ def test_the_utilisation_legend_is_beside_the_plot_not_over_its_rating_line() ->
 def test_the_attitude_is_drawn_in_radians_as_the_bag_records_it() -> None:
     """The guide gives angles in rad everywhere, the bag and the JSON too; the report drew the
     attitude in degrees. Its axis is in rad, each curve the bag's angle as it is."""
-    from mount_twin.analysis.report import _draw_response
+    from mount_twin.analysis.report_plots import draw_response
 
     t = np.linspace(0.0, 1.0, 11)
     stamps = (t * 1e9).astype(np.int64)
@@ -1269,7 +1268,7 @@ def test_the_attitude_is_drawn_in_radians_as_the_bag_records_it() -> None:
     angles |= {f"{n}_rad": k * 0.01 * t for k, n in enumerate(("alpha", "gamma", "delta"), 1)}
     fig = _figure()
     tables = {"pose": Table("pose", pose), "angles": Table("angles", angles)}
-    _draw_response(fig, tables, None, 0, "")
+    draw_response(fig, tables, None, 0, "")
     attitude = fig.axes[-1]
     assert attitude.get_ylabel() == "attitude [rad]"
     for line in attitude.get_lines():
@@ -1280,7 +1279,7 @@ def test_a_scene_equal_to_the_runs_but_for_a_zeros_sign_says_so() -> None:
     """Digests hash the values' JSON text, where -0.0 is not 0.0 though the numbers are equal:
     the list of differences was empty and the message ended in "it differs in ". So from
     the run's file, and from its value as the bag's ~/scene carries it (JSON)."""
-    from mount_twin.analysis.report import _differing
+    from mount_twin.analysis.scene_check import _differing
     from mount_twin.io.scene_record import RecordedScene, scene_text
     from mount_twin.scene.description import scene_digest
 
