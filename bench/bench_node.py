@@ -32,7 +32,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test"))
 from ros_harness import PARAMS_FILE, NodeProcess, Peer, fresh_domain, wait_for
 
 from mount_twin.engine.delay_line import delay_samples
-from mount_twin.io.messages import DIAGNOSTICS, IMU, TYPESTORE, imu_messages
+from mount_twin.io.messages import DIAGNOSTICS, IMU, TYPESTORE
+from mount_twin.io.output_encoding import imu_messages
 from mount_twin.scene import scene_from_params
 from mount_twin.scene.params import flatten
 

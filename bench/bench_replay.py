@@ -24,8 +24,8 @@ from mount_twin.cli import main
 from mount_twin.commands.common import DEFAULT_SCENE, share_dir
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.io.bag import InputBag
+from mount_twin.io.input_decoding import TimeBase, decode_inputs
 from mount_twin.io.mcap_writer import McapBagWriter
-from mount_twin.io.messages import TimeBase, decode_inputs
 from mount_twin.model.assemble import assemble
 from mount_twin.replay import replay
 from mount_twin.scene.loader import load_scene_file

@@ -32,7 +32,7 @@ def per_message_us(scene_path: str, rate_hz: float, seconds: float, per: int) ->
     """CPU time (µs) per message of `per`-message wake-ups, after WARM_S of input."""
     import numpy as np
 
-    from mount_twin.io.messages import imu_messages, messages_of
+    from mount_twin.io.output_encoding import imu_messages, messages_of
     from mount_twin.scene.loader import load_scene_file
     from mount_twin.stream import TwinStream
 

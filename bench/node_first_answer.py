@@ -25,7 +25,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test"))
 from ros_harness import LOSSLESS, PARAMS_FILE, NodeProcess, Peer, fresh_domain
 
-from mount_twin.io.messages import IMU, TYPESTORE, imu_messages
+from mount_twin.io.messages import IMU, TYPESTORE
+from mount_twin.io.output_encoding import imu_messages
 
 POSE = "/mount_twin/pose"
 POSE_TYPE = "geometry_msgs/msg/PoseStamped"

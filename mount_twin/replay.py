@@ -52,19 +52,9 @@ from mount_twin.engine.health import (
 )
 from mount_twin.errors import BagError, DamagedBagError, require
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
-from mount_twin.io.messages import (
-    DIAGNOSTICS_TOPIC,
-    IMU,
-    NODE_NAME,
-    TF,
-    TF_STATIC_TOPIC,
-    Encoded,
-    RowBlock,
-    encode_report,
-    output_types,
-    resolve,
-    static_transforms,
-)
+from mount_twin.io.messages import DIAGNOSTICS_TOPIC, IMU, NODE_NAME, TF, TF_STATIC_TOPIC, resolve
+from mount_twin.io.output_encoding import Encoded, RowBlock, encode_report, static_transforms
+from mount_twin.io.output_topics import output_types
 from mount_twin.io.scene_record import SCENE_TOPIC, STRING, scene_message, scene_metadata
 from mount_twin.physics.rotations import angle_text, quaternion_matrices
 from mount_twin.scene.description import Scene

@@ -19,18 +19,16 @@ from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.health import ENDED, INPUT
 from mount_twin.engine.intake import disregarded, provided, rising_or_back, rotated
 from mount_twin.errors import require
-from mount_twin.io.messages import (
-    IMU,
-    Decoded,
+from mount_twin.io.input_decoding import Decoded, TimeBase, decode_inputs
+from mount_twin.io.messages import IMU
+from mount_twin.io.output_encoding import (
     Encoded,
-    TimeBase,
-    decode_inputs,
     encode_body,
     encode_output_blocks,
     encode_outputs,
     encode_report,
-    output_streams,
 )
+from mount_twin.io.output_topics import output_streams
 from mount_twin.model.assemble import assemble
 from mount_twin.scene.description import Scene
 

@@ -239,7 +239,7 @@ def ageing_messages(
     from scipy.signal import butter, sosfiltfilt
 
     from mount_twin.analysis.calibration import calibrated_scene, predict
-    from mount_twin.io.messages import imu_messages
+    from mount_twin.io.output_encoding import imu_messages
     from mount_twin.io.signals import Signal, ship_motion
 
     rate, stamp0 = 200.0, 1_700_000_000_000_000_000

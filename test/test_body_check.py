@@ -32,17 +32,10 @@ from mount_twin.engine.batch import ERROR, OK, WARN, SampleBatch
 from mount_twin.engine.intake import rotated
 from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.errors import SceneError
-from mount_twin.io.messages import (
-    BODY_PREDICTED_TOPIC,
-    BODY_RESIDUAL_TOPIC,
-    DIAGNOSTICS,
-    DIAGNOSTICS_TOPIC,
-    IMU,
-    TYPESTORE,
-    Encoded,
-    TimeBase,
-    imu_messages,
-)
+from mount_twin.io.input_decoding import TimeBase
+from mount_twin.io.messages import DIAGNOSTICS, DIAGNOSTICS_TOPIC, IMU, TYPESTORE
+from mount_twin.io.output_encoding import Encoded, imu_messages
+from mount_twin.io.output_topics import BODY_PREDICTED_TOPIC, BODY_RESIDUAL_TOPIC
 from mount_twin.io.signals import Signal, ship_motion
 from mount_twin.scene.description import BodySensor, Scene
 from mount_twin.scene.loader import read_scene_yaml, scene_from_dict

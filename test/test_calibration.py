@@ -556,7 +556,8 @@ def test_a_record_marking_a_reading_the_fit_reads_not_provided_is_refused(
 
     from mount_twin.commands.calibrate import BODY_KEYS, _read_record
     from mount_twin.io.bag import write_bag
-    from mount_twin.io.messages import IMU, imu_messages
+    from mount_twin.io.messages import IMU
+    from mount_twin.io.output_encoding import imu_messages
 
     sig = ship_motion(rate_hz=200.0, total=2.0)
     stamps = 10**18 + np.round(sig.t * 1e9).astype(np.int64)

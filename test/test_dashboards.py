@@ -17,14 +17,8 @@ from matplotlib.colors import to_hex
 
 from mount_twin.analysis.dashboards import foxglove_layout, plotjuggler_layout
 from mount_twin.cli import main
-from mount_twin.io.messages import (
-    IMU,
-    NODE_NAME,
-    TYPESTORE,
-    output_streams,
-    output_types,
-    resolve,
-)
+from mount_twin.io.messages import IMU, NODE_NAME, TYPESTORE, resolve
+from mount_twin.io.output_topics import output_streams, output_types
 from mount_twin.scene.description import BodySensor, Scene
 from mount_twin.scene.loader import load_scene_file
 

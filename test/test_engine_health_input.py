@@ -21,7 +21,8 @@ from io_helpers import batch, default_model, default_scene, scene_with, split
 from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus, SampleBatch
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.health import WRONG_FRAMES_COUNTED, _median
-from mount_twin.io.messages import DIAGNOSTICS_TOPIC, imu_messages
+from mount_twin.io.messages import DIAGNOSTICS_TOPIC
+from mount_twin.io.output_encoding import imu_messages
 from mount_twin.model.assemble import assemble
 from mount_twin.scene import Scene
 from mount_twin.stream import TwinStream

@@ -8,7 +8,7 @@ import pytest
 from io_helpers import batch, default_scene, engine_for, split
 
 from mount_twin.engine.batch import OutputBatch
-from mount_twin.io.messages import imu_messages
+from mount_twin.io.output_encoding import imu_messages
 from mount_twin.stream import TwinStream
 
 N, DT, K = 1500, 1e-3, 400  # samples, s, the glitched one

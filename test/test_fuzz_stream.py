@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from io_helpers import batch, default_scene, engine_for, fuzz_settings, split
 
 from mount_twin.engine.batch import OutputBatch
-from mount_twin.io.messages import imu_messages
+from mount_twin.io.output_encoding import imu_messages
 from mount_twin.stream import TwinStream
 
 G = 9.80665

@@ -8,7 +8,9 @@ from io_helpers import default_scene
 
 from mount_twin.engine.batch import OutputBatch
 from mount_twin.io.fixed_layout import FixedLayout
-from mount_twin.io.messages import IMU, TYPESTORE, decode_inputs, encode_outputs
+from mount_twin.io.input_decoding import decode_inputs
+from mount_twin.io.messages import IMU, TYPESTORE
+from mount_twin.io.output_encoding import encode_outputs
 
 T = TYPESTORE.types
 RNG = np.random.default_rng(11)

@@ -11,26 +11,26 @@ from io_helpers import REST, G, batch, default_scene, engine_for, scene_with, st
 
 from mount_twin.engine.batch import ERROR, OK, WARN, HealthReport, HealthStatus, OutputBatch
 from mount_twin.engine.intake import Intake
+from mount_twin.io.input_decoding import TimeBase, decode_inputs
 from mount_twin.io.messages import (
     ACCEL,
-    ANGLES_OUTPUT,
     DIAGNOSTICS,
     IMU,
-    OUTPUTS,
     POSE,
     TF,
     TYPESTORE,
     VECTOR3,
     WRENCH,
+    resolve,
+)
+from mount_twin.io.output_encoding import encode_outputs, imu_messages
+from mount_twin.io.output_topics import (
+    ANGLES_OUTPUT,
+    OUTPUTS,
     WRENCHES_OUTPUT,
-    TimeBase,
-    decode_inputs,
-    encode_outputs,
-    imu_messages,
     output_streams,
     output_table,
     output_types,
-    resolve,
 )
 from mount_twin.stream import TwinStream
 
@@ -118,7 +118,7 @@ def test_a_wake_ups_few_messages_decode_as_rosbags_reads_them(n: int) -> None:
 def _scans(monkeypatch: pytest.MonkeyPatch) -> dict[str, int]:
     """Count the layouts probed and the rows their unpacks scan (FixedLayout's), from no
     layout known (the messages to decode made before: their making probes layouts)."""
-    from mount_twin.io import fixed_layout, messages
+    from mount_twin.io import fixed_layout, input_decoding, messages
 
     seen = {"rows": 0, "probes": 0}
     unpack, probe = fixed_layout.FixedLayout.unpack, fixed_layout.FixedLayout.probe.__func__
@@ -133,8 +133,8 @@ def _scans(monkeypatch: pytest.MonkeyPatch) -> dict[str, int]:
 
     monkeypatch.setattr(fixed_layout.FixedLayout, "unpack", counted_unpack)
     monkeypatch.setattr(fixed_layout.FixedLayout, "probe", classmethod(counted_probe))
-    messages._layout.cache_clear()
-    monkeypatch.setattr(messages, "_LAST_FRAME", {})
+    messages.layout_of.cache_clear()
+    monkeypatch.setattr(input_decoding, "_LAST_FRAME", {})
     return seen
 
 

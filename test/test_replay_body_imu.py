@@ -26,7 +26,8 @@ from mount_twin.cli import main
 from mount_twin.engine.agreement import NAME
 from mount_twin.engine.batch import ERROR, OK
 from mount_twin.io.bag import OutputBag
-from mount_twin.io.messages import IMU, imu_messages
+from mount_twin.io.messages import IMU
+from mount_twin.io.output_encoding import imu_messages
 from mount_twin.io.signals import ship_motion
 
 RATE = 200.0

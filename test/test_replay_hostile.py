@@ -37,7 +37,8 @@ from mount_twin.cli import main
 from mount_twin.errors import BagError
 from mount_twin.io import bag as bag_module
 from mount_twin.io.bag import PARTIAL_KEY, InputBag, OutputBag, write_bag
-from mount_twin.io.messages import IMU, POSE, TYPESTORE, imu_messages, messages_of
+from mount_twin.io.messages import IMU, POSE, TYPESTORE
+from mount_twin.io.output_encoding import imu_messages, messages_of
 from mount_twin.replay import replay
 
 N = 5000  # messages of a 5 s ship-motion bag at 1 kHz

@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 from io_helpers import DATA_DIR, G, default_scene, read_bag, read_raw, scene_with, stamp_ns
 
-from mount_twin.io.messages import IMU, decode_inputs
+from mount_twin.io.input_decoding import decode_inputs
+from mount_twin.io.messages import IMU
 from mount_twin.physics.rotations import rpy_matrix
 from mount_twin.replay import replay
 

@@ -13,17 +13,8 @@ from io_helpers import ROOT, read_bag, read_raw, scene_with, stamp_ns
 
 from mount_twin.cli import main
 from mount_twin.errors import BagError
-from mount_twin.io.messages import (
-    DIAGNOSTICS,
-    IMU,
-    NODE_NAME,
-    POSE,
-    TF,
-    VECTOR3,
-    WRENCH,
-    decode_inputs,
-    resolve,
-)
+from mount_twin.io.input_decoding import decode_inputs
+from mount_twin.io.messages import DIAGNOSTICS, IMU, NODE_NAME, POSE, TF, VECTOR3, WRENCH, resolve
 from mount_twin.io.scene_record import STRING
 from mount_twin.replay import replay
 from mount_twin.stream import TwinStream

@@ -248,7 +248,8 @@ def _pump_input(path: Path, n: int = 10_000, bad: slice = slice(0)) -> Path:
     vertical half-sine in its first second, then at rest; the samples `bad` with every accel
     reading NaN."""
     from mount_twin.io.bag import write_bag
-    from mount_twin.io.messages import IMU, imu_messages
+    from mount_twin.io.messages import IMU
+    from mount_twin.io.output_encoding import imu_messages
     from mount_twin.io.signals import half_sine_shock
 
     shock = half_sine_shock(peak=50.0, duration=0.011, rate_hz=1000.0, total=1.0)

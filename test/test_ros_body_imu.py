@@ -43,15 +43,9 @@ from mount_twin.engine.agreement import NAME
 from mount_twin.engine.batch import ERROR, OK, WARN
 from mount_twin.engine.delay_line import delay_samples
 from mount_twin.io.bag import OutputBag
-from mount_twin.io.messages import (
-    BODY_PREDICTED_TOPIC,
-    BODY_RESIDUAL_TOPIC,
-    DIAGNOSTICS,
-    IMU,
-    NODE_NAME,
-    imu_messages,
-    resolve,
-)
+from mount_twin.io.messages import DIAGNOSTICS, IMU, NODE_NAME, resolve
+from mount_twin.io.output_encoding import imu_messages
+from mount_twin.io.output_topics import BODY_PREDICTED_TOPIC, BODY_RESIDUAL_TOPIC
 from mount_twin.io.signals import ship_motion
 from mount_twin.replay import replay
 from mount_twin.scene import load_scene_file

@@ -44,6 +44,7 @@ from test_start_loaded import C_SOFT, RATED, rated_scene, start_sag
 from mount_twin.engine.batch import ERROR, OK
 from mount_twin.engine.delay_line import delay_samples
 from mount_twin.io.bag import InputBag, OutputBag
+from mount_twin.io.input_decoding import stamp_ns
 from mount_twin.io.messages import (
     ACCEL,
     DIAGNOSTICS,
@@ -54,12 +55,10 @@ from mount_twin.io.messages import (
     TF_STATIC_TOPIC,
     TF_TOPIC,
     TYPESTORE,
-    imu_messages,
-    output_types,
     resolve,
-    stamp_ns,
-    static_transforms,
 )
+from mount_twin.io.output_encoding import imu_messages, static_transforms
+from mount_twin.io.output_topics import output_types
 from mount_twin.io.scene_record import STRING
 from mount_twin.replay import replay
 from mount_twin.scene import load_scene_file, scene_from_params

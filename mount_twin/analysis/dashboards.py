@@ -17,15 +17,14 @@ from __future__ import annotations
 import json
 from xml.etree import ElementTree as ET
 
-from mount_twin.io.messages import (
+from mount_twin.io.messages import NODE_NAME, resolve
+from mount_twin.io.output_topics import (
     ANGLES_OUTPUT,
     BODY_PREDICTED_TOPIC,
     BODY_RESIDUAL_TOPIC,
-    NODE_NAME,
     POSE_OUTPUT,
     WRENCHES_OUTPUT,
     Output,
-    resolve,
 )
 from mount_twin.scene.description import Scene
 

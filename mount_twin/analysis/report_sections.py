@@ -32,8 +32,8 @@ from mount_twin.engine.estimate import NOT_INTEGRATED
 from mount_twin.engine.health import NOT_DESIGNED, why_none
 from mount_twin.errors import ModelError
 from mount_twin.io.bag import partial_marker
-from mount_twin.io.messages import WRENCHES_OUTPUT
 from mount_twin.io.output_tables import Event, Table
+from mount_twin.io.output_topics import WRENCHES_OUTPUT
 from mount_twin.scene.description import STANDARD_GRAVITY, Scene
 
 if TYPE_CHECKING:

@@ -20,8 +20,8 @@ import numpy as np
 from mount_twin.engine.batch import OutputBatch, SampleBatch
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.sensor_reading import cg_specific_force
-from mount_twin.io.messages import WRENCHES_OUTPUT
 from mount_twin.io.output_tables import Table, integration_values
+from mount_twin.io.output_topics import WRENCHES_OUTPUT
 from mount_twin.model.assemble import Model, assemble
 from mount_twin.scene.description import Scene
 

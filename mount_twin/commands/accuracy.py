@@ -48,8 +48,8 @@ def run(args: argparse.Namespace) -> int:
     )
     from mount_twin.commands.common import check_targets, load_scene
     from mount_twin.errors import MountTwinError
+    from mount_twin.io.input_decoding import TimeBase
     from mount_twin.io.input_samples import provided_input
-    from mount_twin.io.messages import TimeBase
     from mount_twin.scene.description import RTOL_RANGE
 
     lo, hi = RTOL_RANGE

@@ -14,7 +14,7 @@ if TYPE_CHECKING:
     from pathlib import Path
 
     from mount_twin.analysis.calibration import Calibration
-    from mount_twin.io.messages import TimeBase
+    from mount_twin.io.input_decoding import TimeBase
     from mount_twin.io.signals import Signal
     from mount_twin.scene.description import Scene
 
@@ -74,7 +74,7 @@ def _read_record(
     returned, for the other record of a pair to share). A bag's sample not finite is refused,
     as a CSV's cell is: named, with how many; so is one whose message marks a reading the fit
     reads (its rate if `reads_rate`) not provided (REP-145)."""
-    from mount_twin.io.messages import TimeBase
+    from mount_twin.io.input_decoding import TimeBase
     from mount_twin.io.signals import Signal
     from mount_twin.io.xsens_csv import read_csv_record
 

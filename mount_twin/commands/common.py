@@ -263,7 +263,8 @@ def write_signal(
     import numpy as np
 
     from mount_twin.io.bag import check_stamp, write_bag
-    from mount_twin.io.messages import IMU, imu_messages
+    from mount_twin.io.messages import IMU
+    from mount_twin.io.output_encoding import imu_messages
     from mount_twin.scene.loader import header_frame_id_problem, topic_name_problem
 
     if problem := topic_name_problem(topic):

@@ -36,14 +36,8 @@ def run(args: argparse.Namespace) -> int:
 def scene_text(scene: Scene) -> str:
     """A scene in a few lines: body, DOFs, each mount, input (and the body IMU), integration,
     and every topic the node publishes with its type."""
-    from mount_twin.io.messages import (
-        IMU,
-        NODE_NAME,
-        TF,
-        TF_STATIC_TOPIC,
-        output_types,
-        resolve,
-    )
+    from mount_twin.io.messages import IMU, NODE_NAME, TF, TF_STATIC_TOPIC, resolve
+    from mount_twin.io.output_topics import output_types
     from mount_twin.io.scene_record import SCENE_TOPIC, STRING
 
     b, i, g = scene.body, scene.input, scene.integration

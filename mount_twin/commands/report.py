@@ -13,7 +13,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from mount_twin.analysis.report import ReportPage
-    from mount_twin.io.messages import Decoded
+    from mount_twin.io.input_decoding import Decoded
     from mount_twin.io.output_tables import Table
     from mount_twin.scene.description import InputSpec, Scene
 

@@ -477,7 +477,7 @@ def _response(args: argparse.Namespace, path: Path) -> tuple[np.ndarray, np.ndar
     from mount_twin.analysis.response import check_response, response_of, wrenches_of
     from mount_twin.commands.common import load_scene, warn_if_partial
     from mount_twin.io.bag_info import bag_info
-    from mount_twin.io.messages import output_table
+    from mount_twin.io.output_topics import output_table
 
     if not (args.response and args.scene):
         msg = "--response and --scene go together: the response of the twin on that scene"
@@ -504,8 +504,8 @@ def _replayed(scene: Scene, path: Path) -> tuple[np.ndarray, np.ndarray]:
     import sys
 
     from mount_twin.analysis.response import followed
+    from mount_twin.io.input_decoding import TimeBase
     from mount_twin.io.input_samples import provided_input
-    from mount_twin.io.messages import TimeBase
 
     decoded, note = provided_input(path, scene.input)
     if note:

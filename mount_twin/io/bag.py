@@ -32,7 +32,8 @@ from mount_twin.errors import BagError, DamagedBagError
 from mount_twin.io.mcap_reader import Batch, plain_messages
 from mount_twin.io.mcap_salvage import Salvage, salvage
 from mount_twin.io.mcap_writer import McapBagWriter
-from mount_twin.io.messages import TYPESTORE, Encoded, RowBlock
+from mount_twin.io.messages import TYPESTORE
+from mount_twin.io.output_encoding import Encoded, RowBlock
 from mount_twin.io.raw_rows import joined, nbytes
 from mount_twin.textfiles import directories_above, new_directory_refusal
 

@@ -25,14 +25,8 @@ from mount_twin.engine.health import INPUT, INTEGRATION
 from mount_twin.errors import BagError
 from mount_twin.io.bag import reader_paths
 from mount_twin.io.bag_info import require_existing
-from mount_twin.io.messages import (
-    BODY_READBACKS,
-    DIAGNOSTICS,
-    OUTPUTS,
-    TYPESTORE,
-    Readback,
-    output_table,
-)
+from mount_twin.io.messages import DIAGNOSTICS, TYPESTORE
+from mount_twin.io.output_topics import BODY_READBACKS, OUTPUTS, Readback, output_table
 from mount_twin.kinds.events import EVENT_IS_ERROR
 from mount_twin.textfiles import replacing_all
 
@@ -54,10 +48,10 @@ class Table:
 
 
 def read_output_bag(path: str | Path) -> list[Table]:
-    """The output tables of a bag (errors name the bag), in the order of `io.messages.OUTPUTS`
+    """The output tables of a bag (errors name the bag), in the order of `io.output_topics.OUTPUTS`
     (each output's tables by name), then diagnostics and events; `t_s` counts from the earliest
     stamp of any of them. Each topic is filed by what the registry says it is
-    (`io.messages.output_table`); other topics are left out."""
+    (`io.output_topics.output_table`); other topics are left out."""
     stamps: dict[str, list[int]] = {}
     rows: dict[str, list[tuple[Any, ...]]] = {}
     columns_of: dict[str, Readback | None] = {}

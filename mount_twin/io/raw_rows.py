@@ -3,8 +3,9 @@
 A chunk of a plain mcap file that holds one IMU of one frame id is a block of records of one
 length (`io.mcap_reader`): its messages are the rows of that block, past each record's head.
 `RawRows` hands them on as a `Sequence[bytes]` without making a bytes object per message (an
-hour at 1 kHz is 3.6 million), and `io.messages.decode_inputs` reads their numbers in one numpy
-pass (`FixedLayout.unpack_rows`). Anything that wants bytes gets them, one message at a time.
+hour at 1 kHz is 3.6 million), and `io.input_decoding.decode_inputs` reads their numbers in one
+numpy pass (`FixedLayout.unpack_rows`). Anything that wants bytes gets them, one message at a
+time.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ from concurrent.futures import Future, ProcessPoolExecutor
 
 from mount_twin.analysis.ageing_live import NAME, WindowJob, run_job
 from mount_twin.engine.batch import ERROR, HealthReport, HealthStatus
-from mount_twin.io.messages import encode_report
+from mount_twin.io.output_encoding import encode_report
 from mount_twin.scene.description import Scene
 
 FIT_WAIT_S = 120.0

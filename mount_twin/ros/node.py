@@ -49,17 +49,9 @@ from rclpy.timer import Timer
 from mount_twin.engine.batch import ERROR, OK, HealthReport, HealthStatus
 from mount_twin.engine.body_check import MIDDLEWARE, STOPPED
 from mount_twin.errors import MountTwinError
-from mount_twin.io.messages import (
-    DIAGNOSTICS_TOPIC,
-    IMU,
-    NODE_NAME,
-    TF,
-    TF_STATIC_TOPIC,
-    encode_report,
-    messages_of,
-    output_types,
-    static_transforms,
-)
+from mount_twin.io.messages import DIAGNOSTICS_TOPIC, IMU, NODE_NAME, TF, TF_STATIC_TOPIC
+from mount_twin.io.output_encoding import encode_report, messages_of, static_transforms
+from mount_twin.io.output_topics import output_types
 from mount_twin.io.scene_record import STRING, scene_message
 from mount_twin.ros.parameters import (
     built_in_type_error,
