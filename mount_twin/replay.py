@@ -41,15 +41,15 @@ from mount_twin.engine.batch import (
 )
 from mount_twin.engine.body_check import RESETS, UNPROVIDED, not_compared
 from mount_twin.engine.estimate import NOT_INTEGRATED, ErrorEstimate
-from mount_twin.engine.health import (
+from mount_twin.engine.health_texts import (
     EVENTS_KEY,
     INTEGRATION,
     NOT_DESIGNED,
     NOW_KEY,
     UTILISATION_KEY,
-    tilt_from_quaternions,
     why_none,
 )
+from mount_twin.engine.tilt import tilt_from_quaternions
 from mount_twin.errors import BagError, DamagedBagError, require
 from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
 from mount_twin.io.messages import DIAGNOSTICS_TOPIC, IMU, NODE_NAME, TF, TF_STATIC_TOPIC, resolve

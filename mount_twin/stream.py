@@ -16,7 +16,8 @@ import numpy as np
 from mount_twin.engine.batch import ERROR, HealthReport, OutputBatch
 from mount_twin.engine.body_check import RESETS, BodyCheck, BodyComparison
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.engine.health import ENDED, INPUT
+from mount_twin.engine.health_statuses import ENDED
+from mount_twin.engine.health_texts import INPUT
 from mount_twin.engine.intake import disregarded, provided, rising_or_back, rotated
 from mount_twin.errors import require
 from mount_twin.io.input_decoding import Decoded, TimeBase, decode_inputs

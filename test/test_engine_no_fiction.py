@@ -15,7 +15,7 @@ from physics_helpers import free_body
 from mount_twin.commands.common import write_signal
 from mount_twin.engine.batch import ERROR, OK
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.engine.health import ATTITUDE, INTEGRATION, MOUNT
+from mount_twin.engine.health_texts import ATTITUDE, INTEGRATION, MOUNT
 from mount_twin.io.signals import Signal
 from mount_twin.model.assemble import assemble
 from mount_twin.replay import replay

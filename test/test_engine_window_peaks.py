@@ -13,7 +13,7 @@ from io_helpers import scene_with
 
 from mount_twin.analysis.accuracy import raw_gyro
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.engine.health import tilt_from_cos, tilt_from_quaternions
+from mount_twin.engine.tilt import tilt_from_cos, tilt_from_quaternions
 from mount_twin.io.input_samples import read_samples
 from mount_twin.model.assemble import assemble
 from mount_twin.scene.loader import load_scene_file

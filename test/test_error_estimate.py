@@ -47,7 +47,7 @@ from mount_twin.engine.estimator import (
     check_divisor,
     new_estimator,
 )
-from mount_twin.engine.health import INTEGRATION
+from mount_twin.engine.health_texts import INTEGRATION
 from mount_twin.io.input_samples import read_samples
 from mount_twin.model.assemble import assemble
 from mount_twin.replay import replay

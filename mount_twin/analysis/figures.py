@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from mount_twin.engine.health import ratio_text
+from mount_twin.engine.health_texts import ratio_text
 from mount_twin.physics.rotations import point_displacements
 
 PEAK_FORCE = "peak_force_magnitude_N"

@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from mount_twin.analysis.srs import damping_ratio
-from mount_twin.engine.health import ratio_text
+from mount_twin.engine.health_texts import ratio_text
 from mount_twin.scene.loader import read_scene_yaml
 from mount_twin.scene.reader import Reader
 

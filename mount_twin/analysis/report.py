@@ -31,7 +31,7 @@ from mount_twin.analysis.report_sections import (
 )
 from mount_twin.analysis.run_verdict import RunVerdict, followed_nothing, verdict_of
 from mount_twin.analysis.scene_check import SceneCheck, check_scene, check_scene_is_the_bags
-from mount_twin.engine.health import why_none
+from mount_twin.engine.health_texts import why_none
 from mount_twin.io.output_tables import Table, events_of, input_values, integration_values
 from mount_twin.scene.description import Scene
 from mount_twin.textfiles import write_text

@@ -12,7 +12,7 @@ import numpy as np
 
 from mount_twin.analysis.log_labels import plain_log_labels
 from mount_twin.engine.batch import LEVEL_NAMES
-from mount_twin.engine.health import UTILISATION_KEY
+from mount_twin.engine.health_texts import UTILISATION_KEY
 from mount_twin.io.output_tables import Event, Table
 from mount_twin.scene.description import STANDARD_GRAVITY
 

@@ -29,7 +29,7 @@ from mount_twin.analysis.modes_text import (
 from mount_twin.analysis.report_plots import draw_forces, draw_srs
 from mount_twin.analysis.run_verdict import RunVerdict
 from mount_twin.engine.estimate import NOT_INTEGRATED
-from mount_twin.engine.health import NOT_DESIGNED, why_none
+from mount_twin.engine.health_texts import NOT_DESIGNED, why_none
 from mount_twin.errors import ModelError
 from mount_twin.io.bag import partial_marker
 from mount_twin.io.output_tables import Event, Table

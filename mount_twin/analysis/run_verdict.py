@@ -7,7 +7,7 @@ from typing import NamedTuple
 
 from mount_twin.analysis.html_page import frame_id_setting
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
-from mount_twin.engine.health import INTEGRATION, NEVER_STARTED
+from mount_twin.engine.health_texts import INTEGRATION, NEVER_STARTED
 from mount_twin.engine.intake import nothing_accepted
 from mount_twin.io.output_tables import Table, input_values, integration_values
 from mount_twin.scene.description import Scene
@@ -33,7 +33,7 @@ def _nothing_accepted(diagnostics: Table | None, scene: Scene | None) -> str:
 def followed_nothing(diagnostics: Table | None, scene: Scene | None) -> str:
     """Why the twin followed none of the input, as its replay says it ('' if it did): no input
     sample accepted (`_nothing_accepted`), or too few to start it, which the stream's last
-    integration status says (`health.NEVER_STARTED`). Either has no figures, and exits 3."""
+    integration status says (`health_texts.NEVER_STARTED`). Either has no figures, and exits 3."""
     if nothing := _nothing_accepted(diagnostics, scene):
         return nothing
     if diagnostics is None:

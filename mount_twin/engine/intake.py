@@ -18,7 +18,9 @@ import numpy as np
 
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.engine.delay_line import Run
-from mount_twin.engine.health import NO_SAMPLE_ACCEPTED, PLATEAU_G, SATURATION_SHARE, HealthWindow
+from mount_twin.engine.health import HealthWindow
+from mount_twin.engine.health_statuses import PLATEAU_G, SATURATION_SHARE
+from mount_twin.engine.health_texts import NO_SAMPLE_ACCEPTED
 from mount_twin.model.assemble import Model
 from mount_twin.scene.description import InputSpec
 

@@ -21,7 +21,7 @@ import numpy as np
 from rosbags.highlevel import AnyReader
 
 from mount_twin.engine.batch import event_level
-from mount_twin.engine.health import INPUT, INTEGRATION
+from mount_twin.engine.health_texts import INPUT, INTEGRATION
 from mount_twin.errors import BagError
 from mount_twin.io.bag import reader_paths
 from mount_twin.io.bag_info import require_existing
@@ -33,7 +33,7 @@ from mount_twin.textfiles import replacing_all
 LEVELS = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
 DIAGNOSTICS_TABLE, EVENTS_TABLE = "diagnostics", "events"
 EVENT = re.compile(r"(\w+) ×(\d+) \(first (\d+\.\d+) s, \|F\| max ([\d.e+-]+) N\)")
-"""An event group in a mount status message (engine.health._events_text)."""
+"""An event group in a mount status message (engine.health_texts.events_text)."""
 
 
 @dataclass(frozen=True)

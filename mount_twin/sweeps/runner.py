@@ -30,7 +30,7 @@ from mount_twin.analysis.figures import (
 )
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, SampleBatch
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.engine.health import tilt_from_quaternions
+from mount_twin.engine.tilt import tilt_from_quaternions
 from mount_twin.errors import MountTwinError
 from mount_twin.model.assemble import assemble
 from mount_twin.physics import pose_row
