@@ -196,7 +196,11 @@ def _ageing_node(domain: int, scene_path: Path, group: bool = False) -> NodeProc
 
 def _send_when_connected(node: NodeProcess, peer: Peer, inputs: list) -> None:
     """Publish `inputs` ((topic, stamp, raw) in order) once the node hears both topics and the
-    peer hears its /diagnostics."""
+    peer hears its /diagnostics; return once the node's (reliable) subscriptions have
+    acknowledged every one: a stop after that finds them all in its queue (a stop while the
+    last were in flight lost them: 597 of 600 counted under a loaded CI run)."""
+    from rclpy.duration import Duration
+
     pubs = {t: peer.publisher(IMU, t) for t in ("/deck/imu", BODY_TOPIC)}
     assert wait_for_node(pubs["/deck/imu"], node), node.failed()
     assert wait_for(lambda: pubs[BODY_TOPIC].get_subscription_count() > 0, 30.0)
@@ -204,6 +208,7 @@ def _send_when_connected(node: NodeProcess, peer: Peer, inputs: list) -> None:
     for topic, _, raw in inputs:
         pubs[topic].publish(raw)
         peer.take()
+    assert all(p.wait_for_all_acked(Duration(seconds=60.0)) for p in pubs.values())
 
 
 def _children(pid: int) -> list[int]:
