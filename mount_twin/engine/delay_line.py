@@ -13,7 +13,10 @@ output. The filter is designed once, from the stream's first intervals (`DESIGN_
 
 Everything depends on the accepted samples alone, in order: any batching gives the same bits.
 The engine works on a `Frame` per push: the samples still pending from earlier pushes, then the
-pushed ones.
+pushed ones. A live node pushes a few samples at a time, so neither is copied whole per push:
+the pending samples wait in arrays with room after them (`Backlog`), a push of a few samples
+is appended there, and the raw Ω the filter reads likewise (`RawWindow`); both move to their
+arrays' start only when the room is used up.
 """
 
 from __future__ import annotations
@@ -36,6 +39,12 @@ before, cannot set it (it did: a 4.5e15 Hz design asked for petabytes)."""
 MAX_RATE_HZ = 1.0e6
 """Above this sample rate (no shock or motion sensor samples faster) the gyro is taken raw,
 with a note, rather than filtered by a design of that many taps."""
+ROOM = 256
+"""Samples of room a store keeps after its contents, at least, when it moves them to its
+arrays' start: a push of one sample moves the pending ones once every ROOM pushes."""
+LARGE = 4096
+"""A push of more samples than this gets a frame of its own (the pending samples and these
+concatenated: one copy of each either way), not a backlog that large kept between pushes."""
 
 
 def filter_bands(spec: InputSpec) -> tuple[float, float] | None:
@@ -101,6 +110,151 @@ class Frame:
         return rel
 
 
+class Backlog:
+    """The samples pending between pushes (stamps s, f m/s², Ω rad/s and stream positions)
+    in arrays with room after them, and the frame of a push: the pushed samples appended
+    into that room (a push of up to LARGE samples), so a push costs its own samples' copies,
+    not the pending ones'. A frame built here is valid until the next push's `keep`."""
+
+    def __init__(self) -> None:
+        self._t = np.empty(0)
+        self._f = np.empty((0, 3))
+        self._w = np.empty((0, 3))
+        self._ids = np.empty(0, np.int64)
+        self._lo = 0
+        """Row of the arrays where the pending samples (or the frame) start."""
+        self._n = 0
+        """Samples pending (0 once a frame has taken them)."""
+        self._framed = False
+        """The last frame lies in these arrays, from row `_lo`."""
+
+    @property
+    def ids(self) -> np.ndarray:
+        """The stream positions of the pending samples, in order (int64, a copy)."""
+        return self._ids[self._lo : self._lo + self._n].copy()
+
+    def frame(self, stamps: np.ndarray, f: np.ndarray, w: np.ndarray, first_id: int) -> Frame:
+        """The frame of a push: the pending samples (taken: none are pending until `keep`),
+        then these: the pushed arrays themselves where none are pending, else copies."""
+        n, m = self._n, stamps.shape[0]
+        self._n, self._framed = 0, False
+        if not n:
+            return Frame(stamps, f, w, 0, np.zeros(0, np.int64), first_id)
+        lo = self._lo
+        kept = slice(lo, lo + n)
+        if m > LARGE:
+            return Frame(
+                np.concatenate([self._t[kept], stamps]),
+                np.concatenate([self._f[kept], f]),
+                np.concatenate([self._w[kept], w]),
+                n,
+                self._ids[kept],
+                first_id,
+            )
+        lo = self._room(n, m)
+        hi = lo + n + m
+        new = slice(lo + n, hi)
+        self._t[new], self._f[new], self._w[new] = stamps, f, w
+        self._ids[new] = np.arange(first_id, first_id + m)
+        self._framed = True
+        return Frame(
+            self._t[lo:hi], self._f[lo:hi], self._w[lo:hi], n, self._ids[lo : lo + n], first_id
+        )
+
+    def keep(self, frame: Frame, rows: np.ndarray) -> None:
+        """Keep the rows `rows` (increasing) of the last frame pending: where they are its
+        last rows and it lies here, where they are; else copied to the arrays' start."""
+        k, size = rows.shape[0], frame.stamps.shape[0]
+        self._n = k
+        if not k:
+            return
+        if self._framed and int(rows[0]) == size - k:
+            self._lo += size - k
+            return
+        ids = frame.relative(rows) + frame.first_id
+        t, f, w = frame.stamps[rows], frame.f[rows], frame.w[rows]
+        self._lo = 0
+        self._room(0, k)
+        self._t[:k], self._f[:k], self._w[:k], self._ids[:k] = t, f, w, ids
+
+    def _room(self, n: int, m: int) -> int:
+        """Room for m samples after the n from row `_lo`: they are moved to row 0 (into
+        larger arrays where 2 (n + m) + ROOM do not fit) unless the room is there; returns
+        their row."""
+        lo = self._lo
+        if lo + n + m <= self._t.shape[0]:
+            return lo
+        old = (self._t, self._f, self._w, self._ids)
+        size = 2 * (n + m) + ROOM
+        if size > self._t.shape[0]:
+            self._t, self._f, self._w = np.empty(size), np.empty((size, 3)), np.empty((size, 3))
+            self._ids = np.empty(size, np.int64)
+        for a, b in zip((self._t, self._f, self._w, self._ids), old, strict=True):
+            a[:n] = b[lo : lo + n]
+        self._lo = 0
+        return 0
+
+
+class RawWindow:
+    """Raw Ω (rad/s, (3, ·): one row per axis, as `fir_rows` reads it) of the pending
+    samples and of up to N of their run before them, in arrays with room before and after
+    (the run's first sample held before it, its last after it at the end), so that a push
+    appends its own samples and the filter reads one copy."""
+
+    def __init__(self) -> None:
+        self._raw = np.empty((3, 0))
+        self._lo = 0
+        self._hi = 0
+
+    @property
+    def size(self) -> int:
+        """Samples in the window."""
+        return self._hi - self._lo
+
+    def clear(self) -> None:
+        """A new run: nothing before its first sample."""
+        self._hi = self._lo
+
+    def append(self, w: np.ndarray) -> None:
+        """Append samples (n, 3) of Ω (rad/s)."""
+        m = w.shape[0]
+        self._room(0, m)
+        self._raw[:, self._hi : self._hi + m] = w.T
+        self._hi += m
+
+    def filtered(self, half: np.ndarray, n: int, before: int, *, end: bool) -> np.ndarray:
+        """Ω filtered by `half` (N + 1 taps) of the n samples after the window's first
+        `before` (3, n): the run's first sample held before it where fewer than N are
+        before them, its last after them with `end`. The n leave the window's filter
+        history: N samples are left before the rest."""
+        delay = half.shape[0] - 1
+        front, back = delay - before, delay if end else 0
+        self._room(front, back)
+        raw, lo, hi = self._raw, self._lo, self._hi
+        if front:
+            raw[:, lo - front : lo] = raw[:, lo : lo + 1]
+        if back:
+            raw[:, hi : hi + back] = raw[:, hi - 1 : hi]
+        self._lo = lo - front
+        out = np.empty((3, n))
+        fir_rows(raw[:, self._lo : self._lo + n + 2 * delay].copy(), half, out)
+        self._lo += n
+        return out
+
+    def _room(self, front: int, back: int) -> None:
+        """Room for `front` samples before the window and `back` after it: the window moved
+        (into larger arrays where 2 (front + size + back) + ROOM do not fit) unless there."""
+        lo, hi = self._lo, self._hi
+        if lo >= front and hi + back <= self._raw.shape[1]:
+            return
+        old, size = self._raw, hi - lo
+        need = front + size + back
+        if need + ROOM > old.shape[1]:
+            self._raw = np.empty((3, 2 * need + ROOM))
+        self._raw[:, front : front + size] = old[:, lo:hi]
+        self._lo, self._hi = front, front + size
+
+
 class GyroDelay:
     """Filters Ω of accepted samples and releases them N samples late (see the module).
 
@@ -119,11 +273,11 @@ class GyroDelay:
         self.design: Design | None = None if bands else RAW
         self._pending = np.zeros(0, dtype=np.int64)
         """Rows of the current frame accepted but not yet released, in order."""
-        self._raw = np.zeros((0, 3))
+        self._raw = RawWindow()
         """Raw Ω of the pending samples and of up to N samples of their run before them."""
         self._restart = False
         """The pending samples' first starts a new state (its run's first release)."""
-        self._stored: Frame | None = None
+        self._backlog = Backlog()
 
     @property
     def delay(self) -> int:
@@ -133,33 +287,19 @@ class GyroDelay:
     @property
     def pending_ids(self) -> np.ndarray:
         """The stream positions of the pending samples, in order (int64)."""
-        return np.zeros(0, np.int64) if self._stored is None else self._stored.stored_ids
+        return self._backlog.ids
 
     def frame(self, stamps: np.ndarray, f: np.ndarray, w: np.ndarray, first_id: int) -> Frame:
         """The frame of a push: pending samples, then these (w: raw Ω, rad/s, filtered in
-        place as samples are released)."""
-        old = self._stored
-        self._stored = None
-        if old is None:
-            return Frame(stamps, f, w, 0, self._pending, first_id)
-        self._pending = np.arange(old.offset)
-        return Frame(
-            np.concatenate([old.stamps, stamps]),
-            np.concatenate([old.f, f]),
-            np.concatenate([old.w, w]),
-            old.offset,
-            old.stored_ids,
-            first_id,
-        )
+        place as samples are released). Valid until the next push's `close`."""
+        frame = self._backlog.frame(stamps, f, w, first_id)
+        self._pending = np.arange(frame.offset)
+        return frame
 
     def close(self, frame: Frame) -> None:
-        """Keep the pending rows of `frame` for the next push."""
-        p = self._pending
-        if p.shape[0]:
-            ids = frame.first_id + p - frame.offset
-            early = p < frame.offset
-            ids[early] = frame.stored_ids[p[early]]
-            self._stored = Frame(frame.stamps[p], frame.f[p], frame.w[p], p.shape[0], ids, 0)
+        """Keep the pending rows of `frame` for the next push (the last use of `frame`: its
+        arrays may be written over after this)."""
+        self._backlog.keep(frame, self._pending)
 
     def feed(self, run: Run, frame: Frame) -> list[Run]:
         """Take a run of accepted samples (batch positions); the runs now ready to integrate
@@ -169,9 +309,10 @@ class GyroDelay:
             return [Run(rows, run.restart)] if rows.shape[0] else []
         ready = self.drain(frame) if run.restart else []
         if run.restart:
-            self._restart, self._raw = True, np.zeros((0, 3))
+            self._restart = True
+            self._raw.clear()
         self._pending = np.concatenate([self._pending, rows])
-        self._raw = np.concatenate([self._raw, frame.w[rows]])
+        self._raw.append(frame.w[rows])
         self._design(frame, DESIGN_SAMPLES)
         if self.design is not None:
             ready.extend(self._release(self._pending.shape[0] - self.delay, frame, end=False))
@@ -203,19 +344,12 @@ class GyroDelay:
         """The first n pending samples, their Ω filtered into frame.w."""
         if n <= 0:
             return []
-        half = (self.design or RAW).half
-        delay = half.shape[0] - 1
-        raw, pending = self._raw, self._pending
-        before = raw.shape[0] - pending.shape[0]
-        parts = [np.repeat(raw[:1], delay - before, axis=0), raw]
-        if end:
-            parts.append(np.repeat(raw[-1:], delay, axis=0))
-        out = np.empty((3, n))
-        fir_rows(np.ascontiguousarray(np.concatenate(parts).T), half, out)
+        pending = self._pending
+        before = self._raw.size - pending.shape[0]
+        out = self._raw.filtered((self.design or RAW).half, n, before, end=end)
         rows = pending[:n]
         frame.w[rows] = out.T
         self._pending = pending[n:]
-        self._raw = raw[max(0, before + n - delay) :]
         released = Run(rows, self._restart)
         self._restart = False
         return [released]

@@ -254,8 +254,9 @@ class TwinEngine:
             start = stop
         if end:
             reports.extend(self._end(frame, rows, parts, len(batch) - 1))
-        self._gyro.close(frame)
-        return self._reporting.batch(frame, rows, parts, reports)
+        out = self._reporting.batch(frame, rows, parts, reports)
+        self._gyro.close(frame)  # the frame's last use: the next push may write over it
+        return out
 
     def _chunk(
         self,
