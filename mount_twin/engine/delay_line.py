@@ -91,23 +91,20 @@ class Run:
 class Frame:
     """The samples of one push, after those still pending from earlier pushes (`offset` of
     them): stamps (s), specific force f (m/s², F), Ω (rad/s, F: the filtered rate once a row
-    is integrated, raw before) per row; `stored_ids` the stream positions (among all pushed
-    samples) of the pending rows, `first_id` that of the push's first sample."""
+    is integrated, raw before) per row; `ids` their stream positions (among all pushed
+    samples, int64), `first_id` that of the push's first sample."""
 
     stamps: np.ndarray
     f: np.ndarray
     w: np.ndarray
     offset: int
-    stored_ids: np.ndarray
+    ids: np.ndarray
     first_id: int
 
     def relative(self, rows: np.ndarray) -> np.ndarray:
         """The positions of rows' samples relative to the push's first sample (negative: a
         sample of an earlier push)."""
-        rel = rows - self.offset
-        early = rows < self.offset
-        rel[early] = self.stored_ids[rows[early]] - self.first_id
-        return rel
+        return self.ids[rows] - self.first_id
 
 
 class Backlog:
@@ -138,8 +135,9 @@ class Backlog:
         then these: the pushed arrays themselves where none are pending, else copies."""
         n, m = self._n, stamps.shape[0]
         self._n, self._framed = 0, False
+        ids = np.arange(first_id, first_id + m)
         if not n:
-            return Frame(stamps, f, w, 0, np.zeros(0, np.int64), first_id)
+            return Frame(stamps, f, w, 0, ids, first_id)
         lo = self._lo
         kept = slice(lo, lo + n)
         if m > LARGE:
@@ -148,18 +146,15 @@ class Backlog:
                 np.concatenate([self._f[kept], f]),
                 np.concatenate([self._w[kept], w]),
                 n,
-                self._ids[kept],
+                np.concatenate([self._ids[kept], ids]),
                 first_id,
             )
         lo = self._room(n, m)
         hi = lo + n + m
         new = slice(lo + n, hi)
-        self._t[new], self._f[new], self._w[new] = stamps, f, w
-        self._ids[new] = np.arange(first_id, first_id + m)
+        self._t[new], self._f[new], self._w[new], self._ids[new] = stamps, f, w, ids
         self._framed = True
-        return Frame(
-            self._t[lo:hi], self._f[lo:hi], self._w[lo:hi], n, self._ids[lo : lo + n], first_id
-        )
+        return Frame(self._t[lo:hi], self._f[lo:hi], self._w[lo:hi], n, self._ids[lo:hi], first_id)
 
     def keep(self, frame: Frame, rows: np.ndarray) -> None:
         """Keep the rows `rows` (increasing) of the last frame pending: where they are its
@@ -171,8 +166,7 @@ class Backlog:
         if self._framed and int(rows[0]) == size - k:
             self._lo += size - k
             return
-        ids = frame.relative(rows) + frame.first_id
-        t, f, w = frame.stamps[rows], frame.f[rows], frame.w[rows]
+        t, f, w, ids = frame.stamps[rows], frame.f[rows], frame.w[rows], frame.ids[rows]
         self._lo = 0
         self._room(0, k)
         self._t[:k], self._f[:k], self._w[:k], self._ids[:k] = t, f, w, ids
