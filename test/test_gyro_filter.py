@@ -20,6 +20,7 @@ from io_helpers import DATA_DIR, batch, engine_for, scene_with, split
 from mount_twin.analysis.deck_motion import SHIP, DeckMotion, deck_samples, rolling
 from mount_twin.commands.common import share_dir
 from mount_twin.engine.batch import OutputBatch, SampleBatch
+from mount_twin.engine.delay_line import LARGE, conditioned_rates
 from mount_twin.engine.gyro_filter import FLATNESS, design, fir_rows, kaiser_window
 from mount_twin.errors import SceneError
 from mount_twin.scene.description import Scene
@@ -153,9 +154,12 @@ def _concat(outs: list[OutputBatch]) -> OutputBatch:
 @pytest.mark.parametrize("sizes", [[1] * 120, [7] * 60, [1, 250, 3, 33, 100], [10_000]])
 def test_every_accepted_sample_is_answered_once_at_its_stamp_in_any_batching(sizes) -> None:
     """A rolling deck with rejected samples among them, pushed in pieces and flushed: one row
-    per accepted sample, its stamp, in order, the same bits as pushed whole."""
-    samples = deck_samples(rolling(0.02, 5.0, fade_s=0.2), 1000.0, 0.6)
-    samples.accel[[5, 77, 300]] = np.nan  # rejected
+    per accepted sample, its stamp, in order, the same bits as pushed whole. The last piece
+    after the small ones is larger than the delay line appends where the samples it holds
+    wait (`delay_line.LARGE`)."""
+    samples = deck_samples(rolling(0.02, 5.0, fade_s=0.2), 1000.0, 6.0)
+    assert len(samples) - 400 > LARGE
+    samples.accel[[5, 77, 300, 5000]] = np.nan  # rejected
     whole_engine = engine_for(_scene())
     whole = whole_engine.run(samples)
     engine = engine_for(_scene())
@@ -175,6 +179,26 @@ def test_every_accepted_sample_is_answered_once_at_its_stamp_in_any_batching(siz
     np.testing.assert_array_equal(got.wrenches, whole.wrenches)
     assert engine.counts["accepted"] == len(got) == kept.sum()
     assert len(tail) == engine.latency == 38
+
+
+def test_each_run_is_filtered_with_its_first_and_last_rates_held_beyond_it() -> None:
+    """The delay line's Ω (`conditioned_rates`) against each run convolved (`np.convolve`, the
+    full symmetric taps) with its first sample repeated N times before it and its last N
+    times after it: a long run, a run shorter than N and one after it, restarted between."""
+    rate_hz, n = 1000.0, 700
+    t = np.arange(n) / rate_hz
+    w = np.column_stack([0.1 + 0.05 * np.sin(2 * math.pi * f * t) for f in (3.0, 7.0, 11.0)])
+    w += 1e-3 * np.random.default_rng(7).standard_normal(w.shape)
+    restarts = [250, 280]
+    got = conditioned_rates((PASSBAND_HZ, STOPBAND_HZ), t, w, restarts)
+    half = design(rate_hz, PASSBAND_HZ, STOPBAND_HZ).half
+    taps, delay = np.concatenate([half[:0:-1], half]), half.shape[0] - 1
+    assert 280 - 250 < delay == 38
+    for run in np.split(np.arange(n), restarts):
+        x = w[run]
+        held = np.concatenate([np.repeat(x[:1], delay, 0), x, np.repeat(x[-1:], delay, 0)])
+        want = np.column_stack([np.convolve(held[:, i], taps, "valid") for i in range(3)])
+        np.testing.assert_allclose(got[run], want, rtol=0.0, atol=1e-14)
 
 
 def test_a_gap_reset_releases_the_delayed_samples_before_restarting() -> None:
