@@ -40,11 +40,18 @@ MAX_RATE_HZ = 1.0e6
 """Above this sample rate (no shock or motion sensor samples faster) the gyro is taken raw,
 with a note, rather than filtered by a design of that many taps."""
 ROOM = 256
-"""Samples of room a store keeps after its contents, at least, when it moves them to its
-arrays' start: a push of one sample moves the pending ones once every ROOM pushes."""
+"""Samples of room a store keeps beside its contents, at least, when it moves them to its
+arrays' start: a push of one sample moves the pending ones once every ROOM pushes or less
+often (`capacity`)."""
 LARGE = 4096
 """A push of more samples than this gets a frame of its own (the pending samples and these
 concatenated: one copy of each either way), not a backlog that large kept between pushes."""
+
+
+def capacity(need: int, have: int) -> int:
+    """Samples to give arrays of `have` samples that must hold `need` with ROOM to spare: the
+    same while they do, else 2 need + ROOM (arrays double as they grow, never shrink)."""
+    return have if need + ROOM <= have else 2 * need + ROOM
 
 
 def filter_bands(spec: InputSpec) -> tuple[float, float] | None:
@@ -111,7 +118,7 @@ class Backlog:
     """The samples pending between pushes (stamps s, f m/s², Ω rad/s and stream positions)
     in arrays with room after them, and the frame of a push: the pushed samples appended
     into that room (a push of up to LARGE samples), so a push costs its own samples' copies,
-    not the pending ones'. A frame built here is valid until the next push's `keep`."""
+    not the pending ones'. A frame built here is valid until `keep`."""
 
     def __init__(self) -> None:
         self._t = np.empty(0)
@@ -173,13 +180,12 @@ class Backlog:
 
     def _room(self, n: int, m: int) -> int:
         """Room for m samples after the n from row `_lo`: they are moved to row 0 (into
-        larger arrays where 2 (n + m) + ROOM do not fit) unless the room is there; returns
-        their row."""
+        larger arrays, `capacity`) unless the room is there; returns their row."""
         lo = self._lo
         if lo + n + m <= self._t.shape[0]:
             return lo
         old = (self._t, self._f, self._w, self._ids)
-        size = 2 * (n + m) + ROOM
+        size = capacity(n + m, self._t.shape[0])
         if size > self._t.shape[0]:
             self._t, self._f, self._w = np.empty(size), np.empty((size, 3)), np.empty((size, 3))
             self._ids = np.empty(size, np.int64)
@@ -237,14 +243,14 @@ class RawWindow:
 
     def _room(self, front: int, back: int) -> None:
         """Room for `front` samples before the window and `back` after it: the window moved
-        (into larger arrays where 2 (front + size + back) + ROOM do not fit) unless there."""
+        to column `front` (into larger arrays, `capacity`) unless the room is there."""
         lo, hi = self._lo, self._hi
         if lo >= front and hi + back <= self._raw.shape[1]:
             return
         old, size = self._raw, hi - lo
-        need = front + size + back
-        if need + ROOM > old.shape[1]:
-            self._raw = np.empty((3, 2 * need + ROOM))
+        columns = capacity(front + size + back, old.shape[1])
+        if columns > old.shape[1]:
+            self._raw = np.empty((3, columns))
         self._raw[:, front : front + size] = old[:, lo:hi]
         self._lo, self._hi = front, front + size
 
@@ -285,7 +291,7 @@ class GyroDelay:
 
     def frame(self, stamps: np.ndarray, f: np.ndarray, w: np.ndarray, first_id: int) -> Frame:
         """The frame of a push: pending samples, then these (w: raw Ω, rad/s, filtered in
-        place as samples are released). Valid until the next push's `close`."""
+        place as samples are released). Valid until `close`."""
         frame = self._backlog.frame(stamps, f, w, first_id)
         self._pending = np.arange(frame.offset)
         return frame
