@@ -255,7 +255,7 @@ class TwinEngine:
         if end:
             reports.extend(self._end(frame, rows, parts, len(batch) - 1))
         out = self._reporting.batch(frame, rows, parts, reports)
-        self._gyro.close(frame)  # the frame's last use: the next push may write over it
+        self._gyro.close(frame)  # last: it may write over the frame's arrays
         return out
 
     def _chunk(
