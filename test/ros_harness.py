@@ -107,6 +107,28 @@ class NodeProcess:
         return self.proc.returncode
 
 
+class InProcessNode:
+    """The node in this process, in DDS domain `domain`, `ros_args` after its --ros-args: its
+    own context and a single-threaded executor, for a test that reaches into it (counts,
+    publishers, timers) or drives its shutdown; `close` destroys them."""
+
+    def __init__(self, domain: int, ros_args: list[str]) -> None:
+        from mount_twin.ros.node import MountTwinNode
+
+        self.context = Context()
+        args = ["mount_twin_node", "--ros-args", *ros_args]
+        rclpy.init(args=args, context=self.context, domain_id=domain)
+        self.node = MountTwinNode(args, context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+
+    def close(self) -> None:
+        """Shut the executor down, destroy the node and its context."""
+        self.executor.shutdown()
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+
+
 class Peer:
     """The test side: publishers of raw input, raw subscriptions recording every output."""
 

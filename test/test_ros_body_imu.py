@@ -30,6 +30,7 @@ from io_helpers import (
 )
 from ros_harness import (
     LOSSLESS,
+    InProcessNode,
     NodeProcess,
     Peer,
     fresh_domain,
@@ -165,25 +166,7 @@ def test_the_node_tracks_mounts_that_age_as_the_replay_does(tmp_path: Path) -> N
     want = statuses_named([r for _, r in read_raw(tmp_path / "out")["/diagnostics"]], AGEING)
     assert [level for _, level, _, _ in want] == [OK, ERROR]
 
-    domain = fresh_domain()
-    peer = Peer(domain)
-    peer.record({"/diagnostics": DIAGNOSTICS})
-    node = _ageing_node(domain, scene_path)
-    try:
-        _send_when_connected(node, peer, inputs)
-
-        def got() -> list[tuple[int, int, str, dict[str, str]]]:
-            return statuses_named(peer.got["/diagnostics"], AGEING)
-
-        assert peer.take_until(lambda: len(got()) == len(want), 120.0), node.failed()
-        assert node.alive  # the fits ran beside the twin, not in place of it
-        code = stop_and_take(node, peer, lambda: True)
-    finally:
-        node.stop()
-        peer.close()
-    assert code == 0, node.stderr
-    assert "Traceback" not in node.stderr, node.stderr
-    assert got() == want
+    assert _ageing_statuses_live(scene_path, inputs, len(want), len(want)) == want
 
 
 def _ageing_node(domain: int, scene_path: Path, group: bool = False) -> NodeProcess:
@@ -194,11 +177,40 @@ def _ageing_node(domain: int, scene_path: Path, group: bool = False) -> NodeProc
     return NodeProcess(domain, [*args, *LOSSLESS, *reliable_body], group=group)
 
 
-def _send_when_connected(node: NodeProcess, peer: Peer, inputs: list) -> None:
+def _ageing_statuses_live(
+    scene_path: Path, inputs: list, running: int, stopped: int
+) -> list[tuple[int, int, str, dict[str, str]]]:
+    """The `mount_twin: ageing` statuses of the node on `scene_path` fed `inputs`
+    (`_send_when_connected`, every one acknowledged): once `running` of them have come, it
+    is stopped (it must still be running: the fits run beside the twin, not in place of it),
+    and they are taken until `stopped` have come; it must exit 0 without a traceback."""
+    domain = fresh_domain()
+    peer = Peer(domain)
+    peer.record({"/diagnostics": DIAGNOSTICS})
+    node = _ageing_node(domain, scene_path)
+
+    def got() -> list[tuple[int, int, str, dict[str, str]]]:
+        return statuses_named(peer.got["/diagnostics"], AGEING)
+
+    try:
+        _send_when_connected(node, peer, inputs, acked=True)
+        assert peer.take_until(lambda: len(got()) >= running, 120.0), node.failed()
+        assert node.alive
+        code = stop_and_take(node, peer, lambda: len(got()) >= stopped)
+    finally:
+        node.stop()
+        peer.close()
+    assert code == 0, node.stderr
+    assert "Traceback" not in node.stderr, node.stderr
+    return got()
+
+
+def _send_when_connected(node: NodeProcess, peer: Peer, inputs: list, acked: bool = False) -> None:
     """Publish `inputs` ((topic, stamp, raw) in order) once the node hears both topics and the
-    peer hears its /diagnostics; return once the node's (reliable) subscriptions have
-    acknowledged every one: a stop after that finds them all in its queue (a stop while the
-    last were in flight lost them: 597 of 600 counted under a loaded CI run)."""
+    peer hears its /diagnostics; with `acked`, return only once the node's (reliable)
+    subscriptions have acknowledged every one, so that a stop then finds them all in its
+    queue (a stop while the last were in flight lost them: 597 of 600 counted in a loaded
+    CI run)."""
     from rclpy.duration import Duration
 
     pubs = {t: peer.publisher(IMU, t) for t in ("/deck/imu", BODY_TOPIC)}
@@ -208,7 +220,8 @@ def _send_when_connected(node: NodeProcess, peer: Peer, inputs: list) -> None:
     for topic, _, raw in inputs:
         pubs[topic].publish(raw)
         peer.take()
-    assert all(p.wait_for_all_acked(Duration(seconds=60.0)) for p in pubs.values())
+    if acked:
+        assert all(p.wait_for_all_acked(Duration(seconds=60.0)) for p in pubs.values())
 
 
 def _children(pid: int) -> list[int]:
@@ -303,12 +316,8 @@ def test_a_second_stop_leaves_the_body_imu_backlog_unprocessed_and_counts_it(
     stamped 0, 1970)). The body backlog had been processed in full at a second stop, however
     long it took. Stopped once, both backlogs are processed in full, as before (nothing
     counted lost)."""
-    import rclpy
-    from rclpy.context import Context
     from rclpy.duration import Duration
-    from rclpy.executors import SingleThreadedExecutor
 
-    from mount_twin.ros.node import MountTwinNode
     from mount_twin.ros.start import StopRequests
 
     scene_path = _scene_file(tmp_path)
@@ -316,14 +325,10 @@ def test_a_second_stop_leaves_the_body_imu_backlog_unprocessed_and_counts_it(
     raws = {t: [r for topic, _, r in inputs if topic == t] for t in ("/deck/imu", BODY_TOPIC)}
     assert [len(r) for r in raws.values()] == [1500, 1500]
     domain = fresh_domain()
-    context = Context()
     reliable_body = ["-p", f"qos_overrides.{BODY_TOPIC}.subscription.reliability:=reliable"]
-    args = ["mount_twin_node", "--ros-args", "-p", f"scene_file:={scene_path}"]
-    args += ["-p", "stall_period_s:=3600.0", *LOSSLESS, *reliable_body]
-    rclpy.init(args=args, context=context, domain_id=domain)
-    node = MountTwinNode(args, context=context)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
+    args = ["-p", f"scene_file:={scene_path}", "-p", "stall_period_s:=3600.0"]
+    twin = InProcessNode(domain, [*args, *LOSSLESS, *reliable_body])
+    node, executor = twin.node, twin.executor
     peer = Peer(domain)
     peer.record({"/diagnostics": DIAGNOSTICS})
     stops = StopRequests()
@@ -356,9 +361,7 @@ def test_a_second_stop_leaves_the_body_imu_backlog_unprocessed_and_counts_it(
         peer.take_until(lambda: False, 0.5)
     finally:
         peer.close()
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
+        twin.close()
     twice = stops_sent == 2
     lost, body_lost = (1500 - first, 1500 - body_first) if twice else (0, 0)
     assert cut_short == (lost > 0)
@@ -406,28 +409,12 @@ def test_the_node_publishes_the_ageing_samples_it_could_not_pair(tmp_path: Path)
     replay(scene, tmp_path / "in", tmp_path / "out", progress=False)
     replayed = statuses_named([r for _, r in read_raw(tmp_path / "out")["/diagnostics"]], AGEING)
 
-    domain = fresh_domain()
-    peer = Peer(domain)
-    peer.record({"/diagnostics": DIAGNOSTICS})
-    node = _ageing_node(domain, scene_path)
-    try:
-        _send_when_connected(node, peer, inputs)
-
-        def got() -> list[tuple[int, int, str, dict[str, str]]]:
-            return statuses_named(peer.got["/diagnostics"], AGEING)
-
-        assert peer.take_until(lambda: len(got()) == 1, 120.0), node.failed()  # the apart WARN
-        code = stop_and_take(node, peer, lambda: len(got()) == 2)
-    finally:
-        node.stop()
-        peer.close()
-    assert code == 0, node.stderr
-    assert "Traceback" not in node.stderr, node.stderr
-    _, level, message, values = got()[-1]
+    got = _ageing_statuses_live(scene_path, inputs, 1, 2)  # the apart WARN, then the end's
+    _, level, message, values = got[-1]
     assert level == WARN, message
     assert {k: values[k] for k in want} == want, message
     assert "stamps jumped back apart" in message and "not tracked from there on" in message
-    assert got() == replayed
+    assert got == replayed
 
 
 TOPICS = ("/deck/imu", BODY_TOPIC)

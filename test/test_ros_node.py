@@ -31,6 +31,7 @@ else:
 from io_helpers import PARAMS_FILE, ROOT, read_raw, unprovided_imu
 from ros_harness import (
     LOSSLESS,
+    InProcessNode,
     NodeProcess,
     Peer,
     fresh_domain,
@@ -963,20 +964,11 @@ def test_the_node_wakes_its_executor_only_for_work() -> None:
     publisher, were 26 of the pump's 31 waitables), and the batch timer runs only while input
     comes (it woke an idle node every 5 ms: 35 % of a core). In this process, the node on an
     executor of its own context, a peer publishing."""
-    import rclpy
-    from rclpy.context import Context
-    from rclpy.executors import SingleThreadedExecutor
-
-    from mount_twin.ros.node import MountTwinNode
-
     domain = fresh_domain()
-    context = Context()
-    args = ["mount_twin_node", "--ros-args", "--params-file", str(PARAMS_FILE), *LOSSLESS]
+    args = ["--params-file", str(PARAMS_FILE), *LOSSLESS]
     args += ["-p", "batch_period_s:=0.005"]  # reliable input: none lost while discovery ends
-    rclpy.init(args=args, context=context, domain_id=domain)
-    node = MountTwinNode(args, context=context)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
+    twin = InProcessNode(domain, args)
+    node, executor = twin.node, twin.executor
     peer = Peer(domain)
     try:
         outputs = [*node._pubs.values(), node._scene_pub, getattr(node, "_static", None)]
@@ -1001,9 +993,7 @@ def test_the_node_wakes_its_executor_only_for_work() -> None:
         assert node._pending and not timer.is_canceled()
     finally:
         peer.close()
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
+        twin.close()
 
 
 def _catches_sigterm(pid: int) -> bool:
@@ -1113,21 +1103,13 @@ def test_a_second_stop_leaves_the_backlog_unprocessed_and_the_last_report_counts
     (the gyro filter's delayed ones flushed), counting the 3000 `lost_unprocessed_at_stop`
     (ERROR: 94 % of the samples due). Before, the shutdown processed the whole backlog, however
     long it took."""
-    import rclpy
-    from rclpy.context import Context
     from rclpy.duration import Duration
-    from rclpy.executors import SingleThreadedExecutor
 
-    from mount_twin.ros.node import MountTwinNode
     from mount_twin.ros.start import StopRequests
 
     domain = fresh_domain()
-    context = Context()
-    args = ["mount_twin_node", "--ros-args", "--params-file", str(PARAMS_FILE), *LOSSLESS]
-    rclpy.init(args=args, context=context, domain_id=domain)
-    node = MountTwinNode(args, context=context)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
+    twin = InProcessNode(domain, ["--params-file", str(PARAMS_FILE), *LOSSLESS])
+    node, executor = twin.node, twin.executor
     peer = Peer(domain)
     peer.record({"/diagnostics": DIAGNOSTICS, "/mount_twin/pose": POSE})
     stops = StopRequests()
@@ -1156,9 +1138,7 @@ def test_a_second_stop_leaves_the_backlog_unprocessed_and_the_last_report_counts
         peer.take_until(lambda: False, 0.5)
     finally:
         peer.close()
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
+        twin.close()
     assert (counts["received"], counts["lost_unprocessed_at_stop"]) == (200, 3000)
     assert len(peer.got["/mount_twin/pose"]) == 200
     (_, statuses), *_ = diagnostics(peer.got["/diagnostics"][-1:])
