@@ -27,6 +27,7 @@ from scipy.signal import butter, sosfiltfilt
 from mount_twin import load_scene_file
 from mount_twin.analysis.calibration import calibrated_scene
 from mount_twin.analysis.response import followed
+from mount_twin.engine import body_check
 from mount_twin.engine.agreement import NAME
 from mount_twin.engine.batch import ERROR, OK, WARN, SampleBatch
 from mount_twin.engine.intake import rotated
@@ -793,6 +794,50 @@ def test_body_messages_lost_by_the_middleware_are_reported_in_the_window_judged_
             assert "nrms_fx" not in values and message.startswith(said), message
         else:
             assert "nrms_fx" in values and "lost_middleware 37" in message, message
+
+
+def test_body_samples_dropped_waiting_after_the_last_judged_window_are_warned_of(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The deck stops at 12 s (windows of 5 s: 10–12 s too short to judge) and the body IMU
+    goes on 7 s more, held waiting for the twin past PENDING_LIMIT (here 1000 samples): the
+    oldest were dropped (dropped_waiting), said by no window and no WARN, only in the run's
+    counts. Now a WARN at the end says how many, the same in each feeding order whose body
+    stream never leads the deck's by the limit (fed whole, body first, it would: the limit
+    drops by arrival, as it is meant to)."""
+    limit, extra = 1000, 1400
+    monkeypatch.setattr(body_check, "PENDING_LIMIT", limit)
+    scene, deck = _pump(), _deck(12.0)
+    _, whole = _whole_record(scene, deck)
+    ns = _stamps(deck)
+    body_ns = np.concatenate([ns, ns[-1] + 5_000_000 * np.arange(1, extra + 1)])  # 200 Hz on
+    body = _body_raws(body_ns, np.vstack([whole, np.zeros((extra, 6))]))
+    deck_raws = _deck_raws(scene, deck)
+    streams = [TwinStream(scene) for _ in range(3)]
+    runs = [
+        _interleaved(scene, deck_raws, ns, (body, body_ns), streams[0]),
+        _chunked(scene, deck_raws, body, 700, body_first=True, stream=streams[1]),
+        _chunked(scene, deck_raws, body, 333, body_first=False, stream=streams[2]),
+    ]
+    # held at the end: the samples at the deck's last two rows (predicted only once the
+    # stream ends: the prediction trails the twin by two rows) and the 1400 after; the oldest
+    # dropped, the `limit` kept left unanswered
+    dropped = 2 + extra - limit
+    said = [_windows(run) for run in runs]
+    assert said[1] == said[0] and said[2] == said[0]
+    for stream in streams:
+        assert stream.body is not None
+        assert stream.body.counts["dropped_waiting"] == dropped
+        assert stream.body.counts["unanswered"] == limit
+    *judged, (level, message, values) = said[0]
+    assert len(judged) == 2 and all(v["body_dropped_waiting"] == "0" for _, _, v in judged)
+    assert level == WARN and "nrms_fx" not in values, message
+    assert message == (
+        f"{dropped} body IMU samples held too long waiting for the twin were dropped "
+        "(counted dropped_waiting)"
+    )
+    assert values["body_dropped_waiting"] == str(dropped)
+    assert values["body_unanswered"] == str(limit)
 
 
 @pytest.mark.parametrize("reason", ["lost_unprocessed_at_stop", "lost_middleware"])

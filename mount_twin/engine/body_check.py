@@ -92,13 +92,16 @@ predictions, inside a gap of the twin's rows, after its last row, held too long,
 body IMU's and the deck's stamps jumped back apart (`Apart`); and why a body message was
 never received: lost by the middleware, or waiting unprocessed in the node's queue when it
 was stopped a second time (STOPPED, `ros.node`)."""
-NEVER_READ = {
+WARNED_AT_END = {
+    "dropped_waiting": "{} body IMU samples held too long waiting for the twin were dropped "
+    "(counted {})",
     MIDDLEWARE: "{} body IMU messages lost by the middleware (counted {})",
     STOPPED: "{} body IMU messages waiting when the node was stopped again were not processed "
     "(counted {})",
 }
-"""The body messages the node never read, by count: how a WARN at the end of the stream says
-those no window reported (`_Windows.finish`)."""
+"""The body samples lost that are not at a place in the stream (held too long; never read by
+the node: lost by the middleware, left unprocessed at a second stop), by count: how a WARN at
+the end of the stream says those no window reported (`_Windows.finish`)."""
 
 
 class Apart:
@@ -520,12 +523,13 @@ class _Window:
 CUT_BY_END = "the last window, closed by the end of the stream"
 CUT_BY_JUMP = "the last window before the body IMU's stamps jumped back"
 """How a window cut short is said (`_Windows._close`)."""
-LOOSE = ("dropped_waiting", "unanswered", *NEVER_READ)
-"""Not compared for the stream's sake, not at a place in it (held too long, left at its end,
+LOOSE = ("unanswered", *WARNED_AT_END)
+"""Not compared for the stream's sake, not at a place in it (left at its end, held too long,
 lost by the middleware, never processed at a second stop; the node counts the last two as it
 learns of them): reported in the window judged next (unanswered at the end of a run the twin
-restarted after: at its place; those never read, NEVER_READ, that no window reports: in a
-WARN of their own, `_Windows.finish`)."""
+restarted after: at its place; the others, WARNED_AT_END, that no window reports: in a WARN
+of their own, `_Windows.finish`; unanswered at the end of the stream, said, not warned of:
+in the last window where it is judged, else in the run's counts alone)."""
 
 
 class _Windows:
@@ -625,7 +629,7 @@ class _Windows:
         """The last, partial window's report, if it spans half a window (with the rejected
         messages after its last sample); if no window was judged over the run although body
         messages came (`counts`), a WARN saying why, stamped `stamp_ns`: silence would read
-        as a check passed. Where messages the node never read (NEVER_READ: lost by the
+        as a check passed. Where samples lost (WARNED_AT_END: held too long, lost by the
         middleware, left unprocessed at a second stop) are not in a window reported, a WARN
         saying how many."""
         if self._window is not None:
@@ -641,9 +645,9 @@ class _Windows:
                 + (f"; not compared: {missed}" if missed else "")
             )
             return [(stamp_ns, HealthStatus(NAME, WARN, message, values))]
-        unsaid = {k: counts[k] - self._loose_reported[k] for k in NEVER_READ}
+        unsaid = {k: counts[k] - self._loose_reported[k] for k in WARNED_AT_END}
         if any(unsaid.values()):
-            message = "; ".join(NEVER_READ[k].format(n, k) for k, n in unsaid.items() if n)
+            message = "; ".join(WARNED_AT_END[k].format(n, k) for k, n in unsaid.items() if n)
             reports.append((stamp_ns, HealthStatus(NAME, WARN, message, values)))
         return reports
 
