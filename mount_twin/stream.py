@@ -361,18 +361,16 @@ class TwinStream:
             for s in report.statuses
         ]
         self.final_report = report
-        stamp_ns = max(stamp_ns, self._stalled_ns)
-        return [encode_report(self.scene, report, stamp_ns)]
+        return [encode_report(self.scene, report, self._end_ns(stamp_ns))]
 
-    def finish(self) -> list[Encoded]:
+    def finish(self, clock_ns: int = 0) -> list[Encoded]:
         """The end of the stream (end of a bag, node shutdown): the outputs the gyro delay
-        still holds, then the last, partial diagnostics period, stamped with the last input
-        stamp answered (none answered: the last received; none with a stamp: 0), or the last
-        stall report's if later (input not stamped by the clock: /diagnostics never goes
-        back); no report if that period is empty. The ageing tracker's end (the samples it
-        could not pair, `AgeingTracker.finish`) comes with `take_ageing_jobs`. The body
-        comparison's reports of the end that have no body stamp to take (every body message
-        lost) take that stamp too."""
+        still holds, then the last, partial diagnostics period, stamped `_end_ns(clock_ns)`
+        (`clock_ns`: the node's clock now, ns; a replay has no clock and passes none: a bag
+        without one input stamp still ends at 0); no report if that period is empty. The
+        ageing tracker's end (the samples it could not pair, `AgeingTracker.finish`) comes
+        with `take_ageing_jobs`. The body comparison's reports of the end that have no body
+        stamp to take (every body message lost) take that stamp too."""
         out = self.engine.flush()
         reports, out.health = out.health, []
         kept, self._kept = self._kept, _Kept()
@@ -385,18 +383,19 @@ class TwinStream:
             )
             self.body.counts["unanswered"] += sum(len(d.stamps_ns) for d in self._body_waiting)
             self._body_waiting = []
-            msgs += self._encode_body(self.body.finish(self._end_ns()))
+            msgs += self._encode_body(self.body.finish(self._end_ns(clock_ns)))
         if self.ageing is not None:  # the samples it could not pair, where any
             self._ageing_jobs += self.ageing.finish()
         self.last_outputs = out
         self.final_report = reports[0] if reports else None
-        return msgs + [encode_report(self.scene, r, self._end_ns()) for r in reports]
+        return msgs + [encode_report(self.scene, r, self._end_ns(clock_ns)) for r in reports]
 
-    def _end_ns(self) -> int:
+    def _end_ns(self, clock_ns: int) -> int:
         """The stamp (ns) of the reports at the end of the stream: the last input stamp
-        answered (none answered: the last received; none with a stamp: 0), or the last stall
-        report's if later (/diagnostics never goes back)."""
-        return max(self._last_ns or self._received_ns, self._stalled_ns)
+        answered (none answered: the last received; none with a stamp: `clock_ns`, the node's
+        clock, as its stall reports are stamped, where 0 had taken /diagnostics back to
+        1970), or the last stall report's if later (/diagnostics never goes back)."""
+        return max(self._last_ns or self._received_ns or clock_ns, self._stalled_ns)
 
 
 def _runs(values: np.ndarray) -> list[tuple[int, int]]:

@@ -859,3 +859,24 @@ def test_body_messages_never_read_are_said_at_the_twins_last_stamp(reason: str) 
     assert stamp == int(_stamps(deck)[-1])
     assert level == WARN and message.startswith("500 body IMU messages"), message
     assert values[f"body_{reason}"] == "500", values
+
+
+@pytest.mark.parametrize("reason", ["lost_unprocessed_at_stop", "lost_middleware"])
+def test_body_messages_never_read_without_any_input_are_said_at_the_nodes_clock(
+    reason: str,
+) -> None:
+    """No deck message came, and 500 body IMU messages were lost before they were read
+    (waiting in the node's queue at a second stop, lost by the middleware): no stamp of the
+    input nor of the body, and the body check's WARN of them was stamped 0 (1970). Now it is
+    stamped with the node's clock, which the node passes to `finish` (as its report that no
+    input came is)."""
+    stream = TwinStream(_pump())
+    assert stream.body is not None
+    stream.body.counts[reason] += 500  # as the node counts them (`MountTwinNode`)
+    clock_ns = NS0 + 7_000_000_000
+    out = stream.finish(clock_ns)
+    said = statuses_named([raw for topic, _, raw in out if topic == DIAGNOSTICS_TOPIC], NAME)
+    assert len(said) == 1, said
+    stamp, level, message, _ = said[0]
+    assert (stamp, level) == (clock_ns, WARN)
+    assert message.startswith("500 body IMU messages"), message

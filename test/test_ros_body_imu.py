@@ -43,6 +43,7 @@ from mount_twin.analysis.ageing_live import NAME as AGEING
 from mount_twin.engine.agreement import NAME
 from mount_twin.engine.batch import ERROR, OK, WARN
 from mount_twin.engine.delay_line import delay_samples
+from mount_twin.engine.health_texts import INPUT
 from mount_twin.io.bag import OutputBag
 from mount_twin.io.messages import DIAGNOSTICS, IMU, NODE_NAME, resolve
 from mount_twin.io.output_encoding import imu_messages
@@ -382,6 +383,38 @@ def test_a_second_stop_leaves_the_body_imu_backlog_unprocessed_and_counts_it(
         assert "nrms_fx" not in values and message.startswith(said), message
     if not body_first:  # no body stamp read: the last deck message's (processed: 1000)
         assert stamp == inputs[2 * (first - 1)][1], stamp
+
+
+def test_a_node_stopped_without_input_stamps_the_body_imus_last_warn_by_its_clock(
+    tmp_path: Path,
+) -> None:
+    """No deck message came and the middleware reported 37 body IMU messages lost (counted as
+    `_on_body_lost` counts them), then the node was stopped: its body sensor WARN of them had
+    no input stamp and no body stamp to take and went out on /diagnostics stamped 0 (1970).
+    Now it takes the node's clock at the stop, as the input's ERROR that no input came does
+    (the same stamp)."""
+    from mount_twin.ros.start import StopRequests
+
+    args = ["-p", f"scene_file:={_scene_file(tmp_path)}", "-p", "stall_period_s:=3600.0"]
+    twin = InProcessNode(fresh_domain(), args)
+    node = twin.node
+    published: list[tuple[str, int, bytes]] = []
+    try:
+        node._publish = published.extend  # type: ignore[method-assign]
+        assert node.stream.body is not None
+        node.stream.body.counts["lost_middleware"] += 37
+        before = node.get_clock().now().nanoseconds
+        node.finish(StopRequests())
+        after = node.get_clock().now().nanoseconds
+    finally:
+        twin.close()
+    raws = [raw for topic, _, raw in published if topic == "/diagnostics"]
+    (stamp, level, message, _), *rest = statuses_named(raws, NAME)
+    assert not rest, rest
+    assert level == WARN and message.startswith("37 body IMU messages lost"), message
+    assert before <= stamp <= after, (before, stamp, after)
+    (input_stamp, input_level, said, _), *_ = statuses_named(raws, INPUT)
+    assert (input_stamp, input_level) == (stamp, ERROR) and "no input received" in said
 
 
 def test_the_node_publishes_the_ageing_samples_it_could_not_pair(tmp_path: Path) -> None:

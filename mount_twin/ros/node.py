@@ -409,7 +409,8 @@ class MountTwinNode(Node):
                 body, self._process_body, stops, "body IMU", self._body_sub
             )
             self.stream.body.counts[STOPPED] += body_unprocessed
-        self._publish(messages_of(self.stream.finish()))
+        now = self.get_clock().now().nanoseconds  # the end's stamp where no input has one
+        self._publish(messages_of(self.stream.finish(now)))
         if not self.stream.engine.counts["received"]:  # nothing to report on: say so, ERROR
             life = time.monotonic() - self._started
             source = (
@@ -418,7 +419,6 @@ class MountTwinNode(Node):
             )
             if unprocessed:
                 source += f", {unprocessed} waiting at the second stop were not processed"
-            now = self.get_clock().now().nanoseconds
             self._publish(self.stream.ended_without_input(source, now))
         self._submit_fits()
         fits_cut = False
