@@ -11,7 +11,8 @@ import pytest
 from io_helpers import CONFIG, DATA_DIR, read_bag, stamp_ns
 
 from mount_twin.cli import main
-from mount_twin.io.csv_import import CsvFormat, read_recorder_csv, time_ns
+from mount_twin.io.csv_cells import time_ns
+from mount_twin.io.csv_import import CsvFormat, read_recorder_csv
 from mount_twin.io.xsens_csv import read_xsens_csv
 
 G = 9.80665

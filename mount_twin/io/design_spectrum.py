@@ -9,13 +9,13 @@ import io
 from itertools import pairwise
 from pathlib import Path
 
-from mount_twin.io.csv_import import read_csv_text
+from mount_twin.io.csv_cells import read_csv_text
 
 
 def read_design_table(path: str) -> tuple[list[float], list[float]]:
     """A design spectrum's (frequencies Hz, accelerations g) from its `frequency_hz,accel_g`
     CSV; a file that is no text, or no table (a field past csv's limit), is an error naming
-    it (`io.csv_import.read_csv_text`: it had said "'utf-8' codec can't decode byte 0x89",
+    it (`io.csv_cells.read_csv_text`: it had said "'utf-8' codec can't decode byte 0x89",
     or ended in csv's traceback)."""
     reader = csv.DictReader(io.StringIO(read_csv_text(Path(path))))
     try:

@@ -4,7 +4,7 @@ Layout: a preamble (`sep=,`, `DeviceTag:`, versions, `StartTime:`, a copyright l
 line), then `PacketCounter,SampleTimeFine,...` with `SampleTimeFine` the device clock in µs
 (32-bit, wrapping), `Acc_X/Y/Z` specific force in m/s² (+g on z at rest) and `Gyr_X/Y/Z` in
 deg/s, in the sensor's frame. The export's first data row is all zeros (no sample): dropped.
-Stamps are read as a recorder CSV's are (`csv_import.time_cells_ns`): each SampleTimeFine
+Stamps are read as a recorder CSV's are (`csv_cells.time_cells_ns`): each SampleTimeFine
 cell exactly in ns, plus the whole wraps of the clock before it, in integers.
 """
 
@@ -16,16 +16,15 @@ from pathlib import Path
 
 import numpy as np
 
-from mount_twin.io.csv_import import (
+from mount_twin.io.csv_cells import (
     CSV_MAX_BYTES,
     TIME_NS,
-    Imported,
     cell_value,
     check_increasing,
     check_width,
-    read_recorder_csv,
     time_cells_ns,
 )
+from mount_twin.io.csv_import import Imported, read_recorder_csv
 from mount_twin.io.signals import Signal
 from mount_twin.textfiles import FileTooLargeError, read_limited
 
@@ -47,7 +46,7 @@ def read_xsens_csv(path: str | Path) -> Imported:
     """The record (on the device clock, SampleTimeFine: two synchronised sensors' records
     share it; specific force m/s², rate rad/s, sensor frame), its stamps exactly in int64 ns
     (`Imported.stamps_ns`) and a note naming its device; errors name the file, the row (its
-    line number) and the column, as a recorder CSV's do (`csv_import.cell_value`,
+    line number) and the column, as a recorder CSV's do (`csv_cells.cell_value`,
     `check_width`, `check_increasing`, `time_cells_ns`)."""
     path = Path(path)
     try:
