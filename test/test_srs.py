@@ -23,7 +23,8 @@ from mount_twin.analysis.sampling import uniform
 from mount_twin.analysis.srs import damping_ratio, gravity_offset, octave_frequencies, srs
 from mount_twin.cli import main
 from mount_twin.commands.common import write_signal
-from mount_twin.commands.srs import EXIT_OUT_OF_TOLERANCE, TOLERANCE_DB
+from mount_twin.commands.design_options import TOLERANCE_DB
+from mount_twin.commands.srs import EXIT_OUT_OF_TOLERANCE
 from mount_twin.io.bag import write_bag
 from mount_twin.io.messages import IMU, TYPESTORE
 from mount_twin.io.output_encoding import imu_messages
@@ -716,11 +717,11 @@ def _spectra_drawn(
     out."""
     pytest.importorskip("matplotlib")
     from mount_twin import figure_files
-    from mount_twin.commands.srs import _plot
+    from mount_twin.commands.srs_outputs import plot
 
     drawn: list = []
     monkeypatch.setattr(figure_files, "save_png", lambda fig, png: drawn.append(fig) or png)
-    clipped = _plot("unused.png", spectra, None, None, "title", 1e9, unit)
+    clipped = plot("unused.png", spectra, None, None, "title", 1e9, unit)
     return drawn[0], clipped
 
 

@@ -69,7 +69,7 @@ def plan_of(args: argparse.Namespace) -> Plan:
     """The plan: --plan's file, or the synthesis options of the command line."""
     from mount_twin.analysis.qualification import Plan, load_plan
     from mount_twin.analysis.srs import damping_ratio
-    from mount_twin.commands.srs import tolerance_of
+    from mount_twin.commands.design_options import tolerance_of
 
     if (args.plan is None) == (args.spectrum is None):
         msg = "give either --spectrum (one axis, options on the command line) or --plan"

@@ -6,8 +6,13 @@ import argparse
 import sys
 from typing import TYPE_CHECKING
 
+from mount_twin.commands.design_options import (
+    add_axis_argument,
+    add_design_arguments,
+    axes_of,
+    tolerance_of,
+)
 from mount_twin.commands.replay import EXIT_FAIL_ON, FAIL_ON, run_exit_status
-from mount_twin.commands.srs import add_axis_argument, add_design_arguments, axes_of, tolerance_of
 
 if TYPE_CHECKING:
     import numpy as np

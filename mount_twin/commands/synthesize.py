@@ -13,7 +13,7 @@ from mount_twin.commands.common import (
     positive_float,
     positive_int,
 )
-from mount_twin.commands.srs import add_tolerance_argument, tolerance_of
+from mount_twin.commands.design_options import add_tolerance_argument, tolerance_of
 from mount_twin.io.epoch import DEFAULT_START_NS
 
 if TYPE_CHECKING:
