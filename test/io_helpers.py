@@ -238,7 +238,8 @@ def ageing_messages(
     `at` on are `by` earlier (a recorder's clock set back)."""
     from scipy.signal import butter, sosfiltfilt
 
-    from mount_twin.analysis.calibration import calibrated_scene, predict
+    from mount_twin.analysis.calibration import predict
+    from mount_twin.analysis.calibration_parameters import calibrated_scene
     from mount_twin.io.output_encoding import imu_messages
     from mount_twin.io.signals import Signal, ship_motion
 

@@ -25,7 +25,7 @@ from io_helpers import (
 from scipy.signal import butter, sosfiltfilt
 
 from mount_twin import load_scene_file
-from mount_twin.analysis.calibration import calibrated_scene
+from mount_twin.analysis.calibration_parameters import calibrated_scene
 from mount_twin.analysis.response import followed
 from mount_twin.engine import body_check
 from mount_twin.engine.agreement import NAME

@@ -17,6 +17,8 @@ from scipy.signal import butter, csd, sosfiltfilt, welch
 
 from mount_twin import load_scene_file
 from mount_twin.analysis import calibration as cal_mod
+from mount_twin.analysis import calibration_parameters
+from mount_twin.analysis.calibration_records import STILL_FOUNDATION, still_record
 from mount_twin.cli import main
 from mount_twin.commands.calibrate import FITTED, ON_REQUEST
 from mount_twin.io.signals import SeaState, Signal, half_sine_shock, ship_motion
@@ -40,7 +42,7 @@ def _pump():
 def _pair(scene, foundation: Signal, truth: dict[str, float]) -> tuple[Signal, Signal]:
     """The body record the changed machine gives (its recorder `lag` late), and both records
     with 0.01 m/s² of sensor noise (a MEMS IMU's, per sample at this rate)."""
-    t, f = cal_mod.predict(cal_mod.calibrated_scene(scene, truth), foundation)
+    t, f = cal_mod.predict(calibration_parameters.calibrated_scene(scene, truth), foundation)
     rng = np.random.default_rng(1)
     tb = t[t > 0.05]
     fb = CubicSpline(t, f, axis=0)(tb - truth.get("lag", 0.0))
@@ -58,8 +60,8 @@ def _vibrating_deck() -> Signal:
 
 
 def test_the_parameters_the_command_offers_are_the_fits() -> None:
-    assert FITTED == cal_mod.PARAMETERS
-    assert ON_REQUEST == cal_mod.ON_REQUEST
+    assert FITTED == calibration_parameters.PARAMETERS
+    assert ON_REQUEST == calibration_parameters.ON_REQUEST
 
 
 def test_twenty_seconds_of_ship_motion_recover_the_changed_machine() -> None:
@@ -380,7 +382,7 @@ def test_a_foundation_record_that_does_not_move_is_refused_at_load_naming_it(
     err = capsys.readouterr().err
     assert f"{still}: the foundation record does not move" in err, err
     assert _said_still(err, "foundation") == pytest.approx(math.sqrt(3.0) * STILL_NOISE, rel=0.1)
-    assert f"at most {cal_mod.STILL_FOUNDATION:g} m/s²" in err, err
+    assert f"at most {STILL_FOUNDATION:g} m/s²" in err, err
     assert "the body record" not in err, err
     assert not out.exists()
 
@@ -444,10 +446,10 @@ def test_a_foundation_that_moves_a_little_more_than_the_threshold_is_not_still()
     t = np.arange(0.0, 10.0, 1.0 / RATE)
     for factor, still in ((1.2, False), (0.8, True)):
         sway = np.zeros((t.size, 3))
-        sway[:, 0] = factor * cal_mod.STILL_FOUNDATION * math.sqrt(2.0) * np.sin(2 * math.pi * t)
+        sway[:, 0] = factor * STILL_FOUNDATION * math.sqrt(2.0) * np.sin(2 * math.pi * t)
         sway[:, 2] = 9.80665
         deck = Signal(t, sway, np.zeros_like(sway))
-        said = cal_mod.still_record(deck, deck)
+        said = still_record(deck, deck)
         assert (said is not None) == still, (factor, said)
         assert said is None or said.record == "foundation", said
 

@@ -16,7 +16,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from mount_twin.analysis.calibration import calibrate, is_mount_scale, is_scale, scaled_mounts
+from mount_twin.analysis.calibration import calibrate
+from mount_twin.analysis.calibration_parameters import is_mount_scale, is_scale, scaled_mounts
 from mount_twin.io.signals import Signal
 from mount_twin.scene.description import Scene, ageing_bands_problem
 
@@ -101,7 +102,8 @@ def track(
     band: Band = Band(),
 ) -> list[WindowFit]:
     """The fit of each `window_s` window of the pair, in order (module docstring); ValueError
-    for a `fit` that is no mount scale (`calibration.is_mount_scale`, `scaled_mounts`)."""
+    for a `fit` that is no mount scale (`calibration_parameters.is_mount_scale`,
+    `scaled_mounts`)."""
     for name in fit:
         if not is_mount_scale(name):
             msg = (

@@ -4,7 +4,8 @@ The twin is the model: it runs on the foundation record, predicts what the body 
 (`engine.sensor_reading`), and `scipy.optimize.least_squares` moves the parameters a user cannot
 read off a data sheet until the prediction matches the body record, in the time domain (the
 twin's non-linear mounts and the recorders' clocks live there; a lag is a phase that grows
-with frequency, which a time-domain fit takes as one number):
+with frequency, which a time-domain fit takes as one number; the parameters and the scene
+their values make: `analysis.calibration_parameters`):
 
 - `stiffness`, `damping`: one scale factor each on every linear mount's stiffness and damping
   (fitted as logarithms: a scale stays positive); `stiffness:fl+fr` (or `damping:…`) scales
@@ -28,36 +29,39 @@ fit's Jacobian and residual (`(JᵀJ)⁻¹ s²`; the residual's own correlation 
 bound). A parameter the record cannot identify (relative 1σ past `MAX_REL_SIGMA`, an angle
 past 2°, a lag past a sample) is refused by name and held at its nominal value, and the rest is
 fitted again; a fit that predicts the body no better than the nominal scene is refused whole.
-A record that does not move (`still_record`: a foundation's still deck, the wrong topic or a
-record taken in harbour; a body's dead or disconnected sensor, another machine's record) leaves
-nothing to fit: every parameter is refused, saying so.
+A record that does not move (`calibration_records.still_record`: a foundation's still deck, the
+wrong topic or a record taken in harbour; a body's dead or disconnected sensor, another
+machine's record) leaves nothing to fit: every parameter is refused, saying so.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
-from typing import cast
 
 import numpy as np
 
+from mount_twin.analysis.calibration_parameters import (
+    ANGLES,
+    CG_OFFSETS,
+    MOUNT_SCALES,
+    OFFSETS,
+    ON_REQUEST,
+    PARAMETERS,
+    calibrated_scene,
+    is_mount_scale,
+    is_scale,
+    scaled_mounts,
+)
+from mount_twin.analysis.calibration_records import compared, overlap_problem, still_record
 from mount_twin.analysis.response import followed
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.engine.intake import rotated
 from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.io.signals import Signal
 from mount_twin.physics.rotations import angle_text
-from mount_twin.scene.description import BodySensor, LinearMount, Scene, Vec3, Vec6
+from mount_twin.scene.description import BodySensor, Scene
 
-PARAMETERS = ("stiffness", "damping", "yaw", "lag")
-"""What `calibrate` fits unless told otherwise."""
-ON_REQUEST = ("roll", "pitch", "sensor_x", "sensor_y", "sensor_z", "mass", "cg_x", "cg_y", "cg_z")
-"""What it fits when named too: the rest of the body sensor's mounting."""
-ANGLES = ("roll", "pitch", "yaw")
-OFFSETS = ("sensor_x", "sensor_y", "sensor_z")
-CG_OFFSETS = ("cg_x", "cg_y", "cg_z")
-MOUNT_SCALES = ("stiffness", "damping")
 MAX_POSITION_SIGMA_M = 0.01
 """A sensor position offset whose 1σ exceeds this (m) is not identified by the record."""
 STIFFNESS_SCAN = tuple(np.geomspace(0.25, 4.0, 17).tolist())
@@ -68,26 +72,6 @@ the nearest (0.84× ± 0.5 % on 12 s of the shake table, whose block is 1.23× a
 MAX_REL_SIGMA = 0.05
 """A scale factor whose relative 1σ exceeds this is not identified by the record."""
 MAX_YAW_SIGMA_RAD = math.radians(2.0)
-EDGE_S = 0.25
-"""Body samples this close to either end of the foundation record are left out of the fit."""
-
-MIN_OVERLAP = 10
-"""Body samples the fit needs within the foundation record (`EDGE_S` off each end) at least."""
-STILL_FOUNDATION = 0.05
-"""A foundation record whose dynamic RMS (its specific force about its mean, all three axes:
-gravity and bias out) over the compared span is at most this, m/s², does not move
-(`still_record`): what it holds is its sensor's noise (a MEMS IMU's 0.01 m/s² per axis is
-0.017 all axes; the shake table's Xsens DOT reads 0.022 in the first second of its trial
-records, before the table starts), and a body's motion is none of the twin's to fit. A deck
-that moves moves more: the slow roll and heave alone of `signals.ship_motion` 0.72 m/s², the
-shake table 1.3. A sensor noisier than this at rest (a 100 g shock accelerometer at 20 kHz
-reads 0.83) is not told from motion here; the fit's own refusals remain."""
-STILL_SHARE = 0.01
-"""A body record whose dynamic RMS (as `STILL_FOUNDATION`'s) is at most this share of the
-foundation's over the compared span does not move (`still_record`). Below its mounts' modes a
-body follows its foundation (a share near 1 or more: 2.1 on the shake table), and no mount
-isolates 40 dB over the whole of a record that moves at all; a sensor that reads a constant, or
-only its own noise (a MEMS IMU's 0.01 m/s² is this share of a 1 m/s² foundation), does."""
 NRMS_RESOLUTION = 1e-9
 """`nrms` of a measured signal whose spread about its mean is at most this share of its size
 is undefined (nan): what is left after the mean is out is rounding, not motion."""
@@ -114,84 +98,6 @@ class Calibration:
     nrms_before: float
     nrms_after: float
     scene: Scene
-
-
-def _times(values: Vec6, factor: float) -> Vec6:
-    """Six values, each times `factor`."""
-    return cast("Vec6", tuple(factor * v for v in values))
-
-
-def is_mount_scale(name: str) -> bool:
-    """Whether a parameter is a stiffness or damping scale (of all mounts or of a group)."""
-    return name.partition(":")[0] in MOUNT_SCALES
-
-
-def is_scale(name: str) -> bool:
-    """Whether a parameter is a scale factor (fitted as a logarithm): a mount scale or mass."""
-    return is_mount_scale(name) or name == "mass"
-
-
-def scaled_mounts(name: str, scene: Scene) -> list[str]:
-    """The linear mounts a scale parameter applies to: all of them, or those `name` lists
-    after its colon, joined by `+`. Raises ValueError naming a mount the scene lacks, or one
-    whose kind has no stiffness and damping scales (a bolt, a key, rubber with its own law),
-    or an empty name in the group."""
-    linear = [m.name for m in scene.mounts if isinstance(m, LinearMount)]
-    _, colon, group = name.partition(":")
-    listed = group.split("+") if colon else linear
-    if colon and not all(listed):
-        msg = f"{name}: a group names its mounts, stiffness:A+B (damping:A+B)"
-        raise ValueError(msg)
-    wrong = [m for m in listed if m not in linear]
-    if not listed:
-        msg = f"{name}: the scene has no linear mount to scale"
-        raise ValueError(msg)
-    if wrong:
-        msg = f"{name}: {', '.join(wrong)} is no linear mount of the scene ({', '.join(linear)})"
-        raise ValueError(msg)
-    return listed
-
-
-def calibrated_scene(scene: Scene, values: dict[str, float]) -> Scene:
-    """`scene` with its linear mounts' stiffness and damping scaled (every scale parameter in
-    `values` multiplies the mounts it names), its body sensor yawed and its lag lengthened by
-    `values` (missing parameters: nominal)."""
-    names = [m.name for m in scene.mounts]
-    factor = {(kind, m): 1.0 for kind in ("stiffness", "damping") for m in names}
-    for name, value in values.items():
-        if is_mount_scale(name):
-            for m in scaled_mounts(name, scene):
-                factor[name.partition(":")[0], m] *= value
-    mounts = tuple(
-        dataclasses.replace(
-            m,
-            stiffness=_times(m.stiffness, factor["stiffness", m.name]),
-            damping=_times(m.damping, factor["damping", m.name]),
-        )
-        if isinstance(m, LinearMount)
-        else m
-        for m in scene.mounts
-    )
-    sensor = scene.body_sensor or BodySensor()
-    turned = tuple(
-        a + values.get(n, 0.0) for a, n in zip(sensor.orientation_rpy, ANGLES, strict=True)
-    )
-    moved = tuple(p + values.get(n, 0.0) for p, n in zip(sensor.position, OFFSETS, strict=True))
-    mounted = dataclasses.replace(
-        sensor,
-        orientation_rpy=cast("Vec3", turned),
-        position=cast("Vec3", moved),
-        lag_s=sensor.lag_s + values.get("lag", 0.0),
-    )
-    mass = values.get("mass", 1.0)
-    cg = tuple(c + values.get(n, 0.0) for c, n in zip(scene.body.cg, CG_OFFSETS, strict=True))
-    body = dataclasses.replace(
-        scene.body,
-        mass=scene.body.mass * mass,
-        inertia=_times(scene.body.inertia, mass),
-        cg=cast("Vec3", cg),
-    )
-    return dataclasses.replace(scene, body=body, mounts=mounts, body_sensor=mounted)
 
 
 def predict(scene: Scene, foundation: Signal) -> tuple[np.ndarray, np.ndarray]:
@@ -230,89 +136,6 @@ def nrms(predicted: np.ndarray, measured: np.ndarray) -> float:
     return float(np.linalg.norm(p - m) / spread)
 
 
-def _compared(foundation: Signal, body: Signal) -> np.ndarray:
-    """Which body samples the fit compares: those within the foundation record, `EDGE_S` off
-    each end (a mask over body.t)."""
-    return (body.t > foundation.t[0] + EDGE_S) & (body.t < foundation.t[-1] - EDGE_S)
-
-
-def overlap_problem(
-    foundation: Signal,
-    body: Signal,
-    named: tuple[str, str] = ("the body record", "the foundation's"),
-) -> str:
-    """Why the fit cannot compare the pair ('' where it can): fewer than `MIN_OVERLAP` body
-    samples within the foundation record, `EDGE_S` off each end (records apart on the clock, or
-    too short: said which). `named`: how the body record
-    and the foundation's (possessive) are said (the command names their files)."""
-    overlap = int(np.count_nonzero(_compared(foundation, body)))
-    if overlap >= MIN_OVERLAP:
-        return ""
-    if max(body.t[0], foundation.t[0]) < min(body.t[-1], foundation.t[-1]):  # too short
-        length = float(foundation.t[-1] - foundation.t[0])
-        why = (
-            f"the foundation record is {length:.3g} s long: give records longer than "
-            f"{2.0 * EDGE_S:g} s (its first and last {EDGE_S:g} s are not compared), with at "
-            f"least {MIN_OVERLAP} body samples between"
-        )
-    else:
-        why = "the two records must overlap on one clock"
-    return (
-        f"{named[0]} ({body.t[0]:.6g} to {body.t[-1]:.6g} s) has {overlap} samples within "
-        f"{named[1]} ({foundation.t[0]:.6g} to {foundation.t[-1]:.6g} s, {EDGE_S:g} s off each "
-        f"end), fewer than {MIN_OVERLAP}: {why}"
-    )
-
-
-def _dynamic_rms(accel: np.ndarray) -> float:
-    """The RMS of (k, 3) specific force about its mean, all axes, m/s² (0 for no sample)."""
-    if not accel.shape[0]:
-        return 0.0
-    return float(np.sqrt(((accel - accel.mean(axis=0)) ** 2).sum(axis=1).mean()))
-
-
-@dataclass(frozen=True)
-class Still:
-    """A record of a pair that does not move (`still_record`): which ("foundation" or
-    "body"), and why, with the measure and the threshold."""
-
-    record: str
-    why: str
-
-
-def still_record(foundation: Signal, body: Signal) -> Still | None:
-    """Which record of the pair shows no motion to fit the twin by, and why; None where both
-    move (or too few body samples overlap the foundation's to say: the fit tells that itself).
-    Over the compared span (`_compared`), each record's dynamic RMS (`_dynamic_rms`, m/s²):
-    the foundation's at most `STILL_FOUNDATION`, then the body's at most `STILL_SHARE` of the
-    foundation's (a body is judged against its foundation's motion: the foundation first)."""
-    keep = _compared(foundation, body)
-    if np.count_nonzero(keep) < MIN_OVERLAP:
-        return None
-    t = body.t[keep]
-    during = (foundation.t >= t[0]) & (foundation.t <= t[-1])
-    moved, shaken = _dynamic_rms(body.accel[keep]), _dynamic_rms(foundation.accel[during])
-    if shaken <= STILL_FOUNDATION:
-        record, rms = "foundation", shaken
-        said = (
-            f"at most {STILL_FOUNDATION:g} m/s²: its sensor's noise, a still deck (the wrong "
-            "topic, or a record taken in harbour): nothing moves the mounts to fit them by"
-        )
-    elif moved <= STILL_SHARE * shaken:
-        record, rms = "body", moved
-        said = (
-            f"{moved / shaken:.2g} of the foundation's ({shaken:.3g} m/s²), at most "
-            f"{STILL_SHARE:g}: a dead or disconnected sensor, or not this machine's record"
-        )
-    else:
-        return None
-    why = (
-        f"the {record} record does not move: its specific force varies by {rms:.3g} m/s² RMS "
-        f"about its mean from {t[0]:.6g} to {t[-1]:.6g} s, {said}"
-    )
-    return Still(record, why)
-
-
 def prediction_error(
     scene: Scene,
     records: tuple[Signal, Signal],
@@ -343,7 +166,7 @@ class _Problem:
         self.scene, self.foundation, self.free = scene, foundation, free
         if problem := overlap_problem(foundation, body):
             raise ValueError(problem)
-        keep = _compared(foundation, body)
+        keep = compared(foundation, body)
         self.t, self.measured = body.t[keep], body.accel[keep]
         self.scale = self.measured.std(axis=0) + 1e-12
 

@@ -24,10 +24,10 @@ EXIT_STATUS = "exit status: 0 calibrated; 2 bad input (a refused parameter is sa
 
 
 FITTED = ("stiffness", "damping", "yaw", "lag")
-"""`analysis.calibration.PARAMETERS` (a test holds them equal: numpy is not imported to build
-the command line)."""
+"""`analysis.calibration_parameters.PARAMETERS` (a test holds them equal: numpy is not imported
+to build the command line)."""
 ON_REQUEST = ("roll", "pitch", "sensor_x", "sensor_y", "sensor_z", "mass", "cg_x", "cg_y", "cg_z")
-"""`analysis.calibration.ON_REQUEST` (held equal likewise)."""
+"""`analysis.calibration_parameters.ON_REQUEST` (held equal likewise)."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -102,10 +102,10 @@ def _read_record(
 def read_pair(args: argparse.Namespace) -> tuple[Scene, Signal, Signal]:
     """The scene (it must have a body_sensor) and its (foundation, body) records, on one
     clock, from `args.scene`, `args.foundation` and `args.body`; a record that does not move
-    (`calibration.still_record`: a still foundation, a body still beside its foundation's
+    (`calibration_records.still_record`: a still foundation, a body still beside its foundation's
     motion) is refused, naming its file (and a bag's topic), as a pair that does not overlap
-    on one clock is (`calibration.overlap_problem`), naming both."""
-    from mount_twin.analysis.calibration import overlap_problem, still_record
+    on one clock is (`calibration_records.overlap_problem`), naming both."""
+    from mount_twin.analysis.calibration_records import overlap_problem, still_record
     from mount_twin.commands.common import load_scene
     from mount_twin.io.messages import IMU
 
@@ -160,7 +160,7 @@ def describe(cal: Calibration) -> list[str]:
     """Each parameter with its 1σ or why it is refused, and the residual before and after;
     every figure in its unit (a scale factor as ×value, its 1σ a plain number): the 1σ had
     none ("lag: 18.89 ms ± 0.29 (1σ)")."""
-    from mount_twin.analysis.calibration import is_scale
+    from mount_twin.analysis.calibration_parameters import is_scale
 
     lines = []
     for name, value in cal.values.items():
@@ -181,7 +181,7 @@ def describe(cal: Calibration) -> list[str]:
 def _in_unit(name: str, value: float, spec: str) -> str:
     """Parameter `name`'s `value` (SI) formatted by `spec` in its unit: an angle in
     rad with degrees beside, a lag in ms, an offset in mm, or a scale factor ×1.23."""
-    from mount_twin.analysis.calibration import ANGLES, is_scale
+    from mount_twin.analysis.calibration_parameters import ANGLES, is_scale
     from mount_twin.physics.rotations import angle_text
 
     if name in ANGLES:
