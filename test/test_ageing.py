@@ -34,7 +34,8 @@ from mount_twin.io.messages import IMU
 from mount_twin.io.signals import Signal, ship_motion
 from mount_twin.replay import replay
 from mount_twin.scene.description import Scene
-from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
+from mount_twin.scene.loader import scene_from_dict
+from mount_twin.scene.yaml_reading import read_scene_yaml
 from mount_twin.stream import TwinStream
 
 RATE, TOTAL, CHANGE = 200.0, 92.5, 45.0

@@ -39,7 +39,8 @@ from mount_twin.io.output_encoding import Encoded, imu_messages
 from mount_twin.io.output_topics import BODY_PREDICTED_TOPIC, BODY_RESIDUAL_TOPIC
 from mount_twin.io.signals import Signal, ship_motion
 from mount_twin.scene.description import BodySensor, Scene
-from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
+from mount_twin.scene.loader import scene_from_dict
+from mount_twin.scene.yaml_reading import read_scene_yaml
 from mount_twin.stream import TwinStream
 
 RATE = 200.0

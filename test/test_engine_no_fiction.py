@@ -21,7 +21,8 @@ from mount_twin.model.assemble import assemble
 from mount_twin.replay import replay
 from mount_twin.scene import load_scene_file
 from mount_twin.scene.description import Scene
-from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
+from mount_twin.scene.loader import scene_from_dict
+from mount_twin.scene.yaml_reading import read_scene_yaml
 
 OMEGA0 = np.array([4.0, 0.3, 0.5])  # rad/s in B, about the axis of least inertia: tips over
 

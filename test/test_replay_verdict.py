@@ -21,7 +21,7 @@ from mount_twin.io.bag import write_bag
 from mount_twin.io.messages import IMU
 from mount_twin.io.output_encoding import imu_messages
 from mount_twin.io.output_tables import input_values, read_output_bag
-from mount_twin.scene.loader import read_scene_yaml
+from mount_twin.scene.yaml_reading import read_scene_yaml
 from mount_twin.sweeps.cases import check
 from mount_twin.sweeps.runner import FAILED, run_case, summary
 from mount_twin.sweeps.spec import load_sweep

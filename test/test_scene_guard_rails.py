@@ -26,9 +26,9 @@ from mount_twin.scene import (
     scene_from_dict,
     scene_from_params,
 )
-from mount_twin.scene.loader import read_scene_yaml, topic_name_problem
 from mount_twin.scene.params import as_params
-from mount_twin.scene.yaml_reading import load_yaml
+from mount_twin.scene.ros_names import topic_name_problem
+from mount_twin.scene.yaml_reading import load_yaml, read_scene_yaml
 
 PUMP = CONFIG / "pump_8_mounts.scene.yaml"
 CORNERS = [(0.5, 0.4), (-0.5, 0.4), (-0.5, -0.4), (0.5, -0.4)]

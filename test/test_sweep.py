@@ -15,7 +15,7 @@ from io_helpers import CONFIG, ROOT
 from mount_twin.analysis.figures import peak_text, utilisation_text
 from mount_twin.cli import main
 from mount_twin.errors import SceneError
-from mount_twin.scene.loader import read_scene_yaml
+from mount_twin.scene.yaml_reading import read_scene_yaml
 from mount_twin.sweeps.cases import apply, check
 from mount_twin.sweeps.cluster import dask_client
 from mount_twin.sweeps.plot import plot_sweep, trade_off

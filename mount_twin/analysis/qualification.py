@@ -30,8 +30,8 @@ from typing import Any
 
 from mount_twin.analysis.srs import damping_ratio
 from mount_twin.engine.health_texts import ratio_text
-from mount_twin.scene.loader import read_scene_yaml
 from mount_twin.scene.reader import Reader
+from mount_twin.scene.yaml_reading import read_scene_yaml
 
 AXES = ("x", "y", "z")
 FAIL_ON = ("error", "warn")

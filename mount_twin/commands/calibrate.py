@@ -195,7 +195,7 @@ def _write_scene(source: str, out: Path, cal: Calibration, lines: list[str]) -> 
     """The scene file with the calibrated values, and what was fitted as a comment on top."""
     import yaml
 
-    from mount_twin.scene.loader import read_scene_yaml
+    from mount_twin.scene.yaml_reading import read_scene_yaml
     from mount_twin.textfiles import write_text
 
     data = read_scene_yaml(source)

@@ -265,7 +265,7 @@ def write_signal(
     from mount_twin.io.bag import check_stamp, write_bag
     from mount_twin.io.messages import IMU
     from mount_twin.io.output_encoding import imu_messages
-    from mount_twin.scene.loader import header_frame_id_problem, topic_name_problem
+    from mount_twin.scene.ros_names import header_frame_id_problem, topic_name_problem
 
     if problem := topic_name_problem(topic):
         msg = f"--topic {topic!r}: not a ROS topic name: {problem}"

@@ -31,7 +31,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _namespace(text: str) -> str:
     """argparse type of a node namespace as `-r __ns:=` takes it: '/', or an absolute name
     a topic could have (rcl refuses `__ns:=pump1`, `__ns:=/pump1/`, `__ns:=/1pump`)."""
-    from mount_twin.scene.loader import topic_name_problem
+    from mount_twin.scene.ros_names import topic_name_problem
 
     if not text.startswith("/"):
         problem = "not absolute: `-r __ns:=` takes one starting with '/' (/pump1)"

@@ -11,7 +11,8 @@ from pathlib import Path
 
 from mount_twin.scene.checks import rated_at_start
 from mount_twin.scene.description import Scene, SceneOrigin
-from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
+from mount_twin.scene.loader import scene_from_dict
+from mount_twin.scene.yaml_reading import read_scene_yaml
 
 INPUT_OPTIONS = {"input.topic": "replay --topic", "input.frame_id": "replay --frame-id"}
 """The scene's input settings that --topic and --frame-id replace, and the option as a message

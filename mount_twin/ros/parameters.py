@@ -26,14 +26,13 @@ from rclpy.utilities import remove_ros_args
 from mount_twin.errors import MountTwinError, SceneError
 from mount_twin.ros.rclpy_private import given_parameters
 from mount_twin.scene.description import Scene
-from mount_twin.scene.loader import read_scene_yaml
 from mount_twin.scene.params import (
     PARAMETERS,
     effective_parameters,
     flatten,
     parameter_description,
 )
-from mount_twin.scene.yaml_reading import load_yaml
+from mount_twin.scene.yaml_reading import load_yaml, read_scene_yaml
 
 
 @dataclass(frozen=True)

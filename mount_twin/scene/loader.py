@@ -1,15 +1,16 @@
-"""Build a validated `Scene` from a nested mapping (a scene YAML file or ROS parameters)."""
+"""Build a validated `Scene` from a nested mapping (a scene YAML file or ROS parameters).
+
+A file's YAML is read in `scene.yaml_reading`; the ROS names a scene gives (mount names, topics,
+frame ids) are read by the rules of `scene.ros_names`.
+"""
 
 from __future__ import annotations
 
 import dataclasses
 import math
 import os
-import re
 from pathlib import Path
 from typing import Any
-
-import yaml
 
 from mount_twin.errors import SceneError
 from mount_twin.integrate.methods import AUTO, METHODS
@@ -37,8 +38,13 @@ from mount_twin.scene.description import (
     ageing_bands_problem,
 )
 from mount_twin.scene.reader import Reader, Used, shown
-from mount_twin.scene.yaml_reading import SceneYamlError, load_yaml
-from mount_twin.textfiles import MIB, FileTooLargeError, read_limited
+from mount_twin.scene.ros_names import (
+    NAME_TOKEN,
+    read_frame_id,
+    read_header_frame_id,
+    read_topic,
+)
+from mount_twin.scene.yaml_reading import read_scene_yaml
 
 INPUT_TYPES = ("sensor_msgs/msg/Imu", "geometry_msgs/msg/AccelStamped")
 START_TILT_MAX_RAD = 1.55
@@ -51,15 +57,7 @@ REACH_M = 1000.0
 """Largest |coordinate| of a position, m: a machine on a deck spans metres (mm, more likely)."""
 ANGLE_LIMIT_RAD = 2.0 * math.pi
 """Largest |angle| of an orientation or start pose, rad: beyond one turn it is degrees."""
-NAME_TOKEN = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,99}")
-"""A mount name: it becomes a token of topic names and a frame id (ASCII: str.isalnum() takes
-"x²", which rclpy refuses), at most 100 characters (its topic ~/mounts/<name>/wrench, with the
-node's namespace and name, must stay within TOPIC_MAX_CHARS)."""
-TOPIC_MAX_CHARS = 247
-"""Longest ROS 2 topic name (rmw: 255 less 8 reserved for the DDS prefix)."""
 STEPPERS = (AUTO, *METHODS)
-SCENE_MAX_BYTES = 16 * MIB
-"""Largest scene, parameter or sweep YAML file read (the bundled scenes are < 10 kB)."""
 
 
 def load_scene_file(path: str | Path) -> Scene:
@@ -67,40 +65,6 @@ def load_scene_file(path: str | Path) -> Scene:
     mistaken is in the Scene's `warnings`; its `origin` is the file's absolute path."""
     origin = SceneOrigin(os.path.abspath(path))
     return scene_from_dict(read_scene_yaml(path), str(path), refuse_unheld=True, origin=origin)
-
-
-def read_scene_yaml(path: str | Path) -> Any:
-    """The YAML document of a scene file, unvalidated; errors name the file."""
-    path = Path(path)
-    try:
-        return load_yaml(read_limited(path, SCENE_MAX_BYTES, "SCENE_MAX_BYTES"))
-    except FileTooLargeError as err:
-        raise SceneError(str(path), "", f"cannot read: {err}") from err
-    except OSError as err:
-        raise SceneError(str(path), "", f"cannot read: {err.strerror}") from err
-    except UnicodeDecodeError as err:
-        msg = f"not UTF-8 text: byte {err.start} is {err.object[err.start : err.start + 1]!r}"
-        raise SceneError(str(path), "", msg) from err
-    except SceneYamlError as err:
-        raise SceneError(str(path), "", str(err)) from err
-    except yaml.YAMLError as err:
-        raise SceneError(str(path), "", f"not valid YAML: {_yaml_problem(err)}") from err
-
-
-def _yaml_problem(err: yaml.YAMLError) -> str:
-    """PyYAML's error on one line, with 1-based positions in the file (its text spans five
-    lines, quoting the line with a caret, and names the file '<unicode string>'):
-    `line 3, column 1: expected ',' or ']', but got '<stream end>' (while parsing a flow
-    sequence from line 2, column 23)`."""
-    if not isinstance(err, yaml.MarkedYAMLError) or err.problem_mark is None:
-        return " ".join(str(err).split())
-    mark = err.problem_mark
-    text = f"line {mark.line + 1}, column {mark.column + 1}: {err.problem}"
-    if err.context:
-        where = err.context_mark
-        at = "" if where is None else f" from line {where.line + 1}, column {where.column + 1}"
-        text += f" ({err.context}{at})"
-    return text
 
 
 def scene_from_dict(
@@ -293,74 +257,12 @@ def _angles(r: Reader, key: str, default: Vec3 | None = None) -> Vec3:
     return a
 
 
-def _topic(r: Reader, key: str, default: str) -> str:
-    """A ROS 2 topic name as rclpy's validate_topic_name takes it (rcl_validate_topic_name),
-    that also expands to a valid full name (no '//', at most TOPIC_MAX_CHARS), without
-    substitutions: a {node} or {ns} would not match the topic of a recorded bag."""
-    name = r.string(key, default)
-    problem = topic_name_problem(name)
-    if problem:
-        raise r.error(key, f"{shown(name)} is not a ROS topic name: {problem}")
-    return name
-
-
-def topic_name_problem(name: str) -> str:
-    """What makes `name` an unusable topic name ('' if nothing): the rules of
-    rcl_validate_topic_name (alphanumerics, '_' and '/'; '~' only first and followed by '/';
-    no token starting with a digit; not empty, not ending with '/'), rmw's full-name rules that
-    apply to it (no '//', length), and no {substitution}."""
-    tokens = (name[2:] if name.startswith("~/") else name.removeprefix("/")).split("/")
-    rules = (
-        (not name, "it is empty"),
-        (len(name) > TOPIC_MAX_CHARS, f"longer than {TOPIC_MAX_CHARS} characters"),
-        (name.endswith("/"), "it ends with '/'"),
-        ("{" in name or "}" in name, "{substitutions} are not accepted in a scene"),
-        (
-            "~" in name[1:] or (name.startswith("~") and name[:2] != "~/"),
-            "'~' only as the '~/' that begins a private name",
-        ),
-        ("" in tokens, "it has an empty token ('//')"),
-        (
-            not all(re.fullmatch(r"[A-Za-z0-9_]*", t) for t in tokens),
-            "only ASCII letters, digits, '_' and '/' are allowed",
-        ),
-        (any(t[:1].isdigit() for t in tokens), "a token starts with a digit"),
-    )
-    return next((why for broken, why in rules if broken), "")
-
-
-def _frame_id(r: Reader, key: str, default: str, *, empty_ok: bool = False) -> str:
-    """A tf2 frame id the twin publishes: no whitespace, no leading '/' (empty only where
-    `empty_ok`: a mount frame prefix)."""
-    frame = r.string(key, default)
-    if (not frame and not empty_ok) or any(c.isspace() for c in frame) or frame.startswith("/"):
-        raise r.error(
-            key,
-            f"{shown(frame)} is not a tf2 frame id (non-empty, no whitespace, no leading '/')",
-        )
-    return frame
-
-
-def _header_frame_id(r: Reader, key: str, default: str) -> str:
-    """A frame id the input's header.frame_id is compared with, as its sensor writes it: no
-    whitespace; empty for any; a leading '/' is ROS 1's (a bag from there says '/imu')."""
-    frame = r.string(key, default)
-    if problem := header_frame_id_problem(frame):
-        raise r.error(key, f"{shown(frame)} {problem}")
-    return frame
-
-
-def header_frame_id_problem(frame: str) -> str:
-    """What makes `frame` no header.frame_id a sensor writes ('' if nothing)."""
-    return "is not a frame id (it has whitespace)" if any(c.isspace() for c in frame) else ""
-
-
 def _input(r: Reader) -> InputSpec:
     d = InputSpec()
     spec = InputSpec(
         msg_type=r.choice("msg_type", INPUT_TYPES, d.msg_type),
-        topic=_topic(r, "topic", d.topic),
-        frame_id=_header_frame_id(r, "frame_id", d.frame_id),
+        topic=read_topic(r, "topic", d.topic),
+        frame_id=read_header_frame_id(r, "frame_id", d.frame_id),
         sensor_rpy=_angles(r, "sensor_rpy", d.sensor_rpy),
         sensor_position=_position(r, "sensor_position", d.sensor_position),
         includes_gravity=r.boolean("includes_gravity", d.includes_gravity),
@@ -492,8 +394,8 @@ MAX_SENSOR_LAG_S = 1.0
 def _body_sensor(r: Reader) -> BodySensor:
     d = BodySensor()
     sensor = BodySensor(
-        topic=_topic(r, "topic", d.topic),
-        frame_id=_header_frame_id(r, "frame_id", d.frame_id),
+        topic=read_topic(r, "topic", d.topic),
+        frame_id=read_header_frame_id(r, "frame_id", d.frame_id),
         position=_position(r, "position", d.position),
         orientation_rpy=_angles(r, "orientation_rpy", d.orientation_rpy),
         lag_s=r.number("lag_s", d.lag_s, lo=-MAX_SENSOR_LAG_S, hi=MAX_SENSOR_LAG_S),
@@ -551,9 +453,9 @@ def _ageing(r: Reader, mounts: tuple[Mount, ...]) -> Ageing:
 def _frames(r: Reader) -> Frames:
     d = Frames()
     frames = Frames(
-        foundation=_frame_id(r, "foundation", d.foundation),
-        body=_frame_id(r, "body", d.body),
-        mount_prefix=_frame_id(r, "mount_prefix", d.mount_prefix, empty_ok=True),
+        foundation=read_frame_id(r, "foundation", d.foundation),
+        body=read_frame_id(r, "body", d.body),
+        mount_prefix=read_frame_id(r, "mount_prefix", d.mount_prefix, empty_ok=True),
     )
     r.finish()
     return frames

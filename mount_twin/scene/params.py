@@ -17,8 +17,9 @@ from mount_twin.errors import SceneError
 from mount_twin.integrate.methods import METHODS
 from mount_twin.kinds import KINDS
 from mount_twin.scene.description import Scene, SceneOrigin
-from mount_twin.scene.loader import load_scene_file, read_scene_yaml, scene_from_dict
+from mount_twin.scene.loader import load_scene_file, scene_from_dict
 from mount_twin.scene.reader import Used, shown
+from mount_twin.scene.yaml_reading import read_scene_yaml
 
 PARAMETERS: dict[str, tuple[str, str]] = {
     "scene_file": (

@@ -13,17 +13,23 @@
   mount file took 8 s only to be refused for its mount count), and an integer written with more
   than MAX_INT_CHARS characters is refused (Python refuses to convert one of 4300 digits, and no
   scene value needs 10³⁰).
+
+A scene file is read into its document by `read_scene_yaml` (at most SCENE_MAX_BYTES, UTF-8),
+every error a SceneError naming the file (PyYAML's on one line, with 1-based positions).
 """
 
 from __future__ import annotations
 
 import re
+from pathlib import Path
 from typing import Any
 
 import yaml
 from yaml.nodes import MappingNode, Node, ScalarNode
 
+from mount_twin.errors import SceneError
 from mount_twin.scene.reader import shown
+from mount_twin.textfiles import MIB, FileTooLargeError, read_limited
 
 MAX_DEPTH = 50
 """Deepest nesting of mappings and lists accepted (a scene needs 4)."""
@@ -115,3 +121,41 @@ def load_yaml(text: str) -> Any:
         msg = f"{len(text)} characters: a scene file has at most {MAX_CHARS}"
         raise SceneYamlError(msg)
     return yaml.load(text, Loader=SceneLoader)
+
+
+SCENE_MAX_BYTES = 16 * MIB
+"""Largest scene, parameter or sweep YAML file read (the bundled scenes are < 10 kB)."""
+
+
+def read_scene_yaml(path: str | Path) -> Any:
+    """The YAML document of a scene file, unvalidated; errors name the file."""
+    path = Path(path)
+    try:
+        return load_yaml(read_limited(path, SCENE_MAX_BYTES, "SCENE_MAX_BYTES"))
+    except FileTooLargeError as err:
+        raise SceneError(str(path), "", f"cannot read: {err}") from err
+    except OSError as err:
+        raise SceneError(str(path), "", f"cannot read: {err.strerror}") from err
+    except UnicodeDecodeError as err:
+        msg = f"not UTF-8 text: byte {err.start} is {err.object[err.start : err.start + 1]!r}"
+        raise SceneError(str(path), "", msg) from err
+    except SceneYamlError as err:
+        raise SceneError(str(path), "", str(err)) from err
+    except yaml.YAMLError as err:
+        raise SceneError(str(path), "", f"not valid YAML: {_yaml_problem(err)}") from err
+
+
+def _yaml_problem(err: yaml.YAMLError) -> str:
+    """PyYAML's error on one line, with 1-based positions in the file (its text spans five
+    lines, quoting the line with a caret, and names the file '<unicode string>'):
+    `line 3, column 1: expected ',' or ']', but got '<stream end>' (while parsing a flow
+    sequence from line 2, column 23)`."""
+    if not isinstance(err, yaml.MarkedYAMLError) or err.problem_mark is None:
+        return " ".join(str(err).split())
+    mark = err.problem_mark
+    text = f"line {mark.line + 1}, column {mark.column + 1}: {err.problem}"
+    if err.context:
+        where = err.context_mark
+        at = "" if where is None else f" from line {where.line + 1}, column {where.column + 1}"
+        text += f" ({err.context}{at})"
+    return text

@@ -28,8 +28,9 @@ from typing import Any
 
 import numpy as np
 
-from mount_twin.scene.loader import read_scene_yaml, scene_from_dict
+from mount_twin.scene.loader import scene_from_dict
 from mount_twin.scene.reader import Reader
+from mount_twin.scene.yaml_reading import read_scene_yaml
 
 GENERATE_KINDS = ("half-sine", "ship-motion")
 GENERATE_KEYS = ("kind", "peak", "pulse", "rebound", "lateral", "rate", "duration")
