@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from mount_twin.analysis.design_margin import TOLERANCE_DB
 from mount_twin.analysis.srs import damping_ratio
 from mount_twin.engine.health_texts import ratio_text
 from mount_twin.scene.reader import Reader
@@ -35,7 +36,6 @@ from mount_twin.scene.yaml_reading import read_scene_yaml
 
 AXES = ("x", "y", "z")
 FAIL_ON = ("error", "warn")
-TOLERANCE_DB = (-1.5, 3.0)
 
 
 @dataclass(frozen=True)
