@@ -835,7 +835,8 @@ def test_body_samples_dropped_waiting_after_the_last_judged_window_are_warned_of
     assert level == WARN and "nrms_fx" not in values, message
     assert message == (
         f"{dropped} body IMU samples held too long waiting for the twin were dropped "
-        "(counted dropped_waiting)"
+        f"(counted dropped_waiting); {limit} body IMU messages not compared after the last "
+        f"window judged: unanswered {limit}"
     )
     assert values["body_dropped_waiting"] == str(dropped)
     assert values["body_unanswered"] == str(limit)
@@ -881,3 +882,37 @@ def test_body_messages_never_read_without_any_input_are_said_at_the_nodes_clock(
     stamp, level, message, _ = said[0]
     assert (stamp, level) == (clock_ns, WARN)
     assert message.startswith("500 body IMU messages"), message
+
+
+def test_body_messages_not_compared_in_a_last_window_too_short_to_judge_are_warned_of() -> None:
+    """The deck stops at 12 s (windows of 5 s: 10–12 s too short to judge) and is silent
+    10.5–11.2 s (a gap past input.max_gap_s 0.5 s); the body IMU at the deck's 200 Hz stamps
+    has 3 garbage messages among the gap's and 2 unset stamps after its last. The 140 samples
+    strictly inside the gap (10.500 … 10.995, 11.000 … 11.195 s) are in_gap, the 5 rejected;
+    all were said by no window, only in the run's counts. Now a WARN at the end says them, the
+    same bytes in every feeding order."""
+    scene, deck = _pump(), _deck(12.0)
+    _, whole = _whole_record(scene, deck)
+    ns = _stamps(deck)
+    silent = (deck.t >= 10.5) & (deck.t < 11.2)
+    deck_raws = [r for r, s in zip(_deck_raws(scene, deck), silent, strict=True) if not s]
+    body = _body_raws(ns, whole)
+    body_ns = ns.copy()
+    body[2150:2150] = [b"\x00\x01garbage"] * 3  # among the gap's samples (10.75 s)
+    body_ns = np.insert(body_ns, 2150, [ns[2150]] * 3)
+    body += _body_raws(np.zeros(2, np.int64), whole[:2])
+    body_ns = np.concatenate([body_ns, [ns[-1]] * 2])
+    runs, streams = _fed_five_ways(scene, deck_raws, ns[~silent], body, body_ns)
+    for stream in streams:
+        assert stream.body is not None
+        assert stream.body.counts["in_gap"] == 140
+    *judged, (stamp, level, message, values) = statuses_named(
+        [raw for topic, _, raw in runs[0] if topic == DIAGNOSTICS_TOPIC], NAME
+    )
+    assert len(judged) == 2 and all(v["body_in_gap"] == "0" for *_, v in judged), judged
+    assert stamp == int(ns[-1])  # the latest body stamp
+    assert level == WARN and "nrms_fx" not in values, message
+    assert message == (
+        "145 body IMU messages not compared after the last window judged: "
+        "rejected_undecodable 3, rejected_nonpositive_stamp 2, in_gap 140"
+    )

@@ -44,7 +44,14 @@ from itertools import pairwise
 
 import numpy as np
 
-from mount_twin.engine.agreement import FIELDS, MIN_SAMPLES, NAME, agreement, window_status
+from mount_twin.engine.agreement import (
+    FIELDS,
+    MIN_SAMPLES,
+    NAME,
+    OUTSIDE_THE_RUN,
+    agreement,
+    window_status,
+)
 from mount_twin.engine.batch import WARN, HealthStatus
 from mount_twin.engine.intake import provided, rising_or_back
 from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
@@ -92,6 +99,8 @@ predictions, inside a gap of the twin's rows, after its last row, held too long,
 body IMU's and the deck's stamps jumped back apart (`Apart`); and why a body message was
 never received: lost by the middleware, or waiting unprocessed in the node's queue when it
 was stopped a second time (STOPPED, `ros.node`)."""
+NOT_COMPARED = (*(f"rejected_{r}" for r in REJECTED), *PROBLEMS)
+"""Every reason a body message was not compared, in the order a window's status says them."""
 WARNED_AT_END = {
     "dropped_waiting": "{} body IMU samples held too long waiting for the twin were dropped "
     "(counted {})",
@@ -629,11 +638,13 @@ class _Windows:
         """The last, partial window's report, if it spans half a window (with the rejected
         messages after its last sample); if no window was judged over the run although body
         messages came (`counts`), a WARN saying why, stamped `stamp_ns`: silence would read
-        as a check passed. Where samples lost (WARNED_AT_END: held too long, lost by the
-        middleware, left unprocessed at a second stop) are not in a window reported, a WARN
-        saying how many."""
-        if self._window is not None:
-            self._attribute(np.iinfo(np.int64).max, self._window.problems)
+        as a check passed. Where body messages not compared are in no window reported (the
+        last too short to judge; WARNED_AT_END: never at a place in the stream), a WARN
+        saying them, as a window judged would: only those `OUTSIDE_THE_RUN` (unanswered at
+        the end, the recorders never stop together) make none, said only in its message where
+        one goes out for the others."""
+        last = np.iinfo(np.int64).max
+        self._attribute(last, self._carried if self._window is None else self._window.problems)
         reports = self._close(CUT_BY_END)
         values = {f"body_{k}": str(v) for k, v in counts.items()}
         if not (reports or self._judged or not counts["received"]):
@@ -645,10 +656,19 @@ class _Windows:
                 + (f"; not compared: {missed}" if missed else "")
             )
             return [(stamp_ns, HealthStatus(NAME, WARN, message, values))]
-        unsaid = {k: counts[k] - self._loose_reported[k] for k in WARNED_AT_END}
-        if any(unsaid.values()):
-            message = "; ".join(WARNED_AT_END[k].format(n, k) for k, n in unsaid.items() if n)
-            reports.append((stamp_ns, HealthStatus(NAME, WARN, message, values)))
+        unsaid = self._carried + Counter(
+            {k: counts[k] - self._loose_reported[k] for k in LOOSE}
+        )  # (Counter's + keeps the counts above 0)
+        if not set(unsaid) - OUTSIDE_THE_RUN:
+            return reports
+        said = [WARNED_AT_END[k].format(unsaid.pop(k), k) for k in WARNED_AT_END if k in unsaid]
+        if unsaid:
+            placed = ", ".join(f"{k} {unsaid[k]}" for k in NOT_COMPARED if k in unsaid)
+            n = unsaid.total()
+            said.append(
+                f"{n} body IMU messages not compared after the last window judged: {placed}"
+            )
+        reports.append((stamp_ns, HealthStatus(NAME, WARN, "; ".join(said), values)))
         return reports
 
     def _close(self, cut: str = "") -> list[tuple[int, HealthStatus]]:
@@ -670,8 +690,7 @@ class _Windows:
         for key in LOOSE:
             window.problems[key] += self._totals[key] - self._loose_reported[key]
             self._loose_reported[key] = self._totals[key]
-        keys = (*(f"rejected_{r}" for r in REJECTED), *PROBLEMS)
-        problems = {key: window.problems[key] for key in keys}
+        problems = {key: window.problems[key] for key in NOT_COMPARED}
         figures = agreement(t, measured, residual, self._sensor, present)
         span = (float(t[-1] - t[0]), int(t.shape[0]))
         status = window_status(figures, self._sensor, span, problems)
@@ -766,8 +785,10 @@ class BodyCheck:
 
     def __init__(self, scene: Scene, sensor: BodySensor) -> None:
         self.sensor = sensor
-        self.counts: Counter[str] = Counter({f"rejected_{r}": 0 for r in REJECTED})
-        self.counts.update(dict.fromkeys((*UNPROVIDED, RESETS), 0))
+        compared = ("received", "accepted", "compared", *(f"compared_{f}" for f in FIELDS))
+        self.counts: Counter[str] = Counter(
+            dict.fromkeys((*compared, *NOT_COMPARED, *UNPROVIDED, RESETS), 0)
+        )  # every key from the start: the order (of a WARN's values) never that of the feeding
         self._back_ns = round(scene.input.back_jump_reset_s * 1e9)
         self.last_ns = 0
         """The last accepted body stamp, ns (0: none yet)."""
