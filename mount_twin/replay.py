@@ -505,16 +505,17 @@ def replay(
 ) -> ReplaySummary:
     """Replay `input_path`'s scene.input.topic into a new mcap bag at `output_path`.
 
-    The output holds what the node publishes: the scene's outputs (`output_types`), and the mount
-    frames on /tf_static and the scene on ~/scene (`io.scene_record`) once, before anything else,
-    stamped with the first output's stamp (that of the first input sample the stream took: never
-    an unset or pre-1970 one) and offered latched (`LATCHED_QOS`) so `ros2 bag play` republishes
-    them to late subscribers; its metadata records the scene too (`scene_metadata`: its source,
-    file, overrides and digest), which `report --scene` checks its scene against. Both bags are
-    checked before the twin is built. `checkpoint` is called once it is built and between
-    chunks (the input's and the body IMU's), where stopping is safe: it may raise to stop the
-    replay (a signal noted by the command line); once the output bag exists, it is then
-    finished and marked partial.
+    The output holds what the node publishes: the scene's outputs (`output_types`), and the
+    mount frames on /tf_static and the scene on ~/scene (`io.scene_record`) once, before
+    anything else, stamped with the first output's stamp (that of the first input sample the
+    stream took: never an unset or pre-1970 one; none taken, the end's, the input's last log
+    time) and offered latched (`LATCHED_QOS`) so `ros2 bag play` republishes them to late
+    subscribers; its metadata records the scene too (`scene_metadata`: its source, file,
+    overrides and digest), which `report --scene` checks its scene against. Both bags are
+    checked before the twin is built. `checkpoint` is called once it is built and between chunks
+    (the input's and the body IMU's), where stopping is safe: it may raise to stop the replay (a
+    signal noted by the command line); once the output bag exists, it is then finished and
+    marked partial.
 
     With a body_sensor, its IMU (body_sensor.topic of `body_path`, else of the input bag if it
     has it) is compared with the twin as the node compares it live (`TwinStream.process_body`):
@@ -565,7 +566,7 @@ def replay(
             outputs: list[Encoded]
             if raws is None:  # the body IMU's rest, then the end
                 outputs = [m for b in body_chunks for m in stream.process_body(b)]
-                outputs += stream.finish()
+                outputs += stream.finish(bag.last_log_ns)  # where no input stamp came
             else:
                 outputs = stream.process(raws)
                 while stream.body_behind and (body := next(body_chunks, None)) is not None:

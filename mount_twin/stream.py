@@ -366,8 +366,9 @@ class TwinStream:
     def finish(self, clock_ns: int = 0) -> list[Encoded]:
         """The end of the stream (end of a bag, node shutdown): the outputs the gyro delay
         still holds, then the last, partial diagnostics period, stamped `_end_ns(clock_ns)`
-        (`clock_ns`: the node's clock now, ns; a replay has no clock and passes none: a bag
-        without one input stamp still ends at 0); no report if that period is empty. The
+        (`clock_ns`, ns: the node's clock now; a replay's, the input bag's log time of its
+        last input message, `InputBag.last_log_ns`: the recorder's clock when the input
+        ended); no report if that period is empty. The
         ageing tracker's end (the samples it could not pair, `AgeingTracker.finish`) comes
         with `take_ageing_jobs`. The body comparison's reports of the end that have no body
         stamp to take (every body message lost) take that stamp too."""
@@ -393,8 +394,9 @@ class TwinStream:
     def _end_ns(self, clock_ns: int) -> int:
         """The stamp (ns) of the reports at the end of the stream: the last input stamp
         answered (none answered: the last received; none with a stamp: `clock_ns`, the node's
-        clock, as its stall reports are stamped, where 0 had taken /diagnostics back to
-        1970), or the last stall report's if later (/diagnostics never goes back)."""
+        clock, as its stall reports are stamped, or a replay's bag's, where 0 had taken
+        /diagnostics back to 1970), or the last stall report's if later (/diagnostics never
+        goes back)."""
         return max(self._last_ns or self._received_ns or clock_ns, self._stalled_ns)
 
 

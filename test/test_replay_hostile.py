@@ -112,6 +112,33 @@ def test_negative_and_zero_stamps_are_rejected_and_counted_and_never_reach_the_o
     assert _partial(out) == ""
 
 
+def test_a_replay_whose_every_input_message_is_unusable_ends_at_the_inputs_last_log_time(
+    ship: dict[str, Path], tmp_path: Path
+) -> None:
+    """Garbage, then a message stamped 0 and one before 1970, logged at 1.000, 1.250 and
+    1.500 s past 1 700 000 000 s: no input stamp to take, and a replay has no clock, so its
+    last report (input ERROR: none accepted) and /tf_static went out stamped 0 (1970). Now
+    they take the input's last log time, 1 700 000 001.5 s, as the node takes its clock."""
+    good = read_raw(ship["mcap"], ["/deck/imu"])["/deck/imu"][0][1]
+    unusable = [b"\x00\x01garbage"]
+    for sec in (0, -5):
+        m: Any = TYPESTORE.deserialize_cdr(good, IMU)
+        m.header.stamp.sec, m.header.stamp.nanosec = sec, 0
+        unusable.append(bytes(TYPESTORE.serialize_cdr(m, IMU)))
+    log0 = 1_700_000_001_000_000_000
+    times = [log0, log0 + 250_000_000, log0 + 500_000_000]
+    bag = tmp_path / "unusable"
+    write_bag(bag, "/deck/imu", IMU, iter(zip(times, unusable, strict=True)))
+    out = tmp_path / "out"
+    assert _replay(bag, out) == 3  # nothing accepted
+    _, got = read_bag(out)
+    last = 1_700_000_001_500_000_000
+    ((static_time, static),) = got["/tf_static"]
+    assert static_time == stamp_ns(static.transforms[0]) == last
+    reports = got["/diagnostics"]
+    assert reports and all(t == stamp_ns(m) == last for t, m in reports), reports
+
+
 def test_an_output_bag_refuses_a_stamp_before_1970_naming_it_and_stays_readable(
     tmp_path: Path,
 ) -> None:

@@ -80,6 +80,9 @@ class InputBag:
         self.topic = topic
         self.msgtype = msgtype
         self._salvage: Salvage | None = None
+        self.last_log_ns = 0
+        """The log time (ns, the recorder's clock) of the topic's last message read (0: none
+        yet): at the end of the chunks, when the input ended."""
         try:
             self._reader = _open_reader(reader_paths(self.path))
         except Exception as err:
@@ -167,6 +170,7 @@ class InputBag:
                 held + nbytes(raws),
                 count + len(raws),
             )
+            self.last_log_ns = last
             if count >= size or held >= CHUNK_MAX_BYTES:
                 left = yield from _pieces(joined(parts), size)
                 parts, held, count = [left] if len(left) else [], nbytes(left), len(left)
@@ -206,6 +210,7 @@ class InputBag:
         damage (`before`: messages of the topic read before them)."""
         raws = [raw for _, raw in salvaged.messages]
         for k in range(0, len(raws), size):
+            self.last_log_ns = salvaged.messages[min(k + size, len(raws)) - 1][0]
             yield raws[k : k + size]
         if salvaged.damage:
             msg = (
