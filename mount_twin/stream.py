@@ -303,10 +303,25 @@ class TwinStream:
             if reason[start]:
                 self.body.reject(reason[start], stop - start)
             elif self.base is None:  # no foundation sample yet: the time base waits for it
-                self._body_waiting.append(decoded.select(_within(decoded, start, stop)))
+                self._hold_body(decoded.select(_within(decoded, start, stop)))
             else:
                 out += self._body_in(decoded.select(_within(decoded, start, stop)))
         return out
+
+    def _hold_body(self, decoded: Decoded) -> None:
+        """Accepted body samples held until the first foundation sample sets the time base:
+        at most `body_check.PENDING_LIMIT`, the oldest dropped (`BodyCheck.over_limit`)."""
+        assert self.body is not None
+        self._body_waiting.append(decoded)
+        cut = self.body.over_limit(sum(d.stamps_ns.shape[0] for d in self._body_waiting))
+        while cut:
+            n = self._body_waiting[0].stamps_ns.shape[0]
+            if n <= cut:
+                self._body_waiting.pop(0)
+                cut -= n
+            else:
+                self._body_waiting[0] = self._body_waiting[0].select(np.arange(n) >= cut)
+                cut = 0
 
     def _body_in(self, decoded: Decoded) -> list[tuple[str, int, bytes]]:
         """Accepted body samples into the comparison, on the twin's time base (a reading

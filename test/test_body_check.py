@@ -916,3 +916,31 @@ def test_body_messages_not_compared_in_a_last_window_too_short_to_judge_are_warn
         "145 body IMU messages not compared after the last window judged: "
         "rejected_undecodable 3, rejected_nonpositive_stamp 2, in_gap 140"
     )
+
+
+def test_a_body_stream_fed_far_ahead_of_the_deck_drops_its_oldest_counted_and_said(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """12 s of body IMU at 200 Hz (2400 samples) fed whole before any deck message, the
+    samples held waiting for the twin limited to PENDING_LIMIT (here 1000): held for the deck's
+    first message (the time base) they were not limited at all (a body IMU live with the deck's
+    dead grew without bound) nor counted until it came. Now the oldest 1400 (0–6.995 s) are
+    dropped and counted at once; with the deck after, the 1000 kept (7–11.995 s) are compared
+    in one window (5 s from 7 s, cut by the end at 4.995 s: judged), a WARN saying the 1400;
+    with no deck at all, the end's WARN says them beside the 1000 unanswered."""
+    monkeypatch.setattr(body_check, "PENDING_LIMIT", 1000)
+    scene, deck = _pump(), _deck(12.0)
+    _, whole = _whole_record(scene, deck)
+    body = _body_raws(_stamps(deck), whole)
+    ahead, alone = TwinStream(scene), TwinStream(scene)
+    out = ahead.process_body(body)
+    assert ahead.body is not None and ahead.body.counts["dropped_waiting"] == 1400
+    out += ahead.process(_deck_raws(scene, deck)) + ahead.finish()
+    assert (ahead.body.counts["compared"], ahead.body.counts["dropped_waiting"]) == (1000, 1400)
+    ((level, message, values),) = _windows(out)
+    assert level == WARN and "nrms_fx" in values and values["samples"] == "1000", message
+    assert values["span_s"] == "4.995" and values["body_dropped_waiting"] == "1400"
+    assert "body messages not compared: dropped_waiting 1400" in message
+    ((level, message, values),) = _windows(alone.process_body(body) + alone.finish())
+    assert level == WARN and message.startswith("no window of the body IMU was judged"), message
+    assert "dropped_waiting 1400" in message and "unanswered 1000" in message

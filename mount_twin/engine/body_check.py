@@ -63,7 +63,10 @@ RETAIN_S = 60.0
 come (once body samples flow, only from the last one compared on): a body stream that trails
 the foundation's by more loses those samples (counted `late`)."""
 PENDING_LIMIT = 100_000
-"""Most body samples held waiting for the twin (a twin that stopped): the oldest go first."""
+"""Most accepted body samples held waiting for the twin (its predictions; before the deck's
+first message, its time base, `TwinStream`): a twin that stopped, a body stream fed far ahead
+of the deck's. The oldest by arrival go first, counted `dropped_waiting`: which ones then
+depends on how the two streams come (a replay feeds the body stream up to the deck's stamps)."""
 REJECTED = (
     "undecodable",
     "nonpositive_stamp",
@@ -876,6 +879,15 @@ class BodyCheck:
         if reason not in REJECTED:
             raise ValueError(f"body messages rejected for {reason!r}, not one of {REJECTED}")
         self.counts[f"rejected_{reason}"] += n
+
+    def over_limit(self, held: int) -> int:
+        """How many of `held` accepted body samples, held before the twin has a time base (no
+        deck message yet: `TwinStream`), are past PENDING_LIMIT: the oldest, dropped and
+        counted `dropped_waiting`, as those waiting for its predictions are (`_Matcher`)."""
+        cut = max(held - PENDING_LIMIT, 0)
+        self.counts["dropped_waiting"] += cut
+        self._matcher.taken += cut  # (their places in the body stream: before any it holds)
+        return cut
 
     def add_rows(
         self, t: np.ndarray, pose: np.ndarray, wrenches: np.ndarray, rate: np.ndarray
