@@ -156,6 +156,47 @@ def test_the_live_body_imu_comparison_equals_the_replays(tmp_path: Path, loops: 
     assert by_loop(_statuses(peer.got["/diagnostics"])) == by_loop(windows)
 
 
+def test_the_node_warns_of_body_messages_no_window_said_as_the_replay_does(
+    tmp_path: Path,
+) -> None:
+    """2.4 s of deck and body IMU at 500 Hz (windows of 1 s from the first body sample at
+    0.001 s: the last, 2.001–2.397 s, too short to judge), then 3 undecodable body messages:
+    those and the body sample 1 ms after the deck's last (past the twin's last row:
+    unanswered) were said by no window. The WARN at the end says them, live over DDS the same
+    status as the replay's of a bag of the same messages."""
+    scene_path = _scene_file(tmp_path)
+    scene = load_scene_file(scene_path)
+    inputs = _inputs()[: 2 * 1200] + [(BODY_TOPIC, STAMP0 + 2_400_000_000, b"\x00\x01garbage")] * 3
+    with OutputBag(tmp_path / "in", {"/deck/imu": IMU, BODY_TOPIC: IMU}) as bag:
+        bag.write([(t, STAMP0 + k, r) for k, (t, _, r) in enumerate(inputs)])  # log times rise
+    replay(scene, tmp_path / "in", tmp_path / "out", progress=False)
+    want = _statuses([raw for _, raw in read_raw(tmp_path / "out")["/diagnostics"]])
+    assert len(want) == 3, want
+    stamp, level, message, values = want[-1]
+    assert (stamp, level) == (inputs[-4][1], WARN)  # the latest body stamp
+    assert message == (
+        "4 body IMU messages not compared after the last window judged: "
+        "rejected_undecodable 3, unanswered 1"
+    )
+    assert (values["body_rejected_undecodable"], values["body_unanswered"]) == ("3", "1")
+    domain = fresh_domain()
+    peer = Peer(domain)
+    peer.record({"/diagnostics": DIAGNOSTICS})
+    reliable_body = ["-p", f"qos_overrides.{BODY_TOPIC}.subscription.reliability:=reliable"]
+    args = ["-p", f"scene_file:={scene_path}", "-p", "stall_period_s:=3600.0"]
+    node = NodeProcess(domain, [*args, *LOSSLESS, *reliable_body])
+    try:
+        _send_when_connected(node, peer, inputs, acked=True)  # the garbage too, by the stop
+        code = stop_and_take(
+            node, peer, lambda: len(_statuses(peer.got["/diagnostics"])) >= len(want)
+        )
+    finally:
+        node.stop()
+        peer.close()
+    assert code == 0, node.stderr
+    assert _statuses(peer.got["/diagnostics"]) == want
+
+
 def test_the_node_tracks_mounts_that_age_as_the_replay_does(tmp_path: Path) -> None:
     """With an `ageing` section, the node re-fits the mounts window by window in a worker
     process while it keeps following: on a machine whose mounts lose 30 % of their stiffness
