@@ -539,9 +539,10 @@ LOOSE = ("unanswered", *WARNED_AT_END)
 """Not compared for the stream's sake, not at a place in it (left at its end, held too long,
 lost by the middleware, never processed at a second stop; the node counts the last two as it
 learns of them): reported in the window judged next (unanswered at the end of a run the twin
-restarted after: at its place; the others, WARNED_AT_END, that no window reports: in a WARN
-of their own, `_Windows.finish`; unanswered at the end of the stream, said, not warned of:
-in the last window where it is judged, else in the run's counts alone)."""
+restarted after: at its place; the others, WARNED_AT_END, that no window reports: in the
+WARN at the end, `_Windows.finish`; unanswered at the end of the stream, said, not warned of:
+in the last window where it is judged, else in that WARN where one goes out, else in the
+run's counts alone)."""
 
 
 class _Windows:
