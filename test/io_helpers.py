@@ -348,3 +348,33 @@ def unprovided_imu(raws: list[bytes], field: str) -> list[bytes]:
         )
         out.append(bytes(TYPESTORE.serialize_cdr(msg, "sensor_msgs/msg/Imu")))
     return out
+
+
+def without_scene_topic(bag: Path, out: Path, custom: dict[str, str]) -> Path:
+    """`bag` rewritten at `out` without its ~/scene topic, its metadata's custom_data
+    `custom`: a replay's bag with the topic filtered out by its user (`custom`: the replay's
+    own), as a mount_twin wrote it before it wrote the scene's topic and keys (`custom`: the
+    one text naming the file, and the digest), or a recording of the node's topics by one
+    that did not publish its scene (`custom` empty)."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    with (
+        AnyReader([bag], default_typestore=TYPESTORE) as reader,
+        Writer(out, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP) as writer,
+    ):
+        kept = [c for c in reader.connections if c.topic != "/mount_twin/scene"]
+        assert len(kept) == len(reader.connections) - 1
+        conns = {
+            c.id: writer.add_connection(
+                c.topic,
+                c.msgtype,
+                typestore=TYPESTORE,
+                offered_qos_profiles=c.ext.offered_qos_profiles,
+            )
+            for c in kept
+        }
+        for conn, t, raw in reader.messages(connections=kept):
+            writer.write(conns[conn.id], t, raw)
+        for key, value in custom.items():
+            writer.set_custom_data(key, value)
+    return out

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from io_helpers import CONFIG, ROOT, read_bag, read_raw, unprovided_imu
+from io_helpers import CONFIG, ROOT, read_bag, read_raw, unprovided_imu, without_scene_topic
 
 from mount_twin.cli import main
 from mount_twin.io.output_tables import Table, events_of, input_values, read_output_bag
@@ -916,45 +916,13 @@ def test_a_scene_with_the_runs_mounts_and_another_value_is_refused_naming_both(
     assert f"NOT the run's, drawn with on request (--other-scene): {other}: scene" in text
 
 
-def _without_scene_topic(bag: Path, out: Path, custom: dict[str, str]) -> Path:
-    """`bag` rewritten at `out` without its ~/scene topic, its metadata's custom_data
-    `custom`: a replay's bag as a mount_twin wrote it before it wrote the scene's topic and
-    keys (`custom`: the one text naming the file, and the digest), or a recording of the
-    node's topics by one that did not publish its scene (`custom` empty)."""
-    from rosbags.highlevel import AnyReader
-    from rosbags.rosbag2 import StoragePlugin, Writer
-
-    from mount_twin.io.messages import TYPESTORE
-
-    with (
-        AnyReader([bag], default_typestore=TYPESTORE) as reader,
-        Writer(out, version=Writer.VERSION_LATEST, storage_plugin=StoragePlugin.MCAP) as writer,
-    ):
-        kept = [c for c in reader.connections if c.topic != "/mount_twin/scene"]
-        assert len(kept) == len(reader.connections) - 1
-        conns = {
-            c.id: writer.add_connection(
-                c.topic,
-                c.msgtype,
-                typestore=TYPESTORE,
-                offered_qos_profiles=c.ext.offered_qos_profiles,
-            )
-            for c in kept
-        }
-        for conn, t, raw in reader.messages(connections=kept):
-            writer.write(conns[conn.id], t, raw)
-        for key, value in custom.items():
-            writer.set_custom_data(key, value)
-    return out
-
-
 def _old_bag(pump_run: Path, out: Path, scene: str) -> Path:
     """The pump's run as a replay wrote it before the scene's topic and separate keys: its
     metadata naming `scene` as the one text (file and overrides) it was replayed with."""
     from mount_twin.io.bag import SCENE_DIGEST_KEY, SCENE_KEY, custom_data
 
     digest = custom_data(pump_run)[SCENE_DIGEST_KEY]
-    return _without_scene_topic(pump_run, out, {SCENE_KEY: scene, SCENE_DIGEST_KEY: digest})
+    return without_scene_topic(pump_run, out, {SCENE_KEY: scene, SCENE_DIGEST_KEY: digest})
 
 
 STIFFER_DIFFERS = (
@@ -1050,6 +1018,32 @@ def test_a_refused_scene_names_its_differences_from_the_bags_scene_with_the_file
     assert f"{STIFFER_DIFFERS} (the run's scene as its /mount_twin/scene topic records it)" in err
 
 
+def test_a_refused_scene_names_its_differences_from_the_metadata_with_the_topic_dropped(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A replay's bag whose user filtered its ~/scene topic out (the metadata kept), the run's
+    scene file moved away: the metadata held the digest alone, so a refused scene was only
+    said to differ ("not found: cannot say which value differs"). It holds the value too: the
+    values that differ are named from it."""
+    from mount_twin.io.bag import custom_data
+
+    monkeypatch.chdir(tmp_path)
+    run_file = _pump_scene(tmp_path / "run.scene.yaml")
+    bag = ROOT / "bags" / "half_sine_shock_10khz"
+    replayed = ["replay", str(bag), "--scene", str(run_file), "-o", "out", "--no-progress"]
+    assert main(replayed) == 0
+    filtered = without_scene_topic(tmp_path / "out", tmp_path / "filtered", custom_data("out"))
+    run_file.unlink()
+    other = _pump_scene(tmp_path / "other.scene.yaml", OTHER_VALUES["a mount's stiffness"])
+    assert main(["report", str(filtered), "--scene", str(other), "-o", "r.html"]) == 2
+    err = capsys.readouterr().err
+    assert f"is not the one {filtered} was replayed with, {run_file}" in err
+    assert (
+        f"{STIFFER_DIFFERS} (the run's scene as its metadata (mount_twin.scene_sha256, "
+        "mount_twin.scene_value) records it)" in err
+    )
+
+
 def test_other_scene_needs_a_scene(pump_run: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["report", str(pump_run), "--other-scene"]) == 2
     assert "--other-scene draws with the scene --scene gives: it needs --scene" in (
@@ -1114,7 +1108,7 @@ def test_without_a_digest_a_scene_is_checked_by_the_settings_the_bag_records(
     status records the solver's rtol and atol. A scene with another atol is refused, naming
     it and both values; one differing elsewhere cannot be told apart, and stderr and the page
     say what it was checked by."""
-    bag = _without_scene_topic(pump_run, tmp_path / "recorded", {})
+    bag = without_scene_topic(pump_run, tmp_path / "recorded", {})
     page = tmp_path / "r.html"
     loose = _pump_scene(tmp_path / "loose.scene.yaml", _set("integration", "atol", value=1e-7))
     assert main(["report", str(bag), "--scene", str(loose), "-o", str(page)]) == 2

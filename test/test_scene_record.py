@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from io_helpers import CONFIG, ROOT
+from io_helpers import CONFIG, ROOT, without_scene_topic
 from rosbags.highlevel import AnyReader
 from rosbags.interfaces import QosDurability, QosReliability
 
@@ -76,6 +76,40 @@ def test_the_replays_metadata_records_file_overrides_and_digest_apart(
     assert json.loads(custom["mount_twin.scene_overrides"]) == {"input.topic": "/deck/imu"}
     assert custom["mount_twin.scene_sha256"] == scene_digest(load_scene_file(PUMP))
     assert custom["mount_twin.scene"] == "run.scene.yaml (with input topic from the command line)"
+
+
+def test_the_replays_metadata_records_the_value_its_digest_hashes(run: tuple[Path, Path]) -> None:
+    """With the ~/scene topic left out of a bag, its metadata held the digest alone: a scene
+    that differs could be told, but not where. It holds the value too, the very text the
+    digest is the sha256 of (hashed here by hashlib), with the file's mass and mount names."""
+    _, bag = run
+    meta = yaml.safe_load((bag / "metadata.yaml").read_text(encoding="utf-8"))
+    custom = meta["rosbag2_bagfile_information"]["custom_data"]
+    text = custom["mount_twin.scene_value"]
+    assert hashlib.sha256(text.encode()).hexdigest() == custom["mount_twin.scene_sha256"]
+    value = json.loads(text)
+    file = yaml.safe_load(PUMP.read_text(encoding="utf-8"))
+    assert value["body"]["mass"] == file["body"]["mass"] == 1200.0
+    assert [m["name"] for m in value["mounts"]] == [m["name"] for m in file["mounts"]]
+
+
+def test_a_metadata_value_that_does_not_hash_to_its_digest_is_refused(
+    run: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """A scene value in the metadata changed after it was hashed is no record of the run."""
+    from mount_twin.errors import BagError
+    from mount_twin.io.bag import custom_data
+    from mount_twin.io.scene_record import recorded_scene
+
+    _, bag = run
+    custom = custom_data(bag)
+    assert '"mass":1200.0' in custom["mount_twin.scene_value"]
+    changed = custom["mount_twin.scene_value"].replace('"mass":1200.0', '"mass":1500.0')
+    filtered = without_scene_topic(bag, tmp_path / "filtered", custom)
+    assert recorded_scene(filtered) is not None
+    damaged = {**custom, "mount_twin.scene_value": changed}
+    with pytest.raises(BagError, match=r"mount_twin\.scene_value in its metadata is no scene"):
+        recorded_scene(without_scene_topic(bag, tmp_path / "damaged", damaged))
 
 
 def test_a_scene_message_whose_value_does_not_hash_to_its_digest_is_refused(

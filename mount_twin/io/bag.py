@@ -430,6 +430,10 @@ its scene file's values, a JSON object of flat parameter name → value (`Scene.
 SCENE_DIGEST_KEY = "mount_twin.scene_sha256"
 """custom_data key in a replay's output bag's metadata.yaml: its scene's digest
 (`scene.description.scene_digest`), which `report --scene` checks its scene against."""
+SCENE_VALUE_KEY = "mount_twin.scene_value"
+"""custom_data key in a replay's output bag's metadata.yaml: its scene's value, the text its
+digest hashes (`scene.description.value_text`), from which `report --scene` names the values a
+scene differs in where the bag's ~/scene topic was left out."""
 
 
 def custom_data(path: str | Path) -> dict[str, str]:

@@ -6,9 +6,11 @@ the same message into its output bag (offered latched like /tf_static); its data
 object (`scene_text`): the scene's digest (`sha256`, `scene.description.scene_digest`), its
 file (`file`, an absolute path, or null), what was put over the file's values (`overrides`,
 by flat parameter name) and its value (`value`, `scene_value`), which hashes to the digest.
-A replay also records the digest, the file and the overrides apart in its output bag's
-metadata (`io.bag`'s SCENE_*_KEY), for a bag whose topic was left out. `recorded_scene`
-reads back whichever a bag holds, for `report --scene`.
+A replay also records the digest, the file, the overrides and the value apart in its output
+bag's metadata (`io.bag`'s SCENE_*_KEY), for a bag whose topic was left out (the value is a
+few kB: 0.2-0.4 kB a mount, about what the metadata's entry of the mount's wrench topic takes,
+so it grows with the metadata as it is). `recorded_scene` reads back whichever a bag holds,
+for `report --scene`.
 """
 
 from __future__ import annotations
@@ -27,12 +29,19 @@ from mount_twin.io.bag import (
     SCENE_FILE_KEY,
     SCENE_KEY,
     SCENE_OVERRIDES_KEY,
+    SCENE_VALUE_KEY,
     custom_data,
     reader_paths,
 )
 from mount_twin.io.messages import TYPESTORE
 from mount_twin.model.scene_file import scene_file_of
-from mount_twin.scene.description import Scene, scene_digest, scene_value, value_digest
+from mount_twin.scene.description import (
+    Scene,
+    scene_digest,
+    scene_value,
+    value_digest,
+    value_text,
+)
 
 SCENE_TOPIC = "~/scene"
 """The run's scene (std_msgs/String of `scene_text`); publish it latched (`io.bag.LATCHED_QOS`)."""
@@ -62,12 +71,15 @@ def scene_message(scene: Scene, stamp_ns: int) -> tuple[str, int, bytes]:
 def scene_metadata(scene: Scene) -> dict[str, str]:
     """What a replay records of its scene in its output bag's metadata: its source as text
     (`SCENE_KEY`), its file's absolute path (`SCENE_FILE_KEY`, '' for none), the overrides
-    as JSON (`SCENE_OVERRIDES_KEY`) and its digest (`SCENE_DIGEST_KEY`)."""
+    as JSON (`SCENE_OVERRIDES_KEY`), its digest (`SCENE_DIGEST_KEY`) and its value, the text
+    the digest hashes (`SCENE_VALUE_KEY`)."""
+    value = scene_value(scene)
     return {
         SCENE_KEY: scene.source,
         SCENE_FILE_KEY: scene.origin.file or "",
         SCENE_OVERRIDES_KEY: json.dumps(dict(scene.origin.overrides), default=list),
-        SCENE_DIGEST_KEY: scene_digest(scene),
+        SCENE_DIGEST_KEY: value_digest(value),
+        SCENE_VALUE_KEY: value_text(value),
     }
 
 
@@ -84,8 +96,8 @@ class RecordedScene:
         overrides: what was put over the file's values, flat parameter name → value (None: a
             value the bag does not hold: one written before `SCENE_OVERRIDES_KEY` names the
             input fields only; the run's, its input status records).
-        value: its value (`scene_value`, read back from JSON), or None: only the metadata
-            records it.
+        value: its value (`scene_value`, read back from JSON), or None: the bag holds only
+            its digest (a replay's metadata written before `SCENE_VALUE_KEY`).
         replayed: a replay recorded it (its metadata names the scene), else a recording of
             the node's topics.
     """
@@ -102,8 +114,9 @@ class RecordedScene:
 def recorded_scene(bag: str | Path) -> RecordedScene | None:
     """The scene a bag records: from its `~/scene` topic (a std_msgs/String topic named
     `…/scene` whose data is `scene_text`'s: a replay's, or the node's recorded), else from
-    its metadata; None where neither records one. A message whose value does not hash to its
-    digest, or messages of two scenes, are a BagError naming the topic."""
+    its metadata; None where neither records one. A message (or metadata) whose value does
+    not hash to its digest, or messages of two scenes, are a BagError naming the topic (the
+    key)."""
     meta = custom_data(bag)
     found = _from_topic(Path(bag))
     return _metadata_scene(bag, meta) if found is None else _topic_scene(*found, meta)
@@ -141,10 +154,26 @@ def _metadata_scene(bag: str | Path, meta: dict[str, str]) -> RecordedScene | No
     elif named:  # a bag written before the file and the overrides were recorded apart
         file, keys = scene_file_of(named)
         overrides = {f"input.{k}": None for k in keys}
-    where = f"its metadata ({SCENE_DIGEST_KEY})"
-    return RecordedScene(
-        digest, where, named or "a scene it does not name", file, overrides, replayed=True
-    )
+    value = _value(bag, meta[SCENE_VALUE_KEY], digest) if SCENE_VALUE_KEY in meta else None
+    held = SCENE_DIGEST_KEY if value is None else f"{SCENE_DIGEST_KEY}, {SCENE_VALUE_KEY}"
+    named = named or "a scene it does not name"
+    return RecordedScene(digest, f"its metadata ({held})", named, file, overrides, value, True)
+
+
+def _value(bag: str | Path, text: str, digest: str) -> dict[str, Any]:
+    """The scene's value a bag's metadata records (`SCENE_VALUE_KEY`'s JSON object), which
+    must hash to its `digest`."""
+    try:
+        value = json.loads(text)
+    except ValueError:
+        value = None
+    if not isinstance(value, dict) or value_digest(value) != digest:
+        msg = (
+            f"{bag}: {SCENE_VALUE_KEY} in its metadata is no scene's value that hashes to its "
+            f"{SCENE_DIGEST_KEY} ({digest}): the metadata is damaged"
+        )
+        raise BagError(msg)
+    return value
 
 
 def _overrides(bag: str | Path, text: str) -> dict[str, Any]:

@@ -387,9 +387,13 @@ def scene_digest(scene: Scene) -> str:
 
 def value_digest(value: Mapping[str, Any]) -> str:
     """sha256 (hex) of a scene's value (`scene_value`, or the same read back from JSON: the
-    text hashed is the same), as `scene_digest` gives it."""
-    text = json.dumps(value, sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode()).hexdigest()
+    text hashed is the same), as `scene_digest` gives it: of its `value_text`."""
+    return hashlib.sha256(value_text(value).encode()).hexdigest()
+
+
+def value_text(value: Mapping[str, Any]) -> str:
+    """A scene's value as the text `value_digest` hashes: JSON, keys sorted, no spaces."""
+    return json.dumps(value, sort_keys=True, separators=(",", ":"))
 
 
 def scene_value(scene: Scene) -> dict[str, Any]:
