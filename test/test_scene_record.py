@@ -16,7 +16,7 @@ from rosbags.interfaces import QosDurability, QosReliability
 
 from mount_twin.cli import main
 from mount_twin.io.messages import TYPESTORE
-from mount_twin.scene.description import scene_digest
+from mount_twin.scene.description import scene_digest, scene_value
 from mount_twin.scene.loader import load_scene_file
 
 PUMP = CONFIG / "pump_8_mounts.scene.yaml"
@@ -110,6 +110,61 @@ def test_a_metadata_value_that_does_not_hash_to_its_digest_is_refused(
     damaged = {**custom, "mount_twin.scene_value": changed}
     with pytest.raises(BagError, match=r"mount_twin\.scene_value in its metadata is no scene"):
         recorded_scene(without_scene_topic(bag, tmp_path / "damaged", damaged))
+
+
+def test_a_scene_changed_in_code_records_its_file_and_the_changes_over_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A scene loaded from a file, then changed in code (`dataclasses.replace`, as the Python
+    API varies one) recorded that file with nothing over it: a file that does not load to the
+    run's value. The record (~/scene and the metadata) names the file and each value changed,
+    by key path; the file with those values written into it (by PyYAML here) loads to the
+    recorded digest, hashed here by hashlib, and `report` takes it as the run's; the file
+    alone is refused, naming the run's scene with the changes."""
+    import dataclasses
+
+    from mount_twin.replay import replay
+
+    base = tmp_path / "base.scene.yaml"
+    base.write_text(PUMP.read_text(encoding="utf-8"), encoding="utf-8")
+    loaded = load_scene_file(base)
+    fl = loaded.mounts[0]
+    stiffer = dataclasses.replace(fl, stiffness=(*fl.stiffness[:2], 2.4e6, *fl.stiffness[3:]))
+    scene = dataclasses.replace(
+        loaded,
+        mounts=(stiffer, *loaded.mounts[1:]),
+        outputs=dataclasses.replace(loaded.outputs, diagnostics_period_s=0.1),
+    )
+    out = tmp_path / "out"
+    replay(scene, ROOT / "bags" / "half_sine_shock_10khz", out, progress=False)
+    with AnyReader([out], default_typestore=TYPESTORE) as reader:
+        (conn,) = [c for c in reader.connections if c.topic == TOPIC]
+        ((_, _, raw),) = list(reader.messages([conn]))
+        record = json.loads(reader.deserialize(raw, conn.msgtype).data)
+    changes = {"mounts[0].stiffness[2]": 2.4e6, "outputs.diagnostics_period_s": 0.1}
+    assert record["file"] == str(base)
+    assert record["overrides"] == changes
+    meta = yaml.safe_load((out / "metadata.yaml").read_text(encoding="utf-8"))
+    custom = meta["rosbag2_bagfile_information"]["custom_data"]
+    assert custom["mount_twin.scene_file"] == str(base)
+    assert json.loads(custom["mount_twin.scene_overrides"]) == changes
+    named = f"{base} (with mounts[0].stiffness[2], outputs.diagnostics_period_s changed in code)"
+    assert custom["mount_twin.scene"] == named
+    data = yaml.safe_load(base.read_text(encoding="utf-8"))
+    assert data["mounts"][0]["stiffness"][2] == 1.2e6
+    data["mounts"][0]["stiffness"][2] = 2.4e6
+    data["outputs"]["diagnostics_period_s"] = 0.1
+    (tmp_path / "changed.scene.yaml").write_text(yaml.safe_dump(data), encoding="utf-8")
+    value = scene_value(load_scene_file(tmp_path / "changed.scene.yaml"))
+    text = json.dumps(value, sort_keys=True, separators=(",", ":"))
+    assert hashlib.sha256(text.encode()).hexdigest() == record["sha256"]
+    page = ["-o", str(tmp_path / "r.html")]
+    assert main(["report", str(out), "--scene", str(tmp_path / "changed.scene.yaml"), *page]) == 0
+    assert main(["report", str(out), "--scene", str(base), *page]) == 2
+    assert (
+        f"{base}: scene pump_8_mounts is not the one {out} was replayed with, {named}: its "
+        "digest" in capsys.readouterr().err
+    )
 
 
 def test_a_scene_message_whose_value_does_not_hash_to_its_digest_is_refused(

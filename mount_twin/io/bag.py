@@ -420,13 +420,15 @@ PARTIAL_KEY = "mount_twin.partial"
 """custom_data key in an output bag's metadata.yaml present when the bag stops early."""
 SCENE_KEY = "mount_twin.scene"
 """custom_data key in a replay's output bag's metadata.yaml: where its scene came from, as
-text (the file as given, and the input settings the command line replaced: `Scene.source`)."""
+text (the file as given, and the input settings the command line replaced: `Scene.source`;
+and the values changed in code since: `io.scene_record.scene_name`)."""
 SCENE_FILE_KEY = "mount_twin.scene_file"
 """custom_data key in a replay's output bag's metadata.yaml: its scene file's absolute path
 (`Scene.origin`; '' for none)."""
 SCENE_OVERRIDES_KEY = "mount_twin.scene_overrides"
-"""custom_data key in a replay's output bag's metadata.yaml: what the command line put over
-its scene file's values, a JSON object of flat parameter name → value (`Scene.origin`)."""
+"""custom_data key in a replay's output bag's metadata.yaml: what was put over its scene
+file's values, a JSON object of flat parameter name (the command line's) or key path (a value
+changed in code) → value (`io.scene_record.scene_overrides`)."""
 SCENE_DIGEST_KEY = "mount_twin.scene_sha256"
 """custom_data key in a replay's output bag's metadata.yaml: its scene's digest
 (`scene.description.scene_digest`), which `report --scene` checks its scene against."""

@@ -5,7 +5,8 @@ The node publishes it on `~/scene` (std_msgs/String, latched: reliable, transien
 the same message into its output bag (offered latched like /tf_static); its data is one JSON
 object (`scene_text`): the scene's digest (`sha256`, `scene.description.scene_digest`), its
 file (`file`, an absolute path, or null), what was put over the file's values (`overrides`,
-by flat parameter name) and its value (`value`, `scene_value`), which hashes to the digest.
+by flat parameter name, or by key path for a value changed in code: `scene_overrides`) and
+its value (`value`, `scene_value`), which hashes to the digest.
 A replay also records the digest, the file, the overrides and the value apart in its output
 bag's metadata (`io.bag`'s SCENE_*_KEY), for a bag whose topic was left out (the value is a
 few kB: 0.2-0.4 kB a mount, about what the metadata's entry of the mount's wrench topic takes,
@@ -39,6 +40,7 @@ from mount_twin.scene.description import (
     Scene,
     scene_digest,
     scene_value,
+    value_differences,
     value_digest,
     value_text,
 )
@@ -50,16 +52,47 @@ STRING = "std_msgs/msg/String"
 
 def scene_text(scene: Scene) -> str:
     """The `~/scene` message's data: the JSON object of the scene's digest (`sha256`), file
-    (`file`: absolute path, or null), overrides (`overrides`: flat parameter name → value) and
-    value (`value`); one line."""
-    origin = scene.origin
+    (`file`: absolute path, or null), overrides (`overrides`: `scene_overrides`) and value
+    (`value`); one line."""
     record = {
         "sha256": scene_digest(scene),
-        "file": origin.file,
-        "overrides": dict(origin.overrides),
+        "file": scene.origin.file,
+        "overrides": scene_overrides(scene),
         "value": scene_value(scene),
     }
     return json.dumps(record, default=list)  # default: rclpy's arrays of a parameter
+
+
+def scene_overrides(scene: Scene) -> dict[str, Any]:
+    """What was put over the values of the scene's file: its origin's overrides (flat
+    parameter name → value), then the values changed in code since (`_changed_in_code`); the
+    file with them put over it is the scene."""
+    return {**scene.origin.overrides, **_changed_in_code(scene)}
+
+
+NAMED_CHANGES = 3
+"""How many of the values changed in code a replay's `SCENE_KEY` names (`scene_name`)."""
+
+
+def scene_name(scene: Scene) -> str:
+    """The scene as a replay names it in its metadata (`SCENE_KEY`), for messages: its source,
+    with the values changed in code since it was loaded (`NAMED_CHANGES` of them)."""
+    changed = list(_changed_in_code(scene))
+    if not changed:
+        return scene.source
+    more = len(changed) - NAMED_CHANGES
+    named = ", ".join(changed[:NAMED_CHANGES]) + (f" and {more} more" if more > 0 else "")
+    return f"{scene.source} (with {named} changed in code)"
+
+
+def _changed_in_code(scene: Scene) -> dict[str, Any]:
+    """Each value of the scene changed in code since its file and overrides built it
+    (`dataclasses.replace` on the scene loaded: `SceneOrigin.value`), by key path
+    (`mounts[0].stiffness[2]`, `outputs.diagnostics_period_s`: `value_differences`) → its
+    value here."""
+    origin = scene.origin
+    changed = value_differences(scene_value(scene), origin.value) if origin.value else []
+    return {path: here for path, here, _ in changed}
 
 
 def scene_message(scene: Scene, stamp_ns: int) -> tuple[str, int, bytes]:
@@ -69,15 +102,15 @@ def scene_message(scene: Scene, stamp_ns: int) -> tuple[str, int, bytes]:
 
 
 def scene_metadata(scene: Scene) -> dict[str, str]:
-    """What a replay records of its scene in its output bag's metadata: its source as text
-    (`SCENE_KEY`), its file's absolute path (`SCENE_FILE_KEY`, '' for none), the overrides
-    as JSON (`SCENE_OVERRIDES_KEY`), its digest (`SCENE_DIGEST_KEY`) and its value, the text
-    the digest hashes (`SCENE_VALUE_KEY`)."""
+    """What a replay records of its scene in its output bag's metadata: its name as text
+    (`SCENE_KEY`: `scene_name`), its file's absolute path (`SCENE_FILE_KEY`, '' for none),
+    the overrides (`scene_overrides`) as JSON (`SCENE_OVERRIDES_KEY`), its digest
+    (`SCENE_DIGEST_KEY`) and its value, the text the digest hashes (`SCENE_VALUE_KEY`)."""
     value = scene_value(scene)
     return {
-        SCENE_KEY: scene.source,
+        SCENE_KEY: scene_name(scene),
         SCENE_FILE_KEY: scene.origin.file or "",
-        SCENE_OVERRIDES_KEY: json.dumps(dict(scene.origin.overrides), default=list),
+        SCENE_OVERRIDES_KEY: json.dumps(scene_overrides(scene), default=list),
         SCENE_DIGEST_KEY: value_digest(value),
         SCENE_VALUE_KEY: value_text(value),
     }

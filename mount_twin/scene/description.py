@@ -333,10 +333,15 @@ class SceneOrigin:
         overrides: what was put over the file's values, by flat parameter name
             (`input.topic`: `replay --topic`, `--frame-id`; the node's parameters given beside
             `scene_file`); empty without a file.
+        value: the value the file and `overrides` built (`scene_value`; the loader sets it),
+            which a scene changed since in code (`dataclasses.replace`, which keeps `origin`)
+            differs from: a record of it names those changes too (`io.scene_record`); None
+            without a file.
     """
 
     file: str | None = None
     overrides: Mapping[str, Any] = field(default_factory=dict)
+    value: Mapping[str, Any] | None = None
 
 
 @dataclass(frozen=True)

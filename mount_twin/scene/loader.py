@@ -36,6 +36,7 @@ from mount_twin.scene.description import (
     Vec3,
     Vec6,
     ageing_bands_problem,
+    scene_value,
 )
 from mount_twin.scene.reader import Reader, Used, shown
 from mount_twin.scene.ros_names import (
@@ -89,7 +90,8 @@ def scene_from_dict(
         refuse_unheld: a free DOF no mount holds is a SceneError (for a start at equilibrium)
             instead of a warning: what scene files and parameter sets get. Off for scenes built
             in code, such as tests of a single mount's law.
-        origin: where it came from, as fields (default: no file, nothing put over it).
+        origin: where it came from, as fields (default: no file, nothing put over it); with a
+            file, its `value` is set to the scene's.
     """
     refuse_parameters_file(data, source)
     top = Reader(data, source, record=record)
@@ -125,6 +127,8 @@ def scene_from_dict(
     )
     top.finish()
     warnings = check_scene(scene, paths, refuse_unheld=refuse_unheld)
+    if origin is not None and origin.file is not None:  # what changes made in code differ from
+        origin = dataclasses.replace(origin, value=scene_value(scene))
     return dataclasses.replace(
         scene, warnings=warnings, mount_paths=tuple(paths), origin=origin or SceneOrigin()
     )
