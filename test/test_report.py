@@ -957,8 +957,8 @@ def test_a_refused_scene_names_the_values_it_differs_in_where_an_old_bags_file_t
     copy.unlink()
     assert main(["report", str(bag), *args]) == 2
     assert (
-        f"the run's scene file {copy} is not found: cannot say which value differs"
-        in capsys.readouterr().err
+        f"the run's scene file is not found at {copy} (as recorded): cannot say which value "
+        "differs" in capsys.readouterr().err
     )
 
 
@@ -982,14 +982,56 @@ def test_an_old_bags_relative_scene_file_is_found_from_the_bags_directory(
     assert main(args) == 2
     found = ran / "config" / "run.scene.yaml"
     assert (
-        f"{STIFFER_DIFFERS} (the run's scene as its file {found}, config/run.scene.yaml "
-        "found from the bag's directory loads it)" in capsys.readouterr().err
+        f"{STIFFER_DIFFERS} (the run's scene as its file {found} loads it: "
+        "config/run.scene.yaml found from the bag's directory, not found at "
+        f"{elsewhere}/config/run.scene.yaml (config/run.scene.yaml from here))"
+        in capsys.readouterr().err
     )
     found.unlink()
     assert main(args) == 2
     assert (
-        f"the run's scene file config/run.scene.yaml is not found from here ({elsewhere}) nor "
-        f"from the bag's directory ({ran}): cannot say which value differs"
+        f"the run's scene file is not found at {elsewhere}/config/run.scene.yaml "
+        f"(config/run.scene.yaml from here) nor {found} (config/run.scene.yaml from the bag's "
+        "directory): cannot say which value differs" in capsys.readouterr().err
+    )
+
+
+def test_a_moved_runs_scene_file_is_found_by_the_path_the_replay_was_given(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A bag whose metadata records the scene file's absolute path but not its value (written
+    before the value was; its ~/scene topic filtered out), its project directory moved: the
+    absolute path was the only one looked at, "not found". The path the replay was given
+    (config/run.scene.yaml) is looked for after it, from here and from the bag's directory,
+    and the messages name each path tried."""
+    from mount_twin.io.bag import SCENE_VALUE_KEY, custom_data
+
+    ran, moved = tmp_path / "ran", tmp_path / "moved"
+    (ran / "config").mkdir(parents=True)
+    _pump_scene(ran / "config" / "run.scene.yaml")
+    monkeypatch.chdir(ran)
+    bag = ROOT / "bags" / "half_sine_shock_10khz"
+    replayed = ["replay", str(bag), "--scene", "config/run.scene.yaml", "-o", "out"]
+    assert main([*replayed, "--no-progress"]) == 0
+    custom = {k: v for k, v in custom_data("out").items() if k != SCENE_VALUE_KEY}
+    without_scene_topic(ran / "out", ran / "bags" / "filtered", custom)
+    ran.rename(moved)
+    monkeypatch.chdir(moved)
+    other = _pump_scene(tmp_path / "other.scene.yaml", OTHER_VALUES["a mount's stiffness"])
+    args = ["report", "bags/filtered", "--scene", str(other), "-o", str(tmp_path / "r.html")]
+    assert main(args) == 2
+    recorded, found = ran / "config" / "run.scene.yaml", moved / "config" / "run.scene.yaml"
+    assert (
+        f"{STIFFER_DIFFERS} (the run's scene as its file {found} loads it: "
+        f"config/run.scene.yaml found from here, not found at {recorded} (as recorded))"
+        in capsys.readouterr().err
+    )
+    found.unlink()
+    assert main(args) == 2
+    assert (
+        f"the run's scene file is not found at {recorded} (as recorded), {found} "
+        f"(config/run.scene.yaml from here) nor {moved}/bags/config/run.scene.yaml "
+        "(config/run.scene.yaml from the bag's directory): cannot say which value differs"
         in capsys.readouterr().err
     )
 

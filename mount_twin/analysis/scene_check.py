@@ -119,11 +119,10 @@ def _run_value(
 ) -> tuple[dict[str, Any], str] | str:
     """The value of the run's scene as its file loads it today, with what was put over it
     (an override whose value the bag does not hold: `scene`'s, which has the run's input),
-    and how it was read; or why it cannot be had. A relative path (a bag written before the
-    replay recorded it absolute) is found from here, else from the bag's directory."""
+    and how it was read; or why it cannot be had (the file found by `_found`)."""
     if recorded.file is None:
         return "the run's scene came from no file"
-    found = _found(recorded.file, output_bag)
+    found = _found(recorded, output_bag)
     if isinstance(found, str):
         return found
     path, how = found
@@ -136,27 +135,49 @@ def _run_value(
         return f"the run's scene file {path} no longer loads ({err})"
     if scene_digest(run) != recorded.sha256:
         return f"the run's scene file {path} has changed since"
-    return scene_value(run), f"as its file {path}{how} loads it"
+    return scene_value(run), f"as its file {path} loads it{how}"
 
 
-def _found(file: str, output_bag: str | Path) -> tuple[Path, str] | str:
-    """The run's scene file recorded as `file`, and how it was found ('' for an absolute
-    path; else ", FILE found from here" or "from the bag's directory"); or why it is not
-    found. A relative path (a bag written before the replay recorded it absolute) is looked
-    for from here, then from the bag's directory: where the replay ran if its `-o` named no
-    directory."""
-    path = Path(file)
-    if path.is_absolute():
-        return (path, "") if path.is_file() else f"the run's scene file {file} is not found"
-    bases = {"here": Path.cwd(), "the bag's directory": Path(output_bag).resolve().parent}
-    for name, base in bases.items():
-        if (base / path).is_file():
-            return base / path, f", {file} found from {name}"
-    here, beside = bases.values()
-    return (
-        f"the run's scene file {file} is not found from here ({here}) nor from the bag's "
-        f"directory ({beside})"
-    )
+def _found(recorded: RecordedScene, output_bag: str | Path) -> tuple[Path, str] | str:
+    """The run's scene file, and how it was found ('' as recorded, absolute; else ": NAME
+    found from …", and the paths tried before it); or why it is not found, naming each path
+    tried (`_tried`)."""
+    tried = _tried(recorded, output_bag)
+    for k, (path, name, where) in enumerate(tried):
+        if path.is_file():
+            if where == AS_RECORDED:  # the first tried
+                return path, ""
+            missed = f", not found at {_listed(tried[:k])}" if k else ""
+            return path, f": {name} found {where}{missed}"
+    return f"the run's scene file is not found at {_listed(tried)}"
+
+
+AS_RECORDED = "as recorded"
+"""How `_tried` names a path recorded absolute."""
+
+
+def _tried(recorded: RecordedScene, output_bag: str | Path) -> list[tuple[Path, str, str]]:
+    """Where the run's scene file is looked for, in order, as (path, the name it was had from,
+    how): the path recorded (`recorded.file`), then the one the replay was given
+    (`recorded.given`: a project moved since, its absolute path gone); a relative one (as a
+    replay recorded it before it recorded it absolute) from here, then from the bag's
+    directory (where the replay ran if its `-o` named no directory). Each path once."""
+    bases = {
+        "from here": Path.cwd(),
+        "from the bag's directory": Path(output_bag).resolve().parent,
+    }
+    tried: dict[Path, tuple[str, str]] = {}
+    for name in (n for n in (recorded.file, recorded.given) if n is not None):
+        places = {AS_RECORDED: Path()} if Path(name).is_absolute() else bases
+        for where, base in places.items():
+            tried.setdefault(base / name, (name, where))
+    return [(path, name, where) for path, (name, where) in tried.items()]
+
+
+def _listed(tried: list[tuple[Path, str, str]]) -> str:
+    """Paths tried, each with how it was had: "A (as recorded), B (NAME from here) nor …"."""
+    named = [f"{p} ({w if w == AS_RECORDED else f'{n} {w}'})" for p, n, w in tried]
+    return " nor ".join([", ".join(named[:-1]), named[-1]] if len(named) > 1 else named)
 
 
 def check_scene_is_the_bags(scene: Scene, in_bag: set[str], output_bag: str | Path) -> None:

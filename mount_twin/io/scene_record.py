@@ -126,6 +126,9 @@ class RecordedScene:
         named: the run's scene as the bag names it, for messages (a replay's `SCENE_KEY`).
         file: its scene file as recorded (None: none; relative in bags written before
             `SCENE_FILE_KEY`: from the replay's directory).
+        given: a replay's scene file as it was given (`SCENE_KEY`'s: relative to where it
+            ran, or absolute), where its value is not recorded: looked for where `file` is
+            not found (a project directory moved); else None.
         overrides: what was put over the file's values, flat parameter name → value (None: a
             value the bag does not hold: one written before `SCENE_OVERRIDES_KEY` names the
             input fields only; the run's, its input status records).
@@ -142,6 +145,7 @@ class RecordedScene:
     overrides: Mapping[str, Any] = field(default_factory=dict)
     value: dict[str, Any] | None = None
     replayed: bool = False
+    given: str | None = None
 
 
 def recorded_scene(bag: str | Path) -> RecordedScene | None:
@@ -189,8 +193,10 @@ def _metadata_scene(bag: str | Path, meta: dict[str, str]) -> RecordedScene | No
         overrides = {f"input.{k}": None for k in keys}
     value = _value(bag, meta[SCENE_VALUE_KEY], digest) if SCENE_VALUE_KEY in meta else None
     held = SCENE_DIGEST_KEY if value is None else f"{SCENE_DIGEST_KEY}, {SCENE_VALUE_KEY}"
+    given = scene_file_of(named)[0] if named and value is None else None
     named = named or "a scene it does not name"
-    return RecordedScene(digest, f"its metadata ({held})", named, file, overrides, value, True)
+    where = f"its metadata ({held})"
+    return RecordedScene(digest, where, named, file, overrides, value, True, given)
 
 
 def _value(bag: str | Path, text: str, digest: str) -> dict[str, Any]:
