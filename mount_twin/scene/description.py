@@ -341,7 +341,7 @@ class SceneOrigin:
 
     file: str | None = None
     overrides: Mapping[str, Any] = field(default_factory=dict)
-    value: Mapping[str, Any] | None = None
+    value: Mapping[str, Any] | None = field(default=None, repr=False)  # a few kB of JSON
 
 
 @dataclass(frozen=True)
