@@ -126,16 +126,17 @@ class RecordedScene:
         named: the run's scene as the bag names it, for messages (a replay's `SCENE_KEY`).
         file: its scene file as recorded (None: none; relative in bags written before
             `SCENE_FILE_KEY`: from the replay's directory).
-        given: a replay's scene file as it was given (`SCENE_KEY`'s: relative to where it
-            ran, or absolute), where its value is not recorded: looked for where `file` is
-            not found (a project directory moved); else None.
-        overrides: what was put over the file's values, flat parameter name → value (None: a
-            value the bag does not hold: one written before `SCENE_OVERRIDES_KEY` names the
-            input fields only; the run's, its input status records).
+        overrides: what was put over the file's values, flat parameter name (or key path of
+            a value changed in code: `scene_overrides`) → value (None: a value the bag does
+            not hold: one written before `SCENE_OVERRIDES_KEY` names the input fields only;
+            the run's, its input status records).
         value: its value (`scene_value`, read back from JSON), or None: the bag holds only
             its digest (a replay's metadata written before `SCENE_VALUE_KEY`).
         replayed: a replay recorded it (its metadata names the scene), else a recording of
             the node's topics.
+        given: a replay's scene file as it was given (`SCENE_KEY`'s: relative to where it
+            ran, or absolute), where its value is not recorded: looked for where `file` is
+            not found (a project directory moved); else None.
     """
 
     sha256: str
@@ -196,7 +197,7 @@ def _metadata_scene(bag: str | Path, meta: dict[str, str]) -> RecordedScene | No
     given = scene_file_of(named)[0] if named and value is None else None
     named = named or "a scene it does not name"
     where = f"its metadata ({held})"
-    return RecordedScene(digest, where, named, file, overrides, value, True, given)
+    return RecordedScene(digest, where, named, file, overrides, value, replayed=True, given=given)
 
 
 def _value(bag: str | Path, text: str, digest: str) -> dict[str, Any]:
