@@ -206,7 +206,9 @@ def test_a_period_decimation_left_without_a_row_has_no_tilt_nor_peak_of_0(tmp_pa
     its own; a period that published rows has its figures."""
     path = pump_scene_file(
         tmp_path,
-        input={"gyro_filter": "none"},  # rows at their samples' stamps: each in its period
+        # rows at their samples' stamps, each in its period: no delay, no start window held
+        input={"gyro_filter": "none"},
+        initial_state={"gravity_window_s": 0.0},
         outputs={"decimation": 1000, "diagnostics_period_s": 0.01},  # 100 samples at 10 kHz
     )
     replay(

@@ -43,6 +43,9 @@ ROOM = 256
 """Samples of room a store keeps beside its contents, at least, when it moves them to its
 arrays' start: a push of one sample moves the pending ones once every ROOM pushes or less
 often (`capacity`)."""
+STAMP_SLACK_S = 1e-9
+"""s: a sample this much past `initial_state.gravity_window_s` after a start sample is within
+the start's window (a ROS stamp's resolution: float stamps lose a few ulps in differences)."""
 LARGE = 4096
 """A push of more samples than this gets a frame of its own (the pending samples and these
 concatenated: one copy of each either way), not a backlog that large kept between pushes."""
@@ -256,20 +259,27 @@ class RawWindow:
 
 
 class GyroDelay:
-    """Filters Ω of accepted samples and releases them N samples late (see the module).
+    """Filters Ω of accepted samples and releases them N samples late (see the module); a
+    run's first release waits until its start's samples have come.
 
     Args:
         bands: (passband, stopband) edges, Hz, for `linear_phase`; None: raw (no delay).
         designed: told the design (and the stamp, s, of the interval it came from) once made.
+        takes: (samples, s) a start's gravity is the mean of (`starts.start_takes`): where
+            s > 0, a run is held back until a sample lies more than s (and STAMP_SLACK_S)
+            after its start sample (the samples-th), or the run ends, so that the start has
+            every sample of its window in any batching.
     """
 
     def __init__(
         self,
         bands: tuple[float, float] | None,
         designed: Callable[[float, Design], None],
+        takes: tuple[int, float] = (1, 0.0),
     ) -> None:
         self._bands = bands
         self._designed = designed
+        self._takes = takes
         self.design: Design | None = None if bands else RAW
         self._pending = np.zeros(0, dtype=np.int64)
         """Rows of the current frame accepted but not yet released, in order."""
@@ -305,7 +315,8 @@ class GyroDelay:
         """Take a run of accepted samples (batch positions); the runs now ready to integrate
         (frame rows, their Ω filtered in frame.w)."""
         rows = run.index + frame.offset
-        if self.delay == 0 and self.design is not None and not self._pending.shape[0]:
+        direct = not (run.restart and self._takes[1] > 0.0)
+        if self.delay == 0 and self.design is not None and not self._pending.shape[0] and direct:
             return [Run(rows, run.restart)] if rows.shape[0] else []
         ready = self.drain(frame) if run.restart else []
         if run.restart:
@@ -315,8 +326,21 @@ class GyroDelay:
         self._raw.append(frame.w[rows])
         self._design(frame, DESIGN_SAMPLES)
         if self.design is not None:
-            ready.extend(self._release(self._pending.shape[0] - self.delay, frame, end=False))
+            ready.extend(self._release(self._releasable(frame), frame, end=False))
         return ready
+
+    def _releasable(self, frame: Frame) -> int:
+        """Pending samples that may go: all but the last N (the filter's), and none of a run
+        not yet released before one lies past its start's window (`takes`)."""
+        n = self._pending.shape[0] - self.delay
+        samples, window_s = self._takes
+        if not (self._restart and window_s > 0.0) or n <= 0:
+            return n
+        if n <= samples:
+            return 0
+        stamps = frame.stamps
+        start, last = stamps[self._pending[samples - 1]], stamps[self._pending[n - 1]]
+        return n if last > start + window_s + STAMP_SLACK_S else 0
 
     def drain(self, frame: Frame) -> list[Run]:
         """Release every pending sample, the rate after the last held at its value (a run's

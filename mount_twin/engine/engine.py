@@ -32,7 +32,7 @@ from mount_twin.engine.intake import Intake, Judged, nothing_accepted, runs
 from mount_twin.engine.kernel import AT_EVENT, Samples
 from mount_twin.engine.reporting import Reporting
 from mount_twin.engine.rows import BatchRows, Part, Tail
-from mount_twin.engine.starts import Starts
+from mount_twin.engine.starts import Starts, start_takes
 from mount_twin.errors import require
 from mount_twin.integrate.stepper import STATUS_TEXT
 from mount_twin.model.assemble import Model
@@ -84,7 +84,9 @@ class TwinEngine:
         self._driver = CoreDriver(model, self.health, self.counts)
         self._starts = Starts(model, self._driver, self.health, self.counts)
         self._reporting = Reporting(self._driver, self.health, self.counts)
-        self._gyro = GyroDelay(filter_bands(self.scene.input), self._designed)
+        self._gyro = GyroDelay(
+            filter_bands(self.scene.input), self._designed, start_takes(self.scene.initial)
+        )
         self._pushed = 0
         """Samples pushed so far (a held one once)."""
         self._done_at = (0, math.nan)
@@ -299,7 +301,7 @@ class TwinEngine:
             self._close_run(out)
             driver.last = None
         if driver.last is None:
-            index, gathered = starts.gather(run, frame.f)
+            index, gathered = starts.gather(run, frame.stamps, frame.f)
             if not len(index) or not starts.started(out, index, samples, gathered, rows):
                 return out
             index = index[1:]

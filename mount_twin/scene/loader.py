@@ -341,6 +341,7 @@ def _initial(r: Reader, dofs: tuple[str, ...]) -> InitialState:
         pose=_pose(r, "pose", d.pose),
         velocity=r.vector("velocity", 6, d.velocity),
         gravity_samples=r.integer("gravity_samples", d.gravity_samples, lo=1),
+        gravity_window_s=r.number("gravity_window_s", d.gravity_window_s, lo=0.0),
         gravity_tolerance=r.number(
             "gravity_tolerance", d.gravity_tolerance, lo=0.0, hi=1.0, lo_open=True
         ),
