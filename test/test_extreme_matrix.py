@@ -50,9 +50,11 @@ INERTIA = [60.0, 80.0, 100.0, 0.0, 0.0, 0.0]
 
 
 def _scene(data: dict[str, Any], rtol: float = 1e-6, atol: float = 1e-9) -> Scene:
-    """A test scene at the bundled scenes' default tolerances, every sample published."""
+    """A test scene at the bundled scenes' default tolerances, every sample published as it is
+    pushed (no gyro delay, no start window held back)."""
     data["integration"].update(rtol=rtol, atol=atol)
     data["input"].update(frame_id="deck_imu", gyro_filter="none")
+    data.setdefault("initial_state", {})["gravity_window_s"] = 0.0
     return scene_from_dict(data, "<extreme matrix>")
 
 

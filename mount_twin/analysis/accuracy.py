@@ -206,7 +206,9 @@ def run_at(
 ) -> Run:
     """The twin over `samples` at `rtol` (atol = rtol·ATOL_PER_RTOL), every sample published
     (`TwinEngine.run`), with its live error estimate if `estimate` (the wall time then
-    includes the estimate's checks and propagation). MountTwinError if it accepted no sample,
+    includes the estimate's checks and propagation), started under the first sample's specific
+    force (`initial_state.gravity_window_s` 0: a window's mean over a refined record is not the
+    record's, and a start is no integration error). MountTwinError if it accepted no sample,
     saying why."""
     atol = rtol * ATOL_PER_RTOL
     integ = dataclasses.replace(
@@ -217,7 +219,9 @@ def run_at(
         error_estimate=estimate,
     )
     outputs = dataclasses.replace(scene.outputs, decimation=1)
-    engine = TwinEngine(assemble(dataclasses.replace(scene, integration=integ, outputs=outputs)))
+    initial = dataclasses.replace(scene.initial, gravity_window_s=0.0)
+    scene = dataclasses.replace(scene, integration=integ, outputs=outputs, initial=initial)
+    engine = TwinEngine(assemble(scene))
     t0 = time.perf_counter()
     out = engine.run(samples)
     wall = time.perf_counter() - t0
