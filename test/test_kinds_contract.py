@@ -300,6 +300,17 @@ def test_an_event_table_of_another_length_than_the_events_is_refused(table: str)
         check_modules({"end_stop": module})
 
 
+def test_a_switch_that_stiffens_is_refused() -> None:
+    """A start's switches (a bolt breaking under the start's load) are logged outside the
+    compiled loop, which alone counts stiffening events and ends a run for `auto` to look
+    again; a switch that stiffened would go unexamined at a start. No kind has one (the one
+    switch, a bolt breaking, softens); a kind declaring one is refused, not run so."""
+    module = fake_kind()
+    module.EVENT_SWITCHES = (True,)
+    with pytest.raises(KindContractError, match="'stop_contact' is a discrete switch that may"):
+        check_modules({"end_stop": module})
+
+
 def test_only_contact_events_may_stiffen_a_scene() -> None:
     """A key closing or a snubber touching adds stiffness; a joint yielding, opening, slipping
     or breaking, an overload or an over-travel (already in contact) adds none."""

@@ -4,7 +4,8 @@ misspelt key is named rather than the check it makes fail), its parameter row (`
 internal states (and which of them a restart resets: `RESTUCK`), force law (`load`), event
 functions (`monitor`), discrete switches between samples (`update`, which says whether it
 switched: the state then jumped, and a stepper must not start from a stage it took before;
-`EVENT_SWITCHES` names the events that are such a switch, which a start reports too) and
+`EVENT_SWITCHES` names the events that are such a switch, which a start reports too, and
+none of which may stiffen the scene: `auto` looks again at none a start makes) and
 its stiffness at the unstressed pose (`nominal_tangent`: statics, modes and `auto`'s first
 choice read it). A module's `load`, `monitor` and `update` are plain Python: the reference the
 compiled core's port of the kind (src/core/kinds/<kind>.hpp) is held to.
@@ -107,6 +108,18 @@ def check_modules(kinds: Mapping[str, ModuleType]) -> None:
         for table in ("EVENT_ERROR", "EVENT_STIFFENS", "EVENT_SWITCHES"):
             if len(getattr(module, table)) != len(module.EVENTS):
                 msg = f"kind {name!r}: {table} and EVENTS differ in length"
+                raise KindContractError(msg)
+        for event, stiffens, switch in zip(
+            module.EVENTS, module.EVENT_STIFFENS, module.EVENT_SWITCHES, strict=True
+        ):
+            if stiffens and switch:
+                # A start's switches are logged outside the compiled loop
+                # (`CoreDriver._log_start_switches`), which alone counts stiffening events and
+                # ends a run for `auto` to look again: one at a start would go unexamined.
+                msg = (
+                    f"kind {name!r}: event {event!r} is a discrete switch that may stiffen the "
+                    "scene; `auto` does not look again at a start's switches"
+                )
                 raise KindContractError(msg)
 
 
