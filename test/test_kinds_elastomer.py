@@ -284,7 +284,11 @@ def test_single_dof_hysteresis_loop_through_the_engine_matches_an_independent_in
         damping=[0.0, 0.0, CZ],
         hysteresis={"ratio": RATIO, **bw, "axes": ["z"]},
     )
-    model = build(base_scene(MASS, [0.0, 0.0, CG_Z], [5.0, 6.0, 7.0, 0, 0, 0], [mount], ["z"]))
+    # the base moves from the first sample on: the start is that sample's, at rest under g (a
+    # 50 ms start window would take the motion's first 0.08 g into the start gravity)
+    initial = {"mode": "equilibrium", "gravity": "first_sample", "gravity_window_s": 0.0}
+    scene = base_scene(MASS, [0.0, 0.0, CG_Z], [5.0, 6.0, 7.0, 0, 0, 0], [mount], ["z"])
+    model = build({**scene, "initial_state": initial})
     assert model.state_names == ("z", "z_dot", "iso.z_z")
     t = np.arange(int(DURATION * RATE) + 1) / RATE
     a = BASE_AMP * np.sin(2 * math.pi * BASE_HZ * t)
