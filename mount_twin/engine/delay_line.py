@@ -1,4 +1,5 @@
-"""The delay line of `input.gyro_filter: linear_phase`: Ω filtered, f delayed alike.
+"""The delay line of `input.gyro_filter: linear_phase`: Ω filtered, f delayed alike; and a
+start's gravity window held back until it has come.
 
 A sample's filtered rate needs the N samples after it (`gyro_filter.fir_rows`), so the twin
 integrates each accepted sample once N more of its run have come: the motion it integrates, Ω,
@@ -8,8 +9,10 @@ same N samples exactly), and its outputs carry sample k's stamp, N samples late.
 Run edges: before a run's first sample the rate is taken as that sample's, held (a start is at
 rest); at its end (a restart, a gap reset, the end of the stream) the pending samples are
 integrated with the rate after them held at the last one, so every accepted sample has its
-output. The filter is designed once, from the stream's first intervals (`DESIGN_SAMPLES`,
-`gyro_filter.design`).
+output. A run's first release waits, besides, until its start's gravity window has come
+(`initial_state.gravity_window_s`, `starts.start_takes`), so that the start takes the same
+samples in any batching; without a filter (no delay) that is the only hold. The filter is
+designed once, from the stream's first intervals (`DESIGN_SAMPLES`, `gyro_filter.design`).
 
 Everything depends on the accepted samples alone, in order: any batching gives the same bits.
 The engine works on a `Frame` per push: the samples still pending from earlier pushes, then the
