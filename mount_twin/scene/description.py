@@ -151,13 +151,14 @@ class InitialState:
         pose: (X, Y, Z) m and (α, γ, δ) rad, for 'given'; also the values of frozen DOFs.
         velocity: (X', Y', Z') m/s and (α', γ', δ') rad/s, for 'given'.
         gravity_samples, gravity_window_s: for 'first_sample', the start gravity is the mean
-            specific force of the accepted samples from each (re)start up to the first one that
-            makes at least `gravity_samples` of them and lies at least `gravity_window_s` (s,
-            within 1 ns) after the first; the twin starts at that one (those before it are
-            taken but not integrated). The default window, 0.05 s, averages a real sensor's
-            noise (the 20 kHz water-entry record at rest: the start tilt 0.067 rad rms off
-            from one sample, 0.0047 rad from 50 ms, bench/start_gravity.py), is shorter than
-            a ship's motions and comparable with the gyro filter's 38 ms delay.
+            specific force of `gravity_samples` accepted samples from each (re)start, the twin
+            starting at the last of them (those before it are taken but not integrated), and
+            of the samples within `gravity_window_s` (s) after that one; of their leading
+            samples at rest only (`engine.starts.at_rest`: a shock among them ends them). The
+            default window, 0.05 s, averages a real sensor's noise (the 20 kHz water-entry
+            record at rest: the start tilt 0.067 rad rms off from one sample, 0.0047 rad from
+            50 ms, bench/start_gravity.py), is short beside a ship's motions and comparable
+            with the gyro filter's 38 ms delay.
         gravity_tolerance: start check: | |f₀| − g | / g past this is a WARN, past three times
             this an ERROR (a start on a shock, free fall, a bias, g added twice), −; at g = 0
             the unit is standard gravity (`InputSpec.g_scale`).
