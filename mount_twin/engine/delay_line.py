@@ -19,7 +19,8 @@ The engine works on a `Frame` per push: the samples still pending from earlier p
 pushed ones. A live node pushes a few samples at a time, so neither is copied whole per push:
 the pending samples wait in arrays with room after them (`Backlog`), a push of a few samples
 is appended there, and the raw Ω the filter reads likewise (`RawWindow`); both move to their
-arrays' start only when the room is used up.
+arrays' start only when the room is used up, into smaller arrays there once a large push's
+samples are gone (`Extent`).
 """
 
 from __future__ import annotations
@@ -45,7 +46,7 @@ with a note, rather than filtered by a design of that many taps."""
 ROOM = 256
 """Samples of room a store keeps beside its contents, at least, when it moves them to its
 arrays' start: a push of one sample moves the pending ones once every ROOM pushes or less
-often (`capacity`)."""
+often (`Extent`)."""
 STAMP_SLACK_S = 1e-9
 """s: a sample this much past `initial_state.gravity_window_s` after a start sample is within
 the start's window (a ROS stamp's resolution: float stamps lose a few ulps in differences)."""
@@ -54,10 +55,29 @@ LARGE = 4096
 concatenated: one copy of each either way), not a backlog that large kept between pushes."""
 
 
-def capacity(need: int, have: int) -> int:
-    """Samples to give arrays of `have` samples that must hold `need` with ROOM to spare: the
-    same while they do, else 2 need + ROOM (arrays double as they grow, never shrink)."""
-    return have if need + ROOM <= have else 2 * need + ROOM
+class Extent:
+    """How many samples a store's arrays (`Backlog`, `RawWindow`) are to hold, decided when
+    its contents move to their start (the room used up): twice the most a push has asked
+    them to hold since the last move, plus ROOM, where they are smaller than what this move
+    needs with ROOM to spare (they grow) or more than twice that (they shrink back); else
+    their size. Moves come once the room is used up, so the arrays shrink after as many
+    samples as a large push left room for (a replay chunk of 100 000: the 100 000 after it),
+    and pushes of mixed sizes keep them at the largest (a large push after small ones finds
+    its room, or asks at its move): they never grow and shrink at every push."""
+
+    def __init__(self) -> None:
+        self._peak = 0
+        """The most a push has asked the arrays to hold since their last move (samples)."""
+
+    def asked(self, need: int) -> None:
+        """A push asks the arrays to hold `need` samples (its own and those kept)."""
+        self._peak = max(self._peak, need)
+
+    def moved(self, need: int, have: int) -> int:
+        """The samples to give arrays of `have` at a move that must hold `need`."""
+        fit = 2 * max(self._peak, need) + ROOM
+        self._peak = 0
+        return have if need + ROOM <= have <= 2 * fit else fit
 
 
 def filter_bands(spec: InputSpec) -> tuple[float, float] | None:
@@ -137,6 +157,7 @@ class Backlog:
         """Samples pending (0 once a frame has taken them)."""
         self._framed = False
         """The last frame lies in these arrays, from row `_lo`."""
+        self._extent = Extent()
 
     @property
     def ids(self) -> np.ndarray:
@@ -162,6 +183,7 @@ class Backlog:
                 np.concatenate([self._ids[kept], ids]),
                 first_id,
             )
+        self._extent.asked(n + m)
         lo = self._room(n, m)
         hi = lo + n + m
         new = slice(lo + n, hi)
@@ -186,13 +208,14 @@ class Backlog:
 
     def _room(self, n: int, m: int) -> int:
         """Room for m samples after the n from row `_lo`: they are moved to row 0 (into
-        larger arrays, `capacity`) unless the room is there; returns their row."""
+        arrays of another size where `Extent` says) unless the room is there; returns their
+        row."""
         lo = self._lo
         if lo + n + m <= self._t.shape[0]:
             return lo
         old = (self._t, self._f, self._w, self._ids)
-        size = capacity(n + m, self._t.shape[0])
-        if size > self._t.shape[0]:
+        size = self._extent.moved(n + m, self._t.shape[0])
+        if size != self._t.shape[0]:
             self._t, self._f, self._w = np.empty(size), np.empty((size, 3)), np.empty((size, 3))
             self._ids = np.empty(size, np.int64)
         for a, b in zip((self._t, self._f, self._w, self._ids), old, strict=True):
@@ -211,6 +234,7 @@ class RawWindow:
         self._raw = np.empty((3, 0))
         self._lo = 0
         self._hi = 0
+        self._extent = Extent()
 
     @property
     def size(self) -> int:
@@ -224,6 +248,7 @@ class RawWindow:
     def append(self, w: np.ndarray) -> None:
         """Append samples (n, 3) of Ω (rad/s)."""
         m = w.shape[0]
+        self._extent.asked(self.size + m)
         self._room(0, m)
         self._raw[:, self._hi : self._hi + m] = w.T
         self._hi += m
@@ -249,13 +274,14 @@ class RawWindow:
 
     def _room(self, front: int, back: int) -> None:
         """Room for `front` samples before the window and `back` after it: the window moved
-        to column `front` (into larger arrays, `capacity`) unless the room is there."""
+        to column `front` (into arrays of another size where `Extent` says) unless the room
+        is there."""
         lo, hi = self._lo, self._hi
         if lo >= front and hi + back <= self._raw.shape[1]:
             return
         old, size = self._raw, hi - lo
-        columns = capacity(front + size + back, old.shape[1])
-        if columns > old.shape[1]:
+        columns = self._extent.moved(front + size + back, old.shape[1])
+        if columns != old.shape[1]:
             self._raw = np.empty((3, columns))
         self._raw[:, front : front + size] = old[:, lo:hi]
         self._lo, self._hi = front, front + size
