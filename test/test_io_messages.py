@@ -76,7 +76,7 @@ def test_imu_messages_decode_back_to_the_same_stamps_vectors_and_frames() -> Non
     assert dec.frame_ids == ["deck_imu"] * 50
 
 
-@pytest.mark.parametrize("n", [1, 2, 5, 8, 9])
+@pytest.mark.parametrize("n", [1, 2, 5, 8, 9, 24, 25])
 def test_a_wake_ups_few_messages_decode_as_rosbags_reads_them(n: int) -> None:
     """A live wake-up's few messages are read one by one against the last layout: each must
     give what rosbags reads from it, each reading marked not provided (-1: the first's
@@ -113,6 +113,30 @@ def test_a_wake_ups_few_messages_decode_as_rosbags_reads_them(n: int) -> None:
         assert dec.unprovided is not None
         np.testing.assert_array_equal(dec.unprovided, unprovided)
         assert dec.accel.flags.c_contiguous and dec.gyro.flags.c_contiguous
+
+
+@pytest.mark.parametrize(("n", "through_rosbags"), [(1, 0), (9, 0), (24, 0), (25, 1)])
+def test_a_wake_up_of_up_to_24_messages_is_read_without_rosbags(
+    monkeypatch: pytest.MonkeyPatch, n: int, through_rosbags: int
+) -> None:
+    """rosbags' decode of a call's first message and the numpy pass after it cost as much as
+    reading 26-28 Imu messages one by one (`python3 bench/bench_decode.py`): a wake-up of up to
+    24 messages of the frame_id last seen is read one by one, rosbags never called; one of 25
+    in bulk, rosbags reading its first message (the same values either way: the test above)."""
+    stamps, accel, gyro = rng_signal(n)
+    raws = [raw for _, raw in imu_messages(stamps, accel, gyro, "deck_imu")]
+    decode_inputs(raws[:1], IMU)  # the frame_id seen
+    calls = []
+    deserialize = TYPESTORE.deserialize_cdr
+
+    def counted(raw: Any, msgtype: str) -> Any:
+        calls.append(msgtype)
+        return deserialize(raw, msgtype)
+
+    monkeypatch.setattr(TYPESTORE, "deserialize_cdr", counted)
+    dec = decode_inputs(raws, IMU)
+    np.testing.assert_array_equal(dec.stamps_ns, stamps)
+    assert len(calls) == through_rosbags
 
 
 def _scans(monkeypatch: pytest.MonkeyPatch) -> dict[str, int]:

@@ -90,11 +90,15 @@ LAYOUT_FRAME_MAX = 256
 """Longest frame_id (characters) whose messages are read through a layout: a longer one (no
 sensor's; a hostile publisher's) is decoded by rosbags alone, neither probed (a probe
 serializes it twice) nor cached (`layout_of` kept 256 of them: 100 kB ids held 25 MB)."""
-ONE_BY_ONE_MAX = 8
+ONE_BY_ONE_MAX = 24
 """Most messages a decode first tries one by one against the layout of the frame_id last seen
-(`FixedLayout.unpack_one`): a live node's wake-up takes one message or a few. Measured
-2026-11-27 (Imu, best of 5 timeit runs, a loaded machine): 1, 2 and 8 messages 5.6, 7.7 and
-18.8 µs this way, 43-49 µs through rosbags (the first message) and the numpy pass."""
+(`FixedLayout.unpack_one`, about 3.5 + 1.8 n µs for n Imu messages) rather than in bulk
+(rosbags for the first message and one numpy pass, about 46 + 0.2 n µs): a live node's
+wake-up takes one message or a few. Set from `python3 bench/bench_decode.py` (the two ways
+alternately, best of 9 runs of 1000 calls each, CPU time), 2026-11-28, three runs: one by one
+was the faster up to 24, 26 and 27 messages (0.87-0.92 of bulk at 24) and no faster from 28;
+24 is the largest n it won in every run, a little short of the crossover, as a call whose
+messages do not all match the layout pays for both ways."""
 LAYOUT_SCANS = 4
 """Most rows a decode of n messages scans against layouts, in units of n (each new frame_id's
 layout scans every message still pending): past it the rest is decoded one by one, in time
@@ -113,7 +117,7 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
     are read in one numpy pass (`FixedLayout`; rows of `RawRows` as they lie), the rest one by
     one through rosbags. Up to ONE_BY_ONE_MAX messages (the live node's usual call) are first
     tried one by one against the layout of the frame_id last seen, without rosbags or the
-    numpy pass (one message: ~200 → ~15 µs). Frame ids past LAYOUT_FRAME_MAX
+    numpy pass (one message: ~46 → ~5 µs). Frame ids past LAYOUT_FRAME_MAX
     characters, and every message once LAYOUT_SCANS is spent, go through rosbags alone.
     """
     n = len(raws)
