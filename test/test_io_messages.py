@@ -139,6 +139,35 @@ def test_a_wake_up_of_up_to_24_messages_is_read_without_rosbags(
     assert len(calls) == through_rosbags
 
 
+def test_a_second_sensors_messages_go_in_bulk_without_trying_each_one_by_one(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A body IMU's calls alternate with the deck's, each of the other frame_id than the one
+    last seen: each call of 16 messages tried all 16 against the wrong layout before going in
+    bulk (a pair of calls took 1.6× the CPU of a decode that tried none). Only its first
+    message is tried now; every message still decodes to its own frame_id and stamp."""
+    from mount_twin.io import fixed_layout
+
+    stamps, accel, gyro = rng_signal(16)
+    deck = [raw for _, raw in imu_messages(stamps, accel, gyro, "deck_imu")]
+    body = [raw for _, raw in imu_messages(stamps, accel, gyro, "body_imu")]
+    tried = []
+    unpack_one = fixed_layout.FixedLayout.unpack_one
+
+    def counted(self: Any, raw: Any, want: Any) -> Any:
+        one = unpack_one(self, raw, want)
+        tried.append(one is not None)
+        return one
+
+    decode_inputs(deck, IMU)
+    monkeypatch.setattr(fixed_layout.FixedLayout, "unpack_one", counted)
+    for raws, frame in [(body, "body_imu"), (deck, "deck_imu")] * 2:
+        dec = decode_inputs(raws, IMU)
+        assert dec.frame_ids == [frame] * 16
+        np.testing.assert_array_equal(dec.stamps_ns, stamps)
+    assert tried == [False] * 4  # one message a call, of the other frame_id
+
+
 def _scans(monkeypatch: pytest.MonkeyPatch) -> dict[str, int]:
     """Count the layouts probed and the rows their unpacks scan (FixedLayout's), from no
     layout known (the messages to decode made before: their making probes layouts)."""

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from itertools import islice
 from typing import Any
 
 import numpy as np
@@ -92,13 +93,13 @@ sensor's; a hostile publisher's) is decoded by rosbags alone, neither probed (a 
 serializes it twice) nor cached (`layout_of` kept 256 of them: 100 kB ids held 25 MB)."""
 ONE_BY_ONE_MAX = 24
 """Most messages a decode first tries one by one against the layout of the frame_id last seen
-(`FixedLayout.unpack_one`, about 3.5 + 1.8 n µs for n Imu messages) rather than in bulk
-(rosbags for the first message and one numpy pass, about 46 + 0.2 n µs): a live node's
-wake-up takes one message or a few. Set from `python3 bench/bench_decode.py` (the two ways
-alternately, best of 9 runs of 1000 calls each, CPU time), 2026-11-28, three runs: one by one
-was the faster up to 24, 26 and 27 messages (0.87-0.92 of bulk at 24) and no faster from 28;
-24 is the largest n it won in every run, a little short of the crossover, as a call whose
-messages do not all match the layout pays for both ways."""
+(`FixedLayout.unpack_one`, about 3.6 + 1.8 n µs for n Imu messages) rather than in bulk
+(rosbags for the first message and one numpy pass, about 43 + 0.2 n µs): a live node's
+wake-up takes one message or a few. Set from `python3 bench/bench_decode.py --repeats 9
+--number 1000` (the two ways alternately, best CPU time of 9 runs of 1000 calls), 2026-11-28,
+three runs: one by one was the faster at every n up to 24 (0.95-0.99 of bulk there), no
+faster from 26 in two runs of three and from 28 in all; 24 is the largest n it won in every
+run."""
 LAYOUT_SCANS = 4
 """Most rows a decode of n messages scans against layouts, in units of n (each new frame_id's
 layout scans every message still pending): past it the rest is decoded one by one, in time
@@ -124,10 +125,14 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
     if 0 < n <= ONE_BY_ONE_MAX and msgtype in _LAST_FRAME:
         frame = _LAST_FRAME[msgtype]
         layout, want = layout_of(msgtype, frame), _INPUT_WANT[msgtype]
-        ones = [layout.unpack_one(raw, want) for raw in raws]
-        read = [one for one in ones if one is not None]
-        if len(read) == n:
-            return _decoded_rows(read, msgtype, frame)
+        first = layout.unpack_one(raws[0], want)
+        # a first message of another layout (a second sensor's frame_id: a body IMU's calls
+        # alternate with the deck's) goes in bulk at once, not after trying every message
+        if first is not None:
+            ones = [first, *[layout.unpack_one(raw, want) for raw in islice(raws, 1, None)]]
+            read = [one for one in ones if one is not None]
+            if len(read) == n:
+                return _decoded_rows(read, msgtype, frame)
     stamps = np.zeros(n, dtype=np.int64)
     accel, gyro, covariance = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 2))
     frames = np.full(n, "", dtype=object)
