@@ -139,33 +139,45 @@ def test_a_wake_up_of_up_to_24_messages_is_read_without_rosbags(
     assert len(calls) == through_rosbags
 
 
-def test_a_second_sensors_messages_go_in_bulk_without_trying_each_one_by_one(
+def test_a_second_sensors_messages_are_read_one_by_one_too(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """A body IMU's calls alternate with the deck's, each of the other frame_id than the one
-    last seen: each call of 16 messages tried all 16 against the wrong layout before going in
-    bulk (a pair of calls took 1.6× the CPU of a decode that tried none). Only its first
-    message is tried now; every message still decodes to its own frame_id and stamp."""
-    from mount_twin.io import fixed_layout
+    last seen: each call went in bulk (rosbags reading its first message), and before that
+    tried all its messages against the wrong layout (a pair of calls of 16 took 1.6× the CPU
+    of a decode that tried none). The frame_ids recently seen are tried on the first message
+    alone: once both sensors have been seen, neither call reaches rosbags, each tries one
+    wrong layout at most, and every message decodes to its own frame_id and stamp."""
+    from mount_twin.io import fixed_layout, input_decoding
 
     stamps, accel, gyro = rng_signal(16)
     deck = [raw for _, raw in imu_messages(stamps, accel, gyro, "deck_imu")]
     body = [raw for _, raw in imu_messages(stamps, accel, gyro, "body_imu")]
-    tried = []
-    unpack_one = fixed_layout.FixedLayout.unpack_one
+    monkeypatch.setattr(input_decoding, "_RECENT_FRAMES", {})
+    decode_inputs(deck, IMU)
+    decode_inputs(body, IMU)  # both seen, the body's the latest
+    tried, calls = [], []
+    unpack_one, deserialize = fixed_layout.FixedLayout.unpack_one, TYPESTORE.deserialize_cdr
 
     def counted(self: Any, raw: Any, want: Any) -> Any:
         one = unpack_one(self, raw, want)
         tried.append(one is not None)
         return one
 
-    decode_inputs(deck, IMU)
+    def counted_rosbags(raw: Any, msgtype: str) -> Any:
+        calls.append(msgtype)
+        return deserialize(raw, msgtype)
+
     monkeypatch.setattr(fixed_layout.FixedLayout, "unpack_one", counted)
-    for raws, frame in [(body, "body_imu"), (deck, "deck_imu")] * 2:
+    monkeypatch.setattr(TYPESTORE, "deserialize_cdr", counted_rosbags)
+    for raws, frame in [(deck, "deck_imu"), (body, "body_imu")] * 2:
         dec = decode_inputs(raws, IMU)
         assert dec.frame_ids == [frame] * 16
         np.testing.assert_array_equal(dec.stamps_ns, stamps)
-    assert tried == [False] * 4  # one message a call, of the other frame_id
+    assert calls == []
+    wrong = tried.count(False)
+    assert wrong <= 4  # one wrong layout a call at most, on its first message
+    assert len(tried) == 4 * 16 + wrong
 
 
 def _scans(monkeypatch: pytest.MonkeyPatch) -> dict[str, int]:
@@ -187,7 +199,7 @@ def _scans(monkeypatch: pytest.MonkeyPatch) -> dict[str, int]:
     monkeypatch.setattr(fixed_layout.FixedLayout, "unpack", counted_unpack)
     monkeypatch.setattr(fixed_layout.FixedLayout, "probe", classmethod(counted_probe))
     messages.layout_of.cache_clear()
-    monkeypatch.setattr(input_decoding, "_LAST_FRAME", {})
+    monkeypatch.setattr(input_decoding, "_RECENT_FRAMES", {})
     return seen
 
 

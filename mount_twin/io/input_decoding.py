@@ -92,14 +92,14 @@ LAYOUT_FRAME_MAX = 256
 sensor's; a hostile publisher's) is decoded by rosbags alone, neither probed (a probe
 serializes it twice) nor cached (`layout_of` kept 256 of them: 100 kB ids held 25 MB)."""
 ONE_BY_ONE_MAX = 24
-"""Most messages a decode first tries one by one against the layout of the frame_id last seen
-(`FixedLayout.unpack_one`, about 3.6 + 1.8 n µs for n Imu messages) rather than in bulk
-(rosbags for the first message and one numpy pass, about 43 + 0.2 n µs): a live node's
-wake-up takes one message or a few. Set from `python3 bench/bench_decode.py --repeats 9
---number 1000` (the two ways alternately, best CPU time of 9 runs of 1000 calls), 2026-11-28,
-three runs: one by one was the faster at every n up to 24 (0.95-0.99 of bulk there), no
-faster from 26 in two runs of three and from 28 in all; 24 is the largest n it won in every
-run."""
+"""Most messages a decode first tries one by one against the layout of a frame_id recently seen
+(`RECENT_FRAMES`; `FixedLayout.unpack_one`, about 3.6 + 1.8 n µs for n Imu messages) rather than
+in bulk (rosbags for the first message and one numpy pass, about 43 + 0.2 n µs): a live node's
+wake-up takes one message or a few. Set from `python3
+bench/bench_decode.py --repeats 9 --number 1000` (the two ways alternately, best CPU time of 9
+runs of 1000 calls), 2026-11-28, three runs: one by one was the faster at every n up to 24
+(0.95-0.99 of bulk there), no faster from 26 in two runs of three and from 28 in all; 24 is the
+largest n it won in every run."""
 LAYOUT_SCANS = 4
 """Most rows a decode of n messages scans against layouts, in units of n (each new frame_id's
 layout scans every message still pending): past it the rest is decoded one by one, in time
@@ -117,22 +117,25 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
     rosbags decodes the first message of each frame_id; the messages that share its fixed layout
     are read in one numpy pass (`FixedLayout`; rows of `RawRows` as they lie), the rest one by
     one through rosbags. Up to ONE_BY_ONE_MAX messages (the live node's usual call) are first
-    tried one by one against the layout of the frame_id last seen, without rosbags or the
-    numpy pass (one message: ~46 → ~5 µs). Frame ids past LAYOUT_FRAME_MAX
-    characters, and every message once LAYOUT_SCANS is spent, go through rosbags alone.
+    tried one by one against the layouts of the frame_ids last seen (`RECENT_FRAMES`: the first
+    message tells which, if any), without rosbags or the numpy pass (one message: ~46 → ~5
+    µs). Frame ids past LAYOUT_FRAME_MAX characters, and every message once LAYOUT_SCANS is
+    spent, go through rosbags alone.
     """
     n = len(raws)
-    if 0 < n <= ONE_BY_ONE_MAX and msgtype in _LAST_FRAME:
-        frame = _LAST_FRAME[msgtype]
-        layout, want = layout_of(msgtype, frame), _INPUT_WANT[msgtype]
-        first = layout.unpack_one(raws[0], want)
-        # a first message of another layout (a second sensor's frame_id: a body IMU's calls
-        # alternate with the deck's) goes in bulk at once, not after trying every message
-        if first is not None:
+    if 0 < n <= ONE_BY_ONE_MAX:
+        want = _INPUT_WANT[msgtype]
+        for frame in _RECENT_FRAMES.get(msgtype, ()):
+            layout = layout_of(msgtype, frame)
+            # a first message of another layout (a second sensor's frame_id: a body IMU's
+            # calls alternate with the deck's) tries the next frame_id, not every message
+            if (first := layout.unpack_one(raws[0], want)) is None:
+                continue
             ones = [first, *[layout.unpack_one(raw, want) for raw in islice(raws, 1, None)]]
             read = [one for one in ones if one is not None]
             if len(read) == n:
                 return _decoded_rows(read, msgtype, frame)
+            break
     stamps = np.zeros(n, dtype=np.int64)
     accel, gyro, covariance = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 2))
     frames = np.full(n, "", dtype=object)
@@ -171,7 +174,7 @@ def decode_inputs(raws: Sequence[bytes | memoryview], msgtype: str) -> Decoded:
         if not match[0]:  # this writer's padding or extras differ: no batch for it
             batched = False
             continue
-        _LAST_FRAME[msgtype] = msg.header.frame_id
+        _seen(msgtype, msg.header.frame_id)
         every = rest.shape[0] == n - 1 and bool(match.all())  # the usual: a slice, no index
         got: slice | np.ndarray = slice(1, n) if every else rest[match[1:]]
         pending[got] = False
@@ -228,5 +231,17 @@ def _input_values(msg: Any, msgtype: str) -> tuple[int, tuple, tuple, tuple]:
 _INPUT_WANT = {IMU: (*range(8), 30, 21), ACCEL: range(5)}
 """Fields an input decode reads: sec, nanosec, acceleration (and for Imu ω, then
 linear_acceleration_covariance[0] and angular_velocity_covariance[0])."""
-_LAST_FRAME: dict[str, str] = {}
-"""Input type → frame_id of the last message decoded through its layout (a cache)."""
+RECENT_FRAMES = 4
+"""Most frame_ids per input type whose layouts a call of up to ONE_BY_ONE_MAX messages tries
+(`_RECENT_FRAMES`): the deck's and a body IMU's, whose calls alternate, and a few more."""
+_RECENT_FRAMES: dict[str, list[str]] = {}
+"""Input type → the frame_ids last decoded through their layouts, the latest first (a cache)."""
+
+
+def _seen(msgtype: str, frame: str) -> None:
+    """`frame` decoded through its layout: first of `_RECENT_FRAMES[msgtype]`."""
+    recent = _RECENT_FRAMES.setdefault(msgtype, [])
+    if frame in recent:
+        recent.remove(frame)
+    recent.insert(0, frame)
+    del recent[RECENT_FRAMES:]
