@@ -4,12 +4,15 @@ whose rows equal single runs of the same cases; resumable, a failing case is a r
 from __future__ import annotations
 
 import csv
+import hashlib
 import math
 import shutil
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import pytest
+import yaml
 from io_helpers import CONFIG, ROOT
 
 from mount_twin.analysis.figures import peak_text, utilisation_text
@@ -211,6 +214,25 @@ def test_results_no_sweep_can_append_to_are_an_error_naming_them_before_any_case
     assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
 
 
+def test_results_written_before_the_scene_digest_column_are_read_but_not_appended_to(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A results CSV of the columns before `scene_sha256`: its rows still read, and a sweep
+    refuses to append rows of another layout to it, naming the column, before any case runs."""
+    sweep = _sweep_file(tmp_path)
+    old = tmp_path / "old.csv"
+    head = [c for c in columns(load_sweep(sweep)) if c != "scene_sha256"]
+    with old.open("w", encoding="utf-8", newline="") as fh:
+        writer = csv.DictWriter(fh, head)
+        writer.writeheader()
+        writer.writerow({"case": "c0", "input": "dhs", "verdict": "OK", "events": 0})
+    before = old.read_bytes()
+    assert [(r["case"], r["verdict"]) for r in read_results(old)] == [("c0", "OK")]
+    assert main(["sweep", str(sweep), "-o", str(old), "--workers", "1", "--no-progress"]) == 2
+    assert "missing ['scene_sha256'], not ours []: write to a new file" in capsys.readouterr().err
+    assert old.read_bytes() == before
+
+
 @pytest.mark.parametrize("rows", [0, 1])
 def test_results_in_directories_it_makes_are_removed_with_them_if_stopped_before_a_row(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, rows: int
@@ -279,6 +301,74 @@ def test_a_bad_case_is_a_failed_row_and_the_rest_still_run(swept) -> None:
     assert len(good) == 4 and all(float(r["peak_force_magnitude_N.fl"]) > 1000.0 for r in good)
     # each case's own error estimate: the pump at one step per sample is ~1e-9 off
     assert all(0.0 < float(r["est_force_error_rel"]) < 1e-6 for r in good)
+
+
+def _pump_scene(scale: float, **values: Any) -> dict[str, Any]:
+    """The bundled pump's scene mapping with every mount's stiffness × `scale` and each
+    `values` (section → key → value) set: a sweep case's scene, built here by hand."""
+    data = yaml.safe_load(PUMP.read_text(encoding="utf-8"))
+    for mount in data["mounts"]:
+        mount["stiffness"] = [scale * k for k in mount["stiffness"]]
+    for section, keys in values.items():
+        data[section].update(keys)
+    return data
+
+
+def _replayed_digest(tmp: Path, data: dict[str, Any]) -> str:
+    """The scene digest a `mount-twin replay` of the scene `data` (written to a file) records in
+    its output bag's metadata, checked to be the sha256 of the scene's value it records beside
+    it (the text `report --scene` reads)."""
+    tmp.mkdir(parents=True)
+    bag, scene, out = tmp / "bag", tmp / "case.scene.yaml", tmp / "out"
+    shock = ["--peak", "150", "--pulse", "0.008", "--rate", "4000", "--duration", "0.1"]
+    assert main(["generate", "half-sine", "-o", str(bag), *shock]) == 0
+    scene.write_text(yaml.safe_dump(data), encoding="utf-8")
+    assert main(["replay", str(bag), "--scene", str(scene), "-o", str(out)]) in (0, 3)
+    metadata = yaml.safe_load((out / "metadata.yaml").read_text(encoding="utf-8"))
+    custom = metadata["rosbag2_bagfile_information"]["custom_data"]
+    digest = custom["mount_twin.scene_sha256"]
+    assert hashlib.sha256(custom["mount_twin.scene_value"].encode()).hexdigest() == digest
+    return digest
+
+
+def test_each_row_names_its_scene_by_the_digest_a_replay_of_that_scene_records(
+    swept, tmp_path: Path
+) -> None:
+    """A row did not say which scene it ran: a surprising one could not be checked against the
+    scene its reader had in mind. Each row holds the digest of its case's scene, the one a
+    replay of that scene records (and `report --scene` checks); the two inputs of one setting
+    share it, the two stiffnesses differ. A case whose scene did not load (a negative mass)
+    has none to name: its cell is empty, its error says why."""
+    _, results, _ = swept
+    digests = {
+        scale: _replayed_digest(tmp_path / str(scale), _pump_scene(scale, body={"mass": 1100.0}))
+        for scale in (0.5, 2.0)
+    }
+    assert digests[0.5] != digests[2.0]
+    rows = read_results(results)
+    for r in rows:
+        if r["body.mass"] == -5.0:
+            assert (r["verdict"], r["scene_sha256"]) == (FAILED, ""), r["case"]
+        else:
+            assert r["scene_sha256"] == digests[r["mounts[*].stiffness (scale)"]], r["case"]
+    assert all(isinstance(r["scene_sha256"], str) for r in rows)  # text, as a case id
+
+
+def test_a_failed_cases_row_names_the_scene_it_failed_on(tmp_path: Path) -> None:
+    """A case whose scene loaded and whose run failed, on the engine's side (the bag's frame_id
+    not the scene's: no sample accepted) or before it (a generated input of rate 0), keeps the
+    digest of its scene: the one a replay of that scene records."""
+    varied = "input.frame_id\n    values: [x]"
+    text = SWEEP.replace("body.mass\n    values: [1100.0, -5.0]", varied)
+    text = text.replace("rate: 4000.0,", "rate: 0.0,")
+    spec = load_sweep(_sweep_file(tmp_path, text))
+    rows = [(c, run_case(spec.base, spec.source, c)) for c in check(spec)]
+    assert [r["verdict"] for _, r in rows] == [FAILED] * 4
+    assert {c.input.name for c, _ in rows} == {"half_sine_shock_10khz", "dhs"}
+    for case, row in rows:
+        scale = case.settings[0][2]
+        data = _pump_scene(scale, input={"frame_id": "x"})
+        assert row["scene_sha256"] == _replayed_digest(tmp_path / case.case_id, data), row
 
 
 def test_results_are_typed_numbers_as_numbers(swept) -> None:

@@ -1,7 +1,8 @@
 """Running a sweep: one case as a pure function of its inputs, many on a Dask cluster.
 
 `run_case` is what a worker runs: it builds the case's scene, reads (once per worker process)
-or generates its input, pushes it through a `TwinEngine` and returns one row of figures. No bag
+or generates its input, pushes it through a `TwinEngine` and returns one row of figures, with
+the digest of the scene it ran (`SCENE_DIGEST`, as a replay of that scene records it). No bag
 is written. `run_sweep` submits the unfinished cases to a `dask.distributed` client (a local
 cluster on this machine's cores by default, or a scheduler address) and appends each row to a
 CSV as it completes, so an interrupted sweep resumes where it stopped; a case that fails is a
@@ -34,7 +35,7 @@ from mount_twin.engine.tilt import tilt_from_quaternions
 from mount_twin.errors import MountTwinError
 from mount_twin.model.assemble import assemble
 from mount_twin.physics import pose_row
-from mount_twin.scene.description import InputSpec, Scene
+from mount_twin.scene.description import InputSpec, Scene, scene_digest
 from mount_twin.scene.loader import scene_from_dict
 from mount_twin.sweeps.cases import Case, apply, expand, key_unit
 from mount_twin.sweeps.cluster import dask_client, results_as_completed
@@ -43,18 +44,24 @@ from mount_twin.textfiles import directories_above
 
 UTILISATION = "utilisation"
 """The result table's per-mount utilisation columns are UTILISATION.<mount> (NaN: unrated)."""
+SCENE_DIGEST = "scene_sha256"
+"""The result table's column of the scene a case ran: its digest (`scene.description.scene_digest`,
+the sha256 a replay of that scene records as `mount_twin.scene_sha256` and `report --scene`
+checks), '' where the case's scene did not load."""
 BATCHES_PER_WORKER = 4
 """Tasks per worker a sweep is cut into: few enough to share the scheduling cost, enough to
 balance the load and to report progress."""
 
 
 def columns(spec: SweepSpec) -> list[str]:
-    """The result table's columns: case, input, one per varied key, then the figures."""
+    """The result table's columns: case, input, one per varied key, the scene's digest
+    (SCENE_DIGEST), then the figures."""
     names = [m["name"] for m in spec.base["mounts"]]
     return [
         "case",
         "input",
         *(v.key if v.op == "set" else f"{v.key} (scale)" for v in spec.variations),
+        SCENE_DIGEST,
         "verdict",
         "error",
         *(f"{PEAK_FORCE}.{n}" for n in names),
@@ -108,15 +115,18 @@ def _input_samples(case: InputCase, spec: InputSpec) -> SampleBatch:
 
 
 def run_case(base: dict[str, Any], source: str, case: Case) -> dict[str, Any]:
-    """One row of figures for `case` (never raises: a failure is a FAILED row)."""
+    """One row of figures for `case` (never raises: a failure is a FAILED row), with the
+    digest of its scene (SCENE_DIGEST) wherever that scene loaded, a failed case's too."""
     row: dict[str, Any] = {"case": case.case_id, "input": case.input.name}
     for key, op, value in case.settings:
         row[key if op == "set" else f"{key} (scale)"] = setting_text(value)
+    row[SCENE_DIGEST] = ""
     t0 = time.perf_counter()
     try:
         scene = scene_from_dict(
             apply(base, case.settings), f"{source} case {case.case_id}", refuse_unheld=True
         )
+        row[SCENE_DIGEST] = scene_digest(scene)
         samples = _input_samples(case.input, scene.input)
         row.update(_figures(scene, samples))
     except (MountTwinError, ValueError, KeyError, OSError) as err:
@@ -263,8 +273,8 @@ def _cell(value: Any) -> Any:
     return repr(value) if isinstance(value, float) else value
 
 
-TEXT_COLUMNS = frozenset({"case", "input", "verdict", "error", "first_event"})
-"""Columns that hold text whatever they look like (a case id of digits stays an id)."""
+TEXT_COLUMNS = frozenset({"case", "input", SCENE_DIGEST, "verdict", "error", "first_event"})
+"""Columns that hold text whatever they look like (a case id or a digest of digits stays one)."""
 
 
 def read_results(results: str | Path) -> list[dict[str, Any]]:
