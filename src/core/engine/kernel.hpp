@@ -61,10 +61,6 @@ struct Companion {
   Integrator integ;
   Vec y;
   Scratch s;
-  Vec y_prev;
-  Mat g;
-  Vec util;
-  Vec pose;
   M6 wrenches;
   Vec figures;  // (N_FIGURES,)
 };
@@ -110,8 +106,10 @@ inline int watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, double
   return (changed ? CHANGED : 0) | (engaged ? ENGAGED : 0);
 }
 
-/// Advance the companion over [t0, t1] under the input u the twin just took, and fold the
-/// differences of its outputs from the twin's (pose, wrenches at t1; y the twin's state).
+/// Advance the companion over [t0, t1] under the input u the twin just took, take its mounts'
+/// discrete switches, and fold the differences of its outputs from the twin's (pose, wrenches
+/// at t1; y the twin's state): its wrenches and angles only, what the estimate compares (no
+/// quaternion, event functions or utilisation of its own: nothing reads them).
 inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
                    Vec d_wdot, Vec pose, M6 wrenches, Vec y) {
   const Vec settings = c.integ.settings, figures = c.figures;
@@ -123,16 +121,13 @@ inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bo
   const int status = integrate::advance(c.integ.method, c.y, t0, t1, settings, m, c.s, u,
                                         c.integ.work2d, c.integ.work1d, c.integ.result);
   if (status != 0) {
-    for (idx i = 0; i < y.n; ++i) {
-      c.y[i] = y[i];
-      c.y_prev[i] = y[i];
-    }
+    copy(y, c.y);
     integrate::forget(settings);
     figures[FAILURES] += 1.0;
     return;
   }
-  physics::outputs(c.y, m, c.s, c.pose, c.wrenches);
-  if (m.has_nl) monitor_switches(c.y, m.nl, c.y_prev, c.s, c.g, c.util, settings);
+  physics::mount_wrenches(c.y, m, c.s, c.wrenches);  // the body's motion at c.y: its last rhs
+  if (m.has_nl && physics::mount_switches(c.y, m.nl, c.s)) settings[CHAINED] = 0.0;
   double force = figures[FORCE_ERROR], scale = figures[FORCE_SCALE];
   for (idx a = 0; a < wrenches.rows; ++a) {
     for (int b = 0; b < 3; ++b) {
@@ -143,7 +138,7 @@ inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bo
   double attitude = figures[ATTITUDE_ERROR];
   for (int i = 0; i < 3; ++i) {
     const int k = pose_row::ANGLES + i;
-    attitude = py_max(attitude, std::fabs(pose[k] - c.pose[k]));
+    attitude = py_max(attitude, std::fabs(pose[k] - c.s.q[3 + i]));
   }
   figures[FORCE_ERROR] = force;
   figures[FORCE_SCALE] = scale;
