@@ -28,7 +28,8 @@ from mount_twin.scene.description import DOF_NAMES
 
 def test_the_settings_slots_are_the_cores() -> None:
     names = ("STEP", "RTOL", "ATOL", "MAX_SUBSTEPS", "CHAINED", "MIN_STEPS", "JACOBIAN_AGE")
-    python = tuple(getattr(settings, n) for n in (*names, "PHI_STEP", "N_SETTINGS"))
+    later = ("PHI_STEP", "HOLD_AFTER_REJECT", "N_SETTINGS")
+    python = tuple(getattr(settings, n) for n in (*names, *later))
     assert python == _core.SETTING_SLOTS
 
 

@@ -29,8 +29,10 @@ from mount_twin.analysis.accuracy import (
     resolution,
     run_at,
 )
+from mount_twin.engine import companion
 from mount_twin.engine import driver as driver_module
 from mount_twin.engine.batch import WARN, SampleBatch
+from mount_twin.engine.companion import new_companion
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.estimator import (
     BORROWED,
@@ -48,6 +50,9 @@ from mount_twin.engine.estimator import (
     new_estimator,
 )
 from mount_twin.engine.health_texts import INTEGRATION
+from mount_twin.integrate.methods import METHODS
+from mount_twin.integrate.settings import HOLD_AFTER_REJECT
+from mount_twin.integrate.stepper import new_stepper
 from mount_twin.io.input_samples import read_samples
 from mount_twin.model.assemble import assemble
 from mount_twin.replay import replay
@@ -376,6 +381,19 @@ def test_the_bundled_scene_reports_a_tiny_estimate_and_it_can_be_turned_off() ->
 
 def test_the_genset_scene_file_loads_with_the_estimate_on_by_default() -> None:
     assert load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml").integration.error_estimate
+
+
+def test_only_the_companion_holds_its_step_after_a_rejection() -> None:
+    """The companion's stepper grows no step right after a rejection (HOLD_AFTER_REJECT: on
+    the genset's sliding joints a step grown at once from one accepted with a tiny error is
+    rejected again), a method switch included; the twin's stepper does not hold, so what it
+    publishes is the plain controller's (bench/core_parity.py: bit for bit)."""
+    model = assemble(load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml"))
+    n, scratch = model.n_state, model.new_scratch()
+    comp = new_companion("auto", n, 1e-6, 1e-9, 100, scratch, model.n_mounts)
+    assert comp.settings[HOLD_AFTER_REJECT] == 1.0
+    assert companion.switch(comp, METHODS["exprb32"].id).settings[HOLD_AFTER_REJECT] == 1.0
+    assert new_stepper("auto", n, 1e-6, 1e-9, 100).settings[HOLD_AFTER_REJECT] == 0.0
 
 
 def test_on_a_stiff_scene_the_linearising_methods_are_stable_where_explicit_ones_hunt() -> None:

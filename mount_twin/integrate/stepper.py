@@ -24,6 +24,7 @@ from mount_twin.integrate.methods import (
 )
 from mount_twin.integrate.settings import (
     ATOL,
+    HOLD_AFTER_REJECT,
     MAX_SUBSTEPS,
     MIN_STEPS,
     N_SETTINGS,
@@ -85,11 +86,19 @@ class Stepper:
 
 
 def new_stepper(
-    method: str, n: int, rtol: float, atol: float, max_substeps: int, min_steps: int = 1
+    method: str,
+    n: int,
+    rtol: float,
+    atol: float,
+    max_substeps: int,
+    min_steps: int = 1,
+    *,
+    hold_after_reject: bool = False,
 ) -> Stepper:
     """A stepper of `method` (a name in METHODS, or AUTO: work arrays for any method, running
     dopri54 until `switch`) for n states; atol in the state's units (m, rad, m/s, rad/s); at
-    least `min_steps` steps per input interval."""
+    least `min_steps` steps per input interval; `hold_after_reject`: no step accepted right
+    after a rejection proposes a longer one (`integrate.settings` HOLD_AFTER_REJECT)."""
     if method not in METHODS and method != AUTO:
         msg = f"unknown integration method {method!r}; choose from {', '.join(METHODS)}"
         raise ValueError(msg)
@@ -104,6 +113,7 @@ def new_stepper(
     settings = np.zeros(N_SETTINGS)
     settings[RTOL], settings[ATOL], settings[MAX_SUBSTEPS] = rtol, atol, float(max_substeps)
     settings[MIN_STEPS] = float(min_steps)
+    settings[HOLD_AFTER_REJECT] = float(hold_after_reject)
     return Stepper(spec.name, spec.id, settings, np.zeros((rows, n)), np.zeros(n))
 
 
@@ -115,13 +125,22 @@ def tighter_arrays(
     max_substeps: int,
     divisor: float,
     min_steps: int,
+    *,
+    hold_after_reject: bool = False,
 ) -> tuple[int, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(method id, settings, work2d, work1d, result) of a stepper like the twin's (`method`,
     rtol, atol, max_substeps) at its tolerances over `divisor` and at least `min_steps` steps
-    per interval (up to min_steps × max_substeps): the error estimate's own stepper, the leading
-    fields of `engine.kernel.Integrator` and of the estimate's arrays."""
+    per interval (up to min_steps × max_substeps; `hold_after_reject` as `new_stepper`): the
+    error estimate's own stepper, the leading fields of `engine.kernel.Integrator` and of the
+    estimate's arrays."""
     own = new_stepper(
-        method, n, rtol / divisor, atol / divisor, min_steps * max_substeps, min_steps
+        method,
+        n,
+        rtol / divisor,
+        atol / divisor,
+        min_steps * max_substeps,
+        min_steps,
+        hold_after_reject=hold_after_reject,
     )
     return own.method, own.settings, own.work2d, own.work1d, own.result
 

@@ -7,7 +7,8 @@ namespace mt {
 
 // A stepper's settings vector (integrate/settings.py).
 enum Setting : int {
-  STEP = 0, RTOL, ATOL, MAX_SUBSTEPS, CHAINED, MIN_STEPS, JACOBIAN_AGE, PHI_STEP, N_SETTINGS
+  STEP = 0, RTOL, ATOL, MAX_SUBSTEPS, CHAINED, MIN_STEPS, JACOBIAN_AGE, PHI_STEP,
+  HOLD_AFTER_REJECT, N_SETTINGS
 };
 
 // A stepper's status (integrate/methods.py).

@@ -7,7 +7,8 @@ PYBIND11_MODULE(_core_ext, m) {
   m.doc() = "mount_twin's compiled core: mount laws, equations of motion, steppers, the loop";
   m.attr("SETTING_SLOTS") = pybind11::make_tuple(
       int(mt::STEP), int(mt::RTOL), int(mt::ATOL), int(mt::MAX_SUBSTEPS), int(mt::CHAINED),
-      int(mt::MIN_STEPS), int(mt::JACOBIAN_AGE), int(mt::PHI_STEP), int(mt::N_SETTINGS));
+      int(mt::MIN_STEPS), int(mt::JACOBIAN_AGE), int(mt::PHI_STEP), int(mt::HOLD_AFTER_REJECT),
+      int(mt::N_SETTINGS));
   m.attr("STATUSES") = pybind11::make_tuple(
       int(mt::SUCCESS), int(mt::TOO_MANY_STEPS), int(mt::STEP_TOO_SMALL), int(mt::LEFT_CHART),
       int(mt::NOT_FINITE), int(mt::UNKNOWN_METHOD));

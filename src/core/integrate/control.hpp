@@ -27,6 +27,17 @@ inline double step_factor(double err, bool not_finite, int order, double max_fac
   return py_min(max_factor, py_max(MIN_FACTOR, SAFETY * std::pow(err, expo)));
 }
 
+/// The largest factor the step may grow by at the step to conclude: max_factor, or 1 where that
+/// step came right after a rejection and settings[HOLD_AFTER_REJECT] is set (Hairer, Nørsett &
+/// Wanner I, §II.4: facmax = 1 right after a rejection, as their DOPRI5 code does). Where the
+/// error does not shrink as the step's order says (a right-hand side that bends inside the
+/// step: a joint face between sticking and sliding), a step grown at once from one accepted
+/// with a tiny error is rejected again, and again (the bolted genset's companion under its
+/// shock: 155 of its 436 rejections, docs/benchmarks.md).
+inline double growth_limit(Vec settings, bool after_rejection, double max_factor) {
+  return after_rejection && settings[HOLD_AFTER_REJECT] != 0.0 ? 1.0 : max_factor;
+}
+
 /// SUCCESS to go on, else the status to stop with: too many steps, or a step too small to go
 /// on with (NaN or inf, the chart's edge, or plain underflow, as the last rejection says).
 inline int give_up(idx steps, double max_steps, bool too_small, bool not_finite,

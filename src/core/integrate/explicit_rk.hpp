@@ -79,6 +79,7 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
   idx n_acc = 0, n_rej = 0;
   bool rhs_failed = false;
   bool not_finite = false;  // the last rejection was for NaN or inf (stage state or error norm)
+  bool retried = false;     // the last step tried was rejected
   if (settings[CHAINED] == 0.0) {  // else the caller put dy/dt at (t0, y) for this input in k[0]
     rhs_failed = physics::rhs(t, y, m, s, u, k.row(0)) != 0;
   }
@@ -104,6 +105,7 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
       }
       h = step * OFF_CHART_SHRINK;
       n_rej += 1;
+      retried = true;
       continue;
     }
     // y_new holds the propagated solution (FSAL: the last stage row of A is the weights B).
@@ -118,7 +120,8 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
     err = std::sqrt(err / static_cast<double>(n));
     // NaN or inf: rejected below and shrunk by the most; if it persists, NOT_FINITE
     not_finite = !std::isfinite(err);
-    const double factor = step_factor(err, not_finite, T::ORDER, T::MAX_FACTOR);
+    const double factor =
+        step_factor(err, not_finite, T::ORDER, growth_limit(settings, retried, T::MAX_FACTOR));
     if (err <= 1.0) {
       t = last ? t1 : t + step;
       for (idx i = 0; i < n; ++i) {
@@ -128,9 +131,11 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
       err_max = py_max(err_max, err);
       n_acc += 1;
       h = next_proposal(step, h, factor, last);
+      retried = false;
     } else {
       h = step * py_min(1.0, factor);
       n_rej += 1;
+      retried = true;
     }
   }
   record(settings, result, h, err_max, n_acc, n_rej);

@@ -68,6 +68,7 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
     return LEFT_CHART;
   }
   bool not_finite = false, off_chart = false;  // what the last rejection was for
+  bool retried = false;                         // the last step tried was rejected
   while (t < t1) {
     const bool too_small = h < MIN_STEP_FRACTION * span;
     const int status = give_up(n_acc + n_rej, max_steps, too_small, not_finite, off_chart);
@@ -126,11 +127,14 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
     if (!ok) {
       h = step * OFF_CHART_SHRINK;
       n_rej += 1;
+      retried = true;
       continue;
     }
     const Concluded done = conclude(y, y_new, t, t1, step, h, last, err, not_finite, ORDER,
-                                    MAX_FACTOR, m, s, u, k, F, FTMP);
+                                    growth_limit(settings, retried, MAX_FACTOR), m, s, u, k, F,
+                                    FTMP);
     take(done, err, t, h, err_max, n_acc, n_rej);
+    retried = !done.accepted;
   }
   record(settings, result, h, err_max, n_acc, n_rej);
   return SUCCESS;
