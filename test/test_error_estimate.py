@@ -54,6 +54,7 @@ from mount_twin.integrate.methods import METHODS
 from mount_twin.integrate.settings import HOLD_AFTER_REJECT
 from mount_twin.integrate.stepper import new_stepper
 from mount_twin.io.input_samples import read_samples
+from mount_twin.model import assemble as assemble_module
 from mount_twin.model.assemble import assemble
 from mount_twin.replay import replay
 from mount_twin.scene.description import Scene
@@ -540,6 +541,23 @@ def test_auto_starts_a_light_body_beside_a_stiff_key_on_what_the_closed_key_need
     assert got["auto"].force_error < 1e-3
     assert 1 / FACTOR < got["auto"].est_force_error / got["auto"].force_error < FACTOR
     assert got["dopri54"].force_error > 1e-2
+
+
+def test_the_tangent_rate_is_the_body_on_its_springs_taken_once_per_model(monkeypatch) -> None:
+    """What `auto` weighs at every start: a body free along z only, on four springs of k each,
+    moves at ω = √(4k/m) rad/s; a model takes it once, not at each engine's start."""
+    k, m = 2.0e6, 50.0
+    mounts = [
+        mount(f"m{i}", (x, y, 0.0), (1e5, 1e5, k, 0, 0, 0)) for i, (x, y) in enumerate(CORNERS)
+    ]
+    data = base_scene(m, [0.0, 0.0, 0.1], [1.0] * 3 + [0.0] * 3, mounts, dofs=["z"])
+    model = assemble(scene_from_dict(data, "<tangent rate test>"))
+    taken = []
+    real = assemble_module.statics
+    monkeypatch.setattr(assemble_module, "statics", lambda scene: taken.append(1) or real(scene))
+    assert model.tangent_rate == pytest.approx(math.sqrt(4.0 * k / m), rel=1e-12)
+    assert model.tangent_rate == pytest.approx(math.sqrt(4.0 * k / m), rel=1e-12)
+    assert len(taken) == 1
 
 
 def test_auto_looks_again_after_a_mount_event_the_same_live_and_replayed() -> None:

@@ -27,8 +27,6 @@ from mount_twin.errors import ModelError
 from mount_twin.integrate.methods import choose
 from mount_twin.model.assemble import Model
 from mount_twin.model.stiffness import spectral_radius
-from mount_twin.scene.description import DOF_NAMES
-from mount_twin.scene.statics import statics
 
 REEXAMINE_S = 0.01
 """Record time (s) after a look at the scene before a mount event prompts the next: a joint
@@ -54,21 +52,9 @@ class Choice:
         return f"{self.method} (auto: {self.why})"
 
 
-def tangent_rate(model: Model) -> float:
-    """The fastest mode (rad/s) of the body on its mounts' nominal tangents (keys bearing,
-    bolted joints closed, snubbers open), free DOFs only; 0 if it is not a number."""
-    st = statics(model.scene)
-    if not st.finite:
-        return 0.0
-    free = [DOF_NAMES.index(d) for d in model.scene.dofs]
-    k, m = st.elastic[np.ix_(free, free)], st.mass[np.ix_(free, free)]
-    omega2 = np.linalg.eigvals(np.linalg.solve(m, k))
-    return float(np.sqrt(np.abs(omega2).max()))
-
-
 def at_start(model: Model, rho_start: float, rho_tangent: float, interval_s: float) -> Choice:
     """The choice at the first sample interval (s), from ρ at the nominal start and the rate
-    of the nominal tangents (rad/s, `tangent_rate`): the larger of the two."""
+    of the nominal tangents (rad/s, `Model.tangent_rate`): the larger of the two."""
     rho_dt = max(rho_start, rho_tangent) * interval_s
     bearing = rho_tangent > TANGENT_MARGIN * rho_start
     why = f"ρ·Δt = {rho_dt:.3g}" + (", keys bearing" if bearing else "")

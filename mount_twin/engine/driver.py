@@ -23,7 +23,6 @@ from mount_twin.engine.auto_method import (
     Choice,
     after_event,
     at_start,
-    tangent_rate,
 )
 from mount_twin.engine.batch import MountEvent
 from mount_twin.engine.companion import Companion, new_companion
@@ -307,7 +306,7 @@ class CoreDriver:
             gravity_up = np.array([0.0, 0.0, self.model.scene.input.g])
             rho = spectral_radius(self.model, self.model.nominal_state, gravity_up)
             interval = stamp - self.last[0]
-            self._use(at_start(self.model, rho, tangent_rate(self.model), interval))
+            self._use(at_start(self.model, rho, self.model.tangent_rate, interval))
 
     def advance(self, segment: Samples, index: np.ndarray, rows: BatchRows) -> Stepped:
         """Integrate through the samples of `segment` (row 0: the last one done), which are
