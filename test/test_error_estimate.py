@@ -54,6 +54,7 @@ from mount_twin.integrate.methods import METHODS
 from mount_twin.integrate.settings import HOLD_AFTER_REJECT
 from mount_twin.integrate.stepper import new_stepper
 from mount_twin.io.input_samples import read_samples
+from mount_twin.kinds import N_EVENTS
 from mount_twin.model import assemble as assemble_module
 from mount_twin.model.assemble import assemble
 from mount_twin.replay import replay
@@ -391,7 +392,7 @@ def test_only_the_companion_holds_its_step_after_a_rejection() -> None:
     publishes is the plain controller's (bench/core_parity.py: bit for bit)."""
     model = assemble(load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml"))
     n, scratch = model.n_state, model.new_scratch()
-    comp = new_companion("auto", n, 1e-6, 1e-9, 100, scratch, model.n_mounts)
+    comp = new_companion("auto", n, 1e-6, 1e-9, 100, scratch, model.n_mounts, (8, N_EVENTS))
     assert comp.settings[HOLD_AFTER_REJECT] == 1.0
     assert companion.switch(comp, METHODS["exprb32"].id).settings[HOLD_AFTER_REJECT] == 1.0
     assert new_stepper("auto", n, 1e-6, 1e-9, 100).settings[HOLD_AFTER_REJECT] == 0.0

@@ -63,7 +63,8 @@ class Companion(NamedTuple):
     after the twin at every sample: `follow` in src/core/engine/kernel.hpp).
 
     method, settings, work2d, work1d, result: its stepper (`integrate.stepper.Stepper`).
-    y: (n_state,) its state; s: its scratch (its angles at the last sample: s.q[3:6]).
+    y: (n_state,) its state; s: its scratch (its angles at the last sample: s.q[3:6]);
+    y_prev, g, util: its mount monitors' arrays (its switches are taken with them).
     wrenches: (n_mounts, 6): its mount wrenches at the last sample.
     figures: (N_FIGURES,) running maxima (see the module docstring), reset by the reader.
     """
@@ -75,6 +76,9 @@ class Companion(NamedTuple):
     result: np.ndarray
     y: np.ndarray
     s: Scratch
+    y_prev: np.ndarray
+    g: np.ndarray
+    util: np.ndarray
     wrenches: np.ndarray
     figures: np.ndarray
 
@@ -87,10 +91,12 @@ def new_companion(
     max_substeps: int,
     scratch: Scratch,
     n_mounts: int,
+    g_shape: tuple[int, int],
 ) -> Companion:
     """A companion of a twin of n states integrated by `method` (a name, or AUTO: then
     `switch` it with the twin) at the twin's tolerances rtol, atol; `scratch`: fresh work
-    arrays of the model."""
+    arrays of the model; g_shape: the shape of the twin's mount event functions (non-linear
+    mounts × events)."""
     own = tighter_arrays(
         method,
         n,
@@ -101,7 +107,16 @@ def new_companion(
         MIN_STEPS,
         hold_after_reject=True,
     )
-    return Companion(*own, np.zeros(n), scratch, np.zeros((n_mounts, 6)), np.zeros(N_FIGURES))
+    return Companion(
+        *own,
+        np.zeros(n),
+        scratch,
+        np.zeros(n),
+        np.full(g_shape, -1.0),
+        np.zeros(g_shape[0]),
+        np.zeros((n_mounts, 6)),
+        np.zeros(N_FIGURES),
+    )
 
 
 def switch(c: Companion, method: int) -> Companion:
@@ -113,4 +128,5 @@ def switch(c: Companion, method: int) -> Companion:
 def restart(c: Companion, y: np.ndarray) -> None:
     """Start the companion again from the twin's state y (a twin start or restart)."""
     c.y[:] = y
+    c.y_prev[:] = y
     forget(c.settings)

@@ -96,9 +96,10 @@ def published_buffers(
     )
 
 
-def _new_estimator(model: Model) -> Estimator | Companion | None:
+def _new_estimator(model: Model, n_watched: tuple[int, int]) -> Estimator | Companion | None:
     """The live error estimate's arrays (`engine.estimator` where the mounts are linear,
-    `engine.companion` where some are not: see there), or None if the scene turns it off."""
+    `engine.companion` where some are not: see there), or None if the scene turns it off.
+    `n_watched`: the shape of the mount watch's event functions."""
     integ = model.scene.integration
     if not integ.error_estimate:
         return None
@@ -112,6 +113,7 @@ def _new_estimator(model: Model) -> Estimator | Companion | None:
             integ.max_substeps,
             model.new_scratch(),
             model.n_mounts,
+            n_watched,
         )
     return sampled_estimator(model)
 
@@ -198,7 +200,7 @@ class CoreDriver:
             scene.outputs.decimation,
             scene.input.hold == "first_order",
         )
-        self.estimator = _new_estimator(model)
+        self.estimator = _new_estimator(model, (self._watch.g.shape[0], self._watch.g.shape[1]))
         self._loop: tuple[tuple[object, ...], Loop] | None = None
         """The arrays bound last, and their `Loop` (`_bound`)."""
         self._choosing = integ.method == AUTO

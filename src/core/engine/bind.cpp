@@ -107,11 +107,15 @@ engine::Estimator estimator(py::handle obj, idx n_state, idx n_mounts) {
   return c;
 }
 
-engine::Companion companion(py::handle obj, idx n_state, idx n_mounts) {
+engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
+                            idx k, idx n_events) {
   engine::Companion c;
   c.integ = integrator(obj, "Companion", n_state);
   c.y = convert::vec(field(obj, "y"), "Companion.y", n_state);
   c.s = convert::scratch(field(obj, "s"));
+  c.y_prev = convert::vec(field(obj, "y_prev"), "Companion.y_prev", n_state);
+  c.g = convert::mat(field(obj, "g"), "Companion.g", k, n_events);
+  c.util = convert::vec(field(obj, "util"), "Companion.util", k);
   c.wrenches = convert::matc<6>(field(obj, "wrenches"), "Companion.wrenches", n_mounts);
   c.figures = convert::vec(field(obj, "figures"), "Companion.figures", N_FIGURES);
   convert::check_scratch(c.s, n_state, "Companion.s");
@@ -163,7 +167,7 @@ struct Loop {
       est = estimator(estimate_, n_state, n_mounts);
       ep = &est;
     } else if (!estimate_.is_none()) {
-      comp = companion(estimate_, n_state, n_mounts);
+      comp = companion(estimate_, n_state, n_mounts, k, w.g.cols);
       cp = &comp;
     }
     u = convert::vec(u_, "u", INPUT_SIZE);

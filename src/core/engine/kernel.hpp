@@ -61,6 +61,9 @@ struct Companion {
   Integrator integ;
   Vec y;
   Scratch s;
+  Vec y_prev;
+  Mat g;
+  Vec util;
   M6 wrenches;
   Vec figures;  // (N_FIGURES,)
 };
@@ -107,9 +110,8 @@ inline int watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, double
 }
 
 /// Advance the companion over [t0, t1] under the input u the twin just took, take its mounts'
-/// discrete switches, and fold the differences of its outputs from the twin's (pose, wrenches
-/// at t1; y the twin's state): its wrenches and angles only, what the estimate compares (no
-/// quaternion, event functions or utilisation of its own: nothing reads them).
+/// switches, and fold the differences of its outputs from the twin's (pose, wrenches at t1; y
+/// the twin's state): its wrenches and angles, what the estimate compares (no pose row).
 inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
                    Vec d_wdot, Vec pose, M6 wrenches, Vec y) {
   const Vec settings = c.integ.settings, figures = c.figures;
@@ -121,13 +123,16 @@ inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bo
   const int status = integrate::advance(c.integ.method, c.y, t0, t1, settings, m, c.s, u,
                                         c.integ.work2d, c.integ.work1d, c.integ.result);
   if (status != 0) {
-    copy(y, c.y);
+    for (idx i = 0; i < y.n; ++i) {
+      c.y[i] = y[i];
+      c.y_prev[i] = y[i];
+    }
     integrate::forget(settings);
     figures[FAILURES] += 1.0;
     return;
   }
   physics::mount_wrenches(c.y, m, c.s, c.wrenches);  // the body's motion at c.y: its last rhs
-  if (m.has_nl && physics::mount_switches(c.y, m.nl, c.s)) settings[CHAINED] = 0.0;
+  if (m.has_nl) monitor_switches(c.y, m.nl, c.y_prev, c.s, c.g, c.util, settings);
   double force = figures[FORCE_ERROR], scale = figures[FORCE_SCALE];
   for (idx a = 0; a < wrenches.rows; ++a) {
     for (int b = 0; b < 3; ++b) {

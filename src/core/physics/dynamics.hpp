@@ -251,10 +251,9 @@ inline double mount_deflections(Vec y, const Model& m, Scratch& s, M3 d) {
   return ct;
 }
 
-/// Each non-linear mount's discrete switch at y (its body motion computed), after its event
-/// functions and utilisation where Monitored (`mount_monitors`). Returns whether one switched.
-template <bool Monitored>
-inline bool switch_mounts(Vec y, Vec y0, const NonLinear& nl, Scratch& s, Mat g, Vec util) {
+/// Event functions g (k, NE) and utilisation util (k) of each non-linear mount at y (its body
+/// motion computed); then their discrete switches. Returns whether one switched (y jumped).
+inline bool mount_monitors(Vec y, Vec y0, const NonLinear& nl, Scratch& s, Mat g, Vec util) {
   const Motion mo = Motion::of(s);
   MountLocal ml;
   bool switched = false;
@@ -262,24 +261,10 @@ inline bool switch_mounts(Vec y, Vec y0, const NonLinear& nl, Scratch& s, Mat g,
     local_motion(i, nl, mo, ml);
     const idx code = nl.kind[i], o = nl.state[i];
     const double* p = &nl.par(i, 0);
-    if constexpr (Monitored) {
-      util[i] = kinds::kind_monitor(code, p, y, y0, o, ml.d, ml.v, g.row(i));
-    }
+    util[i] = kinds::kind_monitor(code, p, y, y0, o, ml.d, ml.v, g.row(i));
     if (kinds::kind_update(code, p, y, o, ml.d)) switched = true;
   }
   return switched;
-}
-
-/// Event functions g (k, NE) and utilisation util (k) of each non-linear mount at y (its body
-/// motion computed); then their discrete switches. Returns whether one switched (y jumped).
-inline bool mount_monitors(Vec y, Vec y0, const NonLinear& nl, Scratch& s, Mat g, Vec util) {
-  return switch_mounts<true>(y, y0, nl, s, g, util);
-}
-
-/// The non-linear mounts' discrete switches alone at y (its body motion computed), where no one
-/// reads their monitors (the error estimate's companion). Returns whether one switched.
-inline bool mount_switches(Vec y, const NonLinear& nl, Scratch& s) {
-  return switch_mounts<false>(y, y, nl, s, Mat{}, Vec{});
 }
 
 inline double cross(const Vec a, const Vec b, idx i) {
