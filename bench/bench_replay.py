@@ -23,7 +23,7 @@ from rosbags.rosbag2 import Reader, StoragePlugin, Writer  # noqa: TID251 (the f
 from mount_twin.cli import main
 from mount_twin.commands.common import DEFAULT_SCENE, share_dir
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.io.bag import InputBag
+from mount_twin.io.input_bag import InputBag
 from mount_twin.io.input_decoding import TimeBase, decode_inputs
 from mount_twin.io.mcap_writer import McapBagWriter
 from mount_twin.model.assemble import assemble

@@ -51,8 +51,9 @@ from mount_twin.engine.health_texts import (
 )
 from mount_twin.engine.tilt import tilt_from_quaternions
 from mount_twin.errors import BagError, DamagedBagError, require
-from mount_twin.io.bag import LATCHED_QOS, InputBag, OutputBag, check_new_bag
+from mount_twin.io.input_bag import InputBag
 from mount_twin.io.messages import DIAGNOSTICS_TOPIC, IMU, NODE_NAME, TF, TF_STATIC_TOPIC, resolve
+from mount_twin.io.output_bag import LATCHED_QOS, OutputBag, check_new_bag
 from mount_twin.io.output_encoding import Encoded, RowBlock, encode_report, static_transforms
 from mount_twin.io.output_topics import output_types
 from mount_twin.io.scene_record import SCENE_TOPIC, STRING, scene_message, scene_metadata

@@ -215,8 +215,8 @@ def ageing_bag(
 ) -> list[tuple[str, int, bytes]]:
     """A bag at `path` of `ageing_messages`. Returns its (topic, stamp ns, raw) messages in
     stamp order."""
-    from mount_twin.io.bag import OutputBag
     from mount_twin.io.messages import IMU
+    from mount_twin.io.output_bag import OutputBag
 
     msgs = ageing_messages(scene, total_s, change_s, body_topic)
     with OutputBag(path, {"/deck/imu": IMU, body_topic: IMU}) as bag:

@@ -29,9 +29,9 @@ from mount_twin.cli import main
 from mount_twin.commands.accuracy import _table, _unresolved
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.errors import MountTwinError
-from mount_twin.io.bag import write_bag
 from mount_twin.io.input_samples import read_samples
 from mount_twin.io.messages import IMU, TYPESTORE
+from mount_twin.io.output_bag import write_bag
 from mount_twin.scene.loader import load_scene_file, scene_from_dict
 
 G = 9.80665

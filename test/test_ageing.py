@@ -29,8 +29,8 @@ from mount_twin.cli import main
 from mount_twin.engine.batch import LEVEL_NAMES
 from mount_twin.engine.body_check import RESETS
 from mount_twin.errors import SceneError
-from mount_twin.io.bag import OutputBag
 from mount_twin.io.messages import IMU
+from mount_twin.io.output_bag import OutputBag
 from mount_twin.io.signals import Signal, ship_motion
 from mount_twin.replay import replay
 from mount_twin.scene.description import Scene

@@ -18,9 +18,9 @@ from io_helpers import ROOT, comparable_messages, push_all, read_raw, scene_with
 
 from mount_twin.engine.batch import OutputBatch, SampleBatch
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.io.bag import write_bag
 from mount_twin.io.input_samples import read_samples
 from mount_twin.io.messages import IMU, TYPESTORE
+from mount_twin.io.output_bag import write_bag
 from mount_twin.model.assemble import assemble
 from mount_twin.replay import replay
 from mount_twin.scene import load_scene_file

@@ -478,8 +478,8 @@ def test_a_bag_record_with_samples_not_finite_is_refused_naming_them(
     body's record of `calibrate`."""
     from io_helpers import read_raw
 
-    from mount_twin.io.bag import write_bag
     from mount_twin.io.messages import IMU, TYPESTORE
+    from mount_twin.io.output_bag import write_bag
 
     scene = str(SHAKE / "block.scene.yaml")
     ground, top = tmp_path / "ground", tmp_path / "top"
@@ -557,8 +557,8 @@ def test_a_record_marking_a_reading_the_fit_reads_not_provided_is_refused(
     from io_helpers import unprovided_imu
 
     from mount_twin.commands.calibrate import BODY_KEYS, _read_record
-    from mount_twin.io.bag import write_bag
     from mount_twin.io.messages import IMU
+    from mount_twin.io.output_bag import write_bag
     from mount_twin.io.output_encoding import imu_messages
 
     sig = ship_motion(rate_hz=200.0, total=2.0)

@@ -10,9 +10,9 @@ from io_helpers import CONFIG, ROOT
 from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
 
 from mount_twin.cli import main
-from mount_twin.io.bag import OutputBag
 from mount_twin.io.bag_info import _bytes_text, bag_info
 from mount_twin.io.messages import IMU, TYPESTORE
+from mount_twin.io.output_bag import OutputBag
 
 
 def test_a_bag_lists_its_topics_types_and_counts(capsys: pytest.CaptureFixture[str]) -> None:

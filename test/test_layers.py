@@ -57,7 +57,7 @@ class Import:
 
 
 def unit_of(module: str) -> str:
-    """The unit of a dotted module name under mount_twin: `mount_twin.io.bag` → "io", the
+    """The unit of a dotted module name under mount_twin: `mount_twin.io.input_bag` → "io", the
     package itself → "mount_twin"."""
     parts = module.split(".")
     return parts[1] if len(parts) > 1 else parts[0]

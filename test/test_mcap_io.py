@@ -21,11 +21,13 @@ from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, W
 
 from mount_twin.errors import DamagedBagError
 from mount_twin.io import mcap_writer
-from mount_twin.io.bag import LATCHED_QOS, PARTIAL_KEY, InputBag, OutputBag
+from mount_twin.io.bag_metadata import PARTIAL_KEY
+from mount_twin.io.input_bag import InputBag
 from mount_twin.io.input_decoding import decode_inputs
 from mount_twin.io.mcap_reader import plain_messages
 from mount_twin.io.mcap_salvage import salvage
 from mount_twin.io.messages import IMU, TYPESTORE
+from mount_twin.io.output_bag import LATCHED_QOS, OutputBag
 from mount_twin.io.output_encoding import RowBlock, imu_messages
 from mount_twin.io.raw_rows import RawRows, joined
 

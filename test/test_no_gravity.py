@@ -19,8 +19,8 @@ from scipy.spatial.transform import Rotation
 
 from mount_twin.cli import main
 from mount_twin.engine.batch import OK
-from mount_twin.io.bag import write_bag
 from mount_twin.io.messages import IMU
+from mount_twin.io.output_bag import write_bag
 from mount_twin.io.output_encoding import imu_messages
 
 RATE_HZ = 1000.0

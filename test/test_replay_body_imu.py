@@ -25,8 +25,8 @@ from mount_twin.analysis.ageing_live import NAME as AGEING
 from mount_twin.cli import main
 from mount_twin.engine.agreement import NAME
 from mount_twin.engine.batch import ERROR, OK
-from mount_twin.io.bag import OutputBag
 from mount_twin.io.messages import IMU
+from mount_twin.io.output_bag import OutputBag
 from mount_twin.io.output_encoding import imu_messages
 from mount_twin.io.signals import ship_motion
 
@@ -332,7 +332,7 @@ def test_a_stop_while_the_body_imus_rest_is_replayed_ends_it_at_the_next_chunk(
     at between them: a long body bag held a Ctrl-C for its whole length). Now the replay
     stops before the next: three body chunks taken in all, KeyboardInterrupt, the output
     bag marked partial."""
-    from mount_twin.io.bag import partial_marker
+    from mount_twin.io.bag_metadata import partial_marker
     from mount_twin.replay import replay
     from mount_twin.stream import TwinStream
 

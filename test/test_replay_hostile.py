@@ -35,9 +35,11 @@ from rosbags.typesys import Stores, get_typestore
 
 from mount_twin.cli import main
 from mount_twin.errors import BagError
-from mount_twin.io import bag as bag_module
-from mount_twin.io.bag import PARTIAL_KEY, InputBag, OutputBag, write_bag
+from mount_twin.io import input_bag as bag_module
+from mount_twin.io.bag_metadata import PARTIAL_KEY
+from mount_twin.io.input_bag import InputBag
 from mount_twin.io.messages import IMU, POSE, TYPESTORE
+from mount_twin.io.output_bag import OutputBag, write_bag
 from mount_twin.io.output_encoding import imu_messages, messages_of
 from mount_twin.replay import replay
 

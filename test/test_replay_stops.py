@@ -18,7 +18,7 @@ from io_helpers import CONFIG, ROOT, read_bag
 from rosbags.highlevel import AnyReader
 
 from mount_twin.cli import main
-from mount_twin.io.bag import PARTIAL_KEY
+from mount_twin.io.bag_metadata import PARTIAL_KEY
 from mount_twin.io.mcap_writer import CHUNK_BYTES
 from mount_twin.io.messages import TYPESTORE
 

@@ -17,8 +17,8 @@ from io_helpers import CONFIG, ROOT, read_bag
 
 from mount_twin.analysis.figures import peak_text, utilisation_text
 from mount_twin.cli import main
-from mount_twin.io.bag import write_bag
 from mount_twin.io.messages import IMU
+from mount_twin.io.output_bag import write_bag
 from mount_twin.io.output_encoding import imu_messages
 from mount_twin.io.output_tables import input_values, read_output_bag
 from mount_twin.scene.yaml_reading import read_scene_yaml

@@ -247,8 +247,8 @@ def _pump_input(path: Path, n: int = 10_000, bad: slice = slice(0)) -> Path:
     """A pump input bag (/deck/imu, frame deck_imu) of `n` samples at 1 kHz: a 5 g, 11 ms
     vertical half-sine in its first second, then at rest; the samples `bad` with every accel
     reading NaN."""
-    from mount_twin.io.bag import write_bag
     from mount_twin.io.messages import IMU
+    from mount_twin.io.output_bag import write_bag
     from mount_twin.io.output_encoding import imu_messages
     from mount_twin.io.signals import half_sine_shock
 
@@ -270,8 +270,8 @@ def test_an_input_marking_accelerations_not_provided_inside_is_refused_naming_th
     readings, a hole in the shock. Between samples the replay takes, leaving them out would
     join those around them: refused, as a sample not finite there is, naming the bag, the
     topic, how many and the first."""
-    from mount_twin.io.bag import write_bag
     from mount_twin.io.messages import IMU
+    from mount_twin.io.output_bag import write_bag
 
     pump = str(CONFIG / "pump_8_mounts.scene.yaml")
     (msgs,) = read_raw(_pump_input(tmp_path / "plain", 2000), ["/deck/imu"]).values()
@@ -355,8 +355,8 @@ def test_an_inputs_samples_the_replay_rejects_at_its_ends_are_left_out_whatever_
     ones but refused the record for the marked ones (exit 2). It leaves both out now, saying
     how many of each and at which end, and its spectra are those of a bag of samples 5–1996
     alone."""
-    from mount_twin.io.bag import write_bag
     from mount_twin.io.messages import IMU
+    from mount_twin.io.output_bag import write_bag
 
     pump = str(CONFIG / "pump_8_mounts.scene.yaml")
     holed = _pump_input(tmp_path / "holed", 2000, bad=slice(0, 5))
@@ -919,7 +919,7 @@ def test_a_scene_with_the_runs_mounts_and_another_value_is_refused_naming_both(
 def _old_bag(pump_run: Path, out: Path, scene: str) -> Path:
     """The pump's run as a replay wrote it before the scene's topic and separate keys: its
     metadata naming `scene` as the one text (file and overrides) it was replayed with."""
-    from mount_twin.io.bag import SCENE_DIGEST_KEY, SCENE_KEY, custom_data
+    from mount_twin.io.bag_metadata import SCENE_DIGEST_KEY, SCENE_KEY, custom_data
 
     digest = custom_data(pump_run)[SCENE_DIGEST_KEY]
     return without_scene_topic(pump_run, out, {SCENE_KEY: scene, SCENE_DIGEST_KEY: digest})
@@ -1004,7 +1004,7 @@ def test_a_moved_runs_scene_file_is_found_by_the_path_the_replay_was_given(
     absolute path was the only one looked at, "not found". The path the replay was given
     (config/run.scene.yaml) is looked for after it, from here and from the bag's directory,
     and the messages name each path tried."""
-    from mount_twin.io.bag import SCENE_VALUE_KEY, custom_data
+    from mount_twin.io.bag_metadata import SCENE_VALUE_KEY, custom_data
 
     ran, moved = tmp_path / "ran", tmp_path / "moved"
     (ran / "config").mkdir(parents=True)
@@ -1067,7 +1067,7 @@ def test_a_refused_scene_names_its_differences_from_the_metadata_with_the_topic_
     scene file moved away: the metadata held the digest alone, so a refused scene was only
     said to differ ("not found: cannot say which value differs"). It holds the value too: the
     values that differ are named from it."""
-    from mount_twin.io.bag import custom_data
+    from mount_twin.io.bag_metadata import custom_data
 
     monkeypatch.chdir(tmp_path)
     run_file = _pump_scene(tmp_path / "run.scene.yaml")

@@ -44,8 +44,8 @@ from mount_twin.engine.agreement import NAME
 from mount_twin.engine.batch import ERROR, OK, WARN
 from mount_twin.engine.delay_line import delay_samples
 from mount_twin.engine.health_texts import INPUT
-from mount_twin.io.bag import OutputBag
 from mount_twin.io.messages import DIAGNOSTICS, IMU, NODE_NAME, resolve
+from mount_twin.io.output_bag import OutputBag
 from mount_twin.io.output_encoding import imu_messages
 from mount_twin.io.output_topics import BODY_PREDICTED_TOPIC, BODY_RESIDUAL_TOPIC
 from mount_twin.io.signals import ship_motion

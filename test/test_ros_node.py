@@ -44,7 +44,7 @@ from test_start_loaded import C_SOFT, RATED, rated_scene, start_sag
 
 from mount_twin.engine.batch import ERROR, OK
 from mount_twin.engine.delay_line import delay_samples
-from mount_twin.io.bag import InputBag, OutputBag
+from mount_twin.io.input_bag import InputBag
 from mount_twin.io.input_decoding import stamp_ns
 from mount_twin.io.messages import (
     ACCEL,
@@ -58,6 +58,7 @@ from mount_twin.io.messages import (
     TYPESTORE,
     resolve,
 )
+from mount_twin.io.output_bag import OutputBag
 from mount_twin.io.output_encoding import imu_messages, static_transforms
 from mount_twin.io.output_topics import output_types
 from mount_twin.io.scene_record import STRING

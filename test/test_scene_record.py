@@ -98,7 +98,7 @@ def test_a_metadata_value_that_does_not_hash_to_its_digest_is_refused(
 ) -> None:
     """A scene value in the metadata changed after it was hashed is no record of the run."""
     from mount_twin.errors import BagError
-    from mount_twin.io.bag import custom_data
+    from mount_twin.io.bag_metadata import custom_data
     from mount_twin.io.scene_record import recorded_scene
 
     _, bag = run
@@ -172,7 +172,7 @@ def test_a_scene_message_whose_value_does_not_hash_to_its_digest_is_refused(
 ) -> None:
     """A ~/scene whose value was changed after it was hashed is no record of the run."""
     from mount_twin.errors import BagError
-    from mount_twin.io.bag import write_bag
+    from mount_twin.io.output_bag import write_bag
     from mount_twin.io.scene_record import STRING, recorded_scene, scene_text
 
     record = json.loads(scene_text(load_scene_file(PUMP)))
@@ -187,7 +187,7 @@ def test_a_recording_of_two_scenes_is_refused_naming_the_topic(tmp_path: Path) -
     """A recording over two runs of the node (restarted with another scene) holds two
     ~/scene messages of different digests: no one scene is the run's."""
     from mount_twin.errors import BagError
-    from mount_twin.io.bag import write_bag
+    from mount_twin.io.output_bag import write_bag
     from mount_twin.io.scene_record import STRING, recorded_scene, scene_text
 
     texts = [

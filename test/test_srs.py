@@ -25,8 +25,8 @@ from mount_twin.cli import main
 from mount_twin.commands.common import write_signal
 from mount_twin.commands.design_options import TOLERANCE_DB
 from mount_twin.commands.srs import EXIT_OUT_OF_TOLERANCE
-from mount_twin.io.bag import write_bag
 from mount_twin.io.messages import IMU, TYPESTORE
+from mount_twin.io.output_bag import write_bag
 from mount_twin.io.output_encoding import imu_messages
 from mount_twin.io.signals import Signal
 

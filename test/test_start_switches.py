@@ -38,8 +38,8 @@ from physics_helpers import G
 from mount_twin.cli import main
 from mount_twin.engine.batch import ERROR, MountEvent, SampleBatch
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.io.bag import write_bag
 from mount_twin.io.messages import IMU
+from mount_twin.io.output_bag import write_bag
 from mount_twin.io.output_encoding import imu_messages as imu_msgs
 from mount_twin.io.output_tables import read_output_bag
 from mount_twin.model.assemble import Model, assemble

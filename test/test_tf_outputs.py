@@ -22,8 +22,8 @@ from scipy.spatial.transform import Rotation
 
 from mount_twin.engine.batch import OutputBatch
 from mount_twin.errors import SceneError
-from mount_twin.io.bag import write_bag
 from mount_twin.io.messages import IMU, NODE_NAME, TF, TF_STATIC_TOPIC, TF_TOPIC, TYPESTORE
+from mount_twin.io.output_bag import write_bag
 from mount_twin.io.output_encoding import encode_outputs, imu_messages, static_transforms
 from mount_twin.io.output_topics import output_types
 from mount_twin.replay import replay

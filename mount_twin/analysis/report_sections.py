@@ -31,7 +31,7 @@ from mount_twin.analysis.run_verdict import RunVerdict
 from mount_twin.engine.estimate import NOT_INTEGRATED
 from mount_twin.engine.health_texts import NOT_DESIGNED, why_none
 from mount_twin.errors import ModelError
-from mount_twin.io.bag import partial_marker
+from mount_twin.io.bag_metadata import partial_marker
 from mount_twin.io.output_tables import Event, Table
 from mount_twin.io.output_topics import WRENCHES_OUTPUT
 from mount_twin.scene.description import STANDARD_GRAVITY, Scene

@@ -189,7 +189,7 @@ def warn_if_partial(bag: str | Path) -> str:
     """Say on stderr that an output bag stops early (a replay stopped by a signal or at damage
     in its input), and why: its figures are then not the whole run's. Returns the marker ('' if
     the bag is whole)."""
-    from mount_twin.io.bag import partial_marker
+    from mount_twin.io.bag_metadata import partial_marker
 
     if marker := partial_marker(bag):
         print(f"mount-twin: warning: {bag} is partial: {marker}", file=sys.stderr)
@@ -262,8 +262,8 @@ def write_signal(
     created."""
     import numpy as np
 
-    from mount_twin.io.bag import check_stamp, write_bag
     from mount_twin.io.messages import IMU
+    from mount_twin.io.output_bag import check_stamp, write_bag
     from mount_twin.io.output_encoding import imu_messages
     from mount_twin.scene.ros_names import header_frame_id_problem, topic_name_problem
 

@@ -9,7 +9,8 @@ from pathlib import Path
 from rosbags.highlevel import AnyReader
 
 from mount_twin.errors import BagError
-from mount_twin.io.bag import STORAGE_IDS, bag_metadata, reader_paths, storage_files
+from mount_twin.io.bag_metadata import bag_metadata
+from mount_twin.io.input_bag import STORAGE_IDS, reader_paths, storage_files
 from mount_twin.io.messages import TYPESTORE
 
 

@@ -10,7 +10,7 @@ import numpy as np
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.engine.intake import disregarded, provided
 from mount_twin.errors import BagError, DamagedBagError
-from mount_twin.io.bag import InputBag
+from mount_twin.io.input_bag import InputBag
 from mount_twin.io.input_decoding import Decoded, TimeBase, decode_inputs
 from mount_twin.scene.description import InputSpec
 

@@ -7,7 +7,7 @@ Only the plain case is read here, the case of every bag a recorder or rosbags wr
 order: a summary with chunk indexes whose chunks do not overlap in time. Within a chunk the
 messages are sorted by log time, stably (as rosbags does). Anything else (no summary, chunks
 that overlap, a split bag) is left to rosbags (`plain_messages` returns None); a chunk found
-damaged while reading raises ValueError (`io.bag` then salvages what the file holds).
+damaged while reading raises ValueError (`io.input_bag` then salvages what the file holds).
 """
 
 from __future__ import annotations

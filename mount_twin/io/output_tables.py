@@ -23,8 +23,8 @@ from rosbags.highlevel import AnyReader
 from mount_twin.engine.batch import event_level
 from mount_twin.engine.health_texts import INPUT, INTEGRATION
 from mount_twin.errors import BagError
-from mount_twin.io.bag import reader_paths
 from mount_twin.io.bag_info import require_existing
+from mount_twin.io.input_bag import reader_paths
 from mount_twin.io.messages import DIAGNOSTICS, TYPESTORE
 from mount_twin.io.output_topics import BODY_READBACKS, OUTPUTS, Readback, output_table
 from mount_twin.kinds.events import EVENT_IS_ERROR

@@ -8,10 +8,10 @@ file (`file`, an absolute path, or null), what was put over the file's values (`
 by flat parameter name, or by key path for a value changed in code: `scene_overrides`) and
 its value (`value`, `scene_value`), which hashes to the digest.
 A replay also records the digest, the file, the overrides and the value apart in its output
-bag's metadata (`io.bag`'s SCENE_*_KEY), for a bag whose topic was left out (the value is a
-few kB: 0.2-0.4 kB a mount, about what the metadata's entry of the mount's wrench topic takes,
-so it grows with the metadata as it is). `recorded_scene` reads back whichever a bag holds,
-for `report --scene`.
+bag's metadata (`io.bag_metadata`'s SCENE_*_KEY), for a bag whose topic was left out (the
+value is a few kB: 0.2-0.4 kB a mount, about what the metadata's entry of the mount's wrench
+topic takes, so it grows with the metadata as it is). `recorded_scene` reads back whichever a
+bag holds, for `report --scene`.
 """
 
 from __future__ import annotations
@@ -25,15 +25,15 @@ from typing import Any
 from rosbags.highlevel import AnyReader
 
 from mount_twin.errors import BagError
-from mount_twin.io.bag import (
+from mount_twin.io.bag_metadata import (
     SCENE_DIGEST_KEY,
     SCENE_FILE_KEY,
     SCENE_KEY,
     SCENE_OVERRIDES_KEY,
     SCENE_VALUE_KEY,
     custom_data,
-    reader_paths,
 )
+from mount_twin.io.input_bag import reader_paths
 from mount_twin.io.messages import TYPESTORE
 from mount_twin.model.scene_file import scene_file_of
 from mount_twin.scene.description import (
@@ -46,7 +46,8 @@ from mount_twin.scene.description import (
 )
 
 SCENE_TOPIC = "~/scene"
-"""The run's scene (std_msgs/String of `scene_text`); publish it latched (`io.bag.LATCHED_QOS`)."""
+"""The run's scene (std_msgs/String of `scene_text`); publish it latched
+(`io.output_bag.LATCHED_QOS`)."""
 STRING = "std_msgs/msg/String"
 
 
