@@ -36,8 +36,8 @@ if TYPE_CHECKING:
     )
     from mount_twin.engine.engine import TwinEngine
     from mount_twin.model.assemble import Model, assemble
-    from mount_twin.replay import ReplaySummary
     from mount_twin.replay import replay as replay_bag
+    from mount_twin.replay_summary import ReplaySummary
     from mount_twin.scene.description import Scene
     from mount_twin.scene.loader import load_scene_file, scene_from_dict
     from mount_twin.scene.params import scene_from_params
@@ -59,7 +59,7 @@ _LAZY = {
     "MountEvent": "mount_twin.engine.batch",
     "TwinStream": "mount_twin.stream",
     "replay_bag": "mount_twin.replay:replay",
-    "ReplaySummary": "mount_twin.replay",
+    "ReplaySummary": "mount_twin.replay_summary",
     "sweep": "mount_twin.sweeps.runner",
 }
 """Exported name → module that defines it (`module:name` where the names differ: the function

@@ -30,7 +30,7 @@ class DamagedBagError(BagError):
     """An input bag is damaged part-way: what came before the damage was processed.
 
     Attributes:
-        summary: where a replay raised it, its `replay.ReplaySummary` up to the damage (its
+        summary: where a replay raised it, its `replay_summary.ReplaySummary` up to the damage (its
             `damaged` says this error); else None.
     """
 

@@ -26,7 +26,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("engine", ("engine",)),
     ("io", ("io",)),
     ("analysis", ("analysis", "sweeps", "plot")),
-    ("adapters", ("stream", "replay", "ros", "commands", "cli")),
+    ("adapters", ("stream", "replay", "replay_summary", "ros", "commands", "cli")),
     ("api", ("mount_twin",)),
 )
 """The layers, lowest first, each with its units: a unit of mount_twin/ (its subpackage or

@@ -13,7 +13,7 @@ from physics_helpers import base_scene, mount
 from mount_twin.engine.batch import ERROR, OK, WARN
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.model.assemble import assemble
-from mount_twin.replay import ReplaySummary
+from mount_twin.replay_summary import ReplaySummary
 from mount_twin.scene.loader import scene_from_dict
 
 G = 9.80665

@@ -43,7 +43,8 @@ def test_exported_names_are_the_defining_modules_objects() -> None:
     from mount_twin.engine.batch import OutputBatch, SampleBatch
     from mount_twin.engine.engine import TwinEngine
     from mount_twin.errors import SceneError
-    from mount_twin.replay import ReplaySummary, replay
+    from mount_twin.replay import replay
+    from mount_twin.replay_summary import ReplaySummary
     from mount_twin.scene.loader import load_scene_file
 
     assert mount_twin.TwinEngine is TwinEngine

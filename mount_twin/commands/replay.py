@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from mount_twin.commands.common import positive_int
 
 if TYPE_CHECKING:
-    from mount_twin.replay import ReplaySummary
+    from mount_twin.replay_summary import ReplaySummary
 
 NAME = "replay"
 HELP = "replay a bag through the twin into an mcap bag"
