@@ -32,7 +32,7 @@ from mount_twin.engine.batch import (
     HealthStatus,
     MountEvent,
 )
-from mount_twin.engine.body_check import RESETS, UNPROVIDED, not_compared
+from mount_twin.engine.body_counts import RESETS, UNPROVIDED, not_compared
 from mount_twin.engine.estimate import NOT_INTEGRATED, ErrorEstimate
 from mount_twin.engine.health_texts import (
     EVENTS_KEY,

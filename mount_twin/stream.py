@@ -14,7 +14,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from mount_twin.engine.batch import ERROR, HealthReport, OutputBatch
-from mount_twin.engine.body_check import RESETS, BodyCheck, BodyComparison
+from mount_twin.engine.body_check import BodyCheck, BodyComparison
+from mount_twin.engine.body_counts import RESETS
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.health_statuses import ENDED
 from mount_twin.engine.health_texts import INPUT
@@ -310,7 +311,7 @@ class TwinStream:
 
     def _hold_body(self, decoded: Decoded) -> None:
         """Accepted body samples held until the first foundation sample sets the time base:
-        at most `body_check.PENDING_LIMIT`, the oldest dropped (`BodyCheck.over_limit`)."""
+        at most `body_matching.PENDING_LIMIT`, the oldest dropped (`BodyCheck.over_limit`)."""
         assert self.body is not None
         self._body_waiting.append(decoded)
         cut = self.body.over_limit(sum(d.stamps_ns.shape[0] for d in self._body_waiting))

@@ -27,7 +27,7 @@ from mount_twin.analysis.ageing import WindowFit, track, window_table
 from mount_twin.analysis.ageing_live import CUT_BY_JUMP, DROPPED, NAME, WindowJob, run_job
 from mount_twin.cli import main
 from mount_twin.engine.batch import LEVEL_NAMES
-from mount_twin.engine.body_check import RESETS
+from mount_twin.engine.body_counts import RESETS
 from mount_twin.errors import SceneError
 from mount_twin.io.messages import IMU
 from mount_twin.io.output_bag import OutputBag

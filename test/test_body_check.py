@@ -27,7 +27,7 @@ from scipy.signal import butter, sosfiltfilt
 from mount_twin import load_scene_file
 from mount_twin.analysis.calibration_parameters import calibrated_scene
 from mount_twin.analysis.response import followed
-from mount_twin.engine import body_check
+from mount_twin.engine import body_check, body_matching
 from mount_twin.engine.agreement import NAME
 from mount_twin.engine.batch import ERROR, OK, WARN, SampleBatch
 from mount_twin.engine.intake import rotated
@@ -797,6 +797,14 @@ def test_body_messages_lost_by_the_middleware_are_reported_in_the_window_judged_
             assert "nrms_fx" in values and "lost_middleware 37" in message, message
 
 
+def _limit_waiting(monkeypatch: pytest.MonkeyPatch, limit: int) -> None:
+    """PENDING_LIMIT set to `limit` where it is read: by the matcher (body samples waiting for
+    the twin's predictions) and by `BodyCheck.over_limit` (waiting for the deck's first
+    message)."""
+    monkeypatch.setattr(body_matching, "PENDING_LIMIT", limit)
+    monkeypatch.setattr(body_check, "PENDING_LIMIT", limit)
+
+
 def test_body_samples_dropped_waiting_after_the_last_judged_window_are_warned_of(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -807,7 +815,7 @@ def test_body_samples_dropped_waiting_after_the_last_judged_window_are_warned_of
     stream never leads the deck's by the limit (fed whole, body first, it would: the limit
     drops by arrival, as it is meant to)."""
     limit, extra = 1000, 1400
-    monkeypatch.setattr(body_check, "PENDING_LIMIT", limit)
+    _limit_waiting(monkeypatch, limit)
     scene, deck = _pump(), _deck(12.0)
     _, whole = _whole_record(scene, deck)
     ns = _stamps(deck)
@@ -928,7 +936,7 @@ def test_a_body_stream_fed_far_ahead_of_the_deck_drops_its_oldest_counted_and_sa
     dropped and counted at once; with the deck after, the 1000 kept (7–11.995 s) are compared
     in one window (5 s from 7 s, cut by the end at 4.995 s: judged), a WARN saying the 1400;
     with no deck at all, the end's WARN says them beside the 1000 unanswered."""
-    monkeypatch.setattr(body_check, "PENDING_LIMIT", 1000)
+    _limit_waiting(monkeypatch, 1000)
     scene, deck = _pump(), _deck(12.0)
     _, whole = _whole_record(scene, deck)
     body = _body_raws(_stamps(deck), whole)

@@ -15,7 +15,7 @@ both streams have in the run, known once one stream has left it and the other ha
 that stamp) if it spans half a window, else dropped and counted, and the windows start again
 from the new run's first body sample plus the lead; a stream's samples of a run the tracker
 is done with (the other stream jumped back, it did not) are not kept. Where the other stream
-never jumps back with it (`body_check.Apart`: its stamps went on past the jump by more than
+never jumps back with it (`stamp_runs.Apart`: its stamps went on past the jump by more than
 back_jump_reset_s), the runs never pair again: once the run is done, a WARN says which stream
 jumped back and when (a `WindowJob` with `apart`), and no sample of a later run is kept. Each
 report says the jumps before its window and the windows dropped so far (`run_job`).
@@ -37,7 +37,8 @@ import numpy as np
 
 from mount_twin.analysis.ageing import LEAD_S, Band, WindowFit, fit_window
 from mount_twin.engine.batch import LEVEL_NAMES, OK, WARN, HealthReport, HealthStatus
-from mount_twin.engine.body_check import RESETS, Apart
+from mount_twin.engine.body_counts import RESETS
+from mount_twin.engine.stamp_runs import Apart
 from mount_twin.io.signals import Signal
 from mount_twin.scene.description import Scene
 

@@ -47,7 +47,7 @@ from rclpy.subscription import Subscription
 from rclpy.timer import Timer
 
 from mount_twin.engine.batch import ERROR, OK, HealthReport, HealthStatus
-from mount_twin.engine.body_check import MIDDLEWARE, STOPPED
+from mount_twin.engine.body_counts import MIDDLEWARE, STOPPED
 from mount_twin.errors import MountTwinError
 from mount_twin.io.messages import DIAGNOSTICS_TOPIC, IMU, NODE_NAME, TF, TF_STATIC_TOPIC
 from mount_twin.io.output_encoding import encode_report, messages_of, static_transforms
