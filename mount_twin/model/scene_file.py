@@ -22,14 +22,14 @@ or the report names it where it did."""
 OVERRIDDEN = " (with input {} from the command line)"
 """What `read_scene` appends to a scene's source where the command line replaced `input`
 fields (their names, comma-separated); `scene_file_of` reads it back from the one text
-(`io.bag.SCENE_KEY`) a replay recorded before it recorded the file and the overrides apart
+(`io.bag_metadata.SCENE_KEY`) a replay recorded before it recorded the file and the overrides apart
 (`Scene.origin`)."""
 
 
 def scene_file_of(source: str) -> tuple[str, list[str]]:
     """The scene file and the `input` fields the command line replaced of a scene's source as
     `read_scene` gives it (recorded by a replay in its output bag's metadata, alone in bags
-    written before `io.bag.SCENE_FILE_KEY`)."""
+    written before `io.bag_metadata.SCENE_FILE_KEY`)."""
     before, _, after = OVERRIDDEN.partition("{}")
     found = re.fullmatch(f"(.*){re.escape(before)}([\\w, ]+){re.escape(after)}", source)
     return (found[1], found[2].split(", ")) if found else (source, [])
