@@ -155,6 +155,20 @@ def _deck_raws(scene: Scene, deck: Signal) -> list[bytes]:
     return [r for _, r in imu_messages(_stamps(deck), deck.accel, deck.gyro, "deck_imu")]
 
 
+def _deck_silent_between(
+    t0: float, t1: float
+) -> tuple[Scene, np.ndarray, np.ndarray, list[bytes], list[bytes], np.ndarray]:
+    """The pump under 12 s of deck record at 200 Hz, the deck silent from t0 to t1 s (a gap):
+    (scene, every sample's stamp ns, the silent ones, the deck's messages sent, the body
+    IMU's messages at every stamp, the whole record's body readings)."""
+    scene, deck = _pump(), _deck(12.0)
+    _, whole = _whole_record(scene, deck)
+    ns = _stamps(deck)
+    silent = (deck.t >= t0) & (deck.t < t1)
+    deck_raws = [r for r, s in zip(_deck_raws(scene, deck), silent, strict=True) if not s]
+    return scene, ns, silent, deck_raws, _body_raws(ns, whole), whole
+
+
 def test_the_live_prediction_is_the_whole_records_at_every_body_sample() -> None:
     """A body IMU sampled at the deck's stamps: each sample's prediction is, to the bit, the
     whole record's at that row (the first and last rows by one-sided differences), and its
@@ -366,12 +380,7 @@ def test_messages_not_compared_are_counted_in_their_own_window_however_interleav
     open when they were counted: the first or the second, by how the two streams were fed
     (0 or 2 rejected in 0–5 s, in_gap moving with them). A sample counts where its stamp
     falls, a rejected message where the accepted sample after it does."""
-    scene, deck = _pump(), _deck(12.0)
-    _, whole = _whole_record(scene, deck)
-    ns = _stamps(deck)
-    silent = (deck.t >= 6.0) & (deck.t < 7.0)
-    deck_raws = [r for r, s in zip(_deck_raws(scene, deck), silent, strict=True) if not s]
-    body = _body_raws(ns, whole)
+    scene, ns, silent, deck_raws, body, whole = _deck_silent_between(6.0, 7.0)
     body[1020:1020] = [_body_raws(np.array([0]), whole[:1])[0], b"\x00\x01garbage"]
     runs = [
         _interleaved(scene, deck_raws, ns[~silent], (body, np.insert(ns, 1020, [ns[1020]] * 2))),
@@ -899,12 +908,7 @@ def test_body_messages_not_compared_in_a_last_window_too_short_to_judge_are_warn
     strictly inside the gap (10.500 … 10.995, 11.000 … 11.195 s) are in_gap, the 5 rejected;
     all were said by no window, only in the run's counts. Now a WARN at the end says them, the
     same bytes in every feeding order."""
-    scene, deck = _pump(), _deck(12.0)
-    _, whole = _whole_record(scene, deck)
-    ns = _stamps(deck)
-    silent = (deck.t >= 10.5) & (deck.t < 11.2)
-    deck_raws = [r for r, s in zip(_deck_raws(scene, deck), silent, strict=True) if not s]
-    body = _body_raws(ns, whole)
+    scene, ns, silent, deck_raws, body, whole = _deck_silent_between(10.5, 11.2)
     body_ns = ns.copy()
     body[2150:2150] = [b"\x00\x01garbage"] * 3  # among the gap's samples (10.75 s)
     body_ns = np.insert(body_ns, 2150, [ns[2150]] * 3)
