@@ -50,13 +50,13 @@ from mount_twin.engine.estimator import (
     new_estimator,
 )
 from mount_twin.engine.health_texts import INTEGRATION
-from mount_twin.integrate.methods import METHODS
+from mount_twin.integrate.methods import METHODS, choose
 from mount_twin.integrate.settings import HOLD_AFTER_REJECT
 from mount_twin.integrate.stepper import new_stepper
 from mount_twin.io.input_samples import read_samples
 from mount_twin.kinds import N_EVENTS
 from mount_twin.model import assemble as assemble_module
-from mount_twin.model.assemble import assemble
+from mount_twin.model.assemble import Model, assemble
 from mount_twin.replay import replay
 from mount_twin.scene.description import Scene
 from mount_twin.scene.loader import load_scene_file, scene_from_dict
@@ -509,8 +509,9 @@ def _soft_beside_a_snubber() -> tuple[Scene, SampleBatch]:
     return _soft_beside(snubbed)
 
 
-def _rho_dt(status) -> float:
-    return float(status.values["method"].split("= ")[1].split(" ")[0])
+def _rho_dt(method: str) -> float:
+    """ρ·Δt in an integration status' `method`, e.g. `ros34pw2 (auto: ρ·Δt = 17.3 ...)`."""
+    return float(method.split("= ")[1].split(" ", maxsplit=1)[0].rstrip(",)"))
 
 
 def test_auto_starts_a_light_body_beside_a_stiff_key_on_what_the_closed_key_needs() -> None:
@@ -572,7 +573,7 @@ def test_auto_looks_again_after_a_mount_event_the_same_live_and_replayed() -> No
     contact = next(e for e in engine.events if e.event == "snubber_contact")
     assert status.values["method"].startswith("ros34pw2 (auto: ρ·Δt = ")
     assert status.values["method"].endswith("after snubber_contact of snubbed)")
-    assert _rho_dt(status) == pytest.approx(BEARING_RHO_DT, rel=0.01)
+    assert _rho_dt(status.values["method"]) == pytest.approx(BEARING_RHO_DT, rel=0.01)
     assert engine.counts["method_switches"] == 1 and engine.counts["integration_failures"] == 0
     assert 1.02 < contact.stamp < 1.07
     whole = TwinEngine(assemble(scene)).push(samples)
@@ -580,6 +581,107 @@ def test_auto_looks_again_after_a_mount_event_the_same_live_and_replayed() -> No
     parts = [live.push(one) for one in split(samples, [1] * len(samples))]
     np.testing.assert_array_equal(whole.wrenches, np.concatenate([p.wrenches for p in parts]))
     assert live.counts["method_switches"] == 1
+
+
+SNUB_RATE_HZ = 100.0
+SNUB_LATERAL = 2.0
+"""m/s² along x of F: a heel of 11.8°, past what the soft mounts take within the snubber's gap."""
+
+
+def _heeled_onto_a_snubber(
+    method: str = "auto", stiffness: float = 1e7, seconds: float = 0.5, rtol: float = 1e-6
+) -> tuple[Scene, Model, SampleBatch, SampleBatch]:
+    """5 kg, CG 0.1 m above four corner mounts soft laterally (1e3 N/m in x and y, 1e4 N/m in
+    z), beside a snubber 1 mm off along x at `stiffness` N/m (linear past the gap), at `rtol`
+    (atol 1e-3 of it), under a 100 Hz input: upright for `seconds`, then after a 1 s gap (past
+    `max_gap_s`, a restart) heeled by SNUB_LATERAL along x as long, with 0.3 m/s² of 5 Hz
+    sway on it. The heel takes 4 N within the gap and presses the snubber with the other 6 N
+    at equilibrium: the restart starts on it, with no contact to log (bench/restart_methods.py
+    measures the methods there). Returns (scene, its model, upright, heeled)."""
+    soft = [
+        mount(f"m{i}", (x, y, 0.0), (1e3, 1e3, 1e4, 0, 0, 0), (20.0,) * 3 + (0,) * 3)
+        for i, (x, y) in enumerate(CORNERS)
+    ]
+    snubbed = kind_mount(
+        "elastomer",
+        "snubbed",
+        (0.0, 0.0, 0.0),
+        stiffness_linear=[1.0, 1.0, 1.0],
+        damping=[0.0, 0.0, 0.0],
+        snubber={"gap": 1e-3, "stiffness": stiffness, "exponent": 1.0, "axes": ["x"]},
+    )
+    data = base_scene(5.0, [0.0, 0.0, 0.1], [0.1, 0.1, 0.1, 0.0, 0.0, 0.0], [*soft, snubbed])
+    data["integration"].update(method=method, rtol=rtol, atol=rtol * 1e-3)
+    data["input"]["max_gap_s"] = 0.5
+    data["initial_state"]["gravity_window_s"] = 0.0
+    scene = raw_gyro(_with_pump_input(data))
+    t = np.arange(round(seconds * SNUB_RATE_HZ)) / SNUB_RATE_HZ
+    sway = 0.3 * np.sin(2.0 * math.pi * 5.0 * t)
+    upright = np.column_stack([np.zeros_like(t), np.zeros_like(t), np.full_like(t, G)])
+    heeled = np.column_stack(
+        [SNUB_LATERAL + sway, np.zeros_like(t), np.full_like(t, math.sqrt(G**2 - SNUB_LATERAL**2))]
+    )
+    frames = [scene.input.frame_id] * t.shape[0]
+    zero = np.zeros_like(upright)
+    return (
+        scene,
+        assemble(scene),
+        SampleBatch(1.0 + t, upright, zero, frames),
+        SampleBatch(2.0 + seconds + t, heeled, zero, frames),
+    )
+
+
+def _pressed_rho(stiffness: float = 1e7) -> float:
+    """ρ (rad/s) of `_heeled_onto_a_snubber` resting on its snubber of `stiffness` (N/m), by
+    hand: its stiff mode is x and pitch coupled, the lateral springs (4·1e3 N/m and the
+    snubber's) acting 0.1 m below the CG, on x − 0.1·θ, and the vertical ones (4·1e4 N/m at
+    x = ±0.4 m) on the pitch alone; ρ² is the largest eigenvalue of M⁻¹K (the weight's
+    geometric stiffness, ~5 N·m/rad against 1e5, left out)."""
+    lateral = 4 * 1e3 + stiffness
+    k = lateral * np.array([[1.0, -0.1], [-0.1, 0.01]]) + np.diag([0.0, 4 * 1e4 * 0.4**2])
+    return math.sqrt(np.linalg.eigvals(np.diag([1 / 5.0, 1 / 0.1]) @ k).real.max())
+
+
+def test_auto_chooses_again_at_a_restart_onto_a_pressed_snubber() -> None:
+    """Upright, the scene is soft (ρ·Δt 2.5): explicit. The gap's restart starts resting on
+    the snubber, which logs no contact (it touched before the first interval), and ρ·Δt there
+    is 17.4 (closed form, `_pressed_rho`): `auto` chooses at the restart as at a first start,
+    from the state it starts at, so the Rosenbrock, as a new twin started there chooses.
+    Before, the upright start's explicit method went on (what each method costs there:
+    docs/scene.md, bench/restart_methods.py)."""
+    _, model, upright, heeled = _heeled_onto_a_snubber()
+    engine = TwinEngine(model)
+    engine.push(upright)
+    assert engine.health.method.startswith("dopri54 (auto: ρ·Δt = 2.5")
+    engine.push(heeled)
+    rho_dt = _pressed_rho() / SNUB_RATE_HZ
+    assert choose(rho_dt, smooth=False) == "ros34pw2"
+    assert engine.health.method.startswith("ros34pw2 (auto: ρ·Δt = ")
+    assert _rho_dt(engine.health.method) == pytest.approx(rho_dt, rel=0.01)
+    assert engine.counts["restarts"] == 1 and engine.counts["method_switches"] == 1
+    assert not engine.events  # no contact logged: the restart's own look
+    fresh = TwinEngine(assemble(model.scene))
+    fresh.push(heeled)
+    assert engine.health.method == fresh.health.method.replace(")", ", at a restart)")
+
+
+def test_auto_looks_again_after_a_restart_whose_stamps_went_back() -> None:
+    """The snubber's contact (`_soft_beside_a_snubber`) twice, the second lap 2 s earlier on
+    the record (a bag looped: a stamp going back past `back_jump_reset_s` restarts the twin).
+    Each start chooses from its state (explicit, at rest and open) and each contact looks
+    again (the Rosenbrock): three switches. A look's throttle is record time after it, and a
+    restart starts it afresh: the second lap's contact falls before the first's throttle
+    ended."""
+    scene, samples = _soft_beside_a_snubber()
+    lap = SampleBatch(samples.stamps - 2.0, samples.accel, samples.gyro, samples.frame_ids)
+    engine = TwinEngine(assemble(scene))
+    fields = ("stamps", "accel", "gyro")
+    both = (np.concatenate([getattr(b, k) for b in (samples, lap)]) for k in fields)
+    engine.run(SampleBatch(*both, [*samples.frame_ids, *lap.frame_ids]))
+    contacts = [e.stamp for e in engine.events if e.event == "snubber_contact"]
+    assert engine.counts["restarts"] == 1 and contacts[0] > 1.0 > contacts[-1]
+    assert engine.counts["method_switches"] == 3
+    assert engine.health.method.endswith("after snubber_contact of snubbed)")
 
 
 def test_the_worst_estimate_over_a_replay_is_one_figure_in_summary_json_and_diagnostics(

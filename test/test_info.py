@@ -33,8 +33,8 @@ def test_a_scene_lists_its_mounts_input_and_resolved_outputs(
     assert "/mount_twin/mounts/foot_fl/wrench" in out
     assert "input:   /deck/imu (sensor_msgs/msg/Imu), frame_id deck_imu" in out
     assert (
-        "integration: auto (by stiffness: at the first sample interval, again after a "
-        "contact), rtol 1e-06" in out
+        "integration: auto (by stiffness: at each start's first sample interval, again after "
+        "a contact), rtol 1e-06" in out
     )
     assert "error estimate on" in out
 

@@ -71,7 +71,7 @@ def scene_text(scene: Scene) -> str:
         ),
         f"integration: {g.method}"
         + (
-            " (by stiffness: at the first sample interval, again after a contact)"
+            " (by stiffness: at each start's first sample interval, again after a contact)"
             if g.method == "auto"
             else ""
         )

@@ -1,18 +1,21 @@
-"""`integration.method: auto`: the method a scene takes, chosen at the first sample interval and
-looked at again after mount events.
+"""`integration.method: auto`: the method a scene takes, chosen at each start (the first and
+every restart) and looked at again after mount events.
 
 The rule is `integrate.methods.choose`: ρ·Δt, the spectral radius of the Jacobian (rad/s) times
 the sample interval (s), against what an explicit method can step, and whether the mounts
-switch. Before the first interval ρ is the larger of the Jacobian's at the nominal start state
-and the rate of the mounts' nominal tangents (`scene.statics`: a shear key counts as bearing,
-however wide its clearance), so a light body beside a stiff key starts on the method the key
-needs when it closes, not on the one its open clearance allows (5 kg beside a 1e9 N/m key at
-1 kHz: 9.8e-4 of the largest force by ros34pw2 from the start, 2.3e-2 by Dormand–Prince until
-the key had closed). ρ is taken again at the state of a sample that logged an event that may
-stiffen the scene beyond that (a snubber touching: its Hertzian contact has no tangent until it
-is pressed), at most once per REEXAMINE_S of record time. The compiled loop ends a run at such
-a sample (`engine.kernel.AT_EVENT`), so a live node pushing one sample at a time and a replay
-pushing thousands make the same choices at the same samples.
+switch. At a start ρ is the larger of the Jacobian's at the start state under the start
+sample's specific force and the rate of the mounts' nominal tangents (`scene.statics`: a shear
+key counts as bearing, however wide its clearance), so a light body beside a stiff key starts
+on the method the key needs when it closes, not on the one its open clearance allows (5 kg
+beside a 1e9 N/m key at 1 kHz: 9.8e-4 of the largest force by ros34pw2 from the start, 2.3e-2
+by Dormand–Prince until the key had closed), and a start resting on a pressed snubber (a
+heel, a restart under a sustained load) on the method the snubber needs: its contact logs no
+event there, having touched before the first interval. ρ is taken again at the state of a
+sample that logged an event that may stiffen the scene beyond that (a snubber touching: its
+Hertzian contact has no tangent until it is pressed), at most once per REEXAMINE_S of record
+time after a look or a start. The compiled loop ends a run at such a sample
+(`engine.kernel.AT_EVENT`), so a live node pushing one sample at a time and a replay pushing
+thousands make the same choices at the same samples.
 """
 
 from __future__ import annotations
@@ -52,12 +55,22 @@ class Choice:
         return f"{self.method} (auto: {self.why})"
 
 
-def at_start(model: Model, rho_start: float, rho_tangent: float, interval_s: float) -> Choice:
-    """The choice at the first sample interval (s), from ρ at the nominal start and the rate
-    of the nominal tangents (rad/s, `Model.tangent_rate`): the larger of the two."""
-    rho_dt = max(rho_start, rho_tangent) * interval_s
-    bearing = rho_tangent > TANGENT_MARGIN * rho_start
-    why = f"ρ·Δt = {rho_dt:.3g}" + (", keys bearing" if bearing else "")
+def at_start(
+    model: Model, y: np.ndarray, specific_force: np.ndarray, interval_s: float, *, restart: bool
+) -> Choice:
+    """The choice at a start's first sample interval (s), from ρ at the start state y under the
+    start sample's specific force (m/s², F) and the rate of the nominal tangents (rad/s,
+    `Model.tangent_rate`): the larger of the two; `restart`: a restart's (the status says so).
+    Where ρ cannot be taken at y (the α/γ/δ chart's edge), at the nominal start."""
+    rho = radius(model, y, specific_force)
+    if rho is None:
+        gravity_up = np.array([0.0, 0.0, model.scene.input.g])
+        rho = spectral_radius(model, model.nominal_state, gravity_up)
+    rho_tangent = model.tangent_rate
+    rho_dt = max(rho, rho_tangent) * interval_s
+    bearing = rho_tangent > TANGENT_MARGIN * rho
+    notes = [n for n, holds in (("keys bearing", bearing), ("at a restart", restart)) if holds]
+    why = ", ".join([f"ρ·Δt = {rho_dt:.3g}", *notes])
     return Choice(choose(rho_dt, smooth=model.arrays.nl is None), why)
 
 
@@ -66,12 +79,19 @@ def after_event(
 ) -> Choice | None:
     """The choice at state y under the sample's specific force (m/s², F) after `event`; None
     where ρ cannot be taken (the state at the α/γ/δ chart's edge): the method stays."""
-    try:
-        rho = spectral_radius(model, y, specific_force)
-    except ModelError:
-        return None
-    if not math.isfinite(rho):
+    rho = radius(model, y, specific_force)
+    if rho is None:
         return None
     rho_dt = rho * interval_s
     method = choose(rho_dt, smooth=model.arrays.nl is None)
     return Choice(method, f"ρ·Δt = {rho_dt:.3g} after {event.event} of {event.mount}")
+
+
+def radius(model: Model, y: np.ndarray, specific_force: np.ndarray) -> float | None:
+    """ρ (rad/s, `model.stiffness.spectral_radius`) at state y under the specific force
+    (m/s², F); None where it cannot be taken (y at the α/γ/δ chart's edge, or not finite)."""
+    try:
+        rho = spectral_radius(model, y, specific_force)
+    except ModelError:
+        return None
+    return rho if math.isfinite(rho) else None

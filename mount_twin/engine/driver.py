@@ -4,8 +4,9 @@
 and the decimation state; `begin` puts the twin at a start state, `advance` runs one segment of
 samples through `kernel.run_samples` and hands what the core logged (steps, error figures,
 mount events) to the health window. Under `integration.method: auto` it makes the method choice
-at the first interval and looks again after mount events that may stiffen the scene
-(`auto_method`). Which samples to run, and what to do at a failure, is the engine's business.
+at each start's first interval, from the start state, and looks again after mount events that
+may stiffen the scene (`auto_method`). Which samples to run, and what to do at a failure, is the
+engine's business.
 """
 
 from __future__ import annotations
@@ -42,7 +43,6 @@ from mount_twin.integrate.methods import AUTO
 from mount_twin.integrate.stepper import new_stepper, switch
 from mount_twin.kinds import KINDS, N_EVENTS
 from mount_twin.model.assemble import Model
-from mount_twin.model.stiffness import spectral_radius
 from mount_twin.physics import pose_row
 from mount_twin.physics.dynamics import (
     INPUT_SIZE,
@@ -203,10 +203,11 @@ class CoreDriver:
         self.estimator = _new_estimator(model, (self._watch.g.shape[0], self._watch.g.shape[1]))
         self._loop: tuple[tuple[object, ...], Loop] | None = None
         """The arrays bound last, and their `Loop` (`_bound`)."""
-        self._choosing = integ.method == AUTO
-        """`auto` has not made its first choice yet (made at the first interval)."""
-        if self._choosing:
-            self._watch.stop_after[0] = -math.inf  # `auto` looks again after mount events
+        self._auto = integ.method == AUTO
+        self._start_due = False
+        """`auto` chooses at the first interval of the start just made (`choose_at_start`)."""
+        self._chosen = False
+        """`auto` has chosen before: a change is a switch (counted)."""
 
     def _integrator(self) -> Integrator:
         """The stepper's arrays as the core takes them."""
@@ -218,7 +219,10 @@ class CoreDriver:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Put the twin at state y at sample `stamp` (s) under specific force f (m/s², F) and
         Ω w (rad/s, F): the stepper's history, the decimation and the error estimate start
-        anew. Returns the start's outputs: its pose row and (n_mounts, 6) wrenches."""
+        anew; under `auto` the method is chosen at the first interval (`choose_at_start`), and
+        the next mount event that may stiffen the scene prompts a look however soon after the
+        last one on the record (the stamps may have gone back). Returns the start's outputs:
+        its pose row and (n_mounts, 6) wrenches."""
         if self._counter[0]:
             msg = "a run ends with its last sample published: close_run before begin"
             raise RuntimeError(msg)
@@ -226,6 +230,9 @@ class CoreDriver:
         self.stepper.reset()
         self._peak[:] = 0.0
         self.last = (stamp, f.copy(), w.copy())
+        if self._auto:
+            self._start_due = True
+            self._watch.stop_after[0] = -math.inf
         outputs = self._start_outputs(stamp)
         if isinstance(self.estimator, Estimator):
             estimator.restart(self.estimator)
@@ -302,13 +309,14 @@ class CoreDriver:
         return bound[1]
 
     def choose_at_start(self, stamp: float) -> None:
-        """`auto`'s first choice, at the interval from the start into the sample at `stamp`
-        (s); nothing otherwise."""
-        if self._choosing and self.last is not None:
-            gravity_up = np.array([0.0, 0.0, self.model.scene.input.g])
-            rho = spectral_radius(self.model, self.model.nominal_state, gravity_up)
-            interval = stamp - self.last[0]
-            self._use(at_start(self.model, rho, self.model.tangent_rate, interval))
+        """`auto`'s choice at a start (the first, or a restart: `begin`), at the interval from
+        it into the sample at `stamp` (s), from the start state under the start sample's
+        specific force; nothing where no start awaits its choice."""
+        if self._start_due and self.last is not None:
+            self._start_due = False
+            start, f, _ = self.last
+            choice = at_start(self.model, self.y, f, stamp - start, restart=self._chosen)
+            self._use(choice)
 
     def advance(self, segment: Samples, index: np.ndarray, rows: BatchRows) -> Stepped:
         """Integrate through the samples of `segment` (row 0: the last one done), which are
@@ -364,14 +372,14 @@ class CoreDriver:
             self._use(choice)
 
     def _use(self, choice: Choice) -> None:
-        """Run `auto`'s choice from now on: the first, or a change after a mount event (its
-        step history forgotten; counted)."""
+        """Run `auto`'s choice from now on: the first, or a change at a restart or after a
+        mount event (its step history forgotten; counted)."""
         self._health.method = choice.status
-        if not self._choosing:
+        if self._chosen:
             if choice.method == self.stepper.name:
                 return
             self._counts["method_switches"] += 1
-        self._choosing = False
+        self._chosen = True
         switch(self.stepper, choice.method)
         self._integ = self._integrator()
         if isinstance(self.estimator, Estimator):

@@ -121,8 +121,9 @@ ROS34PW2 = METHODS["ros34pw2"].id
 EXPRB32 = METHODS["exprb32"].id
 
 AUTO = "auto"
-"""`integration.method: auto` (the default): `choose` decides at the first input interval and
-again after an event that may stiffen the scene (`engine.auto_method` takes ρ)."""
+"""`integration.method: auto` (the default): `choose` decides at each start's first input
+interval (the first start's and every restart's) and again after an event that may stiffen the
+scene (`engine.auto_method` takes ρ)."""
 STIFF_RHO_DT = 10.0
 """ρ·Δt (the body's fastest rate, rad/s, as `engine.auto_method` takes it, times the sample
 interval, s) past which `auto` takes a method that does not step at the stiff modes' rate:
