@@ -73,14 +73,31 @@ def quaternion_from_matrix(rot: np.ndarray, out: np.ndarray) -> None:
             out[i] = -out[i]
 
 
+_ENTRIES = (
+    ((1, 1), (2, 2), 1.0),  # 1 − 2 (y y + z z)
+    ((0, 1), (3, 2), -1.0),  # 2 (x y − w z)
+    ((0, 2), (3, 1), 1.0),  # 2 (x z + w y)
+    ((0, 1), (3, 2), 1.0),  # 2 (x y + w z)
+    ((0, 0), (2, 2), 1.0),  # 1 − 2 (x x + z z)
+    ((1, 2), (3, 0), -1.0),  # 2 (y z − w x)
+    ((0, 2), (3, 1), -1.0),  # 2 (x z − w y)
+    ((1, 2), (3, 0), 1.0),  # 2 (y z + w x)
+    ((0, 0), (1, 1), 1.0),  # 1 − 2 (x x + y y)
+)
+"""The rotation matrix's entries, row by row, of a quaternion (x, y, z, w: 0–3): the pairs
+(i, j) of its two products q_i q_j and the sign the second takes."""
+_FIRST = np.array([4 * i + j for (i, j), _, _ in _ENTRIES])
+_SECOND = np.array([4 * i + j for _, (i, j), _ in _ENTRIES])
+_SIGN = np.array([sign for _, _, sign in _ENTRIES])
+_DIAGONAL = np.array([0, 4, 8])
+
+
 def quaternion_matrices(quat: np.ndarray) -> np.ndarray:
-    """(k, 3, 3) rotation matrices of (k, 4) unit quaternions (x, y, z, w)."""
-    x, y, z, w = (quat[:, i] for i in range(4))
-    return np.stack(
-        [
-            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-        ],
-        axis=1,
-    )
+    """(k, 3, 3) rotation matrices of (k, 4) unit quaternions (x, y, z, w): the entries
+    1 − 2 (y² + z²), 2 (x y − w z), … each from the products q_i q_j of all pairs, formed once
+    (a difference p − q as p + (−q), the same bits)."""
+    k = quat.shape[0]
+    products = (quat[:, :, None] * quat[:, None, :]).reshape(k, 16)
+    twice = 2 * (products.take(_FIRST, 1) + _SIGN * products.take(_SECOND, 1))
+    twice[:, _DIAGONAL] = 1 - twice[:, _DIAGONAL]
+    return twice.reshape(k, 3, 3)
