@@ -48,7 +48,7 @@ import numpy as np
 from mount_twin.engine.agreement import FIELDS, NAME
 from mount_twin.engine.batch import WARN, HealthStatus
 from mount_twin.engine.body_counts import APART, NOT_COMPARED, REJECTED, RESETS, UNPROVIDED
-from mount_twin.engine.body_matching import PENDING_LIMIT, Matcher
+from mount_twin.engine.body_matching import PENDING_LIMIT, Matcher, Taken
 from mount_twin.engine.body_prediction import Lead, TwinRows
 from mount_twin.engine.body_refusals import Refusals
 from mount_twin.engine.body_windows import Windows
@@ -77,6 +77,12 @@ class BodyComparison:
     residual: np.ndarray
     present: np.ndarray
     reports: list[tuple[int, HealthStatus]]
+
+    @classmethod
+    def none(cls, reports: list[tuple[int, HealthStatus]]) -> BodyComparison:
+        """No sample compared; `reports`."""
+        empty = np.zeros((0, 6))
+        return cls(np.zeros(0, np.int64), empty, empty, np.zeros((0, 2), bool), reports)
 
 
 class BodyCheck:
@@ -168,14 +174,7 @@ class BodyCheck:
         before = self._accepted_screened + np.cumsum(accepted) - accepted
         self._windows.mark(before[~accepted], why[~accepted])
         self._accepted_screened += int(accepted.sum())
-        empty = np.zeros((0, 6))
-        return BodyComparison(
-            np.zeros(0, np.int64),
-            empty,
-            empty,
-            np.zeros((0, 2), bool),
-            self._refusals.add(stamps_ns, why),
-        )
+        return BodyComparison.none(self._refusals.add(stamps_ns, why))
 
     def reject(self, reason: str, n: int) -> None:
         """Count n body messages not compared, because `reason` (one of REJECTED)."""
@@ -235,13 +234,7 @@ class BodyCheck:
 
     def _compared(self, final: bool = False) -> BodyComparison:
         taken = self._matcher.take(final)
-        compared = taken.compared()
-        self.counts["compared"] += int(compared.ns.shape[0])
-        for field, given in zip(FIELDS, compared.present.T, strict=True):
-            self.counts[f"compared_{field}"] += int(given.sum())
-        residual = compared.measured - compared.predicted
-        residual[~np.repeat(compared.present, 3, axis=1)] = np.nan
-        reports = self._windows.add(taken, residual)
+        out = self._judged(taken) if taken.ns.shape[0] else BodyComparison.none([])
         stamp_ns = self._matcher.first_apart_ns
         if stamp_ns is not None and not self._said_apart:
             self._said_apart = True
@@ -251,5 +244,17 @@ class BodyCheck:
             assert self._apart.found is not None
             first, _, end = self._apart.found
             values = {"jumped_back_first": first, "jumped_back_at_s": f"{end:.3f}"}
-            reports.append((stamp_ns, HealthStatus(NAME, WARN, message, values)))
+            out.reports.append((stamp_ns, HealthStatus(NAME, WARN, message, values)))
+        return out
+
+    def _judged(self, taken: Taken) -> BodyComparison:
+        """Body samples taken out of the matcher: those compared counted, their residuals, and
+        the windows they close."""
+        compared = taken.compared()
+        self.counts["compared"] += int(compared.ns.shape[0])
+        for field, given in zip(FIELDS, compared.present.T, strict=True):
+            self.counts[f"compared_{field}"] += int(given.sum())
+        residual = compared.measured - compared.predicted
+        residual[~np.repeat(compared.present, 3, axis=1)] = np.nan
+        reports = self._windows.add(taken, residual)
         return BodyComparison(compared.ns, compared.predicted, residual, compared.present, reports)

@@ -130,6 +130,8 @@ class Matcher:
         self._last_ns = 0
         """The stamp of the last body sample added, ns."""
         self._body: list[_Waiting] = []
+        self._held = 0
+        """Body samples waiting (in `_body`)."""
         self.taken = 0
         """Accepted body samples taken out so far (compared, or counted not compared): the
         place among them of the first one waiting."""
@@ -154,9 +156,9 @@ class Matcher:
         run = self._body_run + np.cumsum(back)
         self._body_run, self._last_ns = int(run[-1]), int(ns[-1])
         self._body.append((ns, t, v, present, run))
-        waiting = sum(c[0].shape[0] for c in self._body)
-        if waiting > PENDING_LIMIT:
-            cut = waiting - PENDING_LIMIT
+        self._held += ns.shape[0]
+        if self._held > PENDING_LIMIT:
+            cut, self._held = self._held - PENDING_LIMIT, PENDING_LIMIT
             self._problems["dropped_waiting"] += cut
             self.taken += cut
             ns, t, v, present, run = self._waiting()
@@ -170,7 +172,7 @@ class Matcher:
     def take(self, final: bool = False) -> Taken:
         """The body samples the predictions now decide, in order (`final`: the end of the
         stream, the rest are counted unanswered)."""
-        if not self._body:
+        if not (self._body and (final or self._decides())):
             self._forget()
             return Taken.none()
         ns, t, v, present, run = self._waiting()
@@ -207,10 +209,12 @@ class Matcher:
             self._problems["unanswered"] += left
         rest = (ns[done:], t[done:], v[done:], present[done:], run[done:])
         self._body = [rest] if left and not final else []
+        self._held = left if not final else 0
         first = self.taken
         self.taken += done + (left if final else 0)
-        for reason in ("before_twin", "late", "in_gap", "unanswered", APART):
-            self._problems[reason] += int((why[:done] == reason).sum())
+        for reason, n in Counter(why[:done].tolist()).items():
+            if reason:
+                self._problems[reason] += n
         self._forget()
         return Taken(
             ns[:done],
@@ -222,6 +226,20 @@ class Matcher:
             first + np.arange(done),
             run[:done],
         )
+
+    def _decides(self) -> bool:
+        """Whether the predictions may decide the first body sample waiting now (False: the
+        streams in step, and its run's rows not yet at the motion it measured, or none yet)."""
+        if self._apart.found is not None:
+            return True
+        _, t, _, _, run = self._body[0]
+        r = int(run[0])
+        if r < self._rows_run:  # the twin ended its run
+            return True
+        series = self._pred.get(r) if r == self._rows_run else None
+        if series is None or series.first is None:
+            return False
+        return float(t[0]) - self._lag <= series.t[-1]  # (the run's stamps rise)
 
     def _match(self, series: _Series, tau: np.ndarray, why: np.ndarray, pred: np.ndarray) -> None:
         """The predictions (into `pred`, (k, 6)) of body samples measuring the motion at `tau`
