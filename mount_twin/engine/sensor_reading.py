@@ -137,14 +137,12 @@ def relative_rate(d_dt: Differences, rotation: np.ndarray) -> np.ndarray:
     attitudes at the stamps of `d_dt`: the skew part of Ṙ Rᵀ."""
     dr = d_dt.of(rotation)
 
-    def w(i: int, j: int) -> np.ndarray:  # (Ṙ Rᵀ)_ij
-        return (
-            dr[:, i, 0] * rotation[:, j, 0]
-            + dr[:, i, 1] * rotation[:, j, 1]
-            + dr[:, i, 2] * rotation[:, j, 2]
-        )
+    def w(i: np.ndarray, j: np.ndarray) -> np.ndarray:  # (Ṙ Rᵀ)_ij, three (i, j) at once
+        p = dr.take(i, 1) * rotation.take(j, 1)
+        return p[:, :, 0] + p[:, :, 1] + p[:, :, 2]
 
-    return 0.5 * np.stack([w(2, 1) - w(1, 2), w(0, 2) - w(2, 0), w(1, 0) - w(0, 1)], 1)
+    # axis by axis: (2, 1) − (1, 2), (0, 2) − (2, 0), (1, 0) − (0, 1)
+    return 0.5 * (w(_AFTER, _NEXT) - w(_NEXT, _AFTER))
 
 
 def predicted_reading(
