@@ -92,6 +92,9 @@ class Taken:
             np.zeros(0, np.int64),
         )
 
+    def __len__(self) -> int:
+        return int(self.t.shape[0])
+
     def select(self, k: np.ndarray | slice) -> Taken:
         """Those `k` selects."""
         return Taken(*(getattr(self, f.name)[k] for f in fields(self)))
@@ -248,9 +251,11 @@ class Matcher:
             return
         assert series.first is not None
         pt, pv = series.t, series.v
-        why[tau < series.first] = "before_twin"
-        why[(why == "") & (tau < pt[0])] = "late"
-        kept = np.flatnonzero(why == "")
+        before = tau < series.first
+        late = ~before & (tau < pt[0])
+        why[before] = "before_twin"
+        why[late] = "late"
+        kept = np.flatnonzero(~(before | late))
         after = np.searchsorted(pt, tau[kept], side="right")
         at_row = pt[after - 1] == tau[kept]  # (after ≥ 1: tau ≥ the first row)
         # A sample at a row takes that row's prediction whichever rows come after it (were it

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass
+from itertools import pairwise
 
 import numpy as np
 
@@ -77,13 +78,15 @@ class Windows:
     def add(self, taken: Taken, residual: np.ndarray) -> list[tuple[int, HealthStatus]]:
         """Reports (stamp ns, status) of the windows these samples (all taken out of the
         matcher, the compared ones' `residual` beside them) close."""
+        said = Counter(taken.why.tolist())
         for key in LOOSE:  # those at a place: said there
-            self._loose_reported[key] += int((taken.why == key).sum())
+            self._loose_reported[key] += said[key]
         reports = []
         start = k = 0  # into the samples, the compared ones
         for run in np.unique(taken.run).tolist():
             stop = start + int((taken.run[start:] == run).sum())  # runs rise
-            part = taken.select(slice(start, stop))
+            whole = start == 0 and stop == len(taken)
+            part = taken if whole else taken.select(slice(start, stop))
             n = int((part.why == "").sum())
             if run != self._run:
                 reports += self._close(CUT_BY_JUMP)
@@ -107,24 +110,29 @@ class Windows:
         index = np.maximum(index, 0)  # not compared before the first window: in it
         reports = []
         k = 0  # into the compared ones
-        for i in np.unique(index).tolist():
-            part = index == i
+        cuts = np.flatnonzero(index[1:] != index[:-1]) + 1  # (the windows rise: stamps do)
+        for start, stop in pairwise([0, *cuts.tolist(), index.shape[0]]):
+            i = int(index[start])
             if self._window is not None and self._window.index != i:
                 reports += self._close()
             if self._window is None:
                 self._window, self._carried = _Window(i, [], self._carried), Counter()
             window = self._window
-            window.problems.update(taken.why[part & ~compared].tolist())
-            self._attribute(int(taken.place[part][-1]), window.problems)
-            n = int((part & compared).sum())
+            these = compared[start:stop]
+            n = int(these.sum())
+            part: slice | np.ndarray = slice(start, stop)
+            if n < stop - start:  # (all compared: the rows themselves, no copy)
+                window.problems.update(taken.why[start:stop][~these].tolist())
+                part = np.flatnonzero(these) + start
+            self._attribute(int(taken.place[stop - 1]), window.problems)
             if n:
                 window.chunks.append(
                     (
-                        taken.ns[part & compared],
-                        taken.t[part & compared],
-                        taken.measured[part & compared],
+                        taken.ns[part],
+                        taken.t[part],
+                        taken.measured[part],
                         residual[k : k + n],
-                        taken.present[part & compared],
+                        taken.present[part],
                     )
                 )
                 k += n
