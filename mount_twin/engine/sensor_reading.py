@@ -109,17 +109,18 @@ class Differences:
         dx = np.diff(t)
         h1, h2 = dx[:-1], dx[1:]
         s = h1 + h2
-        inside = np.stack([-h2 / (h1 * s), (h2 - h1) / (h1 * h2), h1 / (h2 * s)], 1)
-        # the ends' rows, on the spacing of the rows inside next to them; a weight subtracted
-        # in np.gradient's formula is added negated here (x − c·f = x + (−c)·f, bit for bit)
-        first = (-(2.0 * h1[0] + h2[0]) / (h1[0] * s[0]), s[0] / (h1[0] * h2[0]), -inside[0, 2])
-        last = (
-            -inside[-1, 0],
-            -(s[-1] / (h1[-1] * h2[-1])),
-            (2.0 * h2[-1] + h1[-1]) / (h2[-1] * s[-1]),
-        )
-        self._weights = np.concatenate([[first], inside, [last]])
-        self._rows = np.clip(np.arange(k), 1, k - 2)[:, None] + np.arange(-1, 2)
+        w = np.empty((k, 3))
+        w[1:-1, 0], w[1:-1, 1], w[1:-1, 2] = -h2 / (h1 * s), (h2 - h1) / (h1 * h2), h1 / (h2 * s)
+        # the ends' rows, on the spacing of the rows inside next to them (as Python floats: the
+        # same IEEE operations); a weight subtracted in np.gradient's formula is added negated
+        # here (x − c·f = x + (−c)·f, bit for bit)
+        a1, a2, z1, z2 = float(h1[0]), float(h2[0]), float(h1[-1]), float(h2[-1])
+        w[0] = (-(2.0 * a1 + a2) / (a1 * (a1 + a2)), (a1 + a2) / (a1 * a2), -w[1, 2])
+        w[-1] = (-w[-2, 0], -((z1 + z2) / (z1 * z2)), (2.0 * z2 + z1) / (z2 * (z1 + z2)))
+        self._weights = w
+        centre = np.arange(k)
+        centre[0], centre[-1] = 1, k - 2
+        self._rows = centre[:, None] + np.arange(-1, 2)
 
     def of(self, f: np.ndarray) -> np.ndarray:
         """d f/dt, f (k, ...) at the stamps."""
