@@ -1,0 +1,61 @@
+"""The body prediction's small kernels (`engine.sensor_reading`, `physics.rotations`), written
+for few numpy calls a live call, against numpy's own and the textbook formulas, bit for bit: the
+live stream's output bytes must not depend on how they are computed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mount_twin.engine.sensor_reading import Differences, _cross
+from mount_twin.physics.rotations import quaternion_matrices
+
+RNG = np.random.default_rng(20261128)
+
+
+def _rows(k: int, width: int = 3) -> np.ndarray:
+    """Rows of very different magnitudes, with signed zeros."""
+    rows = RNG.normal(size=(k, width)) * 10.0 ** RNG.integers(-8, 8, size=(k, width))
+    rows[0, 0], rows[-1, -1] = -0.0, 0.0
+    return rows
+
+
+@pytest.mark.parametrize("k", [1, 5, 1000])
+def test_the_cross_product_is_numpys_bit_for_bit(k: int) -> None:
+    a, b = _rows(k), _rows(k)
+    assert _cross(a, b).tobytes() == np.cross(a, b).tobytes()
+
+
+@pytest.mark.parametrize("k", [3, 4, 5, 200])
+@pytest.mark.parametrize("shape", [(), (3,), (3, 3)])
+def test_the_differences_are_np_gradients_at_uneven_stamps(k: int, shape: tuple[int, ...]) -> None:
+    # np.gradient's edge_order=2 formulas on uneven spacing are the ones Differences takes
+    # (on exactly even spacing numpy switches to another formula, which Differences does not)
+    t = 1e3 + np.cumsum(RNG.uniform(1e-4, 2e-3, k))
+    f = RNG.normal(size=(k, *shape)) * 10.0 ** RNG.integers(-6, 6)
+    expected = np.gradient(f, t, axis=0, edge_order=2)
+    assert Differences(t).of(f).tobytes() == expected.tobytes()
+
+
+def test_the_differences_are_exact_on_a_parabola() -> None:
+    t = np.array([0.0, 0.001, 0.0025, 0.003, 0.0052])
+    f = (3.0 * t**2 - 2.0 * t + 1.0)[:, None]
+    assert np.allclose(Differences(t).of(f)[:, 0], 6.0 * t - 2.0, rtol=0.0, atol=1e-9)
+
+
+@pytest.mark.parametrize("k", [0, 1, 7, 500])
+def test_the_rotation_matrices_are_the_textbook_formulas_bit_for_bit(k: int) -> None:
+    quat = RNG.normal(size=(k, 4))
+    quat /= np.linalg.norm(quat, axis=1, keepdims=True)
+    if k:
+        quat[0] = [0.0, -0.0, 0.0, 1.0]
+    x, y, z, w = quat.T
+    expected = np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        axis=1,
+    ).reshape(k, 3, 3)
+    assert quaternion_matrices(quat).tobytes() == expected.tobytes()
