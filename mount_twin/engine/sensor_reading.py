@@ -11,7 +11,7 @@ body's rate relative to F, from the published attitudes R), α its inertial deri
 (d/dt of ω's components in F, plus Ω_F × ω), p the sensor's position and c the CG at the
 reference pose, all in the axes of F. The sensor reads them in its own axes: Rₛᵀ Rᵀ f_P and
 Rₛᵀ Rᵀ ω, Rₛ its orientation in the body frame. Rates come from the attitudes by central
-differences (`derivative`: second order, exact for the twin's smooth outputs to the square of
+differences (`Differences`: second order, exact for the twin's smooth outputs to the square of
 the step).
 """
 
