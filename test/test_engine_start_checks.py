@@ -290,3 +290,29 @@ def test_the_start_window_is_the_same_in_any_batching(sizes: list[int], gyro_fil
     np.testing.assert_array_equal(stamps_out, stamps)
     np.testing.assert_array_equal(np.concatenate([p.pose for p in parts]), whole.pose)
     np.testing.assert_array_equal(np.concatenate([p.wrenches for p in parts]), whole.wrenches)
+
+
+def test_a_start_waits_for_the_longer_of_its_window_and_the_filters_delay_not_both() -> None:
+    """1 kHz at rest, the gyro filter's delay N samples, the window 50 ms, one pushed at a
+    time: the start needs its window's samples (stamps up to 50 ms after the start sample),
+    and those the filter still holds go with it, so the first output comes with the first
+    sample past the window, or with sample N + 1 (the start sample and one more released),
+    whichever comes later. The window's samples were taken from the released ones alone: the
+    first output waited for the window's end plus the filter's delay (88 ms, not 50)."""
+    from mount_twin.engine.delay_line import delay_samples
+
+    n = 200
+    stamps = 1.0 + np.arange(n) * 1e-3
+    scene = scene_with(input={"gyro_filter": "linear_phase"})
+    delay = delay_samples(scene.input, 1000.0)
+    assert 0 < delay < 50  # the case this test is about: the filter's delay below the window
+    engine = engine_for(scene)
+    first = next(
+        k
+        for k, part in enumerate(
+            engine.push(b) for b in split(batch(stamps, _steady(REST, n)), [1] * n)
+        )
+        if part.stamps.shape[0]
+    )
+    past_window = int(np.argmax(stamps > stamps[0] + 0.05 + 1e-9))
+    assert first == max(past_window, delay + 1)

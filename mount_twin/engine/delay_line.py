@@ -11,7 +11,9 @@ rest); at its end (a restart, a gap reset, the end of the stream) the pending sa
 integrated with the rate after them held at the last one, so every accepted sample has its
 output. A run's first release waits, besides, until its start's gravity window has come
 (`initial_state.gravity_window_s`, `starts.start_takes`), so that the start takes the same
-samples in any batching; without a filter (no delay) that is the only hold. The filter is
+samples in any batching: those of the window still in the filter's delay go with it
+(`Run.ahead`), so the hold is the longer of the window and the delay, not their sum; without
+a filter (no delay) the window is the only hold. The filter is
 designed once, from the stream's first intervals (`DESIGN_SAMPLES`, `gyro_filter.design`).
 
 Everything depends on the accepted samples alone, in order: any batching gives the same bits.
@@ -27,7 +29,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -111,13 +113,19 @@ def conditioned_rates(
     return out
 
 
+_NO_ROWS = np.zeros(0, dtype=np.int64)
+"""No frame rows (a `Run` with none ahead)."""
+
+
 @dataclass
 class Run:
     """Accepted samples to integrate in one go (rows of a Frame); `restart`: the first one
-    starts a new state."""
+    starts a new state; `ahead`: at a restart, the rows of its run's samples still pending
+    after it (the gyro filter's N), whose specific forces a start's gravity window may take."""
 
     index: np.ndarray  # int64
     restart: bool
+    ahead: np.ndarray = field(default_factory=lambda: _NO_ROWS)
 
 
 @dataclass
@@ -297,7 +305,7 @@ class GyroDelay:
         takes: (samples, s) a start's gravity is the mean of (`starts.start_takes`): where
             s > 0, a run is held back until a sample lies more than s (and STAMP_SLACK_S)
             after its start sample (the samples-th), or the run ends, so that the start has
-            every sample of its window in any batching.
+            every sample of its window in any batching (those still pending in `Run.ahead`).
     """
 
     def __init__(
@@ -360,7 +368,9 @@ class GyroDelay:
 
     def _releasable(self, frame: Frame) -> int:
         """Pending samples that may go: all but the last N (the filter's), and none of a run
-        not yet released before one lies past its start's window (`takes`)."""
+        not yet released before one lies past its start's window (`takes`): the window's
+        samples are then those released and those still pending (`Run.ahead`), so the start
+        waits for the longer of the window and the filter's delay, not for both."""
         n = self._pending.shape[0] - self.delay
         samples, window_s = self._takes
         if not (self._restart and window_s > 0.0) or n <= 0:
@@ -368,7 +378,7 @@ class GyroDelay:
         if n <= samples:
             return 0
         stamps = frame.stamps
-        start, last = stamps[self._pending[samples - 1]], stamps[self._pending[n - 1]]
+        start, last = stamps[self._pending[samples - 1]], stamps[self._pending[-1]]
         return n if last > start + window_s + STAMP_SLACK_S else 0
 
     def drain(self, frame: Frame) -> list[Run]:
@@ -403,6 +413,6 @@ class GyroDelay:
         rows = pending[:n]
         frame.w[rows] = out.T
         self._pending = pending[n:]
-        released = Run(rows, self._restart)
+        released = Run(rows, self._restart, self._pending if self._restart else _NO_ROWS)
         self._restart = False
         return [released]

@@ -142,8 +142,9 @@ class Starts:
     def gather(self, run: Run, stamps: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Take a run's samples (frame rows: stamps s, specific forces m/s² in F) toward a
         start: `initial_state.gravity_samples` of them, the start sample their last, and the
-        run's samples within `gravity_window_s` after it (`GyroDelay` holds a run back until
-        they have come, or it ended); a restart after a stepper failure takes the start
+        run's samples within `gravity_window_s` after it, released or still in the gyro
+        filter's delay (`Run.ahead`: `GyroDelay` holds a run back until they have come, or it
+        ended); a restart after a stepper failure takes the start
         sample alone.
 
         Returns the run's samples from the start sample on (none while still gathering) and
@@ -160,12 +161,13 @@ class Starts:
             return run.index[:0], np.empty((0, 3))
         self._health.gathering = None
         after = run.index[len(taken) - 1 :]
-        times = stamps[after]
+        times = stamps[np.concatenate([after, run.ahead])]
         end = (
             np.searchsorted(times, times[0] + window_s + STAMP_SLACK_S, "right") if window_s else 1
         )
         self._gathered.extend(f[taken[:-1]])
-        gathered = np.concatenate([np.reshape(self._gathered, (-1, 3)), f[after[:end]]])
+        window = np.concatenate([after, run.ahead])[:end]
+        gathered = np.concatenate([np.reshape(self._gathered, (-1, 3)), f[window]])
         self._gathered = []
         return after, gathered
 
