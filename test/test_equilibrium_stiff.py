@@ -1,5 +1,6 @@
 """Static equilibrium holds at any stiffness: stiff, light scenes load (an absolute residual
-threshold refused them), the equilibrium matches the closed form, and a DOF no mount holds is
+threshold refused them), the equilibrium matches the closed form, a body heeled onto a snubber
+up to 2.5e6 times stiffer than its mounts starts resting on it, and a DOF no mount holds is
 still refused."""
 
 from __future__ import annotations
@@ -8,14 +9,21 @@ import math
 
 import numpy as np
 import pytest
+from kinds_helpers import kind_mount
 from physics_helpers import base_scene, mount
 
+from mount_twin.engine.restart import start_state
 from mount_twin.errors import ModelError
 from mount_twin.model import newton
-from mount_twin.model.assemble import assemble, initial_state
+from mount_twin.model.assemble import Model, assemble, initial_state
+from mount_twin.physics.dynamics import evaluate
 from mount_twin.scene.loader import scene_from_dict
 
 CORNERS = [(0.4, 0.3), (-0.4, 0.3), (-0.4, -0.3), (0.4, -0.3)]
+G = 9.80665
+SNUB_MASS, SNUB_K, SNUB_KZ, SNUB_K1, SNUB_GAP = 5.0, 1e3, 1e4, 1.0, 1e-3
+"""`_snubbed`: kg; N/m of each corner mount laterally and vertically, and of the snubbed
+mount's elastomer along each axis; m of its snubber's gap."""
 
 
 def _model(mass: float, k: float, stiffness_axes: tuple[float, float, float] = (1, 1, 1)):
@@ -95,3 +103,84 @@ def test_newton_polishes_a_non_linear_root_and_declines_what_it_cannot_solve() -
     assert singular is None
     no_root = newton.solve(lambda x: x**2 + 1.0, lambda x: np.diag(2.0 * x), np.ones(1), tight)
     assert no_root is None
+
+
+def _snubbed(stiffness: float, cg_height: float) -> Model:
+    """SNUB_MASS on four corner mounts soft laterally (SNUB_K; SNUB_KZ vertically) in the plane
+    z = 0, beside an elastomer mount at the origin (SNUB_K1 per axis) with a linear snubber
+    SNUB_GAP off along x of `stiffness` (N/m); the CG `cg_height` (m) above that plane."""
+    soft = [
+        mount(f"m{i}", (x, y, 0.0), (SNUB_K, SNUB_K, SNUB_KZ, 0, 0, 0))
+        for i, (x, y) in enumerate(CORNERS)
+    ]
+    snubbed = kind_mount(
+        "elastomer",
+        "snubbed",
+        stiffness_linear=[SNUB_K1] * 3,
+        damping=[0.0] * 3,
+        snubber={"gap": SNUB_GAP, "stiffness": stiffness, "exponent": 1.0, "axes": ["x"]},
+    )
+    data = base_scene(SNUB_MASS, [0.0, 0.0, cg_height], [0.1] * 3 + [0.0] * 3, [*soft, snubbed])
+    return assemble(scene_from_dict(data, "<snubber equilibrium test>"))
+
+
+def _forces(model: Model, y: np.ndarray) -> np.ndarray:
+    """(n_mounts, 6): each mount's force (N) and couple (N·m) on the body at y, in its axes."""
+    wrenches = np.empty((model.n_mounts, 6))
+    evaluate(y, model.arrays, model.new_scratch(), np.empty(10), wrenches)
+    return wrenches
+
+
+def _heel(lateral: float) -> np.ndarray:
+    """Specific force (m/s², F) of magnitude G heeled `lateral` m/s² along x."""
+    return np.array([lateral, 0.0, math.sqrt(G**2 - lateral**2)])
+
+
+STIFF_SNUBBERS = [1e6, 1e7, 1e8, 1e9, 1e10]
+"""N/m: 250 to 2.5e6 times the four corner mounts' lateral stiffness."""
+
+
+@pytest.mark.parametrize("stiffness", STIFF_SNUBBERS)
+@pytest.mark.parametrize("lateral", [1.0, 5.0])
+def test_a_heel_onto_a_stiff_snubber_rests_on_it_at_the_closed_form(
+    stiffness: float, lateral: float
+) -> None:
+    """Mounts and snubber in the CG's plane, symmetric: the heel translates the body along −x
+    without turning it. The corners and the elastomer (K = 4·SNUB_K + SNUB_K1) take the
+    lateral load m·f_x up to the gap, the snubber the rest: by hand, |x| = (m·f_x + k_s·g) /
+    (K + k_s) where m·f_x > K·g (5 N and 25 N against 4.001 N: 1 N and 21 N bear on the snubber,
+    pressing it 1e-6–1e-10 m at 1e6–1e10 N/m, under the Jacobian's difference step); z =
+    −m·f_z/(4·SNUB_KZ + SNUB_K1). The mounts' forces sum to m·f, to the rounding of a force k_s·x.
+    Before, Newton's halvings crept along the snubber's edge and least squares stalled on it:
+    no equilibrium found (1e9 and 1e10 N/m at 1 m/s²)."""
+    model = _snubbed(stiffness, 0.0)
+    f = _heel(lateral)
+    y = initial_state(model, f)
+    soft = 4.0 * SNUB_K + SNUB_K1
+    x = -(SNUB_MASS * f[0] + stiffness * SNUB_GAP) / (soft + stiffness)
+    assert SNUB_MASS * f[0] > soft * SNUB_GAP  # the snubber bears at the closed form
+    np.testing.assert_allclose(y[0], x, rtol=1e-12)
+    np.testing.assert_allclose(y[2], -SNUB_MASS * f[2] / (4.0 * SNUB_KZ + SNUB_K1), rtol=1e-12)
+    assert abs(y[1]) <= 1e-15 and np.abs(y[3:6]).max() <= 1e-12
+    wrenches = _forces(model, y)
+    floor = 64.0 * np.finfo(float).eps * 1.0 * stiffness  # N: k_s times a position's rounding
+    np.testing.assert_allclose(wrenches[:, :3].sum(axis=0), SNUB_MASS * f, rtol=0, atol=floor)
+
+
+@pytest.mark.parametrize("stiffness", STIFF_SNUBBERS)
+def test_a_restart_heeled_onto_a_stiff_snubber_starts_resting_on_it(stiffness: float) -> None:
+    """CG 0.1 m above the mounts' plane (x and pitch coupled), heeled by 2 m/s²: 10 N
+    laterally, of which the corners take 4 N to the gap. The (re)start under that specific
+    force is its equilibrium, pressing the snubber, with no fallback on nominal gravity (from
+    which the body would swing into the snubber: a transient not in the physics); before, at
+    1e9 N/m and stiffer, none was found. The snubber bears most of the 6 N the corners leave
+    at the gap, and the mounts' forces sum to m·f, to the rounding of a force k_s·x."""
+    model = _snubbed(stiffness, 0.1)
+    f = _heel(2.0)
+    start = start_state(model, model.nominal_state, _heel(0.0), f, np.zeros(3), None)
+    assert start.note is None and start.state is not None
+    wrenches = _forces(model, start.state)
+    snubber = wrenches[-1, 0]  # N, on the body along +x
+    assert snubber > 0.5 * (SNUB_MASS * 2.0 - 4.0 * SNUB_K * SNUB_GAP)
+    floor = 64.0 * np.finfo(float).eps * 1.0 * stiffness  # N: k_s times a position's rounding
+    np.testing.assert_allclose(wrenches[:, :3].sum(axis=0), SNUB_MASS * f, rtol=0, atol=floor)

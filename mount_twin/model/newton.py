@@ -5,8 +5,18 @@ The start's equilibrium is a handful of coordinates on mounts that are linear or
 linear near rest: Newton lands and polishes in three Jacobians (0.2 ms on the genset, its
 Jacobians in compiled code), where scipy's trust-region least squares spent 1.5–3 ms of
 bookkeeping on its evaluations, a tenth of the engine's time on a 0.25 s shock record. Where
-Newton does not get there (a singular Jacobian: a DOF no mount holds; a kink it cycles on), it
-says so and the caller falls back on the robust solver.
+Newton does not get there (a singular Jacobian: a DOF no mount holds), it says so and the
+caller falls back on the robust solver.
+
+A contact far stiffer than the mounts (a snubber, a key or a bolt that bears; k_s 1e5–1e7
+times k) makes r piecewise smooth with a jump in its tangent, which plain damping does not
+cross: halving a step from the soft side creeps along the contact's edge (the step k_s/k
+times too long at each), and |r|, mixing the pieces, has a false minimum on the edge, where
+least squares stalls too. `solve` follows the Newton steps of the piece it lands on instead
+(semismooth Newton: each piece's own tangent; for a stiffening contact they fall
+monotonically from the stiff side), and near a root within a difference step of an edge
+takes a finer Jacobian. A load continuation would meet the same edge at one of its loads,
+and scaling r by the tangent does not remove a tangent that jumps.
 """
 
 from __future__ import annotations
@@ -26,12 +36,25 @@ def solve(
     x0: np.ndarray,
     tolerance: Callable[[np.ndarray], np.ndarray],
     halvings: int = MAX_HALVINGS,
+    fine: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """x with |r(x)| ≤ tolerance(J) component-wise (J = jacobian(x) = ∂r/∂x), from x0,
     polished until a Newton step no longer reduces |r| (the rounding floor, where the
     least-squares solver also ends); returns (x, r(x), J at x), or None where Newton does not
     get there (singular J, no decrease of |r| outside the tolerance in `halvings` halvings of
-    the step, not finite, or outside it after MAX_ITERATIONS)."""
+    the step, not finite, or outside it after MAX_ITERATIONS).
+
+    r piecewise smooth, a contact's stiffness k_s switching on at a kink (the module's note):
+
+    - where the Newton step, across a kink onto the stiffer piece, does not decrease |r|: the
+      Newton steps from where it landed, each with the Jacobian there, while |r| falls, to
+      below |r(x)| (`_ahead`), before halving the step;
+    - where the step misses the root by half |r| or more, outside the tolerance: also the
+      step with `fine` (∂r/∂x by a finer difference step), the better taken. A root within
+      a difference step of a kink (a contact bearing k_s·δ, δ under the step: 1 N on 1e9
+      N/m) has a Jacobian that averages the two pieces, and Newton with it crawls or cycles.
+
+    Where each step of `jacobian` lands within half |r| neither is tried."""
     x = np.array(x0, dtype=float)
     r = residual(x)
     for _ in range(MAX_ITERATIONS):
@@ -43,21 +66,78 @@ def solve(
             step = np.linalg.solve(jac, -r)
         except np.linalg.LinAlgError:
             return None
-        norm = np.linalg.norm(r)
-        for _ in range(halvings + 1):
-            x_new = x + step
-            r_new = residual(x_new)
-            if np.linalg.norm(r_new) < norm:
-                break
-            if within:  # at the floor: polished
-                return x, r, jac
+        norm = float(np.linalg.norm(r))
+        landed = x + step
+        r_landed = residual(landed)
+        best = (landed, r_landed)
+        if fine is not None and not within and np.linalg.norm(best[1]) >= 0.5 * norm:
+            finer = _newton_step(residual, x, r, fine(x))
+            if finer is not None and np.linalg.norm(finer[1]) < np.linalg.norm(best[1]):
+                best = finer
+        if np.linalg.norm(best[1]) < norm:
+            x, r = best
+            continue
+        if within:  # at the floor: polished
+            return x, r, jac
+        ahead = _ahead(residual, jacobian, landed, r_landed, norm)
+        if ahead is not None:
+            x, r = ahead
+            continue
+        for _ in range(halvings):
             step *= 0.5
+            r_new = residual(x + step)
+            if np.linalg.norm(r_new) < norm:
+                x, r = x + step, r_new
+                break
         else:
             return None
-        x, r = x_new, r_new
     # still decreasing at the floor (rounding lets |r| creep down): within is within
     jac = jacobian(x)
     return (x, r, jac) if (np.abs(r) <= tolerance(jac)).all() else None
+
+
+def central(
+    residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray, step: float
+) -> np.ndarray:
+    """∂r/∂x at x by central differences, of step `step`·max(1, |x_c|) along x_c."""
+    columns = []
+    for c in range(x.shape[0]):
+        up, down = x.copy(), x.copy()
+        up[c] += step * max(1.0, abs(x[c]))
+        down[c] -= step * max(1.0, abs(x[c]))
+        columns.append((residual(up) - residual(down)) / (up[c] - down[c]))
+    return np.column_stack(columns)
+
+
+def _ahead(
+    residual: Callable[[np.ndarray], np.ndarray],
+    jacobian: Callable[[np.ndarray], np.ndarray],
+    x: np.ndarray,
+    r: np.ndarray,
+    norm: float,
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """Newton steps from x (r there, |r| ≥ `norm`), each with the Jacobian where it starts, while
+    |r| falls, to the first (x, r) with |r| below `norm`; None where |r| stops falling first
+    (at most MAX_ITERATIONS steps)."""
+    for _ in range(MAX_ITERATIONS):
+        found = _newton_step(residual, x, r, jacobian(x))
+        if found is None or not np.linalg.norm(found[1]) < np.linalg.norm(r):
+            return None
+        x, r = found
+        if np.linalg.norm(r) < norm:
+            return x, r
+    return None
+
+
+def _newton_step(
+    residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray, r: np.ndarray, jac: np.ndarray
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """(x + s, its r) for the Newton step s from x (r there) with `jac`; None where singular."""
+    try:
+        x_new = x - np.linalg.solve(jac, r)
+    except np.linalg.LinAlgError:
+        return None
+    return x_new, residual(x_new)
 
 
 ANCHORS = 10.0 ** -np.arange(2.0, 17.0, 2.0)
