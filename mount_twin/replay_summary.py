@@ -266,7 +266,7 @@ class ReplaySummary:
             f"  ageing tracker: the stamps jumped back {c[RESETS]}× (it restarted), "
             f"{c[DROPPED]} windows open at a jump dropped (under half a window), samples "
             f"paired with none of the other stream's: deck {deck}, body IMU {body} "
-            f"(its windows: {AGEING_STATUS} below)"
+            f"(its fits and counts: {AGEING_STATUS} below)"
         ]
 
     def to_dict(self) -> dict[str, object]:
