@@ -1,7 +1,7 @@
 """Static equilibrium holds at any stiffness: stiff, light scenes load (an absolute residual
 threshold refused them), the equilibrium matches the closed form, a body heeled onto a snubber
-up to 2.5e6 times stiffer than its mounts starts resting on it, and a DOF no mount holds is
-still refused."""
+up to 2.5e6 times stiffer than its mounts starts resting on it, as one heeled from within a
+key's clearance onto the key does, and a DOF no mount holds is still refused."""
 
 from __future__ import annotations
 
@@ -184,3 +184,26 @@ def test_a_restart_heeled_onto_a_stiff_snubber_starts_resting_on_it(stiffness: f
     assert snubber > 0.5 * (SNUB_MASS * 2.0 - 4.0 * SNUB_K * SNUB_GAP)
     floor = 64.0 * np.finfo(float).eps * 1.0 * stiffness  # N: k_s times a position's rounding
     np.testing.assert_allclose(wrenches[:, :3].sum(axis=0), SNUB_MASS * f, rtol=0, atol=floor)
+
+
+@pytest.mark.parametrize(("stiffness", "lateral"), [(1e7, 0.01), (1e9, 0.5), (1e10, 5.0)])
+def test_a_heel_onto_a_key_from_within_its_clearance_rests_on_it_at_the_closed_form(
+    stiffness: float, lateral: float
+) -> None:
+    """x held only by a shear key with a clearance (a spring holds z): the stiffness is singular
+    at the guess, inside the clearance, and the start leaves it (`newton.anchored`). Heeled by
+    `lateral` m/s², the key bears m·f_x (0.1–50 N) pressed 1e-8–5e-9 m at 1e7–1e10 N/m, under
+    the Jacobian's difference step: by hand x = −(c + m·f_x/k), z = −m·f_z/k_z. Before, the
+    anchored solves took no finer Jacobian, and no equilibrium was found."""
+    mass, k_z, clearance = 10.0, 1e6, 5e-4
+    spring = mount("spring", (0.0, 0.0, 0.0), (0.0, 0.0, k_z, 0.0, 0.0, 0.0))
+    key = kind_mount("shear_key", "key", stiffness=[stiffness, 0.0, 0.0], clearance=clearance)
+    data = base_scene(mass, [0.0, 0.0, 0.3], [5.0, 6.0, 7.0, 0, 0, 0], [spring, key], ["x", "z"])
+    model = assemble(scene_from_dict(data, "<key equilibrium test>"))
+    f = _heel(lateral)
+    y = initial_state(model, f)
+    tolerance = 1e-8 * mass / stiffness  # m: the residual allowed, 1e-9·G m/s², over k/m
+    np.testing.assert_allclose(
+        y[0], -(clearance + mass * f[0] / stiffness), rtol=0, atol=tolerance
+    )
+    np.testing.assert_allclose(y[1], -mass * f[2] / k_z, rtol=1e-12)

@@ -155,13 +155,15 @@ def anchored(
     jacobian: Callable[[np.ndarray], np.ndarray],
     x0: np.ndarray,
     tolerance: Callable[[np.ndarray], np.ndarray],
+    fine: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """`solve` where J is singular at x0 and about it, as inside a clearance (a key's gap, where
     the body is free until it bears): r(x) − ε·(x − x0) = 0, whose anchor spring ε keeps J
     regular, for ε falling from 1e-2 to 1e-16 of |J|'s scale, each from the last solution;
-    then `solve` itself from there (bearing, J is regular again). None where it does not get
-    there (J at x0 is regular, 0 or not finite: no clearance to leave; a step does not
-    converge)."""
+    then `solve` itself from there (bearing, J is regular again), each with `fine` (a key
+    bearing less than its stiffness times the difference step has its root within that step of
+    the clearance's edge). None where it does not get there (J at x0 is regular, 0 or not
+    finite: no clearance to leave; a step does not converge)."""
     jac0 = jacobian(x0)
     scale = float(np.abs(jac0).max()) if np.isfinite(jac0).all() else 0.0
     if not scale > 0.0:
@@ -170,17 +172,22 @@ def anchored(
     if sigma[-1] >= SINGULAR * sigma[0] * x0.shape[0]:
         return None
     x = np.array(x0, dtype=float)
-    eye = np.eye(x.shape[0])
     for eps in scale * ANCHORS:
 
         def pulled(z: np.ndarray, e: float = eps) -> np.ndarray:
             return residual(z) - e * (z - x0)
 
-        def pulled_jacobian(z: np.ndarray, e: float = eps) -> np.ndarray:
-            return jacobian(z) - e * eye
-
-        found = solve(pulled, pulled_jacobian, x, tolerance, ANCHORED_HALVINGS)
+        pulled_fine = None if fine is None else _anchor(fine, eps)
+        found = solve(pulled, _anchor(jacobian, eps), x, tolerance, ANCHORED_HALVINGS, pulled_fine)
         if found is None:
             return None
         x = found[0]
-    return solve(residual, jacobian, x, tolerance, ANCHORED_HALVINGS)
+    return solve(residual, jacobian, x, tolerance, ANCHORED_HALVINGS, fine)
+
+
+def _anchor(
+    jacobian: Callable[[np.ndarray], np.ndarray], eps: float
+) -> Callable[[np.ndarray], np.ndarray]:
+    """The Jacobian of `anchored`'s r(x) − ε·(x − x0): jacobian(x) − ε·I (ε = `eps`, r's units
+    per x's)."""
+    return lambda z: jacobian(z) - eps * np.eye(z.shape[0])
