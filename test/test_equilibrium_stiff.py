@@ -105,10 +105,10 @@ def test_newton_polishes_a_non_linear_root_and_declines_what_it_cannot_solve() -
     assert no_root is None
 
 
-def _snubbed(stiffness: float, cg_height: float) -> Model:
+def _snubbed(stiffness: float, cg_height: float, axes: tuple[str, ...] = ("x",)) -> Model:
     """SNUB_MASS on four corner mounts soft laterally (SNUB_K; SNUB_KZ vertically) in the plane
     z = 0, beside an elastomer mount at the origin (SNUB_K1 per axis) with a linear snubber
-    SNUB_GAP off along x of `stiffness` (N/m); the CG `cg_height` (m) above that plane."""
+    SNUB_GAP off along `axes` of `stiffness` (N/m); the CG `cg_height` (m) above that plane."""
     soft = [
         mount(f"m{i}", (x, y, 0.0), (SNUB_K, SNUB_K, SNUB_KZ, 0, 0, 0))
         for i, (x, y) in enumerate(CORNERS)
@@ -118,7 +118,7 @@ def _snubbed(stiffness: float, cg_height: float) -> Model:
         "snubbed",
         stiffness_linear=[SNUB_K1] * 3,
         damping=[0.0] * 3,
-        snubber={"gap": SNUB_GAP, "stiffness": stiffness, "exponent": 1.0, "axes": ["x"]},
+        snubber={"gap": SNUB_GAP, "stiffness": stiffness, "exponent": 1.0, "axes": list(axes)},
     )
     data = base_scene(SNUB_MASS, [0.0, 0.0, cg_height], [0.1] * 3 + [0.0] * 3, [*soft, snubbed])
     return assemble(scene_from_dict(data, "<snubber equilibrium test>"))
@@ -182,6 +182,26 @@ def test_a_restart_heeled_onto_a_stiff_snubber_starts_resting_on_it(stiffness: f
     wrenches = _forces(model, start.state)
     snubber = wrenches[-1, 0]  # N, on the body along +x
     assert snubber > 0.5 * (SNUB_MASS * 2.0 - 4.0 * SNUB_K * SNUB_GAP)
+    floor = 64.0 * np.finfo(float).eps * 1.0 * stiffness  # N: k_s times a position's rounding
+    np.testing.assert_allclose(wrenches[:, :3].sum(axis=0), SNUB_MASS * f, rtol=0, atol=floor)
+
+
+@pytest.mark.parametrize("stiffness", STIFF_SNUBBERS)
+def test_a_heel_onto_a_snubber_along_x_and_y_at_once_starts_resting_on_both(
+    stiffness: float,
+) -> None:
+    """Snubbed along x and y, the CG 0.3 m above the mounts (both coordinates coupled to the
+    rotations), heeled by 8 m/s² along the diagonal: 28 N along each axis, of which the corners
+    take 4 N to the gap. The start rests on the snubber along both axes (it bears most of the
+    24 N the corners leave along each), and the mounts' forces sum to m·f, to the rounding of
+    a force k_s·x. Before, at 1e10 N/m, the steps on from where the first one landed, both
+    contacts within the Jacobian's difference step of their edges, crawled by a few % each, and
+    no equilibrium was found."""
+    model = _snubbed(stiffness, 0.3, ("x", "y"))
+    lateral = 8.0 / math.sqrt(2.0)  # m/s² along x and along y
+    f = np.array([lateral, lateral, math.sqrt(G**2 - 2.0 * lateral**2)])
+    wrenches = _forces(model, initial_state(model, f))
+    assert (wrenches[-1, :2] > 0.5 * (SNUB_MASS * lateral - 4.0 * SNUB_K * SNUB_GAP)).all()
     floor = 64.0 * np.finfo(float).eps * 1.0 * stiffness  # N: k_s times a position's rounding
     np.testing.assert_allclose(wrenches[:, :3].sum(axis=0), SNUB_MASS * f, rtol=0, atol=floor)
 

@@ -25,6 +25,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+Landing = tuple[np.ndarray, np.ndarray]
+"""Where a step lands, and r there."""
 MAX_ITERATIONS = 20
 MAX_HALVINGS = 8
 """Backtracking: the Newton step is halved at most this often while |r| does not decrease."""
@@ -49,10 +51,11 @@ def solve(
     - where the Newton step, across a kink onto the stiffer piece, does not decrease |r|: the
       Newton steps from where it landed, each with the Jacobian there, while |r| falls, to
       below |r(x)| (`_ahead`), before halving the step;
-    - where the step misses the root by half |r| or more, outside the tolerance: also the
-      step with `fine` (∂r/∂x by a finer difference step), the better taken. A root within
-      a difference step of a kink (a contact bearing k_s·δ, δ under the step: 1 N on 1e9
-      N/m) has a Jacobian that averages the two pieces, and Newton with it crawls or cycles.
+    - where the step misses the root by half |r| or more, outside the tolerance, and at each
+      of those steps from where it landed: also the step with `fine` (∂r/∂x by a finer
+      difference step), the better taken. A root within a difference step of a kink (a
+      contact bearing k_s·δ, δ under the step: 1 N on 1e9 N/m) has a Jacobian that averages
+      the two pieces, and Newton with it crawls or cycles.
 
     Where each step of `jacobian` lands within half |r| neither is tried."""
     x = np.array(x0, dtype=float)
@@ -69,17 +72,13 @@ def solve(
         norm = float(np.linalg.norm(r))
         landed = x + step
         r_landed = residual(landed)
-        best = (landed, r_landed)
-        if fine is not None and not within and np.linalg.norm(best[1]) >= 0.5 * norm:
-            finer = _newton_step(residual, x, r, fine(x))
-            if finer is not None and np.linalg.norm(finer[1]) < np.linalg.norm(best[1]):
-                best = finer
-        if np.linalg.norm(best[1]) < norm:
+        best = (landed, r_landed) if within else _or_fine(residual, fine, x, r, (landed, r_landed))
+        if best is not None and np.linalg.norm(best[1]) < norm:
             x, r = best
             continue
         if within:  # at the floor: polished
             return x, r, jac
-        ahead = _ahead(residual, jacobian, landed, r_landed, norm)
+        ahead = _ahead(residual, jacobian, fine, landed, r_landed, norm)
         if ahead is not None:
             x, r = ahead
             continue
@@ -112,15 +111,18 @@ def central(
 def _ahead(
     residual: Callable[[np.ndarray], np.ndarray],
     jacobian: Callable[[np.ndarray], np.ndarray],
+    fine: Callable[[np.ndarray], np.ndarray] | None,
     x: np.ndarray,
     r: np.ndarray,
     norm: float,
-) -> tuple[np.ndarray, np.ndarray] | None:
+) -> Landing | None:
     """Newton steps from x (r there, |r| ≥ `norm`), each with the Jacobian where it starts, while
     |r| falls, to the first (x, r) with |r| below `norm`; None where |r| stops falling first
-    (at most MAX_ITERATIONS steps)."""
+    (at most MAX_ITERATIONS steps). Each step as `solve`'s: with `fine` too where `jacobian`'s
+    misses by half |r| (these steps end within a difference step of the kinks they crossed:
+    two contacts there, `jacobian` averaging both, crawled by a few % a step)."""
     for _ in range(MAX_ITERATIONS):
-        found = _newton_step(residual, x, r, jacobian(x))
+        found = _or_fine(residual, fine, x, r, _newton_step(residual, x, r, jacobian(x)))
         if found is None or not np.linalg.norm(found[1]) < np.linalg.norm(r):
             return None
         x, r = found
@@ -131,13 +133,34 @@ def _ahead(
 
 def _newton_step(
     residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray, r: np.ndarray, jac: np.ndarray
-) -> tuple[np.ndarray, np.ndarray] | None:
+) -> Landing | None:
     """(x + s, its r) for the Newton step s from x (r there) with `jac`; None where singular."""
     try:
         x_new = x - np.linalg.solve(jac, r)
     except np.linalg.LinAlgError:
         return None
     return x_new, residual(x_new)
+
+
+def _or_fine(
+    residual: Callable[[np.ndarray], np.ndarray],
+    fine: Callable[[np.ndarray], np.ndarray] | None,
+    x: np.ndarray,
+    r: np.ndarray,
+    landed: Landing | None,
+) -> Landing | None:
+    """`landed` (x + s, r there: a Newton step from x, r at x; None: singular), or, where it
+    misses by half |r| or more, the step with `fine` where that lands at a smaller |r|."""
+    if fine is None or (
+        landed is not None and np.linalg.norm(landed[1]) < 0.5 * np.linalg.norm(r)
+    ):
+        return landed
+    finer = _newton_step(residual, x, r, fine(x))
+    if landed is None or (
+        finer is not None and np.linalg.norm(finer[1]) < np.linalg.norm(landed[1])
+    ):
+        return finer
+    return landed
 
 
 ANCHORS = 10.0 ** -np.arange(2.0, 17.0, 2.0)
