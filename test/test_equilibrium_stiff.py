@@ -14,7 +14,6 @@ from physics_helpers import base_scene, mount
 
 from mount_twin.engine.restart import start_state
 from mount_twin.errors import ModelError
-from mount_twin.model import newton
 from mount_twin.model.assemble import Model, assemble, initial_state
 from mount_twin.physics.dynamics import evaluate
 from mount_twin.scene.loader import scene_from_dict
@@ -76,33 +75,6 @@ def test_a_start_on_a_turning_deck_rests_relative_to_it() -> None:
     ).max()
     assert shift > 1e-6  # m: the centrifugal load moves the equilibrium
     assert drift < 1e-4 * shift
-
-
-def test_newton_polishes_a_non_linear_root_and_declines_what_it_cannot_solve() -> None:
-    """The start's fast path: on a smooth system with a known root it lands at the rounding
-    floor and returns the Jacobian at the root; on a singular system, and on one with no root,
-    it returns None (the caller then falls back on least squares)."""
-
-    def cubic(x: np.ndarray) -> np.ndarray:  # root (1, −2)
-        return np.array([x[0] ** 3 + x[0] - 2.0, x[0] * x[1] + 2.0])
-
-    def cubic_jacobian(x: np.ndarray) -> np.ndarray:
-        return np.array([[3.0 * x[0] ** 2 + 1.0, 0.0], [x[1], x[0]]])
-
-    def tight(jac: np.ndarray) -> np.ndarray:
-        return np.full(jac.shape[0], 1e-12)
-
-    found = newton.solve(cubic, cubic_jacobian, np.array([3.0, 0.5]), tight)
-    assert found is not None
-    x, r, jac = found
-    np.testing.assert_allclose(x, [1.0, -2.0], rtol=0.0, atol=4e-16)
-    assert np.abs(r).max() <= 4e-16
-    np.testing.assert_allclose(jac, [[4.0, 0.0], [-2.0, 1.0]], rtol=0.0, atol=1e-12)
-    twice = np.array([[1.0, 1.0], [2.0, 2.0]])
-    singular = newton.solve(lambda x: twice @ x - 1.0, lambda x: twice, np.zeros(2), tight)
-    assert singular is None
-    no_root = newton.solve(lambda x: x**2 + 1.0, lambda x: np.diag(2.0 * x), np.ones(1), tight)
-    assert no_root is None
 
 
 def _snubbed(stiffness: float, cg_height: float, axes: tuple[str, ...] = ("x",)) -> Model:
