@@ -497,16 +497,21 @@ def _soft_beside_a_stiff_key() -> tuple[Scene, SampleBatch]:
     return _soft_beside(key)
 
 
-def _soft_beside_a_snubber() -> tuple[Scene, SampleBatch]:
-    snubbed = kind_mount(
+def _snubber_on_x(gap: float, stiffness: float) -> dict:
+    """A mount at the CG's foot of next to no stiffness of its own (1 N/m) with a linear
+    snubber along x, `gap` m off, `stiffness` N/m past it."""
+    return kind_mount(
         "elastomer",
         "snubbed",
         (0.0, 0.0, 0.0),
         stiffness_linear=[1.0, 1.0, 1.0],
         damping=[0.0, 0.0, 0.0],
-        snubber={"gap": 5e-4, "stiffness": 1e9, "exponent": 1.0, "axes": ["x"]},
+        snubber={"gap": gap, "stiffness": stiffness, "exponent": 1.0, "axes": ["x"]},
     )
-    return _soft_beside(snubbed)
+
+
+def _soft_beside_a_snubber() -> tuple[Scene, SampleBatch]:
+    return _soft_beside(_snubber_on_x(5e-4, 1e9))
 
 
 def _rho_dt(method: str) -> float:
@@ -602,14 +607,7 @@ def _heeled_onto_a_snubber(
         mount(f"m{i}", (x, y, 0.0), (1e3, 1e3, 1e4, 0, 0, 0), (20.0,) * 3 + (0,) * 3)
         for i, (x, y) in enumerate(CORNERS)
     ]
-    snubbed = kind_mount(
-        "elastomer",
-        "snubbed",
-        (0.0, 0.0, 0.0),
-        stiffness_linear=[1.0, 1.0, 1.0],
-        damping=[0.0, 0.0, 0.0],
-        snubber={"gap": 1e-3, "stiffness": stiffness, "exponent": 1.0, "axes": ["x"]},
-    )
+    snubbed = _snubber_on_x(1e-3, stiffness)
     data = base_scene(5.0, [0.0, 0.0, 0.1], [0.1, 0.1, 0.1, 0.0, 0.0, 0.0], [*soft, snubbed])
     data["integration"].update(method=method, rtol=rtol, atol=rtol * 1e-3)
     data["input"]["max_gap_s"] = 0.5
