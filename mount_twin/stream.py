@@ -251,7 +251,7 @@ class TwinStream:
         input.back_jump_reset_s back (the twin restarts there, and the tracker with it)."""
         assert self.ageing is not None and self.base is not None
         accel, gyro = provided(decoded.accel, decoded.gyro, decoded.unprovided)
-        good = np.isfinite(np.hstack([accel, gyro])).all(axis=1)
+        good = np.isfinite(np.concatenate([accel, gyro], axis=1)).all(axis=1)
         good &= ~disregarded(decoded.unprovided, good.shape[0], self.scene.input.reads_rate)
         expected = self.scene.input.frame_id
         if expected:
@@ -290,7 +290,7 @@ class TwinStream:
             return []
         decoded = decode_inputs(raws, IMU)
         self.body.counts["received"] += len(raws)
-        measured = np.hstack([decoded.accel, decoded.gyro])
+        measured = np.concatenate([decoded.accel, decoded.gyro], axis=1)
         reason = np.full(len(raws), "undecodable", dtype=object)
         reason[decoded.places()] = self.body.screen(
             decoded.stamps_ns, measured, decoded.frame_ids, decoded.unprovided
@@ -337,7 +337,9 @@ class TwinStream:
         if self.ageing is not None:
             jobs = self.ageing.add_body(decoded.stamps_ns, t, accel, gyro, present[:, 0])
             self._ageing_jobs += jobs
-        rows = self.body.add_body(decoded.stamps_ns, t, np.hstack([accel, gyro]), present)
+        rows = self.body.add_body(
+            decoded.stamps_ns, t, np.concatenate([accel, gyro], axis=1), present
+        )
         return self._encode_body(rows)
 
     def _encode_body(self, rows: BodyComparison) -> list[tuple[str, int, bytes]]:

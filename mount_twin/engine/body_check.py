@@ -116,7 +116,7 @@ class BodyCheck:
         def predict(rows: TwinRows) -> np.ndarray:
             pose = (rows.pose[:, pose_row.POSITION_COLS], rows.pose[:, pose_row.QUATERNION_COLS])
             f, w = predicted_reading(geometry, rows.t, pose, rows.wrenches, rows.rate)
-            return np.hstack([f, w])
+            return np.concatenate([f, w], axis=1)
 
         self._lead = Lead(predict)
         self._apart = Apart(scene.input.back_jump_reset_s, sensor.lag_s)

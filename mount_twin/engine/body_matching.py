@@ -184,7 +184,7 @@ class Matcher:
         pred = np.zeros((t.shape[0], 6))
         paired = int(np.argmax(beyond)) if (beyond := self._apart.beyond(t, run)).any() else None
         done = 0  # the samples decided: a prefix
-        for r in np.unique(run[:paired]).tolist():
+        for r in sorted(set(run[:paired].tolist())):
             stop = done + int((run[done:paired] == r).sum())  # runs rise
             series = self._pred.get(r) if r <= self._rows_run else None
             ended = r < self._rows_run

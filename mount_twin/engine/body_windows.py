@@ -83,7 +83,7 @@ class Windows:
             self._loose_reported[key] += said[key]
         reports = []
         start = k = 0  # into the samples, the compared ones
-        for run in np.unique(taken.run).tolist():
+        for run in sorted(set(taken.run.tolist())):
             stop = start + int((taken.run[start:] == run).sum())  # runs rise
             whole = start == 0 and stop == len(taken)
             part = taken if whole else taken.select(slice(start, stop))

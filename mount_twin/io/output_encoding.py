@@ -268,7 +268,7 @@ def imu_messages(
         extra[unprovided[:, 1], 13] = -1.0  # angular_velocity_covariance[0]
         extra[unprovided[:, 0], 22] = -1.0  # linear_acceleration_covariance[0]
     sec, nsec = np.divmod(stamps_ns, 1_000_000_000)
-    values = np.hstack([accel, gyro, extra])
+    values = np.concatenate([accel, gyro, extra], axis=1)
     return list(
         zip(stamps_ns.tolist(), pack_messages(IMU, frame_id, sec, nsec, values), strict=True)
     )
