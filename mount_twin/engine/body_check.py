@@ -154,8 +154,8 @@ class BodyCheck:
             "no_reading": marked[:, 0] & marked[:, 1],
         }
         why = np.full(stamps_ns.shape[0], "", dtype=object)
-        for reason, bad in reasons.items():
-            why[bad & (why == "")] = reason
+        for reason, bad in reversed(reasons.items()):  # the first that applies, written last
+            why[bad] = reason
         keep = why == ""
         taken, jumped = rising_or_back(stamps_ns, keep, self.last_ns, self._back_ns)
         why[keep & ~taken] = "stamp_back"
