@@ -171,8 +171,9 @@ class BodyCheck:
         '' where not): each rejected one marked at its place in the body stream, and the
         windows of stamps in which none was taken, reported (nothing compared)."""
         accepted = why == ""
-        before = self._accepted_screened + np.cumsum(accepted) - accepted
-        self._windows.mark(before[~accepted], why[~accepted])
+        if not accepted.all():
+            before = self._accepted_screened + np.cumsum(accepted) - accepted
+            self._windows.mark(before[~accepted], why[~accepted])
         self._accepted_screened += int(accepted.sum())
         return BodyComparison.none(self._refusals.add(stamps_ns, why))
 

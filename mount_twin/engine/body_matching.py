@@ -100,8 +100,9 @@ class Taken:
         return Taken(*(getattr(self, f.name)[k] for f in fields(self)))
 
     def compared(self) -> Taken:
-        """Those compared."""
-        return self.select(self.why == "")
+        """Those compared (all of them, as they usually are: these)."""
+        compared = self.why == ""
+        return self if compared.all() else self.select(compared)
 
 
 _Waiting = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]

@@ -66,6 +66,7 @@ class Lead:
 
     def add(self, rows: TwinRows) -> tuple[np.ndarray, np.ndarray]:
         """(stamps s, (k, 6) predictions) of the rows that `rows` completes."""
+        # the window is a copy either way (the engine reuses its buffers): what is held, views
         window = rows.tail(len(rows)) if self._held is None else self._held.then(rows)
         n = len(window)
         if n < self.HELD + 1:
@@ -73,7 +74,7 @@ class Lead:
             return _NO_PREDICTION
         first = 0 if self._at_start else 2
         values = self._predict(window)
-        self._held, self._at_start = window.tail(self.HELD), False
+        self._held, self._at_start = window.part(n - self.HELD, n), False
         return window.t[first : n - 2], values[first : n - 2]
 
     def finish(self) -> tuple[np.ndarray, np.ndarray]:

@@ -76,14 +76,15 @@ def _mount_axes(scene: Scene) -> np.ndarray:
 
 def _specific_force(mount_axes: np.ndarray, mass: float, wrenches: np.ndarray) -> np.ndarray:
     """Σᵢ Qᵢ fᵢ / m, mount by mount in scene order (the same bits per row whatever the batch):
-    each mount's Qᵢ fᵢ as `rotated` forms it, all mounts at once, then summed in order."""
+    each mount's Qᵢ fᵢ as `rotated` forms it, all mounts at once, then summed in order from
+    zero (a running sum: accumulate adds one term after another, never pairwise)."""
     f = wrenches[:, :, :3, None]  # (k, n, 3, 1): Qᵢ fᵢ = Σⱼ fᵢⱼ (column j of Qᵢ)
-    each = f[:, :, 0] * mount_axes[:, :, 0] + f[:, :, 1] * mount_axes[:, :, 1]
+    terms = np.zeros((wrenches.shape[0], wrenches.shape[1] + 1, 3))  # a zero, then each mount's
+    each = terms[:, 1:]
+    np.multiply(f[:, :, 0], mount_axes[:, :, 0], out=each)
+    each += f[:, :, 1] * mount_axes[:, :, 1]
     each += f[:, :, 2] * mount_axes[:, :, 2]
-    total = np.zeros((wrenches.shape[0], 3))
-    for i in range(each.shape[1]):
-        total += each[:, i]
-    return total / mass
+    return np.add.accumulate(terms, axis=1)[:, -1] / mass
 
 
 def cg_specific_force(scene: Scene, wrenches: np.ndarray) -> np.ndarray:
