@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mount_twin.engine.sensor_reading import Differences, _cross
+from mount_twin.engine.sensor_reading import Differences, _cross, _specific_force
 from mount_twin.physics.rotations import quaternion_matrices
 
 RNG = np.random.default_rng(20261128)
@@ -59,3 +59,26 @@ def test_the_rotation_matrices_are_the_textbook_formulas_bit_for_bit(k: int) -> 
         axis=1,
     ).reshape(k, 3, 3)
     assert quaternion_matrices(quat).tobytes() == expected.tobytes()
+
+
+@pytest.mark.parametrize("k", [1, 5, 300])
+@pytest.mark.parametrize("n", [1, 8, 19])
+def test_the_mounts_forces_are_summed_in_scene_order_from_zero(k: int, n: int) -> None:
+    # Σᵢ Qᵢ fᵢ / m as Python floats, row by row: each mount's Qᵢ fᵢ = fᵢ₀ q₀ + fᵢ₁ q₁ + fᵢ₂ q₂
+    # (q_j column j of Qᵢ), added one mount after another to 0.0 in scene order; a row whose
+    # terms are all −0.0 sums to +0.0 so, where a sum started from its first term keeps −0.0
+    axes = np.abs(RNG.normal(size=(n, 3, 3)))
+    axes[0, :, 1] = 0.0
+    wrenches = _rows(k * n, 6).reshape(k, n, 6)
+    wrenches[0] = -0.0  # every product −0.0 (the axes ≥ 0), so every term
+    mass = 812.5
+    expected = np.zeros((k, 3))
+    for row in range(k):
+        for a in range(3):
+            total = 0.0
+            for i in range(n):
+                f = wrenches[row, i, :3].tolist()
+                q = axes[i, a, :].tolist()
+                total = total + (f[0] * q[0] + f[1] * q[1] + f[2] * q[2])
+            expected[row, a] = total / mass
+    assert _specific_force(axes, mass, wrenches).tobytes() == expected.tobytes()
