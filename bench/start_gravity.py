@@ -119,6 +119,8 @@ def main() -> None:
     default = Path(__file__).resolve().parents[2] / "shared/data/real"
     parser.add_argument("--data", type=Path, default=default)
     data = parser.parse_args().data
+    if not data.is_dir():  # the recordings are not in the repository
+        parser.error(f"--data {data}: no such directory (the real recordings, see its README)")
     records = {"water entry, 20 kHz (0-0.28 s)": water_entry(data)}
     records |= {f"{n}, 120 Hz (0-3 s)": xsens(data, n) for n in XSENS}
     records["vehicle, 30 Hz (236-244 s)"] = vehicle(data)

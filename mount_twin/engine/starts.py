@@ -144,8 +144,7 @@ class Starts:
         start: `initial_state.gravity_samples` of them, the start sample their last, and the
         run's samples within `gravity_window_s` after it, released or still in the gyro
         filter's delay (`Run.ahead`: `GyroDelay` holds a run back until they have come, or it
-        ended); a restart after a stepper failure takes the start
-        sample alone.
+        ended); a restart after a stepper failure takes the start sample alone.
 
         Returns the run's samples from the start sample on (none while still gathering) and
         the specific forces (m/s², F) the start's gravity is the mean of.
@@ -161,13 +160,13 @@ class Starts:
             return run.index[:0], np.empty((0, 3))
         self._health.gathering = None
         after = run.index[len(taken) - 1 :]
-        times = stamps[np.concatenate([after, run.ahead])]
+        following = np.concatenate([after, run.ahead])  # the start sample, then its window's
+        times = stamps[following]
         end = (
             np.searchsorted(times, times[0] + window_s + STAMP_SLACK_S, "right") if window_s else 1
         )
         self._gathered.extend(f[taken[:-1]])
-        window = np.concatenate([after, run.ahead])[:end]
-        gathered = np.concatenate([np.reshape(self._gathered, (-1, 3)), f[window]])
+        gathered = np.concatenate([np.reshape(self._gathered, (-1, 3)), f[following[:end]]])
         self._gathered = []
         return after, gathered
 

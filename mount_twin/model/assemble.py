@@ -222,7 +222,9 @@ FINE_STEP = 1e-12
 """Relative central-difference step of the equilibrium's finer Jacobian (`newton.solve`'s
 `fine`): under the penetration of a contact bearing 0.01 N on 1e10 N/m, where the compiled
 step (CENTRAL_STEP, 1e-7) straddles the contact's edge; the accelerations' rounding (~1e-15
-m/s²) then errs ~1e-3 s⁻² in entries of 1e2–1e9 s⁻²."""
+m/s²) then errs ~1e-3 s⁻² in entries of 1e2–1e9 s⁻². Good near an edge only: the rounding of
+accelerations far from it (a deep contact, a body far out in a clearance) grows with them, so
+`newton.solve` takes this Jacobian's step only where it lands better than the compiled one's."""
 
 
 def static_equilibrium(
