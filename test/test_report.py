@@ -103,8 +103,7 @@ def test_the_page_is_self_contained_with_plots_tables_and_names(
 
 def test_input_without_scene_is_refused(genset_run, capsys: pytest.CaptureFixture[str]) -> None:
     out, _ = genset_run
-    assert main(["report", str(out), "--input", str(BAG)]) == 2
-    assert "--input needs --scene" in capsys.readouterr().err
+    assert "--input needs --scene" in _refused(["report", str(out), "--input", str(BAG)], capsys)
 
 
 def test_utilisation_series_come_from_the_diagnostics(genset_run) -> None:
@@ -115,6 +114,12 @@ def test_utilisation_series_come_from_the_diagnostics(genset_run) -> None:
     series = utilisation_of(tables["diagnostics"])
     for name, peak in summary.utilisation_max.items():
         assert np.max(series[name][1]) == pytest.approx(peak, rel=1e-3), name
+
+
+def _refused(args: list[str], capsys: pytest.CaptureFixture[str]) -> str:
+    """What `mount-twin <args>` says on stderr, having asserted that it exits 2 (refused)."""
+    assert main(args) == 2
+    return capsys.readouterr().err
 
 
 def _margins(page: str) -> list[float]:
@@ -204,8 +209,8 @@ def test_a_design_judges_the_axes_axis_names_as_srs_does(
 def test_a_design_needs_the_input(genset_run, capsys: pytest.CaptureFixture[str]) -> None:
     out, _ = genset_run
     table = Path(__file__).parent / "data"  # any path: refused before it is read
-    assert main(["report", str(out), "--design", str(table / "none.csv")]) == 2
-    assert "--design judges the input's spectra: it needs --input" in capsys.readouterr().err
+    err = _refused(["report", str(out), "--design", str(table / "none.csv")], capsys)
+    assert "--design judges the input's spectra: it needs --input" in err
 
 
 def test_with_its_scene_the_report_lists_the_mounts_in_the_scenes_order(tmp_path: Path) -> None:
@@ -233,8 +238,7 @@ def test_another_scenes_mounts_are_refused_naming_both(
     out, _ = genset_run
     page = tmp_path / "wrong.html"
     pump = CONFIG / "pump_8_mounts.scene.yaml"
-    assert main(["report", str(out), "--scene", str(pump), "-o", str(page)]) == 2
-    err = capsys.readouterr().err
+    err = _refused(["report", str(out), "--scene", str(pump), "-o", str(page)], capsys)
     assert (
         "scene pump_8_mounts (report --scene): its mounts (fl, fr, ml1, mr1, ml2, mr2, rl, rr)"
         in err
@@ -301,8 +305,7 @@ def test_an_input_marking_accelerations_not_provided_inside_is_refused_naming_th
         "-o",
         str(page),
     ]
-    assert main(args) == 2
-    err = capsys.readouterr().err
+    err = _refused(args, capsys)
     assert (
         f"{tmp_path / 'marked'}: /deck/imu: 3 of 2000 samples the replay rejects "
         "(no_acceleration 3); sample 1500 (t = 1.5 s from the first) marks its acceleration "
@@ -403,8 +406,7 @@ def test_an_inputs_sample_not_finite_between_finite_ones_is_refused_naming_it(
     capsys.readouterr()
     page = tmp_path / "r.html"
     args = ["report", str(out), "--scene", pump, "--input", str(holed), "-o", str(page)]
-    assert main(args) == 2
-    err = capsys.readouterr().err
+    err = _refused(args, capsys)
     assert (
         f"{holed}: /deck/imu: 1 of 10000 samples the replay rejects (non_finite 1); sample 500 "
         "(t = 0.5 s from the first) has accel x nan, between samples it takes" in err
@@ -904,8 +906,7 @@ def test_a_scene_with_the_runs_mounts_and_another_value_is_refused_naming_both(
     other = _pump_scene(tmp_path / "other.scene.yaml", OTHER_VALUES[what])
     page = tmp_path / "r.html"
     args = ["report", str(pump_run), "--scene", str(other), "-o", str(page)]
-    assert main(args) == 2
-    err = capsys.readouterr().err
+    err = _refused(args, capsys)
     assert (
         f"{other}: scene pump_8_mounts is not the one {pump_run} was replayed with, {PUMP}" in err
     )
@@ -944,21 +945,17 @@ def test_a_refused_scene_names_the_values_it_differs_in_where_an_old_bags_file_t
     copy = _pump_scene(tmp_path / "copy.scene.yaml")
     # the run's file named as a replay with --topic names it (its topic is the run's)
     bag = _old_bag(pump_run, tmp_path / "old", str(copy) + OVERRIDDEN.format("topic"))
-    assert main(["report", str(bag), *args]) == 2
-    assert f"{STIFFER_DIFFERS} (the run's scene as its file {copy} loads it)" in (
-        capsys.readouterr().err
-    )
+    err = _refused(["report", str(bag), *args], capsys)
+    assert f"{STIFFER_DIFFERS} (the run's scene as its file {copy} loads it)" in err
     _pump_scene(copy, _set("body", "mass", value=1500.0))
-    assert main(["report", str(bag), *args]) == 2
     assert (
         f"the run's scene file {copy} has changed since: cannot say which value differs"
-        in capsys.readouterr().err
+        in _refused(["report", str(bag), *args], capsys)
     )
     copy.unlink()
-    assert main(["report", str(bag), *args]) == 2
     assert (
         f"the run's scene file is not found at {copy} (as recorded): cannot say which value "
-        "differs" in capsys.readouterr().err
+        "differs" in _refused(["report", str(bag), *args], capsys)
     )
 
 
@@ -979,20 +976,18 @@ def test_an_old_bags_relative_scene_file_is_found_from_the_bags_directory(
     other = _pump_scene(tmp_path / "other.scene.yaml", OTHER_VALUES["a mount's stiffness"])
     monkeypatch.chdir(elsewhere)
     args = ["report", str(bag), "--scene", str(other), "-o", str(tmp_path / "r.html")]
-    assert main(args) == 2
     found = ran / "config" / "run.scene.yaml"
     assert (
         f"{STIFFER_DIFFERS} (the run's scene as its file {found} loads it: "
         "config/run.scene.yaml found from the bag's directory, not found at "
         f"{elsewhere}/config/run.scene.yaml (config/run.scene.yaml from here))"
-        in capsys.readouterr().err
+        in _refused(args, capsys)
     )
     found.unlink()
-    assert main(args) == 2
     assert (
         f"the run's scene file is not found at {elsewhere}/config/run.scene.yaml "
         f"(config/run.scene.yaml from here) nor {found} (config/run.scene.yaml from the bag's "
-        "directory): cannot say which value differs" in capsys.readouterr().err
+        "directory): cannot say which value differs" in _refused(args, capsys)
     )
 
 
@@ -1019,20 +1014,18 @@ def test_a_moved_runs_scene_file_is_found_by_the_path_the_replay_was_given(
     monkeypatch.chdir(moved)
     other = _pump_scene(tmp_path / "other.scene.yaml", OTHER_VALUES["a mount's stiffness"])
     args = ["report", "bags/filtered", "--scene", str(other), "-o", str(tmp_path / "r.html")]
-    assert main(args) == 2
     recorded, found = ran / "config" / "run.scene.yaml", moved / "config" / "run.scene.yaml"
     assert (
         f"{STIFFER_DIFFERS} (the run's scene as its file {found} loads it: "
         f"config/run.scene.yaml found from here, not found at {recorded} (as recorded))"
-        in capsys.readouterr().err
+        in _refused(args, capsys)
     )
     found.unlink()
-    assert main(args) == 2
     assert (
         f"the run's scene file is not found at {recorded} (as recorded), {found} "
         f"(config/run.scene.yaml from here) nor {moved}/bags/config/run.scene.yaml "
         "(config/run.scene.yaml from the bag's directory): cannot say which value differs"
-        in capsys.readouterr().err
+        in _refused(args, capsys)
     )
 
 
@@ -1054,8 +1047,7 @@ def test_a_refused_scene_names_its_differences_from_the_bags_scene_with_the_file
     monkeypatch.chdir(elsewhere)
     other = _pump_scene(tmp_path / "other.scene.yaml", OTHER_VALUES["a mount's stiffness"])
     args = ["report", "../ran/out", "--scene", str(other), "-o", "r.html"]
-    assert main(args) == 2
-    err = capsys.readouterr().err
+    err = _refused(args, capsys)
     assert "is not the one ../ran/out was replayed with, run.scene.yaml" in err
     assert f"{STIFFER_DIFFERS} (the run's scene as its /mount_twin/scene topic records it)" in err
 
@@ -1077,8 +1069,7 @@ def test_a_refused_scene_names_its_differences_from_the_metadata_with_the_topic_
     filtered = without_scene_topic(tmp_path / "out", tmp_path / "filtered", custom_data("out"))
     run_file.unlink()
     other = _pump_scene(tmp_path / "other.scene.yaml", OTHER_VALUES["a mount's stiffness"])
-    assert main(["report", str(filtered), "--scene", str(other), "-o", "r.html"]) == 2
-    err = capsys.readouterr().err
+    err = _refused(["report", str(filtered), "--scene", str(other), "-o", "r.html"], capsys)
     assert f"is not the one {filtered} was replayed with, {run_file}" in err
     assert (
         f"{STIFFER_DIFFERS} (the run's scene as its metadata (mount_twin.scene_sha256, "
@@ -1087,10 +1078,8 @@ def test_a_refused_scene_names_its_differences_from_the_metadata_with_the_topic_
 
 
 def test_other_scene_needs_a_scene(pump_run: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["report", str(pump_run), "--other-scene"]) == 2
-    assert "--other-scene draws with the scene --scene gives: it needs --scene" in (
-        capsys.readouterr().err
-    )
+    err = _refused(["report", str(pump_run), "--other-scene"], capsys)
+    assert "--other-scene draws with the scene --scene gives: it needs --scene" in err
 
 
 def test_the_runs_scene_rewritten_is_still_its_own(
@@ -1132,8 +1121,7 @@ def test_a_recording_of_the_nodes_topics_is_checked_by_its_scene_topics_digest(
     bag = _recorded(pump_run, tmp_path)
     heavy = _pump_scene(tmp_path / "heavy.scene.yaml", OTHER_VALUES["the mass"])
     page = tmp_path / "r.html"
-    assert main(["report", str(bag), "--scene", str(heavy), "-o", str(page)]) == 2
-    err = capsys.readouterr().err
+    err = _refused(["report", str(bag), "--scene", str(heavy), "-o", str(page)], capsys)
     assert f"is not the one {bag} was run with, {PUMP}: its digest" in err
     assert "differs from the one its /mount_twin/scene topic records" in err
     assert "it differs in body.mass: 1500.0 here, 1200.0 in the run's scene" in err
@@ -1153,8 +1141,7 @@ def test_without_a_digest_a_scene_is_checked_by_the_settings_the_bag_records(
     bag = without_scene_topic(pump_run, tmp_path / "recorded", {})
     page = tmp_path / "r.html"
     loose = _pump_scene(tmp_path / "loose.scene.yaml", _set("integration", "atol", value=1e-7))
-    assert main(["report", str(bag), "--scene", str(loose), "-o", str(page)]) == 2
-    err = capsys.readouterr().err
+    err = _refused(["report", str(bag), "--scene", str(loose), "-o", str(page)], capsys)
     assert (
         f"{loose}: scene pump_8_mounts is not the one {bag} was run with: its integration.atol "
         "is 1e-07, the run's 1e-09" in err
