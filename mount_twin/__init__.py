@@ -91,13 +91,19 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    """Import an exported name's module on first access (PEP 562), then keep the name here."""
-    module = _LAZY.get(name)
-    if module is None:
+    """Import an exported name's module on first access (PEP 562), then keep the name here. An
+    entry of _LAZY whose module lacks the attribute is an ImportError naming the entry, not the
+    AttributeError of an unknown name that `hasattr` and `from mount_twin import` would hide."""
+    entry = _LAZY.get(name)
+    if entry is None:
         msg = f"module {__name__!r} has no attribute {name!r}"
         raise AttributeError(msg)
-    module, _, attribute = module.partition(":")
-    value = getattr(import_module(module), attribute or name)
+    module, _, attribute = entry.partition(":")
+    imported = import_module(module)
+    if not hasattr(imported, attribute or name):
+        msg = f"{__name__}._LAZY maps {name!r} to {entry!r}: {module} has no {attribute or name!r}"
+        raise ImportError(msg, name=module)
+    value = getattr(imported, attribute or name)
     globals()[name] = value
     return value
 

@@ -3,6 +3,7 @@ package ships py.typed, and the usage example of its docstring (the README's) ru
 
 from __future__ import annotations
 
+import re
 import textwrap
 import warnings
 from pathlib import Path
@@ -58,6 +59,22 @@ def test_exported_names_are_the_defining_modules_objects() -> None:
 def test_an_unknown_name_is_an_attribute_error() -> None:
     with pytest.raises(AttributeError, match="module 'mount_twin' has no attribute 'nope'"):
         _ = mount_twin.nope  # type: ignore[attr-defined]
+
+
+def test_a_lazy_entry_naming_no_attribute_is_an_import_error_naming_it(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A broken entry of the lazy table is a programming error: an ImportError that names the
+    entry, which neither `hasattr` nor `from mount_twin import` turns into "no such name"."""
+    monkeypatch.setitem(mount_twin._LAZY, "Mistyped", "mount_twin.scene.loader:load_scene_fil")
+    said = re.escape(
+        "mount_twin._LAZY maps 'Mistyped' to 'mount_twin.scene.loader:load_scene_fil': "
+        "mount_twin.scene.loader has no 'load_scene_fil'"
+    )
+    with pytest.raises(ImportError, match=said):
+        hasattr(mount_twin, "Mistyped")
+    with pytest.raises(ImportError, match=said):
+        exec("from mount_twin import Mistyped", {})
 
 
 def test_importing_the_package_imports_no_core_numpy_or_rosbags() -> None:
