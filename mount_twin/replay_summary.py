@@ -21,7 +21,7 @@ from mount_twin.analysis.figures import (
     peak_text,
     utilisation_text,
 )
-from mount_twin.engine import intake
+from mount_twin.engine import count_texts
 from mount_twin.engine.agreement import FIELDS
 from mount_twin.engine.agreement import NAME as BODY_STATUS
 from mount_twin.engine.batch import (
@@ -127,7 +127,9 @@ class ReplaySummary:
     def nothing_accepted(self) -> str:
         """Why no input sample was accepted ('' if some were): the rejection counts, and the
         bag's header.frame_id when it is the wrong one, pointing at what set the one expected."""
-        return intake.nothing_accepted(self.counts, self.wrong_frame_id, self.frame_id_setting)
+        return count_texts.nothing_accepted(
+            self.counts, self.wrong_frame_id, self.frame_id_setting
+        )
 
     def followed_nothing(self) -> str:
         """Why the run has no motion and no mount loads ('' if it has): no input sample was
@@ -158,7 +160,7 @@ class ReplaySummary:
             *([f"  {nothing}"] if (nothing := self.followed_nothing()) else []),
             *([f"  {FAILED}: {self.failure}"] if self.failure else []),
             f"  input samples: {c.get('received', 0)} received, {c.get('accepted', 0)} accepted, "
-            f"rejected: {intake.counted_text(c, 'rejected_')}, gaps: {c.get('gaps', 0)}, "
+            f"rejected: {count_texts.counted_text(c, 'rejected_')}, gaps: {c.get('gaps', 0)}, "
             f"restarts: {c.get('restarts', 0)}, integration failures: "
             f"{c.get('integration_failures', 0)}",
             *(
@@ -247,12 +249,12 @@ class ReplaySummary:
         on = ""
         if any(marked.values()):  # which readings it was compared on, and the marks
             on = " (" + ", ".join(f"{f.replace('_', ' ')} on {n}" for f, n in fields.items())
-            on += f"; marked not provided: {intake.counted_text(marked, 'unprovided_')})"
+            on += f"; marked not provided: {count_texts.counted_text(marked, 'unprovided_')})"
         jumps = c.get(RESETS, 0)
         restarted = f"; its stamps jumped back {jumps}×, the comparison restarted" if jumps else ""
         return [
             f"  body IMU {self.body_topic}: {c['received']} received, {compared} compared with "
-            f"the twin{on}, not compared: {intake.counted_text(not_compared(c))}{restarted} "
+            f"the twin{on}, not compared: {count_texts.counted_text(not_compared(c))}{restarted} "
             f"(its agreement: {BODY_STATUS} below)"
         ]
 

@@ -19,7 +19,8 @@ from mount_twin.engine.body_counts import RESETS
 from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.health_statuses import ENDED
 from mount_twin.engine.health_texts import INPUT
-from mount_twin.engine.intake import disregarded, provided, rising_or_back, rotated
+from mount_twin.engine.reading_screen import disregarded, provided, rotated
+from mount_twin.engine.stamp_verdicts import rising_or_back
 from mount_twin.errors import require
 from mount_twin.io.input_decoding import Decoded, TimeBase, decode_inputs
 from mount_twin.io.messages import IMU
@@ -245,7 +246,7 @@ class TwinStream:
     def _track_foundation(self, decoded: Decoded) -> None:
         """Deck samples into the ageing tracker, those the twin's intake takes too: finite
         values, no reading the twin reads marked not provided (a rate marked so under
-        input.gyro_filter: ignore is zeroed, not dropped: `intake.disregarded`, `provided`;
+        input.gyro_filter: ignore is zeroed, not dropped: `reading_screen.disregarded`, `provided`;
         it had been dropped, the tracker's window then short of the twin's samples), the
         input's frame_id (if it names one) and rising stamps, or one more than
         input.back_jump_reset_s back (the twin restarts there, and the tracker with it)."""

@@ -30,7 +30,7 @@ from mount_twin.analysis.response import followed
 from mount_twin.engine import body_check, body_matching
 from mount_twin.engine.agreement import NAME
 from mount_twin.engine.batch import ERROR, OK, WARN, SampleBatch
-from mount_twin.engine.intake import rotated
+from mount_twin.engine.reading_screen import rotated
 from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.errors import SceneError
 from mount_twin.io.input_decoding import TimeBase

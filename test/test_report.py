@@ -1167,7 +1167,7 @@ def test_the_readings_rejections_are_those_the_twin_counts(gyro_filter: str) -> 
 
     from mount_twin.engine.batch import SampleBatch
     from mount_twin.engine.engine import TwinEngine
-    from mount_twin.engine.intake import reading_rejections
+    from mount_twin.engine.reading_screen import reading_rejections
     from mount_twin.model.assemble import assemble
 
     scene = load_scene_file(PUMP)

@@ -176,7 +176,7 @@ class _Run:
 class _Record:
     """A stream's samples, by run: a stamp before the last one added starts a new run (the
     stream gives rising stamps but where they jump back by more than input.back_jump_reset_s,
-    `intake.rising_or_back`: a bag played with --loop)."""
+    `stamp_verdicts.rising_or_back`: a bag played with --loop)."""
 
     def __init__(self) -> None:
         self.runs: dict[int, _Run] = {}

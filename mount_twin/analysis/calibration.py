@@ -56,7 +56,7 @@ from mount_twin.analysis.calibration_parameters import (
 from mount_twin.analysis.calibration_records import compared, overlap_problem, still_record
 from mount_twin.analysis.response import followed
 from mount_twin.engine.batch import SampleBatch
-from mount_twin.engine.intake import rotated
+from mount_twin.engine.reading_screen import rotated
 from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.io.signals import Signal
 from mount_twin.physics.rotations import angle_text

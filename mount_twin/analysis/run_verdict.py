@@ -7,8 +7,8 @@ from typing import NamedTuple
 
 from mount_twin.analysis.html_page import frame_id_setting
 from mount_twin.engine.batch import FAILED, LEVEL_NAMES, OK
+from mount_twin.engine.count_texts import nothing_accepted
 from mount_twin.engine.health_texts import INTEGRATION, NEVER_STARTED
-from mount_twin.engine.intake import nothing_accepted
 from mount_twin.io.output_tables import Table, input_values, integration_values
 from mount_twin.scene.description import Scene
 

@@ -81,7 +81,7 @@ def _read_record(
     if _is_csv(path):
         return read_csv_record(path), base
     from mount_twin.commands.common import refuse_not_finite
-    from mount_twin.engine.intake import readable
+    from mount_twin.engine.reading_screen import readable
     from mount_twin.io.input_samples import read_input, refuse_unprovided
     from mount_twin.scene.description import InputSpec
 

@@ -160,7 +160,7 @@ def taken_input(path: str, spec: InputSpec, decoded: Decoded) -> tuple[Decoded, 
     """The input's samples the replay takes as far as their readings tell, and what was left
     out ('' if nothing). The intake rejects a sample with a reading not finite, or marked not
     provided (REP-145: its acceleration, or the rate the twin reads), and goes on
-    (`intake.reading_rejections`): such samples before the first it takes or after its last
+    (`reading_screen.reading_rejections`): such samples before the first it takes or after its last
     are left out here too, and said (how many for each reason, at which end, the first). One
     between taken samples is refused (ValueError naming the bag, the topic, the sample and
     what it lacks): the input's spectra take the samples as evenly spaced, and would join
@@ -169,7 +169,8 @@ def taken_input(path: str, spec: InputSpec, decoded: Decoded) -> tuple[Decoded, 
 
     import numpy as np
 
-    from mount_twin.engine.intake import counted_text, reading_rejections
+    from mount_twin.engine.count_texts import counted_text
+    from mount_twin.engine.reading_screen import reading_rejections
 
     reasons = reading_rejections(decoded.accel, decoded.gyro, decoded.unprovided, spec.reads_rate)
     ok = reasons == ""
@@ -208,7 +209,7 @@ def _sample_text(decoded: Decoded, i: int, reasons: np.ndarray) -> str:
     """What sample i of the record lacks for the intake (`reasons[i]`, its rejection), with its
     place and time from the first sample: a reading not finite, with its axis and value, or
     one its message marks not provided."""
-    from mount_twin.engine.intake import READING_LIMIT, provided
+    from mount_twin.engine.reading_screen import READING_LIMIT, provided
 
     t = (int(decoded.stamps_ns[i]) - int(decoded.stamps_ns[0])) * 1e-9
     at = f"sample {i} (t = {t:.6g} s from the first)"

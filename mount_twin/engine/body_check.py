@@ -52,9 +52,10 @@ from mount_twin.engine.body_matching import PENDING_LIMIT, Matcher, Taken
 from mount_twin.engine.body_prediction import Lead, TwinRows
 from mount_twin.engine.body_refusals import Refusals
 from mount_twin.engine.body_windows import Windows
-from mount_twin.engine.intake import provided, rising_or_back
+from mount_twin.engine.reading_screen import provided
 from mount_twin.engine.sensor_reading import SensorGeometry, predicted_reading
 from mount_twin.engine.stamp_runs import Apart
+from mount_twin.engine.stamp_verdicts import rising_or_back
 from mount_twin.physics import pose_row
 from mount_twin.scene.description import BodySensor, Scene
 

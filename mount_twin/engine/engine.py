@@ -22,13 +22,14 @@ from collections.abc import Callable
 import numpy as np
 
 from mount_twin.engine.batch import HealthReport, MountEvent, OutputBatch, SampleBatch
+from mount_twin.engine.count_texts import nothing_accepted
 from mount_twin.engine.delay_line import Frame, GyroDelay, Run, filter_bands
 from mount_twin.engine.driver import CoreDriver
 from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.gyro_filter import Design
 from mount_twin.engine.health import HealthWindow
 from mount_twin.engine.health_statuses import ENDED
-from mount_twin.engine.intake import Intake, Judged, nothing_accepted, runs
+from mount_twin.engine.intake import Intake, Judged, runs
 from mount_twin.engine.kernel import AT_EVENT, Samples
 from mount_twin.engine.reporting import Reporting
 from mount_twin.engine.rows import BatchRows, Part, Tail
@@ -114,7 +115,7 @@ class TwinEngine:
     @property
     def followed_nothing(self) -> str:
         """Why the twin followed none of the input ('' if it did): no sample accepted
-        (`intake.nothing_accepted`), or too few to start it (`HealthWindow.never_started`). A
+        (`count_texts.nothing_accepted`), or too few to start it (`HealthWindow.never_started`). A
         run like that has no figures: a sweep's case or an accuracy run is FAILED, not a
         machine at rest."""
         counts = self.counts

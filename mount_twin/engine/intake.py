@@ -1,17 +1,17 @@
-"""Input intake: a pushed batch's samples screened, rotated into F and judged.
+"""Input intake: a pushed batch's samples screened, rotated into F and judged, push by push.
 
-Each sample gets a verdict: taken (ACCEPT, a START or restart, a gap bridged or reset), held
-back (HOLD: a stamp jump to confirm), or rejected for a reason (non_finite, wrong_frame,
-duplicate_stamp, ...). Taken samples are grouped into runs split at restarts; the stamp
-intervals into them feed the lost-sample estimate; readings at the sensor's full scale or on a
-plateau are flagged. The twin itself is not touched here (`engine.TwinEngine` drives it).
+Each sample gets a verdict (`stamp_verdicts`): taken (ACCEPT, a START or restart, a gap
+bridged or reset), held back (HOLD: a stamp jump to confirm), or rejected for a reason
+(non_finite, wrong_frame, duplicate_stamp, ...; its readings by `reading_screen`). Taken
+samples are grouped into runs split at restarts; the stamp intervals into them feed the
+lost-sample estimate; readings at the sensor's full scale or on a plateau are flagged; the
+verdicts are counted. The twin itself is not touched here (`engine.TwinEngine` drives it).
 """
 
 from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Mapping
 from typing import NamedTuple
 
 import numpy as np
@@ -20,33 +20,31 @@ from mount_twin.engine.batch import SampleBatch
 from mount_twin.engine.delay_line import Run
 from mount_twin.engine.health import HealthWindow
 from mount_twin.engine.health_statuses import PLATEAU_G, SATURATION_SHARE
-from mount_twin.engine.health_texts import NO_SAMPLE_ACCEPTED
-from mount_twin.model.assemble import Model
-from mount_twin.scene.description import InputSpec
-
-ACCEPT, START, JUMPED_BACK, GAP_RESET, GAP_BRIDGED = (
-    "accept",
-    "start",
-    "jumped_back",
-    "gap_reset",
-    "gap_bridged",
+from mount_twin.engine.reading_screen import (
+    READING_LIMIT,
+    all_axes,
+    any_axis,
+    provided,
+    readable,
+    rotated,
 )
-"""Verdicts on a sample besides the rejection reasons (non_finite, wrong_frame, ...)."""
-HOLD = "hold"
-"""The last sample of a push whose stamp jumped forward: kept for the next push to confirm."""
-JUMP_FACTOR = 2.0
-"""A stamp interval more than this many times the previous one is a jump to confirm: taken if
-the next stamp is later still, rejected as `stamp_glitch` if the next one falls back before it
-(one bad stamp then costs that one sample, not the samples until time catches up with it). At
-2, a stamp glitched forward by 3 intervals or more is caught (at 20, one of 18 ms on a 1 kHz
-stream was taken and the 17 valid samples after it rejected as going back); a jump followed by
-later stamps, jitter included, only delays its sample by one when it ends a push."""
+from mount_twin.engine.stamp_verdicts import (
+    ACCEPT,
+    GAP_BRIDGED,
+    GAP_RESET,
+    HOLD,
+    JUMP_FACTOR,
+    JUMPED_BACK,
+    RESTARTS,
+    START,
+    stamp_verdict,
+)
+from mount_twin.model.assemble import Model
 
-RESTARTS = frozenset((START, JUMPED_BACK, GAP_RESET))
-"""Verdicts whose sample (re)starts the twin."""
 _INTERVALS = frozenset((ACCEPT, GAP_RESET, GAP_BRIDGED))
 """Verdicts whose interval from the previous taken sample enters the lost-sample estimate: a
 gap is input lost (the samples a sensor would have sent in it), however the twin goes on."""
+
 _COUNTS = {
     ACCEPT: ("accepted",),
     START: ("accepted",),
@@ -55,10 +53,6 @@ _COUNTS = {
     GAP_BRIDGED: ("accepted", "gaps"),
 }
 """Counters each taken verdict increments; a rejection increments rejected_<reason>."""
-
-READING_LIMIT = 1e150
-"""Largest |component| of an accepted reading, m/s² or rad/s: a larger one (a garbled message) is
-rejected as non_finite, and the rotation into F cannot overflow."""
 
 
 class Intervals(NamedTuple):
@@ -106,133 +100,6 @@ class Judged(NamedTuple):
     suspect: dict[str, np.ndarray]
 
 
-def counted_text(counts: Mapping[str, int], prefix: str = "") -> str:
-    """The non-zero counts of `counts` whose key starts with `prefix`, as a reader takes them:
-    'non_finite 3, wrong_frame 40' (the prefix off), or 'none'."""
-    kept = [(k, v) for k, v in counts.items() if k.startswith(prefix) and v]
-    return ", ".join(f"{k.removeprefix(prefix)} {v}" for k, v in kept) or "none"
-
-
-def nothing_accepted(
-    counts: Mapping[str, int],
-    wrong_frame_id: str | None = None,
-    frame_id_setting: str = "input.frame_id",
-) -> str:
-    """Why no input sample was accepted, from an engine's `counts` ('' if some were): how many
-    were received and why each was rejected, and the last `wrong_frame_id` rejected if any,
-    pointing at what set the frame id expected (`frame_id_setting`: the scene's key, the
-    option that replaced it, or both where that cannot be told). A run like that has no
-    figures: a peak of 0 N would read as a machine at rest."""
-    if counts.get("accepted", 0):
-        return ""
-    detail = ""
-    if wrong_frame_id is not None:
-        from mount_twin.scene.reader import shown_text  # a 1 MB frame id, shortened
-
-        said = shown_text(wrong_frame_id)
-        detail = f"; the bag's header.frame_id is {said}: see {frame_id_setting}"
-    why = (
-        f"{counts.get('received', 0)} received, rejected: "
-        f"{counted_text(counts, 'rejected_')}{detail}"
-    )
-    return f"{NO_SAMPLE_ACCEPTED} ({why})"
-
-
-def rotated(rows: np.ndarray, rot: np.ndarray) -> np.ndarray:
-    """rows (n, 3) · rotᵀ, as three elementwise products: each row's bits are the same whatever
-    the batch (a BLAS product may pick its kernel by size), and no BLAS thread wakes to spin
-    beside the compiled loop on a two-core machine."""
-    return rows[:, 0:1] * rot[:, 0] + rows[:, 1:2] * rot[:, 1] + rows[:, 2:3] * rot[:, 2]
-
-
-def _any_axis(mask: np.ndarray) -> np.ndarray:
-    """(n,) rows of an (n, 3) bool mask with any axis true: three elementwise operations,
-    which cost a quarter of numpy's reduction along so short a last axis."""
-    return mask[:, 0] | mask[:, 1] | mask[:, 2]
-
-
-def _all_axes(mask: np.ndarray) -> np.ndarray:
-    """(n,) rows of an (n, 3) bool mask with every axis true (see `_any_axis`)."""
-    return mask[:, 0] & mask[:, 1] & mask[:, 2]
-
-
-def readable(accel: np.ndarray, gyro: np.ndarray) -> np.ndarray:
-    """(n,) which samples' (n, 3) readings (m/s², rad/s) are all within ±READING_LIMIT (NaN
-    and ±inf are not): the others the intake rejects as non_finite."""
-    return _all_axes(np.abs(accel) <= READING_LIMIT) & _all_axes(np.abs(gyro) <= READING_LIMIT)
-
-
-def provided(
-    accel: np.ndarray, gyro: np.ndarray, unprovided: np.ndarray | None
-) -> tuple[np.ndarray, np.ndarray]:
-    """The (n, 3) readings with those their message marks not provided (`unprovided`, (n, 2):
-    acceleration, angular velocity; REP-145: to be disregarded) zeroed: never read as values,
-    nor judged as not finite; the sample's screening says whether it can do without them."""
-    if unprovided is None:
-        return accel, gyro
-    return np.where(unprovided[:, :1], 0.0, accel), np.where(unprovided[:, 1:], 0.0, gyro)
-
-
-def disregarded(unprovided: np.ndarray | None, n: int, reads_rate: bool = True) -> np.ndarray:
-    """(n,) which samples lack a reading that is read: their acceleration marked not provided,
-    or (`reads_rate`) their angular velocity (`unprovided`, (n, 2), None: none is marked)."""
-    if unprovided is None:
-        return np.zeros(n, bool)
-    return unprovided[:, 0] | (unprovided[:, 1] & reads_rate)
-
-
-def reading_rejections(
-    accel: np.ndarray, gyro: np.ndarray, unprovided: np.ndarray | None, reads_rate: bool
-) -> np.ndarray:
-    """(n,) the rejection each sample earns at the intake by its readings alone ('' none), as
-    `Intake` judges them, first first: non_finite (a reading not within ±READING_LIMIT, those
-    marked not provided disregarded: `provided`), no_acceleration, no_angular_velocity (where
-    the twin `reads_rate`; `unprovided` as `disregarded` takes it). For an analysis of a record
-    to leave out what the twin did not take."""
-    n = accel.shape[0]
-    reasons = np.full(n, "", dtype=object)
-    if unprovided is not None:
-        reasons[unprovided[:, 1] & reads_rate] = "no_angular_velocity"
-        reasons[unprovided[:, 0]] = "no_acceleration"
-    reasons[~readable(*provided(accel, gyro, unprovided))] = "non_finite"
-    return reasons
-
-
-def rising(stamps: np.ndarray, keep: np.ndarray, last: int) -> np.ndarray:
-    """Of the samples `keep` marks, those (bool mask) whose integer stamp is after `last` and
-    after every kept stamp before it (one going back is not after the others either, so the
-    running maximum over all kept ones is the same as over the rising ones)."""
-    return keep & (stamps > _latest_before(stamps, keep, last))
-
-
-def _latest_before(stamps: np.ndarray, keep: np.ndarray, last: int) -> np.ndarray:
-    """Per sample, the latest of `last` and the stamps `keep` marks before it."""
-    kept = np.where(keep, stamps, np.iinfo(np.int64).min)
-    return np.maximum.accumulate(np.concatenate([[last], kept]))[:-1]
-
-
-def rising_or_back(
-    stamps: np.ndarray, keep: np.ndarray, last: int, reset: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """`rising`, except that a kept stamp more than `reset` before `last` and every kept stamp
-    before it starts afresh, as a stamp jumping back by more than input.back_jump_reset_s
-    restarts the twin (`stamp_verdict`'s JUMPED_BACK: a bag played with --loop): (taken, of
-    them those that jumped back) bool masks (`last`, `reset` and the stamps in one unit)."""
-    taken = np.zeros(stamps.shape[0], bool)
-    jumped = np.zeros(stamps.shape[0], bool)
-    start = 0
-    while True:
-        part, kept = stamps[start:], keep[start:]
-        before = _latest_before(part, kept, last)
-        back = np.flatnonzero(kept & (part < before - reset))
-        stop = int(back[0]) if back.shape[0] else part.shape[0]
-        taken[start : start + stop] = (kept & (part > before))[:stop]
-        if not back.shape[0]:
-            return taken, jumped
-        taken[start + stop] = jumped[start + stop] = True
-        last, start = int(part[stop]), start + stop + 1
-
-
 def runs(verdicts: list[str], start: int, stop: int) -> list[Run]:
     """Group the taken samples in [start, stop) into runs split at restarts."""
     segment = verdicts[start:stop]
@@ -253,29 +120,6 @@ def runs(verdicts: list[str], start: int, stop: int) -> list[Run]:
         else:
             grouped[-1][0].append(i)
     return [Run(np.array(index, dtype=np.int64), restart) for index, restart in grouped]
-
-
-def stamp_verdict(
-    spec: InputSpec, t: float, last_t: float, last_step: float | None, next_t: float | None
-) -> str:
-    """Verdict on a readable sample of stamp t (s) by its stamp alone: after the last taken
-    sample's `last_t`, into which the interval was `last_step` (None: it was a start), and
-    before the next sample's `next_t` (None: it ends the push)."""
-    if t == last_t:
-        return "duplicate_stamp"
-    if t < last_t - spec.back_jump_reset_s:
-        return JUMPED_BACK
-    if t < last_t:
-        return "stamp_went_back"
-    if (
-        last_step is not None
-        and t - last_t > JUMP_FACTOR * last_step
-        and (next_t is None or last_t < next_t < t)
-    ):
-        return HOLD if next_t is None else "stamp_glitch"
-    if t - last_t > spec.max_gap_s:
-        return GAP_RESET if spec.gap_policy == "reset" else GAP_BRIDGED
-    return ACCEPT
 
 
 class Intake:
@@ -365,9 +209,9 @@ class Intake:
             (batch.gyro, spec.gyro_range_rad_s),
         ):
             if full_scale > 0.0:
-                saturated |= _any_axis(np.abs(reading) >= SATURATION_SHARE * full_scale)
+                saturated |= any_axis(np.abs(reading) >= SATURATION_SHARE * full_scale)
         before = np.concatenate([self._last_reading[None, :], accel[:-1]])
-        plateau = _all_axes(accel == before)  # repeated exactly; beyond PLATEAU_G too:
+        plateau = all_axes(accel == before)  # repeated exactly; beyond PLATEAU_G too:
         if plateau.any():
             with np.errstate(invalid="ignore", over="ignore"):
                 beyond = np.linalg.norm(accel[plateau], axis=1) > PLATEAU_G * spec.g_scale

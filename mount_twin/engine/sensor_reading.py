@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mount_twin.engine.intake import rotated
+from mount_twin.engine.reading_screen import rotated
 from mount_twin.physics.rotations import quaternion_matrices, rpy_matrices, rpy_matrix
 from mount_twin.scene.description import BodySensor, Scene
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from mount_twin.engine.batch import SampleBatch
-from mount_twin.engine.intake import disregarded, provided
+from mount_twin.engine.reading_screen import disregarded, provided
 from mount_twin.errors import BagError, DamagedBagError
 from mount_twin.io.input_bag import InputBag
 from mount_twin.io.input_decoding import Decoded, TimeBase, decode_inputs
@@ -74,7 +74,7 @@ def refuse_unprovided(decoded: Decoded, where: str, reads_rate: bool, why: str) 
 
 def provided_input(bag: str | Path, spec: InputSpec) -> tuple[Decoded, str]:
     """`read_input` without the samples the scene's twin disregards for a reading marked not
-    provided (`intake.disregarded`: the acceleration, or the rate unless input.gyro_filter:
+    provided (`reading_screen.disregarded`: the acceleration, or the rate unless input.gyro_filter:
     ignore; a rate it does not read is zeroed), and a note naming the bag and how many were
     dropped ('' if none): for an analysis that runs the twin on input it derives from the
     record (accuracy's reference holds each sample's value to the next), so that it runs on
