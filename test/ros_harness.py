@@ -25,7 +25,7 @@ from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from mount_twin.ros.node import message_class
+from mount_twin.ros.outputs import message_class
 from mount_twin.ros.rclpy_private import take_waiting
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -1,7 +1,10 @@
-"""The rclpy shell: the only module that runs an rclpy node.
+"""The rclpy node of the twin: foundation IMU in through raw subscriptions, the twin's
+outputs out through its byte publishers (`ros/outputs.py`), diagnostics when input stalls, the
+problems only a live node sees, and the shutdown. Parameters: `ros/parameters.py`; the
+process around it: `ros/process.py`.
 
 Moves raw CDR bytes only (raw subscription, byte publishers) so that every (de)serialization is
-the rosbags code the bag replay and the tests run. Parameters: `ros/parameters.py`.
+the rosbags code the bag replay and the tests run.
 
 Input is taken in bulk: each wake-up of the executor takes every message waiting in the
 subscription's queue (`take_waiting`) and pushes them through the engine in one call, so the
@@ -14,52 +17,26 @@ report saying why (no input, all rejected and why), and problems only the live n
 
 from __future__ import annotations
 
-import importlib
 import math
-import sys
 import time
 from collections.abc import Callable, Sequence
-from functools import partial
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any
 
-import rclpy
 from rclpy.clock import Clock, ClockType
-from rclpy.duration import Duration
-from rclpy.event_handler import (
-    PublisherEventCallbacks,
-    QoSMessageLostInfo,
-    SubscriptionEventCallbacks,
-)
-from rclpy.exceptions import InvalidParameterTypeException, InvalidTopicNameException
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
-from rclpy.node import Node
-from rclpy.publisher import Publisher
-from rclpy.qos import (
-    DurabilityPolicy,
-    HistoryPolicy,
-    QoSPolicyKind,
-    QoSProfile,
-    ReliabilityPolicy,
-)
+from rclpy.event_handler import QoSMessageLostInfo, SubscriptionEventCallbacks
+from rclpy.exceptions import InvalidParameterTypeException
+from rclpy.qos import HistoryPolicy, QoSPolicyKind, QoSProfile, ReliabilityPolicy
 from rclpy.qos_overriding_options import QoSOverridingOptions
-from rclpy.signals import SignalHandlerOptions
 from rclpy.subscription import Subscription
 from rclpy.timer import Timer
 
 from mount_twin.engine.batch import ERROR, OK, HealthReport, HealthStatus
 from mount_twin.engine.body_counts import MIDDLEWARE, STOPPED
 from mount_twin.errors import MountTwinError
-from mount_twin.io.messages import DIAGNOSTICS_TOPIC, IMU, NODE_NAME, TF, TF_STATIC_TOPIC
-from mount_twin.io.output_encoding import encode_report, messages_of, static_transforms
-from mount_twin.io.output_topics import output_types
-from mount_twin.io.scene_record import STRING, scene_message
-from mount_twin.ros.parameters import (
-    built_in_type_error,
-    check_command_line,
-    check_qos_overrides,
-    configure,
-    rcl_message,
-)
+from mount_twin.io.messages import DIAGNOSTICS_TOPIC, IMU, NODE_NAME
+from mount_twin.io.output_encoding import encode_report, messages_of
+from mount_twin.ros.outputs import OutputNode, message_class
+from mount_twin.ros.parameters import built_in_type_error, check_qos_overrides, configure
 from mount_twin.ros.rclpy_private import take_waiting
 from mount_twin.stream import TwinStream
 
@@ -69,38 +46,20 @@ if TYPE_CHECKING:
     from mount_twin.ros.ageing_fits import AgeingFits
     from mount_twin.ros.start import StopRequests
 
-T = TypeVar("T")
 TAKE_LIMIT = 100_000
 """Most input messages taken in one wake-up."""
-SHUTDOWN_ACK_S = 10.0
-"""At shutdown, how long (s, steady clock) the node waits for every reliable subscriber to
-acknowledge what it published last (the final, partial diagnostics period among it) before it
-destroys its publishers; what is still unacknowledged then is named in a warning."""
-ACK_POLL_S = 0.05
-"""Slice (s) of that wait per publisher, between which a second stop is seen."""
 SHUTDOWN_CHUNK = 1000
 """Input messages processed in one call at shutdown, between which a second stop is seen."""
 FIT_POLL_S = 0.2
 """Steady-clock period at which finished ageing fits are published."""
-NO_EVENTS = PublisherEventCallbacks(use_default_callbacks=False)
-"""The outputs' publishers take no middleware events. rclpy's default ones (a log line on an
-incompatible QoS or type, which the subscriber's side logs too) are two waitables a publisher,
-and the executor builds its wait set anew at every wake-up: with the pump's 14 publishers, 31
-waitables took 1.6 ms of CPU a wake-up."""
 WATCH_PERIOD_S = 1.0
+"""Steady-clock period of the checks only a live node can make (publisher types, /clock)."""
 TIMER_MAX_S = 9.0e9
 """Longest period (s) an rclpy timer takes (int64 ns: 292 years), and one no node lives to see
 end: a longer stall period (the scene takes any finite diagnostics period) waits this long."""
-"""Steady-clock period of the checks only a live node can make (publisher types, /clock)."""
 
 
-def message_class(msgtype: str) -> type:
-    """The rclpy message class of a ROS type name ('pkg/msg/Name'), without rosidl_runtime_py."""
-    package, _, name = msgtype.split("/")
-    return getattr(importlib.import_module(f"{package}.msg"), name)
-
-
-class MountTwinNode(Node):
+class MountTwinNode(OutputNode):
     """Foundation acceleration in; pose, α/γ/δ, mount wrenches, TF and diagnostics out.
 
     Raises:
@@ -161,57 +120,6 @@ class MountTwinNode(Node):
         for warning in self.stream.scene.warnings:  # implausible: units? the start's ratings?
             self.get_logger().warning(str(warning))
 
-    def _create_outputs(self) -> dict[str, Publisher]:
-        """A reliable publisher per output (unresolved topic → publisher); the mount frames on
-        latched /tf_static (`_latched`). Without tf2_msgs (not on the package registry) no TF,
-        said once."""
-        reliable = QoSProfile(
-            depth=self.options.output_queue_depth,
-            reliability=ReliabilityPolicy.RELIABLE,
-            history=HistoryPolicy.KEEP_LAST,
-        )
-        pubs: dict[str, Publisher] = {}
-        try:
-            tf_class: type | None = message_class(TF)
-        except ImportError:  # tf2_msgs comes with a ROS install, not from the package registry
-            tf_class = None
-            self.get_logger().warning(
-                f"tf2_msgs is not importable: /tf and {TF_STATIC_TOPIC} are not published; "
-                "`mount-twin replay` writes them to bags"
-            )
-        for topic, msgtype in output_types(self.scene).items():
-            if msgtype == TF and tf_class is None:
-                continue
-            cls = message_class(msgtype)  # the others are dependencies: missing ones raise
-            pubs[topic] = self._named(
-                "outputs",
-                partial(self.create_publisher, cls, topic, reliable, event_callbacks=NO_EVENTS),
-            )
-        if tf_class is not None:
-            now = self.get_clock().now().nanoseconds
-            self._static = self._latched(tf_class, static_transforms(self.scene, now))
-        return pubs
-
-    def _publish_scene(self) -> Publisher:
-        """The scene the node runs, once, latched on ~/scene (`io.scene_record`: its digest,
-        file, overrides and value), as robot_state_publisher gives /robot_description; the
-        scene is read-only (a change restarts the node), so once is all."""
-        message = scene_message(self.scene, self.get_clock().now().nanoseconds)
-        return self._latched(message_class(STRING), message)
-
-    def _latched(self, cls: type, message: tuple[str, int, bytes]) -> Publisher:
-        """A latched publisher (reliable, transient local, depth 1: tf2_ros' static
-        broadcaster) of `message`'s topic, which it publishes once."""
-        latched = QoSProfile(
-            depth=1,
-            reliability=ReliabilityPolicy.RELIABLE,
-            durability=DurabilityPolicy.TRANSIENT_LOCAL,
-        )
-        topic, _, data = message
-        pub = self.create_publisher(cls, topic, latched, event_callbacks=NO_EVENTS)
-        pub.publish(bytes(data))
-        return pub
-
     def _create_input(self) -> Subscription:
         """The foundation IMU's raw subscription, with its message-lost and type events."""
         events = SubscriptionEventCallbacks(
@@ -263,14 +171,6 @@ class MountTwinNode(Node):
             msg = f"{self.get_fully_qualified_name()}: {override}: expected 'best_effort' or "
             raise MountTwinError(f"{msg}'reliable' ({err})".replace("\n", " ")) from err
 
-    def _named(self, parameter: str, create: Callable[[], T]) -> T:
-        """Create a publisher or subscription; a name rclpy refuses names the parameter."""
-        try:
-            return create()
-        except InvalidTopicNameException as err:
-            msg = f"{self.get_fully_qualified_name()}: {parameter}: {err}".replace("\n", " ")
-            raise MountTwinError(msg) from err
-
     def _on_input(self, raw: bytes) -> None:
         raws = [raw, *take_waiting(self._sub, TAKE_LIMIT)]
         if self._batch_timer is None:
@@ -316,12 +216,6 @@ class MountTwinNode(Node):
         """The ageing reports whose fits are done, in window order."""
         if self._fits is not None:
             self._publish(self._fits.done())
-
-    def _publish(self, messages: list[tuple[str, int, bytes]]) -> None:
-        for topic, _stamp, data in messages:
-            pub = self._pubs.get(topic)
-            if pub is not None:
-                pub.publish(bytes(data))
 
     def _on_stall_period(self) -> None:
         """A stall period of the node's clock (`stall_period_s`): if it brought no input
@@ -454,71 +348,3 @@ class MountTwinNode(Node):
                 return unprocessed
             process(raws[start : start + SHUTDOWN_CHUNK])
         return 0
-
-    def _wait_for_acks(self, stops: StopRequests) -> bool:
-        """Wait up to SHUTDOWN_ACK_S until every reliable subscriber has acknowledged every
-        output, or until a second stop; a warning names the topics still unacknowledged. True
-        where the second stop cut the wait short."""
-        deadline = time.monotonic() + SHUTDOWN_ACK_S
-        waiting = list(self._pubs.values())
-        slice_s = Duration(seconds=ACK_POLL_S)  # a signal's handler runs only between them
-        while True:  # once at least, even after a second stop: what is acknowledged is not lost
-            waiting = [p for p in waiting if not p.wait_for_all_acked(slice_s)]
-            if not waiting or stops.hurried or time.monotonic() >= deadline:
-                break
-        if not waiting:
-            return False
-        topics = ", ".join(
-            f"{p.topic_name} (subscribers matched: {p.get_subscription_count()})" for p in waiting
-        )
-        if stops.hurried:
-            self.get_logger().warning(
-                f"shutdown: stopped again: the last outputs not acknowledged by every "
-                f"subscriber were dropped on {topics}"
-            )
-            return True
-        self.get_logger().warning(
-            f"shutdown: not acknowledged by every subscriber within {SHUTDOWN_ACK_S} s, "
-            f"the last messages may be lost on {topics}"
-        )
-        return False
-
-
-def run(stops: StopRequests, args: list[str] | None = None) -> int:
-    """The node's process (`mount_twin.ros.start`, whose handler of SIGINT and SIGTERM takes
-    `stops`): spin until the first stop, then publish the last diagnostics period and exit 0;
-    a second stop that cut the shutdown short exits 128 + its signal (130 SIGINT, 143 SIGTERM,
-    as the shell reports a process a signal ended). A configuration error exits 2 with one
-    line. A stop before the node is made exits 0 at once."""
-    if stops.first.is_set():
-        return 0
-    argv = sys.argv if args is None else args
-    try:
-        check_command_line(argv)
-        rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    except MountTwinError as err:
-        print(f"mount_twin_node: {err}", file=sys.stderr)
-        return 2
-    except RuntimeError as err:  # rcl's others (RCLError), e.g. a bad ROS_DOMAIN_ID
-        print(f"mount_twin_node: {rcl_message(err)}", file=sys.stderr)
-        return 2
-    node = None
-    cut_short = False
-    try:
-        node = MountTwinNode(argv)
-        executor = SingleThreadedExecutor()
-        executor.add_node(node)
-        while not stops.first.is_set() and rclpy.ok():
-            executor.spin_once(timeout_sec=0.1)
-    except MountTwinError as err:
-        print(f"mount_twin_node: {err}", file=sys.stderr)
-        return 2
-    except ExternalShutdownException:
-        pass
-    finally:
-        if node is not None:
-            if rclpy.ok():
-                cut_short = node.finish(stops)
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 128 + stops.again if cut_short and stops.again is not None else 0

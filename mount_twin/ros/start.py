@@ -2,7 +2,7 @@
 moment, before the imports of rclpy, numpy and the compiled core (about a second), during which
 Python's default handlers ended the process with a KeyboardInterrupt traceback (exit 130) or
 without a word (exit 143): a stop asked for then ends it with exit 0, as one asked for later
-does, after the last diagnostics (`mount_twin.ros.node.run`). A second stop while the node
+does, after the last diagnostics (`mount_twin.ros.process.run`). A second stop while the node
 shuts down (Ctrl-C pressed again) cuts the shutdown's waits short (`StopRequests`)."""
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ def main(args: list[str] | None = None) -> int:
     stops = StopRequests()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, stops.take)
-    from mount_twin.ros.node import run
+    from mount_twin.ros.process import run
 
     return run(stops, args)
 
