@@ -1,7 +1,7 @@
 """The verdicts on a sample that the intake takes (ACCEPT, a START or restart, a gap bridged
 or reset) or holds back (HOLD), and how its stamp earns one: `stamp_verdict` for one sample
-after the last taken, `rising` and `rising_or_back` for a whole array of stamps, as the streams
-beside the twin's (the ageing tracker, the body IMU) take theirs."""
+after the last taken, `rising_or_back` for a whole array of stamps, as the streams beside the
+twin's (the ageing tracker, the body IMU) take theirs."""
 
 from __future__ import annotations
 
@@ -33,13 +33,6 @@ RESTARTS = frozenset((START, JUMPED_BACK, GAP_RESET))
 """Verdicts whose sample (re)starts the twin."""
 
 
-def rising(stamps: np.ndarray, keep: np.ndarray, last: int) -> np.ndarray:
-    """Of the samples `keep` marks, those (bool mask) whose integer stamp is after `last` and
-    after every kept stamp before it (one going back is not after the others either, so the
-    running maximum over all kept ones is the same as over the rising ones)."""
-    return keep & (stamps > _latest_before(stamps, keep, last))
-
-
 def _latest_before(stamps: np.ndarray, keep: np.ndarray, last: int) -> np.ndarray:
     """Per sample, the latest of `last` and the stamps `keep` marks before it."""
     kept = np.where(keep, stamps, np.iinfo(np.int64).min)
@@ -49,10 +42,13 @@ def _latest_before(stamps: np.ndarray, keep: np.ndarray, last: int) -> np.ndarra
 def rising_or_back(
     stamps: np.ndarray, keep: np.ndarray, last: int, reset: int
 ) -> tuple[np.ndarray, np.ndarray]:
-    """`rising`, except that a kept stamp more than `reset` before `last` and every kept stamp
-    before it starts afresh, as a stamp jumping back by more than input.back_jump_reset_s
-    restarts the twin (`stamp_verdict`'s JUMPED_BACK: a bag played with --loop): (taken, of
-    them those that jumped back) bool masks (`last`, `reset` and the stamps in one unit)."""
+    """Of the samples `keep` marks, those whose integer stamp is after `last` and after every
+    kept stamp before it (one going back is not after the others either, so the running
+    maximum over all kept ones is the same as over the rising ones), except that a kept stamp
+    more than `reset` before `last` and every kept stamp before it starts afresh, as a stamp
+    jumping back by more than input.back_jump_reset_s restarts the twin (`stamp_verdict`'s
+    JUMPED_BACK: a bag played with --loop): (taken, of them those that jumped back) bool masks
+    (`last`, `reset` and the stamps in one unit)."""
     taken = np.zeros(stamps.shape[0], bool)
     jumped = np.zeros(stamps.shape[0], bool)
     start = 0
