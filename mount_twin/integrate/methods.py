@@ -112,6 +112,14 @@ METHODS: dict[str, Method] = {
             square_blocks=11,
             family=EXPONENTIAL,
         ),
+        Method(
+            "verner65",
+            3,
+            "mount_twin.integrate.verner65",
+            6,
+            9,
+            "adaptive Verner 6(5) (the error estimate's companion of dopri54)",
+        ),
     )
 }
 """Methods by scene name; ids are distinct (test/test_integrate_methods.py)."""
@@ -119,6 +127,7 @@ METHODS: dict[str, Method] = {
 DOPRI54 = METHODS["dopri54"].id
 ROS34PW2 = METHODS["ros34pw2"].id
 EXPRB32 = METHODS["exprb32"].id
+VERNER65 = METHODS["verner65"].id
 
 AUTO = "auto"
 """`integration.method: auto` (the default): `choose` decides at each start's first input

@@ -18,7 +18,7 @@ enum Status : int {
 };
 
 // Method ids (integrate/methods.py METHODS[...].id).
-enum Method : int { DOPRI54 = 0, ROS34PW2 = 1, EXPRB32 = 2, N_METHODS = 3 };
+enum Method : int { DOPRI54 = 0, ROS34PW2 = 1, EXPRB32 = 2, VERNER65 = 3, N_METHODS = 4 };
 
 // Right-hand-side status (physics/dynamics.py).
 enum RhsStatus : int { OK = 0, OFF_CHART = 1 };

@@ -13,7 +13,7 @@ PYBIND11_MODULE(_core_ext, m) {
       int(mt::SUCCESS), int(mt::TOO_MANY_STEPS), int(mt::STEP_TOO_SMALL), int(mt::LEFT_CHART),
       int(mt::NOT_FINITE), int(mt::UNKNOWN_METHOD));
   m.attr("METHOD_IDS") = pybind11::make_tuple(int(mt::DOPRI54), int(mt::ROS34PW2),
-                                              int(mt::EXPRB32));
+                                              int(mt::EXPRB32), int(mt::VERNER65));
   m.attr("POSE_ROW") = pybind11::make_tuple(mt::pose_row::POSITION, mt::pose_row::QUATERNION,
                                             mt::pose_row::ANGLES, mt::pose_row::WIDTH);
   m.attr("FIGURE_SLOTS") = pybind11::make_tuple(int(mt::FORCE_ERROR), int(mt::ATTITUDE_ERROR),

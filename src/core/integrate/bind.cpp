@@ -23,6 +23,7 @@ inline const char* method_name(int method) {
     case DOPRI54: return "dopri54";
     case ROS34PW2: return "ros34pw2";
     case EXPRB32: return "exprb32";
+    case VERNER65: return "verner65";
     default: return "";
   }
 }
@@ -111,16 +112,29 @@ py::tuple rows(const double (&v)[R][C]) {
   return t;
 }
 
+/// An explicit method's table T (its A passed whole: T::A is a pointer to its rows) by the names
+/// of its Python module.
+template <class T, std::size_t R, std::size_t C>
+py::dict explicit_table(const double (&a)[R][C]) {
+  py::dict d;
+  py::tuple c(R), e(R);
+  for (std::size_t i = 0; i < R; ++i) {
+    c[i] = T::C[i];
+    e[i] = T::E[i];
+  }
+  d["C"] = c;
+  d["A"] = rows(a);
+  d["E"] = e;
+  d["FSAL"] = T::FSAL;
+  d["ORDER"] = T::ORDER;
+  d["MAX_FACTOR"] = T::MAX_FACTOR;
+  return d;
+}
+
 /// Each method's tables and constants as the core has them, by the names its Python module
 /// uses (test/test_core_contract.py holds them equal to the module's).
 py::dict method_tables() {
-  py::dict dopri, ros, exp, control;
-  dopri["C"] = row(integrate::dopri54::C);
-  dopri["A"] = rows(integrate::dopri54::A);
-  dopri["E"] = row(integrate::dopri54::E);
-  dopri["FSAL"] = integrate::dopri54::FSAL;
-  dopri["ORDER"] = integrate::dopri54::ORDER;
-  dopri["MAX_FACTOR"] = integrate::dopri54::MAX_FACTOR;
+  py::dict ros, exp;
   ros["GAMMA"] = integrate::ros34pw2::GAMMA;
   ros["ALPHA"] = rows(integrate::ros34pw2::ALPHA);
   ros["GAMMAS"] = rows(integrate::ros34pw2::GAMMAS);
@@ -141,7 +155,8 @@ py::dict method_tables() {
   exp["J0"] = integrate::exprb32::J0;
   exp["BLOCKS"] = integrate::exprb32::BLOCKS;
   py::dict out;
-  out["dopri54"] = dopri;
+  out["dopri54"] = explicit_table<integrate::dopri54::Table>(integrate::dopri54::A);
+  out["verner65"] = explicit_table<integrate::verner65::Table>(integrate::verner65::A);
   out["ros34pw2"] = ros;
   out["exprb32"] = exp;
   return out;
@@ -185,6 +200,11 @@ void bind_integrate(py::module_& mod) {
       "Exponential Rosenbrock EXPRB32 across one input interval: `advance` without the method "
       "id (k: (6 + 8n, n): f0, ∂f/∂t, scratch, U, D, balancing, then J, φ1..φ3 and four work "
       "blocks; t0, t1 in s).");
+  def_method_advance<VERNER65>(
+      mod, "verner65_advance",
+      "Verner's 6(5) pair across one input interval: `advance` without the method id (k: "
+      "(9, n) stages; y_new: (n,); t0, t1 in s). On success k[0] holds dy/dt at (t1, y) and "
+      "settings[CHAINED] is 1.");
   mod.def("method_tables", &method_tables,
           "Each method's tables and constants as the core has them: {method: {name: value}}, "
           "by the names of its Python module.");

@@ -9,6 +9,7 @@
 #include "dopri54.hpp"
 #include "exprb32.hpp"
 #include "ros34pw2.hpp"
+#include "verner65.hpp"
 
 namespace mt::integrate {
 
@@ -19,6 +20,7 @@ inline idx work_rows(int method, idx n) {
     case DOPRI54: return dopri54::work_rows(n);
     case ROS34PW2: return ros34pw2::work_rows(n);
     case EXPRB32: return exprb32::work_rows(n);
+    case VERNER65: return verner65::work_rows(n);
     default: return -1;
   }
 }
@@ -35,6 +37,9 @@ inline int advance(int method, Vec y, double t0, double t1, Vec settings, const 
   }
   if (method == EXPRB32) {
     return exprb32::advance(y, t0, t1, settings, m, s, u, work2d, work1d, result);
+  }
+  if (method == VERNER65) {
+    return verner65::advance(y, t0, t1, settings, m, s, u, work2d, work1d, result);
   }
   return UNKNOWN_METHOD;
 }
