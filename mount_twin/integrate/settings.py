@@ -21,7 +21,8 @@ RTOL, ATOL (the state's units), MAX_SUBSTEPS per input interval, CHAINED: 1.0 af
 success, when work2d[0] holds dy/dt at the end state (FSAL); a caller that changes the input
 between calls moves that stage to the new input and leaves the flag, or sets it to 0.0; and
 MIN_STEPS, the fewest steps per input interval (no step longer than the interval / MIN_STEPS:
-1 for the twin, 2 for the error estimate's checking stepper); JACOBIAN_AGE, for methods that keep a
+1 for the twin and for the error estimate's Verner companion, 2 for its checking
+stepper and for a companion running the twin's own method); JACOBIAN_AGE, for methods that keep a
 Jacobian: the input intervals it has served (0: none held); PHI_STEP, for the exponential
 method: the step (s) its matrix functions of the Jacobian held were computed for (0: none);
 HOLD_AFTER_REJECT, 1.0 where a step accepted right after a rejection may not propose a longer
