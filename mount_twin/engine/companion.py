@@ -13,38 +13,40 @@ TOLERANCE_DIVISOR = 8 (an adaptive step's error, hence the global error, 8× sma
 estimate 0.88·e). Where the twin's steps are set by the samples, not its tolerance (one step an
 interval), one step of the twin's own method would be the twin again (r = 1, the estimate 0):
 where the twin runs Dormand–Prince 5(4) the companion runs Verner's 6(5) pair
-(`integrate.verner65`) at least one step an interval (a 6th-order step of the same length:
-its error a small share of the twin's; 8 new right-hand sides a step against the 12 of the
-two Dormand–Prince steps it replaced, which halved the step, r = 2⁵); where `auto` moved the
-twin to a linearising method (`ros34pw2`, `exprb32`) it runs that method at least MIN_STEPS = 2
-steps an interval (HIGHER, `own_method`; `switch` follows the twin). Right after a rejected
-step it grows no step (`integrate.settings` HOLD_AFTER_REJECT, the rule of Hairer, Nørsett &
-Wanner's DOPRI5 code), which the twin's stepper does not: on the bolted genset under its shock
-the joints' faces between sticking and sliding make the error of a step jump with its length,
-and a step grown at once from one accepted with a tiny error was rejected again, and again
-(two Dormand–Prince steps: its right-hand sides 13.9 a sample without the rule, 13.5 with it;
-the twin's 7.4, which the rule would not have changed; docs/benchmarks.md). Verner's "most
-efficient" 6(5) pair was tried first and dropped: its weights of ±176 on stages 0.05 % of a
-step apart make its error estimate's rounding, ε·176·|f|·h, dominate at tight tolerances (the
-genset at rtol 1e-9: 115 right-hand sides a sample where two Dormand–Prince steps take 34, the
-robust pair 29). Measured against a
-reference on smooth, stiff and non-smooth scenes, the estimate is 0.77–1.03 of the true error
-(test/test_error_estimate.py, docs/scene.md "Error estimate"). With two Dormand–Prince steps a
-divisor of 32 gave 0.93–1.3 but cost 10× the integration on the bolted genset, where tight
-tolerances hunt across switches; 4 cost 3× there and gave 0.54. With Verner's pair a divisor
-of 4 saves 0.7 of its 12.6 right-hand sides a sample on the genset at rtol 1e-6 and reads 0.71
-of the true error at rtol 1e-3 (8: 0.89); 2 saves 1.2 and reads 0.57 (docs/benchmarks.md). The companion reads the same held input, takes the
-same discrete mount switches between samples, and restarts with the twin.
+(`integrate.verner65`) at least one step an interval (a 6th-order step of the same length: its
+error a small share of the twin's; 8 new right-hand sides a step against the 12 of the two
+Dormand–Prince steps it replaced, which halved the step, r = 2⁵); where `auto` moved the twin to
+a linearising method (`ros34pw2`, `exprb32`) it runs that method at least MIN_STEPS = 2 steps an
+interval (HIGHER, `own_method`; `switch` follows the twin). Right after a rejected step it grows
+no step (`integrate.settings` HOLD_AFTER_REJECT, the rule of Hairer, Nørsett & Wanner's DOPRI5
+code), which the twin's stepper does not: on the bolted genset under its shock the joints' faces
+between sticking and sliding make the error of a step jump with its length, and a step grown at
+once from one accepted with a tiny error was rejected again, and again (two Dormand–Prince
+steps: its right-hand sides 13.9 a sample without the rule, 13.5 with it; the twin's 7.4, which
+the rule would not have changed; docs/benchmarks.md). Verner's "most efficient" 6(5) pair was
+tried first and dropped: its weights of ±176 on stages 0.05 % of a step apart make its error
+estimate's rounding, ε·176·|f|·h, dominate at tight tolerances (the genset at rtol 1e-9: 115
+right-hand sides a sample where two Dormand–Prince steps take 34, the robust pair 29). Measured
+against a reference on the non-smooth scenes the companion serves (hysteretic rubber on
+snubbers, the genset's joints and keys, Bouc–Wen elastomers) at rtol 1e-3 … 1e-9, the estimate
+is 0.69–1.08 of the true error (test/test_error_estimate.py, docs/scene.md "Error estimate";
+0.69–0.75 where both take one step an interval at loose tolerances, Verner's error a quarter of
+the twin's). With two Dormand–Prince steps a divisor of 32 gave 0.93–1.3 but cost 10× the
+integration on the bolted genset, where tight tolerances hunt across switches; 4 cost 3× there
+and gave 0.54. With Verner's pair a divisor of 4 saves 0.7 of its 12.6 right-hand sides a sample
+on the genset at rtol 1e-6 and reads 0.71 of the true error at rtol 1e-3 (8: 0.89); 2 saves 1.2
+and reads 0.57 (docs/benchmarks.md). The companion reads the same held input, takes the same
+discrete mount switches between samples, and restarts with the twin.
 
 Cost: the engine takes 2.0× as long with it on the bolted genset at rtol 1e-6, 2.1× on 256
-Bouc–Wen elastomers (bench/error_estimate.py, docs/scene.md "Error estimate"; 2.1× and 2.3×
-with two Dormand–Prince steps): its right-hand sides, 12.6 a sample on the genset against the
-twin's 7.7 (floor 8: the rest are rejections and extra steps at the joints' switches under the
-shock), are more than the twin's work, whatever the mounts. Followed on a second thread it
-would hide in wall time only up to its own loop, the slower one: measured on the genset, the
-run's wall time fell from 48–53 to 41 ms and its CPU time rose to 59–60 ms (not kept; a live
-node's runs of one sample would gain nothing). `integration.error_estimate: false` turns it
-off. It never touches the twin's state: the published numbers are identical with it on or off
+Bouc–Wen elastomers (bench/error_estimate.py, docs/scene.md "Error estimate"; 2.1× and 2.3× with
+two Dormand–Prince steps): its right-hand sides, 12.6 a sample on the genset against the twin's
+7.7 (floor 8: the rest are rejections and extra steps at the joints' switches under the shock),
+are more than the twin's work, whatever the mounts. Followed on a second thread it would hide in
+wall time only up to its own loop, the slower one: measured on the genset, the run's wall time
+fell from 48–53 to 41 ms and its CPU time rose to 59–60 ms (not kept; a live node's runs of one
+sample would gain nothing). `integration.error_estimate: false` turns it off. It never touches
+the twin's state: the published numbers are identical with it on or off
 (test/test_error_estimate.py).
 
 Its figures, kept as `engine.estimate` lays them out, are running maxima since the engine last
