@@ -277,9 +277,7 @@ def static_equilibrium(
         return newton.central(accelerations, q, FINE_STEP)
 
     allowed_at = _allowed_residual(model, specific_force)
-    found = newton.solve(accelerations, stiffness, q_guess, allowed_at, fine=fine_stiffness)
-    if found is None:  # a singular stiffness at the guess: within a clearance?
-        found = newton.anchored(accelerations, stiffness, q_guess, allowed_at, fine_stiffness)
+    found = newton.find(accelerations, stiffness, q_guess, allowed_at, fine_stiffness)
     if found is None:  # Newton did not get there: the robust solver says why
         from scipy.optimize import least_squares  # 0.2 s to import: only where Newton fails
 

@@ -17,6 +17,12 @@ least squares stalls too. `solve` follows the Newton steps of the piece it lands
 monotonically from the stiff side), and near a root within a difference step of an edge
 takes a finer Jacobian. A load continuation would meet the same edge at one of its loads,
 and scaling r by the tangent does not remove a tangent that jumps.
+
+Between a tangent and its jump r may be flat: a body within a key's clearance, or a bolted
+joint's face sliding at its friction bound μ·F_K, whatever the slide, until the shank bears on
+its hole past the clearance (a heel past the friction bound). Newton's step there is singular,
+or across the plateau by orders of magnitude where faces slide along different directions;
+`find` leaves the plateau on an anchor spring (`anchored`) from where `solve` stopped on it.
 """
 
 from __future__ import annotations
@@ -27,6 +33,8 @@ import numpy as np
 
 Landing = tuple[np.ndarray, np.ndarray]
 """Where a step lands, and r there."""
+Found = tuple[np.ndarray, np.ndarray, np.ndarray]
+"""A root x, r(x) there (within the tolerance), and J = ∂r/∂x there."""
 MAX_ITERATIONS = 20
 MAX_HALVINGS = 8
 """Backtracking: the Newton step is halved at most this often while |r| does not decrease."""
@@ -39,7 +47,7 @@ def solve(
     tolerance: Callable[[np.ndarray], np.ndarray],
     halvings: int = MAX_HALVINGS,
     fine: Callable[[np.ndarray], np.ndarray] | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+) -> Found | None:
     """x with |r(x)| ≤ tolerance(J) component-wise (J = jacobian(x) = ∂r/∂x), from x0,
     polished until a Newton step no longer reduces |r| (the rounding floor, where the
     least-squares solver also ends); returns (x, r(x), J at x), or None where Newton does not
@@ -58,17 +66,30 @@ def solve(
       the two pieces, and Newton with it crawls or cycles.
 
     Where each step of `jacobian` lands within half |r| neither is tried."""
+    return _solve(residual, jacobian, x0, tolerance, halvings, fine)[0]
+
+
+def _solve(
+    residual: Callable[[np.ndarray], np.ndarray],
+    jacobian: Callable[[np.ndarray], np.ndarray],
+    x0: np.ndarray,
+    tolerance: Callable[[np.ndarray], np.ndarray],
+    halvings: int,
+    fine: Callable[[np.ndarray], np.ndarray] | None,
+) -> tuple[Found | None, np.ndarray]:
+    """`solve`'s result, and the last x it took (x0 where it took none): where it did not get
+    there, the place it stopped (`find` leaves a plateau of r from there)."""
     x = np.array(x0, dtype=float)
     r = residual(x)
     for _ in range(MAX_ITERATIONS):
         if not np.isfinite(r).all():
-            return None
+            return None, x
         jac = jacobian(x)
         within = bool((np.abs(r) <= tolerance(jac)).all())
         try:
             step = np.linalg.solve(jac, -r)
         except np.linalg.LinAlgError:
-            return None
+            return None, x
         norm = float(np.linalg.norm(r))
         landed = x + step
         r_landed = residual(landed)
@@ -77,7 +98,7 @@ def solve(
             x, r = best
             continue
         if within:  # at the floor: polished
-            return x, r, jac
+            return (x, r, jac), x
         ahead = _ahead(residual, jacobian, fine, landed, r_landed, norm)
         if ahead is not None:
             x, r = ahead
@@ -89,10 +110,10 @@ def solve(
                 x, r = x + step, r_new
                 break
         else:
-            return None
+            return None, x
     # still decreasing at the floor (rounding lets |r| creep down): within is within
     jac = jacobian(x)
-    return (x, r, jac) if (np.abs(r) <= tolerance(jac)).all() else None
+    return ((x, r, jac) if (np.abs(r) <= tolerance(jac)).all() else None), x
 
 
 def central(
@@ -167,10 +188,27 @@ ANCHORS = 10.0 ** -np.arange(2.0, 17.0, 2.0)
 """The anchor springs of `anchored`, relative to the stiffness scale, softest last."""
 SINGULAR = 1e-9
 """Smallest singular value of an n × n J, relative to its largest and per unknown, below which
-J counts as singular (`anchored`; the model's check that the mounts hold every DOF)."""
+J counts as singular (the model's check that the mounts hold every DOF)."""
 ANCHORED_HALVINGS = 60
 """Step halvings of `anchored`'s solves: a step across a clearance overshoots into the far
 stiffer bearing by the ratio of the stiffnesses, and must be cut back to the edge."""
+
+
+def find(
+    residual: Callable[[np.ndarray], np.ndarray],
+    jacobian: Callable[[np.ndarray], np.ndarray],
+    x0: np.ndarray,
+    tolerance: Callable[[np.ndarray], np.ndarray],
+    fine: Callable[[np.ndarray], np.ndarray] | None = None,
+) -> Found | None:
+    """`solve` from x0, and where it does not get there, `anchored` from where it stopped: on
+    a plateau of r, where J is singular or nearly so (at x0 within a clearance; or where a step
+    landed with the friction faces sliding at their bounds, μ·F_K whatever the slide, before the
+    shanks bear on their holes: the Newton step there is singular, or, where the faces slide
+    along different directions, so long that it crosses the clearance by orders of magnitude).
+    None where neither gets there."""
+    found, stopped = _solve(residual, jacobian, x0, tolerance, MAX_HALVINGS, fine)
+    return found if found is not None else anchored(residual, jacobian, stopped, tolerance, fine)
 
 
 def anchored(
@@ -179,20 +217,19 @@ def anchored(
     x0: np.ndarray,
     tolerance: Callable[[np.ndarray], np.ndarray],
     fine: Callable[[np.ndarray], np.ndarray] | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """`solve` where J is singular at x0 and about it, as inside a clearance (a key's gap, where
-    the body is free until it bears): r(x) − ε·(x − x0) = 0, whose anchor spring ε keeps J
-    regular, for ε falling from 1e-2 to 1e-16 of |J|'s scale, each from the last solution;
-    then `solve` itself from there (bearing, J is regular again), each with `fine` (a key
-    bearing less than its stiffness times the difference step has its root within that step of
-    the clearance's edge). None where it does not get there (J at x0 is regular, 0 or not
-    finite: no clearance to leave; a step does not converge)."""
+) -> Found | None:
+    """`solve` where J is singular or nearly so at x0 and about it, as inside a clearance (a
+    key's gap, where the body is free until it bears) or along faces sliding at their friction
+    bounds (r then constant, not zero, until the shanks bear): r(x) − ε·(x − x0) = 0, whose
+    anchor spring ε keeps J regular, for ε falling from 1e-2 to 1e-16 of |J|'s scale, each
+    from the last solution; then `solve` itself from there (bearing, J is regular again), each
+    with `fine` (a key bearing less than its stiffness times the difference step has its root
+    within that step of the clearance's edge). Where J is regular about x0 the anchors only
+    lead `solve` to its root. None where it does not get there (J at x0 is 0 or not finite; a
+    step does not converge)."""
     jac0 = jacobian(x0)
     scale = float(np.abs(jac0).max()) if np.isfinite(jac0).all() else 0.0
     if not scale > 0.0:
-        return None
-    sigma = np.linalg.svd(jac0 / scale, compute_uv=False)
-    if sigma[-1] >= SINGULAR * sigma[0] * x0.shape[0]:
         return None
     x = np.array(x0, dtype=float)
     for eps in scale * ANCHORS:

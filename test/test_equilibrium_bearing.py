@@ -1,0 +1,199 @@
+"""The start's equilibrium with bolted joints in bearing and shear keys pressed, under a heel.
+
+A heel past the joints' friction bound slides their faces (μ·F_K, whatever the slide) until the
+shanks bear on their holes past the clearance: between the stuck face and the bearing shank the
+lateral stiffness is zero, a plateau of the residual that Newton's step cannot cross (singular,
+or orders of magnitude too long). Truths: the closed form of a block on four symmetric joints
+heeled along x (each joint's share by statics); the force and moment balance of the mounts
+against m·f for a body pitched and turned by the heel; a key pressed within and past its
+clearance beside a spring, by hand; and a start with no bearing past the friction bound refused
+with the mounts that slide named.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from kinds_helpers import kind_mount
+from physics_helpers import base_scene, mount
+
+from mount_twin.engine.restart import start_state
+from mount_twin.model.assemble import Model, assemble, initial_state
+from mount_twin.physics.dynamics import body_motion, evaluate
+from mount_twin.scene.loader import scene_from_dict
+
+G = 9.80665
+EPS = float(np.finfo(float).eps)
+MASS = 1000.0
+"""kg, the block on the joints."""
+CORNERS = [(0.4, 0.3), (-0.4, 0.3), (-0.4, -0.3), (0.4, -0.3)]
+"""m, the joints in the plane z = 0 of F."""
+K_S, K_P, F_V, MU, K_TAU, CLEAR = 7e8, 3.5e9, 1e3, 0.1, 1e9, 1e-3
+"""Each joint's bolt and clamp stiffness (N/m), preload (N), friction, face stick stiffness
+(N/m) and hole clearance (m): a light preload, so that a heel of 3–6 m/s² slides the faces."""
+
+
+def _joints(bearing: float) -> list[dict]:
+    """Four bolted joints at CORNERS, bolts along z of F, shanks bearing at `bearing` N/m."""
+    return [
+        kind_mount(
+            "bolted_joint",
+            f"j{i}",
+            (x, y, 0.0),
+            bolt_stiffness=K_S,
+            clamp_stiffness=K_P,
+            preload=F_V,
+            yield_force=1.5e5,
+            ultimate_force=2e5,
+            friction=MU,
+            shear_stiffness=K_TAU,
+            hole_clearance=CLEAR,
+            bearing_stiffness=bearing,
+        )
+        for i, (x, y) in enumerate(CORNERS)
+    ]
+
+
+def _block(bearing: float, cg: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> Model:
+    """MASS with its CG at `cg` (m, F) on `_joints(bearing)`."""
+    data = base_scene(MASS, list(cg), [100.0, 150.0, 200.0, 0.0, 0.0, 0.0], _joints(bearing))
+    return assemble(scene_from_dict(data, "<bearing equilibrium test>"))
+
+
+def _heel(lateral: float, azimuth: float = 0.0) -> np.ndarray:
+    """Specific force (m/s², F) of magnitude G heeled `lateral` m/s² toward `azimuth` rad."""
+    horizontal = lateral * np.array([math.cos(azimuth), math.sin(azimuth)])
+    return np.array([*horizontal, math.sqrt(G**2 - lateral**2)])
+
+
+def _wrenches(model: Model, y: np.ndarray) -> np.ndarray:
+    """(n_mounts, 6): each mount's force (N) and couple (N·m) on the body at y, in its axes
+    (here F's)."""
+    wrenches = np.empty((model.n_mounts, 6))
+    evaluate(y, model.arrays, model.new_scratch(), np.empty(10), wrenches)
+    return wrenches
+
+
+def _moment(model: Model, y: np.ndarray, wrenches: np.ndarray) -> np.ndarray:
+    """N·m about the CG, in F: the mounts' forces at their attachment points as the body is
+    turned at y (arms R·a), and their couples."""
+    s = model.new_scratch()
+    body_motion(y, model.arrays, s)
+    arms = np.array([mt.position for mt in model.scene.mounts]) - np.array(model.scene.body.cg)
+    return np.cross(arms @ s.rot.T, wrenches[:, :3]).sum(axis=0) + wrenches[:, 3:].sum(axis=0)
+
+
+def _bearing_floor(bearing: float) -> float:
+    """N: the force the start may leave unbalanced, the equilibrium's accepted residual (1e-9
+    of G over the mass) plus k_b times a position's rounding (64 ulp of 1 m)."""
+    return 1e-9 * G * MASS + 64.0 * EPS * 4.0 * bearing
+
+
+@pytest.mark.parametrize("bearing", [5e8, 1e10, 1e11, 1e12])
+@pytest.mark.parametrize("lateral", [3.0, 6.0])
+def test_a_heel_past_the_friction_bound_rests_on_the_shanks_at_the_closed_form(
+    bearing: float, lateral: float
+) -> None:
+    """CG in the joints' plane, joints symmetric: the heel translates the block without turning
+    it, each joint taking a quarter. Axially u = −m·f_z/(4(k_S + k_P)) (the joint closed), so
+    F_K = F_V − k_P·u; across, the face slides at μ·F_K (295 N and 254 N) under m·f_x/4 (750
+    N and 1500 N) and the shank bears the rest past the clearance: by hand X = −(c + (m·f_x/4
+    − μ·F_K)/k_b), 0.5–2.5e-6 m past it at 5e8 N/m, 5e-10 at 1e12. Before, Newton's first step
+    landed on the faces' plateau (friction at its bound, no lateral stiffness: a singular
+    Jacobian) and least squares stalled there: no equilibrium found at any k_b."""
+    model = _block(bearing)
+    f = _heel(lateral)
+    y = initial_state(model, f)
+    u = -MASS * f[2] / (4.0 * (K_S + K_P))
+    friction = MU * (F_V - K_P * u)
+    assert MASS * f[0] / 4.0 > friction  # the faces slide: the shanks bear
+    x = -(CLEAR + (MASS * f[0] / 4.0 - friction) / bearing)
+    allowed = _bearing_floor(bearing) / (4.0 * bearing)  # m: the force floor over the stiffness
+    np.testing.assert_allclose(y[0], x, rtol=0.0, atol=allowed)
+    np.testing.assert_allclose(y[2], u, rtol=1e-9)
+    assert abs(y[1]) <= 1e-15 and np.abs(y[3:6]).max() <= 1e-12
+    wrenches = _wrenches(model, y)
+    floor = _bearing_floor(bearing)
+    np.testing.assert_allclose(wrenches[:, :3].sum(axis=0), MASS * f, rtol=0.0, atol=floor)
+
+
+@pytest.mark.parametrize("bearing", [5e8])
+@pytest.mark.parametrize(
+    ("cg", "lateral", "azimuth"),
+    [
+        ((0.0, 0.0, 0.3), 3.0, math.pi / 4.0),  # pitched and rolled along the diagonal
+        ((0.0, 0.0, 0.5), 6.0, 0.0),  # pitched onto the front joints
+        ((0.1, 0.15, 0.4), 3.0, 0.6435),  # off-centre: turned about z too (yaw)
+    ],
+)
+def test_a_heel_onto_bolts_in_bearing_turning_the_body_balances_its_weight(
+    bearing: float, cg: tuple[float, float, float], lateral: float, azimuth: float
+) -> None:
+    """The CG above the joints' plane and off centre: the heel pitches, rolls and turns the
+    block, each joint bearing a share of its own (its clamp force, and so its friction bound,
+    moved by the pitch). Every joint's face slides (its lateral force, friction and bearing,
+    past μ·F_K with F_K from its own axial force: F_z = F_K − F_S = −(k_S + k_P)·u), and the
+    mounts' forces balance m·f and their moments about the CG vanish, to the equilibrium's
+    residual. Before, no equilibrium was found."""
+    model = _block(bearing, cg)
+    f = _heel(lateral, azimuth)
+    y = initial_state(model, f)
+    wrenches = _wrenches(model, y)
+    u = -wrenches[:, 2] / (K_S + K_P)
+    bound = MU * (F_V - K_P * u)
+    assert (np.hypot(wrenches[:, 0], wrenches[:, 1]) > bound).all()
+    floor = _bearing_floor(bearing)
+    np.testing.assert_allclose(wrenches[:, :3].sum(axis=0), MASS * f, rtol=0.0, atol=floor)
+    np.testing.assert_allclose(_moment(model, y, wrenches), 0.0, rtol=0.0, atol=floor)
+
+
+def test_a_restart_heeled_past_the_friction_bound_starts_on_the_shanks() -> None:
+    """A (re)start under a 3 m/s² heel (CG 0.3 m up) is its equilibrium on the bearing shanks,
+    with no fallback on nominal gravity (from which the body would slide onto them: a transient
+    not in the physics); before, it fell back, with the note that none held."""
+    model = _block(5e8, (0.0, 0.0, 0.3))
+    f = _heel(3.0)
+    start = start_state(model, model.nominal_state, _heel(0.0), f, np.zeros(3), None)
+    assert start.note is None and start.state is not None
+    wrenches = _wrenches(model, start.state)
+    np.testing.assert_allclose(
+        wrenches[:, :3].sum(axis=0), MASS * f, rtol=0.0, atol=_bearing_floor(5e8)
+    )
+
+
+KEY_MASS, SPRING_K, KEY_CLEAR = 10.0, 1e5, 5e-4
+"""`_keyed`: kg; N/m of the spring along x and z; m of the key's clearance along x."""
+
+
+def _keyed(key: float) -> Model:
+    """KEY_MASS on a spring (SPRING_K along x and z) beside a shear key along x, KEY_CLEAR
+    off, of `key` N/m; x and z free."""
+    spring = mount("spring", (0.0, 0.0, 0.0), (SPRING_K, 0.0, SPRING_K, 0.0, 0.0, 0.0))
+    stop = kind_mount("shear_key", "key", stiffness=[key, 0.0, 0.0], clearance=KEY_CLEAR)
+    data = base_scene(KEY_MASS, [0.0, 0.0, 0.0], [1.0, 1.0, 1.0, 0, 0, 0], [spring, stop])
+    data["dofs"] = ["x", "z"]
+    return assemble(scene_from_dict(data, "<key equilibrium test>"))
+
+
+@pytest.mark.parametrize("key", [1e7, 1e9, 1e11])
+@pytest.mark.parametrize("lateral", [2.0, 4.9, 5.1, 8.0])
+def test_a_key_pressed_within_and_past_its_clearance_is_the_closed_form(
+    key: float, lateral: float
+) -> None:
+    """The spring alone carries m·f_x while it moves the body less than the clearance (20 N
+    and 49 N: 2e-4 m and 4.9e-4 m of 5e-4): X = −m·f_x/k; past it (51 N, 80 N) the key bears
+    the rest, X = −(k_key·c + m·f_x)/(k + k_key), 1e-9–3e-5 m past the edge at 1e11–1e7 N/m.
+    Held these before."""
+    model = _keyed(key)
+    f = _heel(lateral)
+    y = initial_state(model, f)
+    load = KEY_MASS * f[0]
+    if load < SPRING_K * KEY_CLEAR:
+        x = -load / SPRING_K
+    else:
+        x = -(key * KEY_CLEAR + load) / (SPRING_K + key)
+    allowed = (1e-9 * G * KEY_MASS + 64.0 * EPS * key) / (SPRING_K + key)  # m
+    np.testing.assert_allclose(y[0], x, rtol=0.0, atol=allowed + 4.0 * EPS * abs(x))
+    np.testing.assert_allclose(y[1], -KEY_MASS * f[2] / SPRING_K, rtol=1e-12)
