@@ -227,6 +227,14 @@ accelerations far from it (a deep contact, a body far out in a clearance) grows 
 `newton.solve` takes this Jacobian's step only where it lands better than the compiled one's."""
 
 
+MAX_TURN = 0.1
+"""rad: the most one Newton step of the equilibrium turns the body about an axis (`newton`'s
+`limit`). The mounts' geometry is linear in the rotation only near the rest, a few thousandths
+of a radian: on the plateau of friction faces that slid, which hold yaw only by the friction's
+stiffness across its direction, μ·F_K/|e|, unlimited steps turned the body by radians and
+landed on far roots of the mounts' laws, the body turned by π or by whole turns."""
+
+
 def static_equilibrium(
     model: Model,
     y_guess: np.ndarray,
@@ -277,7 +285,8 @@ def static_equilibrium(
         return newton.central(accelerations, q, FINE_STEP)
 
     allowed_at = _allowed_residual(model, specific_force)
-    found = newton.find(accelerations, stiffness, q_guess, allowed_at, fine_stiffness)
+    turns = np.array([MAX_TURN if d in DOF_NAMES[3:] else np.inf for d in model.scene.dofs])
+    found = newton.find(accelerations, stiffness, q_guess, allowed_at, fine_stiffness, turns)
     if found is None:  # Newton did not get there: the robust solver says why
         from scipy.optimize import least_squares  # 0.2 s to import: only where Newton fails
 

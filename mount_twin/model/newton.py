@@ -47,6 +47,7 @@ def solve(
     tolerance: Callable[[np.ndarray], np.ndarray],
     halvings: int = MAX_HALVINGS,
     fine: Callable[[np.ndarray], np.ndarray] | None = None,
+    limit: np.ndarray | None = None,
 ) -> Found | None:
     """x with |r(x)| ≤ tolerance(J) component-wise (J = jacobian(x) = ∂r/∂x), from x0,
     polished until a Newton step no longer reduces |r| (the rounding floor, where the
@@ -65,8 +66,9 @@ def solve(
       contact bearing k_s·δ, δ under the step: 1 N on 1e9 N/m) has a Jacobian that averages
       the two pieces, and Newton with it crawls or cycles.
 
-    Where each step of `jacobian` lands within half |r| neither is tried."""
-    return _solve(residual, jacobian, x0, tolerance, halvings, fine)[0]
+    Where each step of `jacobian` lands within half |r| neither is tried. Each step is
+    shortened along itself where it would move an x_c by more than limit_c (`_limited`)."""
+    return _solve(residual, jacobian, x0, tolerance, halvings, fine, limit)[0]
 
 
 def _solve(
@@ -76,6 +78,7 @@ def _solve(
     tolerance: Callable[[np.ndarray], np.ndarray],
     halvings: int,
     fine: Callable[[np.ndarray], np.ndarray] | None,
+    limit: np.ndarray | None,
 ) -> tuple[Found | None, np.ndarray]:
     """`solve`'s result, and the last x it took (x0 where it took none): where it did not get
     there, the place it stopped (`find` leaves a plateau of r from there)."""
@@ -87,30 +90,27 @@ def _solve(
         jac = jacobian(x)
         within = bool((np.abs(r) <= tolerance(jac)).all())
         try:
-            step = np.linalg.solve(jac, -r)
+            step = _limited(np.linalg.solve(jac, -r), limit)
         except np.linalg.LinAlgError:
             return None, x
         norm = float(np.linalg.norm(r))
         landed = x + step
         r_landed = residual(landed)
-        best = (landed, r_landed) if within else _or_fine(residual, fine, x, r, (landed, r_landed))
+        landing = landed, r_landed
+        best = landing if within else _or_fine(residual, fine, x, r, landing, limit)
         if best is not None and np.linalg.norm(best[1]) < norm:
             x, r = best
             continue
         if within:  # at the floor: polished
             return (x, r, jac), x
-        ahead = _ahead(residual, jacobian, fine, landed, r_landed, norm)
+        ahead = _ahead(residual, jacobian, fine, landed, r_landed, norm, limit)
         if ahead is not None:
             x, r = ahead
             continue
-        for _ in range(halvings):
-            step *= 0.5
-            r_new = residual(x + step)
-            if np.linalg.norm(r_new) < norm:
-                x, r = x + step, r_new
-                break
-        else:
+        halved = _halved(residual, x, r, step, halvings)
+        if halved is None:
             return None, x
+        x, r = halved
     # still decreasing at the floor (rounding lets |r| creep down): within is within
     jac = jacobian(x)
     return ((x, r, jac) if (np.abs(r) <= tolerance(jac)).all() else None), x
@@ -136,15 +136,23 @@ def _ahead(
     x: np.ndarray,
     r: np.ndarray,
     norm: float,
+    limit: np.ndarray | None,
 ) -> Landing | None:
     """Newton steps from x (r there, |r| ≥ `norm`), each with the Jacobian where it starts, while
     |r| falls, to the first (x, r) with |r| below `norm`; None where |r| stops falling first
     (at most MAX_ITERATIONS steps). Each step as `solve`'s: with `fine` too where `jacobian`'s
     misses by half |r| (these steps end within a difference step of the kinks they crossed:
-    two contacts there, `jacobian` averaging both, crawled by a few % a step)."""
+    two contacts there, `jacobian` averaging both, crawled by a few % a step), and halved
+    while it does not decrease |r|, at most MAX_HALVINGS times: on the stiff piece the step of
+    its own tangent is a direction along which |r| falls, but a full one can cross further
+    kinks (shanks that bear past clearances of their own as the body turns)."""
     for _ in range(MAX_ITERATIONS):
-        found = _or_fine(residual, fine, x, r, _newton_step(residual, x, r, jacobian(x)))
-        if found is None or not np.linalg.norm(found[1]) < np.linalg.norm(r):
+        found = _or_fine(
+            residual, fine, x, r, _newton_step(residual, x, r, jacobian(x), limit), limit
+        )
+        if found is not None and not np.linalg.norm(found[1]) < np.linalg.norm(r):
+            found = _halved(residual, x, r, found[0] - x, MAX_HALVINGS)
+        if found is None:
             return None
         x, r = found
         if np.linalg.norm(r) < norm:
@@ -152,15 +160,46 @@ def _ahead(
     return None
 
 
-def _newton_step(
-    residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray, r: np.ndarray, jac: np.ndarray
+def _halved(
+    residual: Callable[[np.ndarray], np.ndarray],
+    x: np.ndarray,
+    r: np.ndarray,
+    step: np.ndarray,
+    halvings: int,
 ) -> Landing | None:
-    """(x + s, its r) for the Newton step s from x (r there) with `jac`; None where singular."""
+    """(x + s, its r) for the first s of `step`/2, `step`/4, ... (at most `halvings` of them)
+    where |r| is below |r(x)|; None where none is."""
+    norm = np.linalg.norm(r)
+    for _ in range(halvings):
+        step = step * 0.5
+        r_new = residual(x + step)
+        if np.linalg.norm(r_new) < norm:
+            return x + step, r_new
+    return None
+
+
+def _newton_step(
+    residual: Callable[[np.ndarray], np.ndarray],
+    x: np.ndarray,
+    r: np.ndarray,
+    jac: np.ndarray,
+    limit: np.ndarray | None,
+) -> Landing | None:
+    """(x + s, its r) for the Newton step s from x (r there) with `jac`, `_limited`; None where
+    singular."""
     try:
-        x_new = x - np.linalg.solve(jac, r)
+        x_new = x + _limited(np.linalg.solve(jac, -r), limit)
     except np.linalg.LinAlgError:
         return None
     return x_new, residual(x_new)
+
+
+def _limited(step: np.ndarray, limit: np.ndarray | None) -> np.ndarray:
+    """`step` shortened along itself so that no |step_c| passes limit_c (None: no limit)."""
+    if limit is None:
+        return step
+    over = float(np.max(np.abs(step) / limit))
+    return step / over if over > 1.0 else step
 
 
 def _or_fine(
@@ -169,6 +208,7 @@ def _or_fine(
     x: np.ndarray,
     r: np.ndarray,
     landed: Landing | None,
+    limit: np.ndarray | None,
 ) -> Landing | None:
     """`landed` (x + s, r there: a Newton step from x, r at x; None: singular), or, where it
     misses by half |r| or more, the step with `fine` where that lands at a smaller |r|."""
@@ -176,7 +216,7 @@ def _or_fine(
         landed is not None and np.linalg.norm(landed[1]) < 0.5 * np.linalg.norm(r)
     ):
         return landed
-    finer = _newton_step(residual, x, r, fine(x))
+    finer = _newton_step(residual, x, r, fine(x), limit)
     if landed is None or (
         finer is not None and np.linalg.norm(finer[1]) < np.linalg.norm(landed[1])
     ):
@@ -200,15 +240,18 @@ def find(
     x0: np.ndarray,
     tolerance: Callable[[np.ndarray], np.ndarray],
     fine: Callable[[np.ndarray], np.ndarray] | None = None,
+    limit: np.ndarray | None = None,
 ) -> Found | None:
     """`solve` from x0, and where it does not get there, `anchored` from where it stopped: on
     a plateau of r, where J is singular or nearly so (at x0 within a clearance; or where a step
     landed with the friction faces sliding at their bounds, μ·F_K whatever the slide, before the
     shanks bear on their holes: the Newton step there is singular, or, where the faces slide
     along different directions, so long that it crosses the clearance by orders of magnitude).
-    None where neither gets there."""
-    found, stopped = _solve(residual, jacobian, x0, tolerance, MAX_HALVINGS, fine)
-    return found if found is not None else anchored(residual, jacobian, stopped, tolerance, fine)
+    None where neither gets there. Each step `_limited` by `limit`."""
+    found, stopped = _solve(residual, jacobian, x0, tolerance, MAX_HALVINGS, fine, limit)
+    if found is not None:
+        return found
+    return anchored(residual, jacobian, stopped, tolerance, fine, limit)
 
 
 def anchored(
@@ -217,6 +260,7 @@ def anchored(
     x0: np.ndarray,
     tolerance: Callable[[np.ndarray], np.ndarray],
     fine: Callable[[np.ndarray], np.ndarray] | None = None,
+    limit: np.ndarray | None = None,
 ) -> Found | None:
     """`solve` where J is singular or nearly so at x0 and about it, as inside a clearance (a
     key's gap, where the body is free until it bears) or along faces sliding at their friction
@@ -238,11 +282,13 @@ def anchored(
             return residual(z) - e * (z - x0)
 
         pulled_fine = None if fine is None else _anchor(fine, eps)
-        found = solve(pulled, _anchor(jacobian, eps), x, tolerance, ANCHORED_HALVINGS, pulled_fine)
+        found = solve(
+            pulled, _anchor(jacobian, eps), x, tolerance, ANCHORED_HALVINGS, pulled_fine, limit
+        )
         if found is None:
             return None
         x = found[0]
-    return solve(residual, jacobian, x, tolerance, ANCHORED_HALVINGS, fine)
+    return solve(residual, jacobian, x, tolerance, ANCHORED_HALVINGS, fine, limit)
 
 
 def _anchor(
