@@ -20,6 +20,7 @@ from kinds_helpers import kind_mount
 from physics_helpers import base_scene, mount
 
 from mount_twin.engine.restart import start_state
+from mount_twin.errors import ModelError
 from mount_twin.model.assemble import Model, assemble, initial_state
 from mount_twin.physics.dynamics import body_motion, evaluate
 from mount_twin.scene.loader import scene_from_dict
@@ -187,6 +188,23 @@ def test_a_restart_heeled_past_the_friction_bound_starts_on_the_shanks() -> None
     np.testing.assert_allclose(
         wrenches[:, :3].sum(axis=0), MASS * f, rtol=0.0, atol=_bearing_floor(5e8)
     )
+
+
+def test_a_heel_past_the_friction_bound_without_bearing_names_the_sliding_joints() -> None:
+    """Shanks that never bear (k_b = 0): past the friction bound nothing holds the heel, and
+    the start is refused with the mounts that slide named (before: only the DOF, and "check
+    that the mounts hold every free DOF"), which a (re)start's note on its fallback to nominal
+    gravity repeats (before: none said why); within the bound the faces hold it, stuck: by hand
+    X = −m·f_x/(4·k_τ) (CG in the joints' plane: no pitch)."""
+    model = _block(0.0)
+    with pytest.raises(ModelError, match=r"joint_slipped at j0, j1, j2, j3"):
+        initial_state(model, _heel(3.0))
+    start = start_state(model, model.nominal_state, _heel(0.0), _heel(3.0), np.zeros(3), None)
+    assert start.note is not None and "joint_slipped at j0, j1, j2, j3" in start.note
+    assert "started from rest under nominal gravity" in start.note
+    f = _heel(0.5)
+    y = initial_state(model, f)
+    np.testing.assert_allclose(y[0], -MASS * f[0] / (4.0 * K_TAU), rtol=1e-6)
 
 
 KEY_MASS, SPRING_K, KEY_CLEAR = 10.0, 1e5, 5e-4

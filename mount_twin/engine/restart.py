@@ -67,11 +67,12 @@ def start_state(
     if init.gravity == "first_sample":
         try:
             return Start(initial_state(model, f0, w0, kept))
-        except ModelError:
-            # Restarting inside a shock: no equilibrium holds under that load.
+        except ModelError as e:
+            # Restarting inside a shock, or heeled past what the mounts hold: no equilibrium
+            # holds under that load (why, and at which mounts, in e).
             note = (
                 f"no static equilibrium under the start specific force "
-                f"{np.linalg.norm(f0):.4g} m/s²: started from rest under nominal gravity"
+                f"{np.linalg.norm(f0):.4g} m/s² ({e}): started from rest under nominal gravity"
             )
     if kept is None or not kept.any():
         return Start(nominal.copy(), note)

@@ -9,7 +9,7 @@ from functools import cached_property
 import numpy as np
 
 from mount_twin.errors import ModelError, require
-from mount_twin.kinds import CODES, KINDS, N_PAR, check_dispatch
+from mount_twin.kinds import CODES, KINDS, N_EVENTS, N_PAR, check_dispatch
 from mount_twin.model import newton
 from mount_twin.model.loading import VirginAxes, virgin_axes
 from mount_twin.model.ratings import start_ratings
@@ -19,6 +19,7 @@ from mount_twin.physics.dynamics import (
     ModelArrays,
     NonLinearMounts,
     Scratch,
+    mount_monitors,
     new_scratch,
     rhs,
 )
@@ -296,15 +297,37 @@ def static_equilibrium(
     allowed = allowed_at(jac)
     if not (np.abs(residual) <= allowed).all():  # NaN (a non-finite load) fails too
         worst = int(np.nanargmax(np.abs(residual) / allowed)) if np.isfinite(residual).all() else 0
+        at(q)
+        there = _conditions(model, y, s) if rhs(0.0, y, m, s, u, dydt) == OK else ""
         msg = (
             f"{model.scene.source}: no static equilibrium found (residual "
             f"{abs(residual[worst]):.3g} m/s² or rad/s² on {model.scene.dofs[worst]}, where "
-            f"rounding allows {allowed[worst]:.3g}): check that the mounts hold every free DOF"
+            f"rounding allows {allowed[worst]:.3g}){there}: check that the mounts hold every "
+            "free DOF under this load"
         )
         raise ModelError(msg)
     _check_restrained(model, jac)
     at(q)
     return y.copy()
+
+
+def _conditions(model: Model, y: np.ndarray, s: Scratch) -> str:
+    """'; where it ends, <event> at <mount>, ...' of the mounts' conditions holding at y (s
+    holding its body motion: the last `rhs` was at y), e.g. faces sliding at their friction
+    bounds (`joint_slipped`) with nothing bearing; '' where none holds."""
+    nl = model.arrays.nl
+    if nl is None:
+        return ""
+    g = np.zeros((nl.slot.shape[0], N_EVENTS))
+    mount_monitors(y.copy(), y, nl, s, g, np.zeros(nl.slot.shape[0]))
+    held: dict[str, list[str]] = {}
+    for row, slot in enumerate(model.nonlinear_slots):
+        mount = model.scene.mounts[slot]
+        for event, value in zip(KINDS[mount.kind].EVENTS, g[row], strict=False):
+            if value >= 0.0:
+                held.setdefault(event, []).append(mount.name)
+    said = [f"{event} at {', '.join(names)}" for event, names in held.items()]
+    return f"; where it ends, {'; '.join(said)}" if said else ""
 
 
 def _loaded_stiffness(
