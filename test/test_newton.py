@@ -38,14 +38,14 @@ def _kinked(stiff: float) -> Field:
     return lambda x: LOAD - K_SOFT * x - stiff * np.maximum(x - EDGE, 0.0)
 
 
-def _jacobians(residual: Field, tangent: Field, kind: str) -> tuple[Field, Field | None]:
+def _jacobians(residual: Field, tangent: Field, kind: str) -> tuple[Field, newton.Fine | None]:
     """(jacobian, fine) of `solve`: each piece's own `tangent`, or central differences of
     step COARSE with the FINE ones beside."""
     if kind == "tangent":
         return tangent, None
     return (
         lambda x: newton.central(residual, x, COARSE),
-        lambda x: newton.central(residual, x, FINE),
+        lambda x, reach: newton.central(residual, x, FINE, reach),
     )
 
 
@@ -167,12 +167,16 @@ def _clearance(stiff: float) -> Field:
     return lambda x: np.array([LOAD - stiff * max(x[0] - CLEARANCE, 0.0), 1.0 - x[1]])
 
 
-@pytest.mark.parametrize("stiff", [1e5, 1e7, 1e9])
+@pytest.mark.parametrize("stiff", [1e5, 1e7, 1e9, 1e10, 1e11])
 def test_a_clearance_is_left_for_the_key_at_the_closed_form(stiff: float) -> None:
     """Free within CLEARANCE (J singular at x0 = 0: `solve` declines), a key of stiffness K
-    past it: `anchored` rests on the key at x₀ = CLEARANCE + LOAD/K, 1e-5 to 1e-9 past the
+    past it: `anchored` rests on the key at x₀ = CLEARANCE + LOAD/K, 1e-5 to 1e-11 past the
     edge, x₁ = 1, with central differences (COARSE, and FINE beside): the COARSE step straddles
-    the edge from 1e9 on. Before, `anchored` took no finer Jacobian and did not get there."""
+    the edge from 1e9 on. Before, `anchored` took no finer Jacobian and did not get there.
+    From 1e10 on the first anchor's step lands 100 past the edge, where r is 1e12–1e13: the
+    step back with COARSE's or FINE's Jacobian, rounded by ε·|r|/step, landed inside the edge
+    again (6e-8 at 1e10), and neither Jacobian left it; the fine one there now steps a
+    hundredth of the way back (`newton.central`'s reach)."""
     residual = _clearance(stiff)
     jacobian, fine = _jacobians(residual, residual, "differences")
     x0 = np.zeros(2)

@@ -281,9 +281,9 @@ def static_equilibrium(
             return np.full((nf, nf), np.nan)
         return by_q[nf : 2 * nf].copy()
 
-    def fine_stiffness(q: np.ndarray) -> np.ndarray:
-        """∂(accelerations)/∂q by the finer step FINE_STEP."""
-        return newton.central(accelerations, q, FINE_STEP)
+    def fine_stiffness(q: np.ndarray, reach: np.ndarray) -> np.ndarray:
+        """∂(accelerations)/∂q by the finer step FINE_STEP (`newton.central`'s `reach`)."""
+        return newton.central(accelerations, q, FINE_STEP, reach)
 
     allowed_at = _allowed_residual(model, specific_force)
     turns = np.array([MAX_TURN if d in DOF_NAMES[3:] else np.inf for d in model.scene.dofs])

@@ -35,6 +35,9 @@ Landing = tuple[np.ndarray, np.ndarray]
 """Where a step lands, and r there."""
 Found = tuple[np.ndarray, np.ndarray, np.ndarray]
 """A root x, r(x) there (within the tolerance), and J = ∂r/∂x there."""
+Fine = Callable[[np.ndarray, np.ndarray], np.ndarray]
+"""∂r/∂x at x by a finer difference step, given how far the last Newton step from x reached
+along each x_c (`central`'s `reach`)."""
 MAX_ITERATIONS = 20
 MAX_HALVINGS = 8
 """Backtracking: the Newton step is halved at most this often while |r| does not decrease."""
@@ -46,7 +49,7 @@ def solve(
     x0: np.ndarray,
     tolerance: Callable[[np.ndarray], np.ndarray],
     halvings: int = MAX_HALVINGS,
-    fine: Callable[[np.ndarray], np.ndarray] | None = None,
+    fine: Fine | None = None,
     limit: np.ndarray | None = None,
 ) -> Found | None:
     """x with |r(x)| ≤ tolerance(J) component-wise (J = jacobian(x) = ∂r/∂x), from x0,
@@ -77,7 +80,7 @@ def _solve(
     x0: np.ndarray,
     tolerance: Callable[[np.ndarray], np.ndarray],
     halvings: int,
-    fine: Callable[[np.ndarray], np.ndarray] | None,
+    fine: Fine | None,
     limit: np.ndarray | None,
 ) -> tuple[Found | None, np.ndarray]:
     """`solve`'s result, and the last x it took (x0 where it took none): where it did not get
@@ -116,15 +119,32 @@ def _solve(
     return ((x, r, jac) if (np.abs(r) <= tolerance(jac)).all() else None), x
 
 
+REACH_SHARE = 1e-2
+"""`central`'s difference step along x_c, at least this share of the reach given there."""
+
+
 def central(
-    residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray, step: float
+    residual: Callable[[np.ndarray], np.ndarray],
+    x: np.ndarray,
+    step: float,
+    reach: np.ndarray | None = None,
 ) -> np.ndarray:
-    """∂r/∂x at x by central differences, of step `step`·max(1, |x_c|) along x_c."""
+    """∂r/∂x at x by central differences, of step `step`·max(1, |x_c|) along x_c, or
+    REACH_SHARE·|reach_c| where that is longer (reach: how far the last Newton step from x
+    went along each x_c). A step relative to x alone is good near a kink; far past one, where
+    r is a stiff contact's force on a deep penetration, its rounding (ε·|r|/step) grows with
+    the depth, and the Newton step back lands off by depth² times ε/step: inside the contact's
+    edge again, where the root is 1e-11 past it (a key 1e11 times the other stiffnesses). A step
+    of a share of the reach is far from that kink, which is where the step back goes, and
+    rounds |reach|/REACH_SHARE times less."""
     columns = []
     for c in range(x.shape[0]):
         up, down = x.copy(), x.copy()
-        up[c] += step * max(1.0, abs(x[c]))
-        down[c] -= step * max(1.0, abs(x[c]))
+        h = step * max(1.0, abs(x[c]))
+        if reach is not None:
+            h = max(h, REACH_SHARE * abs(reach[c]))
+        up[c] += h
+        down[c] -= h
         columns.append((residual(up) - residual(down)) / (up[c] - down[c]))
     return np.column_stack(columns)
 
@@ -132,7 +152,7 @@ def central(
 def _ahead(
     residual: Callable[[np.ndarray], np.ndarray],
     jacobian: Callable[[np.ndarray], np.ndarray],
-    fine: Callable[[np.ndarray], np.ndarray] | None,
+    fine: Fine | None,
     x: np.ndarray,
     r: np.ndarray,
     norm: float,
@@ -147,9 +167,8 @@ def _ahead(
     its own tangent is a direction along which |r| falls, but a full one can cross further
     kinks (shanks that bear past clearances of their own as the body turns)."""
     for _ in range(MAX_ITERATIONS):
-        found = _or_fine(
-            residual, fine, x, r, _newton_step(residual, x, r, jacobian(x), limit), limit
-        )
+        landed = _newton_step(residual, x, r, jacobian(x), limit)
+        found = _or_fine(residual, fine, x, r, landed, limit, norm)
         if found is not None and not np.linalg.norm(found[1]) < np.linalg.norm(r):
             found = _halved(residual, x, r, found[0] - x, MAX_HALVINGS)
         if found is None:
@@ -204,19 +223,23 @@ def _limited(step: np.ndarray, limit: np.ndarray | None) -> np.ndarray:
 
 def _or_fine(
     residual: Callable[[np.ndarray], np.ndarray],
-    fine: Callable[[np.ndarray], np.ndarray] | None,
+    fine: Fine | None,
     x: np.ndarray,
     r: np.ndarray,
     landed: Landing | None,
     limit: np.ndarray | None,
+    goal: float | None = None,
 ) -> Landing | None:
     """`landed` (x + s, r there: a Newton step from x, r at x; None: singular), or, where it
-    misses by half |r| or more, the step with `fine` where that lands at a smaller |r|."""
-    if fine is None or (
-        landed is not None and np.linalg.norm(landed[1]) < 0.5 * np.linalg.norm(r)
-    ):
+    misses by half |r| or more, the step with `fine` where that lands at a smaller |r|. With a
+    `goal` (`_ahead`'s: the |r| to get below, from where a step crossed onto a stiffer piece),
+    half the smaller of |r| and the goal, and `fine` with the reach of the step from x: there x
+    is far past a kink, |r| the stiff piece's far larger force."""
+    bar = float(np.linalg.norm(r)) if goal is None else min(float(np.linalg.norm(r)), goal)
+    if fine is None or (landed is not None and np.linalg.norm(landed[1]) < 0.5 * bar):
         return landed
-    finer = _newton_step(residual, x, r, fine(x), limit)
+    reach = np.zeros_like(x) if goal is None or landed is None else landed[0] - x
+    finer = _newton_step(residual, x, r, fine(x, reach), limit)
     if landed is None or (
         finer is not None and np.linalg.norm(finer[1]) < np.linalg.norm(landed[1])
     ):
@@ -239,7 +262,7 @@ def find(
     jacobian: Callable[[np.ndarray], np.ndarray],
     x0: np.ndarray,
     tolerance: Callable[[np.ndarray], np.ndarray],
-    fine: Callable[[np.ndarray], np.ndarray] | None = None,
+    fine: Fine | None = None,
     limit: np.ndarray | None = None,
 ) -> Found | None:
     """`solve` from x0, and where it does not get there, `anchored` from where it stopped: on
@@ -259,7 +282,7 @@ def anchored(
     jacobian: Callable[[np.ndarray], np.ndarray],
     x0: np.ndarray,
     tolerance: Callable[[np.ndarray], np.ndarray],
-    fine: Callable[[np.ndarray], np.ndarray] | None = None,
+    fine: Fine | None = None,
     limit: np.ndarray | None = None,
 ) -> Found | None:
     """`solve` where J is singular or nearly so at x0 and about it, as inside a clearance (a
@@ -291,9 +314,7 @@ def anchored(
     return solve(residual, jacobian, x, tolerance, ANCHORED_HALVINGS, fine, limit)
 
 
-def _anchor(
-    jacobian: Callable[[np.ndarray], np.ndarray], eps: float
-) -> Callable[[np.ndarray], np.ndarray]:
-    """The Jacobian of `anchored`'s r(x) − ε·(x − x0): jacobian(x) − ε·I (ε = `eps`, r's units
-    per x's)."""
-    return lambda z: jacobian(z) - eps * np.eye(z.shape[0])
+def _anchor(jacobian: Callable[..., np.ndarray], eps: float) -> Callable[..., np.ndarray]:
+    """The Jacobian of `anchored`'s r(x) − ε·(x − x0): jacobian(x, ...) − ε·I (ε = `eps`, r's
+    units per x's; the compiled Jacobian's or `fine`'s, with its reach)."""
+    return lambda z, *reach: jacobian(z, *reach) - eps * np.eye(z.shape[0])
