@@ -1,5 +1,6 @@
 """The body prediction's small kernels (`engine.sensor_reading`, `physics.rotations`), written
-for few numpy calls a live call, against numpy's own and the textbook formulas, bit for bit: the
+for few numpy calls a live call, against numpy's own and the textbook formulas, bit for bit, and
+the live stream's one row as Python floats against the whole window's numpy arithmetic: the
 live stream's output bytes must not depend on how they are computed."""
 
 from __future__ import annotations
@@ -7,8 +8,19 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mount_twin.engine.sensor_reading import Differences, _cross, _specific_force
-from mount_twin.physics.rotations import quaternion_matrices
+from mount_twin.engine.sensor_reading import (
+    Differences,
+    SensorGeometry,
+    _cross,
+    _specific_force,
+    predicted_reading,
+)
+from mount_twin.physics.rotations import (
+    quaternion_matrices,
+    quaternion_matrix_entries,
+    rpy_matrices,
+    rpy_matrix,
+)
 
 RNG = np.random.default_rng(20261128)
 
@@ -59,6 +71,8 @@ def test_the_rotation_matrices_are_the_textbook_formulas_bit_for_bit(k: int) -> 
         axis=1,
     ).reshape(k, 3, 3)
     assert quaternion_matrices(quat).tobytes() == expected.tobytes()
+    one_by_one = [quaternion_matrix_entries(q) for q in quat.tolist()]  # (the one-row path's)
+    assert np.array(one_by_one).reshape(k, 3, 3).tobytes() == expected.tobytes()
 
 
 @pytest.mark.parametrize("k", [1, 5, 300])
@@ -82,3 +96,36 @@ def test_the_mounts_forces_are_summed_in_scene_order_from_zero(k: int, n: int) -
                 total = total + (f[0] * q[0] + f[1] * q[1] + f[2] * q[2])
             expected[row, a] = total / mass
     assert _specific_force(axes, mass, wrenches).tobytes() == expected.tobytes()
+
+
+@pytest.mark.parametrize("k", [5, 6, 11])
+@pytest.mark.parametrize("turning", [True, False])
+def test_one_row_inside_a_window_is_the_windows_own_row_bit_for_bit(k: int, turning: bool) -> None:
+    # the live stream's wake-up of one message asks for one row with two on each side, which
+    # predicted_reading computes as Python floats on those five rows: at every such row of
+    # windows of uneven stamps, tilted axes and mounts, the row of the whole window's numpy
+    # arithmetic, to the bit (the foundation turning or not: zeros where the scene neglects it)
+    n = 8
+    geometry = SensorGeometry(
+        rpy_matrices([(a, b, c) for a, b, c in RNG.uniform(-3.0, 3.0, (n, 3)).tolist()]),
+        812.5,
+        RNG.normal(size=3),
+        rpy_matrix(*RNG.uniform(-3.0, 3.0, 3).tolist()),
+    )
+    for _ in range(20):
+        t = 1e3 + np.cumsum(RNG.uniform(1e-4, 2e-3, k))
+        quat = RNG.normal(size=(k, 4))
+        quat /= np.linalg.norm(quat, axis=1, keepdims=True)
+        pose = (RNG.normal(size=(k, 3)), quat)
+        wrenches = _rows(k * n, 6).reshape(k, n, 6)
+        rate = _rows(k) * 1e-3 if turning else np.zeros((k, 3))
+        whole = predicted_reading(geometry, t, pose, wrenches, rate)
+        for row in range(2, k - 2):
+            one = predicted_reading(geometry, t, pose, wrenches, rate, slice(row, row + 1))
+            for got, expected in zip(one, whole, strict=True):
+                assert got.shape == (1, 3)
+                assert got.tobytes() == expected[row : row + 1].tobytes(), (k, row)
+        for rows in (slice(0, 1), slice(k - 2, k - 1), slice(2, None), slice(1, k - 1)):
+            some = predicted_reading(geometry, t, pose, wrenches, rate, rows)
+            for got, expected in zip(some, whole, strict=True):
+                assert got.tobytes() == expected[rows].tobytes()

@@ -114,9 +114,9 @@ class BodyCheck:
 
         geometry = SensorGeometry.of(scene, sensor)
 
-        def predict(rows: TwinRows) -> np.ndarray:
+        def predict(rows: TwinRows, kept: slice) -> np.ndarray:
             pose = (rows.pose[:, pose_row.POSITION_COLS], rows.pose[:, pose_row.QUATERNION_COLS])
-            f, w = predicted_reading(geometry, rows.t, pose, rows.wrenches, rows.rate)
+            f, w = predicted_reading(geometry, rows.t, pose, rows.wrenches, rows.rate, kept)
             return np.concatenate([f, w], axis=1)
 
         self._lead = Lead(predict)

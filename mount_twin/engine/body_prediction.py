@@ -49,7 +49,8 @@ class TwinRows:
         )
 
 
-Predict = Callable[[TwinRows], np.ndarray]
+Predict = Callable[[TwinRows, slice], np.ndarray]
+"""The (k, 6) predictions of the rows a slice selects of a window of rows."""
 _NO_PREDICTION = (np.zeros(0), np.zeros((0, 6)))
 
 
@@ -73,9 +74,9 @@ class Lead:
             self._held = window
             return _NO_PREDICTION
         first = 0 if self._at_start else 2
-        values = self._predict(window)
+        values = self._predict(window, slice(first, n - 2))
         self._held, self._at_start = window.part(n - self.HELD, n), False
-        return window.t[first : n - 2], values[first : n - 2]
+        return window.t[first : n - 2], values
 
     def finish(self) -> tuple[np.ndarray, np.ndarray]:
         """The rows still held, the last by one-sided differences (fewer than 3 rows in the
@@ -86,4 +87,4 @@ class Lead:
         self._at_start = True
         if window is None or len(window) < 3:
             return _NO_PREDICTION
-        return window.t[first:], self._predict(window)[first:]
+        return window.t[first:], self._predict(window, slice(first, None))

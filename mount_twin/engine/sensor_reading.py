@@ -22,7 +22,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from mount_twin.engine.reading_screen import rotated
-from mount_twin.physics.rotations import quaternion_matrices, rpy_matrices, rpy_matrix
+from mount_twin.physics.rotations import (
+    quaternion_matrices,
+    quaternion_matrix_entries,
+    rpy_matrices,
+    rpy_matrix,
+)
 from mount_twin.scene.description import BodySensor, Scene
 
 
@@ -35,6 +40,8 @@ def _products(m: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 _NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])
 """Each axis's next and the one after it (x → y, z; y → z, x; z → x, y)."""
+_PAIRS = tuple(zip(_NEXT.tolist(), _AFTER.tolist(), strict=True))
+"""The same, as (next, after) of each axis."""
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -153,12 +160,22 @@ def predicted_reading(
     pose: tuple[np.ndarray, np.ndarray],
     wrenches: np.ndarray,
     foundation_rate: np.ndarray,
+    rows: slice = slice(None),
 ) -> tuple[np.ndarray, np.ndarray]:
     """(specific force m/s², angular rate rad/s), each (k, 3) in the sensor's axes, of the body
     sensor (`geometry`) at k rows: `stamps` (s), `pose` (CG positions (k, 3) in F, quaternions
     (k, 4) x, y, z, w of body → F), (k, n, 6) mount `wrenches`, and the foundation's rate
-    (k, 3), rad/s in F (zeros where the scene neglects it). Row by row the same bits whatever
-    rows come with it, but for the differences' neighbours."""
+    (k, 3), rad/s in F (zeros where the scene neglects it); of those `rows` of them (a slice,
+    step 1; all by default). Row by row the same bits whatever rows come with it, but for the
+    differences' neighbours, and whichever are asked for: one row with two on each side (the
+    live stream's wake-up of one message, `body_prediction.Lead`) is `_inner_row`'s, the same
+    arithmetic on the five rows it reads."""
+    start, stop, _ = rows.indices(stamps.shape[0])
+    if stop - start == 1 and start >= 2 and stop + 2 <= stamps.shape[0]:
+        near, around = slice(start - 2, stop + 2), slice(start - 1, stop + 1)
+        return _inner_row(
+            geometry, stamps[near], pose[1][near], wrenches[start:stop], foundation_rate[around]
+        )
     rotation = quaternion_matrices(pose[1])
     f_cg = _specific_force(geometry.mount_axes, geometry.mass, wrenches)
     d_dt = Differences(stamps)
@@ -169,6 +186,88 @@ def predicted_reading(
     to_body = np.swapaxes(rotation, 1, 2)  # R_kᵀ: F → B
     to_sensor = geometry.axes.T  # Rₛᵀ: B → the sensor's axes
     return (
-        rotated(_products(to_body, f_p), to_sensor),
-        rotated(_products(to_body, omega), to_sensor),
+        rotated(_products(to_body, f_p), to_sensor)[rows],
+        rotated(_products(to_body, omega), to_sensor)[rows],
     )
+
+
+# One row as Python floats: each function below is the scalar form of the numpy kernel it
+# names, the same IEEE operations in the same order (so the same bits: `predicted_reading`
+# holds them to each other, test_sensor_reading_bits.py), at a third of its numpy calls' cost
+# on the live stream's one row. Vectors are lists of 3 floats, matrices of 9 (row by row).
+Vector = list[float]
+
+
+def _inner_row(
+    geometry: SensorGeometry,
+    stamps: np.ndarray,
+    quaternions: np.ndarray,
+    wrenches: np.ndarray,
+    foundation_rate: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """`predicted_reading` of the middle row of five (`stamps` (5,) s, `quaternions` (5, 4);
+    its (1, n, 6) `wrenches`; the (3, 3) foundation's rate of it and the rows on either side),
+    each (1, 3): the rates at it and beside it by central differences, as the five rows'
+    `Differences` take them."""
+    t = stamps.tolist()
+    rotation = [quaternion_matrix_entries(q) for q in quaternions.tolist()]
+    rate = foundation_rate.tolist()
+    weights = [_central_weights(t, k) for k in (1, 2, 3)]
+    omega = [
+        _added(
+            rate[k - 1],
+            _relative_rate(_differenced(weights[k - 1], rotation[k - 1 : k + 2]), rotation[k]),
+        )
+        for k in (1, 2, 3)
+    ]
+    middle, turn = omega[1], rotation[2]
+    alpha = _added(_differenced(weights[1], omega), _crossed(rate[1], middle))
+    r = _times(turn, geometry.arm.tolist())
+    f_cg = _specific_force(geometry.mount_axes, geometry.mass, wrenches)[0].tolist()
+    f_p = _added(_added(f_cg, _crossed(alpha, r)), _crossed(middle, _crossed(middle, r)))
+    axes = geometry.axes.ravel().tolist()  # Rₛ: to its transpose, as `rotated` by Rₛᵀ
+    return (
+        np.array([_times_transposed(axes, _times_transposed(turn, f_p))]),
+        np.array([_times_transposed(axes, _times_transposed(turn, middle))]),
+    )
+
+
+def _central_weights(t: list[float], k: int) -> tuple[float, float, float]:
+    """`Differences`' weights (s⁻¹) of row k inside stamps `t` (s)."""
+    h1, h2 = t[k] - t[k - 1], t[k + 1] - t[k]
+    s = h1 + h2
+    return -h2 / (h1 * s), (h2 - h1) / (h1 * h2), h1 / (h2 * s)
+
+
+def _differenced(w: tuple[float, float, float], f: list[list[float]]) -> list[float]:
+    """`Differences.of` at a row inside: weights `w` on the three rows `f` around it."""
+    return [w[0] * a + w[1] * b + w[2] * c for a, b, c in zip(*f, strict=True)]
+
+
+def _relative_rate(dr: list[float], rotation: list[float]) -> Vector:
+    """`relative_rate` of one row: Ṙ `dr` and R `rotation`."""
+
+    def w(i: int, j: int) -> float:  # (Ṙ Rᵀ)_ij
+        row, column = dr[3 * i : 3 * i + 3], rotation[3 * j : 3 * j + 3]
+        return row[0] * column[0] + row[1] * column[1] + row[2] * column[2]
+
+    return [0.5 * (w(a, n) - w(n, a)) for n, a in _PAIRS]
+
+
+def _added(a: Vector, b: Vector) -> Vector:
+    return [x + y for x, y in zip(a, b, strict=True)]
+
+
+def _crossed(a: Vector, b: Vector) -> Vector:
+    """`_cross` of one row."""
+    return [a[n] * b[m] - a[m] * b[n] for n, m in _PAIRS]
+
+
+def _times(m: list[float], v: Vector) -> Vector:
+    """`_products` of one row: m v."""
+    return [m[3 * i] * v[0] + m[3 * i + 1] * v[1] + m[3 * i + 2] * v[2] for i in range(3)]
+
+
+def _times_transposed(m: list[float], v: Vector) -> Vector:
+    """`_products` by the transpose (and `rotated`) of one row: mᵀ v."""
+    return [m[i] * v[0] + m[3 + i] * v[1] + m[6 + i] * v[2] for i in range(3)]

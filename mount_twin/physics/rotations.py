@@ -101,3 +101,12 @@ def quaternion_matrices(quat: np.ndarray) -> np.ndarray:
     twice = 2 * (products.take(_FIRST, 1) + _SIGN * products.take(_SECOND, 1))
     twice[:, _DIAGONAL] = 1 - twice[:, _DIAGONAL]
     return twice.reshape(k, 3, 3)
+
+
+def quaternion_matrix_entries(quat: list[float]) -> list[float]:
+    """The rotation matrix's 9 entries, row by row, of one unit quaternion (x, y, z, w) as
+    Python floats: `quaternion_matrices`' arithmetic (the same bits), at a fraction of its
+    numpy calls' cost for one."""
+    m = [2.0 * (quat[i] * quat[j] + s * (quat[k] * quat[n])) for (i, j), (k, n), s in _ENTRIES]
+    m[0], m[4], m[8] = 1.0 - m[0], 1.0 - m[4], 1.0 - m[8]
+    return m
