@@ -254,9 +254,11 @@ class BodyCheck:
         the windows they close."""
         compared = taken.compared()
         self.counts["compared"] += int(compared.ns.shape[0])
-        for field, given in zip(FIELDS, compared.present.T, strict=True):
-            self.counts[f"compared_{field}"] += int(given.sum())
+        present = compared.present
+        for field, given in zip(FIELDS, present.sum(axis=0).tolist(), strict=True):
+            self.counts[f"compared_{field}"] += given
         residual = compared.measured - compared.predicted
-        residual[~np.repeat(compared.present, 3, axis=1)] = np.nan
+        if not present.all():
+            residual[~np.repeat(present, 3, axis=1)] = np.nan
         reports = self._windows.add(taken, residual)
         return BodyComparison(compared.ns, compared.predicted, residual, compared.present, reports)

@@ -4,6 +4,7 @@ compared in each; at the end, a WARN for those no window said."""
 
 from __future__ import annotations
 
+import math
 from collections import Counter
 from dataclasses import dataclass
 from itertools import pairwise
@@ -22,6 +23,9 @@ from mount_twin.engine.body_counts import NOT_COMPARED, RESETS, WARNED_AT_END, n
 from mount_twin.engine.body_matching import Taken
 from mount_twin.scene.description import BodySensor
 
+_Chunk = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+"""Compared samples of a window: stamps ns, seconds, measured, residual, readings provided."""
+
 
 @dataclass
 class _Window:
@@ -29,7 +33,7 @@ class _Window:
     residual, readings provided), and the body messages not compared in it, by reason."""
 
     index: int
-    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
+    chunks: list[_Chunk]
     problems: Counter[str]
 
 
@@ -78,6 +82,13 @@ class Windows:
     def add(self, taken: Taken, residual: np.ndarray) -> list[tuple[int, HealthStatus]]:
         """Reports (stamp ns, status) of the windows these samples (all taken out of the
         matcher, the compared ones' `residual` beside them) close."""
+        origin = self._origin
+        one = len(taken) == 1 and taken.why[0] == "" and taken.run[0] == self._run
+        if one and origin is not None:  # the live stream's one sample compared: no arrays
+            # `_add_run`'s window index of it, as Python floats (the same bits)
+            index = math.floor((float(taken.t[0]) - origin) / self._sensor.window_s)
+            chunk = (taken.ns, taken.t, taken.measured, residual, taken.present)
+            return self._into(max(index, 0), int(taken.place[0]), [], chunk)
         said = Counter(taken.why.tolist())
         for key in LOOSE:  # those at a place: said there
             self._loose_reported[key] += said[key]
@@ -112,30 +123,46 @@ class Windows:
         k = 0  # into the compared ones
         cuts = np.flatnonzero(index[1:] != index[:-1]) + 1  # (the windows rise: stamps do)
         for start, stop in pairwise([0, *cuts.tolist(), index.shape[0]]):
-            i = int(index[start])
-            if self._window is not None and self._window.index != i:
-                reports += self._close()
-            if self._window is None:
-                self._window, self._carried = _Window(i, [], self._carried), Counter()
-            window = self._window
             these = compared[start:stop]
             n = int(these.sum())
             part: slice | np.ndarray = slice(start, stop)
+            problems: list[str] = []
             if n < stop - start:  # (all compared: the rows themselves, no copy)
-                window.problems.update(taken.why[start:stop][~these].tolist())
+                problems = taken.why[start:stop][~these].tolist()
                 part = np.flatnonzero(these) + start
-            self._attribute(int(taken.place[stop - 1]), window.problems)
+            chunk = None
             if n:
-                window.chunks.append(
-                    (
-                        taken.ns[part],
-                        taken.t[part],
-                        taken.measured[part],
-                        residual[k : k + n],
-                        taken.present[part],
-                    )
+                chunk = (
+                    taken.ns[part],
+                    taken.t[part],
+                    taken.measured[part],
+                    residual[k : k + n],
+                    taken.present[part],
                 )
                 k += n
+            reports += self._into(int(index[start]), int(taken.place[stop - 1]), problems, chunk)
+        return reports
+
+    def _into(
+        self,
+        index: int,
+        place: int,
+        problems: list[str],
+        chunk: _Chunk | None,
+    ) -> list[tuple[int, HealthStatus]]:
+        """Samples of the run in window `index` (the last at `place` among the accepted ones):
+        the reasons of those not compared, and the compared ones' `chunk` (None: none); the
+        reports of the window they close."""
+        reports = []
+        if self._window is not None and self._window.index != index:
+            reports += self._close()
+        if self._window is None:
+            self._window, self._carried = _Window(index, [], self._carried), Counter()
+        window = self._window
+        window.problems.update(problems)
+        self._attribute(place, window.problems)
+        if chunk is not None:
+            window.chunks.append(chunk)
         return reports
 
     def _attribute(self, place: int, into: Counter[str]) -> None:
