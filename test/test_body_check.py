@@ -412,6 +412,67 @@ def test_messages_not_compared_are_counted_in_their_own_window_however_interleav
     assert all(v["body_rejected_undecodable"] == "0" for v in firsts)
 
 
+def test_the_live_one_message_paths_are_the_bulk_ones_on_a_hostile_stream() -> None:
+    """A wake-up of one message takes paths of its own, as Python floats on its one row and
+    its one sample (`sensor_reading.predicted_reading` of one row, `Matcher.take` and
+    `Windows.add` of one sample): fed a message at a time (the deck's first, or the body's, or
+    the body's 0.75 s behind), every body message and window report is the same bytes as fed
+    in chunks or whole (the arrays' paths), with the same counts, through a gap in the deck
+    (samples in_gap), both streams' stamps jumping back, a body recorder 1.3 ms late (each
+    run's first sample before the twin, the others between rows) tilted on the body, and body
+    messages not finite, of another frame_id, stamped back and not CDR."""
+    scene = _pump(frame_id="pump_imu", lag_s=0.0013, orientation_rpy=(0.1, -0.2, 0.3))
+    deck = _deck(12.0)
+    ns = _stamps(deck) - np.where(deck.t >= 8.0, 6_000_000_000, 0)  # back 6 s at 8 s
+    silent = (deck.t >= 3.0) & (deck.t < 3.7)  # longer than input.max_gap_s
+    deck_steps = [[r] for _, r in imu_messages(ns, deck.accel, deck.gyro, "deck_imu")]
+    values = np.random.default_rng(8).normal(0.0, 1.0, (ns.shape[0], 6))
+    values[300:303, 4] = np.nan
+    body_ns = ns - 1_200_000  # the motion 2.5 ms before each deck stamp: between rows
+    body_steps = [[r] for r in _body_raws(body_ns, values, "pump_imu")]
+    for i in (500, 501, 1900):
+        body_steps[i] = _body_raws(body_ns[i : i + 1], values[i : i + 1], "other_imu")
+    body_steps[700].append(body_steps[690][0])  # stamped back
+    body_steps[1000].insert(0, b"\x00\x01garbage")
+    deck_steps = [[] if quiet else step for step, quiet in zip(deck_steps, silent, strict=True)]
+    deck_raws = [r for step in deck_steps for r in step]
+    body_raws = [r for step in body_steps for r in step]
+
+    def stepwise(body_first: bool, behind: int = 0) -> tuple[Messages, TwinStream]:
+        """Step by step, each message alone, a step's body messages before or after its deck's,
+        those of `behind` steps before (past the gap: its samples decided one by one)."""
+        stream, out = TwinStream(scene), []
+        for k in range(len(deck_steps) + behind):
+            feeds = [(stream.process, [r]) for r in deck_steps[k]] if k < len(deck_steps) else []
+            body = (
+                [(stream.process_body, [r]) for r in body_steps[k - behind]] if k >= behind else []
+            )
+            for feed, raws in body + feeds if body_first else feeds + body:
+                out += feed(raws)
+        return out + stream.finish(), stream
+
+    chunks, whole = TwinStream(scene), TwinStream(scene)
+    runs = [
+        stepwise(body_first=False),
+        stepwise(body_first=True),
+        stepwise(body_first=False, behind=150),
+        (_chunked(scene, deck_raws, body_raws, 7, False, chunks), chunks),
+        (whole.process(deck_raws) + whole.process_body(body_raws) + whole.finish(), whole),
+    ]
+    topics = (BODY_PREDICTED_TOPIC, BODY_RESIDUAL_TOPIC)
+    body_msgs = [[m for m in run if m[0] in topics] for run, _ in runs]
+    windows = [sorted(_windows(run), key=lambda w: w[1]) for run, _ in runs]
+    counts = [dict(stream.body.counts) for _, stream in runs if stream.body is not None]
+    assert all(b == body_msgs[0] for b in body_msgs[1:])
+    assert all(w == windows[0] for w in windows[1:]) and len(windows[0]) >= 2
+    assert all(c == counts[0] for c in counts[1:])
+    expected = {"rejected_nonfinite": 3, "rejected_wrong_frame_id": 3, "rejected_stamp_back": 1}
+    assert {k: counts[0][k] for k in expected} == expected
+    assert counts[0]["rejected_undecodable"] == 1 and counts[0]["reset_stamp_jumped_back"] == 1
+    assert counts[0]["in_gap"] >= 130 and counts[0]["before_twin"] == 2
+    assert len(body_msgs[0]) == 2 * counts[0]["compared"] > 2 * 2200
+
+
 def test_a_deck_sample_rejected_for_inf_warns_nothing_with_a_body_sensor() -> None:
     """Its gyro's inf times the sensor rotation's zeros printed numpy's RuntimeWarning
     ("invalid value encountered in multiply") on every replay of such a record."""
