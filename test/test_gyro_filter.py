@@ -58,6 +58,17 @@ def test_gain_is_flat_in_the_passband_and_stops_in_the_stopband(rate_hz: float) 
     assert half[0] + 2.0 * half[1:].sum() == pytest.approx(1.0, abs=1e-14), "DC passes exactly"
 
 
+def test_each_design_has_taps_of_its_own() -> None:
+    """The taps are designed once a process per (rate, bands): a caller writing into its
+    design's taps changes no later design, and each can be filtered with (`fir_rows` takes
+    writable arrays only)."""
+    first = design(4000.0, PASSBAND_HZ, STOPBAND_HZ).half
+    first[:] = 0.0
+    later = design(4000.0, PASSBAND_HZ, STOPBAND_HZ).half
+    assert later[0] + 2.0 * later[1:].sum() == pytest.approx(1.0, abs=1e-14), "DC passes"
+    fir_rows(np.ones((3, 2 * later.shape[0] - 1)), later, np.empty((3, 1)))
+
+
 @pytest.mark.parametrize(("m", "beta"), [(1, 5.0), (2, 5.0), (77, 9.4), (751, 9.4), (41, 0.0)])
 def test_the_window_is_numpys_kaiser(m: int, beta: float) -> None:
     """The power-series window against numpy's Chebyshev-series I₀ (its independent code)."""
