@@ -42,10 +42,11 @@ def at_rest(gathered: np.ndarray, tolerance: float) -> tuple[int, float]:
     parts = np.array_split(gathered, min(REST_BLOCKS, gathered.shape[0]))
     taken, total = parts[0].shape[0], parts[0].sum(axis=0)
     for part in parts[1:]:
-        off = float(np.linalg.norm(part.mean(axis=0) - total / taken))
+        part_sum = part.sum(axis=0)  # its mean is this over its count: np.mean's own reduction
+        off = float(np.linalg.norm(part_sum / part.shape[0] - total / taken))
         if off > tolerance:
             return taken, off
-        taken, total = taken + part.shape[0], total + part.sum(axis=0)
+        taken, total = taken + part.shape[0], total + part_sum
     return taken, 0.0
 
 
