@@ -331,7 +331,8 @@ class CoreDriver:
             self._health.add_estimate(self.estimator.figures)
             self.estimator.figures[:] = 0.0
         if done > 0:
-            self.last = (float(segment.t[done]), segment.f[done], segment.w[done])
+            # copies: the segment's rows may be the push's frame, which a later push reuses
+            self.last = (float(segment.t[done]), segment.f[done].copy(), segment.w[done].copy())
             if self._counter[0]:
                 self._tail_pose[:] = buf.pose[done]
         peaks = buf.wrench_abs_max, float(buf.cos_tilt_min[0])

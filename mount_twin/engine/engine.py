@@ -54,10 +54,33 @@ def _segment(
         msg = "a run continues from the last sample done, and the twin has none (not started)"
         raise RuntimeError(msg)
     n = len(index) + 1
+    before = int(index[0]) - 1
+    if int(index[-1]) - before == n - 1 and _holds(last, frame, before):
+        rows = slice(before, before + n)  # consecutive rows after it: the frame's own
+        return Samples(frame.stamps[rows], frame.f[rows], frame.w[rows])
     t, f, w = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
     t[0], f[0], w[0] = last
     t[1:], f[1:], w[1:] = frame.stamps[index], frame.f[index], frame.w[index]
     return Samples(t, f, w)
+
+
+def _holds(last: tuple[float, np.ndarray, np.ndarray], frame: Frame, row: int) -> bool:
+    """Whether `frame`'s row `row` is the `last` sample done, to the bit, in arrays the core
+    takes as they are (float64, C-contiguous, writable): a run of the rows after it then
+    needs no copy (the 5000 rows of a 5 s record at 1 kHz: 0.1 ms)."""
+    if row < 0:
+        return False
+    arrays = (frame.stamps, frame.f, frame.w)
+    for a in arrays:
+        flags = a.flags
+        if a.dtype != np.float64 or not (flags.c_contiguous and flags.writeable):
+            return False
+    stamp, f, w = last
+    return (
+        frame.stamps[row : row + 1].tobytes() == np.float64(stamp).tobytes()
+        and frame.f[row].tobytes() == f.tobytes()
+        and frame.w[row].tobytes() == w.tobytes()
+    )
 
 
 class TwinEngine:
