@@ -117,6 +117,16 @@ _NO_ROWS = np.zeros(0, dtype=np.int64)
 """No frame rows (a `Run` with none ahead)."""
 
 
+def _consecutive(rows: np.ndarray) -> slice | np.ndarray:
+    """Frame rows (increasing) as a slice where they are consecutive, as they are wherever
+    every sample is accepted: a view rather than a gather or scatter of their rows (29 µs of
+    a 2500-row run)."""
+    n = rows.shape[0]
+    if n and int(rows[-1]) - int(rows[0]) == n - 1:
+        return slice(int(rows[0]), int(rows[0]) + n)
+    return rows
+
+
 @dataclass
 class Run:
     """Accepted samples to integrate in one go (rows of a Frame); `restart`: the first one
@@ -360,7 +370,7 @@ class GyroDelay:
             self._restart = True
             self._raw.clear()
         self._pending = np.concatenate([self._pending, rows])
-        self._raw.append(frame.w[rows])
+        self._raw.append(frame.w[_consecutive(rows)])
         self._design(frame, DESIGN_SAMPLES)
         if self.design is not None:
             ready.extend(self._release(self._releasable(frame), frame, end=False))
@@ -411,7 +421,7 @@ class GyroDelay:
         before = self._raw.size - pending.shape[0]
         out = self._raw.filtered((self.design or RAW).half, n, before, end=end)
         rows = pending[:n]
-        frame.w[rows] = out.T
+        frame.w[_consecutive(rows)] = out.T
         self._pending = pending[n:]
         released = Run(rows, self._restart, self._pending if self._restart else _NO_ROWS)
         self._restart = False
