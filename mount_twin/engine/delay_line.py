@@ -28,6 +28,7 @@ samples are gone (`Extent`).
 from __future__ import annotations
 
 import math
+import statistics
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -403,7 +404,7 @@ class GyroDelay:
         if self.design is not None or self._pending.shape[0] < samples:
             return
         stamps = frame.stamps[self._pending[:DESIGN_SAMPLES]]
-        rate_hz = 1.0 / float(np.median(np.diff(stamps)))
+        rate_hz = 1.0 / statistics.median(np.diff(stamps).tolist())  # np.median's number
         if rate_hz > MAX_RATE_HZ:
             note = (
                 f"sample rate {rate_hz:.4g} Hz is above {MAX_RATE_HZ:g} Hz: the gyro is taken raw"
