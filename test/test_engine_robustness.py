@@ -313,6 +313,28 @@ def test_outputs_do_not_depend_on_how_the_samples_are_batched(pieces: list[int])
     )
 
 
+def test_a_push_of_read_only_or_strided_arrays_gives_the_bits_of_its_own_copies() -> None:
+    """A decoder may push views of its buffers, read-only or strided: the engine reads them
+    as it reads arrays of its own (the compiled loop takes writable, contiguous ones only)."""
+    full = ship_batch(0.6)
+    reference, _ = push_all(engine_for(), [full])
+    arrays = full.stamps.copy(), full.accel.copy(), full.gyro.copy()
+    for a in arrays:
+        a.flags.writeable = False
+    read_only = SampleBatch(*arrays, full.frame_ids)
+    strided = SampleBatch(
+        np.repeat(full.stamps, 2)[::2],
+        np.repeat(full.accel, 2, axis=0)[::2],
+        np.repeat(full.gyro, 2, axis=0)[::2],
+        full.frame_ids,
+    )
+    for pushed in (read_only, strided):
+        out, _ = push_all(engine_for(), [pushed])
+        np.testing.assert_array_equal(out.stamps, reference.stamps)
+        np.testing.assert_array_equal(out.pose, reference.pose)
+        np.testing.assert_array_equal(out.wrenches, reference.wrenches)
+
+
 # --------------------------------------------------------------------------- decimation
 
 
