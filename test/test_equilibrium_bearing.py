@@ -6,8 +6,9 @@ lateral stiffness is zero, a plateau of the residual that Newton's step cannot c
 or orders of magnitude too long). Truths: the closed form of a block on four symmetric joints
 heeled along x (each joint's share by statics); the force and moment balance of the mounts
 against m·f for a body pitched and turned by the heel; a key pressed within and past its
-clearance beside a spring, by hand; and a start with no bearing past the friction bound refused
-with the mounts that slide named.
+clearance beside a spring, by hand; a start with no bearing past the friction bound refused
+with the mounts that slide named; and a body held across only past clearances (frictionless
+joints, or keys), free within them and bearing past them by hand.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from kinds_helpers import kind_mount
 from physics_helpers import base_scene, mount
 
 from mount_twin.engine.restart import start_state
-from mount_twin.errors import ModelError
+from mount_twin.errors import ModelError, SceneError
 from mount_twin.model.assemble import Model, assemble, initial_state
 from mount_twin.physics.dynamics import body_motion, evaluate
 from mount_twin.scene.loader import scene_from_dict
@@ -241,3 +242,68 @@ def test_a_key_pressed_within_and_past_its_clearance_is_the_closed_form(
     allowed = (1e-9 * G * KEY_MASS + 64.0 * EPS * key) / (SPRING_K + key)  # m
     np.testing.assert_allclose(y[0], x, rtol=0.0, atol=allowed + 4.0 * EPS * abs(x))
     np.testing.assert_allclose(y[1], -KEY_MASS * f[2] / SPRING_K, rtol=1e-12)
+
+
+K_B = 5e8
+"""N/m: the shank's bearing in its hole, and the key's stiffness, of `_in_clearances`."""
+
+
+def _in_clearances(kind: str, bearing: float = K_B, cg_height: float = 0.0) -> Model:
+    """MASS, CG `cg_height` m above the middle of CORNERS, held across only past a clearance
+    CLEAR at each corner: by frictionless bolted joints (`_joints(bearing, friction=0)`), or by
+    shear keys of `bearing` N/m along x and y beside linear springs of the joints' axial
+    stiffness K_S + K_P along z. Loaded as a scene file is (a DOF nothing holds refused)."""
+    if kind == "bolted_joint":
+        mounts = _joints(bearing, friction=0.0)
+    else:
+        keys = [
+            kind_mount("shear_key", f"k{i}", (x, y, 0.0), stiffness=[bearing, bearing, 0.0])
+            | {"clearance": CLEAR}
+            for i, (x, y) in enumerate(CORNERS)
+        ]
+        springs = [
+            mount(f"s{i}", (x, y, 0.0), (0.0, 0.0, K_S + K_P, 0.0, 0.0, 0.0))
+            for i, (x, y) in enumerate(CORNERS)
+        ]
+        mounts = keys + springs
+    data = base_scene(MASS, [0.0, 0.0, cg_height], [100.0, 150.0, 200.0, 0.0, 0.0, 0.0], mounts)
+    return assemble(scene_from_dict(data, "<clearance test>", refuse_unheld=True))
+
+
+@pytest.mark.parametrize("kind", ["bolted_joint", "shear_key"])
+def test_a_body_held_across_only_past_clearances_rests_free_within_them(kind: str) -> None:
+    """A frictionless bolted face holds nothing across until its shank bears past the hole's
+    clearance, as a key holds nothing within its clearance: x, y and yaw are held only there,
+    and upright the body rests centred, free within the clearances (a neutral equilibrium),
+    not adrift (it moves by the clearance at most). Both load, as a key always did; the bolts
+    were refused ("no mount holds x, y, delta": their nominal tangent counted nothing across
+    a clearance). By hand: z = −m·g/(4(k_S + k_P)) (the joint closed; the springs), no force
+    across at the start nor anywhere within the clearances (here moved 0.3 mm along x and y
+    and turned 0.5 mrad: corners 0.67 mm off at most), and 1.5 clearances along x each mount
+    bears k_b·0.5·c back."""
+    model = _in_clearances(kind, cg_height=0.3)
+    f = _heel(0.0)
+    y = initial_state(model, f)
+    assert np.abs(y[[0, 1, 3, 4, 5]]).max() <= 1e-15
+    np.testing.assert_allclose(y[2], -MASS * G / (4.0 * (K_S + K_P)), rtol=1e-9)
+    wrenches = _wrenches(model, y)
+    assert (wrenches[:, :2] == 0.0).all()
+    floor = _bearing_floor(K_B)
+    np.testing.assert_allclose(wrenches[:, :3].sum(axis=0), MASS * f, rtol=0.0, atol=floor)
+    within = y.copy()
+    within[[0, 1, 5]] = 0.3 * CLEAR, 0.3 * CLEAR, 5e-4
+    wrenches = _wrenches(model, within)
+    assert (wrenches[:, :2] == 0.0).all()
+    assert _moment(model, within, wrenches)[2] == 0.0
+    past = y.copy()
+    past[0] = 1.5 * CLEAR
+    bearing = _wrenches(model, past)[:, :2]
+    bears = bearing[np.abs(bearing).sum(axis=1) > 0.0]
+    np.testing.assert_allclose(bears, [[-K_B * 0.5 * CLEAR, 0.0]] * 4, rtol=1e-9, atol=0.0)
+
+
+def test_frictionless_bolts_whose_shanks_never_bear_are_refused_at_load() -> None:
+    """μ = 0 and k_b = 0: nothing holds the body across at any displacement, so a scene file
+    is refused naming the DOFs (the body would drift), as before."""
+    with pytest.raises(SceneError, match=r"mounts: no mount holds x, y, delta"):
+        _in_clearances("bolted_joint", bearing=0.0)

@@ -175,12 +175,13 @@ def pack(j: BoltedJoint) -> np.ndarray:
 def nominal_tangent(j: BoltedJoint) -> tuple[tuple[float, ...], tuple[str, ...]]:
     """Stiffness at the unstressed pose, (kx, ky, kz) N/m then (krx, kry, krz) N·m/rad (none: a
     joint has no rotational law), and the scene key each value comes from: the stuck face's
-    shear stiffness (without friction, the bolt bearing on its hole, or nothing across a
-    clearance); axially, the bolt and the clamped parts together."""
+    shear stiffness, or without friction the shank bearing on its hole, counted whatever the
+    clearance, as a shear key's stiffness is (a frictionless face lets the body move by the
+    clearance, not drift: it is held at the clearance's edge); axially, the bolt and the
+    clamped parts together."""
     shear, key = j.shear_stiffness, "shear_stiffness"
     if j.friction == 0.0:
-        shear = j.bearing_stiffness if j.hole_clearance == 0.0 else 0.0
-        key = "bearing_stiffness"
+        shear, key = j.bearing_stiffness, "bearing_stiffness"
     axial = j.bolt_stiffness + j.clamp_stiffness
     rot = tuple(f"rotational_stiffness[{i}]" for i in range(3))
     return (shear, shear, axial, 0.0, 0.0, 0.0), (

@@ -75,10 +75,11 @@ class Model:
 
     @cached_property
     def tangent_rate(self) -> float:
-        """The fastest mode (rad/s) of the body on its mounts' nominal tangents (keys bearing,
-        bolted joints closed, snubbers open; `scene.statics`), free DOFs only; 0 if it is not
-        a number. `integration.method: auto` weighs it at every start (`engine.auto_method`):
-        taken once per model, not at each engine's start (0.1–0.2 ms each)."""
+        """The fastest mode (rad/s) of the body on its mounts' nominal tangents (keys and
+        frictionless joints' shanks bearing, bolted joints closed, snubbers open;
+        `scene.statics`), free DOFs only; 0 if it is not a number. `integration.method: auto`
+        weighs it at every start (`engine.auto_method`): taken once per model, not at each
+        engine's start (0.1–0.2 ms each)."""
         st = statics(self.scene)
         if not st.finite:
             return 0.0
@@ -396,9 +397,9 @@ def _check_restrained(model: Model, jac: np.ndarray) -> None:
     """Refuse a free DOF that no mount holds: the equilibrium's stiffness, ∂(generalized
     accelerations)/∂q, is then singular, and the body would drift under any input along it.
     The message names the DOF that dominates the unrestrained direction. A singular stiffness
-    where the mounts' nominal tangents hold every DOF (`scene.statics`: a shear key counts
-    with its clearance) is a rest within a clearance, which the body leaves at contact: taken,
-    as the loader takes the scene."""
+    where the mounts' nominal tangents hold every DOF (`scene.statics`: a shear key and a
+    frictionless bolted joint's shank count with their clearance) is a rest within a
+    clearance, which the body leaves at contact: taken, as the loader takes the scene."""
     nf = jac.shape[0]
     scale = np.abs(jac).max()
     if not np.isfinite(scale) or scale == 0.0:
@@ -408,7 +409,7 @@ def _check_restrained(model: Model, jac: np.ndarray) -> None:
     _, sigma, vt = np.linalg.svd(jac / scale)
     if sigma[-1] < newton.SINGULAR * sigma[0] * max(nf, 1):
         if not any(loose_dofs(statics(model.scene), model.scene.dofs)):
-            return  # at rest within a clearance (a key's): free there, but not far
+            return  # at rest within a clearance (a key's, a shank's): free there, not far
         dof = model.scene.dofs[int(np.argmax(np.abs(vt[-1])))]
         msg = (
             f"{model.scene.source}: DOF {dof} is not held by any mount (the mounts' stiffness "

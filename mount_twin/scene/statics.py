@@ -24,10 +24,11 @@ Nominal tangent of each kind (`nominal_tangent`), what a kind counts as at its u
 - elastomer: a·F_el′(0) + (1 − a)·k₀·A per axis (the force table's slope at 0 or k₁, with
   Bouc–Wen hysteresis at z = 0), its rotational stiffness; snubbers are open;
 - bolted joint: the closed joint k_S + k_P along the bolt and the stuck face k_τ across it
-  (friction, clamped by the preload or the weight), or without friction the shank bearing k_b
-  if the hole has no clearance; no rotational stiffness (one bolt carries no moment);
-- shear key: its stiffness along its stiff axes, even with a clearance: a key lets the body
-  move by the clearance, not drift.
+  (friction, clamped by the preload or the weight), or without friction the shank bearing k_b,
+  even with a clearance, as a key; no rotational stiffness (one bolt carries no moment);
+- shear key: its stiffness along its stiff axes, even with a clearance: a key, like a
+  frictionless face in its hole's clearance, lets the body move by the clearance, not drift
+  (within it the body rests free: a neutral equilibrium, held at the clearance's edge).
 """
 
 from __future__ import annotations
