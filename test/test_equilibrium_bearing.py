@@ -8,7 +8,8 @@ heeled along x (each joint's share by statics); the force and moment balance of 
 against m·f for a body pitched and turned by the heel; a key pressed within and past its
 clearance beside a spring, by hand; a start with no bearing past the friction bound refused
 with the mounts that slide named; and a body held across only past clearances (frictionless
-joints, or keys), free within them and bearing past them by hand.
+joints, or keys), free within them and bearing past them by hand, heeled onto them at the
+closed form.
 """
 
 from __future__ import annotations
@@ -300,6 +301,30 @@ def test_a_body_held_across_only_past_clearances_rests_free_within_them(kind: st
     bearing = _wrenches(model, past)[:, :2]
     bears = bearing[np.abs(bearing).sum(axis=1) > 0.0]
     np.testing.assert_allclose(bears, [[-K_B * 0.5 * CLEAR, 0.0]] * 4, rtol=1e-9, atol=0.0)
+
+
+@pytest.mark.parametrize("kind", ["bolted_joint", "shear_key"])
+@pytest.mark.parametrize("lateral", [0.5, 3.0])
+def test_a_heel_onto_clearances_rests_on_their_bearing_at_the_closed_form(
+    kind: str, lateral: float
+) -> None:
+    """Heeled along x with nothing across but the bearing past the clearances (CG in the
+    mounts' plane: no pitch), each mount bears a quarter of m·f_x: by hand X = −(c +
+    m·f_x/(4·k_b)), while y and yaw stay free within the clearances (with keys: no stiffness
+    there at all, a neutral rest). Before, the bolts were refused at load, and the keys' start
+    was not found (its Jacobian singular along y at the root itself: Newton gave up there, and
+    least squares stalled in the clearance, 0.5 m/s² off)."""
+    model = _in_clearances(kind)
+    f = _heel(lateral)
+    y = initial_state(model, f)
+    x = -(CLEAR + MASS * f[0] / (4.0 * K_B))
+    allowed = _bearing_floor(K_B) / (4.0 * K_B)  # m: the force floor over the stiffness
+    np.testing.assert_allclose(y[0], x, rtol=0.0, atol=allowed)
+    np.testing.assert_allclose(y[2], -MASS * f[2] / (4.0 * (K_S + K_P)), rtol=1e-9)
+    assert abs(y[1]) <= 1e-15 and np.abs(y[3:6]).max() <= 1e-12
+    wrenches = _wrenches(model, y)
+    floor = _bearing_floor(K_B)
+    np.testing.assert_allclose(wrenches[:, :3].sum(axis=0), MASS * f, rtol=0.0, atol=floor)
 
 
 def test_frictionless_bolts_whose_shanks_never_bear_are_refused_at_load() -> None:

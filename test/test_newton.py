@@ -4,8 +4,9 @@ Truths by hand: the root of a piecewise-linear r with a tangent jump of 1e5–1e
 stiffer than its mount) on its stiff piece, from either side, with the exact one-sided tangents
 and with central differences whose step straddles the kink; a 2-D system with a kink in one
 coordinate (Cramer's rule on the stiff piece); a cubic (Cardano's formula) and a smooth 2-D
-system; a clearance, free until it bears (`anchored`). None where Newton cannot get there: a
-singular Jacobian, no root.
+system; a clearance, free until it bears (`anchored`), and a root free within another
+clearance (a neutral rest: its Jacobian singular there, taken). None where Newton cannot get
+there: a singular Jacobian away from a root, no root.
 """
 
 from __future__ import annotations
@@ -184,3 +185,34 @@ def test_a_clearance_is_left_for_the_key_at_the_closed_form(stiff: float) -> Non
     found = newton.anchored(residual, jacobian, x0, _floor, fine)
     assert found is not None
     np.testing.assert_allclose(found[0], [CLEARANCE + LOAD / stiff, 1.0], rtol=4.0 * EPS)
+
+
+def _two_clearances(stiff: float) -> Field:
+    """r(x) = (LOAD − stiff·⟨x₀ − CLEARANCE⟩, −stiff·⟨|x₁| − CLEARANCE⟩·sign x₁, 1 − x₂) (3-D):
+    two keys, each free within CLEARANCE, the load pressing only the first; x₂ on a unit
+    spring (the scale of `anchored`'s anchors)."""
+    return lambda x: np.array(
+        [
+            LOAD - stiff * max(x[0] - CLEARANCE, 0.0),
+            -stiff * max(abs(x[1]) - CLEARANCE, 0.0) * math.copysign(1.0, x[1]),
+            1.0 - x[2],
+        ]
+    )
+
+
+@pytest.mark.parametrize("stiff", [1e5, 1e9])
+def test_a_root_free_within_a_clearance_is_a_neutral_rest_and_taken(stiff: float) -> None:
+    """Loaded onto one key, free within the other's clearance: every x₁ within it is a root
+    (a neutral rest: J singular there, its column of x₁ zero), and the anchors, pulled to x0,
+    keep x₁ where it started. By hand x = (CLEARANCE + LOAD/K, x0₁, 1), and J's row and
+    column of x₁ zero. Before, the root reached, `solve`'s step there raised on the singular J
+    and none was returned."""
+    residual = _two_clearances(stiff)
+    jacobian, fine = _jacobians(residual, residual, "differences")
+    x0 = np.array([0.0, 0.2 * CLEARANCE, 0.0])
+    found = newton.find(residual, jacobian, x0, _floor, fine)
+    assert found is not None
+    x, r, jac = found
+    np.testing.assert_allclose(x, [CLEARANCE + LOAD / stiff, x0[1], 1.0], rtol=4.0 * EPS)
+    assert (np.abs(r) <= _floor(jac)).all()
+    assert (jac[:, 1] == 0.0).all() and (jac[1] == 0.0).all()  # free along x₁: singular

@@ -5,7 +5,7 @@ The start's equilibrium is a handful of coordinates on mounts that are linear or
 linear near rest: Newton lands and polishes in three Jacobians (0.2 ms on the genset, its
 Jacobians in compiled code), where scipy's trust-region least squares spent 1.5–3 ms of
 bookkeeping on its evaluations, a tenth of the engine's time on a 0.25 s shock record. Where
-Newton does not get there (a singular Jacobian: a DOF no mount holds), it says so and the
+Newton does not get there (a singular Jacobian away from a root), it says so and the
 caller falls back on the robust solver.
 
 A contact far stiffer than the mounts (a snubber, a key or a bolt that bears; k_s 1e5–1e7
@@ -23,6 +23,8 @@ joint's face sliding at its friction bound μ·F_K, whatever the slide, until th
 its hole past the clearance (a heel past the friction bound). Newton's step there is singular,
 or across the plateau by orders of magnitude where faces slide along different directions;
 `find` leaves the plateau on an anchor spring (`anchored`) from where `solve` stopped on it.
+The root itself may lie on a plateau along some direction (heeled onto keys along x, the body
+still within the clearances of those along y): J is singular there, and the root is taken.
 """
 
 from __future__ import annotations
@@ -55,7 +57,9 @@ def solve(
     """x with |r(x)| ≤ tolerance(J) component-wise (J = jacobian(x) = ∂r/∂x), from x0,
     polished until a Newton step no longer reduces |r| (the rounding floor, where the
     least-squares solver also ends); returns (x, r(x), J at x), or None where Newton does not
-    get there (singular J, no decrease of |r| outside the tolerance in `halvings` halvings of
+    get there (singular J outside the tolerance: within it, x is a root where the body rests
+    free along a direction, a neutral equilibrium, such as along keys' clearances while other
+    keys bear; no decrease of |r| outside the tolerance in `halvings` halvings of
     the step, not finite, or outside it after MAX_ITERATIONS).
 
     r piecewise smooth, a contact's stiffness k_s switching on at a kink (the module's note):
@@ -94,8 +98,8 @@ def _solve(
         within = bool((np.abs(r) <= tolerance(jac)).all())
         try:
             step = _limited(np.linalg.solve(jac, -r), limit)
-        except np.linalg.LinAlgError:
-            return None, x
+        except np.linalg.LinAlgError:  # a root where J is singular is a neutral rest: taken
+            return ((x, r, jac) if within else None), x
         norm = float(np.linalg.norm(r))
         landed = x + step
         r_landed = residual(landed)
