@@ -17,8 +17,8 @@ from mount_twin.engine.batch import ERROR, HealthReport, OutputBatch
 from mount_twin.engine.body_check import BodyCheck, BodyComparison
 from mount_twin.engine.body_counts import RESETS
 from mount_twin.engine.engine import TwinEngine
-from mount_twin.engine.health_statuses import ENDED
 from mount_twin.engine.health_texts import INPUT
+from mount_twin.engine.input_status import ENDED
 from mount_twin.engine.reading_screen import disregarded, provided, rotated
 from mount_twin.engine.stamp_verdicts import rising_or_back
 from mount_twin.errors import require

@@ -28,7 +28,7 @@ from mount_twin.engine.driver import CoreDriver
 from mount_twin.engine.estimate import ErrorEstimate
 from mount_twin.engine.gyro_filter import Design
 from mount_twin.engine.health import HealthWindow
-from mount_twin.engine.health_statuses import ENDED
+from mount_twin.engine.input_status import ENDED
 from mount_twin.engine.intake import Intake, Judged, runs
 from mount_twin.engine.kernel import AT_EVENT, Samples
 from mount_twin.engine.reporting import Reporting
@@ -398,7 +398,7 @@ class TwinEngine:
         A sample still held back (a stamp jump that no later sample confirmed) is counted as
         rejected_unconfirmed_jump: the record ends before it can be told from a glitch. Where
         samples were received but none ever accepted, the report (`stamp` NaN) says so at
-        ERROR, and why (`health_statuses.ENDED`).
+        ERROR, and why (`input_status.ENDED`).
         """
         empty = np.zeros((0, 3))
         frame = self._gyro.frame(np.zeros(0), empty, empty, self._pushed)

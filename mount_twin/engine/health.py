@@ -1,6 +1,7 @@
 """Health of the running twin over a diagnostics period: the window's figures (input,
 integration, attitude, mounts), gathered until a report is due; the statuses it reports are
-worded by `health_statuses`, in the texts of `health_texts`."""
+worded by `health_statuses` (the input status by `input_status`), in the texts of
+`health_texts`."""
 
 from __future__ import annotations
 

@@ -19,7 +19,7 @@ import numpy as np
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.engine.delay_line import Run
 from mount_twin.engine.health import HealthWindow
-from mount_twin.engine.health_statuses import PLATEAU_G, SATURATION_SHARE
+from mount_twin.engine.input_status import PLATEAU_G, SATURATION_SHARE
 from mount_twin.engine.reading_screen import (
     READING_LIMIT,
     all_axes,

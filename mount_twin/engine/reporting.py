@@ -75,7 +75,7 @@ class Reporting:
     ) -> HealthReport:
         """The report due at `stamp` (s), after sample `sample` and the output rows of `parts`
         (those published before it in its batch); `stalled_s`: the input stalled that long (s,
-        `health_statuses.ENDED`: the record ended) without a report falling due; `ended`: the
+        `input_status.ENDED`: the record ended) without a report falling due; `ended`: the
         stream's last report. Ends the window."""
         per_mount = np.full(self._n_mounts, math.nan)
         per_mount[self._driver.rated] = self._driver.window_utilisation()
