@@ -20,7 +20,8 @@ import numpy as np
 
 from mount_twin.errors import SceneError
 from mount_twin.scene.description import DOF_NAMES, LinearMount, Scene
-from mount_twin.scene.loader import ANGLE_LIMIT_RAD, MOUNT_KINDS
+from mount_twin.scene.geometry_reading import ANGLE_LIMIT_RAD
+from mount_twin.scene.mount_reading import MOUNT_KINDS
 
 LAW_WORDS = ("stiffness", "damping")
 """A number whose field's name holds one of these is a law's coefficient: not negative (a

@@ -32,7 +32,7 @@ Warnings (SceneWarning, kept on `Scene.warnings`): values that load but are like
   mm, inertia in kg·mm²);
 - an Imu input declared without gravity: sensor_msgs/Imu linear_acceleration is specific force.
 
-Angles beyond 2π are refused when read (`loader.ANGLE_LIMIT_RAD`), not warned of: no
+Angles beyond 2π are refused when read (`geometry_reading.ANGLE_LIMIT_RAD`), not warned of: no
 orientation needs more than a turn, a value in degrees corrupts every output without any other
 sign, and the fix is one edit.
 """

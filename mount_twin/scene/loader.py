@@ -1,7 +1,9 @@
 """Build a validated `Scene` from a nested mapping (a scene YAML file or ROS parameters).
 
 A file's YAML is read in `scene.yaml_reading`; the ROS names a scene gives (mount names, topics,
-frame ids) are read by the rules of `scene.ros_names`.
+frame ids) are read by the rules of `scene.ros_names`, positions and angles within the ranges of
+`scene.geometry_reading`. Each mount is read by `scene.mount_reading`, the optional body IMU
+sections (`body_sensor`, `ageing`) by `scene.body_imu_reading`; the other sections are read here.
 """
 
 from __future__ import annotations
@@ -14,50 +16,34 @@ from typing import Any
 
 from mount_twin.errors import SceneError
 from mount_twin.integrate.methods import AUTO, METHODS
-from mount_twin.kinds import KINDS
+from mount_twin.scene.body_imu_reading import read_ageing, read_body_sensor
 from mount_twin.scene.checks import check_scene
 from mount_twin.scene.description import (
     DOF_NAMES,
     GYRO_FILTERS,
     RTOL_RANGE,
-    SENSOR_AXES,
-    Ageing,
     Body,
-    BodySensor,
     Frames,
     InitialState,
     InputSpec,
     Integration,
-    LinearMount,
-    Mount,
     Outputs,
     Scene,
     SceneOrigin,
-    Vec3,
-    Vec6,
-    ageing_bands_problem,
     scene_value,
 )
+from mount_twin.scene.geometry_reading import read_angles, read_pose, read_position
+from mount_twin.scene.mount_reading import read_mount
 from mount_twin.scene.reader import Reader, Used, shown
-from mount_twin.scene.ros_names import (
-    NAME_TOKEN,
-    read_frame_id,
-    read_header_frame_id,
-    read_topic,
-)
+from mount_twin.scene.ros_names import read_frame_id, read_header_frame_id, read_topic
 from mount_twin.scene.yaml_reading import read_scene_yaml
 
 INPUT_TYPES = ("sensor_msgs/msg/Imu", "geometry_msgs/msg/AccelStamped")
 START_TILT_MAX_RAD = 1.55
 """Largest tilt θ of a given start pose, rad (88.8°): the chart degenerates at π/2."""
 
-MOUNT_KINDS = ("linear", *KINDS)
 MAX_MOUNTS = 1000
 """Most mounts a scene takes (a machine has a few dozen; more is generated garbage)."""
-REACH_M = 1000.0
-"""Largest |coordinate| of a position, m: a machine on a deck spans metres (mm, more likely)."""
-ANGLE_LIMIT_RAD = 2.0 * math.pi
-"""Largest |angle| of an orientation or start pose, rad: beyond one turn it is degrees."""
 STEPPERS = (AUTO, *METHODS)
 
 
@@ -104,7 +90,7 @@ def scene_from_dict(
         raise top.error("mounts", f"{len(mounts_raw)} mounts: at most {MAX_MOUNTS} are accepted")
     paths = mount_paths or [f"mounts[{i}]" for i in range(len(mounts_raw))]
     mounts = tuple(
-        _mount(Reader(m, source, path, record=record))
+        read_mount(Reader(m, source, path, record=record))
         for path, m in zip(paths, mounts_raw, strict=True)
     )
     names = [m.name for m in mounts]
@@ -121,8 +107,8 @@ def scene_from_dict(
         integration=_integration(top.sub("integration")),
         outputs=_outputs(top.sub("outputs")),
         frames=_frames(top.sub("frames")),
-        body_sensor=_body_sensor(top.sub("body_sensor")) if top.has("body_sensor") else None,
-        ageing=_ageing(top.sub("ageing"), mounts) if top.has("ageing") else None,
+        body_sensor=read_body_sensor(top.sub("body_sensor")) if top.has("body_sensor") else None,
+        ageing=read_ageing(top.sub("ageing"), mounts) if top.has("ageing") else None,
         source=source,
     )
     top.finish()
@@ -152,7 +138,7 @@ def refuse_parameters_file(data: Any, source: str) -> None:
 
 def _body(r: Reader) -> Body:
     mass = r.positive("mass")
-    cg = _position(r, "cg")
+    cg = read_position(r, "cg")
     inertia = r.vector("inertia", 6)
     ixx, iyy, izz, ixy, ixz, iyz = inertia
     tensor = [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]
@@ -190,85 +176,14 @@ def _dofs(top: Reader) -> tuple[str, ...]:
     return tuple(d for d in DOF_NAMES if d in dofs)
 
 
-def _mount(r: Reader) -> Mount:
-    kind = r.choice("kind", MOUNT_KINDS, "linear")
-    name = r.string("name")
-    if not NAME_TOKEN.fullmatch(name):
-        raise r.error(
-            "name",
-            "must be a ROS name token (an ASCII letter, then up to 99 letters, digits and _), "
-            f"got {shown(name)}",
-        )
-    position = _position(r, "position")
-    rpy = _angles(r, "orientation_rpy", (0.0, 0.0, 0.0))
-    if kind != "linear":
-        mount: Mount = KINDS[kind].read(r, name, position, rpy)
-        r.finish()  # the kind's read finishes before its checks across keys; this is the net
-        return mount
-    try:
-        mount = LinearMount(
-            name=name,
-            position=position,
-            orientation_rpy=rpy,
-            stiffness=r.vector("stiffness", 6, lo=0.0),
-            damping=r.vector("damping", 6, (0.0,) * 6, lo=0.0),
-            kind=kind,
-            rated_travel=r.vector("rated_travel", 3, (0.0,) * 3, lo=0.0),
-            rated_load=r.vector("rated_load", 3, (0.0,) * 3, lo=0.0),
-        )
-        r.finish()
-    except SceneError as err:
-        guess = None if r.has("kind") else _kind_reading(r, name, position, rpy)
-        if guess is None:
-            raise
-        raise r.error(
-            "kind",
-            f"missing, so the mount was read as linear ({err.path}: {err.message}); its keys "
-            f"read as a {guess}: give kind: {guess}",
-        ) from err
-    return mount
-
-
-def _kind_reading(r: Reader, name: str, position: Vec3, rpy: Vec3) -> str | None:
-    """The one kind of KINDS whose `read` takes the mount mapping of `r` whole, if one does:
-    what a mount whose `kind:` line was lost most likely is."""
-    fits = []
-    for kind, module in KINDS.items():
-        probe = Reader(r.data, r.source, r.path)
-        for key in ("name", "position", "orientation_rpy"):
-            probe.raw(key, ())
-        try:
-            module.read(probe, name, position, rpy)
-        except SceneError:
-            continue
-        fits.append(kind)
-    return fits[0] if len(fits) == 1 else None
-
-
-def _position(r: Reader, key: str, default: Vec3 | None = None) -> Vec3:
-    """A point in F, m, within REACH_M of the origin."""
-    p = r.vector(key, 3, default)
-    if max(abs(v) for v in p) > REACH_M:
-        raise r.error(key, f"{list(p)} m is more than {REACH_M:g} m from F's origin: millimetres?")
-    return p
-
-
-def _angles(r: Reader, key: str, default: Vec3 | None = None) -> Vec3:
-    """Roll, pitch, yaw, rad, within one turn."""
-    a = r.vector(key, 3, default)
-    if max(abs(v) for v in a) > ANGLE_LIMIT_RAD:
-        raise r.error(key, f"{list(a)} exceeds 2π: angles are in radians, not degrees")
-    return a
-
-
 def _input(r: Reader) -> InputSpec:
     d = InputSpec()
     spec = InputSpec(
         msg_type=r.choice("msg_type", INPUT_TYPES, d.msg_type),
         topic=read_topic(r, "topic", d.topic),
         frame_id=read_header_frame_id(r, "frame_id", d.frame_id),
-        sensor_rpy=_angles(r, "sensor_rpy", d.sensor_rpy),
-        sensor_position=_position(r, "sensor_position", d.sensor_position),
+        sensor_rpy=read_angles(r, "sensor_rpy", d.sensor_rpy),
+        sensor_position=read_position(r, "sensor_position", d.sensor_position),
         includes_gravity=r.boolean("includes_gravity", d.includes_gravity),
         g=r.number("g", d.g, lo=0.0),
         hold=r.choice("hold", ("first_order", "zero_order"), d.hold),
@@ -307,14 +222,6 @@ def _gyro_filter(r: Reader, default: str) -> str:
     return r.choice("gyro_filter", GYRO_FILTERS, default)
 
 
-def _pose(r: Reader, key: str, default: Vec6) -> Vec6:
-    """(X, Y, Z) m and (α, γ, δ) rad, in range like positions and angles."""
-    pose = r.vector(key, 6, default)
-    if max(abs(v) for v in pose[:3]) > REACH_M or max(abs(v) for v in pose[3:]) > ANGLE_LIMIT_RAD:
-        raise r.error(key, f"{list(pose)}: positions beyond {REACH_M:g} m or angles beyond 2π")
-    return pose
-
-
 def _refuse_unread_start(r: Reader, state: InitialState, dofs: tuple[str, ...]) -> None:
     """An equilibrium start is at rest and finds the free DOFs itself: a velocity, or a pose
     entry of a free DOF, given with it would be ignored without a word."""
@@ -338,7 +245,7 @@ def _initial(r: Reader, dofs: tuple[str, ...]) -> InitialState:
     state = InitialState(
         mode=r.choice("mode", ("equilibrium", "given"), d.mode),
         gravity=r.choice("gravity", ("first_sample", "nominal"), d.gravity),
-        pose=_pose(r, "pose", d.pose),
+        pose=read_pose(r, "pose", d.pose),
         velocity=r.vector("velocity", 6, d.velocity),
         gravity_samples=r.integer("gravity_samples", d.gravity_samples, lo=1),
         gravity_window_s=r.number("gravity_window_s", d.gravity_window_s, lo=0.0),
@@ -390,69 +297,6 @@ def _outputs(r: Reader) -> Outputs:
     )
     r.finish()
     return spec
-
-
-MAX_SENSOR_LAG_S = 1.0
-"""A body IMU's lag beyond this (s) is a clock, not a latency: align the clocks."""
-
-
-def _body_sensor(r: Reader) -> BodySensor:
-    d = BodySensor()
-    sensor = BodySensor(
-        topic=read_topic(r, "topic", d.topic),
-        frame_id=read_header_frame_id(r, "frame_id", d.frame_id),
-        position=_position(r, "position", d.position),
-        orientation_rpy=_angles(r, "orientation_rpy", d.orientation_rpy),
-        lag_s=r.number("lag_s", d.lag_s, lo=-MAX_SENSOR_LAG_S, hi=MAX_SENSOR_LAG_S),
-        window_s=r.number("window_s", d.window_s, lo=0.1, hi=3600.0),
-        band_hz=_band(r, "band_hz", d.band_hz),
-        warn_nrms=r.positive("warn_nrms", d.warn_nrms),
-        error_nrms=r.positive("error_nrms", d.error_nrms),
-        axes=r.names("axes", d.axes),
-    )
-    wrong = [a for a in sensor.axes if a not in SENSOR_AXES]
-    if wrong or not sensor.axes:
-        raise r.error("axes", f"{list(sensor.axes)}: give some of {', '.join(SENSOR_AXES)}")
-    if sensor.error_nrms < sensor.warn_nrms:
-        raise r.error("error_nrms", f"{sensor.error_nrms} is below warn_nrms {sensor.warn_nrms}")
-    r.finish()
-    return sensor
-
-
-def _band(
-    r: Reader, key: str, default: tuple[float, float], unit: str = "Hz"
-) -> tuple[float, float]:
-    """A band (low, high), 0 ≤ low < high (a frequency band, Hz, or scale factors)."""
-    low, high = r.vector(key, 2, default, lo=0.0)
-    if high <= low:
-        raise r.error(key, f"[{low}, {high}]: expected low < high, {unit}")
-    return low, high
-
-
-def _ageing(r: Reader, mounts: tuple[Mount, ...]) -> Ageing:
-    d = Ageing()
-    ageing = Ageing(
-        window_s=r.number("window_s", d.window_s, lo=10.0, hi=3600.0),
-        fit=r.names("fit", d.fit),
-        warn=_band(r, "warn", d.warn, "scale factors"),
-        error=_band(r, "error", d.error, "scale factors"),
-    )
-    linear = {m.name for m in mounts if isinstance(m, LinearMount)}
-    for i, name in enumerate(ageing.fit):
-        kind, _, group = name.partition(":")
-        wrong = [m for m in group.split("+") if m not in linear] if group else []
-        if kind not in ("stiffness", "damping") or wrong or not linear:
-            why = f"{', '.join(wrong)}: no linear mount of the scene" if wrong else ""
-            raise r.error(
-                f"fit[{i}]",
-                why
-                or f"{shown(name)}: expected stiffness or damping (of all linear mounts), "
-                "or stiffness:A+B (damping:A+B) for a group",
-            )
-    if problem := ageing_bands_problem(ageing.warn, ageing.error):
-        raise r.error("error", problem)
-    r.finish()
-    return ageing
 
 
 def _frames(r: Reader) -> Frames:
