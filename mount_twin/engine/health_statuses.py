@@ -40,7 +40,8 @@ from mount_twin.physics.rotations import angle_text
 class HealthStatuses(InputStatus):
     """The statuses of a health window's report, built from its figures: a part of
     `health.HealthWindow`, which holds the figures declared here and calls these when a report
-    is due (`HealthWindow.report`)."""
+    is due (`HealthWindow.report`). The input's status comes from `InputStatus`, the
+    integration's, the attitude's and the mounts' from here."""
 
     method: str
     published: bool

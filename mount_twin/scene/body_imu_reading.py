@@ -20,6 +20,8 @@ MAX_SENSOR_LAG_S = 1.0
 
 
 def read_body_sensor(r: Reader) -> BodySensor:
+    """The `body_sensor` section (a body-mounted IMU checked against the twin), defaults for
+    keys not given; an error naming the key path for a value out of its range."""
     d = BodySensor()
     sensor = BodySensor(
         topic=read_topic(r, "topic", d.topic),
@@ -53,6 +55,8 @@ def _band(
 
 
 def read_ageing(r: Reader, mounts: tuple[Mount, ...]) -> Ageing:
+    """The `ageing` section (the linear mounts' stiffness and damping scales fitted live to the
+    body IMU), its `fit` entries checked against the scene's linear `mounts`."""
     d = Ageing()
     ageing = Ageing(
         window_s=r.number("window_s", d.window_s, lo=10.0, hi=3600.0),

@@ -15,6 +15,8 @@ MOUNT_KINDS = ("linear", *KINDS)
 
 
 def read_mount(r: Reader) -> Mount:
+    """One entry of `mounts`: its name, pose and the keys of its `kind` (default `linear`),
+    read by the kind's own module."""
     kind = r.choice("kind", MOUNT_KINDS, "linear")
     name = r.string("name")
     if not NAME_TOKEN.fullmatch(name):
