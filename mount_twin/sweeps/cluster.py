@@ -6,7 +6,7 @@ import logging
 import os
 import signal
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from typing import Any
 
 
@@ -21,6 +21,7 @@ def dask_client(scheduler: str | None = None, workers: int | None = None) -> Ite
     from dask.distributed import Client, LocalCluster
 
     cluster = client = None
+    stopped = False
     try:
         if scheduler is None:
             n = (os.cpu_count() or 1) if workers is None else workers
@@ -40,11 +41,30 @@ def dask_client(scheduler: str | None = None, workers: int | None = None) -> Ite
                 )
         client = Client(scheduler or cluster)
         yield client
+    except BaseException:
+        stopped = True
+        raise
     finally:
-        if client is not None:
-            client.close()
-        if cluster is not None:
-            cluster.close()
+        with _quiet_dask() if stopped else nullcontext():
+            if client is not None:
+                client.close()
+            if cluster is not None:
+                cluster.close()
+
+
+@contextmanager
+def _quiet_dask() -> Iterator[None]:
+    """Within this, nothing dask.distributed logs in this process is shown: the work stopped
+    (Ctrl-C, an error), and closing forgets the tasks still running, which the local
+    scheduler (in this process) logged at ERROR ("Couldn't gather keys: {...: 'forgotten'}")
+    beside the command's own line; the command says why it stopped."""
+    logger = logging.getLogger("distributed")
+    level = logger.level
+    logger.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
 
 
 @contextmanager
