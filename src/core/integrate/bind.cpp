@@ -112,10 +112,10 @@ py::tuple rows(const double (&v)[R][C]) {
   return t;
 }
 
-/// An explicit method's table T (its A passed whole: T::A is a pointer to its rows) by the names
-/// of its Python module.
-template <class T, std::size_t R, std::size_t C>
-py::dict explicit_table(const double (&a)[R][C]) {
+/// An explicit method's table T by the names of its Python module.
+template <class T>
+py::dict explicit_table() {
+  constexpr std::size_t R = T::STAGES;
   py::dict d;
   py::tuple c(R), e(R);
   for (std::size_t i = 0; i < R; ++i) {
@@ -123,7 +123,7 @@ py::dict explicit_table(const double (&a)[R][C]) {
     e[i] = T::E[i];
   }
   d["C"] = c;
-  d["A"] = rows(a);
+  d["A"] = rows(T::A);
   d["E"] = e;
   d["FSAL"] = T::FSAL;
   d["ORDER"] = T::ORDER;
@@ -155,8 +155,8 @@ py::dict method_tables() {
   exp["J0"] = integrate::exprb32::J0;
   exp["BLOCKS"] = integrate::exprb32::BLOCKS;
   py::dict out;
-  out["dopri54"] = explicit_table<integrate::dopri54::Table>(integrate::dopri54::A);
-  out["verner65"] = explicit_table<integrate::verner65::Table>(integrate::verner65::A);
+  out["dopri54"] = explicit_table<integrate::dopri54::Table>();
+  out["verner65"] = explicit_table<integrate::verner65::Table>();
   out["ros34pw2"] = ros;
   out["exprb32"] = exp;
   return out;

@@ -4,55 +4,31 @@
 // err / (atol + rtol·|y|).
 #pragma once
 
-#include "../model.hpp"
-#include "../views.hpp"
-#include "explicit_rk.hpp"
-
 namespace mt::integrate::dopri54 {
 
-// The table, as dopri54.py writes it (Python's int/int true division is the correctly rounded
-// quotient, as these double divisions of exactly representable integers are).
-constexpr double C[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0, 1.0};
-constexpr double A[7][6] = {
-    {0.0, 0.0, 0.0, 0.0, 0.0, 0.0},
-    {1.0 / 5, 0.0, 0.0, 0.0, 0.0, 0.0},
-    {3.0 / 40, 9.0 / 40, 0.0, 0.0, 0.0, 0.0},
-    {44.0 / 45, -56.0 / 15, 32.0 / 9, 0.0, 0.0, 0.0},
-    {19372.0 / 6561, -25360.0 / 2187, 64448.0 / 6561, -212.0 / 729, 0.0, 0.0},
-    {9017.0 / 3168, -355.0 / 33, 46732.0 / 5247, 49.0 / 176, -5103.0 / 18656, 0.0},
-    {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84},
-};
-/// 5th-order weights (the last row of A: the last stage is first-same-as-last).
-inline constexpr const double (&B)[6] = A[6];
-/// 5th-order weights minus the embedded 4th-order weights.
-constexpr double E[7] = {71.0 / 57600,      0.0,          -71.0 / 16695, 71.0 / 1920,
-                         -17253.0 / 339200, 22.0 / 525, -1.0 / 40};
-constexpr bool FSAL = true;
-/// Order of the error estimate (the controller's exponent is −1/(ORDER + 1)).
-constexpr int ORDER = 4;
-constexpr double MAX_FACTOR = 10.0;
-/// Rows of the 2-D work array (the stages, the FSAL one included).
-constexpr idx STAGES = 7;
-
-inline idx work_rows(idx /*n*/) { return STAGES; }
-
-/// The table as explicit_rk::advance reads it.
+/// The table as explicit_rk::advance reads it, as dopri54.py writes it (Python's int/int true
+/// division is the correctly rounded quotient, as these double divisions of exactly
+/// representable integers are). The last row of A is the 5th-order weights (the last stage is
+/// first-same-as-last); E the 5th-order weights minus the embedded 4th-order ones.
 struct Table {
-  static constexpr int STAGES = static_cast<int>(dopri54::STAGES);
-  static constexpr int ORDER = dopri54::ORDER;
-  static constexpr double MAX_FACTOR = dopri54::MAX_FACTOR;
-  static constexpr bool FSAL = dopri54::FSAL;
-  static constexpr const double* C = dopri54::C;
-  static constexpr const double (*A)[6] = dopri54::A;
-  static constexpr const double* E = dopri54::E;
+  /// Rows of the 2-D work array (the stages, the FSAL one included).
+  static constexpr int STAGES = 7;
+  /// Order of the error estimate (the controller's exponent is −1/(ORDER + 1)).
+  static constexpr int ORDER = 4;
+  static constexpr double MAX_FACTOR = 10.0;
+  static constexpr bool FSAL = true;
+  static constexpr double C[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0, 1.0};
+  static constexpr double A[7][6] = {
+      {0.0, 0.0, 0.0, 0.0, 0.0, 0.0},
+      {1.0 / 5, 0.0, 0.0, 0.0, 0.0, 0.0},
+      {3.0 / 40, 9.0 / 40, 0.0, 0.0, 0.0, 0.0},
+      {44.0 / 45, -56.0 / 15, 32.0 / 9, 0.0, 0.0, 0.0},
+      {19372.0 / 6561, -25360.0 / 2187, 64448.0 / 6561, -212.0 / 729, 0.0, 0.0},
+      {9017.0 / 3168, -355.0 / 33, 46732.0 / 5247, 49.0 / 176, -5103.0 / 18656, 0.0},
+      {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84},
+  };
+  static constexpr double E[7] = {71.0 / 57600,      0.0,        -71.0 / 16695, 71.0 / 1920,
+                                  -17253.0 / 339200, 22.0 / 525, -1.0 / 40};
 };
-
-/// Advance y (in place) from t0 to t1 s with input u held over the interval: the explicit
-/// step of explicit_rk.hpp on this table (its contract: settings, k (7, n), y_new, result;
-/// returns a Status, y left at the last accepted time on failure).
-inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Scratch& s, Vec u,
-                   Mat k, Vec y_new, Vec result) {
-  return explicit_rk::advance<Table>(y, t0, t1, settings, m, s, u, k, y_new, result);
-}
 
 }  // namespace mt::integrate::dopri54

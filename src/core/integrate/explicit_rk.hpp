@@ -1,6 +1,7 @@
 // The explicit Runge–Kutta step with error control, advancing across one input-sample
-// interval, for any embedded pair given as its table (dopri54.hpp gives Dormand–Prince 5(4)):
-// a new explicit method is its table and a branch in stepper.hpp, not another copy of this loop.
+// interval, for any embedded pair given as its table (dopri54.hpp's `Table` is Dormand–Prince
+// 5(4)'s): a new explicit method is its table and a branch in stepper.hpp, not another copy of
+// this loop.
 //
 // A table T has STAGES, C[STAGES], A[STAGES][STAGES − 1] (row i: the weights of stage i), E[STAGES]
 // (the propagated weights minus the embedded ones), ORDER (of the error estimate), MAX_FACTOR and

@@ -47,7 +47,7 @@ constexpr idx HALF_P1 = 8;  // the first half-step block, in blocks from J0
 inline idx work_rows(idx n) { return ROWS + BLOCKS * n; }
 
 /// Advance y (in place) from t0 to t1 s with input u held over the interval: the signature and
-/// statuses of dopri54::advance (k: work_rows(n) × n; settings[PHI_STEP]: the step, s, the φ
+/// statuses of explicit_rk::advance (k: work_rows(n) × n; settings[PHI_STEP]: the step, s, the φ
 /// functions held were computed for, 0 for none; settings[CHAINED] is left at 0).
 inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Scratch& s, Vec u,
                    Mat k, Vec y_new, Vec result) {

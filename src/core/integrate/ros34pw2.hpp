@@ -122,7 +122,7 @@ inline void lu_solve(Mat a, idx first, idx n, Vec piv_row, Vec b) {
 }
 
 /// Advance y (in place) from t0 to t1 s with input u held over the interval: the signature and
-/// statuses of dopri54::advance (k: work_rows(n) × n; settings[CHAINED] is left at 0).
+/// statuses of explicit_rk::advance (k: work_rows(n) × n; settings[CHAINED] is left at 0).
 inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Scratch& s, Vec u,
                    Mat k, Vec y_new, Vec result) {
   const Interval iv = interval(settings, t0, t1);

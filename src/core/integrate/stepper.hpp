@@ -7,6 +7,7 @@
 #include "../views.hpp"
 #include "control.hpp"
 #include "dopri54.hpp"
+#include "explicit_rk.hpp"
 #include "exprb32.hpp"
 #include "ros34pw2.hpp"
 #include "verner65.hpp"
@@ -17,10 +18,10 @@ namespace mt::integrate {
 /// unknown method.
 inline idx work_rows(int method, idx n) {
   switch (method) {
-    case DOPRI54: return dopri54::work_rows(n);
+    case DOPRI54: return dopri54::Table::STAGES;
     case ROS34PW2: return ros34pw2::work_rows(n);
     case EXPRB32: return exprb32::work_rows(n);
-    case VERNER65: return verner65::work_rows(n);
+    case VERNER65: return verner65::Table::STAGES;
     default: return -1;
   }
 }
@@ -30,7 +31,8 @@ inline idx work_rows(int method, idx n) {
 inline int advance(int method, Vec y, double t0, double t1, Vec settings, const Model& m,
                    Scratch& s, Vec u, Mat work2d, Vec work1d, Vec result) {
   if (method == DOPRI54) {
-    return dopri54::advance(y, t0, t1, settings, m, s, u, work2d, work1d, result);
+    return explicit_rk::advance<dopri54::Table>(y, t0, t1, settings, m, s, u, work2d, work1d,
+                                               result);
   }
   if (method == ROS34PW2) {
     return ros34pw2::advance(y, t0, t1, settings, m, s, u, work2d, work1d, result);
@@ -39,7 +41,8 @@ inline int advance(int method, Vec y, double t0, double t1, Vec settings, const 
     return exprb32::advance(y, t0, t1, settings, m, s, u, work2d, work1d, result);
   }
   if (method == VERNER65) {
-    return verner65::advance(y, t0, t1, settings, m, s, u, work2d, work1d, result);
+    return explicit_rk::advance<verner65::Table>(y, t0, t1, settings, m, s, u, work2d, work1d,
+                                                result);
   }
   return UNKNOWN_METHOD;
 }
