@@ -7,9 +7,10 @@ Python: the scene loader imports it.
 
 Adding a method: a module with its coefficient table (see `dopri54`, `ros34pw2`, `exprb32`), its
 compiled `advance` in the core (src/core/integrate/<method>.hpp, bound as `<method>_advance`; an
-explicit first-same-as-last pair is its table over `explicit_rk::advance`, as dopri54.hpp is),
-an entry here, and a branch in the core's `integrate::advance`. A method here without that
-branch, or with other work rows than the core's, is refused at import
+explicit first-same-as-last pair is only its `Table` struct, which `explicit_rk::advance` and
+the bindings read, as dopri54.hpp's is), an entry here, and a branch in the core's
+`integrate::advance` (and, for an explicit pair, in the bindings' `method_tables`). A method
+here without that branch, or with other work rows than the core's, is refused at import
 (`stepper.check_methods`); test/test_integrate_methods.py checks the tables and that every
 method is dispatched, test/test_core_contract.py that the core has the same ids.
 """
