@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from collections.abc import Callable
 from functools import partial
 from pathlib import Path
 
@@ -172,11 +173,20 @@ def _pump_half_sine() -> tuple[Scene, SampleBatch]:
     return _half_sine_record(default_scene())
 
 
+def _on_verner65(build: Callable[[], tuple[Scene, SampleBatch]]) -> tuple[Scene, SampleBatch]:
+    """A case with its twin on `verner65`, the scene method its companion runs for
+    Dormand–Prince (the companion of a Verner twin: Verner at two steps an interval)."""
+    scene, samples = build()
+    integration = dataclasses.replace(scene.integration, method="verner65")
+    return dataclasses.replace(scene, integration=integration), samples
+
+
 CASES = {
     "stiff_light": (_stiff_light, [1e-3, 1e-6, 1e-7]),
     "stiff_light_rosenbrock": (partial(_stiff_light, "ros34pw2"), [1e-3, 1e-6, 1e-9]),
     "stiff_light_exponential": (partial(_stiff_light, "exprb32"), [1e-3]),
     "rubber_on_snubbers": (_rubber_on_snubbers, [1e-3, 1e-6]),
+    "rubber_on_snubbers_verner65": (partial(_on_verner65, _rubber_on_snubbers), [1e-3, 1e-6]),
     "hysteresis_snubbers_real_shock": (_hysteresis_snubbers_real_shock, [1e-3, 1e-6]),
     "pump_ship_motion": (_pump, [1e-4, 1e-9]),
     "pump_250hz": (partial(_pump, 4), [1e-6]),
