@@ -96,14 +96,11 @@ def _solve(
             return None, x
         jac = jacobian(x)
         within = bool((np.abs(r) <= tolerance(jac)).all())
-        try:
-            step = _limited(np.linalg.solve(jac, -r), limit)
-        except np.linalg.LinAlgError:  # a root where J is singular is a neutral rest: taken
+        landing = _newton_step(residual, x, r, jac, limit)
+        if landing is None:  # a root where J is singular is a neutral rest: taken
             return ((x, r, jac) if within else None), x
         norm = float(np.linalg.norm(r))
-        landed = x + step
-        r_landed = residual(landed)
-        landing = landed, r_landed
+        landed, r_landed = landing
         best = landing if within else _or_fine(residual, fine, x, r, landing, limit)
         if best is not None and np.linalg.norm(best[1]) < norm:
             x, r = best
@@ -114,7 +111,7 @@ def _solve(
         if ahead is not None:
             x, r = ahead
             continue
-        halved = _halved(residual, x, r, step, halvings)
+        halved = _halved(residual, x, r, landed - x, halvings)
         if halved is None:
             return None, x
         x, r = halved
