@@ -239,43 +239,31 @@ class Matcher:
         """`take` where the predictions decide the first body sample waiting and not the next
         (the live stream's usual case: a wake-up's row decides the sample it reaches), its run
         the twin's run the rows come in, the streams in step (None: otherwise, for `take` to
-        decide): `_match`'s arithmetic on it as Python floats (the same bits), the others left
-        waiting as they are, without `take`'s arrays."""
+        decide): `_match` on it alone, the others left waiting as they are, without `take`'s
+        concatenation of the waiting chunks."""
         all_ns, all_t, all_v, all_present, all_run = self._body[0]
         ns, t, v, present, run = all_ns[:1], all_t[:1], all_v[:1], all_present[:1], all_run[:1]
         series = self._pred.get(self._rows_run)
         if self._apart.found is not None or int(run[0]) != self._rows_run or series is None:
             return None
         assert series.first is not None  # (`_decides`: the run has rows, one at or past it)
-        pt, pv = series.t, series.v
+        pt = series.t
         rest = (all_ns[1:], all_t[1:], all_v[1:], all_present[1:], all_run[1:])
         waiting = ([rest] if rest[0].shape[0] else []) + self._body[1:]
         if waiting:  # the next decided too? (if not, none after it: a run's stamps rise)
             _, t_next, _, _, run_next = waiting[0]
             if run_next[0] == run[0] and float(t_next[0]) - self._lag <= pt[-1]:
                 return None
-        tau = float(t[0]) - self._lag  # (numpy's subtraction, the same bits)
-        why = "before_twin" if tau < series.first else "late" if tau < pt[0] else ""
-        if why:
-            predicted = np.zeros((1, 6))
-        else:
-            after = int(np.searchsorted(pt, tau, side="right"))
-            t0 = float(pt[after - 1])
-            if t0 == tau:  # at a row: its prediction (`_match`)
-                predicted = pv[after - 1 : after].copy()
-            else:
-                t1 = float(pt[after])
-                w = (tau - t0) / (t1 - t0)
-                predicted = (1.0 - w) * pv[after - 1 : after] + w * pv[after : after + 1]
-                why = "in_gap" if t1 - t0 > self._max_gap else ""
-            _trim(series, tau)
-        if why:
-            self._problems[why] += 1
+        why = np.array([""], object)
+        predicted = np.zeros((1, 6))
+        self._match(series, t - self._lag, why, predicted)
+        if why[0]:
+            self._problems[why[0]] += 1
         self._body, self._held = waiting, self._held - 1
         place = np.array([self.taken])
         self.taken += 1
         self._forget()
-        return Taken(ns, t, v, present, predicted, np.array([why], object), place, run)
+        return Taken(ns, t, v, present, predicted, why, place, run)
 
     def _decides(self) -> bool:
         """Whether the predictions may decide the first body sample waiting now (False: the
