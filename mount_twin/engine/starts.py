@@ -39,17 +39,14 @@ def at_rest(gathered: np.ndarray, tolerance: float) -> tuple[int, float]:
     consecutive parts: each part's mean within `tolerance` (m/s²) of the mean of those before
     it, up to the first that is not (a shock's, or a drift's). Returns (samples at rest, how
     far the first part not at rest lies from their mean m/s²; 0 where all are)."""
-    n = gathered.shape[0]
-    k = min(REST_BLOCKS, n)
-    size, extra = divmod(n, k)  # the first `extra` parts one longer, as np.array_split's
-    ends = [(i + 1) * size + min(i + 1, extra) for i in range(k)]
-    taken, total = ends[0], gathered[: ends[0]].sum(axis=0)
-    for end in ends[1:]:
-        part_sum = gathered[taken:end].sum(axis=0)  # over its count: np.mean's own reduction
-        off = float(np.linalg.norm(part_sum / (end - taken) - total / taken))
+    parts = np.array_split(gathered, min(REST_BLOCKS, gathered.shape[0]))
+    taken, total = parts[0].shape[0], parts[0].sum(axis=0)
+    for part in parts[1:]:
+        part_sum = part.sum(axis=0)  # over its count: np.mean's own reduction
+        off = float(np.linalg.norm(part_sum / part.shape[0] - total / taken))
         if off > tolerance:
             return taken, off
-        taken, total = end, total + part_sum
+        taken, total = taken + part.shape[0], total + part_sum
     return taken, 0.0
 
 
