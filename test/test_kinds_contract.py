@@ -245,6 +245,7 @@ def fake_kind(name: str = "end_stop") -> ModuleType:
     module.RESTUCK = ()
     module.PARAMETERS = {}
     module.N_PAR = 2
+    module.CONTACT_STIFFNESS = (0,)
     module.read = lambda r, name, position, rpy: None
     module.pack = lambda m: np.array([1.0e6, 1e-3])
     module.state_names = lambda m: ()
@@ -297,6 +298,15 @@ def test_an_event_table_of_another_length_than_the_events_is_refused(table: str)
     module = fake_kind()
     setattr(module, table, (False, True))
     with pytest.raises(KindContractError, match=f"{table} and EVENTS differ in length"):
+        check_modules({"end_stop": module})
+
+
+def test_a_contact_stiffness_outside_the_parameter_row_is_refused() -> None:
+    """The start's equilibrium softens the columns a kind names in CONTACT_STIFFNESS; one past
+    its N_PAR (here column 2 of a row of 2) would scale another kind's parameter or none."""
+    module = fake_kind()
+    module.CONTACT_STIFFNESS = (2,)
+    with pytest.raises(KindContractError, match="CONTACT_STIFFNESS names a column outside"):
         check_modules({"end_stop": module})
 
 

@@ -1,6 +1,8 @@
 """Mount kinds besides the linear one: each module is one place for a kind's scene keys and
 checks (`read`: every key read, then `Reader.finish`, then the checks across keys, so that a
-misspelt key is named rather than the check it makes fail), its parameter row (`pack`),
+misspelt key is named rather than the check it makes fail), its parameter row (`pack`; its
+columns of stiffnesses acting only past a clearance or gap, `CONTACT_STIFFNESS`, which the
+start's equilibrium softens and restores where it is not found at once),
 internal states (and which of them a restart resets: `RESTUCK`), force law (`load`), event
 functions (`monitor`), discrete switches between samples (`update`, which says whether it
 switched: the state then jumped, and a stepper must not start from a stage it took before;
@@ -64,6 +66,7 @@ MODULE_NAMES = (
     "RESTUCK",
     "PARAMETERS",
     "N_PAR",
+    "CONTACT_STIFFNESS",
     "read",
     "pack",
     "state_names",
@@ -104,6 +107,9 @@ def check_modules(kinds: Mapping[str, ModuleType]) -> None:
             raise KindContractError(msg)
         if name != module.KIND:
             msg = f"KINDS maps {name!r} to {module.__name__}, whose KIND is {module.KIND!r}"
+            raise KindContractError(msg)
+        if not all(0 <= col < module.N_PAR for col in module.CONTACT_STIFFNESS):
+            msg = f"kind {name!r}: CONTACT_STIFFNESS names a column outside its N_PAR"
             raise KindContractError(msg)
         for table in ("EVENT_ERROR", "EVENT_STIFFENS", "EVENT_SWITCHES"):
             if len(getattr(module, table)) != len(module.EVENTS):

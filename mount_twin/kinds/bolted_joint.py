@@ -77,6 +77,9 @@ PARAMETERS = {
 # parameter columns
 KS, KP, FV, FY, ALPHA, FU, EPU, MU, KT, CLEAR, KB, CAX, CSH = range(13)
 N_PAR = 13
+CONTACT_STIFFNESS = (KB,)
+"""Parameter columns of stiffnesses acting only past a clearance (the shank bearing on its
+hole), which the start's equilibrium may soften and restore (`model.assemble.CONTINUATION`)."""
 
 
 @dataclass(frozen=True)

@@ -69,6 +69,9 @@ TAB_C = TAB_X + TABLE_MAX
 N_AXIS = TAB_C + 4 * (TABLE_MAX - 1)
 ROT = 3 * N_AXIS
 N_PAR = ROT + 6
+CONTACT_STIFFNESS = tuple(j * N_AXIS + KS for j in range(3))
+"""Parameter columns of stiffnesses acting only past a gap (each axis's snubber k_s), which the
+start's equilibrium may soften and restore (`model.assemble.CONTINUATION`)."""
 
 
 @dataclass(frozen=True)

@@ -43,6 +43,9 @@ PARAMETERS = {
 # parameter columns: stiffness (3), damping (3), clearance, allowable force, engagement height
 K0, C0, CLEAR, FALLOW, HEIGHT = 0, 3, 6, 7, 8
 N_PAR = 9
+CONTACT_STIFFNESS = (K0, K0 + 1, K0 + 2)
+"""Parameter columns of stiffnesses acting only past a clearance (all of a key's), which the
+start's equilibrium may soften and restore (`model.assemble.CONTINUATION`)."""
 
 
 @dataclass(frozen=True)

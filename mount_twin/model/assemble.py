@@ -237,6 +237,38 @@ stiffness across its direction, μ·F_K/|e|, unlimited steps turned the body by 
 landed on far roots of the mounts' laws, the body turned by π or by whole turns."""
 
 
+CONTINUATION = 3
+"""Decades by which the start's equilibrium softens the mounts' contact stiffnesses (each
+kind's `CONTACT_STIFFNESS`: shanks bearing past a hole's clearance, keys, snubbers) where Newton
+does not find it at once: solved with them 10⁻¹ times as stiff, else 10⁻² or 10⁻³, then
+stiffened a decade at a time back to theirs, each solve from the last root. Stiff contacts that
+bear past a clearance, approached from within it (from faces sliding at their friction
+bounds, where nothing bears and Newton's step is singular or orders of magnitude long), have
+their root within the Jacobian's difference step of every contact's edge (1 kN on 1e10 N/m:
+1e-7 m): Newton's landings bear on some of them, the piece whose root lies elsewhere, and end
+creeping along the edges. Softer, the root lies deeper past the edges (a decade per decade),
+and as they stiffen it moves back towards them, each contact's penetration shrinking about as
+1/k_c with its force nearly held, the same contacts bearing: each decade's Newton starts on
+the piece of its root. Of 120 random heels onto bolted joints at 1e10 N/m, 11 were not found
+before (`bench/start_heels.py`, seed 0)."""
+
+
+def _contacts(nl: NonLinearMounts) -> np.ndarray:
+    """Mask of `nl.par`: the mounts' contact stiffnesses (each kind's `CONTACT_STIFFNESS`
+    columns) that are not 0."""
+    mask = np.zeros(nl.par.shape, dtype=bool)
+    for code, module in enumerate(KINDS.values()):
+        mask[np.ix_(nl.kind == code, module.CONTACT_STIFFNESS)] = True
+    return mask & (nl.par != 0.0)
+
+
+def _softened(arrays: ModelArrays, contacts: np.ndarray, scale: float) -> ModelArrays:
+    """`arrays` with the parameters at `contacts` (`_contacts`) times `scale`."""
+    nl = arrays.nl
+    assert nl is not None  # only scenes with contacts are softened
+    return arrays._replace(nl=nl._replace(par=np.where(contacts, scale * nl.par, nl.par)))
+
+
 def static_equilibrium(
     model: Model,
     y_guess: np.ndarray,
@@ -246,13 +278,14 @@ def static_equilibrium(
     loaded: bool = False,
 ) -> np.ndarray:
     """State at rest relative to F where the free generalized accelerations vanish (Newton on
-    the coordinates from those of `y_guess`; least squares where Newton does not get there),
+    the coordinates from those of `y_guess`, else from the contact stiffnesses softened and
+    restored, `CONTINUATION`; least squares where Newton does not get there),
     the foundation turning at `rate_rad_s` (rad/s, F; None: not turning); internal mount
     states as in `y_guess`, but with `loaded` each hysteretic one on its axis's loading curve
     at the pose (`model.loading`: a new machine set down slowly)."""
     nf = len(model.scene.dofs)
     q_guess = y_guess[:nf]
-    m, s = model.arrays, model.new_scratch()
+    m, s = model.arrays, model.new_scratch()  # m: the arrays solved with (`CONTINUATION`)
     u = gravity_input(0.0, specific_force, rate_rad_s)
     y = np.zeros(model.n_state)
     y[2 * nf :] = y_guess[2 * nf :]
@@ -288,7 +321,23 @@ def static_equilibrium(
 
     allowed_at = _allowed_residual(model, specific_force)
     turns = np.array([MAX_TURN if d in DOF_NAMES[3:] else np.inf for d in model.scene.dofs])
-    found = newton.find(accelerations, stiffness, q_guess, allowed_at, fine_stiffness, turns)
+
+    def search(q0: np.ndarray) -> newton.Found | None:
+        return newton.find(accelerations, stiffness, q0, allowed_at, fine_stiffness, turns)
+
+    found = search(q_guess)
+    contacts = np.zeros((0, 0), dtype=bool) if m.nl is None else _contacts(m.nl)
+    for decades in range(1, CONTINUATION + 1):
+        if found is not None or not contacts.any():
+            break
+        q = q_guess
+        for scale in 10.0 ** -np.arange(float(decades), -1.0, -1.0):
+            m = _softened(model.arrays, contacts, scale)  # the closures above read m
+            found = search(q)
+            if found is None:
+                break
+            q = found[0]
+        m = model.arrays
     if found is None:  # Newton did not get there: the robust solver says why
         from scipy.optimize import least_squares  # 0.2 s to import: only where Newton fails
 

@@ -16,7 +16,10 @@ least squares stalls too. `solve` follows the Newton steps of the piece it lands
 (semismooth Newton: each piece's own tangent; for a stiffening contact they fall
 monotonically from the stiff side), and near a root within a difference step of an edge
 takes a finer Jacobian. A load continuation would meet the same edge at one of its loads,
-and scaling r by the tangent does not remove a tangent that jumps.
+and scaling r by the tangent does not remove a tangent that jumps. A continuation in the
+contacts' stiffness is the caller's (`model.assemble.CONTINUATION`), where Newton does not get
+there: a root within a difference step of several stiff contacts' edges, reached from a
+plateau.
 
 Between a tangent and its jump r may be flat: a body within a key's clearance, or a bolted
 joint's face sliding at its friction bound μ·F_K, whatever the slide, until the shank bears on
