@@ -254,6 +254,22 @@ def test_a_key_pressed_within_and_past_its_clearance_is_the_closed_form(
     np.testing.assert_allclose(y[1], -KEY_MASS * f[2] / SPRING_K, rtol=1e-12)
 
 
+@pytest.mark.parametrize("key", [1e7, 1e9, 1e11])
+def test_a_key_along_z_carries_the_weight_from_within_its_clearance(key: float) -> None:
+    """KEY_MASS held along z by a key alone, KEY_CLEAR of clearance, z the one free DOF: the
+    body sinks through the clearance onto it, by hand Z = −(c + m·g/k_key), 9.8e-6–9.8e-10 m
+    past the edge. Before, none was found: at the guess nothing bears, J is 0, and the anchor
+    springs leaving a plateau had no scale to take (now the mounts' nominal tangent's)."""
+    stop = kind_mount("shear_key", "key", stiffness=[0.0, 0.0, key], clearance=KEY_CLEAR)
+    data = base_scene(KEY_MASS, [0.0, 0.0, 0.0], [1.0, 1.0, 1.0, 0, 0, 0], [stop], ["z"])
+    model = assemble(scene_from_dict(data, "<key along z test>"))
+    f = _heel(0.0)
+    y = initial_state(model, f)
+    z = -(KEY_CLEAR + KEY_MASS * G / key)
+    allowed = (1e-9 * G * KEY_MASS + 64.0 * EPS * key) / key  # m: the force floor over k_key
+    np.testing.assert_allclose(y[0], z, rtol=0.0, atol=allowed + 4.0 * EPS * abs(z))
+
+
 K_B = 5e8
 """N/m: the shank's bearing in its hole, and the key's stiffness, of `_in_clearances`."""
 
@@ -341,3 +357,29 @@ def test_frictionless_bolts_whose_shanks_never_bear_are_refused_at_load() -> Non
     is refused naming the DOFs (the body would drift), as before."""
     with pytest.raises(SceneError, match=r"mounts: no mount holds x, y, delta"):
         _in_clearances("bolted_joint", bearing=0.0)
+
+
+@pytest.mark.parametrize("cg", [(0.0, 0.0, 0.3), (0.1, -0.05, 0.3)])
+def test_a_block_on_keys_alone_heeled_from_within_their_clearances_balances_its_weight(
+    cg: tuple[float, float, float],
+) -> None:
+    """MASS on four keys at CORNERS bearing K_B along x, y and z past CLEAR, nothing else:
+    upright and centred it sinks by hand to Z = −(c + m·g/(4·k)); heeled 2 m/s² along x (CG
+    0.3 m up, and off centre) the keys' forces balance m·f and their moments about the CG
+    vanish, to the equilibrium's residual. Before, neither start was found (J 0 at the guess)."""
+    keys = [
+        kind_mount("shear_key", f"k{i}", (x, y, 0.0), stiffness=[K_B] * 3, clearance=CLEAR)
+        for i, (x, y) in enumerate(CORNERS)
+    ]
+    data = base_scene(MASS, list(cg), [100.0, 150.0, 200.0, 0.0, 0.0, 0.0], keys)
+    model = assemble(scene_from_dict(data, "<keys alone test>"))
+    if cg[:2] == (0.0, 0.0):
+        z = -(CLEAR + MASS * G / (4.0 * K_B))
+        allowed = _bearing_floor(K_B) / (4.0 * K_B)
+        np.testing.assert_allclose(model.nominal_state[2], z, rtol=0.0, atol=allowed)
+    f = _heel(2.0)
+    y = initial_state(model, f)
+    wrenches = _wrenches(model, y)
+    floor = _bearing_floor(K_B)
+    np.testing.assert_allclose(wrenches[:, :3].sum(axis=0), MASS * f, rtol=0.0, atol=floor)
+    np.testing.assert_allclose(_moment(model, y, wrenches), 0.0, rtol=0.0, atol=floor)

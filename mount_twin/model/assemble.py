@@ -322,8 +322,15 @@ def static_equilibrium(
     allowed_at = _allowed_residual(model, specific_force)
     turns = np.array([MAX_TURN if d in DOF_NAMES[3:] else np.inf for d in model.scene.dofs])
 
+    def tangent_scale() -> float:
+        """1/s²: the squared fastest mode on the mounts' nominal tangents, keys bearing
+        (`Model.tangent_rate`), J's scale where nothing bears at the guess."""
+        return model.tangent_rate**2
+
     def search(q0: np.ndarray) -> newton.Found | None:
-        return newton.find(accelerations, stiffness, q0, allowed_at, fine_stiffness, turns)
+        return newton.find(
+            accelerations, stiffness, q0, allowed_at, fine_stiffness, turns, tangent_scale
+        )
 
     found = search(q_guess)
     contacts = np.zeros((0, 0), dtype=bool) if m.nl is None else _contacts(m.nl)

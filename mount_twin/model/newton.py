@@ -268,17 +268,18 @@ def find(
     tolerance: Callable[[np.ndarray], np.ndarray],
     fine: Fine | None = None,
     limit: np.ndarray | None = None,
+    scale: Callable[[], float] | None = None,
 ) -> Found | None:
     """`solve` from x0, and where it does not get there, `anchored` from where it stopped: on
     a plateau of r, where J is singular or nearly so (at x0 within a clearance; or where a step
     landed with the friction faces sliding at their bounds, μ·F_K whatever the slide, before the
     shanks bear on their holes: the Newton step there is singular, or, where the faces slide
     along different directions, so long that it crosses the clearance by orders of magnitude).
-    None where neither gets there. Each step `_limited` by `limit`."""
+    None where neither gets there. Each step `_limited` by `limit`; `scale` as `anchored`'s."""
     found, stopped = _solve(residual, jacobian, x0, tolerance, MAX_HALVINGS, fine, limit)
     if found is not None:
         return found
-    return anchored(residual, jacobian, stopped, tolerance, fine, limit)
+    return anchored(residual, jacobian, stopped, tolerance, fine, limit, scale)
 
 
 def anchored(
@@ -288,22 +289,30 @@ def anchored(
     tolerance: Callable[[np.ndarray], np.ndarray],
     fine: Fine | None = None,
     limit: np.ndarray | None = None,
+    scale: Callable[[], float] | None = None,
 ) -> Found | None:
     """`solve` where J is singular or nearly so at x0 and about it, as inside a clearance (a
     key's gap, where the body is free until it bears) or along faces sliding at their friction
     bounds (r then constant, not zero, until the shanks bear): r(x) − ε·(x − x0) = 0, whose
-    anchor spring ε keeps J regular, for ε falling from 1e-2 to 1e-16 of |J|'s scale, each
-    from the last solution; then `solve` itself from there (bearing, J is regular again), each
-    with `fine` (a key bearing less than its stiffness times the difference step has its root
-    within that step of the clearance's edge). Where J is regular about x0 the anchors only
-    lead `solve` to its root. None where it does not get there (J at x0 is 0 or not finite; a
-    step does not converge)."""
+    anchor spring ε keeps J regular, for ε falling from 1e-2 to 1e-16 of |J|'s scale (its
+    largest entry at x0; where J at x0 is 0, `scale()`'s, r's units per x's: a body within
+    clearances along every direction, nothing else holding it, such as keys along z carrying
+    the weight from within their clearance), each from the last solution; then `solve` itself
+    from there (bearing, J is regular again), each with `fine` (a key bearing less than its
+    stiffness times the difference step has its root within that step of the clearance's
+    edge). Where J is regular about x0 the anchors only
+    lead `solve` to its root. None where it does not get there (J at x0 is not finite, or 0
+    without a `scale`; a step does not converge)."""
     jac0 = jacobian(x0)
-    scale = float(np.abs(jac0).max()) if np.isfinite(jac0).all() else 0.0
-    if not scale > 0.0:
+    if not np.isfinite(jac0).all():
+        return None
+    largest = float(np.abs(jac0).max())
+    if largest == 0.0 and scale is not None:
+        largest = scale()
+    if not largest > 0.0:
         return None
     x = np.array(x0, dtype=float)
-    for eps in scale * ANCHORS:
+    for eps in largest * ANCHORS:
 
         def pulled(z: np.ndarray, e: float = eps) -> np.ndarray:
             return residual(z) - e * (z - x0)
