@@ -333,9 +333,9 @@ def static_equilibrium(
         )
 
     found = search(q_guess)
-    contacts = np.zeros((0, 0), dtype=bool) if m.nl is None else _contacts(m.nl)
+    contacts = None if found is not None or m.nl is None else _contacts(m.nl)
     for decades in range(1, CONTINUATION + 1):
-        if found is not None or not contacts.any():
+        if found is not None or contacts is None or not contacts.any():
             break
         q = q_guess
         for scale in 10.0 ** -np.arange(float(decades), -1.0, -1.0):
