@@ -23,7 +23,7 @@ import numpy as np
 
 from mount_twin.errors import ModelError
 from mount_twin.model.assemble import Model, assemble, initial_state
-from mount_twin.physics.dynamics import body_motion, evaluate
+from mount_twin.physics.dynamics import evaluate
 from mount_twin.scene.loader import scene_from_dict
 
 G = 9.80665
@@ -102,10 +102,8 @@ def block(heel: Heel, bearing: float) -> Model:
 def imbalance(model: Model, y: np.ndarray, specific_force: np.ndarray) -> tuple[float, float]:
     """(N, N·m): |Σ mount forces − m·f| and |Σ mount moments about the CG| at the state y,
     from each mount's wrench at its attachment point (arms turned by the body's attitude)."""
-    wrenches = np.empty((model.n_mounts, 6))
-    evaluate(y, model.arrays, model.new_scratch(), np.empty(10), wrenches)
-    s = model.new_scratch()
-    body_motion(y, model.arrays, s)
+    wrenches, s = np.empty((model.n_mounts, 6)), model.new_scratch()
+    evaluate(y, model.arrays, s, np.empty(10), wrenches)  # s: the body's motion at y
     arms = np.array([mt.position for mt in model.scene.mounts]) - np.array(model.scene.body.cg)
     moment = np.cross(arms @ s.rot.T, wrenches[:, :3]).sum(axis=0) + wrenches[:, 3:].sum(axis=0)
     force = wrenches[:, :3].sum(axis=0) - model.scene.body.mass * specific_force

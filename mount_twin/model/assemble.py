@@ -334,17 +334,18 @@ def static_equilibrium(
 
     found = search(q_guess)
     contacts = None if found is not None or m.nl is None else _contacts(m.nl)
-    for decades in range(1, CONTINUATION + 1):
-        if found is not None or contacts is None or not contacts.any():
-            break
-        q = q_guess
-        for scale in 10.0 ** -np.arange(float(decades), -1.0, -1.0):
-            m = _softened(model.arrays, contacts, scale)  # the closures above read m
-            found = search(q)
-            if found is None:
+    if contacts is not None and contacts.any():
+        for decades in range(1, CONTINUATION + 1):
+            q = q_guess
+            for scale in 10.0 ** -np.arange(float(decades), -1.0, -1.0):
+                m = _softened(model.arrays, contacts, scale)  # the closures above read m
+                found = search(q)
+                if found is None:
+                    break
+                q = found[0]
+            m = model.arrays
+            if found is not None:
                 break
-            q = found[0]
-        m = model.arrays
     if found is None:  # Newton did not get there: the robust solver says why
         from scipy.optimize import least_squares  # 0.2 s to import: only where Newton fails
 
