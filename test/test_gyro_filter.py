@@ -69,6 +69,25 @@ def test_each_design_has_taps_of_its_own() -> None:
     fir_rows(np.ones((3, 2 * later.shape[0] - 1)), later, np.empty((3, 1)))
 
 
+@pytest.mark.parametrize("outputs", [1, 7, 8, 9, 15, 16, 17, 23, 24, 31, 33, 250])
+def test_the_filter_sums_in_its_documented_order_at_any_lane_width(outputs: int) -> None:
+    """`fir_rows` bit for bit against NumPy's elementwise sums in the order it documents
+    (h[N]·r[k], then + h[N + j]·(r[k − j] + r[k + j]) for j = 1..N): the same bits whether
+    an output falls in a block of AVX2's lanes, of SSE2's pairs or alone, so neither the
+    batching nor the processor changes a filtered rate."""
+    half = design(2000.0, PASSBAND_HZ, STOPBAND_HZ).half
+    n = half.shape[0] - 1
+    raw = np.random.default_rng(outputs).standard_normal((3, outputs + 2 * n))
+    expected = half[0] * raw[:, n : n + outputs]
+    for j in range(1, n + 1):
+        expected = expected + half[j] * (
+            raw[:, n - j : n - j + outputs] + raw[:, n + j : n + j + outputs]
+        )
+    out = np.empty((3, outputs))
+    fir_rows(raw, half, out)
+    np.testing.assert_array_equal(out.view(np.int64), expected.view(np.int64))
+
+
 @pytest.mark.parametrize(("m", "beta"), [(1, 5.0), (2, 5.0), (77, 9.4), (751, 9.4), (41, 0.0)])
 def test_the_window_is_numpys_kaiser(m: int, beta: float) -> None:
     """The power-series window against numpy's Chebyshev-series I₀ (its independent code)."""
