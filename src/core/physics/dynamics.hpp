@@ -14,6 +14,7 @@
 #include "dynamics_api.hpp"
 #include "linear_mount.hpp"
 #include "rotations.hpp"
+#include "small_angles.hpp"
 
 namespace mt::physics {
 
@@ -41,9 +42,7 @@ inline double body_motion(Vec y, const Model& m, Scratch& s, Motion& mo) {
     qd[3 + m.free_rot[k]] = y[nf + nt + k];
   }
   for (int i = 0; i < 3; ++i) {
-    const double angle = q[3 + i];  // one load: the compiler pairs sin and cos into sincos
-    trig[i] = std::sin(angle);
-    trig[3 + i] = std::cos(angle);
+    sin_cos(q[3 + i], trig[i], trig[3 + i]);
   }
   for (int i = 0; i < 6; ++i) {
     s.q[i] = q[i];
