@@ -9,7 +9,10 @@ against m·f for a body pitched and turned by the heel; a key pressed within and
 clearance beside a spring, by hand; a start with no bearing past the friction bound refused
 with the mounts that slide named; and a body held across only past clearances (frictionless
 joints, or keys), free within them and bearing past them by hand, heeled onto them at the
-closed form.
+closed form. A start whose faces slid leaves each stick point on its friction bound
+(`kinds.bolted_joint.settle`), a new machine's, a given one's and a restart's: admissible by
+the joint diagram's μ·F_K, its wrenches those of the start solved, and a foot moved back
+unloading its face by k_τ per metre at once, by hand.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from physics_helpers import base_scene, mount
 from mount_twin.engine.restart import start_state
 from mount_twin.errors import ModelError, SceneError
 from mount_twin.model.assemble import Model, assemble, initial_state
-from mount_twin.physics.dynamics import body_motion, evaluate
+from mount_twin.physics.dynamics import body_motion, evaluate, mount_deflections
 from mount_twin.scene.loader import scene_from_dict
 
 G = 9.80665
@@ -383,3 +386,130 @@ def test_a_block_on_keys_alone_heeled_from_within_their_clearances_balances_its_
     floor = _bearing_floor(K_B)
     np.testing.assert_allclose(wrenches[:, :3].sum(axis=0), MASS * f, rtol=0.0, atol=floor)
     np.testing.assert_allclose(_moment(model, y, wrenches), 0.0, rtol=0.0, atol=floor)
+
+
+def _faces(model: Model, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(d, s): each joint's deflection (m, its axes) at y's pose, (n, 3), and its stick point
+    (slip_x, slip_y) in y, (n, 2)."""
+    d = np.empty((model.n_mounts, 3))
+    assert mount_deflections(y, model.arrays, model.new_scratch(), d) > 0.0
+    index = {name: i for i, name in enumerate(model.state_names)}
+    s = [[y[index[f"{mt.name}.slip_{a}"]] for a in "xy"] for mt in model.scene.mounts]
+    return d, np.array(s)
+
+
+def _bound(d: np.ndarray, preload: float, friction: float) -> np.ndarray:
+    """N: each joint's friction bound μ·F_K at deflections d (m), F_K = max(F_V − k_P·u, 0)
+    (the joint diagram)."""
+    return friction * np.maximum(preload - K_P * d[:, 2], 0.0)
+
+
+def _unstuck(model: Model, y: np.ndarray) -> np.ndarray:
+    """y with every stick point at zero: the state the start's equilibrium was solved in."""
+    out = y.copy()
+    for i, name in enumerate(model.state_names):
+        if ".slip_" in name:
+            out[i] = 0.0
+    return out
+
+
+SLID = [((0.0, 0.0, 0.0), 3.0, 0.0, F_V, MU, 1e12), *TURNING[:3], TURNING[4], TURNING[8]]
+"""(as TURNING) heels whose faces all slide at the start: on the axis (CG in the joints'
+plane), then pitched, rolled and turned."""
+
+
+@pytest.mark.parametrize(("cg", "lateral", "azimuth", "preload", "friction", "bearing"), SLID)
+def test_a_start_whose_faces_slid_leaves_each_stick_point_on_its_friction_bound(
+    cg: tuple[float, float, float],
+    lateral: float,
+    azimuth: float,
+    preload: float,
+    friction: float,
+    bearing: float,
+) -> None:
+    """Admissible: every face's stick spring k_τ·|d − s| is on its bound μ·F_K (F_K from the
+    joint's own axial deflection), not beyond it, and the mounts' wrenches are those of the
+    start solved with the stick points at zero (to rounding: the radial return leaves the face
+    force μ·F_K along e), balancing m·f with no moment about the CG. Before, the stick points
+    stayed at zero: k_τ·|d|, the feet 1.0–1.003 mm across, was 538–9515 times the bound."""
+    model = _block(bearing, cg, preload, friction)
+    f = _heel(lateral, azimuth)
+    y = initial_state(model, f)
+    d, s = _faces(model, y)
+    bound = _bound(d, preload, friction)
+    spring = K_TAU * np.hypot(*(d[:, :2] - s).T)
+    np.testing.assert_allclose(spring, bound, rtol=1e-9, atol=1e-9)
+    wrenches = _wrenches(model, y)
+    np.testing.assert_allclose(wrenches, _wrenches(model, _unstuck(model, y)), rtol=0, atol=1e-9)
+    floor = _bearing_floor(bearing)
+    np.testing.assert_allclose(wrenches[:, :3].sum(axis=0), MASS * f, rtol=0.0, atol=floor)
+    np.testing.assert_allclose(_moment(model, y, wrenches), 0.0, rtol=0.0, atol=floor)
+
+
+@pytest.mark.parametrize("lateral", [3.0, 6.0])
+def test_a_face_that_slid_at_the_start_sticks_at_once_when_the_foot_moves_back(
+    lateral: float,
+) -> None:
+    """The block heeled along x onto shanks of 1e12 N/m (1e-9 m past the clearance), moved
+    back along +x by δ (a translation: each foot by δ' = δ in its axes, off its shank): the
+    face sticks on reversal and unloads by k_τ per metre, μ·F_K − k_τ·δ' (295 − 100 N at 3
+    m/s²); past 2·μ·F_K/k_τ (5.1–5.9e-7 m) it slides the other way, −μ·F_K. Before, the stick
+    point at zero, |e| = 1 mm: the face stayed at +μ·F_K until the foot had come back 1 mm."""
+    model = _block(1e12)
+    y = initial_state(model, _heel(lateral))
+    d, _ = _faces(model, y)
+    bound = _bound(d, F_V, MU)
+    for delta in (1e-7, 1e-6):
+        back = y.copy()
+        back[0] += delta
+        moved, _ = _faces(model, back)
+        assert (np.hypot(moved[:, 0], moved[:, 1]) < CLEAR).all()  # the shanks bear no more
+        reversed_by = moved[:, 0] - d[:, 0]  # δ': δ to the rounding of the feet's positions
+        np.testing.assert_allclose(reversed_by, delta, rtol=0.0, atol=1e-16)
+        np.testing.assert_allclose(moved[:, 1:] - d[:, 1:], 0.0, rtol=0.0, atol=1e-16)
+        face = np.where(reversed_by < 2.0 * bound / K_TAU, bound - K_TAU * reversed_by, -bound)
+        wrenches = _wrenches(model, back)
+        np.testing.assert_allclose(wrenches[:, 0], face, rtol=1e-9, atol=0.0)
+        np.testing.assert_allclose(wrenches[:, 1], 0.0, rtol=0.0, atol=1e-9)
+
+
+def _given(pose: list[float]) -> Model:
+    """MASS on `_joints(0.0)` started at the given `pose` (X, Y, Z m, angles rad; at rest)."""
+    initial = {"mode": "given", "pose": pose, "velocity": [0.0] * 6}
+    data = base_scene(MASS, [0.0] * 3, [100.0, 150.0, 200.0, 0.0, 0.0, 0.0], _joints(0.0))
+    data["initial_state"] = initial
+    return assemble(scene_from_dict(data, "<given slid test>"))
+
+
+@pytest.mark.parametrize("lift", [1e-7, 1e-6])
+def test_a_given_pose_past_the_friction_bound_or_open_starts_each_face_settled(
+    lift: float,
+) -> None:
+    """A given start translated by (−0.2, 0.1) mm across and `lift` up (each joint's d that
+    translation): closed at 0.1 µm (F_K = F_V − k_P·u = 650 N), the stick point by hand on
+    the bound along d, s = d − (μ·F_K/k_τ)·d/|d|; open at 1 µm (past F_V/k_P = 0.29 µm:
+    nothing holds the face), s = d. Before, s = 0 in both."""
+    d = np.array([-2e-4, 1e-4, lift])
+    model = _given([*d, 0.0, 0.0, 0.0])
+    y = initial_state(model, _heel(0.0))
+    _, s = _faces(model, y)
+    clamp = max(F_V - K_P * lift, 0.0)
+    across = d[:2] - MU * clamp / K_TAU * d[:2] / np.hypot(*d[:2])
+    np.testing.assert_allclose(s, [across] * 4, rtol=1e-12, atol=0.0)
+
+
+def test_a_restart_of_a_damaged_machine_under_a_heel_settles_its_faces() -> None:
+    """A restart keeps a stretched bolt (1 µm of plastic elongation at j0) and zeroes the stick
+    points its run left (`RESTUCK`, here 0.5 mm), then starts in the equilibrium under the
+    heel: there every face slid, and each is settled on its bound as a new machine's is."""
+    model = _block(5e8, (0.0, 0.0, 0.3))
+    nf = len(model.scene.dofs)
+    internal = model.nominal_state[2 * nf :].copy()
+    for i, name in enumerate(model.state_names[2 * nf :]):
+        internal[i] = {"j0.plastic_elongation": 1e-6}.get(name, 5e-4 if ".slip_" in name else 0)
+    f = _heel(3.0)
+    start = start_state(model, model.nominal_state, _heel(0.0), f, np.zeros(3), internal)
+    assert start.note is None and start.state is not None
+    d, s = _faces(model, start.state)
+    spring = K_TAU * np.hypot(*(d[:, :2] - s).T)
+    np.testing.assert_allclose(spring, _bound(d, F_V, MU), rtol=1e-9, atol=1e-9)

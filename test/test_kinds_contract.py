@@ -127,6 +127,29 @@ def test_every_code_runs_its_own_law_in_every_dispatcher(name: str) -> None:
             np.testing.assert_array_equal(got, own, err_msg=f"{dispatcher} for {name}")
 
 
+@pytest.mark.parametrize("name", list(KINDS))
+def test_every_kinds_settle_keeps_its_force_and_settles_once(name: str) -> None:
+    """A start's `settle` changes no force or couple of the kind's own load (the start's
+    equilibrium holds after it), and what it leaves it leaves as it is (an admissible state
+    needs no settling), over the realistic inputs: at rest, faces far past their friction
+    bound and open joints among them."""
+    rng = np.random.default_rng(11)
+    module = KINDS[name]
+    for x in realistic_inputs(name, rng):
+        forces = []
+        for settles in (0, 1, 2):
+            y = x["y"].copy()
+            for _ in range(settles):
+                module.settle(x["p"], y, 3, x["d"])
+            if settles == 1:
+                once = y.copy()
+            f, c, dydt = np.zeros(3), np.zeros(3), np.zeros(16)
+            module.load(x["p"], y, 3, x["d"], x["v"], x["phi"], x["w"], dydt, f, c)
+            forces.append(np.concatenate([f, c]))
+        np.testing.assert_allclose(forces[1], forces[0], rtol=1e-9, atol=1e-9, err_msg=name)
+        np.testing.assert_allclose(y, once, rtol=4.0 * np.finfo(float).eps, err_msg=name)
+
+
 def test_theprobe_input_tells_every_law_apart() -> None:
     """On the load-time probe's sample input, no two kinds' laws agree: a branch that runs
     another kind's law cannot pass the probe."""
@@ -250,6 +273,7 @@ def fake_kind(name: str = "end_stop") -> ModuleType:
     module.pack = lambda m: np.array([1.0e6, 1e-3])
     module.state_names = lambda m: ()
     module.load, module.monitor, module.update = _stop_load, _stop_monitor, _stop_update
+    module.settle = lambda p, y, o, d: None
     module.nominal_tangent = lambda m: ((1.0e6,) * 3 + (0.0,) * 3, ("stiffness",) * 6)
     return module
 
@@ -280,7 +304,7 @@ def test_crossed_branches_are_refused() -> None:
         check_dispatch(crossed)
 
 
-@pytest.mark.parametrize("name", ["update", "nominal_tangent"])
+@pytest.mark.parametrize("name", ["update", "settle", "nominal_tangent"])
 def test_a_module_lacking_part_of_the_contract_is_refused(name: str) -> None:
     """check_modules (run at import) names what a kind module lacks, and a KIND mismatch: a
     kind without its own nominal tangent cannot be taken for another (statics asks each)."""

@@ -7,10 +7,13 @@ internal states (and which of them a restart resets: `RESTUCK`), force law (`loa
 functions (`monitor`), discrete switches between samples (`update`, which says whether it
 switched: the state then jumped, and a stepper must not start from a stage it took before;
 `EVENT_SWITCHES` names the events that are such a switch, which a start reports too, and
-none of which may stiffen the scene: `auto` looks again at none a start makes) and
-its stiffness at the unstressed pose (`nominal_tangent`: statics, modes and `auto`'s first
-choice read it). A module's `load`, `monitor` and `update` are plain Python: the reference the
-compiled core's port of the kind (src/core/kinds/<kind>.hpp) is held to.
+none of which may stiffen the scene: `auto` looks again at none a start makes), a start's
+internal states made admissible at its pose (`settle`, run once a start's pose is found by
+`model.assemble.initial_state`: a face that slid put on its friction bound) and its
+stiffness at the unstressed pose (`nominal_tangent`: statics, modes and `auto`'s first choice
+read it). A module's `load`, `monitor` and `update` are plain Python: the reference the
+compiled core's port of the kind (src/core/kinds/<kind>.hpp) is held to; `settle` runs only in
+Python, at starts.
 
 The core's dispatchers (`kind_load`, `kind_monitor`, `kind_update` below) select a kind by its
 code; adding a kind is a new module here, a line in KINDS, its header in src/core/kinds/ with
@@ -73,6 +76,7 @@ MODULE_NAMES = (
     "load",
     "monitor",
     "update",
+    "settle",
     "nominal_tangent",
 )
 """What a kind module defines (see the module docstring of any kind)."""

@@ -49,11 +49,12 @@ monitors make is reported as that event at the start; the others holding at a st
 states there, not events."""
 STATES = ("plastic_elongation", "slip_x", "slip_y", "fractured")
 RESTUCK = ("slip_x", "slip_y")
-"""States a restart sets to zero: the joint face's stick point, where it stuck relative to a
-pose the restart discards. Kept, it would start the face loaded to its friction bound (the
-frame of a machine that slid before a gap pulled sideways while "at rest", and with broken
-bolts no equilibrium: friction at its bound holds no yaw). Plastic elongation and fracture are
-damage, and stay."""
+"""States a restart sets to zero before its equilibrium: the joint face's stick point, where it
+stuck relative to a pose the restart discards. Kept, it would start the face loaded to its
+friction bound (the frame of a machine that slid before a gap pulled sideways while "at rest",
+and with broken bolts no equilibrium: friction at its bound holds no yaw). Where the restart's
+pose then slides the face, `settle` puts the stick point back on the bound. Plastic elongation
+and fracture are damage, and stay."""
 ROTATIONAL = False
 """A single bolt carries no moment: `load` reads no local rotation or rate and gives no couple."""
 
@@ -285,6 +286,27 @@ def monitor(p, y, y0, o, d, v, g) -> float:
     f_s = bolt_force(p, u, e_p, broken)
     g[3] = 1.0 if broken > 0.5 else max(f_s / p[FU] - 1.0, e_p / p[EPU] - 1.0)
     return f_s / p[FY]
+
+
+def settle(p, y, o, d) -> None:
+    """A start's stick point made admissible at the deflection d (m, local axes), in y from o:
+    the radial return of rate-independent friction. A start solves its pose with the stick
+    point it is given (zero for a new machine and after `RESTUCK`), the face force clamped to
+    μ·F_K where the pose deflects the face further than μ·F_K/k_τ; left there, the stick spring
+    would hold k_τ·|e| far above the bound, and a foot moving back would keep the face at μ·F_K,
+    sliding no more, until it had come back by |e| − μ·F_K/k_τ. Here, where k_τ·|e| > μ·F_K
+    (e = d − s_p), s_p ← d − (μ·F_K/k_τ)·e/|e|: on the bound along e, so that the face sticks
+    at once on reversal and unloads by k_τ per metre; where nothing holds the face (the joint
+    open, or μ = 0: μ·F_K = 0), s_p ← d (e = 0); else s_p stays. The face force, and so the
+    start's equilibrium, is unchanged (to rounding)."""
+    ex, ey = d[0] - y[o + 1], d[1] - y[o + 2]
+    limit = p[MU] * max(p[FV] - p[KP] * d[2], 0.0)
+    tau = p[KT] * math.sqrt(ex * ex + ey * ey)
+    if limit <= 0.0:
+        y[o + 1], y[o + 2] = d[0], d[1]
+    elif tau > limit:
+        scale = limit / tau
+        y[o + 1], y[o + 2] = d[0] - scale * ex, d[1] - scale * ey
 
 
 def update(p, y, o, d) -> bool:

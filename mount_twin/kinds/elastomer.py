@@ -366,6 +366,12 @@ def monitor(p, y, y0, o, d, v, g) -> float:
     return util
 
 
+def settle(p, y, o, d) -> None:
+    """A start's states need no settling: a Bouc–Wen z anywhere within ±z_max is a state of
+    the law (a new machine's on its loading curve, `model.loading`; a restart's as its run left
+    it; a given start's zero), and the snubbers have none."""
+
+
 def update(p, y, o, d) -> bool:
     """No discrete state: never switches."""
     return False

@@ -141,6 +141,10 @@ def _engaged(p, d) -> bool:
     return p[HEIGHT] <= 0.0 or d[2] <= p[HEIGHT]
 
 
+def settle(p, y, o, d) -> None:
+    """A key has no internal state to settle at a start."""
+
+
 def update(p, y, o, d) -> bool:
     """No discrete state: never switches."""
     return False

@@ -19,6 +19,7 @@ from mount_twin.physics.dynamics import (
     ModelArrays,
     NonLinearMounts,
     Scratch,
+    mount_deflections,
     mount_monitors,
     new_scratch,
     rhs,
@@ -205,7 +206,9 @@ def initial_state(
     its mounts carrying the centrifugal load too (a deck that rolls at the first sample).
     `internal`: the mounts' internal states to start with (a restart keeps a broken bolt
     broken and a yielded one stretched); None: a new machine, its internal states zero but its
-    hysteretic ones on their loading curves (`model.loading`) in equilibrium mode.
+    hysteretic ones on their loading curves (`model.loading`) in equilibrium mode. Either way,
+    the start's internal states are then made admissible at its pose (`settle`: a joint face
+    that slid put on its friction bound).
     """
     scene = model.scene
     nf = len(scene.dofs)
@@ -215,9 +218,29 @@ def initial_state(
     y0[nf : 2 * nf] = np.array(scene.initial.velocity)[idx]
     if internal is not None:
         y0[2 * nf :] = internal
-    if scene.initial.mode == "given":
-        return y0
-    return static_equilibrium(model, y0, specific_force, rate_rad_s, loaded=internal is None)
+    y = y0
+    if scene.initial.mode != "given":
+        y = static_equilibrium(model, y0, specific_force, rate_rad_s, loaded=internal is None)
+    settle(model, y)
+    return y
+
+
+def settle(model: Model, y: np.ndarray) -> None:
+    """Each non-linear mount's internal states in y made admissible at y's pose, in place (its
+    kind's `settle` at its local deflection): a start's pose is found with the states it is
+    given, which need not be states of the law there (a joint face's stick point zero where
+    the pose deflects the face past its friction bound). The mounts' forces, and so an
+    equilibrium, are unchanged (to rounding). Every start, a new machine's or a restart's,
+    equilibrium or given, comes through `initial_state`, which calls this once."""
+    nl = model.arrays.nl
+    if nl is None:
+        return
+    d = np.empty((nl.kind.shape[0], 3))
+    on_chart = mount_deflections(y, model.arrays, model.new_scratch(), d) > 0.0
+    assert on_chart, "a start's pose is on the chart: the loader checks a given one"
+    kinds = list(KINDS.values())
+    for row, code in enumerate(nl.kind.tolist()):
+        kinds[code].settle(nl.par[row], y, int(nl.state[row]), d[row])
 
 
 FINE_STEP = 1e-12
