@@ -2,11 +2,13 @@
 
 A restart (a gap, a stamp jumping back, a stepper failure) discards the motion but keeps the
 mounts' damage: a broken bolt stays broken, a yielded one stretched. What it resets is the
-kinds' `RESTUCK` states (a friction face's stick point, relative to the discarded pose). The
-machine as it is then starts at rest in its own equilibrium: under the start specific force,
-else (a restart inside a shock) under nominal gravity. A damaged machine may have none (nothing
-holds it any more, e.g. a machine hanging from bolts that broke): then there is no state to
-start from, and the twin publishes nothing rather than a pose it is not in.
+kinds' `RESTUCK` states (a friction face's stick point, relative to the discarded pose), which
+the start then settles at its own pose (`model.assemble.settle`: a face that slid there on its
+friction bound). The machine as it is then starts at rest in its own equilibrium: under the
+start specific force, else (a restart inside a shock) under nominal gravity. A damaged machine
+may have none (nothing holds it any more, e.g. a machine hanging from bolts that broke): then
+there is no state to start from, and the twin publishes nothing rather than a pose it is not
+in.
 """
 
 from __future__ import annotations

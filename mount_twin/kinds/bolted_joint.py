@@ -294,17 +294,21 @@ def settle(p, y, o, d) -> None:
     point it is given (zero for a new machine and after `RESTUCK`), the face force clamped to
     μ·F_K where the pose deflects the face further than μ·F_K/k_τ; left there, the stick spring
     would hold k_τ·|e| far above the bound, and a foot moving back would keep the face at μ·F_K,
-    sliding no more, until it had come back by |e| − μ·F_K/k_τ. Here, where k_τ·|e| > μ·F_K
+    sliding no more, until it had come back by |e| − μ·F_K/k_τ. Here, where k_τ·|e| > μ·F_K > 0
     (e = d − s_p), s_p ← d − (μ·F_K/k_τ)·e/|e|: on the bound along e, so that the face sticks
-    at once on reversal and unloads by k_τ per metre; where nothing holds the face (the joint
-    open, or μ = 0: μ·F_K = 0), s_p ← d (e = 0); else s_p stays. The face force, and so the
-    start's equilibrium, is unchanged (to rounding)."""
+    at once on reversal and unloads by k_τ per metre. The face force, and so the start's
+    equilibrium, is unchanged (to rounding).
+
+    A face that nothing holds (the joint open, or μ = 0: μ·F_K = 0) keeps its stick point, as
+    `load` keeps e while the joint is open: its force is zero whatever s_p. Moved to d, e = 0
+    exactly would turn `monitor`'s slip function (k_τ·|d − s_p| of the previous sample, with
+    no floor where the bound is zero) from −1 at the start to positive at the first sample
+    whose rounding moves the foot (2e-35 m on a hung machine at rest), a `joint_slipped` event
+    at rest."""
     ex, ey = d[0] - y[o + 1], d[1] - y[o + 2]
     limit = p[MU] * max(p[FV] - p[KP] * d[2], 0.0)
     tau = p[KT] * math.sqrt(ex * ex + ey * ey)
-    if limit <= 0.0:
-        y[o + 1], y[o + 2] = d[0], d[1]
-    elif tau > limit:
+    if 0.0 < limit < tau:
         scale = limit / tau
         y[o + 1], y[o + 2] = d[0] - scale * ex, d[1] - scale * ey
 
