@@ -24,10 +24,13 @@ import pytest
 from kinds_helpers import kind_mount
 from physics_helpers import base_scene, mount
 
+from mount_twin.engine.batch import SampleBatch
+from mount_twin.engine.engine import TwinEngine
 from mount_twin.engine.restart import start_state
 from mount_twin.errors import ModelError, SceneError
 from mount_twin.model.assemble import Model, assemble, initial_state
 from mount_twin.physics.dynamics import body_motion, evaluate, mount_deflections
+from mount_twin.physics.pose_row import ANGLES_COLS, POSITION_COLS
 from mount_twin.scene.loader import scene_from_dict
 
 G = 9.80665
@@ -509,3 +512,28 @@ def test_a_restart_of_a_damaged_machine_under_a_heel_settles_its_faces() -> None
     d, s = _faces(model, start.state)
     spring = K_TAU * np.hypot(*(d[:, :2] - s).T)
     np.testing.assert_allclose(spring, _bound(d, F_V, MU), rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize(("cg", "lateral", "azimuth", "preload", "friction", "bearing"), SLID)
+def test_a_start_whose_faces_slid_rests_without_slip_events(
+    cg: tuple[float, float, float],
+    lateral: float,
+    azimuth: float,
+    preload: float,
+    friction: float,
+    bearing: float,
+) -> None:
+    """Held at the start's heel for 40 ms, the block stays where it started and logs no event:
+    its faces, settled on their bounds, move only by the rounding of a body at rest (some 1e-15
+    m a sample), which is no slip (`bolted_joint.SLIP_FLOOR`; without it these heels logged
+    hundreds of `joint_slipped` events at rest)."""
+    model = _block(bearing, cg, preload, friction)
+    f = _heel(lateral, azimuth)
+    n = 40
+    stamps = 1.0 + 1e-3 * np.arange(n)
+    engine = TwinEngine(model)
+    out = engine.run(SampleBatch(stamps, np.tile(f, (n, 1)), np.zeros((n, 3)), ["imu"] * n))
+    assert engine.events == []
+    for cols in (POSITION_COLS, ANGLES_COLS):  # m, rad
+        moved = out.pose[:, cols] - out.pose[:1, cols]
+        np.testing.assert_allclose(moved, 0.0, rtol=0.0, atol=1e-12)

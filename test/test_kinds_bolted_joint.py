@@ -24,6 +24,8 @@ import pytest
 from kinds_helpers import Law, along, drive, kind_mount, law_of, leg, nodes, quasi_static
 from scipy.integrate import quad
 
+from mount_twin.kinds.bolted_joint import SLIP_FLOOR
+
 A_S, R_P02, R_M = 245e-6, 640e6, 800e6  # m², Pa, Pa: M20 8.8
 F_Y, F_U = A_S * R_P02, A_S * R_M  # 156.8 kN, 196 kN
 K_S, K_P, F_V = 7e8, 3.5e9, 1e5  # N/m, N/m, N
@@ -210,7 +212,8 @@ def test_the_joint_face_sticks_then_slides_at_mu_times_the_clamp_force(axis, u_a
     stuck = np.abs(x - slip) < half * (1 - 1e-9)
     assert np.all(g[stuck] < 0.0)
     if f_k > 0.0:
-        assert np.max(np.abs(g[~stuck])) <= 1e-9 * MU * F_V
+        # on the bound: the slip function's floor below 0 (SLIP_FLOOR: rounding is no slip)
+        assert np.max(np.abs(g[~stuck] + K_T * SLIP_FLOOR)) <= 1e-9 * MU * F_V
         return
     # open: the face carries no shear once it has slid; the engine judges the trial state
     # (slip frozen at the previous sample), on which every move slides
@@ -226,15 +229,19 @@ def test_the_joint_face_sticks_then_slides_at_mu_times_the_clamp_force(axis, u_a
 def test_an_open_face_with_no_shear_on_it_does_not_slip() -> None:
     """Opened, the face's friction bound is 0: with no shear on it the slip function was
     0 − 0 = 0, and every joint_opened came with a joint_slipped (a WARN, stamped at the
-    sample, not at a crossing). Any shear on an open face slips."""
+    sample, not at a crossing). Any shear on an open face past SLIP_FLOOR slips."""
     law = joint()
     for u in (U_OPEN, 2.0 * U_OPEN):
         g = law.monitor([0.0, 0.0, u], y=law.states())[1]
         assert g[EVENT["joint_opened"]] >= 0.0 and g[EVENT["joint_slipped"]] < 0.0
-        g = law.monitor([1e-12, 0.0, u], y=law.states())[1]
-        assert g[EVENT["joint_slipped"]] == pytest.approx(K_T * 1e-12, rel=1e-9)
+        g = law.monitor([1e-9, 0.0, u], y=law.states())[1]
+        assert g[EVENT["joint_slipped"]] == pytest.approx(K_T * (1e-9 - SLIP_FLOOR), rel=1e-9)
+        g = law.monitor([1e-13, 0.0, u], y=law.states())[1]
+        assert g[EVENT["joint_slipped"]] < 0.0, "rounding's shear on an open face is no slip"
     closed = law.monitor([0.0, 0.0, 0.5 * U_OPEN], y=law.states())[1]
-    assert closed[EVENT["joint_slipped"]] == pytest.approx(-MU * 0.5 * F_V, rel=1e-12)
+    assert closed[EVENT["joint_slipped"]] == pytest.approx(
+        -MU * 0.5 * F_V - K_T * SLIP_FLOOR, rel=1e-12
+    )
 
 
 def play_operator(x: np.ndarray, half_width: np.ndarray) -> np.ndarray:

@@ -85,6 +85,10 @@ inline void load(const double* p, Vec y, idx o, const double* d, const double* v
   c[2] = 0.0;
 }
 
+/// m: the trial slip past the friction bound in one sample below which `monitor` sees no slip
+/// (bolted_joint.py SLIP_FLOOR).
+inline constexpr double SLIP_FLOOR = 1e-12;
+
 /// Event functions into g (order of EVENTS; ≥ 0: happening); returns the utilisation F_S/F_y.
 /// Yield and slip are judged on the trial state (e_p and slip frozen at y0, the previous
 /// sample's state).
@@ -97,7 +101,7 @@ inline double monitor(const double* p, Vec y, Vec y0, idx o, const double* d,
   g[1] = p[KP] * u - p[FV];
   const double tx = p[KT] * (d[0] - sx), ty = p[KT] * (d[1] - sy);
   const double shear = std::sqrt(tx * tx + ty * ty), bound = p[MU] * py_max(p[FV] - p[KP] * u, 0.0);
-  g[2] = shear > 0.0 || bound > 0.0 ? shear - bound : -1.0;  // open, unsheared: no slip
+  g[2] = shear - bound - p[KT] * SLIP_FLOOR;
   const double f_s = bolt_force(p, u, e_p, broken);
   g[3] = broken > 0.5 ? 1.0 : py_max(f_s / p[FU] - 1.0, e_p / p[EPU] - 1.0);
   return f_s / p[FY];
