@@ -236,8 +236,9 @@ def settle(model: Model, y: np.ndarray) -> None:
     if nl is None:
         return
     d = np.empty((nl.kind.shape[0], 3))
-    on_chart = mount_deflections(y, model.arrays, model.new_scratch(), d) > 0.0
-    assert on_chart, "a start's pose is on the chart: the loader checks a given one"
+    if not mount_deflections(y, model.arrays, model.new_scratch(), d) > 0.0:
+        # the loader holds a given pose within the chart, an equilibrium is found on it
+        raise ModelError("the start's pose is off the α/γ/δ chart: no mount deflections")
     kinds = list(KINDS.values())
     for row, code in enumerate(nl.kind.tolist()):
         kinds[code].settle(nl.par[row], y, int(nl.state[row]), d[row])
