@@ -421,22 +421,17 @@ SLID = [((0.0, 0.0, 0.0), 3.0, 0.0, F_V, MU, 1e12), *TURNING[:3], TURNING[4], TU
 plane), then pitched, rolled and turned."""
 
 
-@pytest.mark.parametrize(("cg", "lateral", "azimuth", "preload", "friction", "bearing"), SLID)
+@pytest.mark.parametrize("heel", SLID)
 def test_a_start_whose_faces_slid_leaves_each_stick_point_on_its_friction_bound(
-    cg: tuple[float, float, float],
-    lateral: float,
-    azimuth: float,
-    preload: float,
-    friction: float,
-    bearing: float,
+    heel: tuple,
 ) -> None:
     """Admissible: every face's stick spring k_τ·|d − s| is on its bound μ·F_K (F_K from the
     joint's own axial deflection), not beyond it, and the mounts' wrenches are those of the
     start solved with the stick points at zero (to rounding: the radial return leaves the face
     force μ·F_K along e), balancing m·f with no moment about the CG. Before, the stick points
     stayed at zero: k_τ·|d|, the feet 1.0–1.003 mm across, was 538–9515 times the bound."""
-    model = _block(bearing, cg, preload, friction)
-    f = _heel(lateral, azimuth)
+    cg, lateral, azimuth, preload, friction, bearing = heel
+    model, f = _block(bearing, cg, preload, friction), _heel(lateral, azimuth)
     y = initial_state(model, f)
     d, s = _faces(model, y)
     bound = _bound(d, preload, friction)
@@ -514,21 +509,14 @@ def test_a_restart_of_a_damaged_machine_under_a_heel_settles_its_faces() -> None
     np.testing.assert_allclose(spring, _bound(d, F_V, MU), rtol=1e-9, atol=1e-9)
 
 
-@pytest.mark.parametrize(("cg", "lateral", "azimuth", "preload", "friction", "bearing"), SLID)
-def test_a_start_whose_faces_slid_rests_without_slip_events(
-    cg: tuple[float, float, float],
-    lateral: float,
-    azimuth: float,
-    preload: float,
-    friction: float,
-    bearing: float,
-) -> None:
+@pytest.mark.parametrize("heel", SLID)
+def test_a_start_whose_faces_slid_rests_without_slip_events(heel: tuple) -> None:
     """Held at the start's heel for 40 ms, the block stays where it started and logs no event:
     its faces, settled on their bounds, move only by the rounding of a body at rest (some 1e-15
     m a sample), which is no slip (`bolted_joint.SLIP_FLOOR`; without it these heels logged
     hundreds of `joint_slipped` events at rest)."""
-    model = _block(bearing, cg, preload, friction)
-    f = _heel(lateral, azimuth)
+    cg, lateral, azimuth, preload, friction, bearing = heel
+    model, f = _block(bearing, cg, preload, friction), _heel(lateral, azimuth)
     n = 40
     stamps = 1.0 + 1e-3 * np.arange(n)
     engine = TwinEngine(model)
