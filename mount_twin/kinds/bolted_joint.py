@@ -208,6 +208,11 @@ def bolt_force(p: np.ndarray, u: float, e_p: float, broken: float) -> float:
     return max(p[FV] + p[KS] * (u - e_p), 0.0)
 
 
+def clamp_force(p: np.ndarray, u: float) -> float:
+    """Clamp force F_K = max(F_V − k_P·u, 0), N, at the axial deflection u (m): 0 once open."""
+    return max(p[FV] - p[KP] * u, 0.0)
+
+
 def yield_limit(p: np.ndarray, e_p: float) -> float:
     """Current yield force, N: linear hardening with the post-yield tangent α·k_S."""
     return p[FY] + p[ALPHA] * p[KS] / (1.0 - p[ALPHA]) * e_p
@@ -224,7 +229,7 @@ def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
     e_p, sx, sy, broken = y[o], y[o + 1], y[o + 2], y[o + 3]
     u, ud = d[2], v[2]
     f_s = bolt_force(p, u, e_p, broken)
-    f_k = max(p[FV] - p[KP] * u, 0.0)
+    f_k = clamp_force(p, u)
     flow = broken < 0.5 and f_s >= yield_limit(p, e_p) and ud > 0.0
     dydt[o] = (1.0 - p[ALPHA]) * ud if flow else 0.0
     dydt[o + 3] = 0.0
@@ -292,7 +297,7 @@ def monitor(p, y, y0, o, d, v, g) -> float:
     g[0] = bolt_force(p, u, e_t, broken) - yield_limit(p, e_t) if broken < 0.5 else -1.0
     g[1] = p[KP] * u - p[FV]
     tx, ty = p[KT] * (d[0] - sx), p[KT] * (d[1] - sy)
-    shear, bound = math.sqrt(tx * tx + ty * ty), p[MU] * max(p[FV] - p[KP] * u, 0.0)
+    shear, bound = math.sqrt(tx * tx + ty * ty), p[MU] * clamp_force(p, u)
     g[2] = shear - bound - p[KT] * SLIP_FLOOR
     f_s = bolt_force(p, u, e_p, broken)
     g[3] = 1.0 if broken > 0.5 else max(f_s / p[FU] - 1.0, e_p / p[EPU] - 1.0)
@@ -316,7 +321,7 @@ def settle(p, y, o, d) -> None:
     A face left on its bound is on the verge of sliding: `monitor` sees no slip in the rounding
     of a body at rest (SLIP_FLOOR)."""
     ex, ey = d[0] - y[o + 1], d[1] - y[o + 2]
-    limit = p[MU] * max(p[FV] - p[KP] * d[2], 0.0)
+    limit = p[MU] * clamp_force(p, d[2])
     tau = p[KT] * math.sqrt(ex * ex + ey * ey)
     if 0.0 < limit < tau:
         scale = limit / tau
