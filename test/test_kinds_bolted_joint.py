@@ -24,6 +24,7 @@ import pytest
 from kinds_helpers import Law, along, drive, kind_mount, law_of, leg, nodes, quasi_static
 from scipy.integrate import quad
 
+from mount_twin.kinds import BOLTED_JOINT, N_PAR, kind_carry
 from mount_twin.kinds.bolted_joint import SLIP_FLOOR
 
 A_S, R_P02, R_M = 245e-6, 640e6, 800e6  # m², Pa, Pa: M20 8.8
@@ -362,3 +363,54 @@ def test_a_circular_slide_dissipates_friction_times_the_slip_circle_per_turn():
     ends = np.stack([radius * np.cos(t_eval), radius * np.sin(t_eval)])
     stick = np.linalg.norm(ends - run.states[SLIP_X : SLIP_Y + 1], axis=0)
     np.testing.assert_allclose(stick[100:], D_STICK, rtol=1e-7)
+
+
+def carried(
+    twin: tuple[tuple[float, float, float], tuple[float, float]],
+    before: tuple[float, float],
+    after: tuple[float, float],
+    d: tuple[float, float, float],
+) -> np.ndarray:
+    """The core's carry of the M20 joint: the companion's stick point `after` its error's kick,
+    `before` it, at deflection d (m), beside the twin's deflection and stick point `twin`.
+    Returns the companion's states (e_p 1e-6 and broken 0 as kicked: kept)."""
+    law = joint()
+    p = np.zeros(N_PAR)  # the core's row: every kind's columns
+    p[: law.p.shape[0]] = law.p
+    y = law.states(1e-6, *after, 0.0)
+    y0 = law.states(2e-6, *before, 0.0)
+    yt = law.states(0.0, *twin[1], 0.0)
+    kind_carry(BOLTED_JOINT, p, y, y0, yt, 0, np.array(d), np.array(twin[0]))
+    return y
+
+
+def test_beside_a_sliding_twin_the_companions_face_slides_on_its_bound_along_its_own_e():
+    """The twin's face on its bound (k_τ·|e| = μ·F_K): the companion's stick point, its kick
+    undone, is put on its own bound along its own e, whatever side of it it stood."""
+    twin = ((2 * D_STICK, 0.0, 0.0), (D_STICK, 0.0))
+    for before in ((D_STICK + 3e-6, 1e-6), (D_STICK - 4e-6, -2e-6)):
+        d = (2 * D_STICK + 1e-6, 0.0, 0.0)
+        y = carried(twin, before, (5e-3, 5e-3), d)
+        e = np.array(d[:2]) - np.array(before)
+        s = np.array(d[:2]) - D_STICK * e / np.hypot(*e)
+        assert y[SLIP_X : SLIP_Y + 1] == pytest.approx(s, rel=1e-12, abs=1e-18)
+        assert np.hypot(d[0] - y[SLIP_X], d[1] - y[SLIP_Y]) == pytest.approx(D_STICK, rel=1e-12)
+        assert (y[E_P], y[BROKEN]) == (1e-6, 0.0)
+
+
+def test_beside_a_sticking_twin_the_companions_face_keeps_its_carried_stick_point():
+    """The twin's face inside its bound: the companion's stick point is the one it carried,
+    its kick undone, inside its bound; past it, radial return onto it (`settle`)."""
+    twin = ((D_STICK / 2, 0.0, 0.0), (0.0, 0.0))
+    y = carried(twin, (1e-6, 0.0), (5e-3, 5e-3), (D_STICK / 2, 0.0, 0.0))
+    assert (y[SLIP_X], y[SLIP_Y]) == (1e-6, 0.0)
+    y = carried(twin, (0.0, 0.0), (5e-3, 5e-3), (0.0, 3 * D_STICK, 0.0))
+    assert (y[SLIP_X], y[SLIP_Y]) == pytest.approx((0.0, 2 * D_STICK), rel=1e-12)
+
+
+def test_an_open_companion_face_keeps_its_kick():
+    """Past U_OPEN nothing holds the face (μ·F_K = 0): its stick point moves with the foot at
+    a rate, and the companion keeps what the kick gave it."""
+    twin = ((0.0, 0.0, 2 * U_OPEN), (0.0, 0.0))
+    y = carried(twin, (1e-6, 0.0), (4e-6, -3e-6), (0.0, 0.0, 2 * U_OPEN))
+    assert (y[SLIP_X], y[SLIP_Y]) == (4e-6, -3e-6)

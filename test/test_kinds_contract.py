@@ -112,13 +112,17 @@ def realistic_inputs(name: str, rng: np.random.Generator) -> list[dict[str, np.n
                     "g": np.full(N_EVENTS, 0.25),
                 }
             )
+            d = inputs[-1]["d"]  # the twin beside the companion, as `carry` sees it
+            inputs[-1]["dt"] = d + rng.uniform(-0.1, 0.1, 3) * np.abs(d)
+            inputs[-1]["yt"] = y + rng.uniform(-1e-6, 1e-6, 16) * (y != 0.0)
     return inputs
 
 
 @pytest.mark.parametrize("name", list(KINDS))
 def test_every_code_runs_its_own_law_in_every_dispatcher(name: str) -> None:
-    """kind_load, kind_monitor and kind_update with the kind's code give exactly what the kind
-    module's own load, monitor and update give, on its real parameters over its whole range."""
+    """kind_load, kind_monitor, kind_update and kind_carry with the kind's code give exactly what
+    the kind module's own load, monitor, update and carry give, on its real parameters over its
+    whole range."""
     rng = np.random.default_rng(7)
     code, module = CODES[name], KINDS[name]
     for x in realistic_inputs(name, rng):
@@ -264,6 +268,7 @@ def fake_kind(name: str = "end_stop") -> ModuleType:
     module.EVENT_ERROR = (False,)
     module.EVENT_STIFFENS = (True,)
     module.EVENT_SWITCHES = (False,)
+    module.EVENT_CARRIED = (True,)
     module.ROTATIONAL = False
     module.RESTUCK = ()
     module.PARAMETERS = {}
@@ -274,6 +279,7 @@ def fake_kind(name: str = "end_stop") -> ModuleType:
     module.state_names = lambda m: ()
     module.load, module.monitor, module.update = _stop_load, _stop_monitor, _stop_update
     module.settle = lambda p, y, o, d: None
+    module.carry = lambda p, y, y0, yt, o, d, dt: None
     module.nominal_tangent = lambda m: ((1.0e6,) * 3 + (0.0,) * 3, ("stiffness",) * 6)
     return module
 
@@ -304,7 +310,7 @@ def test_crossed_branches_are_refused() -> None:
         check_dispatch(crossed)
 
 
-@pytest.mark.parametrize("name", ["update", "settle", "nominal_tangent"])
+@pytest.mark.parametrize("name", ["update", "settle", "carry", "nominal_tangent"])
 def test_a_module_lacking_part_of_the_contract_is_refused(name: str) -> None:
     """check_modules (run at import) names what a kind module lacks, and a KIND mismatch: a
     kind without its own nominal tangent cannot be taken for another (statics asks each)."""
@@ -316,7 +322,9 @@ def test_a_module_lacking_part_of_the_contract_is_refused(name: str) -> None:
         check_modules({"other_name": fake_kind()})
 
 
-@pytest.mark.parametrize("table", ["EVENT_ERROR", "EVENT_STIFFENS", "EVENT_SWITCHES"])
+@pytest.mark.parametrize(
+    "table", ["EVENT_ERROR", "EVENT_STIFFENS", "EVENT_SWITCHES", "EVENT_CARRIED"]
+)
 def test_an_event_table_of_another_length_than_the_events_is_refused(table: str) -> None:
     """Each event has its level and whether it may stiffen the scene (`auto` looks again)."""
     module = fake_kind()

@@ -7,15 +7,20 @@ internal states (and which of them a restart resets: `RESTUCK`), force law (`loa
 functions (`monitor`), discrete switches between samples (`update`, which says whether it
 switched: the state then jumped, and a stepper must not start from a stage it took before;
 `EVENT_SWITCHES` names the events that are such a switch, which a start reports too, and
-none of which may stiffen the scene: `auto` looks again at none a start makes), a start's
+none of which may stiffen the scene: `auto` looks again at none a start makes; `EVENT_CARRIED`
+those the error estimate's companion carries its error through, the others having it
+integrated over an interval that starts with them holding, `engine.companion`), a start's
 internal states made admissible at its pose (`settle`, run once a start's pose is found by
-`model.assemble.initial_state`: a face that slid put on its friction bound) and its
+`model.assemble.initial_state`: a face that slid put on its friction bound), the error
+estimate's companion after its carried error's kick (`carry`: its rate-independent states, a
+face's stick point, carried and returned onto its bound, `engine.companion`) and its
 stiffness at the unstressed pose (`nominal_tangent`: statics, modes and `auto`'s first choice
-read it). A module's `load`, `monitor` and `update` are plain Python: the reference the
-compiled core's port of the kind (src/core/kinds/<kind>.hpp) is held to; `settle` runs only in
-Python, at starts.
+read it). A module's `load`, `monitor`, `update` and `carry` are plain Python: the reference
+the compiled core's port of the kind (src/core/kinds/<kind>.hpp) is held to; `settle` runs
+only in Python, at starts.
 
-The core's dispatchers (`kind_load`, `kind_monitor`, `kind_update` below) select a kind by its
+The core's dispatchers (`kind_load`, `kind_monitor`, `kind_update`, `kind_carry` below) select
+a kind by its
 code; adding a kind is a new module here, a line in KINDS, its header in src/core/kinds/ with
 a line in KIND_NAMES and a branch in each dispatcher of dispatch.hpp. The integrator and the
 engine never change.
@@ -28,10 +33,10 @@ The contract is checked, so a forgotten step cannot run another kind's law:
   the engine reports it, never another kind's answer;
 - `check_dispatch` (run by `model.assemble` before the first model with such mounts) drives
   every code through every dispatcher on a sample input and compares with the kind's own
-  `load`, `monitor` and `update`; a missing or crossed branch is a `KindContractError` at load.
-  It also holds a kind that declares `ROTATIONAL = False` to it: the right-hand side then
-  leaves its local rotation and rate uncomputed (NaN) and takes no couple from it, so its
-  `load` must give finite forces, rates and a zero couple with NaN there.
+  `load`, `monitor`, `update` and `carry`; a missing or crossed branch is a
+  `KindContractError` at load. It also holds a kind that declares `ROTATIONAL = False` to it:
+  the right-hand side then leaves its local rotation and rate uncomputed (NaN) and takes no
+  couple from it, so its `load` must give finite forces, rates and a zero couple with NaN there.
 """
 
 from __future__ import annotations
@@ -65,6 +70,7 @@ MODULE_NAMES = (
     "EVENT_ERROR",
     "EVENT_STIFFENS",
     "EVENT_SWITCHES",
+    "EVENT_CARRIED",
     "ROTATIONAL",
     "RESTUCK",
     "PARAMETERS",
@@ -77,6 +83,7 @@ MODULE_NAMES = (
     "monitor",
     "update",
     "settle",
+    "carry",
     "nominal_tangent",
 )
 """What a kind module defines (see the module docstring of any kind)."""
@@ -100,6 +107,10 @@ kind_update = _core.kind_update
 """kind_update(code, p, y, o, d) -> switched: the kind's `update` as the core runs it: discrete
 switches between samples. An unknown code writes NaN into the state (its own, or y[0] for a
 kind without states; the next step fails) and returns True."""
+kind_carry = _core.kind_carry
+"""kind_carry(code, p, y, y0, yt, o, d, dt): the kind's `carry` as the core runs it: the error
+estimate's companion after its carried error's kick (y after it, y0 before it, yt the twin's
+state; d, dt their deflections). An unknown code writes NaN into y[max(o, 0)]."""
 
 
 def check_modules(kinds: Mapping[str, ModuleType]) -> None:
@@ -115,7 +126,7 @@ def check_modules(kinds: Mapping[str, ModuleType]) -> None:
         if not all(0 <= col < module.N_PAR for col in module.CONTACT_STIFFNESS):
             msg = f"kind {name!r}: CONTACT_STIFFNESS names a column outside its N_PAR"
             raise KindContractError(msg)
-        for table in ("EVENT_ERROR", "EVENT_STIFFENS", "EVENT_SWITCHES"):
+        for table in ("EVENT_ERROR", "EVENT_STIFFENS", "EVENT_SWITCHES", "EVENT_CARRIED"):
             if len(getattr(module, table)) != len(module.EVENTS):
                 msg = f"kind {name!r}: {table} and EVENTS differ in length"
                 raise KindContractError(msg)
@@ -160,7 +171,9 @@ _PROBE_STATE_OFFSET, _PROBE_STATES = 3, 16
 _LOAD_ARGS = ("p", "y", "o", "d", "v", "phi", "w", "dydt", "f", "c")
 _MONITOR_ARGS = ("p", "y", "y0", "o", "d", "v", "g")
 _UPDATE_ARGS = ("p", "y", "o", "d")
-"""Arguments of a kind's load, monitor and update (after the code, for the dispatchers)."""
+_CARRY_ARGS = ("p", "y", "y0", "yt", "o", "d", "dt")
+"""Arguments of a kind's load, monitor, update and carry (after the code, for the
+dispatchers)."""
 
 
 def probe_input(n_par: int, n_events: int, seed: int) -> dict[str, np.ndarray]:
@@ -179,6 +192,8 @@ def probe_input(n_par: int, n_events: int, seed: int) -> dict[str, np.ndarray]:
         "f": np.full(3, 0.25),
         "c": np.full(3, 0.25),
         "g": np.full(n_events, 0.25),
+        "yt": rng.uniform(0.1, 0.9, _PROBE_STATES),
+        "dt": rng.uniform(-1.0e-3, 1.0e-3, 3),
     }
 
 
@@ -192,6 +207,7 @@ def dispatch_results(
         ("kind_load", kind_load, module.load, _LOAD_ARGS, ("f", "c", "dydt")),
         ("kind_monitor", kind_monitor, module.monitor, _MONITOR_ARGS, ("g",)),
         ("kind_update", kind_update, module.update, _UPDATE_ARGS, ("y",)),
+        ("kind_carry", kind_carry, module.carry, _CARRY_ARGS, ("y",)),
     ):
         results = []
         for fn, lead in ((dispatcher, (code,)), (own, ())):
@@ -210,10 +226,11 @@ _checked: set[tuple[str, ...]] = set()
 
 
 def check_dispatch(kinds: Mapping[str, ModuleType] | None = None, samples: int = 2) -> None:
-    """Raise KindContractError unless kind_load, kind_monitor and kind_update run, for the code
-    of each kind in `kinds` (default KINDS; code = index), that kind's own function (same
-    outputs to 1e-12, finite, on `samples` sample inputs): the core's port of each kind against
-    its Python reference. Done once per process for KINDS (about a millisecond)."""
+    """Raise KindContractError unless kind_load, kind_monitor, kind_update and kind_carry run,
+    for the code of each kind in `kinds` (default KINDS; code = index), that kind's own
+    function (same outputs to 1e-12, finite, on `samples` sample inputs): the core's port of
+    each kind against its Python reference. Done once per process for KINDS (about a
+    millisecond)."""
     kinds = KINDS if kinds is None else kinds
     key = tuple(kinds)
     if kinds is KINDS and key in _checked:

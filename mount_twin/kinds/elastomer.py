@@ -26,6 +26,8 @@ EVENTS = ("snubber_contact", "over_travel")
 EVENT_ERROR = (False, True)
 EVENT_STIFFENS = (True, False)
 """A snubber that touches stiffens the mount (`auto` looks again); over-travel is in contact."""
+EVENT_CARRIED = (True, True)
+"""A snubber's contact is a law of the state: the carried error follows it (`engine.companion`)."""
 EVENT_SWITCHES = (False, False)
 """No event is a discrete switch (`update` never switches)."""
 RESTUCK: tuple[str, ...] = ()
@@ -370,6 +372,11 @@ def settle(p, y, o, d) -> None:
     """A start's states need no settling: a Bouc–Wen z anywhere within ±z_max is a state of
     the law (a new machine's on its loading curve, `model.loading`; a restart's as its run left
     it; a given start's zero), and the snubbers have none."""
+
+
+def carry(p, y, y0, yt, o, d, dt) -> None:
+    """The error estimate's companion after its carried error's kick (bolted_joint.carry):
+    a Bouc–Wen z has a rate: the kick carries its error, and nothing is returned."""
 
 
 def update(p, y, o, d) -> bool:

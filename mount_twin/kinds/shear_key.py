@@ -22,6 +22,8 @@ EVENT_ERROR = (False, True)
 EVENT_STIFFENS = (True, False)
 """A key that closes its clearance stiffens the scene (`auto` looks again); overload is in
 contact."""
+EVENT_CARRIED = (True, True)
+"""A key's contact is a law of the state: the carried error follows it (`engine.companion`)."""
 EVENT_SWITCHES = (False, False)
 """No event is a discrete switch (`update` never switches): a key past its allowable force at
 a start is a state there, not an event."""
@@ -143,6 +145,11 @@ def _engaged(p, d) -> bool:
 
 def settle(p, y, o, d) -> None:
     """A key has no internal state to settle at a start."""
+
+
+def carry(p, y, y0, yt, o, d, dt) -> None:
+    """The error estimate's companion after its carried error's kick (bolted_joint.carry):
+    a key has no internal state."""
 
 
 def update(p, y, o, d) -> bool:

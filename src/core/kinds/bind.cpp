@@ -1,8 +1,8 @@
 // Python bindings of the core's kinds (mount_twin._core.kind_load, kind_monitor, kind_update,
-// KIND_NAMES, N_PAR, N_EVENTS): the dispatchers of dispatch.hpp on numpy float64 arrays, for
-// mount_twin.kinds.check_dispatch and the tests. Every array is checked (dtype, contiguity,
-// length) and every index the law will use is checked to lie inside its array, so a wrong
-// argument raises TypeError/ValueError naming it instead of reaching the law.
+// kind_carry, KIND_NAMES, N_PAR, N_EVENTS): the dispatchers of dispatch.hpp on numpy float64
+// arrays, for mount_twin.kinds.check_dispatch and the tests. Every array is checked (dtype,
+// contiguity, length) and every index the law will use is checked to lie inside its array, so
+// a wrong argument raises TypeError/ValueError naming it instead of reaching the law.
 #include <pybind11/pybind11.h>
 
 #include <string>
@@ -94,6 +94,18 @@ inline bool update(idx code, py::handle p_, py::handle y_, idx o, py::handle d_)
   return kinds::kind_update(code, p.d, y, o, d);
 }
 
+inline void carry(idx code, py::handle p_, py::handle y_, py::handle y0_, py::handle yt_, idx o,
+                  py::handle d_, py::handle dt_) {
+  const Vec p = par(p_, code);
+  const Vec y = state(y_, code, p, o);
+  if (kinds::kind_states(code, p.d) < 0 && y.n == 0) {
+    throw py::value_error("y: empty, where an unknown kind code writes NaN into y[max(o, 0)]");
+  }
+  const Vec y0 = convert::vec(y0_, "y0", y.n);
+  const Vec yt = convert::vec(yt_, "yt", y.n);
+  kinds::kind_carry(code, p.d, y, y0, yt, o, vec3(d_, "d"), vec3(dt_, "dt"));
+}
+
 }  // namespace kinds_bind
 
 void bind_kinds(pybind11::module_& m) {
@@ -130,6 +142,18 @@ p: (>= N_PAR,) parameter row; y, y0: (n,) state now and at the previous sample; 
 the mount's states (-1: none); d: (3,) local deflection, m; v: (3,) its rate, m/s;
 g: (>= the kind's event count,) out, entries past the kind's count untouched.
 An unknown code writes NaN into all of g and returns NaN.)doc");
+
+  m.def("kind_carry", &kinds_bind::carry, "code"_a, "p"_a, "y"_a, "y0"_a, "yt"_a, "o"_a, "d"_a,
+        "dt"_a,
+        R"doc(The rate-independent states of a mount of kind `code` in the error estimate's companion,
+after its carried error's kick (a bolted joint's plastic elongation and stick point, returned
+onto the yield line and the friction bound where the twin's bolt flows or face is on its bound,
+or the companion's passes them), in place in y's entries from o.
+
+p: (>= N_PAR,) parameter row; y: (n,) the companion's state after the kick; y0: (n,) before
+it; yt: (n,) the twin's state; o: offset of the mount's states (-1: none); d, dt: (3,) the
+companion's and the twin's local deflections, m.
+An unknown code writes NaN into y[max(o, 0)].)doc");
 
   m.def("kind_update", &kinds_bind::update, "code"_a, "p"_a, "y"_a, "o"_a, "d"_a,
         R"doc(Discrete switches of a mount of kind `code` between samples (e.g. a bolt that breaks), in

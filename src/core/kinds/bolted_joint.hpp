@@ -120,6 +120,39 @@ inline bool update(const double* p, Vec y, idx o, const double* d) {
   return false;
 }
 
+/// The companion's bolt and face after its carried error's kick (engine/kernel.hpp
+/// carry_interval; bolted_joint.py carry says why): y the companion's state after the kick, y0
+/// the state the kick started from, yt the twin's; d, dt the companion's and the twin's
+/// deflections (m, local axes). Where the twin's bolt flows or the companion's passes its yield
+/// force, the companion's e_p on its hardening line at its u. While μ·F_K > 0 the stick point's
+/// error is carried, not kicked (s ← y0's), then, where the twin's face is on its bound or the
+/// companion's passes its own, put on the bound along e (radial return). An open face keeps
+/// its kick (ṡ = v there).
+inline void carry(const double* p, Vec y, Vec y0, Vec yt, idx o, const double* d,
+                  const double* dt) {
+  if (y[o + 3] < 0.5 && yt[o + 3] < 0.5) {
+    const bool flows = bolt_force(p, dt[2], yt[o], 0.0) >= yield_limit(p, yt[o]);
+    if (flows || bolt_force(p, d[2], y[o], 0.0) > yield_limit(p, y[o])) {
+      const double line = p[KS] + p[ALPHA] * p[KS] / (1.0 - p[ALPHA]);
+      y[o] = py_max((p[FV] + p[KS] * d[2] - p[FY]) / line, 0.0);
+    }
+  }
+  const double limit = p[MU] * py_max(p[FV] - p[KP] * d[2], 0.0);
+  if (!(limit > 0.0)) return;
+  y[o + 1] = y0[o + 1];
+  y[o + 2] = y0[o + 2];
+  const double ex = d[0] - y[o + 1], ey = d[1] - y[o + 2];
+  const double tau = p[KT] * std::sqrt(ex * ex + ey * ey);
+  const double twin_limit = p[MU] * py_max(p[FV] - p[KP] * dt[2], 0.0);
+  const double tx = dt[0] - yt[o + 1], ty = dt[1] - yt[o + 2];
+  const bool on_bound = twin_limit > 0.0 && p[KT] * std::sqrt(tx * tx + ty * ty) >= twin_limit;
+  if (tau > 0.0 && (on_bound || tau > limit)) {
+    const double scale = limit / tau;
+    y[o + 1] = d[0] - scale * ex;
+    y[o + 2] = d[1] - scale * ey;
+  }
+}
+
 /// Internal states of a joint (all joints have them). For the bindings' checks.
 inline idx states(const double* /*p*/) { return N_STATES; }
 

@@ -70,6 +70,17 @@ inline bool kind_update(idx code, const double* p, Vec y, idx o, const double* d
   return true;
 }
 
+/// The kind's carry: the companion's rate-independent states after its carried error's kick
+/// (y after the kick, y0 before it, yt the twin's; d, dt their deflections). An unknown code
+/// writes NaN into y[max(o, 0)].
+inline void kind_carry(idx code, const double* p, Vec y, Vec y0, Vec yt, idx o, const double* d,
+                       const double* dt) {
+  if (code == ELASTOMER) return elastomer::carry(p, y, y0, yt, o, d, dt);
+  if (code == BOLTED_JOINT) return bolted_joint::carry(p, y, y0, yt, o, d, dt);
+  if (code == SHEAR_KEY) return shear_key::carry(p, y, y0, yt, o, d, dt);
+  y[o > 0 ? o : 0] = NOT_A_NUMBER;
+}
+
 /// Internal states the kind reads and writes from o for the row p (-1: unknown code). For the
 /// bindings' checks.
 inline idx kind_states(idx code, const double* p) {

@@ -115,6 +115,10 @@ inline double monitor(const double* p, Vec /*y*/, Vec /*y0*/, idx /*o*/, const d
   return util;
 }
 
+/// The companion after its carried error's kick (bolted_joint.hpp carry): A Bouc–Wen z has a rate: its kick carries it. Nothing to return.
+inline void carry(const double* /*p*/, Vec /*y*/, Vec /*y0*/, Vec /*yt*/, idx /*o*/,
+                  const double* /*d*/, const double* /*dt*/) {}
+
 /// No discrete state: never switches.
 inline bool update(const double* /*p*/, Vec /*y*/, idx /*o*/, const double* /*d*/) {
   return false;

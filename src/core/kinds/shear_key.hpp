@@ -66,6 +66,10 @@ inline double monitor(const double* p, Vec /*y*/, Vec /*y0*/, idx /*o*/, const d
   return 0.0;
 }
 
+/// The companion after its carried error's kick (bolted_joint.hpp carry): A key has no internal state.
+inline void carry(const double* /*p*/, Vec /*y*/, Vec /*y0*/, Vec /*yt*/, idx /*o*/,
+                  const double* /*d*/, const double* /*dt*/) {}
+
 /// No discrete state: never switches.
 inline bool update(const double* /*p*/, Vec /*y*/, idx /*o*/, const double* /*d*/) {
   return false;
