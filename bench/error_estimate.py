@@ -1,7 +1,8 @@
 """The live error estimate against the true error, and its cost, per tolerance.
 
 For the cases of test/test_error_estimate.py (a stiff, light body at its stability limit;
-hysteretic rubber hitting its snubbers; the bundled pump under ship motion), each rtol's true
+hysteretic rubber hitting its snubbers; the bundled pump under ship motion; the bundled bolted,
+keyed genset under its 10 kHz shock bag), each rtol's true
 mount-force error against a reference run (the same twin at rtol 1e-12 on the input refined
 8×), the twin's own estimate of it, their ratio, the attitude errors, substeps per sample, and
 the engine's wall time with the estimate over without it (side by side).
@@ -18,8 +19,7 @@ The cost is one run each way; with `--repeats N`, the best of N runs each way, a
 
 `--sampled` gives every scene the sampled estimator (`engine.estimator`), the non-linear ones
 included, which the engine gives the companion (`engine.companion`): how honest and how dear
-the cheaper method is where mounts slip, open and hit their stops. The case `genset` (the
-bundled bolted, keyed genset under its 10 kHz shock bag) and the cases `hysteretic_N` (N = 4,
+the cheaper method is where mounts slip, open and hit their stops. The cases `hysteretic_N` (N = 4,
 16, 64, 256 Bouc–Wen elastomers on a grid under the same 200 kg body, together as stiff as
 four, 2 s of the pump's ship motion: how the estimate's cost grows with the mounts) are run
 only when named in `--cases`.
@@ -40,17 +40,7 @@ from physics_helpers import base_scene
 from test_error_estimate import CASES, _ship_motion, _with_pump_input
 
 from mount_twin.analysis.accuracy import RESOLVED, measure, reference_run, resolution, run_at
-from mount_twin.commands.common import share_dir
 from mount_twin.engine import driver
-from mount_twin.io.input_samples import read_samples
-from mount_twin.scene.loader import load_scene_file
-
-
-def _genset():
-    root = share_dir()
-    scene = load_scene_file(root / "config" / "genset_bolted_keyed.scene.yaml")
-    return scene, read_samples(root / "bags" / "genset_shock_10khz", scene.input)
-
 
 HYSTERETIC_COUNTS = (4, 16, 64, 256)
 
@@ -93,7 +83,6 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rtol", type=float, nargs="+", default=[1e-3, 1e-4, 1e-5, 1e-6, 1e-7])
     builds = {name: build for name, (build, _) in CASES.items()}
-    builds["genset"] = _genset
     for n in HYSTERETIC_COUNTS:
         builds[f"hysteretic_{n}"] = partial(_hysteretic, n)
     parser.add_argument(

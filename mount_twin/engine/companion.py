@@ -1,60 +1,83 @@
 """The live error estimate where the model has non-linear mounts: a companion solution of the
 twin of a smaller error (models of linear mounts take the cheaper `engine.estimator`, which is
 not cheaper here: on the bolted genset at rtol 1e-6 it read 0.92 of the true error at 2.8–3.3×
-the engine's time against this one's 0.95 at 2.1×, 0.99 since it holds its step after a
-rejection, 1.00 at 2.0× since it runs Verner's pair; see there).
+the engine's time; see there).
 
 Richardson's global error estimate (Hairer, Nørsett & Wanner, *Solving Ordinary Differential
-Equations I*, §II.4 and §II.12): integrate the same problem twice, the published solution y and
-a companion ŷ of smaller error e/r; then y − ŷ = (1 − 1/r)·e: the difference is the published
-solution's error, not a bound on a local error norm (which is what the stepper's `error_norm`
-is: it tracks rtol, not the error). The companion runs with rtol and atol divided by
-TOLERANCE_DIVISOR = 8 (an adaptive step's error, hence the global error, 8× smaller: r ≈ 8, the
-estimate 0.88·e). Where the twin's steps are set by the samples, not its tolerance (one step an
-interval), one step of the twin's own method would be the twin again (r = 1, the estimate 0):
-where the twin runs Dormand–Prince 5(4) the companion runs Verner's 6(5) pair
-(`integrate.verner65`) at least one step an interval (a 6th-order step of the same length: its
-error a small share of the twin's; 8 new right-hand sides a step against the 12 of the two
-Dormand–Prince steps it replaced, which halved the step, r = 2⁵); where `auto` moved the twin to
-a linearising method (`ros34pw2`, `exprb32`) it runs that method at least MIN_STEPS = 2 steps an
-interval (HIGHER, `own_method`; `switch` follows the twin). Right after a rejected step it grows
-no step (`integrate.settings` HOLD_AFTER_REJECT, the rule of Hairer, Nørsett & Wanner's DOPRI5
-code), which the twin's stepper does not: on the bolted genset under its shock the joints' faces
-between sticking and sliding make the error of a step jump with its length, and a step grown at
-once from one accepted with a tiny error was rejected again, and again (two Dormand–Prince
-steps: its right-hand sides 13.9 a sample without the rule, 13.5 with it; the twin's 7.4, which
-the rule would not have changed; docs/benchmarks.md). Verner's "most efficient" 6(5) pair was
-tried first and dropped: its weights of ±176 on stages 0.05 % of a step apart make its error
-estimate's rounding, ε·176·|f|·h, dominate at tight tolerances (the genset at rtol 1e-9: 115
-right-hand sides a sample where two Dormand–Prince steps take 34, the robust pair 29). Measured
-against a reference on the non-smooth scenes the companion serves (hysteretic rubber on
-snubbers, the genset's joints and keys, Bouc–Wen elastomers) at rtol 1e-3 … 1e-9, the estimate
-is 0.69–1.08 of the true error (test/test_error_estimate.py, docs/scene.md "Error estimate";
-0.69–0.75 where both take one step an interval at loose tolerances, Verner's error a quarter of
-the twin's). With two Dormand–Prince steps a divisor of 32 gave 0.93–1.3 but cost 10× the
-integration on the bolted genset, where tight tolerances hunt across switches; 4 cost 3× there
-and gave 0.54. With Verner's pair a divisor of 4 saves 0.7 of its 12.6 right-hand sides a sample
-on the genset at rtol 1e-6 and reads 0.71 of the true error at rtol 1e-3 (8: 0.89); 2 saves 1.2
-and reads 0.57 (docs/benchmarks.md). The companion reads the same held input, takes the same
-discrete mount switches between samples, and restarts with the twin.
+Equations I*, §II.4 and §II.12): the published solution y and a companion ŷ of smaller error;
+y − ŷ is the published solution's error, not a bound on a local error norm (which is what the
+stepper's `error_norm` is: it tracks rtol, not the error).
 
-Cost: the engine takes 2.0× as long with it on the bolted genset at rtol 1e-6, 2.1× on 256
-Bouc–Wen elastomers (bench/error_estimate.py, docs/scene.md "Error estimate"; 2.1× and 2.3× with
-two Dormand–Prince steps): its right-hand sides, 12.6 a sample on the genset against the twin's
-7.7 (floor 8: the rest are rejections and extra steps at the joints' switches under the shock),
-are more than the twin's work, whatever the mounts. Followed on a second thread it would hide in
-wall time only up to its own loop, the slower one: measured on the genset, the run's wall time
-fell from 48–53 to 41 ms and its CPU time rose to 59–60 ms (not kept; a live node's runs of one
-sample would gain nothing). `integration.error_estimate: false` turns it off. It never touches
-the twin's state: the published numbers are identical with it on or off
+**Carried** (src/core/engine/kernel.hpp `carry_interval`). The companion is kept as the twin's
+state plus its error e, and e is carried interval by interval, eₙ₊₁ = Φₙ(eₙ) + ℓₙ (the "Lady
+Windermere's fan", *ibid.* §II.3), instead of integrated a second time:
+
+- Φₙ by symplectic Euler through one right-hand side of the non-linear law itself: the body's
+  position errors drift by h·(their rates' errors), then the rates' and internal states' errors
+  are kicked by h·(f(t₁, y + e) − f(t₁, y)), f(t₁, y) being the twin's last stage (free). It is
+  a difference of the law, not a linearisation: a snubber met or a key closed in the companion
+  and not in the twin is in it, with no Jacobian and no switch rule. Symplectic Euler keeps a
+  free mode's error amplitude where h·ω < 2; an interval is carried only where h times the body's
+  fastest mode on its mounts' tangents (`Model.tangent_rate`, KICK_RATE) is within KICK_LIMIT = 1
+  (the bolted genset at 10 kHz: 0.36; at 1 kHz, 3.6, carried it read 1e6 times its true error);
+- a kind's rate-independent states are not kicked but returned by the kind's `carry` (a bolted
+  joint's stick point onto its friction bound, its bolt's plastic elongation onto its yield
+  line, where the twin's is there or the companion's passes it): kicked, a sliding face's
+  stick point, whose rate turns with e as μ·F_K/k_τ goes to 0, read the genset 18.6 and 1090
+  times its true error at rtol 1e-6 and 1e-8;
+- ℓₙ measured, not modelled: the twin's end state less one step of the companion's stepper
+  (below) from the twin's start state, at every special interval (a mount's switch or an event
+  function changing sign, a rejected step, an error norm over SPIKE_RATIO times its running
+  mean, the first after a restart) and every CARRY_CHECK_EVERY = 32 intervals; the intervals
+  between add the last measured ℓ scaled by the twin's error norms (at most SPIKE_RATIO times).
+  Added where it is committed, ℓ is then carried by Φ like the rest, damped and turned as the
+  motion damps and turns it. Counting the skipped intervals into the next measured ℓ instead, in
+  phase, read 0.46–0.53 of the true error under the real 47 g record at rtol 1e-3 and 1e-5
+  (checks 8 and 32 apart), by their number 1.8–9.3 times it.
+
+Where the twin runs a linearising method, where the interval is too long for the kick, where
+y + e is off the α/γ/δ chart, and over an interval that starts with an event holding that its
+kind does not carry through (`EVENT_CARRIED`: any of a bolted joint's, flowing, open, slipping
+or broken; `integrates`), the companion is integrated over the interval as below, from the
+twin's state plus e, and carried again after it.
+
+Measured against a reference (`python3 bench/error_estimate.py`; docs/scene.md "Error
+estimate" and docs/benchmarks.md have the table), it reads 0.67–1.38 of the true force error on
+the genset, rubber on snubbers, hysteresis with snubbers under the real shock and 4 to 256
+Bouc–Wen elastomers at rtol 1e-3 … 1e-9, at 1.1–1.65× the engine's time, where the companion
+integrated at every interval read 0.69–1.08 at 1.4–2.1×: its work an interval is one right-hand
+side, one evaluation of the outputs and, at a special interval or one in 32, one step of the
+check, where the integrated companion's was 8 right-hand sides at least, more across the
+joints' switches.
+
+**Integrated** (over the intervals above): the same model integrated beside the twin with rtol and
+atol divided by TOLERANCE_DIVISOR = 8. Where the twin's steps are set by the samples, not its
+tolerance (one step an interval), one step of the twin's own method would be the twin again (the
+estimate 0): where the twin runs Dormand–Prince 5(4) the companion runs Verner's 6(5) pair
+(`integrate.verner65`) at least one step an interval (a 6th-order step of the same length: its
+error a small share of the twin's; 8 new right-hand sides a step); where the twin runs a
+linearising method it runs that method at least MIN_STEPS = 2 steps an interval (HIGHER,
+`own_method`; `switch` follows the twin). This stepper is also the carried error's check. Right
+after a rejected step it grows no step (`integrate.settings` HOLD_AFTER_REJECT, the rule of Hairer,
+Nørsett & Wanner's DOPRI5 code): on the bolted genset under its shock the joints' faces between
+sticking and sliding make the error of a step jump with its length, and a step grown at once from
+one accepted with a tiny error was rejected again, and again. Verner's "most efficient" 6(5) pair
+was tried first and dropped: its weights of ±176 on stages 0.05 % of a step apart make its error
+estimate's rounding, ε·176·|f|·h, dominate at tight tolerances. With Verner's pair a divisor of 4
+reads 0.71 of the true error at rtol 1e-3 on the genset (8: 0.89), 2 reads 0.57
+(docs/benchmarks.md).
+
+Both read the same held input, take the same discrete mount switches between samples, and
+restart with the twin. `integration.error_estimate: false` turns the estimate off. It never
+touches the twin's state: the published numbers are identical with it on or off
 (test/test_error_estimate.py).
 
 Its figures, kept as `engine.estimate` lays them out, are running maxima since the engine last
 read them: the largest |ΔF| over mounts and force components (N, mount axes), the largest
 |Δα|, |Δγ|, |Δδ| (rad), the largest |F| component of the twin (N: the scale of a relative
-error), and the intervals where the companion's own stepper failed (FAILURES: it is then
-re-synchronised to the twin, the error carried until then is lost, and the estimate counts
-it); it carries every state (UNCARRIED stays 0).
+error), and the intervals where the companion's own stepper (or its check) failed (FAILURES: it
+is then re-synchronised to the twin, the error carried until then is lost, and the estimate
+counts it); it carries every state (UNCARRIED stays 0).
 """
 
 from __future__ import annotations
@@ -63,6 +86,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from mount_twin import _core
 from mount_twin.engine.estimate import (
     N_FIGURES,
 )
@@ -70,12 +94,36 @@ from mount_twin.integrate.methods import AUTO, DOPRI54, METHODS, VERNER65
 from mount_twin.integrate.settings import MAX_SUBSTEPS
 from mount_twin.integrate.settings import MIN_STEPS as MIN_STEPS_SLOT
 from mount_twin.integrate.stepper import forget, tighter_arrays
+from mount_twin.physics import pose_row
 from mount_twin.physics.dynamics import Scratch
 
 TOLERANCE_DIVISOR = 8.0
 """The companion's rtol and atol are the twin's over this (see the module docstring)."""
 MIN_STEPS = 2
 """The companion's fewest steps per input interval where it runs the twin's own method."""
+(
+    Y_START,
+    ERROR,
+    TRIAL,
+    RATE,
+    TWIN_RATE,
+    CHECK,
+    LOCAL,
+    N_ERROR_ROWS,
+) = _core.ERROR_ROWS
+"""Rows of `Companion.error_rows` (src/core/engine/kernel.hpp ErrorRow says what each holds)."""
+(
+    CARRYING,
+    SINCE_CHECK,
+    CHECK_NORM,
+    NORM_MEAN,
+    INTERVALS,
+    KICK_RATE,
+    N_CARRY_SLOTS,
+) = _core.CARRY_SLOTS
+"""Slots of `Companion.carry` (src/core/engine/kernel.hpp CarrySlot)."""
+CARRY_CHECK_EVERY = _core.CARRY_CHECK_EVERY
+"""A carried interval's local error is measured at least this often (intervals)."""
 HIGHER = {DOPRI54: VERNER65}
 """The companion's method where the twin's is a key (ids): one step of it an interval is a
 different solution of a smaller error, where one of the twin's own would be the twin again."""
@@ -97,6 +145,10 @@ class Companion(NamedTuple):
     y_prev, g, util: its mount monitors' arrays (its switches are taken with them).
     wrenches: (n_mounts, 6): its mount wrenches at the last sample.
     figures: (N_FIGURES,) running maxima (see the module docstring), reset by the reader.
+    error_rows: (N_ERROR_ROWS, n_state) the carried error's rows; pose: (pose_row.WIDTH,) its
+    pose row where carried; carry: (N_CARRY_SLOTS,) its slots; integrates: (k, NE) 1.0 where
+    it is integrated over an interval that starts with the event holding (in the twin's
+    monitors or its own).
     """
 
     method: int
@@ -111,6 +163,10 @@ class Companion(NamedTuple):
     util: np.ndarray
     wrenches: np.ndarray
     figures: np.ndarray
+    error_rows: np.ndarray
+    pose: np.ndarray
+    carry: np.ndarray
+    integrates: np.ndarray
 
 
 def new_companion(
@@ -121,12 +177,15 @@ def new_companion(
     max_substeps: int,
     scratch: Scratch,
     n_mounts: int,
-    g_shape: tuple[int, int],
+    integrates: np.ndarray,
+    kick_rate: float,
 ) -> Companion:
     """A companion of a twin of n states integrated by `method` (a name, or AUTO: then
     `switch` it with the twin) at the twin's tolerances rtol, atol; `scratch`: fresh work
-    arrays of the model; g_shape: the shape of the twin's mount event functions (non-linear
-    mounts × events)."""
+    arrays of the model; integrates: (non-linear mounts, events), the shape of the twin's mount
+    event functions, 1.0 where the companion is integrated while the event holds (its kind's
+    EVENT_CARRIED false); kick_rate: the body's fastest mode on its mounts' tangents (rad/s,
+    `Model.tangent_rate`; 0 where unknown: then never carried)."""
     twin = METHODS["dopri54" if method == AUTO else method].id
     own, min_steps = own_method(twin)
     name = AUTO if method == AUTO else next(k for k, m in METHODS.items() if m.id == own)
@@ -140,17 +199,36 @@ def new_companion(
         min_steps,
         hold_after_reject=True,
     )
+    carry = np.zeros(N_CARRY_SLOTS)
+    carry[KICK_RATE] = kick_rate
     return Companion(
         own,
         *arrays[1:],
         np.zeros(n),
         scratch,
         np.zeros(n),
-        np.full(g_shape, -1.0),
-        np.zeros(g_shape[0]),
+        np.full(integrates.shape, -1.0),
+        np.zeros(integrates.shape[0]),
         np.zeros((n_mounts, 6)),
         np.zeros(N_FIGURES),
+        np.zeros((N_ERROR_ROWS, n)),
+        np.zeros(pose_row.WIDTH),
+        _reset_carry(carry, own),
+        np.array(integrates, dtype=float),
     )
+
+
+def _reset_carry(carry: np.ndarray, method: int) -> np.ndarray:
+    """`carry` (returned) as a companion (re)started running `method` (an id) has it: carried
+    where that is Verner's pair, the check of an explicit twin, and the body's fastest tangent
+    mode is known (KICK_RATE > 0; the core carries only beside an explicit twin, and only over
+    intervals short enough for it, whatever this says); no local error measured yet."""
+    rate = carry[KICK_RATE]
+    carry[:] = 0.0
+    carry[CARRYING] = 1.0 if method == VERNER65 and rate > 0.0 else 0.0
+    carry[CHECK_NORM] = -1.0
+    carry[KICK_RATE] = rate
+    return carry
 
 
 def switch(c: Companion, method: int) -> Companion:
@@ -162,11 +240,15 @@ def switch(c: Companion, method: int) -> Companion:
     settings[MAX_SUBSTEPS] *= min_steps / settings[MIN_STEPS_SLOT]
     settings[MIN_STEPS_SLOT] = float(min_steps)
     forget(settings)
+    _reset_carry(c.carry, own)
     return c._replace(method=own)
 
 
 def restart(c: Companion, y: np.ndarray) -> None:
-    """Start the companion again from the twin's state y (a twin start or restart)."""
+    """Start the companion again from the twin's state y (a twin start or restart): its error
+    zero, carried again where its method is the check of an explicit twin, its local error
+    measured afresh."""
     c.y[:] = y
     c.y_prev[:] = y
     forget(c.settings)
+    _reset_carry(c.carry, c.method)

@@ -96,10 +96,12 @@ def published_buffers(
     )
 
 
-def _new_estimator(model: Model, n_watched: tuple[int, int]) -> Estimator | Companion | None:
+def _new_estimator(model: Model, integrates: np.ndarray) -> Estimator | Companion | None:
     """The live error estimate's arrays (`engine.estimator` where the mounts are linear,
     `engine.companion` where some are not: see there), or None if the scene turns it off.
-    `n_watched`: the shape of the mount watch's event functions."""
+    `integrates`: (non-linear mounts, N_EVENTS), 1.0 where the companion is integrated while
+    the event holds (the kinds' EVENT_CARRIED false), the shape of the mount watch's event
+    functions."""
     integ = model.scene.integration
     if not integ.error_estimate:
         return None
@@ -113,7 +115,8 @@ def _new_estimator(model: Model, n_watched: tuple[int, int]) -> Estimator | Comp
             integ.max_substeps,
             model.new_scratch(),
             model.n_mounts,
-            n_watched,
+            integrates,
+            model.tangent_rate,
         )
     return sampled_estimator(model)
 
@@ -175,10 +178,12 @@ class CoreDriver:
             )
         ]
         """Each non-linear mount's internal states in y, in the core's order (empty: none)."""
-        stiffens = np.zeros((len(model.nonlinear_slots), N_EVENTS))
-        for i, (_, kind) in enumerate(self._event_meta.values()):
-            stiffens[i, : len(kind.EVENTS)] = kind.EVENT_STIFFENS
-        self._watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state, stiffens)
+        self._watch = new_watch(
+            len(model.nonlinear_slots),
+            N_EVENTS,
+            model.n_state,
+            self._event_table("EVENT_STIFFENS"),
+        )
         self.events: list[MountEvent] = []
         """Every mount event so far, in time order (the first MAX_EVENTS; the rest counted)."""
         lin_slots = model.arrays.lin_slot.tolist()
@@ -200,7 +205,7 @@ class CoreDriver:
             scene.outputs.decimation,
             scene.input.hold == "first_order",
         )
-        self.estimator = _new_estimator(model, (self._watch.g.shape[0], self._watch.g.shape[1]))
+        self.estimator = _new_estimator(model, self._event_table("EVENT_CARRIED", negate=True))
         self._loop: tuple[tuple[object, ...], Loop] | None = None
         """The arrays bound last, and their `Loop` (`_bound`)."""
         self._auto = integ.method == AUTO
@@ -387,6 +392,14 @@ class CoreDriver:
             self.estimator = estimator.switch(self.estimator, self.stepper.method)
         elif self.estimator is not None:
             self.estimator = companion.switch(self.estimator, self.stepper.method)
+
+    def _event_table(self, name: str, *, negate: bool = False) -> np.ndarray:
+        """(non-linear mounts, N_EVENTS): each mount's kind's event table `name` (1.0 where
+        true, or with `negate` where false; 0 past its kind's events)."""
+        table = np.zeros((len(self._event_meta), N_EVENTS))
+        for i, (_, kind) in enumerate(self._event_meta.values()):
+            table[i, : len(kind.EVENTS)] = [v != negate for v in getattr(kind, name)]
+        return table
 
     def stiffens(self, event: MountEvent) -> bool:
         """Whether a mount event may stiffen the scene (its kind's EVENT_STIFFENS)."""

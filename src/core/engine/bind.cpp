@@ -118,6 +118,11 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
   c.util = convert::vec(field(obj, "util"), "Companion.util", k);
   c.wrenches = convert::matc<6>(field(obj, "wrenches"), "Companion.wrenches", n_mounts);
   c.figures = convert::vec(field(obj, "figures"), "Companion.figures", N_FIGURES);
+  c.error_rows = convert::mat(field(obj, "error_rows"), "Companion.error_rows",
+                              engine::N_ERROR_ROWS, n_state);
+  c.pose = convert::vec(field(obj, "pose"), "Companion.pose", pose_row::WIDTH);
+  c.carry = convert::vec(field(obj, "carry"), "Companion.carry", engine::N_CARRY_SLOTS);
+  c.integrates = convert::mat(field(obj, "integrates"), "Companion.integrates", k, n_events);
   convert::check_scratch(c.s, n_state, "Companion.s");
   return c;
 }
@@ -192,6 +197,16 @@ void bind_engine(py::module_& mod) {
       int(engine::SINCE_LINEARISED),
       int(engine::N_CARRIED), int(engine::CHECKS), int(engine::LINEARISATIONS),
       int(engine::EXPONENTIALS), int(engine::BORROWED), int(engine::N_ESTIMATOR_SLOTS));
+  mod.attr("ERROR_ROWS") = py::make_tuple(
+      int(engine::Y_START), int(engine::ERROR), int(engine::TRIAL), int(engine::RATE),
+      int(engine::TWIN_RATE), int(engine::CHECK), int(engine::LOCAL),
+      int(engine::N_ERROR_ROWS));
+  mod.attr("CARRY_SLOTS") = py::make_tuple(
+      int(engine::CARRYING), int(engine::SINCE_CHECK), int(engine::CHECK_NORM),
+      int(engine::NORM_MEAN), int(engine::INTERVALS), int(engine::KICK_RATE),
+      int(engine::N_CARRY_SLOTS));
+  mod.attr("CARRY_CHECK_EVERY") = engine::CARRY_CHECK_EVERY;
+  mod.attr("KICK_LIMIT") = engine::KICK_LIMIT;
   mod.attr("ENGAGED_CHECK_EVERY") = engine::ENGAGED_CHECK_EVERY;
   mod.attr("PERIOD_SHARE") = engine::PERIOD_SHARE;
   mod.attr("BOUND_PERIOD_SHARE") = engine::BOUND_PERIOD_SHARE;

@@ -66,7 +66,41 @@ struct Companion {
   Vec util;
   M6 wrenches;
   Vec figures;  // (N_FIGURES,)
+  Mat error_rows;  // (N_ERROR_ROWS, n): the carried error's work rows (ErrorRow)
+  Vec pose;     // (pose_row::WIDTH,): its pose row (the angles are what the estimate reads)
+  Vec carry;    // (N_CARRY_SLOTS,): CarrySlot
+  Mat integrates;  // (k, NE): 1.0 where an event holding makes the interval integrated
 };
+
+/// Rows of Companion.error_rows (engine/companion.py ERROR_ROWS).
+enum ErrorRow : int {
+  Y_START = 0,  // the twin's state at the interval's start
+  ERROR,        // the companion's state less the twin's, e
+  TRIAL,        // the twin's end state plus e drifted: where the kick is taken
+  RATE,         // the right-hand side there
+  TWIN_RATE,    // the twin's at its end state, where a mount's switch moved it off its last stage
+  CHECK,        // the check's end state
+  LOCAL,        // the last measured local error
+  N_ERROR_ROWS
+};
+
+/// Slots of Companion.carry (engine/companion.py CARRY_SLOTS).
+enum CarrySlot : int {
+  CARRYING = 0,  // 1: the error may be carried (an explicit twin: `carries`); 0: integrated
+  SINCE_CHECK,   // carried intervals since the local error was last measured
+  CHECK_NORM,    // the twin's error norm at that interval (< 0: none measured since a restart)
+  NORM_MEAN,     // running mean of the twin's error norms
+  INTERVALS,     // carried intervals the mean has seen
+  KICK_RATE,     // rad/s: the body's fastest mode on its mounts' tangents (model.tangent_rate)
+  N_CARRY_SLOTS
+};
+
+/// A carried interval's local error is measured at least every CARRY_CHECK_EVERY intervals
+/// (engine/companion.py: between, the last one scaled).
+constexpr idx CARRY_CHECK_EVERY = 32;
+/// h·ω of the fastest tangent mode above which an interval's error is not carried (the
+/// companion is integrated over it): symplectic Euler is stable for h·ω < 2.
+constexpr double KICK_LIMIT = 1.0;
 
 /// The mounts' monitors and discrete switches at a sample (y_prev: the state at the previous
 /// one, then y); a switch (y jumped) clears the stepper's chain flag: its last stage is not
@@ -109,30 +143,10 @@ inline int watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, double
   return (changed ? CHANGED : 0) | (engaged ? ENGAGED : 0);
 }
 
-/// Advance the companion over [t0, t1] under the input u the twin just took, take its mounts'
-/// switches, and fold the differences of its outputs from the twin's (pose, wrenches at t1; y
-/// the twin's state): its wrenches and angles, what the estimate compares (no pose row).
-inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
-                   Vec d_wdot, Vec pose, M6 wrenches, Vec y) {
-  const Vec settings = c.integ.settings, figures = c.figures;
-  if (chain && settings[CHAINED] == 1.0) {
-    physics::rhs_after_rate_step(m, c.s, d_wdot, c.integ.work2d.row(0));
-  } else {
-    settings[CHAINED] = 0.0;
-  }
-  const int status = integrate::advance(c.integ.method, c.y, t0, t1, settings, m, c.s, u,
-                                        c.integ.work2d, c.integ.work1d, c.integ.result);
-  if (status != 0) {
-    for (idx i = 0; i < y.n; ++i) {
-      c.y[i] = y[i];
-      c.y_prev[i] = y[i];
-    }
-    integrate::forget(settings);
-    figures[FAILURES] += 1.0;
-    return;
-  }
-  physics::mount_wrenches(c.y, m, c.s, c.wrenches);  // the body's motion at c.y: its last rhs
-  if (m.has_nl) monitor_switches(c.y, m.nl, c.y_prev, c.s, c.g, c.util, settings);
+/// The companion's outputs (its wrenches, its angles q[3:6]) against the twin's (pose,
+/// wrenches at the sample) into its running figures.
+inline void fold_figures(Companion& c, const Vec q, Vec pose, M6 wrenches) {
+  const Vec figures = c.figures;
   double force = figures[FORCE_ERROR], scale = figures[FORCE_SCALE];
   for (idx a = 0; a < wrenches.rows; ++a) {
     for (int b = 0; b < 3; ++b) {
@@ -143,11 +157,158 @@ inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bo
   double attitude = figures[ATTITUDE_ERROR];
   for (int i = 0; i < 3; ++i) {
     const int k = pose_row::ANGLES + i;
-    attitude = py_max(attitude, std::fabs(pose[k] - c.s.q[3 + i]));
+    attitude = py_max(attitude, std::fabs(pose[k] - q[3 + i]));
   }
   figures[FORCE_ERROR] = force;
   figures[FORCE_SCALE] = scale;
   figures[ATTITUDE_ERROR] = attitude;
+}
+
+/// The companion set back onto the twin's state y after a failure, which the estimate counts.
+inline void resynchronise(Companion& c, Vec y) {
+  copy(y, c.y);
+  copy(y, c.y_prev);
+  integrate::forget(c.integ.settings);
+  c.figures[FAILURES] += 1.0;
+}
+
+/// Advance the companion over [t0, t1] under the input u the twin just took, take its mounts'
+/// switches, and fold the differences of its outputs from the twin's (pose, wrenches at t1; y
+/// the twin's state): its wrenches and angles, what the estimate compares (no pose row).
+inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
+                   Vec d_wdot, Vec pose, M6 wrenches, Vec y) {
+  const Vec settings = c.integ.settings;
+  if (chain && settings[CHAINED] == 1.0) {
+    physics::rhs_after_rate_step(m, c.s, d_wdot, c.integ.work2d.row(0));
+  } else {
+    settings[CHAINED] = 0.0;
+  }
+  const int status = integrate::advance(c.integ.method, c.y, t0, t1, settings, m, c.s, u,
+                                        c.integ.work2d, c.integ.work1d, c.integ.result);
+  if (status != 0) {
+    resynchronise(c, y);
+    return;
+  }
+  physics::mount_wrenches(c.y, m, c.s, c.wrenches);  // the body's motion at c.y: its last rhs
+  if (m.has_nl) monitor_switches(c.y, m.nl, c.y_prev, c.s, c.g, c.util, settings);
+  fold_figures(c, c.s.q, pose, wrenches);
+}
+
+/// Whether the companion carries its error over [t0, t1]: it says so (CARRYING), the twin's
+/// method is explicit (a linearising twin's stiff modes would put the explicit kick out of its
+/// stable range), the interval times the fastest rate of the body on its mounts' tangents
+/// (KICK_RATE, rad/s) is within KICK_LIMIT, and no event its kind does not carry through
+/// (`integrates`: a bolted joint's, any) holds at t0 in the twin's monitors g or the
+/// companion's.
+inline bool carries(const Companion& c, int twin_method, double t0, double t1, const Mat g) {
+  if (!(c.carry[CARRYING] == 1.0 && (twin_method == DOPRI54 || twin_method == VERNER65) &&
+        (t1 - t0) * c.carry[KICK_RATE] <= KICK_LIMIT)) {
+    return false;
+  }
+  for (idx i = 0; i < c.integrates.rows; ++i) {
+    for (idx e = 0; e < c.integrates.cols; ++e) {
+      if (c.integrates(i, e) > 0.0 && (g(i, e) >= 0.0 || c.g(i, e) >= 0.0)) return false;
+    }
+  }
+  return true;
+}
+
+/// The local error the twin committed over the interval, added to e: measured (the twin's end
+/// state y less the companion's stepper's from the twin's start state) where the interval is
+/// special (a mount switched or an event function changed sign, the twin rejected a step, its
+/// error norm passed SPIKE_RATIO times its running mean, or none was measured since a
+/// restart), and every CARRY_CHECK_EVERY intervals; between, the last measured one scaled by
+/// the twin's error norms (at most SPIKE_RATIO times). Returns false where the measurement
+/// failed (nothing added).
+inline bool add_local_error(const Model& m, Companion& c, Vec u, double t0, double t1,
+                            const Vec twin_result, int watched, Vec y) {
+  const Vec carry = c.carry, e = c.error_rows.row(ERROR), local = c.error_rows.row(LOCAL);
+  const double norm = twin_result[0];
+  carry[INTERVALS] += 1.0;
+  const double mean = carry[NORM_MEAN], last = carry[CHECK_NORM];
+  const bool spike = carry[INTERVALS] > 1.0 && norm > SPIKE_RATIO * mean;
+  carry[NORM_MEAN] += (norm - mean) / py_min(carry[INTERVALS], 64.0);
+  const bool special = (watched & CHANGED) != 0 || twin_result[2] > 0.0 || spike || last < 0.0;
+  carry[SINCE_CHECK] += 1.0;
+  if (special || carry[SINCE_CHECK] >= static_cast<double>(CARRY_CHECK_EVERY)) {
+    const Vec check = c.error_rows.row(CHECK), settings = c.integ.settings;
+    copy(c.error_rows.row(Y_START), check);
+    settings[CHAINED] = 0.0;  // from the twin's start state: no stage of it at hand
+    const int status = integrate::advance(c.integ.method, check, t0, t1, settings, m, c.s, u,
+                                          c.integ.work2d, c.integ.work1d, c.integ.result);
+    if (status != 0) return false;
+    for (idx i = 0; i < y.n; ++i) local[i] = y[i] - check[i];
+    carry[CHECK_NORM] = norm;
+    carry[SINCE_CHECK] = 0.0;
+    for (idx i = 0; i < y.n; ++i) e[i] += local[i];
+    return true;
+  }
+  // at most SPIKE_RATIO times what was measured; both norms 0: nothing committed
+  const double scale = last > 0.0 ? py_min(norm / last, SPIKE_RATIO) : 0.0;
+  for (idx i = 0; i < y.n; ++i) e[i] += scale * local[i];
+  return true;
+}
+
+/// The kinds' carry on each non-linear mount (their rate-independent states after the kick):
+/// the companion's state c.y, before the kick `trial`, the twin's y.
+inline void carry_kinds(const Model& m, Companion& c, Vec trial, Vec y) {
+  physics::Motion twin, own;
+  if (!(physics::body_motion(y, m, c.s, twin) > 0.0)) return;
+  if (!(physics::body_motion(c.y, m, c.s, own) > 0.0)) return;
+  const NonLinear& nl = m.nl;
+  physics::MountLocal at_twin, at_own;
+  for (idx i = 0; i < nl.k; ++i) {
+    physics::local_motion(i, nl, twin, at_twin);
+    physics::local_motion(i, nl, own, at_own);
+    kinds::kind_carry(nl.kind[i], &nl.par(i, 0), c.y, trial, y, nl.state[i], at_own.d,
+                      at_twin.d);
+  }
+}
+
+/// The companion over [t0, t1] as the twin's state plus its error e, carried: eₙ₊₁ = Φ(eₙ) +
+/// ℓₙ (engine/companion.py says why and what it read). Φ by symplectic Euler through one
+/// right-hand side of the non-linear law itself, at the twin's end state plus e: the body's
+/// position errors drift by h·(their rates' errors), then the rates' and the internal states'
+/// errors are kicked by h·(f(t₁, y + e) − f(t₁, y)); the kinds' carry returns their
+/// rate-independent states. ℓ by `add_local_error`. twin_rate: f(t₁, y), the twin's last stage
+/// (`fresh`: false where a mount's switch moved y off it). Where y + e is off the α/γ/δ chart
+/// the companion is integrated over the interval (`follow`).
+inline void carry_interval(const Model& m, Companion& c, Vec u, double t0, double t1,
+                           Vec twin_rate, bool fresh, const Vec twin_result, int watched,
+                           Vec d_wdot, Vec pose, M6 wrenches, Vec y) {
+  const idx n = y.n, nf = m.free_trans.n + m.free_rot.n;
+  const double h = t1 - t0;
+  const Mat rows = c.error_rows;
+  const Vec e = rows.row(ERROR), trial = rows.row(TRIAL), rate = rows.row(RATE);
+  const Vec y_start = rows.row(Y_START);
+  for (idx i = 0; i < n; ++i) e[i] = c.y[i] - y_start[i];
+  for (idx k = 0; k < nf; ++k) e[k] += h * e[nf + k];
+  for (idx i = 0; i < n; ++i) trial[i] = y[i] + e[i];
+  if (!fresh) {
+    twin_rate = rows.row(TWIN_RATE);
+    if (physics::rhs(t1, y, m, c.s, u, twin_rate) != OK) {
+      resynchronise(c, y);
+      return;
+    }
+  }
+  if (physics::rhs(t1, trial, m, c.s, u, rate) != OK) {
+    follow(m, c, u, t0, t1, false, d_wdot, pose, wrenches, y);  // from c.y, still y_start + e
+    return;
+  }
+  for (idx i = nf; i < n; ++i) e[i] += h * (rate[i] - twin_rate[i]);
+  if (!add_local_error(m, c, u, t0, t1, twin_result, watched, y)) {
+    resynchronise(c, y);
+    return;
+  }
+  for (idx i = 0; i < n; ++i) c.y[i] = y[i] + e[i];
+  if (m.has_nl) carry_kinds(m, c, trial, y);
+  if (!(physics::evaluate(c.y, m, c.s, c.pose, c.wrenches) > 0.0)) {
+    resynchronise(c, y);
+    return;
+  }
+  if (m.has_nl) monitor_switches(c.y, m.nl, c.y_prev, c.s, c.g, c.util, c.integ.settings);
+  c.integ.settings[CHAINED] = 0.0;  // its stepper's stages are not at c.y
+  fold_figures(c, c.s.q, pose, wrenches);
 }
 
 /// run_samples' result: the index of the last sample done and the status (0 all done;
@@ -185,6 +346,9 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
       settings[CHAINED] = 0.0;
     }
     if (estimator != nullptr) copy(y, estimator->y_start);
+    const bool carried = companion != nullptr &&
+                         carries(*companion, integ.method, smp.t[j - 1], smp.t[j], watch.g);
+    if (carried) copy(y, companion->error_rows.row(Y_START));
     const int status = integrate::advance(integ.method, y, smp.t[j - 1], smp.t[j], settings, m,
                                           s, u, integ.work2d, integ.work1d, integ.result);
     if (status != 0) return {j - 1, status};
@@ -202,7 +366,11 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
       estimate_interval(m, *estimator, u, smp.t[j - 1], smp.t[j], watched, integ, wrenches_j,
                         y);
     }
-    if (companion != nullptr) {
+    if (carried) {
+      carry_interval(m, *companion, u, smp.t[j - 1], smp.t[j], integ.work2d.row(0),
+                     settings[CHAINED] == 1.0, integ.result, watched, d_wdot, out.pose.row(j),
+                     wrenches_j, y);
+    } else if (companion != nullptr) {
       follow(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, d_wdot, out.pose.row(j),
              wrenches_j, y);
     }
