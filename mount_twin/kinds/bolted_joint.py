@@ -48,7 +48,7 @@ EVENT_CARRIED = (False, False, False, False)
 (`engine.companion`): none; over an interval that starts with a bolt flowing, a joint open, a
 face slipping or a bolt broken the companion is integrated. Carried through them, the genset
 under two synthesised 30 g shocks read 0.51–2.09 of its true force error (0.88–1.40 with
-flowing and open joints integrated, 0.90–1.18 with all), and under its own shock bag at rtol
+flowing and open joints integrated, 0.89–1.23 with all), and under its own shock bag at rtol
 1e-6 and 1e-7 2.0 and 3.5 times its true attitude error with slipping faces carried: the yaw
 their slide left in the companion was ten times the reference's (0.86–1.07 with them
 integrated, at the same cost, 1.2–1.65×: `python3 bench/error_estimate.py --cases genset`)."""

@@ -95,8 +95,9 @@ enum CarrySlot : int {
   N_CARRY_SLOTS
 };
 
-/// A carried interval's local error is measured at least every CARRY_CHECK_EVERY intervals
-/// (engine/companion.py: between, the last one scaled).
+/// A carried interval's local error is measured at least every CARRY_CHECK_EVERY intervals,
+/// and every half period of the body's fastest tangent mode (engine/companion.py: between, the
+/// last one scaled).
 constexpr idx CARRY_CHECK_EVERY = 32;
 /// h·ω of the fastest tangent mode above which an interval's error is not carried (the
 /// companion is integrated over it): symplectic Euler is stable for h·ω < 2.
@@ -217,8 +218,9 @@ inline bool carries(const Companion& c, int twin_method, double t0, double t1, c
 /// state y less the companion's stepper's from the twin's start state) where the interval is
 /// special (a mount switched or an event function changed sign, the twin rejected a step, its
 /// error norm passed SPIKE_RATIO times its running mean, or none was measured since a
-/// restart), and every CARRY_CHECK_EVERY intervals; between, the last measured one scaled by
-/// the twin's error norms (at most SPIKE_RATIO times). Returns false where the measurement
+/// restart), and every CARRY_CHECK_EVERY intervals or half a period of the fastest tangent
+/// mode (KICK_RATE), whichever is fewer; between, the last measured one scaled by the twin's
+/// error norms (at most SPIKE_RATIO times). Returns false where the measurement
 /// failed (nothing added).
 inline bool add_local_error(const Model& m, Companion& c, Vec u, double t0, double t1,
                             const Vec twin_result, int watched, Vec y) {
@@ -230,7 +232,9 @@ inline bool add_local_error(const Model& m, Companion& c, Vec u, double t0, doub
   carry[NORM_MEAN] += (norm - mean) / py_min(carry[INTERVALS], 64.0);
   const bool special = (watched & CHANGED) != 0 || twin_result[2] > 0.0 || spike || last < 0.0;
   carry[SINCE_CHECK] += 1.0;
-  if (special || carry[SINCE_CHECK] >= static_cast<double>(CARRY_CHECK_EVERY)) {
+  const double every = py_min(static_cast<double>(CARRY_CHECK_EVERY),
+                              py_max(1.0, std::floor(M_PI / ((t1 - t0) * carry[KICK_RATE]))));
+  if (special || carry[SINCE_CHECK] >= every) {
     const Vec check = c.error_rows.row(CHECK), settings = c.integ.settings;
     copy(c.error_rows.row(Y_START), check);
     settings[CHAINED] = 0.0;  // from the twin's start state: no stage of it at hand
