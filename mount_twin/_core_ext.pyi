@@ -14,7 +14,6 @@ FIGURE_SLOTS: tuple[int, ...]
 ESTIMATOR_SLOTS: tuple[int, ...]
 ERROR_ROWS: tuple[int, ...]
 CARRY_SLOTS: tuple[int, ...]
-CARRY_CHECK_EVERY: int
 KICK_LIMIT: float
 ENGAGED_CHECK_EVERY: float
 PERIOD_SHARE: float

@@ -414,3 +414,26 @@ def test_an_open_companion_face_keeps_its_kick():
     twin = ((0.0, 0.0, 2 * U_OPEN), (0.0, 0.0))
     y = carried(twin, (1e-6, 0.0), (4e-6, -3e-6), (0.0, 0.0, 2 * U_OPEN))
     assert (y[SLIP_X], y[SLIP_Y]) == (4e-6, -3e-6)
+
+
+def test_beside_a_flowing_twin_the_companions_bolt_is_put_on_its_yield_line():
+    """The twin's bolt at its yield force: the companion's plastic elongation is put where its
+    own bolt force equals its own hardened yield force at its deflection (F_V + k_S·(u − e_p)
+    = F_y + α·k_S/(1 − α)·e_p), whatever the kick gave it; an elastic twin leaves it alone."""
+    law = joint()
+    p = np.zeros(N_PAR)
+    p[: law.p.shape[0]] = law.p
+    u_t = U_Y + 2e-4  # the twin past first yield, its e_p on the line
+    e_t = (F_V + K_S * u_t - F_Y) / (K_S + 0.02 * K_S / 0.98)
+    u = u_t + 1e-5
+    for e_kicked in (0.0, 5e-3):
+        y = law.states(e_kicked, 0.0, 0.0, 0.0)
+        yt = law.states(e_t, 0.0, 0.0, 0.0)
+        kind_carry(
+            BOLTED_JOINT, p, y, y.copy(), yt, 0, np.array([0.0, 0.0, u]), np.array([0.0, 0.0, u_t])
+        )
+        hardened = F_Y + 0.02 * K_S / 0.98 * y[E_P]
+        assert F_V + K_S * (u - y[E_P]) == pytest.approx(hardened, rel=1e-12)
+    y = law.states(1e-6, 0.0, 0.0, 0.0)
+    kind_carry(BOLTED_JOINT, p, y, y.copy(), law.states(), 0, np.zeros(3), np.zeros(3))
+    assert y[E_P] == 1e-6

@@ -125,8 +125,6 @@ MIN_STEPS = 2
     N_CARRY_SLOTS,
 ) = _core.CARRY_SLOTS
 """Slots of `Companion.carry` (src/core/engine/kernel.hpp CarrySlot)."""
-CARRY_CHECK_EVERY = _core.CARRY_CHECK_EVERY
-"""A carried interval's local error is measured at least this often (intervals)."""
 HIGHER = {DOPRI54: VERNER65}
 """The companion's method where the twin's is a key (ids): one step of it an interval is a
 different solution of a smaller error, where one of the twin's own would be the twin again."""

@@ -222,9 +222,21 @@ def clamp_force(p: np.ndarray, u: float) -> float:
     return max(p[FV] - p[KP] * u, 0.0)
 
 
+def hardening(p: np.ndarray) -> float:
+    """The yield force's rise per metre of plastic elongation, N/m: α·k_S/(1 − α), so that the
+    bolt flows along the post-yield tangent α·k_S."""
+    return p[ALPHA] * p[KS] / (1.0 - p[ALPHA])
+
+
 def yield_limit(p: np.ndarray, e_p: float) -> float:
     """Current yield force, N: linear hardening with the post-yield tangent α·k_S."""
-    return p[FY] + p[ALPHA] * p[KS] / (1.0 - p[ALPHA]) * e_p
+    return p[FY] + hardening(p) * e_p
+
+
+def yield_elongation(p: np.ndarray, u: float) -> float:
+    """The plastic elongation (m) that puts the bolt on its yield line at the axial deflection
+    u (m): F_V + k_S·(u − e_p) = F_y + hardening·e_p."""
+    return (p[FV] + p[KS] * u - p[FY]) / (p[KS] + hardening(p))
 
 
 def load(p, y, o, d, v, phi, w, dydt, f, c) -> None:
@@ -362,8 +374,7 @@ def carry(p, y, y0, yt, o, d, dt) -> None:
     if y[o + 3] < 0.5 and yt[o + 3] < 0.5:
         flows = bolt_force(p, dt[2], yt[o], 0.0) >= yield_limit(p, yt[o])
         if flows or bolt_force(p, d[2], y[o], 0.0) > yield_limit(p, y[o]):
-            line = p[KS] + p[ALPHA] * p[KS] / (1.0 - p[ALPHA])
-            y[o] = max((p[FV] + p[KS] * d[2] - p[FY]) / line, 0.0)
+            y[o] = max(yield_elongation(p, d[2]), 0.0)
     if not p[MU] * clamp_force(p, d[2]) > 0.0:
         return
     y[o + 1], y[o + 2] = y0[o + 1], y0[o + 2]

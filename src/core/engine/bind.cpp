@@ -205,7 +205,6 @@ void bind_engine(py::module_& mod) {
       int(engine::CARRYING), int(engine::SINCE_CHECK), int(engine::CHECK_NORM),
       int(engine::NORM_MEAN), int(engine::INTERVALS), int(engine::KICK_RATE),
       int(engine::N_CARRY_SLOTS));
-  mod.attr("CARRY_CHECK_EVERY") = engine::CARRY_CHECK_EVERY;
   mod.attr("KICK_LIMIT") = engine::KICK_LIMIT;
   mod.attr("ENGAGED_CHECK_EVERY") = engine::ENGAGED_CHECK_EVERY;
   mod.attr("PERIOD_SHARE") = engine::PERIOD_SHARE;

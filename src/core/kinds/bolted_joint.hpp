@@ -28,9 +28,31 @@ inline double bolt_force(const double* p, double u, double e_p, double broken) {
   return py_max(p[FV] + p[KS] * (u - e_p), 0.0);
 }
 
+/// Clamp force F_K = max(F_V − k_P·u, 0), N, at the axial deflection u (m): 0 once open.
+inline double clamp_force(const double* p, double u) { return py_max(p[FV] - p[KP] * u, 0.0); }
+
+/// The yield force's rise per metre of plastic elongation, N/m: α·k_S/(1 − α), so that the bolt
+/// flows along the post-yield tangent α·k_S.
+inline double hardening(const double* p) { return p[ALPHA] * p[KS] / (1.0 - p[ALPHA]); }
+
 /// Current yield force, N: linear hardening with the post-yield tangent α·k_S.
-inline double yield_limit(const double* p, double e_p) {
-  return p[FY] + p[ALPHA] * p[KS] / (1.0 - p[ALPHA]) * e_p;
+inline double yield_limit(const double* p, double e_p) { return p[FY] + hardening(p) * e_p; }
+
+/// The plastic elongation (m) that puts the bolt on its yield line at the axial deflection u:
+/// F_V + k_S·(u − e_p) = F_y + hardening·e_p.
+inline double yield_elongation(const double* p, double u) {
+  return (p[FV] + p[KS] * u - p[FY]) / (p[KS] + hardening(p));
+}
+
+/// A face's friction bound μ·F_K (N), its stick spring's stretch e = d − s_p (m, local x and y)
+/// and the spring's force k_τ·|e| (N), at the deflection d with the stick point in y from o.
+struct Face {
+  double limit, ex, ey, tau;
+};
+
+inline Face face(const double* p, Vec y, idx o, const double* d) {
+  const double ex = d[0] - y[o + 1], ey = d[1] - y[o + 2];
+  return {p[MU] * clamp_force(p, d[2]), ex, ey, p[KT] * std::sqrt(ex * ex + ey * ey)};
 }
 
 /// Force f and couple c (N, N·m) on the body in local axes; state rates into dydt from o.
@@ -40,7 +62,7 @@ inline void load(const double* p, Vec y, idx o, const double* d, const double* v
   const double e_p = y[o], sx = y[o + 1], sy = y[o + 2], broken = y[o + 3];
   const double u = d[2], ud = v[2];
   const double f_s = bolt_force(p, u, e_p, broken);
-  const double f_k = py_max(p[FV] - p[KP] * u, 0.0);
+  const double f_k = clamp_force(p, u);
   const bool flow = broken < 0.5 && f_s >= yield_limit(p, e_p) && ud > 0.0;
   dydt[o] = flow ? (1.0 - p[ALPHA]) * ud : 0.0;
   dydt[o + 3] = 0.0;
@@ -100,7 +122,7 @@ inline double monitor(const double* p, Vec y, Vec y0, idx o, const double* d,
   g[0] = broken < 0.5 ? bolt_force(p, u, e_t, broken) - yield_limit(p, e_t) : -1.0;
   g[1] = p[KP] * u - p[FV];
   const double tx = p[KT] * (d[0] - sx), ty = p[KT] * (d[1] - sy);
-  const double shear = std::sqrt(tx * tx + ty * ty), bound = p[MU] * py_max(p[FV] - p[KP] * u, 0.0);
+  const double shear = std::sqrt(tx * tx + ty * ty), bound = p[MU] * clamp_force(p, u);
   g[2] = shear - bound - p[KT] * SLIP_FLOOR;
   const double f_s = bolt_force(p, u, e_p, broken);
   g[3] = broken > 0.5 ? 1.0 : py_max(f_s / p[FU] - 1.0, e_p / p[EPU] - 1.0);
@@ -133,23 +155,17 @@ inline void carry(const double* p, Vec y, Vec y0, Vec yt, idx o, const double* d
   if (y[o + 3] < 0.5 && yt[o + 3] < 0.5) {
     const bool flows = bolt_force(p, dt[2], yt[o], 0.0) >= yield_limit(p, yt[o]);
     if (flows || bolt_force(p, d[2], y[o], 0.0) > yield_limit(p, y[o])) {
-      const double line = p[KS] + p[ALPHA] * p[KS] / (1.0 - p[ALPHA]);
-      y[o] = py_max((p[FV] + p[KS] * d[2] - p[FY]) / line, 0.0);
+      y[o] = py_max(yield_elongation(p, d[2]), 0.0);
     }
   }
-  const double limit = p[MU] * py_max(p[FV] - p[KP] * d[2], 0.0);
-  if (!(limit > 0.0)) return;
+  if (!(p[MU] * clamp_force(p, d[2]) > 0.0)) return;
   y[o + 1] = y0[o + 1];
   y[o + 2] = y0[o + 2];
-  const double ex = d[0] - y[o + 1], ey = d[1] - y[o + 2];
-  const double tau = p[KT] * std::sqrt(ex * ex + ey * ey);
-  const double twin_limit = p[MU] * py_max(p[FV] - p[KP] * dt[2], 0.0);
-  const double tx = dt[0] - yt[o + 1], ty = dt[1] - yt[o + 2];
-  const bool on_bound = twin_limit > 0.0 && p[KT] * std::sqrt(tx * tx + ty * ty) >= twin_limit;
-  if (tau > 0.0 && (on_bound || tau > limit)) {
-    const double scale = limit / tau;
-    y[o + 1] = d[0] - scale * ex;
-    y[o + 2] = d[1] - scale * ey;
+  const Face own = face(p, y, o, d), twin = face(p, yt, o, dt);
+  if (own.tau > 0.0 && ((twin.limit > 0.0 && twin.tau >= twin.limit) || own.tau > own.limit)) {
+    const double scale = own.limit / own.tau;
+    y[o + 1] = d[0] - scale * own.ex;
+    y[o + 2] = d[1] - scale * own.ey;
   }
 }
 
