@@ -20,7 +20,7 @@ from physics_helpers import base_scene, build, gravity_u, mount
 from mount_twin.errors import ModelError, SceneError
 from mount_twin.integrate import methods, stepper
 from mount_twin.integrate.methods import METHODS, STATUS_TEXT, UNKNOWN_METHOD
-from mount_twin.integrate.settings import JACOBIAN_AGE
+from mount_twin.integrate.settings import CHAINED, JACOBIAN_AGE, MIN_STEPS, STEP
 from mount_twin.model.assemble import initial_state
 from mount_twin.scene import loader, scene_from_dict
 
@@ -316,6 +316,53 @@ def test_compiled_error_norm_bounds_the_true_error_of_an_oscillator_step(name: s
         floor = 16.0 * np.finfo(float).eps * np.abs(exact).max()
         slack = 2.0 if name == "verner65" else 1.0
         assert true_norm <= max(slack * result[0], floor), (h, true_norm, result[0])
+
+
+def run_fixed(name: str, model, y: np.ndarray, u, t1: float, steps: int):
+    """stepper.advance_fixed of `name` from 0 to t1 by `steps` steps, the proposal set to a
+    marker; (status, y, result, settings)."""
+    st = stepper.new_stepper(name, model.n_state, 1e-13, 1e-13, 1)
+    st.settings[MIN_STEPS] = steps
+    st.settings[STEP] = 1.25e-5
+    y = y.copy()
+    args = (y, 0.0, t1, st.settings, model.arrays, model.new_scratch(), u, st.work2d, st.work1d)
+    status = stepper.advance_fixed(METHODS[name].id, *args, st.result)
+    return int(status), y, st.result.copy(), st.settings.copy()
+
+
+@pytest.mark.parametrize("name", EXPLICIT)
+def test_fixed_steps_converge_at_the_methods_order_on_the_oscillator(name: str) -> None:
+    """advance_fixed takes exactly MIN_STEPS equal steps, none rejected at a tolerance no step
+    meets, and its error against the closed-form free vibration (ω = 2π·50 rad/s over 4 ms,
+    ω·t = 1.26; the error's amplitude, displacement and velocity over ω) falls at the method's
+    order as the steps double; the controller's proposal is untouched and the last stage
+    chained."""
+    omega = 2.0 * math.pi * 50.0
+    model, y_eq, u = oscillator(omega)
+    dz, t1 = 1e-3, 4e-3
+    y0 = y_eq.copy()
+    y0[0] += dz
+    exact = np.array([y_eq[0] + dz * math.cos(omega * t1), -dz * omega * math.sin(omega * t1)])
+    errors = []
+    for steps in (2, 4, 8, 16):
+        status, y1, result, settings = run_fixed(name, model, y0, u, t1, steps)
+        assert status == methods.SUCCESS
+        assert result[1] == steps and result[2] == 0 and result[0] > 1.0  # none met rtol 1e-13
+        assert settings[STEP] == 1.25e-5 and settings[CHAINED] == 1.0
+        d = (y1 - exact) / dz
+        errors.append(math.hypot(d[0], d[1] / omega))
+    slopes = np.diff(np.log2(errors))
+    assert np.all(np.abs(slopes + METHODS[name].order) < 0.2), (errors, slopes)
+
+
+@pytest.mark.parametrize("name", IMPLICIT + [n for n in LINEARISING if n not in IMPLICIT])
+def test_fixed_steps_refuse_a_method_that_is_not_explicit(name: str) -> None:
+    """advance_fixed has no steps without error control for a linearising method: the status
+    UNKNOWN_METHOD, the state untouched."""
+    model, y0, u = oscillator()
+    status, y1, _, _ = run_fixed(name, model, y0, u, 1e-3, 1)
+    assert status == UNKNOWN_METHOD
+    np.testing.assert_array_equal(y1, y0)
 
 
 # ------------------------------------------------------------------- the Rosenbrock method(s)

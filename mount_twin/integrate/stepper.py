@@ -36,6 +36,7 @@ __all__ = [
     "STATUS_TEXT",
     "Stepper",
     "advance",
+    "advance_fixed",
     "dormand_prince",
     "new_stepper",
     "switch",
@@ -166,6 +167,11 @@ advance = _core.advance
 """advance(method, y, t0, t1, settings, m, s, u, work2d, work1d, result) -> status: advance y
 from t0 to t1 (s) with the stepper `method` (its id; UNKNOWN_METHOD for an id no method has,
 nothing touched); the core checks the work arrays hold the method (`Method.work_rows`)."""
+advance_fixed = _core.advance_fixed
+"""advance_fixed(method, y, t0, t1, settings, m, s, u, work2d, work1d, result) -> status:
+`advance` by settings[MIN_STEPS] equal steps of an explicit method, every one taken (no error
+control; the proposal settings[STEP] untouched); result [largest error norm, steps, 0];
+UNKNOWN_METHOD for a method that is not explicit (nothing touched)."""
 forget = _core.forget
 """forget(settings): forget a stepper's history (after its state jumped: a start, a restart, a
 resync): the step proposal, the chained last stage, the Jacobian held and its matrix functions."""

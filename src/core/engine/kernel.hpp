@@ -238,8 +238,13 @@ inline bool add_local_error(const Model& m, Companion& c, Vec u, double t0, doub
     const Vec check = c.error_rows.row(CHECK), settings = c.integ.settings;
     copy(c.error_rows.row(Y_START), check);
     settings[CHAINED] = 0.0;  // from the twin's start state: no stage of it at hand
-    const int status = integrate::advance(c.integ.method, check, t0, t1, settings, m, c.s, u,
-                                          c.integ.work2d, c.integ.work1d, c.integ.result);
+    // the twin took one step over the interval, none rejected, and no mount switched: the
+    // check's fewest steps, of a higher order or shorter, every one taken (engine/companion.py
+    // says why); else its stepper at its tolerance
+    const bool smooth = (watched & CHANGED) == 0 && twin_result[1] == 1.0 && twin_result[2] == 0.0;
+    const auto step = smooth ? integrate::advance_fixed : integrate::advance;
+    const int status = step(c.integ.method, check, t0, t1, settings, m, c.s, u, c.integ.work2d,
+                            c.integ.work1d, c.integ.result);
     if (status != 0) return false;
     for (idx i = 0; i < y.n; ++i) local[i] = y[i] - check[i];
     carry[CHECK_NORM] = norm;

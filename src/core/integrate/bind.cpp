@@ -186,6 +186,22 @@ void bind_integrate(py::module_& mod) {
       py::arg("method"), py::arg("y"), py::arg("t0"), py::arg("t1"), py::arg("settings"),
       py::arg("m"), py::arg("s"), py::arg("u"), py::arg("work2d"), py::arg("work1d"),
       py::arg("result"));
+  mod.def(
+      "advance_fixed",
+      [](int method, py::handle y_, double t0, double t1, py::handle settings_, py::handle m_,
+         py::handle s_, py::handle u_, py::handle work2d_, py::handle work1d_,
+         py::handle result_) {
+        Args a = args(method, y_, settings_, m_, s_, u_, work2d_, work1d_, result_);
+        return integrate::advance_fixed(method, a.y, t0, t1, a.settings, a.m, a.s, a.u,
+                                        a.work2d, a.work1d, a.result);
+      },
+      "`advance` by settings[MIN_STEPS] equal steps of an explicit method (dopri54, verner65), "
+      "every one taken: no error control; settings[STEP] untouched. result: [largest error "
+      "norm of the steps at the settings' tolerances, steps taken, 0]. Returns a status "
+      "(UNKNOWN_METHOD for a method that is not explicit, nothing touched).",
+      py::arg("method"), py::arg("y"), py::arg("t0"), py::arg("t1"), py::arg("settings"),
+      py::arg("m"), py::arg("s"), py::arg("u"), py::arg("work2d"), py::arg("work1d"),
+      py::arg("result"));
   def_method_advance<DOPRI54>(
       mod, "dopri54_advance",
       "Dormand–Prince 5(4) across one input interval: `advance` without the method id (k: "

@@ -59,6 +59,65 @@ inline bool stages(Vec y, double t, double step, const Model& m, Scratch& s, Vec
   }
 }
 
+/// The error norm of the step of `step` s just taken from y (stages in k, its propagated
+/// solution in y_new): the root mean square over the states of step·Σⱼ E[j]·k[j] over
+/// atol + rtol·max(|y|, |y_new|).
+template <class T>
+inline double error_norm(Vec y, Vec y_new, Mat k, double step, double rtol, double atol) {
+  double err = 0.0;
+  for (idx i = 0; i < y.n; ++i) {
+    double e = 0.0;
+    for (int j = 0; j < T::STAGES; ++j) e += T::E[j] * k(j, i);
+    const double scale = atol + rtol * py_max(std::fabs(y[i]), std::fabs(y_new[i]));
+    const double x = step * e / scale;
+    err += x * x;  // numba's x ** 2 (a literal integer exponent): x·x
+  }
+  return std::sqrt(err / static_cast<double>(y.n));
+}
+
+/// Advance y (in place) from t0 to t1 s by settings[MIN_STEPS] equal steps, every one taken: no
+/// error control (a step of a length known to serve: the carried error's check where the twin
+/// took one step, engine/kernel.hpp `add_local_error`). settings[CHAINED] is read and left as
+/// `advance` reads and leaves it; settings[STEP], the controller's proposal, is untouched.
+/// result: [largest error norm of the steps at settings' tolerances, steps, 0]. Returns
+/// SUCCESS, else LEFT_CHART (a right-hand side failed) or NOT_FINITE (a stage state was not
+/// finite), y then at the failed step's start.
+template <class T>
+inline int advance_fixed(Vec y, double t0, double t1, Vec settings, const Model& m, Scratch& s,
+                         Vec u, Mat k, Vec y_new, Vec result) {
+  static_assert(T::FSAL, "explicit_rk::advance_fixed takes first-same-as-last tables only");
+  const idx steps = settings[MIN_STEPS] > 1.0 ? static_cast<idx>(settings[MIN_STEPS]) : 1, n = y.n;
+  const double span = t1 - t0;
+  const bool chained = settings[CHAINED] != 0.0;
+  settings[CHAINED] = 0.0;  // set again below on success: k[0] is then dy/dt at (t1, y)
+  if (!chained && physics::rhs(t0, y, m, s, u, k.row(0)) != 0) return LEFT_CHART;
+  double err_max = 0.0, t = t0;
+  idx taken = 0;
+  int status = SUCCESS;
+  for (; taken < steps; ++taken) {
+    const double t_next = taken + 1 == steps ? t1 : t0 + span * (taken + 1.0) / steps;
+    const double step = t_next - t;
+    if (!stages<T, 1>(y, t, step, m, s, u, k, y_new)) {
+      status = LEFT_CHART;
+      for (idx i = 0; i < n; ++i) {
+        if (!std::isfinite(y_new[i])) status = NOT_FINITE;
+      }
+      break;
+    }
+    err_max = py_max(err_max, error_norm<T>(y, y_new, k, step, settings[RTOL], settings[ATOL]));
+    for (idx i = 0; i < n; ++i) {
+      y[i] = y_new[i];
+      k(0, i) = k(T::STAGES - 1, i);
+    }
+    t = t_next;
+  }
+  result[0] = err_max;
+  result[1] = static_cast<double>(taken);
+  result[2] = 0.0;
+  if (status == SUCCESS) settings[CHAINED] = 1.0;
+  return status;
+}
+
 /// Advance y (in place) from t0 to t1 s with input u held over the interval.
 ///
 /// settings: the slots of constants.hpp Setting (STEP: first trial step s, 0 for the whole
@@ -110,15 +169,7 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
       continue;
     }
     // y_new holds the propagated solution (FSAL: the last stage row of A is the weights B).
-    double err = 0.0;
-    for (idx i = 0; i < n; ++i) {
-      double e = 0.0;
-      for (int j = 0; j < T::STAGES; ++j) e += T::E[j] * k(j, i);
-      const double scale = atol + rtol * py_max(std::fabs(y[i]), std::fabs(y_new[i]));
-      const double x = step * e / scale;
-      err += x * x;  // numba's x ** 2 (a literal integer exponent): x·x
-    }
-    err = std::sqrt(err / static_cast<double>(n));
+    double err = error_norm<T>(y, y_new, k, step, rtol, atol);
     // NaN or inf: rejected below and shrunk by the most; if it persists, NOT_FINITE
     not_finite = !std::isfinite(err);
     const double factor =

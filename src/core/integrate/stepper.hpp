@@ -47,4 +47,20 @@ inline int advance(int method, Vec y, double t0, double t1, Vec settings, const 
   return UNKNOWN_METHOD;
 }
 
+/// Advance y from t0 to t1 (s) by settings[MIN_STEPS] equal steps of the explicit method
+/// `method`, no error control (explicit_rk::advance_fixed); UNKNOWN_METHOD for an id that is not
+/// an explicit method's (nothing touched).
+inline int advance_fixed(int method, Vec y, double t0, double t1, Vec settings, const Model& m,
+                         Scratch& s, Vec u, Mat work2d, Vec work1d, Vec result) {
+  if (method == DOPRI54) {
+    return explicit_rk::advance_fixed<dopri54::Table>(y, t0, t1, settings, m, s, u, work2d,
+                                                     work1d, result);
+  }
+  if (method == VERNER65) {
+    return explicit_rk::advance_fixed<verner65::Table>(y, t0, t1, settings, m, s, u, work2d,
+                                                      work1d, result);
+  }
+  return UNKNOWN_METHOD;
+}
+
 }  // namespace mt::integrate
