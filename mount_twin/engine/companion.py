@@ -12,14 +12,19 @@ stepper's `error_norm` is: it tracks rtol, not the error).
 state plus its error e, and e is carried interval by interval, eₙ₊₁ = Φₙ(eₙ) + ℓₙ (the "Lady
 Windermere's fan", *ibid.* §II.3), instead of integrated a second time:
 
-- Φₙ by symplectic Euler through one right-hand side of the non-linear law itself: the body's
-  position errors drift by h·(their rates' errors), then the rates' and internal states' errors
-  are kicked by h·(f(t₁, y + e) − f(t₁, y)), f(t₁, y) being the twin's last stage (free). It is
-  a difference of the law, not a linearisation: a snubber met or a key closed in the companion
-  and not in the twin is in it, with no Jacobian and no switch rule. Symplectic Euler keeps a
-  free mode's error amplitude where h·ω < 2; an interval is carried only where h times the body's
-  fastest mode on its mounts' tangents (`Model.tangent_rate`, KICK_RATE) is within KICK_LIMIT = 1
-  (the bolted genset at 10 kHz: 0.36; at 1 kHz, 3.6, carried it read 1e6 times its true error);
+- Φₙ by symplectic Euler through one right-hand side of the non-linear law itself: the rates'
+  and internal states' errors are kicked by h·(f(t₀, y + e) − f(t₀, y)), then the body's
+  position errors drift by h·(their rates' errors). f(t₀, y) is the twin's first stage
+  (free); f(t₀, y + e) is taken at the end of the interval before in one pass with the
+  companion's outputs (src/core/physics/dynamics.hpp `rhs_with_wrenches`), moved to the new
+  input's Ω′ as the twin's chain moves its stage: one pass over the mounts an interval, where a
+  kick at t₁ took a right-hand side and an evaluation of the outputs (256 Bouc–Wen mounts
+  1.30× → 1.22× the engine's time). It is a difference of the law, not a linearisation: a
+  snubber met or a key closed in the companion and not in the twin is in it, with no Jacobian
+  and no switch rule. Symplectic Euler keeps a free mode's error amplitude where h·ω < 2; an
+  interval is carried only where h times the body's fastest mode on its mounts' tangents
+  (`Model.tangent_rate`, KICK_RATE) is within KICK_LIMIT = 1 (the bolted genset at 10 kHz:
+  0.36; at 1 kHz, 3.6, carried it read 1e6 times its true error);
 - a kind's rate-independent states are not kicked but returned by the kind's `carry` (a bolted
   joint's stick point onto its friction bound, its bolt's plastic elongation onto its yield
   line, where the twin's is there or the companion's passes it): kicked, a sliding face's
@@ -104,7 +109,6 @@ from mount_twin.integrate.methods import AUTO, DOPRI54, METHODS, VERNER65
 from mount_twin.integrate.settings import MAX_SUBSTEPS
 from mount_twin.integrate.settings import MIN_STEPS as MIN_STEPS_SLOT
 from mount_twin.integrate.stepper import forget, tighter_arrays
-from mount_twin.physics import pose_row
 from mount_twin.physics.dynamics import Scratch
 
 TOLERANCE_DIVISOR = 8.0
@@ -129,6 +133,8 @@ MIN_STEPS = 2
     NORM_MEAN,
     INTERVALS,
     KICK_RATE,
+    RATED,
+    TWIN_RATED,
     N_CARRY_SLOTS,
 ) = _core.CARRY_SLOTS
 """Slots of `Companion.carry` (src/core/engine/kernel.hpp CarrySlot)."""
@@ -153,8 +159,8 @@ class Companion(NamedTuple):
     y_prev, g, util: its mount monitors' arrays (its switches are taken with them).
     wrenches: (n_mounts, 6): its mount wrenches at the last sample.
     figures: (N_FIGURES,) running maxima (see the module docstring), reset by the reader.
-    error_rows: (N_ERROR_ROWS, n_state) the carried error's rows; pose: (pose_row.WIDTH,) its
-    pose row where carried; carry: (N_CARRY_SLOTS,) its slots; integrates: (k, NE) 1.0 where
+    error_rows: (N_ERROR_ROWS, n_state) the carried error's rows; carry: (N_CARRY_SLOTS,) its
+    slots; integrates: (k, NE) 1.0 where
     it is integrated over an interval that starts with the event holding (in the twin's
     monitors or its own).
     """
@@ -172,7 +178,6 @@ class Companion(NamedTuple):
     wrenches: np.ndarray
     figures: np.ndarray
     error_rows: np.ndarray
-    pose: np.ndarray
     carry: np.ndarray
     integrates: np.ndarray
 
@@ -220,7 +225,6 @@ def new_companion(
         np.zeros((n_mounts, 6)),
         np.zeros(N_FIGURES),
         np.zeros((N_ERROR_ROWS, n)),
-        np.zeros(pose_row.WIDTH),
         _reset_carry(carry, own),
         np.array(integrates, dtype=float),
     )

@@ -120,7 +120,6 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
   c.figures = convert::vec(field(obj, "figures"), "Companion.figures", N_FIGURES);
   c.error_rows = convert::mat(field(obj, "error_rows"), "Companion.error_rows",
                               engine::N_ERROR_ROWS, n_state);
-  c.pose = convert::vec(field(obj, "pose"), "Companion.pose", pose_row::WIDTH);
   c.carry = convert::vec(field(obj, "carry"), "Companion.carry", engine::N_CARRY_SLOTS);
   c.integrates = convert::mat(field(obj, "integrates"), "Companion.integrates", k, n_events);
   convert::check_scratch(c.s, n_state, "Companion.s");
@@ -203,7 +202,8 @@ void bind_engine(py::module_& mod) {
       int(engine::N_ERROR_ROWS));
   mod.attr("CARRY_SLOTS") = py::make_tuple(
       int(engine::CARRYING), int(engine::SINCE_CHECK), int(engine::CHECK_NORM),
-      int(engine::NORM_MEAN), int(engine::INTERVALS), int(engine::KICK_RATE),
+      int(engine::NORM_MEAN), int(engine::INTERVALS), int(engine::KICK_RATE), int(engine::RATED),
+      int(engine::TWIN_RATED),
       int(engine::N_CARRY_SLOTS));
   mod.attr("KICK_LIMIT") = engine::KICK_LIMIT;
   mod.attr("ENGAGED_CHECK_EVERY") = engine::ENGAGED_CHECK_EVERY;

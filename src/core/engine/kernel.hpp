@@ -67,7 +67,6 @@ struct Companion {
   M6 wrenches;
   Vec figures;  // (N_FIGURES,)
   Mat error_rows;  // (N_ERROR_ROWS, n): the carried error's work rows (ErrorRow)
-  Vec pose;     // (pose_row::WIDTH,): its pose row (the angles are what the estimate reads)
   Vec carry;    // (N_CARRY_SLOTS,): CarrySlot
   Mat integrates;  // (k, NE): 1.0 where an event holding makes the interval integrated
 };
@@ -76,9 +75,9 @@ struct Companion {
 enum ErrorRow : int {
   Y_START = 0,  // the twin's state at the interval's start
   ERROR,        // the companion's state less the twin's, e
-  TRIAL,        // the twin's end state plus e drifted: where the kick is taken
-  RATE,         // the right-hand side there
-  TWIN_RATE,    // the twin's at its end state, where a mount's switch moved it off its last stage
+  TRIAL,        // the twin's end state plus e before the kick (the kinds' carry reads it)
+  RATE,         // the right-hand side at the companion's state (RATED)
+  TWIN_RATE,    // the twin's at the interval's start: its first stage (TWIN_RATED)
   CHECK,        // the check's end state
   LOCAL,        // the last measured local error
   N_ERROR_ROWS
@@ -92,6 +91,8 @@ enum CarrySlot : int {
   NORM_MEAN,     // running mean of the twin's error norms
   INTERVALS,     // carried intervals the mean has seen
   KICK_RATE,     // rad/s: the body's fastest mode on its mounts' tangents (model.tangent_rate)
+  RATED,         // 1: RATE holds f at the companion's state, under the last interval's input
+  TWIN_RATED,    // 1: TWIN_RATE holds the twin's f at the interval's start, under its input
   N_CARRY_SLOTS
 };
 
@@ -276,47 +277,57 @@ inline void carry_kinds(const Model& m, Companion& c, Vec trial, Vec y) {
 
 /// The companion over [t0, t1] as the twin's state plus its error e, carried: eₙ₊₁ = Φ(eₙ) +
 /// ℓₙ (engine/companion.py says why and what it read). Φ by symplectic Euler through one
-/// right-hand side of the non-linear law itself, at the twin's end state plus e: the body's
-/// position errors drift by h·(their rates' errors), then the rates' and the internal states'
-/// errors are kicked by h·(f(t₁, y + e) − f(t₁, y)); the kinds' carry returns their
-/// rate-independent states. ℓ by `add_local_error`. twin_rate: f(t₁, y), the twin's last stage
-/// (`fresh`: false where a mount's switch moved y off it). Where y + e is off the α/γ/δ chart
-/// the companion is integrated over the interval (`follow`).
-inline void carry_interval(const Model& m, Companion& c, Vec u, double t0, double t1,
-                           Vec twin_rate, bool fresh, const Vec twin_result, int watched,
-                           Vec d_wdot, Vec pose, M6 wrenches, Vec y) {
+/// right-hand side of the non-linear law itself, at the interval's start: the rates' and the
+/// internal states' errors are kicked by h·(f(t₀, y + e) − f(t₀, y)), then the body's position
+/// errors drift by h·(their rates' errors); the kinds' carry returns their rate-independent
+/// states. ℓ by `add_local_error`. f(t₀, y) is the twin's first stage (TWIN_RATE, taken before
+/// its step); f(t₀, y + e) the right-hand side taken with the companion's outputs at the end of
+/// the interval before (RATE), moved to this interval's input as the twin's chain moves its
+/// stage (d_wdot; `chain`), so that the interval takes one right-hand side in all. Where a
+/// state is off the α/γ/δ chart the companion is integrated over the interval (`follow`).
+inline void carry_interval(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
+                           const Vec twin_result, int watched, Vec d_wdot, Vec pose,
+                           M6 wrenches, Vec y) {
   const idx n = y.n, nf = m.free_trans.n + m.free_rot.n;
   const double h = t1 - t0;
   const Mat rows = c.error_rows;
   const Vec e = rows.row(ERROR), trial = rows.row(TRIAL), rate = rows.row(RATE);
-  const Vec y_start = rows.row(Y_START);
-  for (idx i = 0; i < n; ++i) e[i] = c.y[i] - y_start[i];
-  for (idx k = 0; k < nf; ++k) e[k] += h * e[nf + k];
-  for (idx i = 0; i < n; ++i) trial[i] = y[i] + e[i];
-  if (!fresh) {
-    twin_rate = rows.row(TWIN_RATE);
-    if (physics::rhs(t1, y, m, c.s, u, twin_rate) != OK) {
-      resynchronise(c, y);
-      return;
-    }
+  const Vec y_start = rows.row(Y_START), twin_rate = rows.row(TWIN_RATE);
+  const Vec carry = c.carry;
+  bool rated = chain && carry[RATED] == 1.0;
+  if (rated) {
+    physics::rhs_after_rate_step(m, c.s, d_wdot, rate);  // c.s: the companion's, from then
+  } else {
+    rated = physics::rhs(t0, c.y, m, c.s, u, rate) == OK;
   }
-  if (physics::rhs(t1, trial, m, c.s, u, rate) != OK) {
-    follow(m, c, u, t0, t1, false, d_wdot, pose, wrenches, y);  // from c.y, still y_start + e
+  if (rated && carry[TWIN_RATED] != 1.0) {
+    rated = physics::rhs(t0, y_start, m, c.s, u, twin_rate) == OK;
+  }
+  carry[RATED] = 0.0;
+  if (!rated) {
+    follow(m, c, u, t0, t1, false, d_wdot, pose, wrenches, y);  // from c.y
     return;
   }
+  for (idx i = 0; i < n; ++i) {
+    e[i] = c.y[i] - y_start[i];
+    trial[i] = y[i] + e[i];
+  }
   for (idx i = nf; i < n; ++i) e[i] += h * (rate[i] - twin_rate[i]);
+  for (idx k = 0; k < nf; ++k) e[k] += h * e[nf + k];
   if (!add_local_error(m, c, u, t0, t1, twin_result, watched, y)) {
     resynchronise(c, y);
     return;
   }
   for (idx i = 0; i < n; ++i) c.y[i] = y[i] + e[i];
   if (m.has_nl) carry_kinds(m, c, trial, y);
-  if (!(physics::evaluate(c.y, m, c.s, c.pose, c.wrenches) > 0.0)) {
+  if (physics::rhs_with_wrenches(t1, c.y, m, c.s, u, rate, c.wrenches) != OK) {
     resynchronise(c, y);
     return;
   }
-  if (m.has_nl) monitor_switches(c.y, m.nl, c.y_prev, c.s, c.g, c.util, c.integ.settings);
-  c.integ.settings[CHAINED] = 0.0;  // its stepper's stages are not at c.y
+  const bool switched =
+      m.has_nl && monitor_switches(c.y, m.nl, c.y_prev, c.s, c.g, c.util, c.integ.settings);
+  carry[RATED] = switched ? 0.0 : 1.0;  // a switch moved c.y off the rate taken there
+  c.integ.settings[CHAINED] = 0.0;     // its stepper's stages are not at c.y
   fold_figures(c, c.s.q, pose, wrenches);
 }
 
@@ -357,7 +368,13 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
     if (estimator != nullptr) copy(y, estimator->y_start);
     const bool carried = companion != nullptr &&
                          carries(*companion, integ.method, smp.t[j - 1], smp.t[j], watch.g);
-    if (carried) copy(y, companion->error_rows.row(Y_START));
+    if (carried) {  // the twin's start: its state and, chained, its first stage
+      copy(y, companion->error_rows.row(Y_START));
+      companion->carry[TWIN_RATED] = settings[CHAINED];
+      if (settings[CHAINED] == 1.0) copy(integ.work2d.row(0), companion->error_rows.row(TWIN_RATE));
+    } else if (companion != nullptr) {
+      companion->carry[RATED] = 0.0;  // integrated: its rate is not kept
+    }
     const int status = integrate::advance(integ.method, y, smp.t[j - 1], smp.t[j], settings, m,
                                           s, u, integ.work2d, integ.work1d, integ.result);
     if (status != 0) return {j - 1, status};
@@ -376,9 +393,8 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
                         y);
     }
     if (carried) {
-      carry_interval(m, *companion, u, smp.t[j - 1], smp.t[j], integ.work2d.row(0),
-                     settings[CHAINED] == 1.0, integ.result, watched, d_wdot, out.pose.row(j),
-                     wrenches_j, y);
+      carry_interval(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, integ.result,
+                     watched, d_wdot, out.pose.row(j), wrenches_j, y);
     } else if (companion != nullptr) {
       follow(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, d_wdot, out.pose.row(j),
              wrenches_j, y);

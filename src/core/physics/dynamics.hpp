@@ -187,8 +187,12 @@ inline void add_load(const double* arm, const double* f, const double* c, double
 }
 
 /// Sum the mount loads on the body at the motion mo into s.total_force, s.total_moment (F,
-/// about the CG); the internal-state rates of the mounts that have them into dydt.
-inline void mount_loads(Vec y, const Model& m, const Motion& mo, Scratch& s, Vec dydt) {
+/// about the CG); the internal-state rates of the mounts that have them into dydt. With
+/// kWrenches, each non-linear mount's force and own couple in its axes into its row of
+/// *wrenches as well (`mount_wrenches`' rows, from the same loads).
+template <bool kWrenches>
+inline void mount_loads_into(Vec y, const Model& m, const Motion& mo, Scratch& s, Vec dydt,
+                             M6* wrenches) {
   double total_f[3] = {0.0, 0.0, 0.0}, total_m[3] = {0.0, 0.0, 0.0};
   linear_loads(m, mo, total_f, total_m);
   if (m.lin_point.rows > 0) {  // their own couples, through their summed K_r, C_r
@@ -205,12 +209,25 @@ inline void mount_loads(Vec y, const Model& m, const Motion& mo, Scratch& s, Vec
       out_of_axes(nl, i, ml.f, f);
       if (nl.rotational[i]) nl_couple(i, nl, mo, ml, c);
       add_load(ml.arm, f, c, total_f, total_m);
+      if constexpr (kWrenches) {
+        if (nl.rotational[i]) into_axes(nl, i, c[0], c[1], c[2], ml.c);
+        const idx row = nl.slot[i];
+        for (int j = 0; j < 3; ++j) {
+          (*wrenches)(row, j) = ml.f[j];
+          (*wrenches)(row, 3 + j) = ml.c[j];
+        }
+      }
     }
   }
   for (int j = 0; j < 3; ++j) {
     s.total_force[j] = total_f[j];
     s.total_moment[j] = total_m[j];
   }
+}
+
+/// `mount_loads_into` without the wrenches: the right-hand side's.
+inline void mount_loads(Vec y, const Model& m, const Motion& mo, Scratch& s, Vec dydt) {
+  mount_loads_into<false>(y, m, mo, s, dydt, nullptr);
 }
 
 /// Each mount's force (N) and own couple (N·m) on the body, in its axes: wrenches row slot.
@@ -427,11 +444,17 @@ inline bool rotational(const Model& m, Scratch& s, double ct, Vec dydt, idx firs
   return true;
 }
 
-inline int rhs(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt) {
+/// The right-hand side (`rhs`); with kWrenches, every mount's wrench into *wrenches as well,
+/// from the same loads (`mount_wrenches`' rows: the error estimate's carried companion takes
+/// its rate and its outputs in one pass).
+template <bool kWrenches>
+inline int rhs_into(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt,
+                    M6* wrenches) {
   Motion mo;
   const double ct = body_motion(y, m, s, mo);
   if (!(ct > 0.0)) return OFF_CHART;
-  mount_loads(y, m, mo, s, dydt);
+  mount_loads_into<kWrenches>(y, m, mo, s, dydt, wrenches);
+  if constexpr (kWrenches) linear_wrenches(m, mo, *wrenches);
   const idx nt = m.free_trans.n, nr = m.free_rot.n, nf = nt + nr;
   for (idx k = 0; k < nf; ++k) dydt[k] = y[nf + k];
   const double tau = t - u[0];
@@ -443,6 +466,17 @@ inline int rhs(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt) {
   if (nt > 0) translational(m, s, dydt, nf);
   if (nr > 0 && !rotational(m, s, ct, dydt, nf + nt)) return OFF_CHART;
   return OK;
+}
+
+inline int rhs(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt) {
+  return rhs_into<false>(t, y, m, s, u, dydt, nullptr);
+}
+
+/// `rhs`, and each mount's force (N) and own couple (N·m) on the body in its axes into its
+/// wrenches row, as `mount_wrenches` gives them, in one pass over the mounts.
+inline int rhs_with_wrenches(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt,
+                             M6 wrenches) {
+  return rhs_into<true>(t, y, m, s, u, dydt, &wrenches);
 }
 
 /// Outputs when s already holds the body motion at y (the last rhs was at y): the pose row
