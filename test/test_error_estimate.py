@@ -532,20 +532,43 @@ def test_at_1_khz_the_genset_companion_is_integrated_and_honest(monkeypatch) -> 
     assert 1 / FACTOR < acc.est_force_error / acc.force_error < FACTOR, acc
 
 
-@pytest.mark.parametrize(
-    ("stiffness", "rtol", "within"), [(1e10, 1e-3, FACTOR), (1e11, 1e-6, 1e3)]
-)
-def test_a_kick_past_its_reach_is_integrated_not_carried(
-    stiffness: float, rtol: float, within: float
+@pytest.mark.parametrize(("stiffness", "rtol"), [(1e10, 1e-3), (1e11, 1e-3), (1e11, 1e-6)])
+def test_a_contact_past_the_kicks_reach_is_integrated_not_carried(
+    stiffness: float, rtol: float
 ) -> None:
-    """Snubbers far stiffer than the open tangents at 1 kHz: where h²·|Δa|/|eₓ| of the kick
-    passes KICK_LIMIT² (kernel.hpp `in_reach`) the interval is integrated. Carried, the estimate
-    read 1.2e5 and 1e35 times the true error; now 1.49 and 410 (an over-read the guard does not
-    reach: a contact that opens and closes inside an interval is kicked from t₀, before it;
-    docs/benchmarks.md)."""
+    """Snubbers far stiffer than the open tangents at 1 kHz: an interval whose kick meets a
+    stiffness past its reach (h²·|Δa|/|eₓ| > KICK_LIMIT², kernel.hpp `in_reach`) or in which a
+    contact closes or opens (an event function changing sign) is integrated. Carried, the
+    estimate read 1.2e5, 5e9 and 1e35 times the true error; with the reach alone 1.49, 8.0 and
+    410."""
     scene, samples = _rubber_on_stiff_snubbers_1khz(stiffness)
     acc = measure(scene, samples, rtol, 100_000, reference_run(scene, samples, 1_000_000))
-    assert 1 / FACTOR < acc.est_force_error / acc.force_error < within, acc
+    assert 1 / FACTOR < acc.est_force_error / acc.force_error < FACTOR, acc
+
+
+@pytest.mark.parametrize("case", ["rubber_on_snubbers", "hysteresis_snubbers_real_shock"])
+def test_the_carried_companion_lies_on_the_references_side_of_the_twin(
+    case: str, monkeypatch
+) -> None:
+    """At the run's last sample the companion's mount forces less the twin's point as the
+    reference's less the twin's (the error, not its mirror image): the local errors were added
+    as the twin's less the check's, which the estimate's magnitudes cannot see while the carry
+    is linear (correlation −1.00 and −0.92 then), but which integrating the companion from the
+    mirror over an interval half cancelled (docs/benchmarks.md)."""
+    made: list[companion.Companion] = []
+
+    def keep(*args):
+        made.append(new_companion(*args))
+        return made[-1]
+
+    monkeypatch.setattr(driver_module, "new_companion", keep)
+    scene, samples = CASES[case][0]()
+    ref = reference_run(scene, samples, 1_000_000)
+    run = run_at(scene, samples, 1e-6, 100_000, True)
+    twin = run.out.wrenches[-1][:, :3]
+    own = (made[-1].wrenches[:, :3] - twin).ravel()
+    true = (ref.out.wrenches[-1][:, :3] - twin).ravel()
+    assert own @ true > 0.9 * np.linalg.norm(own) * np.linalg.norm(true), (own, true)
 
 
 def test_a_restart_zeroes_the_carried_error_and_measures_the_local_error_afresh() -> None:

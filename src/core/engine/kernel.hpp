@@ -215,23 +215,26 @@ inline bool carries(const Companion& c, int twin_method, double t0, double t1, c
   return true;
 }
 
-/// The local error the twin committed over the interval, added to e: measured (the twin's end
-/// state y less the companion's stepper's from the twin's start state) where the interval is
-/// special (a mount switched or an event function changed sign, the twin rejected a step, its
-/// error norm passed SPIKE_RATIO times its running mean, or none was measured since a
+/// The local error the twin committed over the interval, added to e (the companion less the
+/// twin, so the check's end state less the twin's: added the other way round, the companion
+/// was the twin's mirror image, its error the twin's with the sign turned, which only a linear
+/// carry leaves alone; where it was integrated next, from the mirror, the two halves cancelled,
+/// docs/benchmarks.md): measured (one step of the companion's stepper from the twin's start
+/// state, less the twin's end state y) where the interval is special (the twin rejected a step,
+/// its error norm passed SPIKE_RATIO times its running mean, or none was measured since a
 /// restart), and every CARRY_CHECK_EVERY intervals or half a period of the fastest tangent
 /// mode (KICK_RATE), whichever is fewer; between, the last measured one scaled by the twin's
 /// error norms (at most SPIKE_RATIO times). Returns false where the measurement
 /// failed (nothing added).
 inline bool add_local_error(const Model& m, Companion& c, Vec u, double t0, double t1,
-                            const Vec twin_result, int watched, Vec y) {
+                            const Vec twin_result, Vec y) {
   const Vec carry = c.carry, e = c.error_rows.row(ERROR), local = c.error_rows.row(LOCAL);
   const double norm = twin_result[0];
   carry[INTERVALS] += 1.0;
   const double mean = carry[NORM_MEAN], last = carry[CHECK_NORM];
   const bool spike = carry[INTERVALS] > 1.0 && norm > SPIKE_RATIO * mean;
   carry[NORM_MEAN] += (norm - mean) / py_min(carry[INTERVALS], 64.0);
-  const bool special = (watched & CHANGED) != 0 || twin_result[2] > 0.0 || spike || last < 0.0;
+  const bool special = twin_result[2] > 0.0 || spike || last < 0.0;
   carry[SINCE_CHECK] += 1.0;
   const double every = py_min(static_cast<double>(CARRY_CHECK_EVERY),
                               py_max(1.0, std::floor(M_PI / ((t1 - t0) * carry[KICK_RATE]))));
@@ -239,15 +242,15 @@ inline bool add_local_error(const Model& m, Companion& c, Vec u, double t0, doub
     const Vec check = c.error_rows.row(CHECK), settings = c.integ.settings;
     copy(c.error_rows.row(Y_START), check);
     settings[CHAINED] = 0.0;  // from the twin's start state: no stage of it at hand
-    // the twin took one step over the interval, none rejected, and no mount switched: the
-    // check's fewest steps, of a higher order or shorter, every one taken (engine/companion.py
-    // says why); else its stepper at its tolerance
-    const bool smooth = (watched & CHANGED) == 0 && twin_result[1] == 1.0 && twin_result[2] == 0.0;
+    // the twin took one step over the interval, none rejected: the check's fewest steps, of a
+    // higher order or shorter, every one taken (engine/companion.py says why); else its
+    // stepper at its tolerance
+    const bool smooth = twin_result[1] == 1.0 && twin_result[2] == 0.0;
     const auto step = smooth ? integrate::advance_fixed : integrate::advance;
     const int status = step(c.integ.method, check, t0, t1, settings, m, c.s, u, c.integ.work2d,
                             c.integ.work1d, c.integ.result);
     if (status != 0) return false;
-    for (idx i = 0; i < y.n; ++i) local[i] = y[i] - check[i];
+    for (idx i = 0; i < y.n; ++i) local[i] = check[i] - y[i];
     carry[CHECK_NORM] = norm;
     carry[SINCE_CHECK] = 0.0;
     for (idx i = 0; i < y.n; ++i) e[i] += local[i];
@@ -321,14 +324,16 @@ inline void carry_interval(const Model& m, Companion& c, Vec u, double t0, doubl
   }
   carry[RATED] = 0.0;
   for (idx i = 0; i < n; ++i) e[i] = c.y[i] - y_start[i];
-  if (!(rated && in_reach(nf, h, rate, twin_rate, e))) {  // integrated
+  // integrated where the kick is out of its reach, and where a mount switched or an event
+  // function changed sign over the interval (a contact the kick from t₀ does not see)
+  if (!(rated && in_reach(nf, h, rate, twin_rate, e)) || (watched & CHANGED) != 0) {
     follow(m, c, u, t0, t1, false, d_wdot, pose, wrenches, y);  // from c.y
     return;
   }
   for (idx i = 0; i < n; ++i) trial[i] = y[i] + e[i];
   for (idx i = nf; i < n; ++i) e[i] += h * (rate[i] - twin_rate[i]);
   for (idx k = 0; k < nf; ++k) e[k] += h * e[nf + k];
-  if (!add_local_error(m, c, u, t0, t1, twin_result, watched, y)) {
+  if (!add_local_error(m, c, u, t0, t1, twin_result, y)) {
     resynchronise(c, y);
     return;
   }
