@@ -53,16 +53,23 @@ Windermere's fan", *ibid.* §II.3), instead of integrated a second time:
 Where the twin runs a linearising method, where the interval is too long for the kick, where
 the kick meets a stiffness past its reach (h²·|Δa|/|eₓ| along the error over KICK_LIMIT², the
 core's `in_reach`: a snubber driven far past its gap stiffens the body beyond the open tangents
-KICK_RATE is taken on; snubbers of 1e10 and 1e11 N/m^1.5 at 1 kHz read 1.2e5 and 1e35 times
-their true error carried, 1.49 and 410 since), where y + e is off the α/γ/δ chart, and over an
-interval that starts with an event holding that its kind does not carry through
-(`EVENT_CARRIED`: any of a bolted joint's, flowing, open, slipping or broken; `integrates`), the
-companion is integrated over the interval as below, from the twin's state plus e, and carried
-again after it. A contact that closes inside an interval is still kicked from its start,
-before it: the 410 (docs/benchmarks.md).
+KICK_RATE is taken on), over an interval in which an event function changes sign (a contact
+closing or opening inside it, which a kick from its start does not see: snubbers of 1e10 and
+1e11 N/m^1.5 at 1 kHz read 1.2e5 and 1e35 times their true error carried, 1.31 and 1.01 at rtol
+1e-3 integrated there), where y + e is off the α/γ/δ chart, and over an interval that starts
+with an event holding that its kind does not carry through (`EVENT_CARRIED`: any of a bolted
+joint's, flowing, open, slipping or broken; `integrates`), the companion is integrated over the
+interval as below, from the twin's state plus e, and carried again after it.
+
+The sign matters where the two meet: e is the companion less the twin, so ℓ is added as the
+check's end state less the twin's. Added the other way round (until 2026-11-28), the carried
+companion was the twin's mirror image, its error the true one with the sign turned, which the
+estimate's magnitudes do not see while Φ is linear; integrated from the mirror over an
+interval, the mirrored error and the new local one half cancelled (rubber on snubbers read
+0.50 of its true error so).
 
 Measured against a reference (`python3 bench/error_estimate.py`; docs/scene.md "Error
-estimate" and docs/benchmarks.md have the table), it reads 0.67–1.35 of the true force error on
+estimate" and docs/benchmarks.md have the table), it reads 0.79–1.48 of the true force error on
 the genset, rubber on snubbers, hysteresis with snubbers under the real shock and 4 to 256
 Bouc–Wen elastomers at rtol 1e-3 … 1e-9, at 1.1–1.7× the engine's time, where the companion
 integrated at every interval read 0.69–1.08 at 1.4–2.1×: its work an interval is one pass over

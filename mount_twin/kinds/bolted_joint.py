@@ -51,7 +51,10 @@ under two synthesised 30 g shocks read 0.51–2.09 of its true force error (0.88
 flowing and open joints integrated, 0.89–1.23 with all), and under its own shock bag at rtol
 1e-6 and 1e-7 2.0 and 3.5 times its true attitude error with slipping faces carried: the yaw
 their slide left in the companion was ten times the reference's (0.86–1.07 with them
-integrated, at the same cost, 1.2–1.65×: `python3 bench/error_estimate.py --cases genset`)."""
+integrated, at the same cost, 1.2–1.65×: `python3 bench/error_estimate.py --cases genset`).
+Those figures were taken while the companion was the twin's mirror (`engine.companion`); with
+the sign right, all four carried read the genset 0.96–1.42 of its force error at rtol 1e-3 …
+1e-9 but 3.7 times its attitude error at 1e-7, at 1.24–1.88× against 1.31–1.63×."""
 EVENT_SWITCHES = (False, False, False, True)
 """Whether each event is a discrete switch of `update` (the bolt breaking): one that a start's
 monitors make is reported as that event at the start; the others holding at a start are
