@@ -59,19 +59,9 @@ def advance(
     work1d: _A,
     result: _A,
 ) -> int: ...
-def advance_fixed(
-    method: int,
-    y: _A,
-    t0: float,
-    t1: float,
-    settings: _A,
-    m: Any,
-    s: Any,
-    u: _A,
-    work2d: _A,
-    work1d: _A,
-    result: _A,
-) -> int: ...
+
+advance_fixed = advance
+
 def dopri54_advance(
     y: _A, t0: float, t1: float, settings: _A, m: Any, s: Any, u: _A, k: _A, y_new: _A, result: _A
 ) -> int: ...

@@ -84,6 +84,22 @@ inline void check_rows(const Mat& k, idx first, idx count, const char* what) {
   }
 }
 
+/// Bind Fn, a switch on the method id with `integrate::advance`'s signature, as `name`.
+template <auto Fn>
+void def_switch(py::module_& mod, const char* name, const char* doc) {
+  mod.def(
+      name,
+      [](int method, py::handle y_, double t0, double t1, py::handle settings_, py::handle m_,
+         py::handle s_, py::handle u_, py::handle work2d_, py::handle work1d_,
+         py::handle result_) {
+        Args a = args(method, y_, settings_, m_, s_, u_, work2d_, work1d_, result_);
+        return Fn(method, a.y, t0, t1, a.settings, a.m, a.s, a.u, a.work2d, a.work1d, a.result);
+      },
+      doc, py::arg("method"), py::arg("y"), py::arg("t0"), py::arg("t1"), py::arg("settings"),
+      py::arg("m"), py::arg("s"), py::arg("u"), py::arg("work2d"), py::arg("work1d"),
+      py::arg("result"));
+}
+
 template <int Method>
 void def_method_advance(py::module_& mod, const char* name, const char* doc) {
   mod.def(
@@ -166,15 +182,8 @@ py::dict method_tables() {
 
 void bind_integrate(py::module_& mod) {
   using namespace integrate_binding;
-  mod.def(
-      "advance",
-      [](int method, py::handle y_, double t0, double t1, py::handle settings_, py::handle m_,
-         py::handle s_, py::handle u_, py::handle work2d_, py::handle work1d_,
-         py::handle result_) {
-        Args a = args(method, y_, settings_, m_, s_, u_, work2d_, work1d_, result_);
-        return integrate::advance(method, a.y, t0, t1, a.settings, a.m, a.s, a.u, a.work2d,
-                                  a.work1d, a.result);
-      },
+  def_switch<integrate::advance>(
+      mod, "advance",
       "Advance the state y (in place; m, rad, m/s, rad/s and the mounts' internal states) from "
       "t0 to t1 (s) with the stepper `method` (a methods.METHODS id) under the input u held "
       "over the interval. settings: the slots of integrate.settings (STEP s, RTOL, ATOL in the "
@@ -182,26 +191,13 @@ void bind_integrate(py::module_& mod) {
       "work2d: (Method.work_rows(n), n), work1d: (n,) work arrays; result: out [largest "
       "accepted error norm, accepted, rejected substeps]. Returns a status of "
       "integrate.methods (0 = SUCCESS; UNKNOWN_METHOD for an id no method has, nothing "
-      "touched).",
-      py::arg("method"), py::arg("y"), py::arg("t0"), py::arg("t1"), py::arg("settings"),
-      py::arg("m"), py::arg("s"), py::arg("u"), py::arg("work2d"), py::arg("work1d"),
-      py::arg("result"));
-  mod.def(
-      "advance_fixed",
-      [](int method, py::handle y_, double t0, double t1, py::handle settings_, py::handle m_,
-         py::handle s_, py::handle u_, py::handle work2d_, py::handle work1d_,
-         py::handle result_) {
-        Args a = args(method, y_, settings_, m_, s_, u_, work2d_, work1d_, result_);
-        return integrate::advance_fixed(method, a.y, t0, t1, a.settings, a.m, a.s, a.u,
-                                        a.work2d, a.work1d, a.result);
-      },
+      "touched).");
+  def_switch<integrate::advance_fixed>(
+      mod, "advance_fixed",
       "`advance` by settings[MIN_STEPS] equal steps of an explicit method (dopri54, verner65), "
       "every one taken: no error control; settings[STEP] untouched. result: [largest error "
       "norm of the steps at the settings' tolerances, steps taken, 0]. Returns a status "
-      "(UNKNOWN_METHOD for a method that is not explicit, nothing touched).",
-      py::arg("method"), py::arg("y"), py::arg("t0"), py::arg("t1"), py::arg("settings"),
-      py::arg("m"), py::arg("s"), py::arg("u"), py::arg("work2d"), py::arg("work1d"),
-      py::arg("result"));
+      "(UNKNOWN_METHOD for a method that is not explicit, nothing touched).");
   def_method_advance<DOPRI54>(
       mod, "dopri54_advance",
       "Dormand–Prince 5(4) across one input interval: `advance` without the method id (k: "
