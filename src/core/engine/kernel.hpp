@@ -303,7 +303,8 @@ inline bool in_reach(idx nf, double h, const Vec rate, const Vec twin_rate, cons
 /// its step); f(t₀, y + e) the right-hand side taken with the companion's outputs at the end of
 /// the interval before (RATE), moved to this interval's input as the twin's chain moves its
 /// stage (d_wdot; `chain`), so that the interval takes one right-hand side in all. Where a
-/// state is off the α/γ/δ chart the companion is integrated over the interval (`follow`).
+/// state is off the α/γ/δ chart, the kick is out of its reach (`in_reach`) or an event
+/// function changed sign over the interval, the companion is integrated over it (`follow`).
 inline void carry_interval(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
                            const Vec twin_result, int watched, Vec d_wdot, Vec pose,
                            M6 wrenches, Vec y) {
@@ -390,7 +391,9 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
     if (carried) {  // the twin's start: its state and, chained, its first stage
       copy(y, companion->error_rows.row(Y_START));
       companion->carry[TWIN_RATED] = settings[CHAINED];
-      if (settings[CHAINED] == 1.0) copy(integ.work2d.row(0), companion->error_rows.row(TWIN_RATE));
+      if (settings[CHAINED] == 1.0) {
+        copy(integ.work2d.row(0), companion->error_rows.row(TWIN_RATE));
+      }
     } else if (companion != nullptr) {
       companion->carry[RATED] = 0.0;  // integrated: its rate is not kept
     }
