@@ -37,7 +37,7 @@ Windermere's fan", *ibid.* §II.3), instead of integrated a second time:
   body's fastest tangent mode, at most CARRY_CHECK_EVERY = 32 intervals apart (the genset at
   10 kHz: 8); the intervals between add the last measured ℓ scaled by the twin's error norms
   (at most SPIKE_RATIO times). Measured every 32 intervals there, the genset under the bundled
-  half-sine read 0.49 of its true error (every 17: 0.53; every 8: 1.26 and 0.94 at rtol 1e-6
+  half-sine read 0.49 of its true error (every 17: 0.53; every 8: 1.25 and 0.87 at rtol 1e-6
   and 1e-8). Where the twin took one step over the interval, none rejected, the check is the
   stepper's fewest steps, every one taken (`integrate.stepper.advance_fixed`): a step of
   Verner's 6th order as long as the twin's accepted 5th-order one, or two of the twin's own
@@ -51,12 +51,13 @@ Windermere's fan", *ibid.* §II.3), instead of integrated a second time:
   (checks 8 and 32 apart), by their number 1.8–9.3 times it.
 
 Where the twin runs a linearising method, where the interval is too long for the kick, where
-the kick meets a stiffness past its reach (h²·|Δa|/|eₓ| along the error over KICK_LIMIT², the
-core's `in_reach`: a snubber driven far past its gap stiffens the body beyond the open tangents
-KICK_RATE is taken on), over an interval in which an event function changes sign (a contact
-closing or opening inside it, which a kick from its start does not see: snubbers of 1e10 and
-1e11 N/m^1.5 at 1 kHz read 1.2e5 and 1e35 times their true error carried, 1.31 and 1.01 at rtol
-1e-3 integrated there), where y + e is off the α/γ/δ chart, and over an interval that starts
+the kick meets a stiffness past its reach on some coordinate k of the body (h²·|Δaₖ| over
+KICK_LIMIT²·|eₖ|, the core's `in_reach`: a snubber driven far past its gap stiffens the body
+beyond the open tangents KICK_RATE is taken on), over an interval in which an event function
+changes sign (a contact closing or opening inside it, which a kick from its start does not
+see: snubbers of 1e10 and 1e11 N/m^1.5 at 1 kHz read 1.2e5 and 1e35 times their true error
+carried, 0.92–1.19 at rtol 1e-3 and 1e-6 integrated there), where y + e is off the α/γ/δ
+chart, and over an interval that starts
 with an event holding that its kind does not carry through (`EVENT_CARRIED`: any of a bolted
 joint's, flowing, open, slipping or broken; `integrates`), the companion is integrated over the
 interval as below, from the twin's state plus e, and carried again after it.
@@ -69,7 +70,7 @@ interval, the mirrored error and the new local one half cancelled (rubber on snu
 0.50 of its true error so).
 
 Measured against a reference (`python3 bench/error_estimate.py`; docs/scene.md "Error
-estimate" and docs/benchmarks.md have the table), it reads 0.79–1.48 of the true force error on
+estimate" and docs/benchmarks.md have the table), it reads 0.79–1.49 of the true force error on
 the genset, rubber on snubbers, hysteresis with snubbers under the real shock and 4 to 256
 Bouc–Wen elastomers at rtol 1e-3 … 1e-9, at 1.1–1.7× the engine's time, where the companion
 integrated at every interval read 0.69–1.08 at 1.4–2.1×: its work an interval is one pass over
