@@ -186,6 +186,17 @@ inline void add_load(const double* arm, const double* f, const double* c, double
   total_m[2] += arm[0] * f[1] - arm[1] * f[0] + c[2];
 }
 
+/// Non-linear mount i's wrench row (slot) in its axes: its force ml.f and, where it is
+/// rotational, its couple c on the body (F) taken into its axes (ml.c otherwise, its law's).
+inline void put_wrench(const NonLinear& nl, idx i, const double* c, MountLocal& ml, M6 wrenches) {
+  if (nl.rotational[i]) into_axes(nl, i, c[0], c[1], c[2], ml.c);
+  const idx row = nl.slot[i];
+  for (int j = 0; j < 3; ++j) {
+    wrenches(row, j) = ml.f[j];
+    wrenches(row, 3 + j) = ml.c[j];
+  }
+}
+
 /// Sum the mount loads on the body at the motion mo into s.total_force, s.total_moment (F,
 /// about the CG); the internal-state rates of the mounts that have them into dydt. With
 /// kWrenches, each non-linear mount's force and own couple in its axes into its row of
@@ -209,14 +220,7 @@ inline void mount_loads_into(Vec y, const Model& m, const Motion& mo, Scratch& s
       out_of_axes(nl, i, ml.f, f);
       if (nl.rotational[i]) nl_couple(i, nl, mo, ml, c);
       add_load(ml.arm, f, c, total_f, total_m);
-      if constexpr (kWrenches) {
-        if (nl.rotational[i]) into_axes(nl, i, c[0], c[1], c[2], ml.c);
-        const idx row = nl.slot[i];
-        for (int j = 0; j < 3; ++j) {
-          (*wrenches)(row, j) = ml.f[j];
-          (*wrenches)(row, 3 + j) = ml.c[j];
-        }
-      }
+      if constexpr (kWrenches) put_wrench(nl, i, c, ml, *wrenches);
     }
   }
   for (int j = 0; j < 3; ++j) {
@@ -239,16 +243,9 @@ inline void mount_wrenches(Vec y, const Model& m, Scratch& s, M6 wrenches) {
   MountLocal ml;
   for (idx i = 0; i < nl.k; ++i) {
     nl_load(i, y, nl, mo, ml, s.sink);
-    if (nl.rotational[i]) {
-      double c[3];
-      nl_couple(i, nl, mo, ml, c);
-      into_axes(nl, i, c[0], c[1], c[2], ml.c);
-    }
-    const idx row = nl.slot[i];
-    for (int j = 0; j < 3; ++j) {
-      wrenches(row, j) = ml.f[j];
-      wrenches(row, 3 + j) = ml.c[j];
-    }
+    double c[3] = {0.0, 0.0, 0.0};
+    if (nl.rotational[i]) nl_couple(i, nl, mo, ml, c);
+    put_wrench(nl, i, c, ml, wrenches);
   }
 }
 
