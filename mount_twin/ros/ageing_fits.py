@@ -89,9 +89,12 @@ class AgeingFits:
             if hung:  # its fit would hold the interpreter's exit (it joins the pool's thread)
                 for worker in self._pool._processes.values():  # no public way before 3.14
                     worker.kill()
-            # Joined where every fit is done: left running (wait=False), the pool's thread
-            # closed its wake-up pipe under the interpreter's exit hook, which then printed
-            # "OSError: Bad file descriptor" after a clean shutdown (CPython gh-83279).
-            self._pool.shutdown(wait=not hung, cancel_futures=True)
+                    worker.join()
+            # Joined, the worker done or killed and reaped (the pool's thread then sees it
+            # gone and ends): left running (wait=False), the pool's thread closed its wake-up
+            # pipe under the interpreter's exit hook, which then printed "OSError: Bad file
+            # descriptor" after the shutdown (CPython gh-83279; a second stop's, 1 CI run in 6
+            # on 2026-11-28).
+            self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
         return msgs
