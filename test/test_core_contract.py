@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_helpers import default_scene
+from io_helpers import CONFIG, default_scene
 
 from mount_twin import _core, core_sources
 from mount_twin.engine import estimate, kernel
@@ -163,3 +163,37 @@ def test_the_loop_refuses_work_arrays_too_small_for_the_method(pump) -> None:
         ValueError, match=rf"Integrator\.work2d: 7 rows where method 1 needs {rows}"
     ):
         Loop(integ, *args, None)
+
+
+def test_the_loop_refuses_a_companion_switching_to_a_method_its_stage_does_not_serve() -> None:
+    """Where a joint's faces switch the companion steps by its switching method in its own
+    arrays, its chained first stage carried over (kernel.hpp `companion_advance`): only the
+    explicit first-same-as-last pairs share that stage, so a linearising method beside Verner's
+    pair is refused by name when the loop is bound, not stepped from a stage it does not mean."""
+    from mount_twin.engine.companion import new_companion
+    from mount_twin.engine.kernel import Loop, RunOptions, new_watch
+    from mount_twin.integrate.stepper import new_stepper
+    from mount_twin.scene.loader import load_scene_file
+
+    model = assemble(load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml"))
+    n, k = model.n_state, len(model.nonlinear_slots)
+    u = np.zeros(dynamics.INPUT_SIZE)
+    u[3] = 9.80665
+    twin = new_stepper("dopri54", n, 1e-6, 1e-9, 100)
+    comp = new_companion(
+        "auto",
+        n,
+        1e-6,
+        1e-9,
+        100,
+        model.new_scratch(),
+        model.n_mounts,
+        np.zeros((k, N_EVENTS)),
+        1.0,
+    )
+    args = (model.arrays, model.new_scratch(), u, initial_state(model, u[1:4]))
+    integ = kernel.Integrator(twin.method, twin.settings, twin.work2d, twin.work1d, twin.result)
+    rest = (RunOptions(False, 1, False), new_watch(k, N_EVENTS, n))
+    Loop(integ, *args, *rest, comp)  # Verner's pair, Dormand–Prince's where the faces switch
+    with pytest.raises(ValueError, match=r"Companion\.switching_method 1 at 2\.0+ steps beside"):
+        Loop(integ, *args, *rest, comp._replace(switching_method=methods.ROS34PW2))

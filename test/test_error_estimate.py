@@ -207,7 +207,7 @@ CASES = {
     "rubber_on_snubbers": (_rubber_on_snubbers, [1e-3, 1e-6]),
     "rubber_on_snubbers_verner65": (partial(_on_verner65, _rubber_on_snubbers), [1e-3, 1e-6]),
     "hysteresis_snubbers_real_shock": (_hysteresis_snubbers_real_shock, [1e-3, 1e-6]),
-    "genset": (_genset, [1e-6]),
+    "genset": (_genset, [1e-3, 1e-6, 1e-9]),
     "genset_half_sine": (partial(_genset, "half_sine_shock_10khz"), [1e-6]),
     "pump_ship_motion": (_pump, [1e-4, 1e-9]),
     "pump_250hz": (partial(_pump, 4), [1e-6]),
@@ -436,16 +436,18 @@ def test_the_companion_of_dormand_prince_is_one_step_of_verner_and_switches_with
 ):
     """Where the twin runs dopri54 the companion runs Verner's 6(5) pair at one step an interval
     at least (a different solution of a smaller error for 8 right-hand sides a step, where one
-    step of the twin's own method would be the twin again); where auto moves the twin to a
-    linearising method the companion runs that method at two steps at least, and back. Its
-    work arrays, made for auto, hold every method; its step limit stays the twin's per step of
-    its fewest."""
+    step of the twin's own method would be the twin again), and dopri54 at two steps at least
+    over an interval where a joint's faces switch (`switching_method`); where auto
+    moves the twin to a linearising method the companion runs that method at two steps at
+    least, and back. Its work arrays, made for auto, hold every method; its step limit stays
+    the twin's per step of its fewest."""
     model = assemble(load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml"))
     n, scratch = model.n_state, model.new_scratch()
     own = new_companion(
         "dopri54", n, 1e-6, 1e-9, 100, scratch, model.n_mounts, np.zeros((8, N_EVENTS)), 1.0
     )
     assert (own.method, own.settings[MIN_STEPS], own.settings[MAX_SUBSTEPS]) == (VERNER65, 1, 100)
+    assert (own.switching_method, own.switching_min_steps) == (DOPRI54, 2)
     comp = new_companion(
         "auto", n, 1e-6, 1e-9, 100, scratch, model.n_mounts, np.zeros((8, N_EVENTS)), 1.0
     )
@@ -453,12 +455,14 @@ def test_the_companion_of_dormand_prince_is_one_step_of_verner_and_switches_with
     for twin, method, fewest in ((ROS34PW2, ROS34PW2, 2), (DOPRI54, VERNER65, 1)):
         comp = companion.switch(comp, twin)
         assert (comp.method, comp.settings[MIN_STEPS]) == (method, fewest)
+        assert (comp.switching_method, comp.switching_min_steps) == (twin, 2)
         assert comp.settings[MAX_SUBSTEPS] == 100 * fewest
     assert comp.work2d.shape[0] >= max(m.work_rows(n) for m in METHODS.values())
     ros = new_companion(
         "ros34pw2", n, 1e-6, 1e-9, 100, scratch, model.n_mounts, np.zeros((8, N_EVENTS)), 1.0
     )
     assert (ros.method, ros.settings[MIN_STEPS]) == (ROS34PW2, 2.0)
+    assert (ros.switching_method, ros.switching_min_steps) == (ROS34PW2, 2)
 
 
 def _companion_per_interval(

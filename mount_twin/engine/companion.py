@@ -77,8 +77,8 @@ integrated at every interval read 0.69–1.08 at 1.4–2.1×: its work an interv
 the mounts (a right-hand side with the outputs) and, at a special interval or every half
 period, one step of the check, where the integrated companion's was 8 right-hand sides at
 least, more across the joints' switches. On the genset most of what is left is the intervals
-it is integrated over: 214 of 2 500 under its shock, about half the twin's own time (an
-instrumented build).
+it is integrated over: 214 of 2 500 under its shock, a third of the twin's right-hand sides
+(an instrumented build; half before the switching intervals took the twin's method, below).
 
 **Integrated** (over the intervals above): the same model integrated beside the twin with rtol and
 atol divided by TOLERANCE_DIVISOR = 8. Where the twin's steps are set by the samples, not its
@@ -87,15 +87,30 @@ estimate 0): where the twin runs Dormand–Prince 5(4) the companion runs Verner
 (`integrate.verner65`) at least one step an interval (a 6th-order step of the same length: its
 error a small share of the twin's; 8 new right-hand sides a step); where the twin runs a
 linearising method it runs that method at least MIN_STEPS = 2 steps an interval (HIGHER,
-`own_method`; `switch` follows the twin). This stepper is also the carried error's check. Right
-after a rejected step it grows no step (`integrate.settings` HOLD_AFTER_REJECT, the rule of Hairer,
-Nørsett & Wanner's DOPRI5 code): on the bolted genset under its shock the joints' faces between
-sticking and sliding make the error of a step jump with its length, and a step grown at once from
-one accepted with a tiny error was rejected again, and again. Verner's "most efficient" 6(5) pair
-was tried first and dropped: its weights of ±176 on stages 0.05 % of a step apart make its error
-estimate's rounding, ε·176·|f|·h, dominate at tight tolerances. With Verner's pair a divisor of 4
-reads 0.71 of the true error at rtol 1e-3 on the genset (8: 0.89), 2 reads 0.57
-(docs/benchmarks.md).
+`own_method`; `switch` follows the twin). This stepper is also the carried error's check.
+Where a joint's faces switch inside the steps (an interval that starts with a joint's event
+holding, over which the twin's tolerance bound its steps: more than one, or one rejected), the
+companion runs the twin's own method at MIN_STEPS steps at least instead (`switching_method`):
+there a step's error jumps with its length whatever its order, so a higher order saves few
+steps, and a step costs what its stages cost, 6 new right-hand sides where Verner's take 8. On the
+genset under its shock the intervals integrated with a joint's event holding took 9 840
+right-hand sides by Verner's pair, 6 332 so (the twin's whole run 18 609), and the estimate's
+cost went from 1.67–1.68× to 1.53–1.54× (best of 5 at rtol 1e-6, alternating with the tree
+before), its estimate 0.89–0.99 of the true force error at rtol 1e-3 … 1e-9 (0.90–1.01 before),
+its attitude 0.86–1.12.
+Taken wherever the twin's tolerance bound its steps, snubbers, contacts and all, the rubber on
+snubbers of 1e9 N/m^1.5 at 1 kHz read 0.42 of its true error at rtol 1e-6 (attitude 0.32 at
+1e-3): beside the twin's own method the companion's errors follow the twin's where a contact,
+not a friction bound, sets the steps.
+
+Right after a rejected step the companion grows no step (`integrate.settings` HOLD_AFTER_REJECT,
+the rule of Hairer, Nørsett & Wanner's DOPRI5 code): on the bolted genset under its shock the
+joints' faces between sticking and sliding make the error of a step jump with its length, and a
+step grown at once from one accepted with a tiny error was rejected again, and again. Verner's
+"most efficient" 6(5) pair was tried first and dropped: its weights of ±176 on stages 0.05 % of a
+step apart make its error estimate's rounding, ε·176·|f|·h, dominate at tight tolerances. With
+Verner's pair a divisor of 4 reads 0.71 of the true error at rtol 1e-3 on the genset (8: 0.89), 2
+reads 0.57 (docs/benchmarks.md).
 
 Both read the same held input, take the same discrete mount switches between samples, and
 restart with the twin. `integration.error_estimate: false` turns the estimate off. It never
@@ -165,11 +180,22 @@ def own_method(twin: int) -> tuple[int, int]:
     return (HIGHER[twin], 1) if twin in HIGHER else (twin, MIN_STEPS)
 
 
+def switching_method(twin: int) -> tuple[int, int]:
+    """(method id, fewest steps per input interval) of the companion of a twin running the
+    method `twin` (an id) over an interval where a bolted joint's faces switch inside the
+    steps (an event holds that the companion is integrated over, and the twin's tolerance bound
+    its steps): the twin's own at MIN_STEPS (see the module docstring)."""
+    return twin, MIN_STEPS
+
+
 class Companion(NamedTuple):
     """The companion solution's stepper, state and work arrays (the core's loop advances it
     after the twin at every sample: `follow` in src/core/engine/kernel.hpp).
 
     method, settings, work2d, work1d, result: its stepper (`integrate.stepper.Stepper`).
+    switching_method, switching_min_steps: the method (an id) and fewest steps it takes
+    instead, with the same arrays, over an interval where a joint's faces switch
+    (`switching_method`).
     y: (n_state,) its state; s: its scratch (its angles at the last sample: s.q[3:6]);
     y_prev, g, util: its mount monitors' arrays (its switches are taken with them).
     wrenches: (n_mounts, 6): its mount wrenches at the last sample.
@@ -185,6 +211,8 @@ class Companion(NamedTuple):
     work2d: np.ndarray
     work1d: np.ndarray
     result: np.ndarray
+    switching_method: int
+    switching_min_steps: int
     y: np.ndarray
     s: Scratch
     y_prev: np.ndarray
@@ -232,6 +260,7 @@ def new_companion(
     return Companion(
         own,
         *arrays[1:],
+        *switching_method(twin),
         np.zeros(n),
         scratch,
         np.zeros(n),
@@ -268,7 +297,8 @@ def switch(c: Companion, method: int) -> Companion:
     settings[MIN_STEPS_SLOT] = float(min_steps)
     forget(settings)
     _reset_carry(c.carry, own)
-    return c._replace(method=own)
+    bound, bound_steps = switching_method(method)
+    return c._replace(method=own, switching_method=bound, switching_min_steps=bound_steps)
 
 
 def restart(c: Companion, y: np.ndarray) -> None:

@@ -111,6 +111,21 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
                             idx k, idx n_events) {
   engine::Companion c;
   c.integ = integrator(obj, "Companion", n_state);
+  c.switching_method = field(obj, "switching_method").cast<int>();
+  c.switching_min_steps = field(obj, "switching_min_steps").cast<double>();
+  // its own arrays hold it, and the chained first stage means the same to both (kernel.hpp
+  // companion_advance: the explicit first-same-as-last pairs), or it is its own method
+  const auto fsal = [](int method) { return method == DOPRI54 || method == VERNER65; };
+  const int own = c.integ.method, other = c.switching_method;
+  const idx need = integrate::work_rows(other, n_state);
+  if (need < 0 || c.integ.work2d.rows < need || !(c.switching_min_steps >= 1.0) ||
+      !(other == own || (fsal(own) && fsal(other)))) {
+    throw py::value_error("Companion.switching_method " + std::to_string(other) + " at " +
+                          std::to_string(c.switching_min_steps) + " steps beside method " +
+                          std::to_string(own) + " in " + std::to_string(c.integ.work2d.rows) +
+                          " work rows: not an explicit pair both hold, nor its own method, "
+                          "or under 1 step");
+  }
   c.y = convert::vec(field(obj, "y"), "Companion.y", n_state);
   c.s = convert::scratch(field(obj, "s"));
   c.y_prev = convert::vec(field(obj, "y_prev"), "Companion.y_prev", n_state);

@@ -59,6 +59,8 @@ struct Published {
 /// (engine/companion.py Companion; engine/estimator.py says why).
 struct Companion {
   Integrator integ;
+  int switching_method;        // where a joint's faces switch inside the steps (`follow`) ...
+  double switching_min_steps;  // ... this method, at least this many steps, in integ's arrays
   Vec y;
   Scratch s;
   Vec y_prev;
@@ -166,6 +168,40 @@ inline void fold_figures(Companion& c, const Vec q, Vec pose, M6 wrenches) {
   figures[ATTITUDE_ERROR] = attitude;
 }
 
+/// Whether an event holds at the interval's start that the companion's kind does not carry
+/// through (`integrates`: a bolted joint's, any), in the twin's monitors g or the companion's.
+inline bool integrated_event_holds(const Companion& c, const Mat g) {
+  for (idx i = 0; i < c.integrates.rows; ++i) {
+    for (idx e = 0; e < c.integrates.cols; ++e) {
+      if (c.integrates(i, e) > 0.0 && (g(i, e) >= 0.0 || c.g(i, e) >= 0.0)) return true;
+    }
+  }
+  return false;
+}
+
+/// Advance the companion's stepper over [t0, t1] from y (in place) with error control: by its
+/// own method, or, `switching`, by c.switching_method at least c.switching_min_steps steps
+/// (engine/companion.py says why: where a joint's faces switch between sticking and sliding
+/// inside the steps, a step costs what its stages cost, not what its order saves). Both
+/// methods are first-same-as-last: settings[CHAINED]'s stage holds for either.
+inline int companion_advance(const Model& m, Companion& c, Vec y, double t0, double t1, Vec u,
+                             bool switching) {
+  const Integrator& g = c.integ;
+  const Vec settings = g.settings;
+  if (!switching || c.switching_method == g.method) {
+    return integrate::advance(g.method, y, t0, t1, settings, m, c.s, u, g.work2d, g.work1d,
+                              g.result);
+  }
+  const double min_steps = settings[MIN_STEPS], max_steps = settings[MAX_SUBSTEPS];
+  settings[MIN_STEPS] = c.switching_min_steps;
+  settings[MAX_SUBSTEPS] = max_steps * c.switching_min_steps / min_steps;
+  const int status = integrate::advance(c.switching_method, y, t0, t1, settings, m, c.s, u,
+                                        g.work2d, g.work1d, g.result);
+  settings[MIN_STEPS] = min_steps;
+  settings[MAX_SUBSTEPS] = max_steps;
+  return status;
+}
+
 /// The companion set back onto the twin's state y after a failure, which the estimate counts.
 inline void resynchronise(Companion& c, Vec y) {
   copy(y, c.y);
@@ -174,20 +210,19 @@ inline void resynchronise(Companion& c, Vec y) {
   c.figures[FAILURES] += 1.0;
 }
 
-/// Advance the companion over [t0, t1] under the input u the twin just took, take its mounts'
-/// switches, and fold the differences of its outputs from the twin's (pose, wrenches at t1; y
-/// the twin's state): its wrenches and angles, what the estimate compares (no pose row).
+/// Advance the companion over [t0, t1] under the input u the twin just took
+/// (`companion_advance`, `switching` as it says), take its mounts' switches, and fold the
+/// differences of its outputs from the twin's (pose, wrenches at t1; y the twin's state): its
+/// wrenches and angles, what the estimate compares (no pose row).
 inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
-                   Vec d_wdot, Vec pose, M6 wrenches, Vec y) {
+                   bool switching, Vec d_wdot, Vec pose, M6 wrenches, Vec y) {
   const Vec settings = c.integ.settings;
   if (chain && settings[CHAINED] == 1.0) {
     physics::rhs_after_rate_step(m, c.s, d_wdot, c.integ.work2d.row(0));
   } else {
     settings[CHAINED] = 0.0;
   }
-  const int status = integrate::advance(c.integ.method, c.y, t0, t1, settings, m, c.s, u,
-                                        c.integ.work2d, c.integ.work1d, c.integ.result);
-  if (status != 0) {
+  if (companion_advance(m, c, c.y, t0, t1, u, switching) != 0) {
     resynchronise(c, y);
     return;
   }
@@ -199,20 +234,11 @@ inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bo
 /// Whether the companion carries its error over [t0, t1]: it says so (CARRYING), the twin's
 /// method is explicit (a linearising twin's stiff modes would put the explicit kick out of its
 /// stable range), the interval times the fastest rate of the body on its mounts' tangents
-/// (KICK_RATE, rad/s) is within KICK_LIMIT, and no event its kind does not carry through
-/// (`integrates`: a bolted joint's, any) holds at t0 in the twin's monitors g or the
-/// companion's.
-inline bool carries(const Companion& c, int twin_method, double t0, double t1, const Mat g) {
-  if (!(c.carry[CARRYING] == 1.0 && (twin_method == DOPRI54 || twin_method == VERNER65) &&
-        (t1 - t0) * c.carry[KICK_RATE] <= KICK_LIMIT)) {
-    return false;
-  }
-  for (idx i = 0; i < c.integrates.rows; ++i) {
-    for (idx e = 0; e < c.integrates.cols; ++e) {
-      if (c.integrates(i, e) > 0.0 && (g(i, e) >= 0.0 || c.g(i, e) >= 0.0)) return false;
-    }
-  }
-  return true;
+/// (KICK_RATE, rad/s) is within KICK_LIMIT, and no event its kind does not carry through holds
+/// at t0 (`holding`: `integrated_event_holds`).
+inline bool carries(const Companion& c, int twin_method, double t0, double t1, bool holding) {
+  return c.carry[CARRYING] == 1.0 && (twin_method == DOPRI54 || twin_method == VERNER65) &&
+         (t1 - t0) * c.carry[KICK_RATE] <= KICK_LIMIT && !holding;
 }
 
 /// The local error the twin committed over the interval, added to e (the companion less the
@@ -329,7 +355,7 @@ inline void carry_interval(const Model& m, Companion& c, Vec u, double t0, doubl
   // integrated where the kick is out of its reach, and where a mount switched or an event
   // function changed sign over the interval (a contact the kick from t₀ does not see)
   if (!(rated && in_reach(nf, h, rate, twin_rate, e)) || (watched & CHANGED) != 0) {
-    follow(m, c, u, t0, t1, false, d_wdot, pose, wrenches, y);  // from c.y
+    follow(m, c, u, t0, t1, false, false, d_wdot, pose, wrenches, y);  // from c.y
     return;
   }
   for (idx i = 0; i < n; ++i) trial[i] = y[i] + e[i];
@@ -387,8 +413,10 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
       settings[CHAINED] = 0.0;
     }
     if (estimator != nullptr) copy(y, estimator->y_start);
+    // at the interval's start, as the twin's monitors and the companion's stand
+    const bool holding = companion != nullptr && integrated_event_holds(*companion, watch.g);
     const bool carried = companion != nullptr &&
-                         carries(*companion, integ.method, smp.t[j - 1], smp.t[j], watch.g);
+                         carries(*companion, integ.method, smp.t[j - 1], smp.t[j], holding);
     if (carried) {  // the twin's start: its state and, chained, its first stage
       copy(y, companion->error_rows.row(Y_START));
       companion->carry[TWIN_RATED] = settings[CHAINED];
@@ -419,8 +447,11 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
       carry_interval(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, integ.result,
                      watched, d_wdot, out.pose.row(j), wrenches_j, y);
     } else if (companion != nullptr) {
-      follow(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, d_wdot, out.pose.row(j),
-             wrenches_j, y);
+      // the twin's tolerance bound its steps (more than one, or one rejected) while a joint's
+      // event holds: its faces switch inside the steps
+      const bool switching = holding && (integ.result[1] > 1.0 || integ.result[2] > 0.0);
+      follow(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, switching, d_wdot,
+             out.pose.row(j), wrenches_j, y);
     }
     *out.counter += 1;
     for (idx a = 0; a < nm; ++a) {
