@@ -132,6 +132,21 @@ def test_every_code_runs_its_own_law_in_every_dispatcher(name: str) -> None:
 
 
 @pytest.mark.parametrize("name", list(KINDS))
+def test_a_kind_the_companion_does_not_carry_writes_nothing_in_its_carry(name: str) -> None:
+    """The companion skips the carry of a kind whose `kind_carries` is false (and the mount's
+    motion it would read): on the kind's realistic inputs its carry, dispatched and its own,
+    leaves the state as it is. A kind that does carry (a bolted joint) moves it on some."""
+    rng = np.random.default_rng(13)
+    code, module = CODES[name], KINDS[name]
+    moved = False
+    for x in realistic_inputs(name, rng):
+        got, own = dispatch_results(code, module, x)["kind_carry"]
+        np.testing.assert_array_equal(got, own, err_msg=name)
+        moved = moved or not np.array_equal(got, x["y"])
+    assert moved == kinds.kind_carries(code), name
+
+
+@pytest.mark.parametrize("name", list(KINDS))
 def test_every_kinds_settle_keeps_its_force_and_settles_once(name: str) -> None:
     """A start's `settle` changes no force or couple of the kind's own load (the start's
     equilibrium holds after it), and what it leaves it leaves as it is (an admissible state

@@ -107,6 +107,10 @@ kind_update = _core.kind_update
 """kind_update(code, p, y, o, d) -> switched: the kind's `update` as the core runs it: discrete
 switches between samples. An unknown code writes NaN into the state (its own, or y[0] for a
 kind without states; the next step fails) and returns True."""
+kind_carries = _core.kind_carries
+"""kind_carries(code) -> bool: whether the kind's `carry` returns anything (its CARRIES in the
+core; an unknown code: True). The companion takes the carry, and the mount's motion it reads,
+only for such a kind (test_kinds_contract holds that the others' write nothing)."""
 kind_carry = _core.kind_carry
 """kind_carry(code, p, y, y0, yt, o, d, dt): the kind's `carry` as the core runs it: the error
 estimate's companion after its carried error's kick (y after it, y0 before it, yt the twin's

@@ -143,6 +143,8 @@ the mount's states (-1: none); d: (3,) local deflection, m; v: (3,) its rate, m/
 g: (>= the kind's event count,) out, entries past the kind's count untouched.
 An unknown code writes NaN into all of g and returns NaN.)doc");
 
+  m.def("kind_carries", &kinds::kind_carries, "code"_a,
+        "Whether the kind's `kind_carry` returns anything (the companion calls it only then).");
   m.def("kind_carry", &kinds_bind::carry, "code"_a, "p"_a, "y"_a, "y0"_a, "yt"_a, "o"_a, "d"_a,
         "dt"_a,
         R"doc(The rate-independent states of a mount of kind `code` in the error estimate's companion,

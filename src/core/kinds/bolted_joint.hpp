@@ -150,6 +150,7 @@ inline bool update(const double* p, Vec y, idx o, const double* d) {
 /// error is carried, not kicked (s ← y0's), then, where the twin's face is on its bound or the
 /// companion's passes its own, put on the bound along e (radial return). An open face keeps
 /// its kick (ṡ = v there).
+constexpr bool CARRIES = true;
 inline void carry(const double* p, Vec y, Vec y0, Vec yt, idx o, const double* d,
                   const double* dt) {
   if (y[o + 3] < 0.5 && yt[o + 3] < 0.5) {

@@ -81,6 +81,16 @@ inline void kind_carry(idx code, const double* p, Vec y, Vec y0, Vec yt, idx o, 
   y[o > 0 ? o : 0] = NOT_A_NUMBER;
 }
 
+/// Whether the kind's carry returns anything (its CARRIES; an unknown code: true, so that
+/// kind_carry marks it): the companion skips the carry, and the mount's motion it needs, of
+/// a kind that returns nothing.
+inline bool kind_carries(idx code) {
+  if (code == ELASTOMER) return elastomer::CARRIES;
+  if (code == BOLTED_JOINT) return bolted_joint::CARRIES;
+  if (code == SHEAR_KEY) return shear_key::CARRIES;
+  return true;
+}
+
 /// Internal states the kind reads and writes from o for the row p (-1: unknown code). For the
 /// bindings' checks.
 inline idx kind_states(idx code, const double* p) {

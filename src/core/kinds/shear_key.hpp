@@ -67,6 +67,9 @@ inline double monitor(const double* p, Vec /*y*/, Vec /*y0*/, idx /*o*/, const d
 }
 
 /// The companion after its carried error's kick (bolted_joint.hpp carry): A key has no internal state.
+/// CARRIES false: the companion does not call it (test_core_contract holds that it writes
+/// nothing).
+constexpr bool CARRIES = false;
 inline void carry(const double* /*p*/, Vec /*y*/, Vec /*y0*/, Vec /*yt*/, idx /*o*/,
                   const double* /*d*/, const double* /*dt*/) {}
 
