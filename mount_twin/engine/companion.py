@@ -290,15 +290,15 @@ def _reset_carry(carry: np.ndarray, method: int) -> np.ndarray:
 def switch(c: Companion, method: int) -> Companion:
     """The companion of a twin now running `method` (an id; its work arrays were made for AUTO)
     afresh: its own method and fewest steps (`own_method`), at most MAX_SUBSTEPS of the twin's
-    per step of its fewest."""
+    per step of its fewest, and its method where a joint's faces switch (`switching_method`)."""
     own, min_steps = own_method(method)
     settings = c.settings
     settings[MAX_SUBSTEPS] *= min_steps / settings[MIN_STEPS_SLOT]
     settings[MIN_STEPS_SLOT] = float(min_steps)
     forget(settings)
     _reset_carry(c.carry, own)
-    bound, bound_steps = switching_method(method)
-    return c._replace(method=own, switching_method=bound, switching_min_steps=bound_steps)
+    switching, fewest = switching_method(method)
+    return c._replace(method=own, switching_method=switching, switching_min_steps=fewest)
 
 
 def restart(c: Companion, y: np.ndarray) -> None:
