@@ -179,6 +179,12 @@ inline bool integrated_event_holds(const Companion& c, const Mat g) {
   return false;
 }
 
+/// Whether the twin's tolerance bound its steps over the interval, not the samples: it took
+/// more than one, or rejected one (twin_result: its stepper's [error norm, accepted, rejected]).
+inline bool twin_bound(const Vec twin_result) {
+  return twin_result[1] > 1.0 || twin_result[2] > 0.0;
+}
+
 /// Advance the companion's stepper over [t0, t1] from y (in place) with error control: by its
 /// own method, or, `switching`, by c.switching_method at least c.switching_min_steps steps
 /// (engine/companion.py says why: where a joint's faces switch between sticking and sliding
@@ -271,8 +277,7 @@ inline bool add_local_error(const Model& m, Companion& c, Vec u, double t0, doub
     // the twin took one step over the interval, none rejected: the check's fewest steps, of a
     // higher order or shorter, every one taken (engine/companion.py says why); else its
     // stepper at its tolerance
-    const bool smooth = twin_result[1] == 1.0 && twin_result[2] == 0.0;
-    const auto step = smooth ? integrate::advance_fixed : integrate::advance;
+    const auto step = twin_bound(twin_result) ? integrate::advance : integrate::advance_fixed;
     const int status = step(c.integ.method, check, t0, t1, settings, m, c.s, u, c.integ.work2d,
                             c.integ.work1d, c.integ.result);
     if (status != 0) return false;
@@ -454,9 +459,9 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
       carry_interval(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, integ.result,
                      watched, d_wdot, out.pose.row(j), wrenches_j, y);
     } else if (companion != nullptr) {
-      // the twin's tolerance bound its steps (more than one, or one rejected) while a joint's
-      // event holds: its faces switch inside the steps
-      const bool switching = holding && (integ.result[1] > 1.0 || integ.result[2] > 0.0);
+      // the twin's tolerance bound its steps while a joint's event holds: its faces switch
+      // inside the steps
+      const bool switching = holding && twin_bound(integ.result);
       follow(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, switching, d_wdot,
              out.pose.row(j), wrenches_j, y);
     }
