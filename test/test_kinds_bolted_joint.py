@@ -245,6 +245,21 @@ def test_an_open_face_with_no_shear_on_it_does_not_slip() -> None:
     )
 
 
+def test_a_frictionless_face_never_slips() -> None:
+    """With friction 0 the face has no grip to lose: it slides with the foot by design, closed
+    or open, so its slip function stays below 0 however far the foot moved in a sample (it read
+    the foot's travel, k_τ·|Δd| past the floor: every start of motion WARNed, and the event
+    held throughout); with friction, the same move on the open face slips."""
+    frictionless, rough = joint(friction=0.0), joint()
+    for u in (0.0, 0.5 * U_OPEN, 2.0 * U_OPEN):
+        for move in (1e-13, 1e-9, 1e-6, 2.0 * CLEAR):
+            y0 = frictionless.states()
+            g = frictionless.monitor([move, -move, u], y=y0, y0=y0)[1]
+            assert g[EVENT["joint_slipped"]] < 0.0, (u, move)
+    g = rough.monitor([1e-6, 0.0, 2.0 * U_OPEN], y=rough.states())[1]
+    assert g[EVENT["joint_slipped"]] > 0.0
+
+
 def play_operator(x: np.ndarray, half_width: np.ndarray) -> np.ndarray:
     """Slip of a Jenkins element whose half-width changes along the path (the clamp force
     moves the friction bound): s_k = clip(s_{k−1}, x_k − h_k, x_k + h_k)."""

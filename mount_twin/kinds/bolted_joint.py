@@ -313,7 +313,11 @@ def monitor(p, y, y0, o, d, v, g) -> float:
     Yield and slip are judged on the trial state: plastic elongation and slip frozen at their
     values y0 of the previous sample. The actual yield and slip functions stay at zero while the
     bolt flows or the face slides, so between two samples only the trial ones, which grow with
-    the deflection, locate the onset by interpolation.
+    the deflection, locate the onset by interpolation. A frictionless face (μ = 0) has no
+    grip to lose: it slides with the foot by design, and its slip function is −1 (it read the
+    foot's travel in a sample, past 0 at any motion: `joint_slipped` WARNs on a joint whose
+    shank alone is meant to hold it, and an event holding that made the error estimate's
+    companion integrate every interval).
     """
     e_p, broken = y[o], y[o + 3]
     e_t, sx, sy = y0[o], y0[o + 1], y0[o + 2]
@@ -322,7 +326,7 @@ def monitor(p, y, y0, o, d, v, g) -> float:
     g[1] = p[KP] * u - p[FV]
     tx, ty = p[KT] * (d[0] - sx), p[KT] * (d[1] - sy)
     shear, bound = math.sqrt(tx * tx + ty * ty), p[MU] * clamp_force(p, u)
-    g[2] = shear - bound - p[KT] * SLIP_FLOOR
+    g[2] = shear - bound - p[KT] * SLIP_FLOOR if p[MU] > 0.0 else -1.0  # frictionless: no grip
     f_s = bolt_force(p, u, e_p, broken)
     g[3] = 1.0 if broken > 0.5 else max(f_s / p[FU] - 1.0, e_p / p[EPU] - 1.0)
     return f_s / p[FY]

@@ -123,7 +123,7 @@ inline double monitor(const double* p, Vec y, Vec y0, idx o, const double* d,
   g[1] = p[KP] * u - p[FV];
   const double tx = p[KT] * (d[0] - sx), ty = p[KT] * (d[1] - sy);
   const double shear = std::sqrt(tx * tx + ty * ty), bound = p[MU] * clamp_force(p, u);
-  g[2] = shear - bound - p[KT] * SLIP_FLOOR;
+  g[2] = p[MU] > 0.0 ? shear - bound - p[KT] * SLIP_FLOOR : -1.0;  // frictionless: no grip
   const double f_s = bolt_force(p, u, e_p, broken);
   g[3] = broken > 0.5 ? 1.0 : py_max(f_s / p[FU] - 1.0, e_p / p[EPU] - 1.0);
   return f_s / p[FY];
