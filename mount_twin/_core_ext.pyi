@@ -14,6 +14,7 @@ FIGURE_SLOTS: tuple[int, ...]
 ESTIMATOR_SLOTS: tuple[int, ...]
 ERROR_ROWS: tuple[int, ...]
 CARRY_SLOTS: tuple[int, ...]
+TREATMENTS: dict[str, int]
 KICK_LIMIT: float
 ENGAGED_CHECK_EVERY: float
 PERIOD_SHARE: float

@@ -283,7 +283,7 @@ def fake_kind(name: str = "end_stop") -> ModuleType:
     module.EVENT_ERROR = (False,)
     module.EVENT_STIFFENS = (True,)
     module.EVENT_SWITCHES = (False,)
-    module.EVENT_CARRIED = (True,)
+    module.EVENT_COMPANION = ("carried",)
     module.ROTATIONAL = False
     module.RESTUCK = ()
     module.PARAMETERS = {}
@@ -338,7 +338,7 @@ def test_a_module_lacking_part_of_the_contract_is_refused(name: str) -> None:
 
 
 @pytest.mark.parametrize(
-    "table", ["EVENT_ERROR", "EVENT_STIFFENS", "EVENT_SWITCHES", "EVENT_CARRIED"]
+    "table", ["EVENT_ERROR", "EVENT_STIFFENS", "EVENT_SWITCHES", "EVENT_COMPANION"]
 )
 def test_an_event_table_of_another_length_than_the_events_is_refused(table: str) -> None:
     """Each event has its level and whether it may stiffen the scene (`auto` looks again)."""
@@ -346,6 +346,17 @@ def test_an_event_table_of_another_length_than_the_events_is_refused(table: str)
     setattr(module, table, (False, True))
     with pytest.raises(KindContractError, match=f"{table} and EVENTS differ in length"):
         check_modules({"end_stop": module})
+
+
+def test_a_companion_treatment_the_core_does_not_know_is_refused() -> None:
+    """EVENT_COMPANION names how the error estimate's companion takes an interval that starts
+    with each event holding; its index in COMPANION_TREATMENTS is the code the core reads, so a
+    misspelt one (or a flag, as the table was) cannot reach it as some other treatment."""
+    for wrong in ("integrate", True):
+        module = fake_kind()
+        module.EVENT_COMPANION = (wrong,)
+        with pytest.raises(KindContractError, match=r"EVENT_COMPANION holds .* not one of"):
+            check_modules({"end_stop": module})
 
 
 def test_a_contact_stiffness_outside_the_parameter_row_is_refused() -> None:

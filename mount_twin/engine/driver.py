@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import math
 from collections import Counter
+from collections.abc import Callable
 from operator import is_not
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -41,7 +42,7 @@ from mount_twin.engine.kernel import (
 from mount_twin.engine.rows import BatchRows, Rows
 from mount_twin.integrate.methods import AUTO
 from mount_twin.integrate.stepper import new_stepper, switch
-from mount_twin.kinds import KINDS, N_EVENTS
+from mount_twin.kinds import COMPANION_TREATMENTS, KINDS, N_EVENTS
 from mount_twin.model.assemble import Model
 from mount_twin.physics import pose_row
 from mount_twin.physics.dynamics import (
@@ -96,12 +97,12 @@ def published_buffers(
     )
 
 
-def _new_estimator(model: Model, integrates: np.ndarray) -> Estimator | Companion | None:
+def _new_estimator(model: Model, treatments: np.ndarray) -> Estimator | Companion | None:
     """The live error estimate's arrays (`engine.estimator` where the mounts are linear,
     `engine.companion` where some are not: see there), or None if the scene turns it off.
-    `integrates`: (non-linear mounts, N_EVENTS), 1.0 where the companion is integrated while
-    the event holds (the kinds' EVENT_CARRIED false), the shape of the mount watch's event
-    functions."""
+    `treatments`: (non-linear mounts, N_EVENTS), how the companion takes an interval that
+    starts with the event holding (the core's code, COMPANION_TREATMENTS, of its kind's
+    EVENT_COMPANION), the shape of the mount watch's event functions."""
     integ = model.scene.integration
     if not integ.error_estimate:
         return None
@@ -115,7 +116,7 @@ def _new_estimator(model: Model, integrates: np.ndarray) -> Estimator | Companio
             integ.max_substeps,
             model.new_scratch(),
             model.n_mounts,
-            integrates,
+            treatments,
             model.tangent_rate,
         )
     return sampled_estimator(model)
@@ -205,7 +206,8 @@ class CoreDriver:
             scene.outputs.decimation,
             scene.input.hold == "first_order",
         )
-        self.estimator = _new_estimator(model, self._event_table("EVENT_CARRIED", negate=True))
+        treatments = self._event_table("EVENT_COMPANION", COMPANION_TREATMENTS.__getitem__)
+        self.estimator = _new_estimator(model, treatments)
         self._loop: tuple[tuple[object, ...], Loop] | None = None
         """The arrays bound last, and their `Loop` (`_bound`)."""
         self._auto = integ.method == AUTO
@@ -393,12 +395,12 @@ class CoreDriver:
         elif self.estimator is not None:
             self.estimator = companion.switch(self.estimator, self.stepper.method)
 
-    def _event_table(self, name: str, *, negate: bool = False) -> np.ndarray:
-        """(non-linear mounts, N_EVENTS): each mount's kind's event table `name` (1.0 where
-        true, or with `negate` where false; 0 past its kind's events)."""
+    def _event_table(self, name: str, code: Callable[[Any], float] = float) -> np.ndarray:
+        """(non-linear mounts, N_EVENTS): each mount's kind's event table `name`, each entry as
+        `code` gives it (a flag: 1.0 where true; 0 past its kind's events)."""
         table = np.zeros((len(self._event_meta), N_EVENTS))
         for i, (_, kind) in enumerate(self._event_meta.values()):
-            table[i, : len(kind.EVENTS)] = [v != negate for v in getattr(kind, name)]
+            table[i, : len(kind.EVENTS)] = [code(v) for v in getattr(kind, name)]
         return table
 
     def stiffens(self, event: MountEvent) -> bool:

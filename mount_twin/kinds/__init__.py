@@ -7,9 +7,9 @@ internal states (and which of them a restart resets: `RESTUCK`), force law (`loa
 functions (`monitor`), discrete switches between samples (`update`, which says whether it
 switched: the state then jumped, and a stepper must not start from a stage it took before;
 `EVENT_SWITCHES` names the events that are such a switch, which a start reports too, and
-none of which may stiffen the scene: `auto` looks again at none a start makes; `EVENT_CARRIED`
-those the error estimate's companion carries its error through, the others having it
-integrated over an interval that starts with them holding, `engine.companion`), a start's
+none of which may stiffen the scene: `auto` looks again at none a start makes;
+`EVENT_COMPANION` how the error estimate's companion takes an interval that starts with each
+holding, one of COMPANION_TREATMENTS, `engine.companion`), a start's
 internal states made admissible at its pose (`settle`, run once a start's pose is found by
 `model.assemble.initial_state`: a face that slid put on its friction bound), the error
 estimate's companion after its carried error's kick (`carry`: its rate-independent states, a
@@ -70,7 +70,7 @@ MODULE_NAMES = (
     "EVENT_ERROR",
     "EVENT_STIFFENS",
     "EVENT_SWITCHES",
-    "EVENT_CARRIED",
+    "EVENT_COMPANION",
     "ROTATIONAL",
     "RESTUCK",
     "PARAMETERS",
@@ -87,6 +87,12 @@ MODULE_NAMES = (
     "nominal_tangent",
 )
 """What a kind module defines (see the module docstring of any kind)."""
+COMPANION_TREATMENTS: dict[str, int] = _core.TREATMENTS
+"""How the error estimate's companion takes an interval that starts with an event holding (a
+kind's EVENT_COMPANION names one), and the core's code for it (kernel.hpp `Treatment`):
+"carried", its error carried through it; "integrated", integrated over it by its own method;
+"switching", integrated by the twin's own method where the twin's tolerance bound its steps,
+else by its own (`engine.companion`). Where several hold, the core takes the last of these."""
 
 
 class KindContractError(ModelError):
@@ -130,10 +136,16 @@ def check_modules(kinds: Mapping[str, ModuleType]) -> None:
         if not all(0 <= col < module.N_PAR for col in module.CONTACT_STIFFNESS):
             msg = f"kind {name!r}: CONTACT_STIFFNESS names a column outside its N_PAR"
             raise KindContractError(msg)
-        for table in ("EVENT_ERROR", "EVENT_STIFFENS", "EVENT_SWITCHES", "EVENT_CARRIED"):
+        for table in ("EVENT_ERROR", "EVENT_STIFFENS", "EVENT_SWITCHES", "EVENT_COMPANION"):
             if len(getattr(module, table)) != len(module.EVENTS):
                 msg = f"kind {name!r}: {table} and EVENTS differ in length"
                 raise KindContractError(msg)
+        if unknown := set(module.EVENT_COMPANION) - COMPANION_TREATMENTS.keys():
+            msg = (
+                f"kind {name!r}: EVENT_COMPANION holds {', '.join(sorted(map(repr, unknown)))}, "
+                f"not one of {', '.join(COMPANION_TREATMENTS)}"
+            )
+            raise KindContractError(msg)
         for event, stiffens, switch in zip(
             module.EVENTS, module.EVENT_STIFFENS, module.EVENT_SWITCHES, strict=True
         ):

@@ -43,10 +43,12 @@ EVENT_ERROR = (True, True, False, True)
 EVENT_STIFFENS = (False, False, False, False)
 """Whether each event can make the scene stiffer (`auto` then looks at it again): a joint that
 yields, opens, slips or breaks only loses stiffness."""
-EVENT_CARRIED = (False, False, False, False)
-"""Whether the error estimate's companion may carry its error while each event holds
-(`engine.companion`): none; over an interval that starts with a bolt flowing, a joint open, a
-face slipping or a bolt broken the companion is integrated. Carried through them, the genset
+EVENT_COMPANION = ("switching",) * 4
+"""How the error estimate's companion takes an interval that starts with each event holding
+(`kinds.COMPANION_TREATMENTS`, `engine.companion`): integrated, by the twin's own method where
+the twin's tolerance bound its steps, over any that starts with a bolt flowing, a joint open, a
+face slipping or a bolt broken (a face switching between sticking and sliding inside the
+steps: there a higher order saves few steps). Carried through them, the genset
 under two synthesised 30 g shocks read 0.51–2.09 of its true force error (0.88–1.40 with
 flowing and open joints integrated, 0.89–1.23 with all), and under its own shock bag at rtol
 1e-6 and 1e-7 2.0 and 3.5 times its true attitude error with slipping faces carried: the yaw
@@ -376,7 +378,7 @@ def carry(p, y, y0, yt, o, d, dt) -> None:
       true error). An open face keeps its kick (ṡ_p = ḋ there).
 
     The intervals that start with any of the joint's events holding are integrated
-    (EVENT_CARRIED): this returns what an interval that starts stuck, closed and elastic
+    (EVENT_COMPANION): this returns what an interval that starts stuck, closed and elastic
     crosses into."""
     if y[o + 3] < 0.5 and yt[o + 3] < 0.5:
         flows = bolt_force(p, dt[2], yt[o], 0.0) >= yield_limit(p, yt[o])

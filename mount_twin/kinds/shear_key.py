@@ -22,8 +22,11 @@ EVENT_ERROR = (False, True)
 EVENT_STIFFENS = (True, False)
 """A key that closes its clearance stiffens the scene (`auto` looks again); overload is in
 contact."""
-EVENT_CARRIED = (True, True)
-"""A key's contact is a law of the state: the carried error follows it (`engine.companion`)."""
+EVENT_COMPANION = ("carried", "carried")
+"""How the error estimate's companion takes an interval that starts with each event holding
+(`kinds.COMPANION_TREATMENTS`): carried. A key bears linearly past its clearance, so the kick
+taken at the interval's start holds through it, and a key stiffer than its reach is
+integrated by the reach (`engine.companion`)."""
 EVENT_SWITCHES = (False, False)
 """No event is a discrete switch (`update` never switches): a key past its allowable force at
 a start is a state there, not an event."""

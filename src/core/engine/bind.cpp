@@ -136,7 +136,7 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
   c.error_rows = convert::mat(field(obj, "error_rows"), "Companion.error_rows",
                               engine::N_ERROR_ROWS, n_state);
   c.carry = convert::vec(field(obj, "carry"), "Companion.carry", engine::N_CARRY_SLOTS);
-  c.integrates = convert::mat(field(obj, "integrates"), "Companion.integrates", k, n_events);
+  c.treatments = convert::mat(field(obj, "treatments"), "Companion.treatments", k, n_events);
   convert::check_scratch(c.s, n_state, "Companion.s");
   return c;
 }
@@ -220,6 +220,11 @@ void bind_engine(py::module_& mod) {
       int(engine::NORM_MEAN), int(engine::INTERVALS), int(engine::KICK_RATE), int(engine::RATED),
       int(engine::TWIN_RATED),
       int(engine::N_CARRY_SLOTS));
+  py::dict treatments;
+  treatments["carried"] = int(engine::CARRIED_THROUGH);
+  treatments["integrated"] = int(engine::INTEGRATED);
+  treatments["switching"] = int(engine::SWITCHING);
+  mod.attr("TREATMENTS") = treatments;
   mod.attr("KICK_LIMIT") = engine::KICK_LIMIT;
   mod.attr("ENGAGED_CHECK_EVERY") = engine::ENGAGED_CHECK_EVERY;
   mod.attr("PERIOD_SHARE") = engine::PERIOD_SHARE;

@@ -70,7 +70,7 @@ struct Companion {
   Vec figures;  // (N_FIGURES,)
   Mat error_rows;  // (N_ERROR_ROWS, n): the carried error's work rows (ErrorRow)
   Vec carry;    // (N_CARRY_SLOTS,): CarrySlot
-  Mat integrates;  // (k, NE): 1.0 where an event holding makes the interval integrated
+  Mat treatments;  // (k, NE): how an interval that starts with the event holding is taken
 };
 
 /// Rows of Companion.error_rows (engine/companion.py ERROR_ROWS).
@@ -168,15 +168,22 @@ inline void fold_figures(Companion& c, const Vec q, Vec pose, M6 wrenches) {
   figures[ATTITUDE_ERROR] = attitude;
 }
 
-/// Whether an event holds at the interval's start that the companion's kind does not carry
-/// through (`integrates`: a bolted joint's, any), in the twin's monitors g or the companion's.
-inline bool integrated_event_holds(const Companion& c, const Mat g) {
-  for (idx i = 0; i < c.integrates.rows; ++i) {
-    for (idx e = 0; e < c.integrates.cols; ++e) {
-      if (c.integrates(i, e) > 0.0 && (g(i, e) >= 0.0 || c.g(i, e) >= 0.0)) return true;
+/// How the companion takes an interval that starts with an event holding (Companion.treatments;
+/// the kinds name them, `kinds.COMPANION_TREATMENTS`, bound to these codes): its error carried
+/// through; integrated by its own method; integrated by its switching method where the twin's
+/// tolerance bound its steps. In this order: the interval takes the last one holding.
+enum Treatment : int { CARRIED_THROUGH = 0, INTEGRATED = 1, SWITCHING = 2 };
+
+/// The treatment of the interval: the last in Treatment's order of the events holding at its
+/// start, in the twin's monitors g or the companion's (none: CARRIED_THROUGH).
+inline int holding_treatment(const Companion& c, const Mat g) {
+  double treatment = CARRIED_THROUGH;
+  for (idx i = 0; i < c.treatments.rows; ++i) {
+    for (idx e = 0; e < c.treatments.cols; ++e) {
+      if (g(i, e) >= 0.0 || c.g(i, e) >= 0.0) treatment = py_max(treatment, c.treatments(i, e));
     }
   }
-  return false;
+  return static_cast<int>(treatment);
 }
 
 /// Whether the twin's tolerance bound its steps over the interval, not the samples: it took
@@ -241,7 +248,7 @@ inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bo
 /// method is explicit (a linearising twin's stiff modes would put the explicit kick out of its
 /// stable range), the interval times the fastest rate of the body on its mounts' tangents
 /// (KICK_RATE, rad/s) is within KICK_LIMIT, and no event its kind does not carry through holds
-/// at t0 (`holding`: `integrated_event_holds`).
+/// at t0 (`holding`: `holding_treatment` is not CARRIED_THROUGH).
 inline bool carries(const Companion& c, int twin_method, double t0, double t1, bool holding) {
   return c.carry[CARRYING] == 1.0 && (twin_method == DOPRI54 || twin_method == VERNER65) &&
          (t1 - t0) * c.carry[KICK_RATE] <= KICK_LIMIT && !holding;
@@ -426,9 +433,10 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
     }
     if (estimator != nullptr) copy(y, estimator->y_start);
     // at the interval's start, as the twin's monitors and the companion's stand
-    const bool holding = companion != nullptr && integrated_event_holds(*companion, watch.g);
-    const bool carried = companion != nullptr &&
-                         carries(*companion, integ.method, smp.t[j - 1], smp.t[j], holding);
+    const int holding =
+        companion != nullptr ? holding_treatment(*companion, watch.g) : CARRIED_THROUGH;
+    const bool carried = companion != nullptr && carries(*companion, integ.method, smp.t[j - 1],
+                                                         smp.t[j], holding != CARRIED_THROUGH);
     if (carried) {  // the twin's start: its state and, chained, its first stage
       copy(y, companion->error_rows.row(Y_START));
       companion->carry[TWIN_RATED] = settings[CHAINED];
@@ -459,9 +467,9 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
       carry_interval(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, integ.result,
                      watched, d_wdot, out.pose.row(j), wrenches_j, y);
     } else if (companion != nullptr) {
-      // the twin's tolerance bound its steps while a joint's event holds: its faces switch
-      // inside the steps
-      const bool switching = holding && twin_bound(integ.result);
+      // the twin's tolerance bound its steps while an event holds that switches the law inside
+      // the steps (a joint's faces between sticking and sliding)
+      const bool switching = holding == SWITCHING && twin_bound(integ.result);
       follow(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, switching, d_wdot,
              out.pose.row(j), wrenches_j, y);
     }
