@@ -35,33 +35,12 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test"))
 
-from kinds_helpers import kind_mount
-from physics_helpers import base_scene
-from test_error_estimate import CASES, _ship_motion, _with_pump_input
+from test_error_estimate import CASES, _bouc_wen_grid
 
 from mount_twin.analysis.accuracy import RESOLVED, measure, reference_run, resolution, run_at
 from mount_twin.engine import driver
 
 HYSTERETIC_COUNTS = (4, 16, 64, 256)
-
-
-def _hysteretic(n: int):
-    """n Bouc–Wen elastomers on a grid over 0.8 × 0.6 m, each 1/n of four's stiffness and
-    damping, under 200 kg; 2 s of the pump's ship motion."""
-    side = math.ceil(math.sqrt(n))
-    mounts = [
-        kind_mount(
-            "elastomer",
-            f"r{i}",
-            (0.8 * (i % side) / (side - 1) - 0.4, 0.6 * (i // side) / (side - 1) - 0.3, 0.0),
-            stiffness_linear=[4e5 / n, 4e5 / n, 8e5 / n],
-            damping=[1200.0 / n, 1200.0 / n, 2000.0 / n],
-            hysteresis={"ratio": 0.6, "beta": 120.0, "gamma": 80.0},
-        )
-        for i in range(n)
-    ]
-    body = base_scene(200.0, [0.0, 0.0, 0.3], [20.0, 30.0, 40.0, 0.0, 0.0, 0.0], mounts)
-    return _ship_motion(_with_pump_input(body), 2.0)
 
 
 def _sampled(model, n_watched):
@@ -84,7 +63,7 @@ def main() -> None:
     parser.add_argument("--rtol", type=float, nargs="+", default=[1e-3, 1e-4, 1e-5, 1e-6, 1e-7])
     builds = {name: build for name, (build, _) in CASES.items()}
     for n in HYSTERETIC_COUNTS:
-        builds[f"hysteretic_{n}"] = partial(_hysteretic, n)
+        builds[f"hysteretic_{n}"] = partial(_bouc_wen_grid, n)
     parser.add_argument(
         "--cases",
         nargs="+",
