@@ -69,8 +69,8 @@ it. A Hertzian snubber in contact stiffens through the interval past the kick ta
 start, which the reach at the start cannot see: carried there, rubber on snubbers of 1e9
 N/m^1.5 at 1 kHz read 2.22, 0.20 and 19.6 times its true force error at rtol 1e-3, 3e-4 and
 1e-5 (attitude 48 times at 1e-5), and 1e10 N/m^1.5 5.0 at 3e-5; integrated, 0.89–1.03 and
-0.80–1.23 at rtol 7e-4 … 1e-7, the 10 kHz rubber on snubbers and the real shock at 1.16–1.25×
-the engine's time (1.06–1.17× carried).
+0.80–1.23 at rtol 7e-4 … 1e-7, the 10 kHz rubber on snubbers and the real shock at 1.17–1.27×
+the engine's time (1.10–1.17× carried).
 
 The sign matters where the two meet: e is the companion less the twin, so ℓ is added as the
 check's end state less the twin's. Added the other way round (until 2026-11-28), the carried

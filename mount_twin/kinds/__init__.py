@@ -92,7 +92,7 @@ COMPANION_TREATMENTS: dict[str, int] = _core.TREATMENTS
 kind's EVENT_COMPANION names one), and the core's code for it (kernel.hpp `Treatment`):
 "carried", its error carried through it; "integrated", integrated over it by its own method;
 "switching", integrated by the twin's own method where the twin's tolerance bound its steps,
-else by its own (`engine.companion`). Where several hold, the core takes the last of these."""
+else by its own (`engine.companion`). Where several hold, the core takes the highest code."""
 
 
 class KindContractError(ModelError):

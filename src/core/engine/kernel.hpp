@@ -171,11 +171,11 @@ inline void fold_figures(Companion& c, const Vec q, Vec pose, M6 wrenches) {
 /// How the companion takes an interval that starts with an event holding (Companion.treatments;
 /// the kinds name them, `kinds.COMPANION_TREATMENTS`, bound to these codes): its error carried
 /// through; integrated by its own method; integrated by its switching method where the twin's
-/// tolerance bound its steps. In this order: the interval takes the last one holding.
+/// tolerance bound its steps. In this order: the interval takes the highest code holding.
 enum Treatment : int { CARRIED_THROUGH = 0, INTEGRATED = 1, SWITCHING = 2 };
 
-/// The treatment of the interval: the last in Treatment's order of the events holding at its
-/// start, in the twin's monitors g or the companion's (none: CARRIED_THROUGH).
+/// The treatment of the interval: the highest of the events holding at its start, in the twin's
+/// monitors g or the companion's (none: CARRIED_THROUGH).
 inline int holding_treatment(const Companion& c, const Mat g) {
   double treatment = CARRIED_THROUGH;
   for (idx i = 0; i < c.treatments.rows; ++i) {
