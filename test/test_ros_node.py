@@ -467,12 +467,12 @@ def _node_parameters(
     try:
         client = AsyncParameterClient(peer.node, "/mount_twin")
         assert client.wait_for_services(60.0), node.stop()
-        names = peer.call(client.list_parameters()).result.names
-        values = peer.call(client.get_parameters(names)).values
-        described = peer.call(client.describe_parameters(names)).descriptors
+        names = peer.call(client.list_parameters).result.names
+        values = peer.call(lambda: client.get_parameters(names)).values
+        described = peer.call(lambda: client.describe_parameters(names)).descriptors
         if set_mass:
             mass = [Parameter("body.mass", value=1.0)]
-            refused = peer.call(client.set_parameters(mass)).results
+            refused = peer.call(lambda: client.set_parameters(mass)).results
     finally:
         code = node.stop()
         peer.close()
@@ -776,7 +776,8 @@ def test_sim_time_switched_on_at_run_time_counts_the_missing_clock_from_the_swit
         peer.take_until(lambda: False, 6.0)  # the node runs 6 s on wall time
         assert not clock_said()
         asked = time.monotonic()  # the node switches after this
-        result = peer.call(client.set_parameters([Parameter("use_sim_time", value=True)]))
+        use_sim_time = [Parameter("use_sim_time", value=True)]
+        result = peer.call(lambda: client.set_parameters(use_sim_time))
         assert all(r.successful for r in result.results), result
         assert peer.take_until(clock_said, 20.0), "no report of the missing /clock"
     finally:
