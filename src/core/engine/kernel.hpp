@@ -266,10 +266,11 @@ inline bool carries(const Companion& c, int twin_method, double t0, double t1, b
 /// mode (KICK_RATE), whichever is fewer; between, the last measured one scaled by the twin's
 /// error norms (at most SPIKE_RATIO times). The norm of an interval is the twin's largest
 /// accepted one times its accepted steps (their errors add). A check the twin's rejection or
-/// spike called for adds its own error but is not what the intervals after it scale: there the
-/// error's ratio to the norm is the event's (a Bouc–Wen mount turning, a contact), tens of
-/// times a smooth interval's (4 Bouc–Wen mounts under ship motion at rtol 1e-9: 7.1 times the
-/// true error; docs/benchmarks.md). Returns false where the measurement failed (nothing added).
+/// spike called for adds its own error but is not what the intervals after it scale, nor does it
+/// put the next regular check off: there the error's ratio to the norm is the event's (a
+/// Bouc–Wen mount turning, a contact), tens of times a smooth interval's (4 Bouc–Wen mounts
+/// under ship motion at rtol 1e-9: 7.1 times the true error; docs/benchmarks.md). Returns false
+/// where the measurement failed (nothing added).
 inline bool add_local_error(const Model& m, Companion& c, Vec u, double t0, double t1,
                             const Vec twin_result, Vec y) {
   const Vec carry = c.carry, e = c.error_rows.row(ERROR), local = c.error_rows.row(LOCAL);
