@@ -80,16 +80,18 @@ estimate's magnitudes do not see while Φ is linear; integrated from the mirror 
 interval, the mirrored error and the new local one half cancelled (rubber on snubbers read
 0.50 of its true error so).
 
-Measured against a reference (`python3 bench/error_estimate.py`; docs/scene.md "Error
-estimate" and docs/benchmarks.md have the table), it reads 0.79–1.49 of the true force error on
-the genset, rubber on snubbers, hysteresis with snubbers under the real shock and 4 to 256
-Bouc–Wen elastomers at rtol 1e-3 … 1e-9, at 1.1–1.7× the engine's time, where the companion
-integrated at every interval read 0.69–1.08 at 1.4–2.1×: its work an interval is one pass over
-the mounts (a right-hand side with the outputs) and, at a special interval or every half
-period, one step of the check, where the integrated companion's was 8 right-hand sides at
-least, more across the joints' switches. On the genset most of what is left is the intervals
-it is integrated over: 214 of 2 500 under its shock, a third of the twin's right-hand sides
-(an instrumented build; half before the switching intervals took the twin's method, below).
+Measured against a reference (`python3 bench/error_estimate.py`; docs/scene.md "Error estimate" and
+docs/benchmarks.md have the table), it reads 0.67–1.73 of the true force error on the genset (under
+its shock bag and two synthesised 30 g shocks), rubber on snubbers (at 10 kHz, and at 1 kHz on
+snubbers of 1e9 to 1e11 N/m^1.5), hysteresis with snubbers under the real shock and 4 to 256
+Bouc–Wen elastomers at rtol 1e-3 … 1e-9 (2026-11-28 evening; 1e10 N/m^1.5 at rtol 1e-3 and looser
+excepted, its attitude 2.3–3.1), at 1.0–2.6× the engine's time (1.1–1.7× at rtol 1e-6), where the
+companion integrated at every interval read 0.69–1.08 at 1.4–2.1×: its work an interval is one pass
+over the mounts (a right-hand side with the outputs) and, at a special interval or every half
+period, one step of the check, where the integrated companion's was 8 right-hand sides at least,
+more across the joints' switches. On the genset most of what is left is the intervals it is
+integrated over: 214 of 2 500 under its shock, a third of the twin's right-hand sides (an
+instrumented build; half before the switching intervals took the twin's method, below).
 
 **Integrated** (over the intervals above): the same model integrated beside the twin with rtol and
 atol divided by TOLERANCE_DIVISOR = 8. Where the twin's steps are set by the samples, not its
