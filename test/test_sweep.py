@@ -816,6 +816,30 @@ def test_a_rerun_after_the_bag_was_recorded_again_runs_every_case_on_the_new_rec
                 assert row[key] > 1.1 * old[key], n  # twice the shock: not the old record's
 
 
+def test_a_bag_recorded_again_between_load_and_run_is_a_failed_row_naming_it(
+    tmp_path: Path,
+) -> None:
+    """A bag recorded again after the sweep was loaded (its cases' ids hash the old content)
+    was run as the new record under the old ids: rows of one shock filed as another's. The
+    case is now a FAILED row that names the bag; loaded again, the sweep runs the new one."""
+    bag = tmp_path / "shock"
+    options = ["--pulse", "0.005", "--rate", "4000", "--duration", "0.15"]
+    assert main(["generate", "half-sine", "-o", str(bag), "--peak", "150", *options]) == 0
+    text = SWEEP.replace(str(ROOT / "bags" / "half_sine_shock_10khz"), str(bag))
+    text = text.split("  - name: dhs", maxsplit=1)[0].replace("[1100.0, -5.0]", "[1100.0]")
+    sweep = _sweep_file(tmp_path, text)
+    old_spec = load_sweep(sweep)
+    shutil.rmtree(bag)
+    assert main(["generate", "half-sine", "-o", str(bag), "--peak", "300", *options]) == 0
+    for case in check(old_spec):
+        row = run_case(old_spec.base, old_spec.source, case)
+        assert row["verdict"] == FAILED, row
+        assert row["error"].startswith(f"MountTwinError: {bag}: recorded again since the sweep")
+    spec = load_sweep(sweep)
+    for case in check(spec):
+        assert run_case(spec.base, spec.source, case)["verdict"] != FAILED
+
+
 def _fake_pyarrow(monkeypatch: pytest.MonkeyPatch, write: object) -> None:
     """pyarrow (not installed here) as modules whose `parquet.write_table(table, where)` is
     `write` and whose `Table.from_pylist` keeps the rows."""

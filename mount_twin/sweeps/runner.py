@@ -39,7 +39,7 @@ from mount_twin.scene.description import InputSpec, Scene, scene_digest
 from mount_twin.scene.loader import scene_from_dict
 from mount_twin.sweeps.cases import Case, apply, expand, key_unit
 from mount_twin.sweeps.cluster import dask_client, results_as_completed
-from mount_twin.sweeps.spec import InputCase, SweepSpec
+from mount_twin.sweeps.spec import InputCase, SweepSpec, bag_digest
 from mount_twin.textfiles import directories_above
 
 UTILISATION = "utilisation"
@@ -91,11 +91,17 @@ def value_text(column: str, value: Any, units: dict[str, str]) -> str:
 @lru_cache(maxsize=8)
 def _input_samples(case: InputCase, spec: InputSpec) -> SampleBatch:
     """The input of a case (read once per worker process, input and input spec: a bag recorded
-    again is another input, `InputCase.content`, read anew by a worker that read the old)."""
+    again is another input, `InputCase.content`, read anew by a worker that read the old).
+    A bag is read only as the sweep loaded it: its digest is taken again before and after the
+    read, and a bag recorded again since (its cases' ids hash the old content) is a
+    MountTwinError, the case's FAILED row, not the new record's figures under the old ids."""
     if case.bag:
         from mount_twin.io.input_samples import read_samples
 
-        return read_samples(case.bag, spec)
+        _same_bag(case)
+        samples = read_samples(case.bag, spec)
+        _same_bag(case)
+        return samples
     from mount_twin.io.signals import half_sine_shock, ship_motion
 
     g = dict(case.generate)
@@ -112,6 +118,18 @@ def _input_samples(case: InputCase, spec: InputSpec) -> SampleBatch:
         sig = ship_motion(rate_hz=g.get("rate", 1000.0), total=g.get("duration", 5.0))
     stamps = 1.0 + sig.t  # engine seconds; the record's origin is immaterial to a case
     return SampleBatch(stamps, sig.accel, sig.gyro, [spec.frame_id] * stamps.shape[0])
+
+
+def _same_bag(case: InputCase) -> None:
+    """MountTwinError unless the bag at case.bag still has the content the sweep loaded."""
+    now = bag_digest(Path(case.bag), {})
+    if now != case.content:
+        msg = (
+            f"{case.bag}: recorded again since the sweep was loaded (content SHA-256 "
+            f"{now[:12]}…, loaded as {case.content[:12]}…): load the sweep again to run it "
+            "on the new record"
+        )
+        raise MountTwinError(msg)
 
 
 def run_case(base: dict[str, Any], source: str, case: Case) -> dict[str, Any]:
