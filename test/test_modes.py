@@ -421,6 +421,37 @@ def test_bolted_joints_enter_closed_with_a_stuck_face_and_keys_in_their_clearanc
     assert result.mounts[-1].force_n == (0.0, 0.0, 0.0)
 
 
+def test_a_face_the_weight_slid_enters_settled_on_its_bound_as_the_twin_starts() -> None:
+    """A block hung on a wall by four bolts along x of F, a light preload: the weight shears
+    each face past μ·F_V, so the faces slide and the shanks bear past their clearance c, each
+    foot s = c + (m·g/4 − μ·F_V)/k_b down. The twin starts such a face with its stick point on
+    its friction bound (`kinds.bolted_joint.settle`); modes were taken about the stick point
+    zero, a face past its bound, which holds a lateral motion along y with μ·F_V/s (the
+    capped force turning) instead of the stuck face's k_τ: 15.7 Hz where it is 24.5. Lateral
+    y by hand: ω² = 4·(k_τ + k_b·(s − c)/s)/m (the shank bears radially)."""
+    m_, ktau, mu, preload, kb, clear = 2000.0, 1.0e7, 0.3, 1.0e4, 5.0e8, 1.0e-3
+    bolt = {
+        "bolt_stiffness": 7.0e8,
+        "clamp_stiffness": 3.5e9,
+        "preload": preload,
+        "yield_force": 1.57e5,
+        "ultimate_force": 1.96e5,
+        "friction": mu,
+        "shear_stiffness": ktau,
+        "hole_clearance": clear,
+        "bearing_stiffness": kb,
+    }
+    feet = [(0.0, y, z) for y, z in ((0.4, 0.3), (-0.4, 0.3), (0.4, -0.3), (-0.4, -0.3))]
+    wall = (0.0, math.pi / 2.0, 0.0)  # each bolt's axis (local z) along x of F
+    layout = [kind_mount("bolted_joint", f"f{i}", p, wall, **bolt) for i, p in enumerate(feet)]
+    result = analyse(base_scene(m_, [0.0, 0.0, 0.0], [300.0, 200.0, 250.0, 0.0, 0.0, 0.0], layout))
+    shear = m_ * G / 4.0
+    assert shear > mu * preload  # the faces slide: the shanks bear
+    s = clear + (shear - mu * preload) / kb
+    w2 = 4.0 * (ktau + kb * (s - clear) / s) / m_
+    assert by_dominant(result, "y").frequency_hz == pytest.approx(math.sqrt(w2) / TWO_PI, rel=1e-6)
+
+
 # ------------------------------------------------------------------ stiffness centre
 def test_the_vertical_stiffness_centre_is_the_stiffness_weighted_centroid() -> None:
     """Vertical springs k_i at (x_i, y_i) (with lateral stiffness, CG high and off-centre): a

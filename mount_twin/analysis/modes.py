@@ -5,7 +5,11 @@ Everything comes from the twin itself, so every mount kind enters as it is simul
 - Equilibrium: the model's own solver (`static_equilibrium`) under the scene's nominal gravity
   (specific force g along +z of F, foundation at rest), as the twin starts a new machine: the
   mounts' internal states at zero but the hysteretic ones on their loading curves
-  (`model.loading`).
+  (`model.loading`), then made admissible at its pose as every start's are
+  (`model.assemble.settle`): a joint face the weight slid has its stick point on its friction
+  bound, where it holds a small motion across the slide with its stick stiffness k_τ (about
+  the stick point zero, a face past its bound, it held it with μ·F_K over the slide: a wall-hung
+  block's lateral mode 15.7 Hz where it is 24.5).
 - Linearisation: central differences (`model.stiffness.jacobian`) of the twin's right-hand side
   about it give ∂q″/∂q, ∂q″/∂q′, ∂q″/∂s and ∂s′/∂q′ (q: the free coordinates, m and rad; s: the
   mounts' internal states). The kinds expose no closed tangent, so this is how elastomers,
@@ -64,7 +68,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import eig, eigh, solve
 
-from mount_twin.model.assemble import Model, assemble, gravity_input, static_equilibrium
+from mount_twin.model.assemble import (
+    Model,
+    assemble,
+    gravity_input,
+    settle,
+    static_equilibrium,
+)
 from mount_twin.model.stiffness import jacobian
 from mount_twin.physics.chart import kinematic_matrix, rotation_matrix
 from mount_twin.physics.dynamics import evaluate
@@ -196,6 +206,7 @@ def modes(scene: Scene, *, geometric: bool = True) -> Modes:
     nf = len(scene.dofs)
     g_up = np.array([0.0, 0.0, scene.input.g])
     y_eq = static_equilibrium(model, np.zeros(model.n_state), g_up, loaded=True)
+    settle(model, y_eq)  # as every start of the twin: a face the weight slid on its bound
     jac = jacobian(model, y_eq, gravity_input(0.0, g_up))
     q, v, s = slice(0, nf), slice(nf, 2 * nf), slice(2 * nf, model.n_state)
     q6 = model.arrays.q_fixed.copy()
