@@ -297,7 +297,10 @@ inline bool add_local_error(const Model& m, Companion& c, Vec u, double t0, doub
   if (special || carry[SINCE_CHECK] >= every) {
     const Vec check = c.error_rows.row(CHECK), settings = c.integ.settings;
     copy(c.error_rows.row(Y_START), check);
-    settings[CHAINED] = 0.0;  // from the twin's start state: no stage of it at hand
+    // from the twin's start state under its input: its first stage is the twin's (TWIN_RATE,
+    // which `carry_interval` holds before it comes here), one right-hand side a check saved
+    copy(c.error_rows.row(TWIN_RATE), c.integ.work2d.row(0));
+    settings[CHAINED] = 1.0;
     // the twin took one step over the interval, none rejected: the check's fewest steps, of a
     // higher order or shorter, every one taken (engine/companion.py says why); else its
     // stepper at its tolerance
