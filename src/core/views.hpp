@@ -28,6 +28,7 @@ struct Mat {
   idx cols = 0;
   double& operator()(idx i, idx j) const { return d[i * cols + j]; }
   Vec row(idx i) const { return Vec{d + i * cols, cols}; }
+  Vec flat() const { return Vec{d, rows * cols}; }  // every element, row by row
 };
 
 /// A 3-D float64 array (n, r, c), row-major: a stack of matrices.

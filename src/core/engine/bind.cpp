@@ -130,6 +130,7 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
   c.s = convert::scratch(field(obj, "s"));
   c.y_prev = convert::vec(field(obj, "y_prev"), "Companion.y_prev", n_state);
   c.g = convert::mat(field(obj, "g"), "Companion.g", k, n_events);
+  c.g_prev = convert::mat(field(obj, "g_prev"), "Companion.g_prev", k, n_events);
   c.util = convert::vec(field(obj, "util"), "Companion.util", k);
   c.wrenches = convert::matc<6>(field(obj, "wrenches"), "Companion.wrenches", n_mounts);
   c.figures = convert::vec(field(obj, "figures"), "Companion.figures", N_FIGURES);
