@@ -205,8 +205,9 @@ inline bool twin_bound(const Vec twin_result) {
   return twin_result[1] > 1.0 || twin_result[2] > 0.0;
 }
 
-/// How the companion steps over an integrated interval (`companion_advance`).
+/// How the companion steps over an integrated interval (`companion_advance`), or CARRIED.
 enum Stepping : int {
+  CARRIED = -1,  // not integrated: its error carried over the interval (`carry_interval`)
   OWN = 0,    // its own method at its fewest steps
   SWITCHED,   // c.switching_method at least c.switching_min_steps steps
   HALVED,     // its own method at twice its fewest steps
@@ -386,8 +387,10 @@ inline bool in_reach(idx nf, double h, const Vec rate, const Vec twin_rate, cons
 /// the interval before (RATE), moved to this interval's input as the twin's chain moves its
 /// stage (d_wdot; `chain`), so that the interval takes one right-hand side in all. Where a
 /// state is off the α/γ/δ chart, the kick is out of its reach (`in_reach`) or an event
-/// function changed sign over the interval, the companion is integrated over it (`follow`).
-inline void carry_interval(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
+/// function changed sign over the interval, the twin's or, after the kick, the companion's
+/// own, the companion is to be integrated over it from c.y (`follow`, its stepper's chain
+/// broken): returns how (a Stepping), else CARRIED.
+inline int carry_interval(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
                            const Vec twin_result, int watched, Vec d_wdot, Vec pose,
                            M6 wrenches, Vec y) {
   const idx n = y.n, nf = m.free_trans.n + m.free_rot.n;
@@ -410,21 +413,21 @@ inline void carry_interval(const Model& m, Companion& c, Vec u, double t0, doubl
   // integrated where the kick is out of its reach, and where a mount switched or an event
   // function changed sign over the interval (a contact the kick from t₀ does not see)
   if (!(rated && in_reach(nf, h, rate, twin_rate, e)) || (watched & CHANGED) != 0) {
-    follow(m, c, u, t0, t1, false, OWN, d_wdot, pose, wrenches, y);  // from c.y
-    return;
+    c.integ.settings[CHAINED] = 0.0;
+    return OWN;
   }
   for (idx i = 0; i < n; ++i) trial[i] = y[i] + e[i];
   for (idx i = nf; i < n; ++i) e[i] += h * (rate[i] - twin_rate[i]);
   for (idx k = 0; k < nf; ++k) e[k] += h * e[nf + k];
   if (!add_local_error(m, c, u, t0, t1, twin_result, y)) {
     resynchronise(c, y);
-    return;
+    return CARRIED;
   }
   for (idx i = 0; i < n; ++i) c.y[i] = y[i] + e[i];
   if (m.has_nl) carry_kinds(m, c, trial, y);
   if (physics::rhs_with_wrenches(t1, c.y, m, c.s, u, rate, c.wrenches) != OK) {
     resynchronise(c, y);
-    return;
+    return CARRIED;
   }
   bool switched = false;
   if (m.has_nl) {
@@ -438,14 +441,15 @@ inline void carry_interval(const Model& m, Companion& c, Vec u, double t0, doubl
       // read as the state before), its steps halved as over the twin's crossings
       copy(c.y_prev, c.y);
       copy(c.g_prev.flat(), c.g.flat());
-      follow(m, c, u, t0, t1, false, HALVED, d_wdot, pose, wrenches, y);
-      return;
+      c.integ.settings[CHAINED] = 0.0;  // the check's stages are at the twin's state
+      return HALVED;
     }
     copy(c.y, c.y_prev);
   }
   carry[RATED] = switched ? 0.0 : 1.0;  // a switch moved c.y off the rate taken there
   c.integ.settings[CHAINED] = 0.0;     // its stepper's stages are not at c.y
   fold_figures(c, c.s.q, pose, wrenches);
+  return CARRIED;
 }
 
 /// run_samples' result: the index of the last sample done and the status (0 all done;
@@ -514,20 +518,25 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
       estimate_interval(m, *estimator, u, smp.t[j - 1], smp.t[j], watched, integ, wrenches_j,
                         y);
     }
-    if (carried) {
-      carry_interval(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, integ.result,
-                     watched, d_wdot, out.pose.row(j), wrenches_j, y);
-    } else if (companion != nullptr) {
-      // an event function changed sign inside the interval: halved (a joint's faces opening or
-      // slipping in the genset under a synthesised 30 g shock read 0.28 of the true error at
-      // rtol 1e-5 across it by one step, by the switching method's two steps too); else the
-      // twin's tolerance bound its steps while an event holds that switches the law inside the
-      // steps (a joint's faces between sticking and sliding): switched
-      const int stepping = (watched & CHANGED) != 0                                 ? HALVED
-                           : holding == SWITCHING && twin_bound(integ.result) ? SWITCHED
-                                                                                : OWN;
-      follow(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, stepping, d_wdot,
-             out.pose.row(j), wrenches_j, y);
+    if (companion != nullptr) {
+      int stepping = CARRIED;
+      if (carried) {
+        stepping = carry_interval(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain,
+                                  integ.result, watched, d_wdot, out.pose.row(j), wrenches_j, y);
+      } else if ((watched & CHANGED) != 0) {
+        // an event function changed sign inside the interval: halved (a joint's faces opening
+        // or slipping in the genset under a synthesised 30 g shock read 0.28 of the true error
+        // at rtol 1e-5 across it by one step, by the switching method's two steps too)
+        stepping = HALVED;
+      } else {
+        // where the twin's tolerance bound its steps while an event holds that switches the
+        // law inside the steps (a joint's faces between sticking and sliding): switched
+        stepping = holding == SWITCHING && twin_bound(integ.result) ? SWITCHED : OWN;
+      }
+      if (stepping != CARRIED) {
+        follow(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, stepping, d_wdot,
+               out.pose.row(j), wrenches_j, y);
+      }
     }
     *out.counter += 1;
     for (idx a = 0; a < nm; ++a) {
