@@ -31,31 +31,31 @@ Windermere's fan", *ibid.* §II.3), instead of integrated a second time:
   stick point, whose rate turns with e as μ·F_K/k_τ goes to 0, read the genset 18.6 and 1090
   times its true error at rtol 1e-6 and 1e-8;
 - ℓₙ measured, not modelled: one step of the companion's stepper (below) from the twin's start
-  state (its first stage the twin's, which the kick holds: one right-hand side less a check, 256
-  Bouc–Wen mounts 1.22–1.24× → 1.20× the engine's time) less the twin's end state, at every
-  special interval (a rejected step, an error norm over SPIKE_RATIO times its running mean, the
-  first after a restart; an interval in which an event function changes sign is integrated,
-  below) and every half period of the body's fastest tangent mode, at most CARRY_CHECK_EVERY =
-  32 intervals apart (the genset at 10 kHz: 8); the intervals between add the last measured ℓ
-  scaled by the twin's error norms (at most SPIKE_RATIO times; an interval's norm is its largest
-  accepted one times its accepted steps). A check a rejection or a spike called for adds its own
-  ℓ but is not the one scaled after it, nor does it put the next regular check off: at such an
-  event (a Bouc–Wen mount turning, a contact) ℓ is tens of times what a smooth interval's norm
-  predicts, and scaled onto the smooth ones after it 4 and 16 Bouc–Wen mounts under ship motion
-  read 7.1 and 5.6 times their true error at rtol 1e-9 (1.05 and 0.93 so; with the norm of the
-  largest step alone, 64 mounts still 2.0). Checked every 32 intervals instead of 8, the genset
-  under the bundled half-sine read 0.49 of its true error (every 17: 0.53; every 8: 1.25 and
-  0.87 at rtol 1e-6 and 1e-8). Where the twin took one step over the interval, none rejected,
-  the check is the stepper's fewest steps, every one taken (`integrate.stepper.advance_fixed`):
-  a step of Verner's 6th order as long as the twin's accepted 5th-order one, or two of the
-  twin's own method half as long (error 1/64 of the twin's), the same argument as one integrated
-  step an interval below. Held to its tolerance (rtol/8 on its 5th-order estimate, not on the
-  error it has), the check took 4 steps a check on 256 Bouc–Wen mounts, 169 of its 523 rejected,
-  and cost the estimate 0.15× of the engine's time (1.44× → 1.30×). Added where it is committed,
-  ℓ is then carried by Φ like the rest, damped and turned as the motion damps and turns it.
-  Counting the skipped intervals into the next measured ℓ instead, in phase, read 0.46–0.53 of
-  the true error under the real 47 g record at rtol 1e-3 and 1e-5 (checks 8 and 32 apart), by
-  their number 1.8–9.3 times it.
+  state (its first stage the twin's, which the kick holds: one right-hand side less a check; 256
+  Bouc–Wen mounts 1.20× against 1.22–1.24×, within an hour's noise) less the twin's end state,
+  at every special interval (a rejected step, an error norm over SPIKE_RATIO times its running
+  mean, the first after a restart; an interval in which an event function changes sign is
+  integrated, below) and every half period of the body's fastest tangent mode, at most
+  CARRY_CHECK_EVERY = 32 intervals apart (the genset at 10 kHz: 8); the intervals between add
+  the last measured ℓ scaled by the twin's error norms (at most SPIKE_RATIO times; an interval's
+  norm is its largest accepted one times its accepted steps). A check a rejection or a spike
+  called for adds its own ℓ but is not the one scaled after it, nor does it put the next regular
+  check off: at such an event (a Bouc–Wen mount turning, a contact) ℓ is tens of times what a
+  smooth interval's norm predicts, and scaled onto the smooth ones after it 4 and 16 Bouc–Wen
+  mounts under ship motion read 7.1 and 5.6 times their true error at rtol 1e-9 (1.05 and 0.93
+  so; with the norm of the largest step alone, 64 mounts still 2.0). Checked every 32 intervals
+  instead of 8, the genset under the bundled half-sine read 0.49 of its true error (every 17:
+  0.53; every 8: 1.25 and 0.87 at rtol 1e-6 and 1e-8). Where the twin took one step over the
+  interval, none rejected, the check is the stepper's fewest steps, every one taken
+  (`integrate.stepper.advance_fixed`): a step of Verner's 6th order as long as the twin's
+  accepted 5th-order one, or two of the twin's own method half as long (error 1/64 of the
+  twin's), the same argument as one integrated step an interval below. Held to its tolerance
+  (rtol/8 on its 5th-order estimate, not on the error it has), the check took 4 steps a check on
+  256 Bouc–Wen mounts, 169 of its 523 rejected, and cost the estimate 0.15× of the engine's time
+  (1.44× → 1.30×). Added where it is committed, ℓ is then carried by Φ like the rest, damped and
+  turned as the motion damps and turns it. Counting the skipped intervals into the next measured
+  ℓ instead, in phase, read 0.46–0.53 of the true error under the real 47 g record at rtol 1e-3
+  and 1e-5 (checks 8 and 32 apart), by their number 1.8–9.3 times it.
 
 Where the twin runs a linearising method, where the interval is too long for the kick, where
 the kick meets a stiffness past its reach on some coordinate k of the body (h²·|Δaₖ| over
