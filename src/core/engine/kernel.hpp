@@ -107,15 +107,21 @@ constexpr idx CARRY_CHECK_EVERY = 32;
 /// companion is integrated over it): symplectic Euler is stable for h·ω < 2.
 constexpr double KICK_LIMIT = 1.0;
 
+/// After the mounts' monitors at a sample (`switched`: a discrete switch moved y): y into
+/// y_prev; a switch clears the stepper's chain flag, its last stage not at this y. Returns
+/// `switched`.
+inline bool settle_switches(bool switched, Vec y, Vec y_prev, Vec settings) {
+  if (switched) settings[CHAINED] = 0.0;
+  copy(y, y_prev);
+  return switched;
+}
+
 /// The mounts' monitors and discrete switches at a sample (y_prev: the state at the previous
-/// one, then y); a switch (y jumped) clears the stepper's chain flag: its last stage is not
-/// at this y.
+/// one, then y; `settle_switches`).
 inline bool monitor_switches(Vec y, const NonLinear& nl, Vec y_prev, Scratch& s, Mat g, Vec util,
                              Vec settings) {
-  const bool switched = physics::mount_monitors(y, y_prev, nl, s, g, util);
-  if (switched) settings[CHAINED] = 0.0;
-  for (idx i = 0; i < y.n; ++i) y_prev[i] = y[i];
-  return switched;
+  return settle_switches(physics::mount_monitors(y, y_prev, nl, s, g, util), y, y_prev,
+                         settings);
 }
 
 /// Whether an event function changed sign from g0 to g1: one of them below 0, the other not.
@@ -129,11 +135,12 @@ inline bool sign_changed(const Mat g0, const Mat g) {
   return false;
 }
 
-/// `monitor_switches` at t1, then log each upward zero crossing of an event function since t0
-/// (located by linear interpolation). Returns `Watched` bits.
-inline int watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, double t0, double t1,
-                         M6 wrenches, Vec settings) {
-  bool changed = monitor_switches(y, nl, w.y_prev, s, w.g, w.util, settings), engaged = false;
+/// After the monitors at t1 (w.g, w.util; `switched` as `monitor_switches` returns it), log
+/// each upward zero crossing of an event function since t0 (located by linear interpolation).
+/// Returns `Watched` bits.
+inline int log_crossings(bool switched, const NonLinear& nl, Watch& w, double t0, double t1,
+                         M6 wrenches) {
+  bool changed = switched, engaged = false;
   for (idx i = 0; i < w.g.rows; ++i) {
     w.util_peak[i] = py_max(w.util_peak[i], w.util[i]);
     for (idx e = 0; e < w.g.cols; ++e) {
@@ -157,6 +164,13 @@ inline int watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, double
     }
   }
   return (changed ? CHANGED : 0) | (engaged ? ENGAGED : 0);
+}
+
+/// `monitor_switches` at t1, then `log_crossings`. Returns `Watched` bits.
+inline int watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, double t0, double t1,
+                         M6 wrenches, Vec settings) {
+  const bool switched = monitor_switches(y, nl, w.y_prev, s, w.g, w.util, settings);
+  return log_crossings(switched, nl, w, t0, t1, wrenches);
 }
 
 /// The companion's outputs (its wrenches, its angles q[3:6]) against the twin's (pose,
@@ -263,8 +277,10 @@ inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bo
     resynchronise(c, y);
     return;
   }
-  physics::mount_wrenches(c.y, m, c.s, c.wrenches);  // the body's motion at c.y: its last rhs
-  if (m.has_nl) monitor_switches(c.y, m.nl, c.y_prev, c.s, c.g, c.util, settings);
+  // the body's motion at c.y: its last rhs; the monitors in the wrenches' pass
+  physics::MonitorRows mon{c.y_prev, c.g, c.util};
+  physics::mount_wrenches(c.y, m, c.s, c.wrenches, m.has_nl ? &mon : nullptr);
+  if (m.has_nl) settle_switches(mon.switched, c.y, c.y_prev, settings);
   fold_figures(c, c.s.q, pose, wrenches);
 }
 
@@ -425,14 +441,17 @@ inline int carry_interval(const Model& m, Companion& c, Vec u, double t0, double
   }
   for (idx i = 0; i < n; ++i) c.y[i] = y[i] + e[i];
   if (m.has_nl) carry_kinds(m, c, trial, y);
-  if (physics::rhs_with_wrenches(t1, c.y, m, c.s, u, rate, c.wrenches) != OK) {
+  // the monitors in the outputs' pass (c.y_prev the state before: at the interval's start)
+  if (m.has_nl) copy(c.g.flat(), c.g_prev.flat());
+  physics::MonitorRows mon{c.y_prev, c.g, c.util};
+  if (physics::rhs_with_wrenches(t1, c.y, m, c.s, u, rate, c.wrenches,
+                                 m.has_nl ? &mon : nullptr) != OK) {
+    if (m.has_nl) copy(c.g_prev.flat(), c.g.flat());  // as before the pass
     resynchronise(c, y);
     return CARRIED;
   }
-  bool switched = false;
+  const bool switched = mon.switched;
   if (m.has_nl) {
-    copy(c.g.flat(), c.g_prev.flat());
-    switched = physics::mount_monitors(c.y, c.y_prev, m.nl, c.s, c.g, c.util);
     if (sign_changed(c.g_prev, c.g)) {
       // an event function of its own changed sign over the interval (a snubber met inside
       // it, which the kick from t₀ does not see: rubber on snubbers of 1e10 N/m^1.5 at 1 kHz
@@ -508,11 +527,14 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
     const idx stiffening = *watch.n_stiffening;
     for (int k = 0; k < 3; ++k) out.step_log(j, k) = integ.result[k];
     const M6 wrenches_j = out.wrenches.mat(j);
-    physics::outputs(y, m, s, out.pose.row(j), wrenches_j);
+    // the monitors in the outputs' pass over the mounts
+    physics::MonitorRows mon{watch.y_prev, watch.g, watch.util};
+    physics::outputs(y, m, s, out.pose.row(j), wrenches_j, m.has_nl ? &mon : nullptr);
     physics::linear_utilisation(m, s, wrenches_j, out.lin_util);
     int watched = 0;
     if (m.has_nl) {
-      watched = watch_mounts(y, m.nl, s, watch, smp.t[j - 1], smp.t[j], wrenches_j, settings);
+      const bool switched = settle_switches(mon.switched, y, watch.y_prev, settings);
+      watched = log_crossings(switched, m.nl, watch, smp.t[j - 1], smp.t[j], wrenches_j);
     }
     if (estimator != nullptr) {
       estimate_interval(m, *estimator, u, smp.t[j - 1], smp.t[j], watched, integ, wrenches_j,

@@ -197,13 +197,37 @@ inline void put_wrench(const NonLinear& nl, idx i, const double* c, MountLocal& 
   }
 }
 
+/// The mounts' monitors where a pass over them for their wrenches takes them too, each mount's
+/// event functions and discrete switch from the local motion its load was taken at (one local
+/// motion a mount where a pass for the wrenches and one for the monitors took two, at every
+/// sample of the twin and every interval of the companion): y0 the state at the previous
+/// sample, g (k, NE) and util (k) written as `mount_monitors` writes them, `switched` whether
+/// a switch moved y.
+struct MonitorRows {
+  Vec y0;
+  Mat g;
+  Vec util;
+  bool switched = false;
+};
+
+/// Non-linear mount i's event functions and utilisation at its motion ml into mon, then its
+/// discrete switch (y's states may jump): `mount_monitors`' work on one mount.
+inline void monitor_mount(idx i, Vec y, const NonLinear& nl, const MountLocal& ml,
+                          MonitorRows& mon) {
+  const idx code = nl.kind[i], o = nl.state[i];
+  const double* p = &nl.par(i, 0);
+  mon.util[i] = kinds::kind_monitor(code, p, y, mon.y0, o, ml.d, ml.v, mon.g.row(i));
+  if (kinds::kind_update(code, p, y, o, ml.d)) mon.switched = true;
+}
+
 /// Sum the mount loads on the body at the motion mo into s.total_force, s.total_moment (F,
 /// about the CG); the internal-state rates of the mounts that have them into dydt. With
 /// kWrenches, each non-linear mount's force and own couple in its axes into its row of
-/// *wrenches as well (`mount_wrenches`' rows, from the same loads).
+/// *wrenches as well (`mount_wrenches`' rows, from the same loads), and where mon is given its
+/// monitors after its load (`monitor_mount`: a switch moves y after every load was taken).
 template <bool kWrenches>
 inline void mount_loads_into(Vec y, const Model& m, const Motion& mo, Scratch& s, Vec dydt,
-                             M6* wrenches) {
+                             M6* wrenches, MonitorRows* mon) {
   double total_f[3] = {0.0, 0.0, 0.0}, total_m[3] = {0.0, 0.0, 0.0};
   linear_loads(m, mo, total_f, total_m);
   if (m.lin_point.rows > 0) {  // their own couples, through their summed K_r, C_r
@@ -220,7 +244,10 @@ inline void mount_loads_into(Vec y, const Model& m, const Motion& mo, Scratch& s
       out_of_axes(nl, i, ml.f, f);
       if (nl.rotational[i]) nl_couple(i, nl, mo, ml, c);
       add_load(ml.arm, f, c, total_f, total_m);
-      if constexpr (kWrenches) put_wrench(nl, i, c, ml, *wrenches);
+      if constexpr (kWrenches) {
+        put_wrench(nl, i, c, ml, *wrenches);
+        if (mon != nullptr) monitor_mount(i, y, nl, ml, *mon);
+      }
     }
   }
   for (int j = 0; j < 3; ++j) {
@@ -231,11 +258,13 @@ inline void mount_loads_into(Vec y, const Model& m, const Motion& mo, Scratch& s
 
 /// `mount_loads_into` without the wrenches: the right-hand side's.
 inline void mount_loads(Vec y, const Model& m, const Motion& mo, Scratch& s, Vec dydt) {
-  mount_loads_into<false>(y, m, mo, s, dydt, nullptr);
+  mount_loads_into<false>(y, m, mo, s, dydt, nullptr, nullptr);
 }
 
-/// Each mount's force (N) and own couple (N·m) on the body, in its axes: wrenches row slot.
-inline void mount_wrenches(Vec y, const Model& m, Scratch& s, M6 wrenches) {
+/// Each mount's force (N) and own couple (N·m) on the body, in its axes: wrenches row slot;
+/// where mon is given, each non-linear mount's monitors after its wrench (`monitor_mount`).
+inline void mount_wrenches(Vec y, const Model& m, Scratch& s, M6 wrenches,
+                           MonitorRows* mon = nullptr) {
   const Motion mo = Motion::of(s);
   linear_wrenches(m, mo, wrenches);
   if (!m.has_nl) return;
@@ -246,6 +275,7 @@ inline void mount_wrenches(Vec y, const Model& m, Scratch& s, M6 wrenches) {
     double c[3] = {0.0, 0.0, 0.0};
     if (nl.rotational[i]) nl_couple(i, nl, mo, ml, c);
     put_wrench(nl, i, c, ml, wrenches);
+    if (mon != nullptr) monitor_mount(i, y, nl, ml, *mon);
   }
 }
 
@@ -269,15 +299,12 @@ inline double mount_deflections(Vec y, const Model& m, Scratch& s, M3 d) {
 inline bool mount_monitors(Vec y, Vec y0, const NonLinear& nl, Scratch& s, Mat g, Vec util) {
   const Motion mo = Motion::of(s);
   MountLocal ml;
-  bool switched = false;
+  MonitorRows mon{y0, g, util};
   for (idx i = 0; i < nl.k; ++i) {
     local_motion(i, nl, mo, ml);
-    const idx code = nl.kind[i], o = nl.state[i];
-    const double* p = &nl.par(i, 0);
-    util[i] = kinds::kind_monitor(code, p, y, y0, o, ml.d, ml.v, g.row(i));
-    if (kinds::kind_update(code, p, y, o, ml.d)) switched = true;
+    monitor_mount(i, y, nl, ml, mon);
   }
-  return switched;
+  return mon.switched;
 }
 
 inline double cross(const Vec a, const Vec b, idx i) {
@@ -446,11 +473,11 @@ inline bool rotational(const Model& m, Scratch& s, double ct, Vec dydt, idx firs
 /// its rate and its outputs in one pass).
 template <bool kWrenches>
 inline int rhs_into(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt,
-                    M6* wrenches) {
+                    M6* wrenches, MonitorRows* mon) {
   Motion mo;
   const double ct = body_motion(y, m, s, mo);
   if (!(ct > 0.0)) return OFF_CHART;
-  mount_loads_into<kWrenches>(y, m, mo, s, dydt, wrenches);
+  mount_loads_into<kWrenches>(y, m, mo, s, dydt, wrenches, mon);
   if constexpr (kWrenches) linear_wrenches(m, mo, *wrenches);
   const idx nt = m.free_trans.n, nr = m.free_rot.n, nf = nt + nr;
   for (idx k = 0; k < nf; ++k) dydt[k] = y[nf + k];
@@ -466,20 +493,24 @@ inline int rhs_into(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt
 }
 
 inline int rhs(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt) {
-  return rhs_into<false>(t, y, m, s, u, dydt, nullptr);
+  return rhs_into<false>(t, y, m, s, u, dydt, nullptr, nullptr);
 }
 
 /// `rhs`, and each mount's force (N) and own couple (N·m) on the body in its axes into its
-/// wrenches row, as `mount_wrenches` gives them, in one pass over the mounts.
+/// wrenches row, as `mount_wrenches` gives them, in one pass over the mounts; where mon is
+/// given, their monitors in that pass too (taken where the body's motion is on the chart,
+/// even if the rotational rows then fail).
 inline int rhs_with_wrenches(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt,
-                             M6 wrenches) {
-  return rhs_into<true>(t, y, m, s, u, dydt, &wrenches);
+                             M6 wrenches, MonitorRows* mon = nullptr) {
+  return rhs_into<true>(t, y, m, s, u, dydt, &wrenches, mon);
 }
 
 /// Outputs when s already holds the body motion at y (the last rhs was at y): the pose row
-/// (physics/pose_row.py) and each mount's wrench in its axes.
-inline void outputs(Vec y, const Model& m, Scratch& s, Vec pose, M6 wrenches) {
-  mount_wrenches(y, m, s, wrenches);
+/// (physics/pose_row.py) and each mount's wrench in its axes; where mon is given, the
+/// non-linear mounts' monitors in the same pass (`mount_wrenches`).
+inline void outputs(Vec y, const Model& m, Scratch& s, Vec pose, M6 wrenches,
+                    MonitorRows* mon = nullptr) {
+  mount_wrenches(y, m, s, wrenches, mon);
   if (!m.rotation_read) quaternion_from_matrix(s.rot, s.quat);
   for (int i = 0; i < 3; ++i) {
     pose[pose_row::POSITION + i] = m.cg_ref[i] + s.q[i];
