@@ -838,6 +838,18 @@ def test_a_bag_recorded_again_between_load_and_run_is_a_failed_row_naming_it(
     spec = load_sweep(sweep)
     for case in check(spec):
         assert run_case(spec.base, spec.source, case)["verdict"] != FAILED
+    # replaced, after the load, by a record its read fails on: the row says it was recorded
+    # again, not what the read met
+    shutil.rmtree(bag)
+    assert main(["generate", "half-sine", "-o", str(bag), "--peak", "200", *options]) == 0
+    spec = load_sweep(sweep)
+    shutil.rmtree(bag)
+    bag.mkdir()
+    (bag / "metadata.yaml").write_text("rosbag2_bagfile_information: {version: 9}\n")
+    for case in check(spec):
+        row = run_case(spec.base, spec.source, case)
+        assert row["verdict"] == FAILED, row
+        assert row["error"].startswith(f"MountTwinError: {bag}: recorded again since the sweep")
 
 
 def _fake_pyarrow(monkeypatch: pytest.MonkeyPatch, write: object) -> None:

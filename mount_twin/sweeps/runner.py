@@ -16,7 +16,7 @@ import json
 import math
 import time
 from collections.abc import Callable, Iterable, Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -92,14 +92,23 @@ def value_text(column: str, value: Any, units: dict[str, str]) -> str:
 def _input_samples(case: InputCase, spec: InputSpec) -> SampleBatch:
     """The input of a case (read once per worker process, input and input spec: a bag recorded
     again is another input, `InputCase.content`, read anew by a worker that read the old).
-    A bag is read only as the sweep loaded it: its digest is taken again before and after the
-    read, and a bag recorded again since (its cases' ids hash the old content) is a
-    MountTwinError, the case's FAILED row, not the new record's figures under the old ids."""
+    A bag is read only as the sweep loaded it: its digest is taken again once the read ends (or
+    fails), and a bag recorded again since the load, before the read or during it (its cases'
+    ids hash the old content), is a MountTwinError, the case's FAILED row, not the new
+    record's figures under the old ids. (Taken before the read as well, it cost every worker a
+    third pass over the bag for the one change it alone sees: a record replaced and put back
+    while the worker read it.)"""
     if case.bag:
         from mount_twin.io.input_samples import read_samples
 
-        _same_bag(case)
-        samples = read_samples(case.bag, spec)
+        try:
+            samples = read_samples(case.bag, spec)
+        except Exception:
+            # a record replaced since the load is why, not what its read met; a bag gone or
+            # unreadable: the read's own error says so
+            with suppress(OSError):
+                _same_bag(case)
+            raise
         _same_bag(case)
         return samples
     from mount_twin.io.signals import half_sine_shock, ship_motion
