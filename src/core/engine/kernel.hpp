@@ -234,20 +234,35 @@ enum Stepping : int {
 /// its own error, and its error, shrinking with its length, then is the twin's own). Both
 /// methods are first-same-as-last: settings[CHAINED]'s stage holds for either.
 inline int companion_advance(const Model& m, Companion& c, Vec y, double t0, double t1, Vec u,
-                             int stepping) {
+                             Stepping stepping) {
   const Integrator& g = c.integ;
   const Vec settings = g.settings;
-  const bool switched = stepping == SWITCHED && c.switching_method != g.method;
-  if (stepping == OWN || (stepping == SWITCHED && !switched)) {
-    return integrate::advance(g.method, y, t0, t1, settings, m, c.s, u, g.work2d, g.work1d,
+  const double min_steps = settings[MIN_STEPS], max_steps = settings[MAX_SUBSTEPS];
+  int method = g.method;
+  double fewest = min_steps;
+  switch (stepping) {  // every Stepping (-Wswitch): one added is taken here or warned of
+    case OWN:
+      break;
+    case SWITCHED:
+      if (c.switching_method != g.method) {
+        method = c.switching_method;
+        fewest = c.switching_min_steps;
+      }
+      break;
+    case HALVED:
+      fewest = 2.0 * min_steps;
+      break;
+    case CARRIED:  // a carried interval is not integrated: asked to, a caller's mistake, failed
+      return UNKNOWN_METHOD;  // (`follow` resynchronises; the estimate counts the failure)
+  }
+  if (method == g.method && stepping != HALVED) {
+    return integrate::advance(method, y, t0, t1, settings, m, c.s, u, g.work2d, g.work1d,
                               g.result);
   }
-  const double min_steps = settings[MIN_STEPS], max_steps = settings[MAX_SUBSTEPS];
-  const double fewest = switched ? c.switching_min_steps : 2.0 * min_steps;
   settings[MIN_STEPS] = fewest;
   settings[MAX_SUBSTEPS] = max_steps * fewest / min_steps;
-  const int status = integrate::advance(switched ? c.switching_method : g.method, y, t0, t1,
-                                        settings, m, c.s, u, g.work2d, g.work1d, g.result);
+  const int status = integrate::advance(method, y, t0, t1, settings, m, c.s, u, g.work2d,
+                                        g.work1d, g.result);
   settings[MIN_STEPS] = min_steps;
   settings[MAX_SUBSTEPS] = max_steps;
   return status;
@@ -266,7 +281,7 @@ inline void resynchronise(Companion& c, Vec y) {
 /// differences of its outputs from the twin's (pose, wrenches at t1; y the twin's state): its
 /// wrenches and angles, what the estimate compares (no pose row).
 inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
-                   int stepping, Vec d_wdot, Vec pose, M6 wrenches, Vec y) {
+                   Stepping stepping, Vec d_wdot, Vec pose, M6 wrenches, Vec y) {
   const Vec settings = c.integ.settings;
   if (chain && settings[CHAINED] == 1.0) {
     physics::rhs_after_rate_step(m, c.s, d_wdot, c.integ.work2d.row(0));
@@ -406,9 +421,9 @@ inline bool in_reach(idx nf, double h, const Vec rate, const Vec twin_rate, cons
 /// function changed sign over the interval, the twin's or, after the kick, the companion's
 /// own, the companion is to be integrated over it from c.y (`follow`, its stepper's chain
 /// broken): returns how (a Stepping), else CARRIED.
-inline int carry_interval(const Model& m, Companion& c, Vec u, double t0, double t1, bool chain,
-                           const Vec twin_result, int watched, Vec d_wdot, Vec pose,
-                           M6 wrenches, Vec y) {
+inline Stepping carry_interval(const Model& m, Companion& c, Vec u, double t0, double t1,
+                               bool chain, const Vec twin_result, int watched, Vec d_wdot,
+                               Vec pose, M6 wrenches, Vec y) {
   const idx n = y.n, nf = m.free_trans.n + m.free_rot.n;
   const double h = t1 - t0;
   const Mat rows = c.error_rows;
@@ -541,7 +556,7 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
                         y);
     }
     if (companion != nullptr) {
-      int stepping = CARRIED;
+      Stepping stepping = CARRIED;
       if (carried) {
         stepping = carry_interval(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain,
                                   integ.result, watched, d_wdot, out.pose.row(j), wrenches_j, y);
