@@ -224,7 +224,8 @@ inline void monitor_mount(idx i, Vec y, const NonLinear& nl, const MountLocal& m
 /// about the CG); the internal-state rates of the mounts that have them into dydt. With
 /// kWrenches, each non-linear mount's force and own couple in its axes into its row of
 /// *wrenches as well (`mount_wrenches`' rows, from the same loads), and where mon is given its
-/// monitors after its load (`monitor_mount`: a switch moves y after every load was taken).
+/// monitors after its load (`monitor_mount`: a mount's switch moves its own states alone, after
+/// its load, so every load is the one a pass without the monitors takes).
 template <bool kWrenches>
 inline void mount_loads_into(Vec y, const Model& m, const Motion& mo, Scratch& s, Vec dydt,
                              M6* wrenches, MonitorRows* mon) {
