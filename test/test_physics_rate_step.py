@@ -11,8 +11,19 @@ import numpy as np
 import pytest
 from io_helpers import default_scene
 
-from mount_twin.engine.kernel import monitor_switches, new_watch, watch_mounts
+from mount_twin.engine.driver import published_buffers
+from mount_twin.engine.kernel import (
+    Integrator,
+    Loop,
+    RunOptions,
+    Samples,
+    monitor_switches,
+    new_watch,
+    run_samples,
+    watch_mounts,
+)
 from mount_twin.integrate.settings import CHAINED, N_SETTINGS
+from mount_twin.integrate.stepper import new_stepper
 from mount_twin.kinds import N_EVENTS, bolted_joint
 from mount_twin.model.assemble import assemble, initial_state
 from mount_twin.physics import pose_row
@@ -77,7 +88,8 @@ def _check_rate_step(scene, position: float, rate: float) -> None:
 def test_a_bolt_breaking_between_samples_ends_the_chain() -> None:
     """The stepper's last stage starts the next interval only while the state is continuous: a
     bolt that breaks between samples (its `update`) clears the chain flag, the twin's (the
-    kernel's watch and its monitor), and nothing else does."""
+    kernel's watch and its monitor, and the compiled loop's own pass, which fuses the monitors
+    into the outputs'), and nothing else does."""
     model = assemble(load_scene_file(GENSET))
     nl = model.arrays.nl
     g = np.array([0.0, 0.0, model.scene.input.g])
@@ -86,17 +98,46 @@ def test_a_bolt_breaking_between_samples_ends_the_chain() -> None:
     for broken in (False, True):
         if broken:
             y[foot] = nl.par[0, bolted_joint.EPU]  # at its ultimate plastic elongation
-        for watch_or_monitor in ("watch", "monitor"):
+        for path in ("watch", "monitor", "loop"):
             state = y.copy()
-            s = model.new_scratch()
-            pose, wrenches = np.zeros(pose_row.WIDTH), np.zeros((model.n_mounts, 6))
-            assert evaluate(state, model.arrays, s, pose, wrenches) > 0.0
-            settings = np.zeros(N_SETTINGS)
-            settings[CHAINED] = 1.0
-            watch = new_watch(nl.kind.shape[0], N_EVENTS, model.n_state)
-            if watch_or_monitor == "watch":
-                watch_mounts(state, nl, s, watch, 0.0, 1e-3, wrenches, settings)
+            if path == "loop":
+                settings = _loop_over_one_interval(model, state, g)
             else:
-                monitor_switches(state, nl, state.copy(), s, watch.g, watch.util, settings)
-            assert state[foot + 3] == (1.0 if broken else 0.0)
-            assert settings[CHAINED] == (0.0 if broken else 1.0), watch_or_monitor
+                settings = _watch_or_monitor(model, state, path)
+            assert state[foot + 3] == (1.0 if broken else 0.0), path
+            assert settings[CHAINED] == (0.0 if broken else 1.0), path
+
+
+def _watch_or_monitor(model, state: np.ndarray, path: str) -> np.ndarray:
+    """The chain flag (set on entry) after the bound `watch_mounts` or `monitor_switches` at
+    `state` (its switches taken in place): the settings array."""
+    nl = model.arrays.nl
+    s = model.new_scratch()
+    pose, wrenches = np.zeros(pose_row.WIDTH), np.zeros((model.n_mounts, 6))
+    assert evaluate(state, model.arrays, s, pose, wrenches) > 0.0
+    settings = np.zeros(N_SETTINGS)
+    settings[CHAINED] = 1.0
+    watch = new_watch(nl.kind.shape[0], N_EVENTS, model.n_state)
+    if path == "watch":
+        watch_mounts(state, nl, s, watch, 0.0, 1e-3, wrenches, settings)
+    else:
+        monitor_switches(state, nl, state.copy(), s, watch.g, watch.util, settings)
+    return settings
+
+
+def _loop_over_one_interval(model, state: np.ndarray, g: np.ndarray) -> np.ndarray:
+    """The twin's settings after `run_samples` stepped `state` (in place) over one 0.1 ms
+    interval at rest under gravity g (m/s², F), chained: Dormand–Prince leaves its last stage
+    there (the chain flag set) unless a mount switched at the sample."""
+    twin = new_stepper("dopri54", model.n_state, 1e-6, 1e-9, 100)
+    integ = Integrator(twin.method, twin.settings, twin.work2d, twin.work1d, twin.result)
+    s, u = model.new_scratch(), np.zeros(INPUT_SIZE)
+    watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
+    watch.y_prev[:] = state
+    opts = RunOptions(zero_order=False, decimation=1, chain=True)
+    loop = Loop(integ, model.arrays, s, u, state, opts, watch, None)
+    samples = Samples(np.array([0.0, 1e-4]), np.tile(g, (2, 1)), np.zeros((2, 3)))
+    nm = model.n_mounts
+    out = published_buffers(2, np.zeros(1, np.int64), np.zeros((nm, 6)), np.zeros(0))
+    assert run_samples(loop, samples, out) == (1, 0)
+    return twin.settings
