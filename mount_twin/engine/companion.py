@@ -100,8 +100,8 @@ companion integrated at every interval read 0.69–1.08 at 1.4–2.1×: its work
 over the mounts (a right-hand side with the outputs) and, at a special interval or every half
 period, one step of the check, where the integrated companion's was 8 right-hand sides at least,
 more across the joints' switches. On the genset most of what is left is the intervals it is
-integrated over: 214 of 2 500 under its shock, a third of the twin's right-hand sides (an
-instrumented build; half before the switching intervals took the twin's method, below).
+integrated over: 305 of 2 499 under its shock, 0.63 of the twin's right-hand sides, 0.41 in the
+58 whose crossings are halved (below; an instrumented build, docs/benchmarks.md).
 
 **Integrated** (over the intervals above): the same model integrated beside the twin with rtol and
 atol divided by TOLERANCE_DIVISOR = 8. Where the twin's steps are set by the samples, not its
