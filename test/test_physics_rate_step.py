@@ -12,22 +12,12 @@ import pytest
 from io_helpers import default_scene
 
 from mount_twin.engine.driver import published_buffers
-from mount_twin.engine.kernel import (
-    Integrator,
-    Loop,
-    RunOptions,
-    Samples,
-    monitor_switches,
-    new_watch,
-    run_samples,
-    watch_mounts,
-)
-from mount_twin.integrate.settings import CHAINED, N_SETTINGS
+from mount_twin.engine.kernel import Integrator, Loop, RunOptions, Samples, new_watch, run_samples
+from mount_twin.integrate.settings import CHAINED
 from mount_twin.integrate.stepper import new_stepper
 from mount_twin.kinds import N_EVENTS, bolted_joint
 from mount_twin.model.assemble import assemble, initial_state
-from mount_twin.physics import pose_row
-from mount_twin.physics.dynamics import INPUT_SIZE, OK, evaluate, rhs, rhs_after_rate_step
+from mount_twin.physics.dynamics import INPUT_SIZE, OK, rhs, rhs_after_rate_step
 from mount_twin.scene.loader import load_scene_file
 
 GENSET = Path(__file__).resolve().parent.parent / "config" / "genset_bolted_keyed.scene.yaml"
@@ -87,9 +77,9 @@ def _check_rate_step(scene, position: float, rate: float) -> None:
 
 def test_a_bolt_breaking_between_samples_ends_the_chain() -> None:
     """The stepper's last stage starts the next interval only while the state is continuous: a
-    bolt that breaks between samples (its `update`) clears the chain flag, the twin's (the
-    kernel's watch and its monitor, and the compiled loop's own pass, which fuses the monitors
-    into the outputs'), and nothing else does."""
+    bolt that breaks between samples (its `update`, in the compiled loop's pass over the mounts
+    at the sample, which takes their monitors with their outputs) clears the twin's chain flag,
+    and nothing else does."""
     model = assemble(load_scene_file(GENSET))
     nl = model.arrays.nl
     g = np.array([0.0, 0.0, model.scene.input.g])
@@ -98,31 +88,10 @@ def test_a_bolt_breaking_between_samples_ends_the_chain() -> None:
     for broken in (False, True):
         if broken:
             y[foot] = nl.par[0, bolted_joint.EPU]  # at its ultimate plastic elongation
-        for path in ("watch", "monitor", "loop"):
-            state = y.copy()
-            if path == "loop":
-                settings = _loop_over_one_interval(model, state, g)
-            else:
-                settings = _watch_or_monitor(model, state, path)
-            assert state[foot + 3] == (1.0 if broken else 0.0), path
-            assert settings[CHAINED] == (0.0 if broken else 1.0), path
-
-
-def _watch_or_monitor(model, state: np.ndarray, path: str) -> np.ndarray:
-    """The chain flag (set on entry) after the bound `watch_mounts` or `monitor_switches` at
-    `state` (its switches taken in place): the settings array."""
-    nl = model.arrays.nl
-    s = model.new_scratch()
-    pose, wrenches = np.zeros(pose_row.WIDTH), np.zeros((model.n_mounts, 6))
-    assert evaluate(state, model.arrays, s, pose, wrenches) > 0.0
-    settings = np.zeros(N_SETTINGS)
-    settings[CHAINED] = 1.0
-    watch = new_watch(nl.kind.shape[0], N_EVENTS, model.n_state)
-    if path == "watch":
-        watch_mounts(state, nl, s, watch, 0.0, 1e-3, wrenches, settings)
-    else:
-        monitor_switches(state, nl, state.copy(), s, watch.g, watch.util, settings)
-    return settings
+        state = y.copy()
+        settings = _loop_over_one_interval(model, state, g)
+        assert state[foot + 3] == (1.0 if broken else 0.0)
+        assert settings[CHAINED] == (0.0 if broken else 1.0)
 
 
 def _loop_over_one_interval(model, state: np.ndarray, g: np.ndarray) -> np.ndarray:

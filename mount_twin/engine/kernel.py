@@ -126,16 +126,6 @@ class Published(NamedTuple):
     lin_util: np.ndarray
 
 
-watch_mounts = _core.watch_mounts
-"""watch_mounts(y, nl, s, watch, t0, t1, wrenches, settings) -> bool: `monitor_switches` at t1
-(s), then each upward zero crossing of an event function since t0 logged into the watch (located
-by linear interpolation; |force| from the wrenches rows); returns whether a mount switched or an
-event function changed sign (the error estimate measures such an interval on its own)."""
-monitor_switches = _core.monitor_switches
-"""monitor_switches(y, nl, y_prev, s, g, util, settings): the mounts' event functions g,
-utilisation util and discrete switches at a sample (y_prev: the state at the previous one, then
-y); a switch (y jumped) clears settings[CHAINED]; returns whether one switched. The twin's
-watch takes its switches through it."""
 Loop = _core.Loop
 """Loop(integ, m, s, u, y, opts, watch, estimate): the arrays `run_samples` advances, converted
 and checked once (dtype, shape against the model: a wrong one raises naming it), held so their

@@ -283,49 +283,6 @@ void bind_engine(py::module_& mod) {
       "failure).",
       py::arg("loop"), py::arg("samples"), py::arg("out"));
   mod.def(
-      "watch_mounts",
-      [](py::handle y_, py::handle nl_, py::handle s_, py::handle watch_, double t0, double t1,
-         py::handle wrenches_, py::handle settings_) {
-        const NonLinear nl = convert::nonlinear(nl_);
-        Scratch s = convert::scratch(s_);
-        const Vec y = convert::vec(y_, "y");
-        convert::check_scratch(s, y.n, "s");
-        engine::Watch w = watch(watch_, nl.k, y.n);
-        const M6 wrenches = convert::matc<6>(wrenches_, "wrenches");
-        for (idx i = 0; i < nl.k; ++i) {
-          if (nl.slot[i] >= wrenches.rows || nl.state[i] >= y.n) {
-            throw py::value_error("wrenches or y: shorter than the mounts need");
-          }
-        }
-        return engine::watch_mounts(y, nl, s, w, t0, t1, wrenches,
-                                    convert::vec(settings_, "settings", N_SETTINGS));
-      },
-      "The mounts' monitors and switches at t1 (s), and their events since t0 logged into "
-      "the watch; a switch clears settings[CHAINED]. Returns bits: 1 a mount switched or an "
-      "event function changed sign, 2 an event function is at or above zero.",
-      py::arg("y"), py::arg("nl"), py::arg("s"), py::arg("watch"), py::arg("t0"), py::arg("t1"),
-      py::arg("wrenches"), py::arg("settings"));
-  mod.def(
-      "monitor_switches",
-      [](py::handle y_, py::handle nl_, py::handle y_prev_, py::handle s_, py::handle g_,
-         py::handle util_, py::handle settings_) {
-        const NonLinear nl = convert::nonlinear(nl_);
-        Scratch s = convert::scratch(s_);
-        const Vec y = convert::vec(y_, "y");
-        convert::check_scratch(s, y.n, "s");
-        for (idx i = 0; i < nl.k; ++i) {
-          if (nl.state[i] >= y.n) throw py::value_error("y: shorter than the mounts' states");
-        }
-        return engine::monitor_switches(y, nl, convert::vec(y_prev_, "y_prev", y.n), s,
-                                        convert::mat(g_, "g", nl.k),
-                                        convert::vec(util_, "util", nl.k),
-                                        convert::vec(settings_, "settings", N_SETTINGS));
-      },
-      "The mounts' monitors and discrete switches at a sample (y_prev: the previous state, "
-      "then y); a switch clears settings[CHAINED]. Returns whether one switched.",
-      py::arg("y"), py::arg("nl"), py::arg("y_prev"), py::arg("s"), py::arg("g"),
-      py::arg("util"), py::arg("settings"));
-  mod.def(
       "expm",
       [](py::handle a_, double scale) {
         const Mat a = convert::mat(a_, "a");

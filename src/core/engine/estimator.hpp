@@ -38,7 +38,7 @@ enum EstimatorSlot : int {
   N_ESTIMATOR_SLOTS
 };
 
-/// What the mounts' watch saw at a sample (engine/kernel.hpp watch_mounts), as bits: a mount
+/// What the mounts' watch saw at a sample (engine/kernel.hpp log_crossings), as bits: a mount
 /// switched or an event function changed sign over the interval (CHANGED); an event function is
 /// at or above zero, a mount's event under way (ENGAGED: in contact, slipping, open).
 enum Watched : int { CHANGED = 1, ENGAGED = 2 };

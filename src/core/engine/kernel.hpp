@@ -116,14 +116,6 @@ inline bool settle_switches(bool switched, Vec y, Vec y_prev, Vec settings) {
   return switched;
 }
 
-/// The mounts' monitors and discrete switches at a sample (y_prev: the state at the previous
-/// one, then y; `settle_switches`).
-inline bool monitor_switches(Vec y, const NonLinear& nl, Vec y_prev, Scratch& s, Mat g, Vec util,
-                             Vec settings) {
-  return settle_switches(physics::mount_monitors(y, y_prev, nl, s, g, util), y, y_prev,
-                         settings);
-}
-
 /// Whether an event function changed sign from g0 to g1: one of them below 0, the other not.
 inline bool crossed(double g0, double g1) { return (g0 < 0.0) != (g1 < 0.0); }
 
@@ -135,7 +127,7 @@ inline bool sign_changed(const Mat g0, const Mat g) {
   return false;
 }
 
-/// After the monitors at t1 (w.g, w.util; `switched` as `monitor_switches` returns it), log
+/// After the monitors at t1 (w.g, w.util; `switched` as `settle_switches` returns it), log
 /// each upward zero crossing of an event function since t0 (located by linear interpolation).
 /// Returns `Watched` bits.
 inline int log_crossings(bool switched, const NonLinear& nl, Watch& w, double t0, double t1,
@@ -164,13 +156,6 @@ inline int log_crossings(bool switched, const NonLinear& nl, Watch& w, double t0
     }
   }
   return (changed ? CHANGED : 0) | (engaged ? ENGAGED : 0);
-}
-
-/// `monitor_switches` at t1, then `log_crossings`. Returns `Watched` bits.
-inline int watch_mounts(Vec y, const NonLinear& nl, Scratch& s, Watch& w, double t0, double t1,
-                         M6 wrenches, Vec settings) {
-  const bool switched = monitor_switches(y, nl, w.y_prev, s, w.g, w.util, settings);
-  return log_crossings(switched, nl, w, t0, t1, wrenches);
 }
 
 /// The companion's outputs (its wrenches, its angles q[3:6]) against the twin's (pose,
