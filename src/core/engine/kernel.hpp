@@ -240,7 +240,7 @@ inline int companion_advance(const Model& m, Companion& c, Vec y, double t0, dou
     case CARRIED:  // a carried interval is not integrated: asked to, a caller's mistake, failed
       return UNKNOWN_METHOD;  // (`follow` resynchronises; the estimate counts the failure)
   }
-  if (method == g.method && stepping != HALVED) {
+  if (method == g.method && fewest == min_steps) {  // its own stepping: nothing to set
     return integrate::advance(method, y, t0, t1, settings, m, c.s, u, g.work2d, g.work1d,
                               g.result);
   }
