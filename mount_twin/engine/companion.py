@@ -100,7 +100,7 @@ companion integrated at every interval read 0.69–1.08 at 1.4–2.1×: its work
 over the mounts (a right-hand side with the outputs) and, at a special interval or every half
 period, one step of the check, where the integrated companion's was 8 right-hand sides at least,
 more across the joints' switches. On the genset most of what is left is the intervals it is
-integrated over: 305 of 2 499 under its shock, 0.63 of the twin's right-hand sides, 0.41 in the
+integrated over: 305 of 2 499 under its shock, 0.42 of the twin's right-hand sides, 0.22 in the
 58 whose crossings are halved (below; an instrumented build, docs/benchmarks.md).
 
 **Integrated** (over the intervals above): the same model integrated beside the twin with rtol and
@@ -128,16 +128,32 @@ snubbers of 1e9 N/m^1.5 at 1 kHz read 0.42 of its true error at rtol 1e-6 (attit
 not a friction bound, sets the steps. So a snubber in contact is "integrated", by the
 companion's own method: as "switching", 1e10 N/m^1.5 read 0.54 at rtol 1e-5 (0.97 so).
 Over an integrated interval in which an event function changes sign (a joint opening or a face
-starting to slip inside it) the companion takes its own method at twice its fewest steps
-(kernel.hpp `Stepping` HALVED), whatever holds: a step across the switch misjudges its error,
-so the companion's one step there erred as the twin's did, and the difference missed it. The
-genset under a vertical shock synthesised to 60 g at 300 Hz (`mount-twin synthesize`, seed 0)
-read 0.44 and 0.28 of its true force error at rtol 1e-3 and 1e-5 (integrated throughout by
-the old rule, 0.52 and 0.35; by the switching method there, 0.66 and 0.28), 0.69 and 0.89 so;
-its cost under its own shock bag 1.52–1.54× → 1.65–1.69× (best of 5 at rtol 1e-6, alternating
-with a tree of 17db827), its real-time factor 22.7× → 20.9×. The carried intervals' own
-crossings (integrated from the carried state) are taken by the companion's fewest steps still:
-halved too they read the same and cost more.
+starting to slip inside it; a carried interval over which one of the companion's own changed
+sign, taken again) the companion takes twice its fewest steps (kernel.hpp `halved`), whatever
+holds: a step across the switch misjudges its error, so the companion's one step there erred as
+the twin's did, and the difference missed it. The genset under a vertical shock synthesised to
+60 g at 300 Hz (`mount-twin synthesize`, seed 0) read 0.44 and 0.28 of its true force error at
+rtol 1e-3 and 1e-5 (integrated throughout by the old rule, 0.52 and 0.35; by the switching
+method at its 2 steps, 0.66 and 0.28), 0.69 and 0.89 by Verner's pair at 2 steps; its cost
+under its own shock bag 1.52–1.54× → 1.65–1.69× (best of 5 at rtol 1e-6, alternating with a
+tree of 17db827), its real-time factor 22.7× → 20.9×. Where the event is a joint's (its
+treatment "switching"), the twice is of the switching method's steps (`switching_method`,
+Dormand–Prince at 4 steps at least beside Dormand–Prince): across its faces' switches, as where
+they switch inside the steps, a step's error falls about as its length whatever its order, so
+a step costs what its stages cost. Over the genset's 58 halved intervals under its shock
+Verner's pair took 528 steps and had 431 rejected, 7 672 right-hand sides (46 % of the
+companion's); now Dormand–Prince 408 and 189 over the 55 where a joint's event crossed, 3 582,
+and Verner's pair 432 over the other 3 (an instrumented build). The estimate's cost went from
+1.64–1.70× to 1.50–1.56× (as shipped, `bench/bench_engine.py`, three rounds alternating with a
+tree of bad7234), the genset's real-time factor from 17.1–18.1× to 19.4–20.0×; the synthesised
+shock read 0.60–0.87 of its true force error at rtol 3e-3 … 2e-9 (attitude 0.62–0.88; seed 1
+0.84–1.04), the genset under its shock 0.76–0.98 (attitude 0.73–1.37), under the half-sine
+0.88–1.24 (2026-11-29). Elsewhere (a contact) it is of the companion's own method's steps:
+halved by Dormand–Prince too, rubber on snubbers of 1e10 N/m^1.5 at 1 kHz read 0.59 and 0.55 of
+its true force error at rtol 1e-4 and 1e-5 (0.88 and 0.91 so), as a contact "switching" read
+above. A carried interval over which the twin's event function changed sign is integrated from
+the carried state at the companion's fewest steps still: halved too it read the same and cost
+more.
 
 Right after a rejected step the companion grows no step (`integrate.settings` HOLD_AFTER_REJECT,
 the rule of Hairer, Nørsett & Wanner's DOPRI5 code): on the bolted genset under its shock the
@@ -220,7 +236,8 @@ def switching_method(twin: int) -> tuple[int, int]:
     """(method id, fewest steps per input interval) of the companion of a twin running the
     method `twin` (an id) over an interval where a bolted joint's faces switch inside the
     steps (an event holds that the companion is integrated over, and the twin's tolerance bound
-    its steps): the twin's own at MIN_STEPS (see the module docstring)."""
+    its steps), and at twice those steps over one in which an event function changes sign: the
+    twin's own at MIN_STEPS (see the module docstring)."""
     return twin, MIN_STEPS
 
 
@@ -230,8 +247,8 @@ class Companion(NamedTuple):
 
     method, settings, work2d, work1d, result: its stepper (`integrate.stepper.Stepper`).
     switching_method, switching_min_steps: the method (an id) and fewest steps it takes
-    instead, with the same arrays, over an interval where a joint's faces switch
-    (`switching_method`).
+    instead, with the same arrays, over an interval where a joint's faces switch, and at twice
+    those steps across an event's crossing (`switching_method`).
     y: (n_state,) its state; s: its scratch (its angles at the last sample: s.q[3:6]);
     y_prev, g, util: its mount monitors' arrays (its switches are taken with them); g_prev:
     g at a carried interval's start, while its end is monitored (the interval is integrated

@@ -210,14 +210,34 @@ enum Stepping : int {
   OWN = 0,    // its own method at its fewest steps
   SWITCHED,   // c.switching_method at least c.switching_min_steps steps
   HALVED,     // its own method at twice its fewest steps
+  SWITCHED_HALVED,  // c.switching_method at twice c.switching_min_steps steps
 };
+
+/// The highest treatment of the events whose function changed sign from g0 to g (the same
+/// shape as c.treatments; none: CARRIED_THROUGH).
+inline int crossed_treatment(const Companion& c, const Mat g0, const Mat g) {
+  double treatment = CARRIED_THROUGH;
+  for (idx i = 0; i < g.rows; ++i) {
+    for (idx e = 0; e < g.cols; ++e) {
+      if (crossed(g0(i, e), g(i, e))) treatment = py_max(treatment, c.treatments(i, e));
+    }
+  }
+  return static_cast<int>(treatment);
+}
+
+/// How the companion takes an interval across an event's crossing (`crossed_treatment`
+/// `crossing`): halved, by the switching method where a joint's faces switched, else by its own
+/// (engine/companion.py says why).
+inline Stepping halved(int crossing) {
+  return crossing == SWITCHING ? SWITCHED_HALVED : HALVED;
+}
 
 /// Advance the companion's stepper over [t0, t1] from y (in place) with error control, as
 /// `stepping` says (engine/companion.py says why: where a joint's faces switch between sticking
 /// and sliding inside the steps, a step costs what its stages cost, not what its order saves;
 /// where an event function changes sign inside the interval, a step across the switch misjudges
-/// its own error, and its error, shrinking with its length, then is the twin's own). Both
-/// methods are first-same-as-last: settings[CHAINED]'s stage holds for either.
+/// its own error, and its error, shrinking with its length, then is the twin's own: halved).
+/// Both methods are first-same-as-last: settings[CHAINED]'s stage holds for either.
 inline int companion_advance(const Model& m, Companion& c, Vec y, double t0, double t1, Vec u,
                              Stepping stepping) {
   const Integrator& g = c.integ;
@@ -229,13 +249,15 @@ inline int companion_advance(const Model& m, Companion& c, Vec y, double t0, dou
     case OWN:
       break;
     case SWITCHED:
-      if (c.switching_method != g.method) {
-        method = c.switching_method;
-        fewest = c.switching_min_steps;
-      }
+      method = c.switching_method;
+      fewest = c.switching_min_steps;
       break;
     case HALVED:
       fewest = 2.0 * min_steps;
+      break;
+    case SWITCHED_HALVED:
+      method = c.switching_method;
+      fewest = 2.0 * c.switching_min_steps;
       break;
     case CARRIED:  // a carried interval is not integrated: asked to, a caller's mistake, failed
       return UNKNOWN_METHOD;  // (`follow` resynchronises; the estimate counts the failure)
@@ -458,10 +480,11 @@ inline Stepping carry_interval(const Model& m, Companion& c, Vec u, double t0, d
       // read 2.3–3.2 times its true attitude error at rtol 1e-3 and looser carried across,
       // 0.95–0.99 so): taken again, integrated from its start (y_prev, which the monitors
       // read as the state before), its steps halved as over the twin's crossings
+      const Stepping stepping = halved(crossed_treatment(c, c.g_prev, c.g));
       copy(c.y_prev, c.y);
       copy(c.g_prev.flat(), c.g.flat());
       c.integ.settings[CHAINED] = 0.0;  // the check's stages are at the twin's state
-      return HALVED;
+      return stepping;
     }
     copy(c.y, c.y_prev);
   }
@@ -531,9 +554,12 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
     physics::MonitorRows mon{watch.y_prev, watch.g, watch.util};
     physics::outputs(y, m, s, out.pose.row(j), wrenches_j, m.has_nl ? &mon : nullptr);
     physics::linear_utilisation(m, s, wrenches_j, out.lin_util);
-    int watched = 0;
+    int watched = 0, crossing = CARRIED_THROUGH;
     if (m.has_nl) {
       const bool switched = settle_switches(mon.switched, y, watch.y_prev, settings);
+      if (companion != nullptr && !carried) {  // before the log moves g_prev on
+        crossing = crossed_treatment(*companion, watch.g_prev, watch.g);
+      }
       watched = log_crossings(switched, m.nl, watch, smp.t[j - 1], smp.t[j], wrenches_j);
     }
     if (estimator != nullptr) {
@@ -549,7 +575,7 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
         // an event function changed sign inside the interval: halved (a joint's faces opening
         // or slipping in the genset under a synthesised 30 g shock read 0.28 of the true error
         // at rtol 1e-5 across it by one step, by the switching method's two steps too)
-        stepping = HALVED;
+        stepping = halved(crossing);
       } else {
         // where the twin's tolerance bound its steps while an event holds that switches the
         // law inside the steps (a joint's faces between sticking and sliding): switched
