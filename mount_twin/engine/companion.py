@@ -29,7 +29,10 @@ Windermere's fan", *ibid.* §II.3), instead of integrated a second time:
   joint's stick point onto its friction bound, its bolt's plastic elongation onto its yield
   line, where the twin's is there or the companion's passes it): kicked, a sliding face's
   stick point, whose rate turns with e as μ·F_K/k_τ goes to 0, read the genset 18.6 and 1090
-  times its true error at rtol 1e-6 and 1e-8;
+  times its true error at rtol 1e-6 and 1e-8. The carry is taken in the pass of the outputs,
+  before each mount's load, from its deflection there and the twin's in the twin's own pass
+  (src/core/physics/dynamics.hpp `KindCarry`), where a pass of its own took both bodies'
+  motions and two local motions a joint again;
 - ℓₙ measured, not modelled: one step of the companion's stepper (below) from the twin's start
   state (its first stage the twin's, which the kick holds: one right-hand side less a check; 256
   Bouc–Wen mounts 1.20× against 1.22–1.24×, within an hour's noise) less the twin's end state,
@@ -258,7 +261,9 @@ class Companion(NamedTuple):
     error_rows: (N_ERROR_ROWS, n_state) the carried error's rows; carry: (N_CARRY_SLOTS,) its
     slots; treatments: (k, NE) how it takes an interval that starts with the event holding
     (in the twin's monitors or its own): the core's code of its kind's EVENT_COMPANION
-    (`kinds.COMPANION_TREATMENTS`).
+    (`kinds.COMPANION_TREATMENTS`); twin_d: (k, 3) the twin's mount deflections (m, their
+    axes) at the sample, from the twin's own pass over its mounts, where the kinds' carry reads
+    them.
     """
 
     method: int
@@ -279,6 +284,7 @@ class Companion(NamedTuple):
     error_rows: np.ndarray
     carry: np.ndarray
     treatments: np.ndarray
+    twin_d: np.ndarray
 
 
 def new_companion(
@@ -328,6 +334,7 @@ def new_companion(
         np.zeros((N_ERROR_ROWS, n)),
         _reset_carry(carry, own),
         np.array(treatments, dtype=float),
+        np.zeros((treatments.shape[0], 3)),
     )
 
 

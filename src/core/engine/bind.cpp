@@ -138,6 +138,7 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
                               engine::N_ERROR_ROWS, n_state);
   c.carry = convert::vec(field(obj, "carry"), "Companion.carry", engine::N_CARRY_SLOTS);
   c.treatments = convert::mat(field(obj, "treatments"), "Companion.treatments", k, n_events);
+  c.twin_d = convert::mat(field(obj, "twin_d"), "Companion.twin_d", k, 3);
   convert::check_scratch(c.s, n_state, "Companion.s");
   return c;
 }

@@ -72,6 +72,8 @@ struct Companion {
   Mat error_rows;  // (N_ERROR_ROWS, n): the carried error's work rows (ErrorRow)
   Vec carry;    // (N_CARRY_SLOTS,): CarrySlot
   Mat treatments;  // (k, NE): how an interval that starts with the event holding is taken
+  Mat twin_d;  // (k, 3) m: the twin's mount deflections at the sample, in their axes (the
+               // kinds' carry reads them: `carry_interval`)
 };
 
 /// Rows of Companion.error_rows (engine/companion.py ERROR_ROWS).
@@ -375,29 +377,6 @@ inline bool add_local_error(const Model& m, Companion& c, Vec u, double t0, doub
   return true;
 }
 
-/// The kinds' carry on each non-linear mount whose kind returns anything (`kind_carries`: a
-/// bolted joint's; 256 Bouc–Wen mounts took their two local motions an interval for nothing):
-/// their rate-independent states after the kick, the companion's state c.y, before the kick
-/// `trial`, the twin's y.
-inline void carry_kinds(const Model& m, Companion& c, Vec trial, Vec y) {
-  const NonLinear& nl = m.nl;
-  physics::Motion twin, own;
-  bool moved = false;  // the bodies' motions, taken at the first mount that needs them
-  physics::MountLocal at_twin, at_own;
-  for (idx i = 0; i < nl.k; ++i) {
-    if (!kinds::kind_carries(nl.kind[i])) continue;
-    if (!moved && !(physics::body_motion(y, m, c.s, twin) > 0.0 &&
-                    physics::body_motion(c.y, m, c.s, own) > 0.0)) {
-      return;
-    }
-    moved = true;
-    physics::local_motion(i, nl, twin, at_twin);
-    physics::local_motion(i, nl, own, at_own);
-    kinds::kind_carry(nl.kind[i], &nl.par(i, 0), c.y, trial, y, nl.state[i], at_own.d,
-                      at_twin.d);
-  }
-}
-
 /// Whether a kick over h s is in symplectic Euler's reach on every free coordinate k of the
 /// body: h²·|Δaₖ| within KICK_LIMIT²·|eₖ|, Δa the body's accelerations at the companion's state
 /// less the twin's (`rate` less `twin_rate` in rows nf.., nf the free coordinates), e its
@@ -462,12 +441,14 @@ inline Stepping carry_interval(const Model& m, Companion& c, Vec u, double t0, d
     return CARRIED;
   }
   for (idx i = 0; i < n; ++i) c.y[i] = y[i] + e[i];
-  if (m.has_nl) carry_kinds(m, c, trial, y);
-  // the monitors in the outputs' pass (c.y_prev the state before: at the interval's start)
+  // the kinds' carry and the monitors in the outputs' pass (c.y_prev the state before: at the
+  // interval's start; the twin's deflections from its own pass at y: c.twin_d)
   if (m.has_nl) copy(c.g.flat(), c.g_prev.flat());
   physics::MonitorRows mon{c.y_prev, c.g, c.util};
+  const physics::KindCarry kinds_carry{trial, y, c.twin_d};
   if (physics::rhs_with_wrenches(t1, c.y, m, c.s, u, rate, c.wrenches,
-                                 m.has_nl ? &mon : nullptr) != OK) {
+                                 m.has_nl ? &mon : nullptr,
+                                 m.has_nl ? &kinds_carry : nullptr) != OK) {
     if (m.has_nl) copy(c.g_prev.flat(), c.g.flat());  // as before the pass
     resynchronise(c, y);
     return CARRIED;
@@ -550,8 +531,10 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
     const idx stiffening = *watch.n_stiffening;
     for (int k = 0; k < 3; ++k) out.step_log(j, k) = integ.result[k];
     const M6 wrenches_j = out.wrenches.mat(j);
-    // the monitors in the outputs' pass over the mounts
+    // the monitors in the outputs' pass over the mounts (and, carried, the deflections the
+    // companion's carry reads)
     physics::MonitorRows mon{watch.y_prev, watch.g, watch.util};
+    if (carried) mon.d = companion->twin_d;
     physics::outputs(y, m, s, out.pose.row(j), wrenches_j, m.has_nl ? &mon : nullptr);
     physics::linear_utilisation(m, s, wrenches_j, out.lin_util);
     int watched = 0, crossing = CARRIED_THROUGH;

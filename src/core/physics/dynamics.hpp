@@ -208,16 +208,41 @@ struct MonitorRows {
   Mat g;
   Vec util;
   bool switched = false;
+  Mat d{};  // where given (k, 3): each mount's deflection (m, its axes) the pass took
 };
 
-/// Non-linear mount i's event functions and utilisation at its motion ml into mon, then its
-/// discrete switch (y's states may jump): `mount_monitors`' work on one mount.
+/// The kinds' carry of the error estimate's companion where a pass over the mounts for its
+/// wrenches takes it too (`rhs_with_wrenches`; kernel.hpp `carry_interval` says what each
+/// holds): each mount's rate-independent states returned by its kind's carry before its load,
+/// from its deflection in the pass and the twin's, twin_d (k, 3), as the twin's pass took them.
+/// A carry moves its own mount's states alone, so every load is the one after a carry of all.
+struct KindCarry {
+  Vec trial;   // the companion's state before the kick
+  Vec twin;    // the twin's state
+  Mat twin_d;  // (k, 3) m: the twin's mount deflections, in their axes
+};
+
+/// Non-linear mount i's event functions and utilisation at its motion ml into mon (and its
+/// deflection where mon.d is given), then its discrete switch (y's states may jump):
+/// `mount_monitors`' work on one mount.
 inline void monitor_mount(idx i, Vec y, const NonLinear& nl, const MountLocal& ml,
                           MonitorRows& mon) {
   const idx code = nl.kind[i], o = nl.state[i];
   const double* p = &nl.par(i, 0);
+  if (mon.d.rows > 0) {
+    for (int j = 0; j < 3; ++j) mon.d(i, j) = ml.d[j];
+  }
   mon.util[i] = kinds::kind_monitor(code, p, y, mon.y0, o, ml.d, ml.v, mon.g.row(i));
   if (kinds::kind_update(code, p, y, o, ml.d)) mon.switched = true;
+}
+
+/// Non-linear mount i's rate-independent states in y returned by its kind's carry (a kind
+/// that returns nothing skipped, `kind_carries`), at its deflection ml.d and the twin's.
+inline void carry_kind(idx i, const NonLinear& nl, Vec y, const MountLocal& ml,
+                       const KindCarry& carry) {
+  if (!kinds::kind_carries(nl.kind[i])) return;
+  kinds::kind_carry(nl.kind[i], &nl.par(i, 0), y, carry.trial, carry.twin, nl.state[i], ml.d,
+                    &carry.twin_d(i, 0));
 }
 
 /// Sum the mount loads on the body at the motion mo into s.total_force, s.total_moment (F,
@@ -225,10 +250,11 @@ inline void monitor_mount(idx i, Vec y, const NonLinear& nl, const MountLocal& m
 /// kWrenches, each non-linear mount's force and own couple in its axes into its row of
 /// *wrenches as well (`mount_wrenches`' rows, from the same loads), and where mon is given its
 /// monitors after its load (`monitor_mount`: a mount's switch moves its own states alone, after
-/// its load, so every load is the one a pass without the monitors takes).
+/// its load, so every load is the one a pass without the monitors takes), and where carry is
+/// given its kind's carry before its load (`carry_kind`).
 template <bool kWrenches>
 inline void mount_loads_into(Vec y, const Model& m, const Motion& mo, Scratch& s, Vec dydt,
-                             M6* wrenches, MonitorRows* mon) {
+                             M6* wrenches, MonitorRows* mon, const KindCarry* carry) {
   double total_f[3] = {0.0, 0.0, 0.0}, total_m[3] = {0.0, 0.0, 0.0};
   linear_loads(m, mo, total_f, total_m);
   if (m.lin_point.rows > 0) {  // their own couples, through their summed K_r, C_r
@@ -241,7 +267,12 @@ inline void mount_loads_into(Vec y, const Model& m, const Motion& mo, Scratch& s
     MountLocal ml;
     for (idx i = 0; i < nl.k; ++i) {
       double f[3], c[3] = {0.0, 0.0, 0.0};
-      nl_load(i, y, nl, mo, ml, dydt);
+      local_motion(i, nl, mo, ml);
+      if constexpr (kWrenches) {
+        if (carry != nullptr) carry_kind(i, nl, y, ml, *carry);
+      }
+      kinds::kind_load(nl.kind[i], &nl.par(i, 0), y, nl.state[i], ml.d, ml.v, ml.phi, ml.w, dydt,
+                       ml.f, ml.c);
       out_of_axes(nl, i, ml.f, f);
       if (nl.rotational[i]) nl_couple(i, nl, mo, ml, c);
       add_load(ml.arm, f, c, total_f, total_m);
@@ -259,7 +290,7 @@ inline void mount_loads_into(Vec y, const Model& m, const Motion& mo, Scratch& s
 
 /// `mount_loads_into` without the wrenches: the right-hand side's.
 inline void mount_loads(Vec y, const Model& m, const Motion& mo, Scratch& s, Vec dydt) {
-  mount_loads_into<false>(y, m, mo, s, dydt, nullptr, nullptr);
+  mount_loads_into<false>(y, m, mo, s, dydt, nullptr, nullptr, nullptr);
 }
 
 /// Each mount's force (N) and own couple (N·m) on the body, in its axes: wrenches row slot;
@@ -474,11 +505,11 @@ inline bool rotational(const Model& m, Scratch& s, double ct, Vec dydt, idx firs
 /// its rate and its outputs in one pass).
 template <bool kWrenches>
 inline int rhs_into(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt,
-                    M6* wrenches, MonitorRows* mon) {
+                    M6* wrenches, MonitorRows* mon, const KindCarry* carry) {
   Motion mo;
   const double ct = body_motion(y, m, s, mo);
   if (!(ct > 0.0)) return OFF_CHART;
-  mount_loads_into<kWrenches>(y, m, mo, s, dydt, wrenches, mon);
+  mount_loads_into<kWrenches>(y, m, mo, s, dydt, wrenches, mon, carry);
   if constexpr (kWrenches) linear_wrenches(m, mo, *wrenches);
   const idx nt = m.free_trans.n, nr = m.free_rot.n, nf = nt + nr;
   for (idx k = 0; k < nf; ++k) dydt[k] = y[nf + k];
@@ -494,16 +525,18 @@ inline int rhs_into(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt
 }
 
 inline int rhs(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt) {
-  return rhs_into<false>(t, y, m, s, u, dydt, nullptr, nullptr);
+  return rhs_into<false>(t, y, m, s, u, dydt, nullptr, nullptr, nullptr);
 }
 
 /// `rhs`, and each mount's force (N) and own couple (N·m) on the body in its axes into its
 /// wrenches row, as `mount_wrenches` gives them, in one pass over the mounts; where mon is
 /// given, their monitors in that pass too (taken where the body's motion is on the chart,
-/// even if the rotational rows then fail).
+/// even if the rotational rows then fail); where carry is given, each kind's carry before its
+/// mount's load (`KindCarry`: the error estimate's carried companion).
 inline int rhs_with_wrenches(double t, Vec y, const Model& m, Scratch& s, Vec u, Vec dydt,
-                             M6 wrenches, MonitorRows* mon = nullptr) {
-  return rhs_into<true>(t, y, m, s, u, dydt, &wrenches, mon);
+                             M6 wrenches, MonitorRows* mon = nullptr,
+                             const KindCarry* carry = nullptr) {
+  return rhs_into<true>(t, y, m, s, u, dydt, &wrenches, mon, carry);
 }
 
 /// Outputs when s already holds the body motion at y (the last rhs was at y): the pose row
