@@ -10,11 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 from io_helpers import default_scene
+from loop_helpers import step_one_interval
 
-from mount_twin.engine.driver import published_buffers
-from mount_twin.engine.kernel import Integrator, Loop, RunOptions, Samples, new_watch, run_samples
+from mount_twin.engine.kernel import new_watch
 from mount_twin.integrate.settings import CHAINED
-from mount_twin.integrate.stepper import new_stepper
 from mount_twin.kinds import N_EVENTS, bolted_joint
 from mount_twin.model.assemble import assemble, initial_state
 from mount_twin.physics.dynamics import INPUT_SIZE, OK, rhs, rhs_after_rate_step
@@ -89,24 +88,8 @@ def test_a_bolt_breaking_between_samples_ends_the_chain() -> None:
         if broken:
             y[foot] = nl.par[0, bolted_joint.EPU]  # at its ultimate plastic elongation
         state = y.copy()
-        settings = _loop_over_one_interval(model, state, g)
+        watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
+        watch.y_prev[:] = state
+        settings = step_one_interval(model, state, g, watch, chain=True).settings
         assert state[foot + 3] == (1.0 if broken else 0.0)
         assert settings[CHAINED] == (0.0 if broken else 1.0)
-
-
-def _loop_over_one_interval(model, state: np.ndarray, g: np.ndarray) -> np.ndarray:
-    """The twin's settings after `run_samples` stepped `state` (in place) over one 0.1 ms
-    interval at rest under gravity g (m/s², F), chained: Dormand–Prince leaves its last stage
-    there (the chain flag set) unless a mount switched at the sample."""
-    twin = new_stepper("dopri54", model.n_state, 1e-6, 1e-9, 100)
-    integ = Integrator(twin.method, twin.settings, twin.work2d, twin.work1d, twin.result)
-    s, u = model.new_scratch(), np.zeros(INPUT_SIZE)
-    watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
-    watch.y_prev[:] = state
-    opts = RunOptions(zero_order=False, decimation=1, chain=True)
-    loop = Loop(integ, model.arrays, s, u, state, opts, watch, None)
-    samples = Samples(np.array([0.0, 1e-4]), np.tile(g, (2, 1)), np.zeros((2, 3)))
-    nm = model.n_mounts
-    out = published_buffers(2, np.zeros(1, np.int64), np.zeros((nm, 6)), np.zeros(0))
-    assert run_samples(loop, samples, out) == (1, 0)
-    return twin.settings

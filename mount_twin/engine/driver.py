@@ -97,6 +97,17 @@ def published_buffers(
     )
 
 
+def event_table(model: Model, name: str, code: Callable[[Any], float] = float) -> np.ndarray:
+    """(non-linear mounts, N_EVENTS), in the core's order: each mount's kind's event table
+    `name`, each entry as `code` gives it (a flag: 1.0 where true; 0 past its kind's events)."""
+    slots = model.nonlinear_slots
+    table = np.zeros((len(slots), N_EVENTS))
+    for i, slot in enumerate(slots):
+        kind = KINDS[model.scene.mounts[slot].kind]
+        table[i, : len(kind.EVENTS)] = [code(v) for v in getattr(kind, name)]
+    return table
+
+
 def _new_estimator(model: Model, treatments: np.ndarray) -> Estimator | Companion | None:
     """The live error estimate's arrays (`engine.estimator` where the mounts are linear,
     `engine.companion` where some are not: see there), or None if the scene turns it off.
@@ -183,7 +194,7 @@ class CoreDriver:
             len(model.nonlinear_slots),
             N_EVENTS,
             model.n_state,
-            self._event_table("EVENT_STIFFENS"),
+            event_table(model, "EVENT_STIFFENS"),
         )
         self.events: list[MountEvent] = []
         """Every mount event so far, in time order (the first MAX_EVENTS; the rest counted)."""
@@ -206,7 +217,7 @@ class CoreDriver:
             scene.outputs.decimation,
             scene.input.hold == "first_order",
         )
-        treatments = self._event_table("EVENT_COMPANION", COMPANION_TREATMENTS.__getitem__)
+        treatments = event_table(model, "EVENT_COMPANION", COMPANION_TREATMENTS.__getitem__)
         self.estimator = _new_estimator(model, treatments)
         self._loop: tuple[tuple[object, ...], Loop] | None = None
         """The arrays bound last, and their `Loop` (`_bound`)."""
@@ -394,14 +405,6 @@ class CoreDriver:
             self.estimator = estimator.switch(self.estimator, self.stepper.method)
         elif self.estimator is not None:
             self.estimator = companion.switch(self.estimator, self.stepper.method)
-
-    def _event_table(self, name: str, code: Callable[[Any], float] = float) -> np.ndarray:
-        """(non-linear mounts, N_EVENTS): each mount's kind's event table `name`, each entry as
-        `code` gives it (a flag: 1.0 where true; 0 past its kind's events)."""
-        table = np.zeros((len(self._event_meta), N_EVENTS))
-        for i, (_, kind) in enumerate(self._event_meta.values()):
-            table[i, : len(kind.EVENTS)] = [code(v) for v in getattr(kind, name)]
-        return table
 
     def stiffens(self, event: MountEvent) -> bool:
         """Whether a mount event may stiffen the scene (its kind's EVENT_STIFFENS)."""

@@ -1,0 +1,49 @@
+"""One input interval through the compiled loop itself (`engine.kernel.run_samples`), for tests
+that check what the loop does at a sample, not what the driver around it does."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mount_twin.engine.companion import Companion
+from mount_twin.engine.driver import published_buffers
+from mount_twin.engine.kernel import Integrator, Loop, RunOptions, Samples, Watch, run_samples
+from mount_twin.integrate.stepper import Stepper, new_stepper
+from mount_twin.model.assemble import Model
+from mount_twin.physics.dynamics import INPUT_SIZE
+
+INTERVAL_S = 1e-4
+"""The interval stepped: one sample at 10 kHz."""
+
+
+def step_one_interval(
+    model: Model,
+    state: np.ndarray,
+    g: np.ndarray,
+    watch: Watch,
+    *,
+    chain: bool,
+    estimate: Companion | None = None,
+) -> Stepper:
+    """The twin's Dormand–Prince stepper (rtol 1e-6, atol 1e-9) after `run_samples` stepped
+    `state` (in place) over one INTERVAL_S interval under the constant specific force g (m/s²,
+    F) and no rotation of the foundation, with `watch` and the error estimate `estimate`
+    (None: off); `chain`: the first stage chained from the sample's rate step."""
+    twin = new_stepper("dopri54", model.n_state, 1e-6, 1e-9, 100)
+    integ = Integrator(twin.method, twin.settings, twin.work2d, twin.work1d, twin.result)
+    opts = RunOptions(zero_order=False, decimation=1, chain=chain)
+    loop = Loop(
+        integ,
+        model.arrays,
+        model.new_scratch(),
+        np.zeros(INPUT_SIZE),
+        state,
+        opts,
+        watch,
+        estimate,
+    )
+    samples = Samples(np.array([0.0, INTERVAL_S]), np.tile(g, (2, 1)), np.zeros((2, 3)))
+    nm = model.n_mounts
+    out = published_buffers(2, np.zeros(1, np.int64), np.zeros((nm, 6)), np.zeros(0))
+    assert run_samples(loop, samples, out) == (1, 0)
+    return twin
