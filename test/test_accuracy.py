@@ -304,3 +304,20 @@ def test_the_table_heads_each_column_with_its_unit() -> None:
         end = head.index(name) + len(name)  # columns are right-aligned
         assert units[:end].endswith(unit), (name, units)
         assert figures[:end].endswith(figure), (name, figures)
+
+
+def test_a_run_whose_stepper_fails_is_compared_where_it_answered_its_failures_counted() -> None:
+    """At one substep per sample and rtol 1e-9 the stepper fails into the samples of the shock,
+    each failure leaving that sample unanswered (the twin restarts at the next): the figures
+    are the errors over the samples the run answered, against the independent solution there,
+    and the failures are counted, not a refusal of the whole comparison."""
+    scene, samples = _case()
+    truth = _truth(samples)
+    ref = reference_run(scene, samples, 100_000)
+    run = run_at(scene, samples, 1e-9, 1)
+    answered = np.isin(samples.stamps, run.out.stamps)
+    assert run.failures > 0 and 0 < answered.sum() < len(samples)
+    got = compare(run, ref, 0.3)
+    true = np.abs(run.out.position[:, 2] - truth[answered]).max()
+    assert got.failures == run.failures
+    assert 0.9 < got.position_error_m / true < 1.1, (got.position_error_m, true)
