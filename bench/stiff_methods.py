@@ -7,7 +7,10 @@ real-time factor without the error estimate, and the substeps per sample. The sc
 
 - `stiff_light`: 10 kg on 4 × 1e9 N/m (modes of 2–6 kHz) under 1 kHz ship motion, `--seconds`
   of it (linear mounts: `auto` takes the exponential method);
-- `stiff_snubbed`: the same with a fifth, soft mount on a snubber (not smooth: `ros34pw2`);
+- `stiff_snubbed`: the same with a fifth, soft mount on a snubber (a law with pieces:
+  `ros34pw2`), 0.1 s;
+- `stiff_hysteretic`: the same with a soft Bouc–Wen elastomer instead (no pieces: `exprb32`),
+  0.3 s;
 - `key`: 5 kg on soft mounts beside a 1e9 N/m shear key 0.5 mm off, pushed into it by a 3 g
   half-sine at 1 kHz (ρ·Δt 17.3 bearing: `ros34pw2` from the start);
 - `snubber`: the same beside a 1e9 N/m snubber (`auto` goes to `ros34pw2` at its contact).
@@ -31,6 +34,7 @@ from test_error_estimate import (
     _soft_beside_a_snubber,
     _soft_beside_a_stiff_key,
     _stiff_light,
+    _stiff_with_a_hysteretic_mount,
     _stiff_with_a_snubbed_mount,
 )
 
@@ -42,6 +46,7 @@ from mount_twin.scene.description import Scene
 CASES: dict[str, Callable[[float], tuple[Scene, SampleBatch]]] = {
     "stiff_light": lambda seconds: _ship_motion(_stiff_light()[0], seconds),
     "stiff_snubbed": lambda _: _stiff_with_a_snubbed_mount(),
+    "stiff_hysteretic": lambda _: _stiff_with_a_hysteretic_mount(),
     "key": lambda _: _soft_beside_a_stiff_key(),
     "snubber": lambda _: _soft_beside_a_snubber(),
 }

@@ -1,19 +1,45 @@
 """One input interval through the compiled loop itself (`engine.kernel.run_samples`), for tests
-that check what the loop does at a sample, not what the driver around it does."""
+that check what the loop does at a sample, not what the driver around it does; and the error
+estimate's companion as those tests build it."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from mount_twin.engine.companion import Companion
+from mount_twin.engine.companion import Companion, new_companion
 from mount_twin.engine.driver import published_buffers
 from mount_twin.engine.kernel import Integrator, Loop, RunOptions, Samples, Watch, run_samples
 from mount_twin.integrate.stepper import Stepper, new_stepper
+from mount_twin.kinds import N_EVENTS
 from mount_twin.model.assemble import Model
 from mount_twin.physics.dynamics import INPUT_SIZE
 
 INTERVAL_S = 1e-4
 """The interval stepped: one sample at 10 kHz."""
+
+
+def companion_of(
+    model: Model,
+    method: str,
+    kick_rate: float = 1.0,
+    treatments: np.ndarray | None = None,
+) -> Companion:
+    """A companion of `model`'s twin by `method` at rtol 1e-6, atol 1e-9, 100 substeps, with
+    the body's fastest tangent mode `kick_rate` (rad/s) and the event `treatments` (non-linear
+    mounts, N_EVENTS; default all 0)."""
+    k = len(model.nonlinear_slots)
+    return new_companion(
+        method,
+        model.n_state,
+        1e-6,
+        1e-9,
+        100,
+        model.new_scratch(),
+        model.n_mounts,
+        np.zeros((k, N_EVENTS)) if treatments is None else treatments,
+        kick_rate,
+        piecewise=model.piecewise,
+    )
 
 
 def step_one_interval(

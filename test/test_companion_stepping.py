@@ -9,10 +9,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from loop_helpers import step_one_interval
+from loop_helpers import companion_of, step_one_interval
 
 from mount_twin.engine import companion
-from mount_twin.engine.companion import Companion, new_companion
+from mount_twin.engine.companion import Companion
 from mount_twin.engine.driver import event_table
 from mount_twin.engine.kernel import new_watch
 from mount_twin.integrate.methods import METHODS
@@ -41,17 +41,7 @@ def _one_interval_crossing(model: Model, crossed: tuple[int, int]) -> Companion:
     y = initial_state(model, g)
     n = model.n_state
     treatments = event_table(model, "EVENT_COMPANION", COMPANION_TREATMENTS.__getitem__)
-    comp = new_companion(
-        "dopri54",
-        n,
-        1e-6,
-        1e-9,
-        100,
-        model.new_scratch(),
-        model.n_mounts,
-        treatments,
-        model.tangent_rate,
-    )
+    comp = companion_of(model, "dopri54", model.tangent_rate, treatments)
     companion.restart(comp, y)
     slip = bolted_joint.EVENTS.index("joint_slipped")
     comp.g[_first(model, "bolted_joint"), slip] = 0.0

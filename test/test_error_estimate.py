@@ -19,6 +19,7 @@ import pytest
 import scipy.linalg
 from io_helpers import CONFIG, DATA_DIR, ROOT, default_scene, split
 from kinds_helpers import kind_mount
+from loop_helpers import companion_of
 from physics_helpers import base_scene, mount
 
 from mount_twin import _core
@@ -52,11 +53,17 @@ from mount_twin.engine.estimator import (
     new_estimator,
 )
 from mount_twin.engine.health_texts import INTEGRATION
-from mount_twin.integrate.methods import DOPRI54, METHODS, ROS34PW2, VERNER65, choose
+from mount_twin.integrate.methods import (
+    DOPRI54,
+    EXPRB32,
+    METHODS,
+    ROS34PW2,
+    VERNER65,
+    choose,
+)
 from mount_twin.integrate.settings import HOLD_AFTER_REJECT, MAX_SUBSTEPS, MIN_STEPS
 from mount_twin.integrate.stepper import new_stepper
 from mount_twin.io.input_samples import read_samples
-from mount_twin.kinds import N_EVENTS
 from mount_twin.model import assemble as assemble_module
 from mount_twin.model.assemble import Model, assemble
 from mount_twin.replay import replay
@@ -225,6 +232,50 @@ def _on_verner65(build: Callable[[], tuple[Scene, SampleBatch]]) -> tuple[Scene,
     return dataclasses.replace(scene, integration=integration), samples
 
 
+def _stiff_beside(
+    soft: dict, method: str = "auto", seconds: float = 0.1
+) -> tuple[Scene, SampleBatch]:
+    """The stiff scene (`_stiff_light`) with a fifth, soft elastomer mount at the CG's foot
+    (1e4 N/m: ρ·Δt stays the yaw mode's), its other keys `soft`, integrated by `method` under
+    `seconds` of the ship motion."""
+    data = base_scene(
+        10.0,
+        [0.0, 0.0, 0.1],
+        [1.0] * 3 + [0.0] * 3,
+        [
+            *(
+                mount(f"m{i}", (x, y, 0.0), (1e9,) * 3 + (0,) * 3, (2e3,) * 3 + (0,) * 3)
+                for i, (x, y) in enumerate(CORNERS)
+            ),
+            kind_mount(
+                "elastomer",
+                "soft",
+                (0.0, 0.0, 0.0),
+                stiffness_linear=[1e4, 1e4, 1e4],
+                damping=[10.0, 10.0, 10.0],
+                **soft,
+            ),
+        ],
+    )
+    data["integration"]["method"] = method
+    return _ship_motion(_with_pump_input(data), seconds)
+
+
+def _stiff_with_a_snubbed_mount() -> tuple[Scene, SampleBatch]:
+    """The stiff scene with a soft elastomer on a snubber beside it: as stiff, its laws with
+    pieces (the snubber's contact, though it never touches)."""
+    return _stiff_beside(
+        {"snubber": {"gap": 3e-3, "stiffness": 1e8, "exponent": 1.5, "axes": ["z"]}}
+    )
+
+
+def _stiff_with_a_hysteretic_mount(method: str = "auto") -> tuple[Scene, SampleBatch]:
+    """The stiff scene with a soft Bouc–Wen elastomer beside it: as stiff, non-linear, and no
+    law with pieces."""
+    hysteresis = {"ratio": 0.6, "beta": 120.0, "gamma": 80.0}
+    return _stiff_beside({"hysteresis": hysteresis}, method, 0.3)
+
+
 def _genset(bag: str = "genset_shock_10khz") -> tuple[Scene, SampleBatch]:
     """The bundled genset under a bundled 10 kHz bag (its shock, by default), as shipped."""
     scene = load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml")
@@ -235,6 +286,10 @@ CASES = {
     "stiff_light": (_stiff_light, [1e-3, 1e-6, 1e-7]),
     "stiff_light_rosenbrock": (partial(_stiff_light, "ros34pw2"), [1e-3, 1e-6, 1e-9]),
     "stiff_light_exponential": (partial(_stiff_light, "exprb32"), [1e-3]),
+    "stiff_hysteretic_rosenbrock": (
+        partial(_stiff_with_a_hysteretic_mount, "ros34pw2"),
+        [1e-3, 1e-6, 1e-9],
+    ),
     "rubber_on_snubbers": (_rubber_on_snubbers, [1e-3, 1e-6]),
     "rubber_on_snubbers_verner65": (partial(_on_verner65, _rubber_on_snubbers), [1e-3, 1e-6]),
     "hysteresis_snubbers_real_shock": (_hysteresis_snubbers_real_shock, [1e-3, 1e-6]),
@@ -460,10 +515,8 @@ def test_only_the_companion_holds_its_step_after_a_rejection() -> None:
     rejected again), a method switch included; the twin's stepper does not hold, so what it
     publishes is the plain controller's (bench/core_parity.py: bit for bit)."""
     model = assemble(load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml"))
-    n, scratch = model.n_state, model.new_scratch()
-    comp = new_companion(
-        "auto", n, 1e-6, 1e-9, 100, scratch, model.n_mounts, np.zeros((8, N_EVENTS)), 1.0
-    )
+    n = model.n_state
+    comp = companion_of(model, "auto")
     assert comp.settings[HOLD_AFTER_REJECT] == 1.0
     assert companion.switch(comp, METHODS["exprb32"].id).settings[HOLD_AFTER_REJECT] == 1.0
     assert new_stepper("auto", n, 1e-6, 1e-9, 100).settings[HOLD_AFTER_REJECT] == 0.0
@@ -480,15 +533,11 @@ def test_the_companion_of_dormand_prince_is_one_step_of_verner_and_switches_with
     least, and back. Its work arrays, made for auto, hold every method; its step limit stays
     the twin's per step of its fewest."""
     model = assemble(load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml"))
-    n, scratch = model.n_state, model.new_scratch()
-    own = new_companion(
-        "dopri54", n, 1e-6, 1e-9, 100, scratch, model.n_mounts, np.zeros((8, N_EVENTS)), 1.0
-    )
+    n = model.n_state
+    own = companion_of(model, "dopri54")
     assert (own.method, own.settings[MIN_STEPS], own.settings[MAX_SUBSTEPS]) == (VERNER65, 1, 100)
     assert (own.switching_method, own.switching_min_steps) == (DOPRI54, 2)
-    comp = new_companion(
-        "auto", n, 1e-6, 1e-9, 100, scratch, model.n_mounts, np.zeros((8, N_EVENTS)), 1.0
-    )
+    comp = companion_of(model, "auto")
     assert (comp.method, comp.settings[MIN_STEPS]) == (VERNER65, 1.0)
     for twin, method, fewest in ((ROS34PW2, ROS34PW2, 2), (DOPRI54, VERNER65, 1)):
         comp = companion.switch(comp, twin)
@@ -496,11 +545,38 @@ def test_the_companion_of_dormand_prince_is_one_step_of_verner_and_switches_with
         assert (comp.switching_method, comp.switching_min_steps) == (twin, 2)
         assert comp.settings[MAX_SUBSTEPS] == 100 * fewest
     assert comp.work2d.shape[0] >= max(m.work_rows(n) for m in METHODS.values())
-    ros = new_companion(
-        "ros34pw2", n, 1e-6, 1e-9, 100, scratch, model.n_mounts, np.zeros((8, N_EVENTS)), 1.0
-    )
+    ros = companion_of(model, "ros34pw2")
     assert (ros.method, ros.settings[MIN_STEPS]) == (ROS34PW2, 2.0)
     assert (ros.switching_method, ros.switching_min_steps) == (ROS34PW2, 2)
+
+
+def test_the_companion_of_a_rosenbrock_twin_without_pieces_is_exact_on_the_linear_part() -> None:
+    """Where no mount's law has pieces (`Model.piecewise`: contacts, joints' faces) the
+    companion of a ros34pw2 twin is exprb32 at one step an interval (EXACT_ON_LINEAR), also
+    where `auto` moves the twin there (it does not on such a scene: it takes exprb32 itself),
+    and dopri54's is still Verner's pair; with pieces, ros34pw2 at two steps (above)."""
+    model = assemble(_stiff_with_a_hysteretic_mount()[0])
+    assert not model.piecewise
+    ros = companion_of(model, "ros34pw2")
+    assert (ros.method, ros.settings[MIN_STEPS]) == (EXPRB32, 1.0)
+    assert (ros.switching_method, ros.switching_min_steps) == (EXPRB32, 1)
+    comp = companion_of(model, "auto")
+    assert comp.method == VERNER65
+    comp = companion.switch(comp, ROS34PW2)
+    assert (comp.method, comp.settings[MIN_STEPS], comp.switching_method) == (EXPRB32, 1, EXPRB32)
+
+
+def test_a_law_has_pieces_where_a_contact_or_a_joint_can_switch_it() -> None:
+    """`Model.piecewise`: linear mounts, a Bouc–Wen elastomer and one on a force table (PCHIP,
+    its slope continuous) have none; an elastomer's snubber (touching or not), a shear key, a
+    bolted joint have."""
+    assert not assemble(_pump()[0]).piecewise
+    assert not assemble(_stiff_with_a_hysteretic_mount()[0]).piecewise
+    table = {"z": {"deflection": [-1e-3, 0.0, 1e-3], "force": [-20.0, 0.0, 10.0]}}
+    assert not assemble(_stiff_beside({"force_table": table})[0]).piecewise
+    assert assemble(_stiff_with_a_snubbed_mount()[0]).piecewise
+    assert assemble(_soft_beside_a_stiff_key()[0]).piecewise
+    assert assemble(load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml")).piecewise
 
 
 def _companion_per_interval(
@@ -512,8 +588,8 @@ def _companion_per_interval(
     the samples the gyro delay held as one batch, is not counted."""
     made: list[companion.Companion] = []
 
-    def keep(*args):
-        made.append(new_companion(*args))
+    def keep(*args, **kwargs):
+        made.append(new_companion(*args, **kwargs))
         return made[-1]
 
     rows: list[tuple[float, bool, float]] = []
@@ -623,8 +699,8 @@ def test_the_carried_companion_lies_on_the_references_side_of_the_twin(
     mirror over an interval half cancelled (docs/benchmarks.md)."""
     made: list[companion.Companion] = []
 
-    def keep(*args):
-        made.append(new_companion(*args))
+    def keep(*args, **kwargs):
+        made.append(new_companion(*args, **kwargs))
         return made[-1]
 
     monkeypatch.setattr(driver_module, "new_companion", keep)
@@ -642,13 +718,13 @@ def test_a_restart_zeroes_the_carried_error_and_measures_the_local_error_afresh(
     tangent rate is known (never without one, nor beside a linearising twin), no local error
     measured yet (the first interval measures one)."""
     model = assemble(load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml"))
-    n, scratch, g = model.n_state, model.new_scratch(), np.zeros((8, N_EVENTS))
+    n = model.n_state
     for method, rate, carrying in (
         ("dopri54", 3e3, 1.0),
         ("dopri54", 0.0, 0.0),
         ("ros34pw2", 3e3, 0.0),
     ):
-        comp = new_companion(method, n, 1e-6, 1e-9, 100, scratch, model.n_mounts, g, rate)
+        comp = companion_of(model, method, rate)
         comp.carry[:] = 7.0
         comp.carry[companion.KICK_RATE] = rate
         y = np.linspace(0.0, 1.0, n)
@@ -682,37 +758,13 @@ def test_on_a_stiff_scene_the_linearising_methods_are_stable_where_explicit_ones
         assert 1 / FACTOR < acc.est_force_error / acc.force_error < FACTOR, acc
 
 
-def _stiff_with_a_snubbed_mount() -> tuple[Scene, SampleBatch]:
-    """The stiff scene with a fifth, soft elastomer mount on a snubber: as stiff, not smooth."""
-    data = base_scene(
-        10.0,
-        [0.0, 0.0, 0.1],
-        [1.0] * 3 + [0.0] * 3,
-        [
-            *(
-                mount(f"m{i}", (x, y, 0.0), (1e9,) * 3 + (0,) * 3, (2e3,) * 3 + (0,) * 3)
-                for i, (x, y) in enumerate(CORNERS)
-            ),
-            kind_mount(
-                "elastomer",
-                "soft",
-                (0.0, 0.0, 0.0),
-                stiffness_linear=[1e4, 1e4, 1e4],
-                damping=[10.0, 10.0, 10.0],
-                snubber={"gap": 3e-3, "stiffness": 1e8, "exponent": 1.5, "axes": ["z"]},
-            ),
-        ],
-    )
-    data["integration"]["method"] = "auto"
-    return _ship_motion(_with_pump_input(data), 0.1)
-
-
 def test_auto_takes_a_linearising_method_where_the_explicit_one_would_be_stability_bound() -> None:
     """ρ of 10 kg on 4 × 1e9 N/m at (±0.4, ±0.3) m is its yaw mode, √(4k(a² + b²)/I_zz) =
     31 623 rad/s (the mounts' plane holds no coupling to it): ρ·Δt = 31.6 at 1 kHz, past
     STIFF_RHO_DT. Its mounts are linear: the exponential method; with a snubbed elastomer
-    beside them (a switch in the right-hand side), the L-stable Rosenbrock. The bundled pump
-    (modes below 20 Hz) stays explicit."""
+    beside them (a law with pieces in the right-hand side), the L-stable Rosenbrock; with a
+    Bouc–Wen elastomer beside them (non-linear, no pieces), the exponential method again. The
+    bundled pump (modes below 20 Hz) stays explicit."""
     scene, samples = _stiff_light("auto")
     _, status = _integration_status(scene, samples)
     yaw = math.sqrt(4 * 1e9 * (0.4**2 + 0.3**2) / 1.0) * 1e-3
@@ -720,6 +772,9 @@ def test_auto_takes_a_linearising_method_where_the_explicit_one_would_be_stabili
     scene, samples = _stiff_with_a_snubbed_mount()
     _, status = _integration_status(scene, samples)
     assert status.values["method"].startswith("ros34pw2 (auto: ρ·Δt = 31.")
+    scene, samples = _stiff_with_a_hysteretic_mount()
+    _, status = _integration_status(scene, samples)
+    assert status.values["method"].startswith("exprb32 (auto: ρ·Δt = 31.")
     scene, samples = _pump()
     _, status = _integration_status(scene, samples)
     assert status.values["method"].startswith("dopri54 (auto: ρ·Δt = 0.1")

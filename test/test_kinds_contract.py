@@ -296,6 +296,7 @@ def fake_kind(name: str = "end_stop") -> ModuleType:
     module.settle = lambda p, y, o, d: None
     module.carry = lambda p, y, y0, yt, o, d, dt: None
     module.nominal_tangent = lambda m: ((1.0e6,) * 3 + (0.0,) * 3, ("stiffness",) * 6)
+    module.piecewise = lambda m: True
     return module
 
 
@@ -325,7 +326,7 @@ def test_crossed_branches_are_refused() -> None:
         check_dispatch(crossed)
 
 
-@pytest.mark.parametrize("name", ["update", "settle", "carry", "nominal_tangent"])
+@pytest.mark.parametrize("name", ["update", "settle", "carry", "nominal_tangent", "piecewise"])
 def test_a_module_lacking_part_of_the_contract_is_refused(name: str) -> None:
     """check_modules (run at import) names what a kind module lacks, and a KIND mismatch: a
     kind without its own nominal tangent cannot be taken for another (statics asks each)."""

@@ -129,6 +129,7 @@ def _new_estimator(model: Model, treatments: np.ndarray) -> Estimator | Companio
             model.n_mounts,
             treatments,
             model.tangent_rate,
+            piecewise=model.piecewise,
         )
     return sampled_estimator(model)
 

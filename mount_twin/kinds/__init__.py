@@ -2,22 +2,23 @@
 checks (`read`: every key read, then `Reader.finish`, then the checks across keys, so that a
 misspelt key is named rather than the check it makes fail), its parameter row (`pack`; its
 columns of stiffnesses acting only past a clearance or gap, `CONTACT_STIFFNESS`, which the
-start's equilibrium softens and restores where it is not found at once),
-internal states (and which of them a restart resets: `RESTUCK`), force law (`load`), event
-functions (`monitor`), discrete switches between samples (`update`, which says whether it
-switched: the state then jumped, and a stepper must not start from a stage it took before;
-`EVENT_SWITCHES` names the events that are such a switch, which a start reports too, and
-none of which may stiffen the scene: `auto` looks again at none a start makes;
-`EVENT_COMPANION` how the error estimate's companion takes an interval that starts with each
-holding, one of COMPANION_TREATMENTS, `engine.companion`), a start's
-internal states made admissible at its pose (`settle`, run once a start's pose is found by
-`model.assemble.initial_state`: a face that slid put on its friction bound), the error
-estimate's companion after its carried error's kick (`carry`: its rate-independent states, a
-face's stick point, carried and returned onto its bound, `engine.companion`) and its
-stiffness at the unstressed pose (`nominal_tangent`: statics, modes and `auto`'s first choice
-read it). A module's `load`, `monitor`, `update` and `carry` are plain Python: the reference
-the compiled core's port of the kind (src/core/kinds/<kind>.hpp) is held to; `settle` runs
-only in Python, at starts.
+start's equilibrium softens and restores where it is not found at once), internal states (and
+which of them a restart resets: `RESTUCK`), force law (`load`), event functions (`monitor`),
+discrete switches between samples (`update`, which says whether it switched: the state then
+jumped, and a stepper must not start from a stage it took before; `EVENT_SWITCHES` names the
+events that are such a switch, which a start reports too, and none of which may stiffen the
+scene: `auto` looks again at none a start makes; `EVENT_COMPANION` how the error estimate's
+companion takes an interval that starts with each holding, one of COMPANION_TREATMENTS,
+`engine.companion`), a start's internal states made admissible at its pose (`settle`, run once
+a start's pose is found by `model.assemble.initial_state`: a face that slid put on its friction
+bound), the error estimate's companion after its carried error's kick (`carry`: its
+rate-independent states, a face's stick point, carried and returned onto its bound,
+`engine.companion`) and its stiffness at the unstressed pose (`nominal_tangent`: statics, modes
+and `auto`'s first choice read it), and whether a mount's law has pieces its motion moves
+between (`piecewise`: a contact, a joint's faces; `auto` and the error estimate's companion
+take the exponential method only for scenes with none). A module's `load`, `monitor`, `update`
+and `carry` are plain Python: the reference the compiled core's port of the kind
+(src/core/kinds/<kind>.hpp) is held to; `settle` runs only in Python, at starts.
 
 The core's dispatchers (`kind_load`, `kind_monitor`, `kind_update`, `kind_carry` below) select
 a kind by its
@@ -85,6 +86,7 @@ MODULE_NAMES = (
     "settle",
     "carry",
     "nominal_tangent",
+    "piecewise",
 )
 """What a kind module defines (see the module docstring of any kind)."""
 COMPANION_TREATMENTS: dict[str, int] = _core.TREATMENTS

@@ -190,6 +190,12 @@ def pack(j: BoltedJoint) -> np.ndarray:
     return row
 
 
+def piecewise(j: BoltedJoint) -> bool:
+    """Whether the mount's force law has pieces its motion moves between (`Model.piecewise`):
+    a joint's does, its faces sticking, slipping and opening."""
+    return True
+
+
 def nominal_tangent(j: BoltedJoint) -> tuple[tuple[float, ...], tuple[str, ...]]:
     """Stiffness at the unstressed pose, (kx, ky, kz) N/m then (krx, kry, krz) N·m/rad (none: a
     joint has no rotational law), and the scene key each value comes from: the stuck face's

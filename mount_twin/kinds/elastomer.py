@@ -224,6 +224,13 @@ def _snubber(sn: Reader) -> Snubber:
     return snub
 
 
+def piecewise(e: Elastomer) -> bool:
+    """Whether the mount's force law has pieces its motion moves between (`Model.piecewise`):
+    a snubber's contact. A force table's PCHIP interpolant has a continuous slope, and Bouc–Wen
+    hysteresis turns its state with the motion, its force continuous: no pieces."""
+    return e.snubber is not None and bool(e.snubber.axes)
+
+
 def nominal_tangent(e: Elastomer) -> tuple[tuple[float, ...], tuple[str, ...]]:
     """Stiffness at the unstressed pose, (kx, ky, kz) N/m then (krx, kry, krz) N·m/rad, and the
     scene key each value comes from: the hysteretic spring at z = 0 (α·k₀ + (1 − α)·k₀·A), or

@@ -94,6 +94,12 @@ def pack(k: ShearKey) -> np.ndarray:
     )
 
 
+def piecewise(k: ShearKey) -> bool:
+    """Whether the mount's force law has pieces its motion moves between (`Model.piecewise`):
+    a key's does, open within its clearance and bearing past it."""
+    return True
+
+
 def nominal_tangent(k: ShearKey) -> tuple[tuple[float, ...], tuple[str, ...]]:
     """Stiffness at the unstressed pose, (kx, ky, kz) N/m then (krx, kry, krz) N·m/rad (none: a
     key has no rotational law), and the scene key each value comes from: its bearing stiffness

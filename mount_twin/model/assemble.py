@@ -75,6 +75,16 @@ class Model:
         return new_scratch(self.n_state)
 
     @cached_property
+    def piecewise(self) -> bool:
+        """Whether some mount's force law has pieces its motion moves between (its kind's
+        `piecewise`: a contact, a joint's faces; linear mounts have none). `auto` takes the
+        exponential method for a stiff scene only where none has, and the error estimate's
+        companion beside a Rosenbrock twin too (`engine.companion.own_method`)."""
+        return any(
+            KINDS[m.kind].piecewise(m) for m in self.scene.mounts if not isinstance(m, LinearMount)
+        )
+
+    @cached_property
     def tangent_rate(self) -> float:
         """The fastest mode (rad/s) of the body on its mounts' nominal tangents (keys and
         frictionless joints' shanks bearing, bolted joints closed, snubbers open;
