@@ -9,8 +9,10 @@ real-time factor without the error estimate, and the substeps per sample. The sc
   of it (linear mounts: `auto` takes the exponential method);
 - `stiff_snubbed`: the same with a fifth, soft mount on a snubber (a law with pieces:
   `ros34pw2`), 0.1 s;
-- `stiff_hysteretic`: the same with a soft Bouc–Wen elastomer instead (no pieces: `exprb32`),
-  0.3 s;
+- `stiff_hysteretic`: the same with a soft Bouc–Wen elastomer instead (no pieces, the
+  stiffness the linear mounts': `exprb32`), 0.3 s;
+- `stiff_bouc_wen`: 10 kg on four 1e9 N/m Bouc–Wen elastomers of strong hysteresis (the
+  stiffness non-linear: `ros34pw2`), 0.3 s;
 - `key`: 5 kg on soft mounts beside a 1e9 N/m shear key 0.5 mm off, pushed into it by a 3 g
   half-sine at 1 kHz (ρ·Δt 17.3 bearing: `ros34pw2` from the start);
 - `snubber`: the same beside a 1e9 N/m snubber (`auto` goes to `ros34pw2` at its contact).
@@ -33,6 +35,7 @@ from test_error_estimate import (
     _ship_motion,
     _soft_beside_a_snubber,
     _soft_beside_a_stiff_key,
+    _stiff_hysteretic_mounts,
     _stiff_light,
     _stiff_with_a_hysteretic_mount,
     _stiff_with_a_snubbed_mount,
@@ -47,6 +50,7 @@ CASES: dict[str, Callable[[float], tuple[Scene, SampleBatch]]] = {
     "stiff_light": lambda seconds: _ship_motion(_stiff_light()[0], seconds),
     "stiff_snubbed": lambda _: _stiff_with_a_snubbed_mount(),
     "stiff_hysteretic": lambda _: _stiff_with_a_hysteretic_mount(),
+    "stiff_bouc_wen": lambda _: _stiff_hysteretic_mounts(),
     "key": lambda _: _soft_beside_a_stiff_key(),
     "snubber": lambda _: _soft_beside_a_snubber(),
 }

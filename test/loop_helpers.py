@@ -38,7 +38,7 @@ def companion_of(
         model.n_mounts,
         np.zeros((k, N_EVENTS)) if treatments is None else treatments,
         kick_rate,
-        piecewise=model.piecewise,
+        linear_stiffness=model.linear_stiffness,
     )
 
 

@@ -269,6 +269,27 @@ def _stiff_with_a_snubbed_mount() -> tuple[Scene, SampleBatch]:
     )
 
 
+def _stiff_hysteretic_mounts() -> tuple[Scene, SampleBatch]:
+    """10 kg on four 1e9 N/m Bouc–Wen elastomers of strong hysteresis (β·x of order 1 at their
+    µm deflections) at the stiff scene's corners, under 0.3 s of the ship motion: stiff, and its
+    stiffness non-linear."""
+    hysteresis = {"ratio": 0.6, "beta": 1e6, "gamma": 5e5}
+    mounts = [
+        kind_mount(
+            "elastomer",
+            f"r{i}",
+            (x, y, 0.0),
+            stiffness_linear=[1e9] * 3,
+            damping=[2e3] * 3,
+            hysteresis=hysteresis,
+        )
+        for i, (x, y) in enumerate(CORNERS)
+    ]
+    data = base_scene(10.0, [0.0, 0.0, 0.1], [1.0] * 3 + [0.0] * 3, mounts)
+    data["integration"]["method"] = "auto"
+    return _ship_motion(_with_pump_input(data), 0.3)
+
+
 def _stiff_with_a_hysteretic_mount(method: str = "auto") -> tuple[Scene, SampleBatch]:
     """The stiff scene with a soft Bouc–Wen elastomer beside it: as stiff, non-linear, and no
     law with pieces."""
@@ -550,13 +571,14 @@ def test_the_companion_of_dormand_prince_is_one_step_of_verner_and_switches_with
     assert (ros.switching_method, ros.switching_min_steps) == (ROS34PW2, 2)
 
 
-def test_the_companion_of_a_rosenbrock_twin_without_pieces_is_exact_on_the_linear_part() -> None:
-    """Where no mount's law has pieces (`Model.piecewise`: contacts, joints' faces) the
-    companion of a ros34pw2 twin is exprb32 at one step an interval (EXACT_ON_LINEAR), also
-    where `auto` moves the twin there (it does not on such a scene: it takes exprb32 itself),
-    and dopri54's is still Verner's pair; with pieces, ros34pw2 at two steps (above)."""
+def test_the_companion_of_a_rosenbrock_twin_on_stiff_linear_mounts_is_exact_on_them() -> None:
+    """Where the stiff modes are the linear mounts' (`Model.linear_stiffness`: no law with
+    pieces, the non-linear mounts soft) the companion of a ros34pw2 twin is exprb32 at one step
+    an interval (EXACT_ON_LINEAR), also where `auto` moves the twin there (it does not on such
+    a scene: it takes exprb32 itself), and dopri54's is still Verner's pair; elsewhere,
+    ros34pw2 at two steps (above)."""
     model = assemble(_stiff_with_a_hysteretic_mount()[0])
-    assert not model.piecewise
+    assert model.linear_stiffness
     ros = companion_of(model, "ros34pw2")
     assert (ros.method, ros.settings[MIN_STEPS]) == (EXPRB32, 1.0)
     assert (ros.switching_method, ros.switching_min_steps) == (EXPRB32, 1)
@@ -566,17 +588,27 @@ def test_the_companion_of_a_rosenbrock_twin_without_pieces_is_exact_on_the_linea
     assert (comp.method, comp.settings[MIN_STEPS], comp.switching_method) == (EXPRB32, 1, EXPRB32)
 
 
-def test_a_law_has_pieces_where_a_contact_or_a_joint_can_switch_it() -> None:
+def test_the_stiff_modes_are_the_linear_mounts_where_no_law_has_pieces_and_the_rest_is_soft() -> (
+    None
+):
     """`Model.piecewise`: linear mounts, a Bouc–Wen elastomer and one on a force table (PCHIP,
     its slope continuous) have none; an elastomer's snubber (touching or not), a shear key, a
-    bolted joint have."""
-    assert not assemble(_pump()[0]).piecewise
-    assert not assemble(_stiff_with_a_hysteretic_mount()[0]).piecewise
+    bolted joint have. `Model.linear_stiffness` holds where none has and the non-linear mounts
+    alone move the body at most NONLINEAR_SHARE of its fastest rate: the stiff scene beside a
+    1e4 N/m elastomer (rate share √(1e4/(4·1e9)) in x, 1.6e-3), not four stiff Bouc–Wen
+    elastomers alone (share 1); a scene of linear mounts (the pump) always."""
     table = {"z": {"deflection": [-1e-3, 0.0, 1e-3], "force": [-20.0, 0.0, 10.0]}}
-    assert not assemble(_stiff_beside({"force_table": table})[0]).piecewise
-    assert assemble(_stiff_with_a_snubbed_mount()[0]).piecewise
-    assert assemble(_soft_beside_a_stiff_key()[0]).piecewise
-    assert assemble(load_scene_file(CONFIG / "genset_bolted_keyed.scene.yaml")).piecewise
+    for build, piecewise, linear in (
+        (_pump, False, True),
+        (_stiff_with_a_hysteretic_mount, False, True),
+        (partial(_stiff_beside, {"force_table": table}), False, True),
+        (_stiff_hysteretic_mounts, False, False),
+        (_stiff_with_a_snubbed_mount, True, False),
+        (_soft_beside_a_stiff_key, True, False),
+        (_genset, True, False),
+    ):
+        model = assemble(build()[0])
+        assert (model.piecewise, model.linear_stiffness) == (piecewise, linear), build
 
 
 def _companion_per_interval(
@@ -762,9 +794,10 @@ def test_auto_takes_a_linearising_method_where_the_explicit_one_would_be_stabili
     """ρ of 10 kg on 4 × 1e9 N/m at (±0.4, ±0.3) m is its yaw mode, √(4k(a² + b²)/I_zz) =
     31 623 rad/s (the mounts' plane holds no coupling to it): ρ·Δt = 31.6 at 1 kHz, past
     STIFF_RHO_DT. Its mounts are linear: the exponential method; with a snubbed elastomer
-    beside them (a law with pieces in the right-hand side), the L-stable Rosenbrock; with a
-    Bouc–Wen elastomer beside them (non-linear, no pieces), the exponential method again. The
-    bundled pump (modes below 20 Hz) stays explicit."""
+    beside them (a law with pieces in the right-hand side), the L-stable Rosenbrock; with a soft
+    Bouc–Wen elastomer beside them (non-linear, no pieces), the exponential method again; on
+    four stiff Bouc–Wen elastomers instead (their non-linear law the stiff part), the
+    Rosenbrock. The bundled pump (modes below 20 Hz) stays explicit."""
     scene, samples = _stiff_light("auto")
     _, status = _integration_status(scene, samples)
     yaw = math.sqrt(4 * 1e9 * (0.4**2 + 0.3**2) / 1.0) * 1e-3
@@ -775,6 +808,9 @@ def test_auto_takes_a_linearising_method_where_the_explicit_one_would_be_stabili
     scene, samples = _stiff_with_a_hysteretic_mount()
     _, status = _integration_status(scene, samples)
     assert status.values["method"].startswith("exprb32 (auto: ρ·Δt = 31.")
+    scene, samples = _stiff_hysteretic_mounts()
+    _, status = _integration_status(scene, samples)
+    assert status.values["method"].startswith("ros34pw2 (auto: ρ·Δt = ")
     scene, samples = _pump()
     _, status = _integration_status(scene, samples)
     assert status.values["method"].startswith("dopri54 (auto: ρ·Δt = 0.1")

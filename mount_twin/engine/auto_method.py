@@ -3,12 +3,12 @@ every restart) and looked at again after mount events.
 
 The rule is `integrate.methods.choose`: ρ·Δt, the spectral radius of the Jacobian (rad/s) times
 the sample interval (s), against what an explicit method can step, and whether some mount's law
-has pieces (`Model.piecewise`: a contact, a joint's faces). At a start ρ is the larger of the
-Jacobian's at the start state under the start sample's specific force and the rate of the
-mounts' nominal tangents (`scene.statics`: a shear key, and a frictionless bolted joint's
-shank, counts as bearing, however wide its clearance), so a light body beside a stiff key
-starts on the method the key needs when it closes, not on the one its open clearance allows (5
-kg beside a 1e9 N/m key at 1 kHz: 9.8e-4 of the largest force by ros34pw2 from the start,
+has pieces or the non-linear mounts are stiff (`Model.linear_stiffness`). At a start ρ is the
+larger of the Jacobian's at the start state under the start sample's specific force and the
+rate of the mounts' nominal tangents (`scene.statics`: a shear key, and a frictionless bolted
+joint's shank, counts as bearing, however wide its clearance), so a light body beside a stiff
+key starts on the method the key needs when it closes, not on the one its open clearance allows
+(5 kg beside a 1e9 N/m key at 1 kHz: 9.8e-4 of the largest force by ros34pw2 from the start,
 2.3e-2 by Dormand–Prince until the key had closed), and a start resting on a pressed snubber (a
 heel, a restart under a sustained load) on the method the snubber needs: its contact logs no
 event there, having touched before the first interval. ρ is taken again at the state of a
@@ -72,7 +72,7 @@ def at_start(
     bearing = rho_tangent > TANGENT_MARGIN * rho
     notes = [n for n, holds in (("keys bearing", bearing), ("at a restart", restart)) if holds]
     why = ", ".join([f"ρ·Δt = {rho_dt:.3g}", *notes])
-    return Choice(choose(rho_dt, smooth=not model.piecewise), why)
+    return Choice(choose(rho_dt, smooth=model.linear_stiffness), why)
 
 
 def after_event(
@@ -84,7 +84,7 @@ def after_event(
     if rho is None:
         return None
     rho_dt = rho * interval_s
-    method = choose(rho_dt, smooth=not model.piecewise)
+    method = choose(rho_dt, smooth=model.linear_stiffness)
     return Choice(method, f"ρ·Δt = {rho_dt:.3g} after {event.event} of {event.mount}")
 
 

@@ -113,10 +113,10 @@ estimate 0): where the twin runs Dormand–Prince 5(4) the companion runs Verner
 (`integrate.verner65`) at least one step an interval (a 6th-order step of the same length: its
 error a small share of the twin's; 8 new right-hand sides a step); where the twin runs a
 linearising method it runs that method at least MIN_STEPS = 2 steps an interval (HIGHER,
-`own_method`; `switch` follows the twin), but beside the Rosenbrock on a scene where no mount's
-law has pieces, where it runs the exponential method at one step (EXACT_ON_LINEAR: the
-Rosenbrock damps the stiff modes, its own companion too). This stepper is also the carried
-error's check.
+`own_method`; `switch` follows the twin), but beside the Rosenbrock on a scene whose stiff
+modes are its linear mounts' (`Model.linear_stiffness`), where it runs the exponential method at
+one step (EXACT_ON_LINEAR: the Rosenbrock damps the stiff modes, its own companion too). This
+stepper is also the carried error's check.
 Where a joint's faces switch inside the steps (an interval that starts with a joint's event
 holding, its treatment "switching", over which the twin's tolerance bound its steps: more than
 one, or one rejected), the companion runs the twin's own method at MIN_STEPS steps at least
@@ -230,35 +230,36 @@ HIGHER = {DOPRI54: VERNER65}
 """The companion's method where the twin's is a key (ids): one step of it an interval is a
 different solution of a smaller error, where one of the twin's own would be the twin again."""
 EXACT_ON_LINEAR = {ROS34PW2: EXPRB32}
-"""The companion's method where the twin's is a key (ids) on a scene where no mount's law has
-pieces (`Model.piecewise`), at one step an interval: the Rosenbrock steps over the stiff modes
-by damping them, and a companion by the Rosenbrock damps them too; the exponential method is
-exact on the linear part. On 10 kg on 4 × 1e9 N/m beside a Bouc–Wen elastomer under 1 kHz ship
+"""The companion's method where the twin's is a key (ids) on a scene whose stiff modes are its
+linear mounts' (`Model.linear_stiffness`: no mount's law has pieces, the non-linear mounts
+soft), at one step an interval: the Rosenbrock steps over the stiff modes by damping them, and
+a companion by the Rosenbrock damps them too; the exponential method is exact on the linear
+part. On 10 kg on 4 × 1e9 N/m beside a Bouc–Wen elastomer under 1 kHz ship
 motion the Rosenbrock's own companion read 0.28, 0.88 and 0.85 of the true force error at rtol
 1e-3, 1e-6 and 1e-9; this one 1.00, 1.00, 1.00 (2026-11-29). Where a law has pieces it is the
 worst method there is: beside a 1e9 N/m key or snubber at 1 kHz it read 17–381 times the true
 error (docs/scene.md), so the Rosenbrock's own it stays."""
 
 
-def own_method(twin: int, piecewise: bool) -> tuple[int, int]:
+def own_method(twin: int, linear_stiffness: bool) -> tuple[int, int]:
     """(method id, fewest steps per input interval) of the companion of a twin running the
-    method `twin` (an id) on a scene where some mount's law has pieces or none (`piecewise`):
-    a higher-order method at one step (HIGHER), on a scene without pieces the one exact on the
-    linear part at one step (EXACT_ON_LINEAR), else the twin's at MIN_STEPS."""
-    if not piecewise and twin in EXACT_ON_LINEAR:
+    method `twin` (an id) on a scene whose stiff modes are its linear mounts' or not
+    (`linear_stiffness`): a higher-order method at one step (HIGHER), where they are the one
+    exact on the linear part at one step (EXACT_ON_LINEAR), else the twin's at MIN_STEPS."""
+    if linear_stiffness and twin in EXACT_ON_LINEAR:
         return EXACT_ON_LINEAR[twin], 1
     return (HIGHER[twin], 1) if twin in HIGHER else (twin, MIN_STEPS)
 
 
-def switching_method(twin: int, piecewise: bool) -> tuple[int, int]:
+def switching_method(twin: int, linear_stiffness: bool) -> tuple[int, int]:
     """(method id, fewest steps per input interval) of the companion of a twin running the
     method `twin` (an id) over an interval where a bolted joint's faces switch inside the
     steps (an event holds that the companion is integrated over, and the twin's tolerance bound
     its steps), and at twice those steps over one in which an event function changes sign: the
-    twin's own at MIN_STEPS (see the module docstring); on a scene without pieces (no joint)
-    the companion's own (`own_method`)."""
-    if not piecewise and twin in EXACT_ON_LINEAR:
-        return own_method(twin, piecewise)
+    twin's own at MIN_STEPS (see the module docstring); where the stiff modes are the linear
+    mounts' (no joint) the companion's own (`own_method`)."""
+    if linear_stiffness and twin in EXACT_ON_LINEAR:
+        return own_method(twin, linear_stiffness)
     return twin, MIN_STEPS
 
 
@@ -276,8 +277,8 @@ class Companion(NamedTuple):
     again where one of its event functions changed sign over it).
     wrenches: (n_mounts, 6): its mount wrenches at the last sample.
     figures: (N_FIGURES,) running maxima (see the module docstring), reset by the reader.
-    piecewise: whether some mount's law of the scene has pieces (`Model.piecewise`: which
-    method is its own, `own_method`).
+    linear_stiffness: whether the scene's stiff modes are its linear mounts'
+    (`Model.linear_stiffness`: which method is its own, `own_method`).
     error_rows: (N_ERROR_ROWS, n_state) the carried error's rows; carry: (N_CARRY_SLOTS,) its
     slots; treatments: (k, NE) how it takes an interval that starts with the event holding
     (in the twin's monitors or its own): the core's code of its kind's EVENT_COMPANION
@@ -305,7 +306,7 @@ class Companion(NamedTuple):
     carry: np.ndarray
     treatments: np.ndarray
     twin_d: np.ndarray
-    piecewise: bool
+    linear_stiffness: bool
 
 
 def new_companion(
@@ -319,17 +320,17 @@ def new_companion(
     treatments: np.ndarray,
     kick_rate: float,
     *,
-    piecewise: bool,
+    linear_stiffness: bool,
 ) -> Companion:
     """A companion of a twin of n states integrated by `method` (a name, or AUTO: then
     `switch` it with the twin) at the twin's tolerances rtol, atol; `scratch`: fresh work
     arrays of the model; treatments: (non-linear mounts, events), the shape of the twin's mount
     event functions, how the companion takes an interval that starts with the event holding
     (`Companion.treatments`); kick_rate: the body's fastest mode on its mounts' tangents (rad/s,
-    `Model.tangent_rate`; 0 where unknown: then never carried); piecewise: whether some mount's
-    law has pieces (`Model.piecewise`)."""
+    `Model.tangent_rate`; 0 where unknown: then never carried); linear_stiffness: whether the
+    scene's stiff modes are its linear mounts' (`Model.linear_stiffness`)."""
     twin = METHODS["dopri54" if method == AUTO else method].id
-    own, min_steps = own_method(twin, piecewise)
+    own, min_steps = own_method(twin, linear_stiffness)
     name = AUTO if method == AUTO else next(k for k, m in METHODS.items() if m.id == own)
     arrays = tighter_arrays(
         name,
@@ -346,7 +347,7 @@ def new_companion(
     return Companion(
         own,
         *arrays[1:],
-        *switching_method(twin, piecewise),
+        *switching_method(twin, linear_stiffness),
         np.zeros(n),
         scratch,
         np.zeros(n),
@@ -359,7 +360,7 @@ def new_companion(
         _reset_carry(carry, own),
         np.array(treatments, dtype=float),
         np.zeros((treatments.shape[0], 3)),
-        piecewise,
+        linear_stiffness,
     )
 
 
@@ -380,13 +381,13 @@ def switch(c: Companion, method: int) -> Companion:
     """The companion of a twin now running `method` (an id; its work arrays were made for AUTO)
     afresh: its own method and fewest steps (`own_method`), at most MAX_SUBSTEPS of the twin's
     per step of its fewest, and its method where a joint's faces switch (`switching_method`)."""
-    own, min_steps = own_method(method, c.piecewise)
+    own, min_steps = own_method(method, c.linear_stiffness)
     settings = c.settings
     settings[MAX_SUBSTEPS] *= min_steps / settings[MIN_STEPS_SLOT]
     settings[MIN_STEPS_SLOT] = float(min_steps)
     forget(settings)
     _reset_carry(c.carry, own)
-    switching, fewest = switching_method(method, c.piecewise)
+    switching, fewest = switching_method(method, c.linear_stiffness)
     return c._replace(method=own, switching_method=switching, switching_min_steps=fewest)
 
 

@@ -129,7 +129,7 @@ def _new_estimator(model: Model, treatments: np.ndarray) -> Estimator | Companio
             model.n_mounts,
             treatments,
             model.tangent_rate,
-            piecewise=model.piecewise,
+            linear_stiffness=model.linear_stiffness,
         )
     return sampled_estimator(model)
 

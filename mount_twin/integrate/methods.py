@@ -144,12 +144,12 @@ genset at 0.36 (10 kHz) and 3.6 (1 kHz), 10 kg on 4 × 1e9 N/m at 31.6 (1 kHz)."
 
 def choose(rho_dt: float, smooth: bool) -> str:
     """The method `auto` takes for a scene whose ρ·Δt (see STIFF_RHO_DT) is `rho_dt`: past it,
-    on a smooth scene (no mount's law has pieces: linear mounts, elastomers without snubbers or
-    force tables, Bouc–Wen hysteresis and all; `Model.piecewise`) the exponential method, exact
-    on the linear part (its modes resolved in one step per sample); where the mounts' laws have
-    pieces (contact, slip, joints opening) the L-stable Rosenbrock, which damps what a switch
-    rings: on a stiff contact the exponential method is the worst of the three (docs/scene.md,
-    `bench/stiff_methods.py --case key`)."""
+    on a `smooth` scene (its stiff modes its linear mounts': no mount's law has pieces, the
+    non-linear mounts soft; `Model.linear_stiffness`) the exponential method, exact on the
+    linear part (its modes resolved in one step per sample); where a mount's law has pieces
+    (contact, slip, joints opening) or the non-linear mounts are stiff, the L-stable Rosenbrock,
+    which damps what a switch rings: on a stiff contact the exponential method is the worst of
+    the three (docs/scene.md, `bench/stiff_methods.py --case key`)."""
     if rho_dt <= STIFF_RHO_DT:
         return "dopri54"
     return "exprb32" if smooth else "ros34pw2"

@@ -16,9 +16,10 @@ rate-independent states, a face's stick point, carried and returned onto its bou
 `engine.companion`) and its stiffness at the unstressed pose (`nominal_tangent`: statics, modes
 and `auto`'s first choice read it), and whether a mount's law has pieces its motion moves
 between (`piecewise`: a contact, a joint's faces; `auto` and the error estimate's companion
-take the exponential method only for scenes with none). A module's `load`, `monitor`, `update`
-and `carry` are plain Python: the reference the compiled core's port of the kind
-(src/core/kinds/<kind>.hpp) is held to; `settle` runs only in Python, at starts.
+take the exponential method only for scenes with none, `Model.linear_stiffness`). A module's
+`load`, `monitor`, `update` and `carry` are plain Python: the reference the compiled core's
+port of the kind (src/core/kinds/<kind>.hpp) is held to; `settle` runs only in Python, at
+starts.
 
 The core's dispatchers (`kind_load`, `kind_monitor`, `kind_update`, `kind_carry` below) select
 a kind by its
