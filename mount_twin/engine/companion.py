@@ -234,11 +234,11 @@ EXACT_ON_LINEAR = {ROS34PW2: EXPRB32}
 linear mounts' (`Model.linear_stiffness`: no mount's law has pieces, the non-linear mounts
 soft), at one step an interval: the Rosenbrock steps over the stiff modes by damping them, and
 a companion by the Rosenbrock damps them too; the exponential method is exact on the linear
-part. On 10 kg on 4 × 1e9 N/m beside a Bouc–Wen elastomer under 1 kHz ship
-motion the Rosenbrock's own companion read 0.28, 0.88 and 0.85 of the true force error at rtol
-1e-3, 1e-6 and 1e-9; this one 1.00, 1.00, 1.00 (2026-11-29). Where a law has pieces it is the
-worst method there is: beside a 1e9 N/m key or snubber at 1 kHz it read 17–381 times the true
-error (docs/scene.md), so the Rosenbrock's own it stays."""
+part. On 10 kg on 4 × 1e9 N/m beside a soft Bouc–Wen elastomer under 1 kHz ship motion the
+Rosenbrock's own companion read 0.28, 0.88 and 0.85 of the true force error at rtol 1e-3, 1e-6
+and 1e-9; this one 1.00, 1.00, 1.00 (2026-11-29). Where a law has pieces it is the worst method
+there is: beside a 1e9 N/m key or snubber at 1 kHz it read 17–381 times the true error
+(docs/scene.md), so the Rosenbrock's own it stays."""
 
 
 def own_method(twin: int, linear_stiffness: bool) -> tuple[int, int]:
@@ -277,14 +277,14 @@ class Companion(NamedTuple):
     again where one of its event functions changed sign over it).
     wrenches: (n_mounts, 6): its mount wrenches at the last sample.
     figures: (N_FIGURES,) running maxima (see the module docstring), reset by the reader.
-    linear_stiffness: whether the scene's stiff modes are its linear mounts'
-    (`Model.linear_stiffness`: which method is its own, `own_method`).
     error_rows: (N_ERROR_ROWS, n_state) the carried error's rows; carry: (N_CARRY_SLOTS,) its
     slots; treatments: (k, NE) how it takes an interval that starts with the event holding
     (in the twin's monitors or its own): the core's code of its kind's EVENT_COMPANION
     (`kinds.COMPANION_TREATMENTS`); twin_d: (k, 3) the twin's mount deflections (m, their
     axes) at the sample, from the twin's own pass over its mounts, where the kinds' carry reads
     them.
+    linear_stiffness: whether the scene's stiff modes are its linear mounts'
+    (`Model.linear_stiffness`: which method is its own, `own_method`).
     """
 
     method: int
