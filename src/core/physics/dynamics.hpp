@@ -159,11 +159,32 @@ inline void local_motion(idx i, const NonLinear& nl, const Motion& mo, MountLoca
   }
 }
 
-/// Load of non-linear mount i in its axes into ml.f, ml.c (its motion first); its state rates
-/// into dydt.
+/// The kinds' carry of the error estimate's companion where a pass over the mounts for its
+/// wrenches takes it too (`rhs_with_wrenches`; kernel.hpp `carry_interval` says what each
+/// holds): each mount's rate-independent states returned by its kind's carry before its load,
+/// from its deflection in the pass and the twin's, twin_d (k, 3), as the twin's pass took them.
+/// A carry moves its own mount's states alone, so every load is the one after a carry of all.
+struct KindCarry {
+  Vec trial;   // the companion's state before the kick
+  Vec twin;    // the twin's state
+  Mat twin_d;  // (k, 3) m: the twin's mount deflections, in their axes
+};
+
+/// Non-linear mount i's rate-independent states in y returned by its kind's carry (a kind
+/// that returns nothing skipped, `kind_carries`), at its deflection ml.d and the twin's.
+inline void carry_kind(idx i, const NonLinear& nl, Vec y, const MountLocal& ml,
+                       const KindCarry& carry) {
+  if (!kinds::kind_carries(nl.kind[i])) return;
+  kinds::kind_carry(nl.kind[i], &nl.par(i, 0), y, carry.trial, carry.twin, nl.state[i], ml.d,
+                    &carry.twin_d(i, 0));
+}
+
+/// Load of non-linear mount i in its axes into ml.f, ml.c (its motion first, then, where carry
+/// is given, its kind's carry: `carry_kind`); its state rates into dydt.
 inline void nl_load(idx i, Vec y, const NonLinear& nl, const Motion& mo, MountLocal& ml,
-                    Vec dydt) {
+                    Vec dydt, const KindCarry* carry = nullptr) {
   local_motion(i, nl, mo, ml);
+  if (carry != nullptr) carry_kind(i, nl, y, ml, *carry);
   kinds::kind_load(nl.kind[i], &nl.par(i, 0), y, nl.state[i], ml.d, ml.v, ml.phi, ml.w, dydt,
                    ml.f, ml.c);
 }
@@ -211,17 +232,6 @@ struct MonitorRows {
   Mat d{};  // where given (k, 3): each mount's deflection (m, its axes) the pass took
 };
 
-/// The kinds' carry of the error estimate's companion where a pass over the mounts for its
-/// wrenches takes it too (`rhs_with_wrenches`; kernel.hpp `carry_interval` says what each
-/// holds): each mount's rate-independent states returned by its kind's carry before its load,
-/// from its deflection in the pass and the twin's, twin_d (k, 3), as the twin's pass took them.
-/// A carry moves its own mount's states alone, so every load is the one after a carry of all.
-struct KindCarry {
-  Vec trial;   // the companion's state before the kick
-  Vec twin;    // the twin's state
-  Mat twin_d;  // (k, 3) m: the twin's mount deflections, in their axes
-};
-
 /// Non-linear mount i's event functions and utilisation at its motion ml into mon (and its
 /// deflection where mon.d is given), then its discrete switch (y's states may jump):
 /// `mount_monitors`' work on one mount.
@@ -234,15 +244,6 @@ inline void monitor_mount(idx i, Vec y, const NonLinear& nl, const MountLocal& m
   }
   mon.util[i] = kinds::kind_monitor(code, p, y, mon.y0, o, ml.d, ml.v, mon.g.row(i));
   if (kinds::kind_update(code, p, y, o, ml.d)) mon.switched = true;
-}
-
-/// Non-linear mount i's rate-independent states in y returned by its kind's carry (a kind
-/// that returns nothing skipped, `kind_carries`), at its deflection ml.d and the twin's.
-inline void carry_kind(idx i, const NonLinear& nl, Vec y, const MountLocal& ml,
-                       const KindCarry& carry) {
-  if (!kinds::kind_carries(nl.kind[i])) return;
-  kinds::kind_carry(nl.kind[i], &nl.par(i, 0), y, carry.trial, carry.twin, nl.state[i], ml.d,
-                    &carry.twin_d(i, 0));
 }
 
 /// Sum the mount loads on the body at the motion mo into s.total_force, s.total_moment (F,
@@ -267,12 +268,7 @@ inline void mount_loads_into(Vec y, const Model& m, const Motion& mo, Scratch& s
     MountLocal ml;
     for (idx i = 0; i < nl.k; ++i) {
       double f[3], c[3] = {0.0, 0.0, 0.0};
-      local_motion(i, nl, mo, ml);
-      if constexpr (kWrenches) {
-        if (carry != nullptr) carry_kind(i, nl, y, ml, *carry);
-      }
-      kinds::kind_load(nl.kind[i], &nl.par(i, 0), y, nl.state[i], ml.d, ml.v, ml.phi, ml.w, dydt,
-                       ml.f, ml.c);
+      nl_load(i, y, nl, mo, ml, dydt, carry);
       out_of_axes(nl, i, ml.f, f);
       if (nl.rotational[i]) nl_couple(i, nl, mo, ml, c);
       add_load(ml.arm, f, c, total_f, total_m);
