@@ -107,17 +107,23 @@ def _bouc_wen_grid(n: int) -> tuple[Scene, SampleBatch]:
     return _ship_motion(_with_pump_input(body), 2.0)
 
 
-def _stiff_light(method: str = "dopri54") -> tuple[Scene, SampleBatch]:
-    """10 kg on 4 × 1e9 N/m (modes of 2–6 kHz) under 1 kHz ship motion: Dormand–Prince runs
-    at its stability limit, where a loose tolerance gives percent errors (`auto` would take
-    the Rosenbrock here)."""
+def _stiff_scene(method: str, *beside: dict) -> dict:
+    """10 kg on 4 × 1e9 N/m at (±0.4, ±0.3) m (modes of 2–6 kHz), the mounts `beside` with
+    them, integrated by `method`: the scene's dictionary."""
     mounts = [
         mount(f"m{i}", (x, y, 0.0), (1e9,) * 3 + (0,) * 3, (2e3,) * 3 + (0,) * 3)
         for i, (x, y) in enumerate(CORNERS)
     ]
-    data = base_scene(10.0, [0.0, 0.0, 0.1], [1.0] * 3 + [0.0] * 3, mounts)
+    data = base_scene(10.0, [0.0, 0.0, 0.1], [1.0] * 3 + [0.0] * 3, [*mounts, *beside])
     data["integration"]["method"] = method
-    return _ship_motion(_with_pump_input(data), 1.0)
+    return data
+
+
+def _stiff_light(method: str = "dopri54") -> tuple[Scene, SampleBatch]:
+    """10 kg on 4 × 1e9 N/m (modes of 2–6 kHz) under 1 kHz ship motion: Dormand–Prince runs
+    at its stability limit, where a loose tolerance gives percent errors (`auto` would take
+    the Rosenbrock here)."""
+    return _ship_motion(_with_pump_input(_stiff_scene(method)), 1.0)
 
 
 def _on_hysteretic_rubber(
@@ -238,27 +244,15 @@ def _stiff_beside(
     """The stiff scene (`_stiff_light`) with a fifth, soft elastomer mount at the CG's foot
     (1e4 N/m: ρ·Δt stays the yaw mode's), its other keys `soft`, integrated by `method` under
     `seconds` of the ship motion."""
-    data = base_scene(
-        10.0,
-        [0.0, 0.0, 0.1],
-        [1.0] * 3 + [0.0] * 3,
-        [
-            *(
-                mount(f"m{i}", (x, y, 0.0), (1e9,) * 3 + (0,) * 3, (2e3,) * 3 + (0,) * 3)
-                for i, (x, y) in enumerate(CORNERS)
-            ),
-            kind_mount(
-                "elastomer",
-                "soft",
-                (0.0, 0.0, 0.0),
-                stiffness_linear=[1e4, 1e4, 1e4],
-                damping=[10.0, 10.0, 10.0],
-                **soft,
-            ),
-        ],
+    fifth = kind_mount(
+        "elastomer",
+        "soft",
+        (0.0, 0.0, 0.0),
+        stiffness_linear=[1e4, 1e4, 1e4],
+        damping=[10.0, 10.0, 10.0],
+        **soft,
     )
-    data["integration"]["method"] = method
-    return _ship_motion(_with_pump_input(data), seconds)
+    return _ship_motion(_with_pump_input(_stiff_scene(method, fifth)), seconds)
 
 
 def _stiff_with_a_snubbed_mount() -> tuple[Scene, SampleBatch]:

@@ -28,7 +28,7 @@ from mount_twin.physics.jacobian import STEP as CENTRAL_STEP
 from mount_twin.physics.jacobian import central_columns
 from mount_twin.physics.rotations import rpy_matrices, rpy_matrix
 from mount_twin.scene.built import check_built
-from mount_twin.scene.description import DOF_NAMES, LinearMount, Scene
+from mount_twin.scene.description import DOF_NAMES, LinearMount, Mount, Scene
 from mount_twin.scene.statics import loose_dofs, statics
 
 
@@ -78,9 +78,7 @@ class Model:
     def piecewise(self) -> bool:
         """Whether some mount's force law has pieces its motion moves between (its kind's
         `piecewise`: a contact, a joint's faces; linear mounts have none)."""
-        return any(
-            KINDS[m.kind].piecewise(m) for m in self.scene.mounts if not isinstance(m, LinearMount)
-        )
+        return any(KINDS[m.kind].piecewise(m) for m in self._nonlinear_mounts)
 
     @cached_property
     def linear_stiffness(self) -> bool:
@@ -92,11 +90,15 @@ class Model:
         estimate's companion beside a Rosenbrock twin too (`engine.companion.own_method`)."""
         if self.piecewise:
             return False
-        soft = [m for m in self.scene.mounts if not isinstance(m, LinearMount)]
-        if not soft:
+        if not self.nonlinear_slots:
             return True
-        alone = fastest_rate(replace(self.scene, mounts=tuple(soft)))
+        alone = fastest_rate(replace(self.scene, mounts=self._nonlinear_mounts))
         return alone <= NONLINEAR_SHARE * self.tangent_rate
+
+    @property
+    def _nonlinear_mounts(self) -> tuple[Mount, ...]:
+        """The mounts of a kind in mount_twin.kinds, in the core's order (`nonlinear_slots`)."""
+        return tuple(self.scene.mounts[i] for i in self.nonlinear_slots)
 
     @cached_property
     def tangent_rate(self) -> float:
