@@ -62,7 +62,8 @@ def _estimate_text(est: ErrorEstimate | None) -> str:
     if est.lower_bound:
         text += (
             f" (a lower bound: {est.failed_checks} intervals not measured, "
-            f"{est.uncarried_states} states not carried)"
+            f"{est.uncarried_states} states not carried, the fastest mode stepped over in "
+            f"{est.stepped_over_intervals} of {est.intervals} intervals)"
         )
     return text
 

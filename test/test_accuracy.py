@@ -244,7 +244,7 @@ def test_errors_within_the_references_resolution_are_named_not_resolved() -> Non
 
 
 def _accuracy(rtol: float, force: float, attitude: float) -> Accuracy:
-    return Accuracy(rtol, force, 0.0, attitude, 0.0, 0.0, 1.0, 0, NAN, NAN, NAN)
+    return Accuracy(rtol, force, 0.0, attitude, 0.0, 0.0, 1.0, 0, NAN, NAN, NAN, NAN)
 
 
 def test_the_command_goes_on_where_the_second_reference_fails(
@@ -290,7 +290,7 @@ def test_the_table_heads_each_column_with_its_unit() -> None:
     """`force err 1.03e-09` read as newtons: the force errors are ratios (of the largest force,
     of each mount's peak), and every column's unit stands under its name, aligned with its
     figures."""
-    row = Accuracy(1e-6, 2e-3, 9e-5, 4.8e-7, 3.2e-7, 0.1, 1.23, 0, 1.9e-3, 4.4e-7, 1.7)
+    row = Accuracy(1e-6, 2e-3, 9e-5, 4.8e-7, 3.2e-7, 0.1, 1.23, 0, 1.9e-3, 4.4e-7, 1.7, 0.0)
     head, units, figures = _table([row]).splitlines()
     expected = {
         "force err": ("of max |F|", "2.00e-03"),
