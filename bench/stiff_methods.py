@@ -78,7 +78,7 @@ def main() -> None:
             print(
                 f"{method:<9} {rtol:>6.0e} {a.force_error:>10.2e} {a.peak_force_error:>9.2e} "
                 f"{a.est_force_error / a.force_error:>8.2f} {1 / a.wall_s_per_sim_s:>7.1f} "
-                f"{a.substeps_per_sample:>8.2f} {a.est_stepped_over:>5.2f}",
+                f"{a.substeps_per_sample:>8.2f} {a.stepped_over_share:>5.2f}",
                 flush=True,
             )
 

@@ -198,9 +198,11 @@ def _unresolved(rows: list[Accuracy], resolved: Accuracy) -> str:
 
 def _stepped_over(rows: list[Accuracy]) -> str:
     """A line naming the rtols whose estimate's companion stepped over the body's fastest mode
-    in some intervals, with their share (`Accuracy.est_stepped_over`: the estimate a lower
+    in some intervals, with their share (`Accuracy.stepped_over_share`: the estimate a lower
     bound there, engine.companion); '' where none did."""
-    named = [f"{r.rtol:g} ({r.est_stepped_over:.0%})" for r in rows if r.est_stepped_over > 0.0]
+    named = [
+        f"{r.rtol:g} ({r.stepped_over_share:.0%})" for r in rows if r.stepped_over_share > 0.0
+    ]
     if not named:
         return ""
     return (
