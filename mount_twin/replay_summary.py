@@ -62,8 +62,7 @@ def _estimate_text(est: ErrorEstimate | None) -> str:
     if est.lower_bound:
         text += (
             f" (a lower bound: {est.failed_checks} intervals not measured, "
-            f"{est.uncarried_states} states not carried, the fastest mode stepped over in "
-            f"{est.stepped_over_intervals} of {est.intervals} intervals)"
+            f"{est.uncarried_states} states not carried)"
         )
     return text
 

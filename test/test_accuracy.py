@@ -26,7 +26,7 @@ from mount_twin.analysis.accuracy import (
     run_at,
 )
 from mount_twin.cli import main
-from mount_twin.commands.accuracy import _stepped_over, _table, _unresolved
+from mount_twin.commands.accuracy import _table, _unresolved
 from mount_twin.engine.batch import SampleBatch
 from mount_twin.errors import MountTwinError
 from mount_twin.io.input_samples import read_samples
@@ -243,19 +243,8 @@ def test_errors_within_the_references_resolution_are_named_not_resolved() -> Non
     assert _unresolved(rows[:1], resolved) == ""
 
 
-def test_rtols_whose_estimate_stepped_over_the_fastest_mode_are_named_a_lower_bound() -> None:
-    """The command names each rtol whose estimate's companion stepped over the body's fastest
-    mode, with the share of the intervals (NaN: not estimated, and 0 are not named)."""
-    rows = [
-        _accuracy(r, 1e-5, 1e-9, over) for r, over in ((1e-4, 1.0), (1e-6, 0.123), (1e-7, 0.0))
-    ]
-    line = _stepped_over([*rows, _accuracy(1e-9, 1e-5, 1e-9)])
-    assert line.endswith("rtol 0.0001 (100%), 1e-06 (12%)"), line
-    assert _stepped_over(rows[2:]) == ""
-
-
-def _accuracy(rtol: float, force: float, attitude: float, over: float = NAN) -> Accuracy:
-    return Accuracy(rtol, force, 0.0, attitude, 0.0, 0.0, 1.0, 0, NAN, NAN, NAN, over)
+def _accuracy(rtol: float, force: float, attitude: float) -> Accuracy:
+    return Accuracy(rtol, force, 0.0, attitude, 0.0, 0.0, 1.0, 0, NAN, NAN, NAN)
 
 
 def test_the_command_goes_on_where_the_second_reference_fails(
@@ -301,7 +290,7 @@ def test_the_table_heads_each_column_with_its_unit() -> None:
     """`force err 1.03e-09` read as newtons: the force errors are ratios (of the largest force,
     of each mount's peak), and every column's unit stands under its name, aligned with its
     figures."""
-    row = Accuracy(1e-6, 2e-3, 9e-5, 4.8e-7, 3.2e-7, 0.1, 1.23, 0, 1.9e-3, 4.4e-7, 1.7, 0.0)
+    row = Accuracy(1e-6, 2e-3, 9e-5, 4.8e-7, 3.2e-7, 0.1, 1.23, 0, 1.9e-3, 4.4e-7, 1.7)
     head, units, figures = _table([row]).splitlines()
     expected = {
         "force err": ("of max |F|", "2.00e-03"),

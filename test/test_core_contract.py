@@ -44,14 +44,7 @@ def test_the_layouts_are_the_cores() -> None:
     assert (pose_row.POSITION, pose_row.QUATERNION, pose_row.ANGLES, pose_row.WIDTH) == (
         _core.POSE_ROW
     )
-    figures = (
-        "FORCE_ERROR",
-        "ATTITUDE_ERROR",
-        "FORCE_SCALE",
-        "FAILURES",
-        "UNCARRIED",
-        "STEPPED_OVER",
-    )
+    figures = ("FORCE_ERROR", "ATTITUDE_ERROR", "FORCE_SCALE", "FAILURES", "UNCARRIED")
     assert tuple(getattr(estimate, n) for n in (*figures, "N_FIGURES")) == _core.FIGURE_SLOTS
     assert tuple(range(len(figures) + 1)) == _core.FIGURE_SLOTS
     assert (dynamics.INPUT_SIZE, kernel.AT_EVENT) == (13, -100)

@@ -110,9 +110,6 @@ class Accuracy:
             and attitude_error_rad (NaN: not estimated).
         estimate_cost: wall time with the live estimate over wall time without (NaN: not
             estimated); wall_s_per_sim_s is without it.
-        stepped_over_share: the share of the estimated intervals whose fastest mode the
-            estimate's companion stepped over (`ErrorEstimate.stepped_over_intervals`; NaN:
-            not estimated).
     """
 
     rtol: float
@@ -126,7 +123,6 @@ class Accuracy:
     est_force_error: float
     est_attitude_error_rad: float
     estimate_cost: float
-    stepped_over_share: float
 
 
 def raw_gyro(scene: Scene) -> Scene:
@@ -323,7 +319,4 @@ def compare(run: Run, ref: Run, duration_s: float, estimated: Run | None = None)
         est_force_error=est.force_error_rel if est else NAN,
         est_attitude_error_rad=est.attitude_error_rad if est else NAN,
         estimate_cost=cost,
-        stepped_over_share=est.stepped_over_intervals / est.intervals
-        if est and est.intervals
-        else NAN,
     )

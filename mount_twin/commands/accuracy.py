@@ -99,9 +99,8 @@ def run(args: argparse.Namespace) -> int:
         )
     print(_table(rows))
     unresolved = "" if resolved is None else _unresolved(rows, resolved)
-    for line in (unresolved, _stepped_over(rows)):
-        if line:
-            print(line)
+    if unresolved:
+        print(unresolved)
     if args.csv:
         _write_csv(rows, args.csv)
         print(f"csv: {args.csv}")
@@ -193,21 +192,6 @@ def _unresolved(rows: list[Accuracy], resolved: Accuracy) -> str:
     return (
         f"not resolved (within {RESOLVED:g}× the reference's resolution: the error and its "
         f"estimate are not compared there): rtol {', '.join(named)}"
-    )
-
-
-def _stepped_over(rows: list[Accuracy]) -> str:
-    """A line naming the rtols whose estimate's companion stepped over the body's fastest mode
-    in some intervals, with their share (`Accuracy.stepped_over_share`: the estimate a lower
-    bound there, engine.companion); '' where none did."""
-    named = [
-        f"{r.rtol:g} ({r.stepped_over_share:.0%})" for r in rows if r.stepped_over_share > 0.0
-    ]
-    if not named:
-        return ""
-    return (
-        "estimate a lower bound (its companion stepped over the body's fastest mode, which the "
-        f"Rosenbrock damps, in a share of the intervals): rtol {', '.join(named)}"
     )
 
 

@@ -180,15 +180,7 @@ read them: the largest |ΔF| over mounts and force components (N, mount axes), t
 |Δα|, |Δγ|, |Δδ| (rad), the largest |F| component of the twin (N: the scale of a relative
 error), and the intervals where the companion's own stepper (or its check) failed (FAILURES: it
 is then re-synchronised to the twin, the error carried until then is lost, and the estimate
-counts it); it carries every state (UNCARRIED stays 0); and the intervals over which, beside a
-Rosenbrock twin, its own Rosenbrock steps were longer than 2/ω of the body's fastest mode on
-the Jacobian it holds (STEPPED_OVER, kernel.hpp `stepped_over`). Such steps damp that mode
-(L-stable), the companion's as the twin's, and the error of it is in neither: 10 kg on four
-1e9 N/m Bouc–Wen elastomers under 1 kHz ship motion read 0.29 and 0.08 of its true force error
-at rtol 1e-3 and 1e-4, stepped over in every interval, 0.93 at 1e-7, in none (twelve companion
-steps an interval still read 0.17 at 3.6× the engine's time). The estimate then says it is a
-lower bound, and the integration status WARNs where more than half the intervals were stepped
-over (`engine.estimate.STEPPED_OVER_WARN_SHARE`; docs/scene.md).
+counts it); it carries every state (UNCARRIED stays 0).
 """
 
 from __future__ import annotations

@@ -13,21 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-FORCE_ERROR, ATTITUDE_ERROR, FORCE_SCALE, FAILURES, UNCARRIED, STEPPED_OVER, N_FIGURES = range(7)
+FORCE_ERROR, ATTITUDE_ERROR, FORCE_SCALE, FAILURES, UNCARRIED, N_FIGURES = range(6)
 """Slots of the figures: largest |ΔF| (N), largest |Δα|, |Δγ|, |Δδ| (rad), largest |F|
 component (N), failed checks (intervals whose local error could not be measured), states the
-estimate does not carry (`engine.estimator.DENSE_MAX`), intervals over which the companion of
-a Rosenbrock twin, by the Rosenbrock too, stepped over the body's fastest mode
-(`engine.companion`)."""
-STEPPED_OVER_WARN_SHARE = 0.5
-"""Where the companion stepped over the body's fastest mode in more than this share of the
-intervals, the estimate is not to be trusted, a WARN (tighten integration.rtol): 10 kg on four
-1e9 N/m Bouc–Wen elastomers, and on 4 × 1e9 N/m beside a snubbed elastomer, under 1 kHz ship
-motion (test/test_error_estimate.py) read 0.08–0.29 of their true force error at rtol 1e-4 and
-1e-3 and 0.64–0.76 at 1e-5, stepped over in 98–100 % of the intervals; 0.77–0.86 at 1e-6, in 12
-and 13 %; 0.85–1.00 at 1e-7 and 1e-9, in none."""
-COUNTS = [FAILURES, STEPPED_OVER]
-"""The figures that count intervals (added up over reads; the others are maxima)."""
+estimate does not carry (`engine.estimator.DENSE_MAX`)."""
 NOT_INTEGRATED = "none (no input interval was integrated)"
 """The estimated error of a run where nothing was estimated (`ErrorEstimate.estimated` false)."""
 WARN_FORCE_ERROR_REL = 0.01
@@ -53,10 +42,6 @@ class ErrorEstimate:
         uncarried_states: the model's states whose error the estimate does not carry from
             interval to interval (a model of more than `engine.estimator.DENSE_MAX` states:
             its mounts' internal states).
-        stepped_over_intervals: input intervals over which the companion, by the Rosenbrock
-            as the twin, took steps too long for the body's fastest mode (`engine.companion`):
-            they damp it, as the twin's do, and the error of that mode is not in the estimate.
-        intervals: the input intervals estimated.
     """
 
     force_error_rel: float
@@ -64,8 +49,6 @@ class ErrorEstimate:
     attitude_error_rad: float
     failed_checks: int
     uncarried_states: int
-    stepped_over_intervals: int
-    intervals: int
 
     @property
     def estimated(self) -> bool:
@@ -81,9 +64,8 @@ class ErrorEstimate:
 
     @property
     def lower_bound(self) -> bool:
-        """Whether the figures may be short of the error (failed checks, uncarried states,
-        intervals stepped over)."""
-        return any((self.failed_checks, self.uncarried_states, self.stepped_over_intervals))
+        """Whether the figures may be short of the error (failed checks, uncarried states)."""
+        return self.failed_checks > 0 or self.uncarried_states > 0
 
     @classmethod
     def of(cls, figures: np.ndarray, intervals: int) -> ErrorEstimate:
@@ -98,14 +80,11 @@ class ErrorEstimate:
             float(figures[ATTITUDE_ERROR]) if estimated else math.nan,
             int(figures[FAILURES]),
             int(figures[UNCARRIED]),
-            int(figures[STEPPED_OVER]),
-            intervals,
         )
 
 
 def accumulate(total: np.ndarray, figures: np.ndarray) -> None:
-    """Fold figures (as the core keeps them) into `total`: the counts of intervals (COUNTS)
-    added, the rest maxima."""
-    counts = total[COUNTS] + figures[COUNTS]
+    """Fold figures (as the core keeps them) into `total`: failures added, the rest maxima."""
+    failures = total[FAILURES] + figures[FAILURES]
     np.maximum(total, figures, out=total)
-    total[COUNTS] = counts
+    total[FAILURES] = failures

@@ -237,7 +237,6 @@ class HealthStatuses(InputStatus):
             "est_attitude_error_rad": f"{est.attitude_error_rad:.2g}",
             "est_failed_checks": str(est.failed_checks),
             "est_uncarried_states": str(est.uncarried_states),
-            "est_stepped_over_intervals": str(est.stepped_over_intervals),
             "est_force_error_rel_run": f"{run.force_error_rel:.2g}",
             "est_force_error_n_run": f"{run.force_error_n:.3g}",
             "est_attitude_error_rad_run": f"{run.attitude_error_rad:.2g}",

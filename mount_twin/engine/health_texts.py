@@ -6,11 +6,7 @@ bag back."""
 from __future__ import annotations
 
 from mount_twin.engine.batch import MountEvent
-from mount_twin.engine.estimate import (
-    STEPPED_OVER_WARN_SHARE,
-    WARN_FORCE_ERROR_REL,
-    ErrorEstimate,
-)
+from mount_twin.engine.estimate import WARN_FORCE_ERROR_REL, ErrorEstimate
 
 PREFIX = "mount_twin"
 INTEGRATION = f"{PREFIX}: integration"
@@ -88,23 +84,14 @@ def why_none(nothing: str) -> str:
 
 def estimate_warning(run: ErrorEstimate) -> str | None:
     """The integration status' warning on the estimated error of everything published so far
-    (`run`), None while it is within WARN_FORCE_ERROR_REL of the largest force and its
-    companion stepped over the body's fastest mode in at most STEPPED_OVER_WARN_SHARE of the
-    intervals: the figure of the diagnostics and of the replay summary, one definition."""
-    warnings = []
-    if run.force_error_rel > WARN_FORCE_ERROR_REL:  # NaN: nothing estimated yet
-        warnings.append(
-            f"estimated mount-force error {run.force_error_rel:.2g} of the largest force over "
-            "the run so far"
-        )
-    if run.stepped_over_intervals > STEPPED_OVER_WARN_SHARE * run.intervals:
-        warnings.append(
-            f"the error estimate's companion stepped over the body's fastest mode in "
-            f"{run.stepped_over_intervals} of {run.intervals} intervals (the Rosenbrock damps "
-            "it in the twin and its companion alike): the error of that mode is not in the "
-            "estimate"
-        )
-    return "; ".join(warnings) + ": tighten integration.rtol" if warnings else None
+    (`run`), None while it is within WARN_FORCE_ERROR_REL of the largest force: the figure of
+    the diagnostics and of the replay summary, one definition."""
+    if not run.force_error_rel > WARN_FORCE_ERROR_REL:  # NaN: nothing estimated yet
+        return None
+    return (
+        f"estimated mount-force error {run.force_error_rel:.2g} of the largest force over the "
+        "run so far: tighten integration.rtol"
+    )
 
 
 def samples_text(n: int) -> str:

@@ -30,7 +30,7 @@ constexpr int POSITION = 0, QUATERNION = 3, ANGLES = 7, WIDTH = 10;
 
 // The error estimate's figures (engine/estimate.py).
 enum Figure : int {
-  FORCE_ERROR = 0, ATTITUDE_ERROR, FORCE_SCALE, FAILURES, UNCARRIED, STEPPED_OVER, N_FIGURES
+  FORCE_ERROR = 0, ATTITUDE_ERROR, FORCE_SCALE, FAILURES, UNCARRIED, N_FIGURES
 };
 
 // run_samples' status when it ended the run at an event that may stiffen the scene.

@@ -18,8 +18,7 @@ PYBIND11_MODULE(_core_ext, m) {
                                             mt::pose_row::ANGLES, mt::pose_row::WIDTH);
   m.attr("FIGURE_SLOTS") = pybind11::make_tuple(int(mt::FORCE_ERROR), int(mt::ATTITUDE_ERROR),
                                                 int(mt::FORCE_SCALE), int(mt::FAILURES),
-                                                int(mt::UNCARRIED), int(mt::STEPPED_OVER),
-                                                int(mt::N_FIGURES));
+                                                int(mt::UNCARRIED), int(mt::N_FIGURES));
   m.attr("AT_EVENT") = mt::AT_EVENT;
   m.attr("SOURCE_SHA256") = MT_SOURCE_SHA256;
   m.attr("INPUT_SIZE") = mt::INPUT_SIZE;

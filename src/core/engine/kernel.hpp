@@ -285,21 +285,6 @@ inline void resynchronise(Companion& c, Vec y) {
   c.figures[FAILURES] += 1.0;
 }
 
-/// A step of the Rosenbrock longer than this over the body's fastest mode's rate (rad/s) damps
-/// that mode by more than a tenth (|R(2i)| = 0.88; R its stability function, L-stable).
-constexpr double STEP_OVER = 2.0;
-
-/// Whether the companion's steps just taken over an interval of h, by the Rosenbrock, were
-/// longer than STEP_OVER over the body's fastest mode on the Jacobian it holds (`fastest_rate`:
-/// a key bearing, a snubber pressed; not one open): they damp that mode, as the twin's do, and
-/// the error of it is in neither solution, nor in their difference (engine/companion.py).
-inline bool stepped_over(const Model& m, const Companion& c, double h) {
-  if (c.integ.method != ROS34PW2) return false;
-  const idx n = c.y.n, nf = m.free_trans.n + m.free_rot.n;
-  const Mat jac{&c.integ.work2d(integrate::ros34pw2::J0, 0), n, n};
-  return fastest_rate(jac, nf) * h > STEP_OVER * c.integ.result[1];
-}
-
 /// Advance the companion over [t0, t1] under the input u the twin just took
 /// (`companion_advance`, as `stepping` says), take its mounts' switches, and fold the
 /// differences of its outputs from the twin's (pose, wrenches at t1; y the twin's state): its
@@ -316,7 +301,6 @@ inline void follow(const Model& m, Companion& c, Vec u, double t0, double t1, bo
     resynchronise(c, y);
     return;
   }
-  if (stepped_over(m, c, t1 - t0)) c.figures[STEPPED_OVER] += 1.0;
   // the body's motion at c.y: its last rhs; the monitors in the wrenches' pass
   physics::MonitorRows mon{c.y_prev, c.g, c.util};
   physics::mount_wrenches(c.y, m, c.s, c.wrenches, m.has_nl ? &mon : nullptr);
