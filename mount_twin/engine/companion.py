@@ -115,8 +115,18 @@ error a small share of the twin's; 8 new right-hand sides a step); where the twi
 linearising method it runs that method at least MIN_STEPS = 2 steps an interval (HIGHER,
 `own_method`; `switch` follows the twin), but beside the Rosenbrock on a scene whose stiff
 modes are its linear mounts' (`Model.linear_stiffness`), where it runs the exponential method at
-one step (EXACT_ON_LINEAR: the Rosenbrock damps the stiff modes, its own companion too). This
-stepper is also the carried error's check.
+one step (EXACT_ON_LINEAR: the Rosenbrock damps the stiff modes, its own companion too). On
+other scenes beside the Rosenbrock it runs the exponential method at one step over an interval
+whose twin steps were longer than 2/ω of the body's fastest mode on the twin's Jacobian
+(`exact_method`, kernel.hpp `stepped_over`, Stepping EXACT; its Jacobian and φ functions kept
+over consecutive such intervals): there the Rosenbrock damps that mode (|R(2i)| = 0.88 a step),
+and its own companion's steps, shorter but damping too, left the error of it out. 10 kg on four
+1e9 N/m Bouc–Wen elastomers of strong hysteresis under 1 kHz ship motion read 0.29, 0.08 and
+0.64 of its true force error at rtol 1e-3, 1e-4 and 1e-5 by the Rosenbrock's own companion
+(at twelve steps an interval still 0.17), 1.08–1.09 so, at 1.34–1.40× the engine's time
+against 1.44–2.18×; the stiff scene beside a snubbed elastomer 0.28, 0.18 and 0.76, and 1.00
+so, at 0.92–1.07× (docs/scene.md has the table). Beside a stiff key or snubber no interval is
+stepped over, so nothing changes there. This stepper is also the carried error's check.
 Where a joint's faces switch inside the steps (an interval that starts with a joint's event
 holding, its treatment "switching", over which the twin's tolerance bound its steps: more than
 one, or one rejected), the companion runs the twin's own method at MIN_STEPS steps at least
@@ -223,6 +233,7 @@ MIN_STEPS = 2
     KICK_RATE,
     RATED,
     TWIN_RATED,
+    EXACT_HELD,
     N_CARRY_SLOTS,
 ) = _core.CARRY_SLOTS
 """Slots of `Companion.carry` (src/core/engine/kernel.hpp CarrySlot)."""
@@ -237,8 +248,10 @@ a companion by the Rosenbrock damps them too; the exponential method is exact on
 part. On 10 kg on 4 × 1e9 N/m beside a soft Bouc–Wen elastomer under 1 kHz ship motion the
 Rosenbrock's own companion read 0.28, 0.88 and 0.85 of the true force error at rtol 1e-3, 1e-6
 and 1e-9; this one 1.00, 1.00, 1.00 (2026-11-29). Where a law has pieces it is the worst method
-there is: beside a 1e9 N/m key or snubber at 1 kHz it read 17–381 times the true error
-(docs/scene.md), so the Rosenbrock's own it stays."""
+there is as the companion throughout: beside a 1e9 N/m key or snubber at 1 kHz it read 17–381
+times the true error (docs/scene.md), so the Rosenbrock's own it stays, but over an interval
+whose twin steps passed over the body's fastest mode, where the Rosenbrock's own reads a
+fraction of the error (`exact_method`)."""
 
 
 def own_method(twin: int, linear_stiffness: bool) -> tuple[int, int]:
@@ -249,6 +262,15 @@ def own_method(twin: int, linear_stiffness: bool) -> tuple[int, int]:
     if linear_stiffness and twin in EXACT_ON_LINEAR:
         return EXACT_ON_LINEAR[twin], 1
     return (HIGHER[twin], 1) if twin in HIGHER else (twin, MIN_STEPS)
+
+
+def exact_method(twin: int, linear_stiffness: bool) -> int:
+    """The method (an id) the companion of a twin running `twin` (an id) takes at one step over
+    an interval whose twin steps were longer than the body's fastest mode allows (kernel.hpp
+    `stepped_over`): EXACT_ON_LINEAR's, where that is not its own already (`own_method`); -1
+    where there is none (an explicit twin's steps are bound to its fastest mode)."""
+    exact = EXACT_ON_LINEAR.get(twin, -1)
+    return -1 if exact == own_method(twin, linear_stiffness)[0] else exact
 
 
 def switching_method(twin: int, linear_stiffness: bool) -> tuple[int, int]:
@@ -271,6 +293,8 @@ class Companion(NamedTuple):
     switching_method, switching_min_steps: the method (an id) and fewest steps it takes
     instead, with the same arrays, over an interval where a joint's faces switch, and at twice
     those steps across an event's crossing (`switching_method`).
+    exact_method: the method (an id) it takes at one step, with the same arrays, over an
+    interval whose twin steps passed over the body's fastest mode (`exact_method`; -1: none).
     y: (n_state,) its state; s: its scratch (its angles at the last sample: s.q[3:6]);
     y_prev, g, util: its mount monitors' arrays (its switches are taken with them); g_prev:
     g at a carried interval's start, while its end is monitored (the interval is integrated
@@ -294,6 +318,7 @@ class Companion(NamedTuple):
     result: np.ndarray
     switching_method: int
     switching_min_steps: int
+    exact_method: int
     y: np.ndarray
     s: Scratch
     y_prev: np.ndarray
@@ -331,7 +356,13 @@ def new_companion(
     scene's stiff modes are its linear mounts' (`Model.linear_stiffness`)."""
     twin = METHODS["dopri54" if method == AUTO else method].id
     own, min_steps = own_method(twin, linear_stiffness)
-    name = AUTO if method == AUTO else next(k for k, m in METHODS.items() if m.id == own)
+    exact = exact_method(twin, linear_stiffness)
+    # arrays that hold every method where it may take another than its own
+    name = (
+        AUTO
+        if method == AUTO or exact >= 0
+        else next(k for k, m in METHODS.items() if m.id == own)
+    )
     arrays = tighter_arrays(
         name,
         n,
@@ -348,6 +379,7 @@ def new_companion(
         own,
         *arrays[1:],
         *switching_method(twin, linear_stiffness),
+        exact,
         np.zeros(n),
         scratch,
         np.zeros(n),
@@ -388,7 +420,12 @@ def switch(c: Companion, method: int) -> Companion:
     forget(settings)
     _reset_carry(c.carry, own)
     switching, fewest = switching_method(method, c.linear_stiffness)
-    return c._replace(method=own, switching_method=switching, switching_min_steps=fewest)
+    return c._replace(
+        method=own,
+        switching_method=switching,
+        switching_min_steps=fewest,
+        exact_method=exact_method(method, c.linear_stiffness),
+    )
 
 
 def restart(c: Companion, y: np.ndarray) -> None:

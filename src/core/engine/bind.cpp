@@ -126,6 +126,12 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
                           " work rows: not an explicit pair both hold, nor its own method, "
                           "or under 1 step");
   }
+  c.exact_method = field(obj, "exact_method").cast<int>();
+  if (c.exact_method >= 0 && !(integrate::work_rows(c.exact_method, n_state) >= 0 &&
+                               c.integ.work2d.rows >= integrate::work_rows(c.exact_method, n_state))) {
+    throw py::value_error("Companion.exact_method " + std::to_string(c.exact_method) + " in " +
+                          std::to_string(c.integ.work2d.rows) + " work rows: not a method they hold");
+  }
   c.y = convert::vec(field(obj, "y"), "Companion.y", n_state);
   c.s = convert::scratch(field(obj, "s"));
   c.y_prev = convert::vec(field(obj, "y_prev"), "Companion.y_prev", n_state);
@@ -220,7 +226,7 @@ void bind_engine(py::module_& mod) {
   mod.attr("CARRY_SLOTS") = py::make_tuple(
       int(engine::CARRYING), int(engine::SINCE_CHECK), int(engine::CHECK_NORM),
       int(engine::NORM_MEAN), int(engine::INTERVALS), int(engine::KICK_RATE), int(engine::RATED),
-      int(engine::TWIN_RATED),
+      int(engine::TWIN_RATED), int(engine::EXACT_HELD),
       int(engine::N_CARRY_SLOTS));
   py::dict treatments;
   treatments["carried"] = int(engine::CARRIED_THROUGH);

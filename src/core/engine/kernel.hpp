@@ -61,6 +61,8 @@ struct Companion {
   Integrator integ;
   int switching_method;        // where a joint's faces switch inside the steps (`follow`) ...
   double switching_min_steps;  // ... this method, at least this many steps, in integ's arrays
+  int exact_method;  // where the twin's steps passed over the body's fastest mode, this one at
+                     // one step at least, in integ's arrays (-1: none; `stepped_over`)
   Vec y;
   Scratch s;
   Vec y_prev;
@@ -98,6 +100,7 @@ enum CarrySlot : int {
   KICK_RATE,     // rad/s: the body's fastest mode on its mounts' tangents (model.tangent_rate)
   RATED,         // 1: RATE holds f at the companion's state, under the last interval's input
   TWIN_RATED,    // 1: TWIN_RATE holds the twin's f at the interval's start, under its input
+  EXACT_HELD,    // 1: the stepper's settings hold exact_method's linearisation (`EXACT`)
   N_CARRY_SLOTS
 };
 
@@ -213,6 +216,7 @@ enum Stepping : int {
   SWITCHED,   // c.switching_method at least c.switching_min_steps steps
   HALVED,     // its own method at twice its fewest steps
   SWITCHED_HALVED,  // c.switching_method at twice c.switching_min_steps steps
+  EXACT,      // c.exact_method at one step at least (`stepped_over`)
 };
 
 /// The highest treatment of the events whose function changed sign from g0 to g (the same
@@ -261,8 +265,19 @@ inline int companion_advance(const Model& m, Companion& c, Vec y, double t0, dou
       method = c.switching_method;
       fewest = 2.0 * c.switching_min_steps;
       break;
+    case EXACT:
+      method = c.exact_method;
+      fewest = 1.0;
+      break;
     case CARRIED:  // a carried interval is not integrated: asked to, a caller's mistake, failed
       return UNKNOWN_METHOD;  // (`follow` resynchronises; the estimate counts the failure)
+  }
+  const double exact = stepping == EXACT ? 1.0 : 0.0;
+  if (c.carry[EXACT_HELD] != exact) {  // the other method's Jacobian and φ functions: not ours
+    settings[JACOBIAN_AGE] = 0.0;
+    settings[PHI_STEP] = 0.0;
+    settings[CHAINED] = 0.0;
+    c.carry[EXACT_HELD] = exact;
   }
   if (method == g.method && fewest == min_steps) {  // its own stepping: nothing to set
     return integrate::advance(method, y, t0, t1, settings, m, c.s, u, g.work2d, g.work1d,
@@ -283,6 +298,23 @@ inline void resynchronise(Companion& c, Vec y) {
   copy(y, c.y_prev);
   integrate::forget(c.integ.settings);
   c.figures[FAILURES] += 1.0;
+}
+
+/// A step of the Rosenbrock longer than this over the body's fastest mode's rate (rad/s) damps
+/// that mode by more than a tenth (|R(2i)| = 0.88; R its stability function, L-stable).
+constexpr double STEP_OVER = 2.0;
+
+/// Whether the twin's steps over an interval of h (twin: its stepper after them) were longer
+/// than STEP_OVER over the body's fastest mode on the Jacobian it holds (`fastest_rate`: a key
+/// bearing and a snubber pressed count, not one open), where it runs the Rosenbrock and the
+/// companion has an exact method (Companion.exact_method): the Rosenbrock damps such a mode
+/// (L-stable) and its error estimate does not see it, so a companion by the Rosenbrock too
+/// damps it as the twin does, and its error is in neither (engine/companion.py).
+inline bool stepped_over(const Model& m, const Companion& c, const Integrator& twin, double h) {
+  if (c.exact_method < 0 || twin.method != ROS34PW2) return false;
+  const idx n = c.y.n, nf = m.free_trans.n + m.free_rot.n;
+  const Mat jac{&twin.work2d(integrate::ros34pw2::J0, 0), n, n};
+  return fastest_rate(jac, nf) * h > STEP_OVER * twin.result[1];
 }
 
 /// Advance the companion over [t0, t1] under the input u the twin just took
@@ -563,6 +595,9 @@ inline RunResult run_samples(Integrator& integ, const Model& m, Scratch& s, Vec 
         // where the twin's tolerance bound its steps while an event holds that switches the
         // law inside the steps (a joint's faces between sticking and sliding): switched
         stepping = holding == SWITCHING && twin_bound(integ.result) ? SWITCHED : OWN;
+      }
+      if (stepping != CARRIED && stepped_over(m, *companion, integ, smp.t[j] - smp.t[j - 1])) {
+        stepping = EXACT;
       }
       if (stepping != CARRIED) {
         follow(m, *companion, u, smp.t[j - 1], smp.t[j], opts.chain, stepping, d_wdot,
