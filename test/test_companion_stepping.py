@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 from loop_helpers import companion_of, step_one_interval
 
 from mount_twin.engine import companion
@@ -78,3 +79,18 @@ def test_a_contacts_crossing_is_halved_by_the_companions_own_method() -> None:
     comp = _one_interval_crossing(model, (_first(model, "shear_key"), contact))
     assert np.isfinite(comp.work2d[_dopri54_rows(model) :]).all()
     assert comp.result[1] >= 2
+
+
+def test_the_loop_refuses_an_exact_method_the_companions_arrays_do_not_hold() -> None:
+    """The companion of Dormand–Prince has arrays for Verner's pair and Dormand–Prince alone:
+    given the exponential method for the intervals its twin steps over (which only a Rosenbrock
+    twin's companion takes, in arrays made for every method), the loop refuses it by name
+    before any step, where the φ functions would have run past the arrays."""
+    model = assemble(load_scene_file(GENSET))
+    g = np.array([0.0, 0.0, model.scene.input.g])
+    y = initial_state(model, g)
+    comp = companion_of(model, "dopri54")._replace(exact_method=METHODS["exprb32"].id)
+    assert comp.work2d.shape[0] < METHODS["exprb32"].work_rows(model.n_state)
+    watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
+    with pytest.raises(ValueError, match=r"Companion\.exact_method"):
+        step_one_interval(model, y, g, watch, chain=False, estimate=comp)

@@ -126,11 +126,11 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
                           " work rows: not an explicit pair both hold, nor its own method, "
                           "or under 1 step");
   }
-  c.exact_method = field(obj, "exact_method").cast<int>();
-  if (c.exact_method >= 0 && !(integrate::work_rows(c.exact_method, n_state) >= 0 &&
-                               c.integ.work2d.rows >= integrate::work_rows(c.exact_method, n_state))) {
+  c.exact_method = field(obj, "exact_method").cast<int>();  // -1: none
+  const idx exact_rows = c.exact_method < 0 ? 0 : integrate::work_rows(c.exact_method, n_state);
+  if (exact_rows < 0 || c.integ.work2d.rows < exact_rows) {
     throw py::value_error("Companion.exact_method " + std::to_string(c.exact_method) + " in " +
-                          std::to_string(c.integ.work2d.rows) + " work rows: not a method they hold");
+                          std::to_string(c.integ.work2d.rows) + " work rows: not one they hold");
   }
   c.y = convert::vec(field(obj, "y"), "Companion.y", n_state);
   c.s = convert::scratch(field(obj, "s"));
