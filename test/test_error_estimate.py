@@ -45,6 +45,7 @@ from mount_twin.engine.estimator import (
     FLOOR_DIVISOR,
     JACOBIAN_KEEP,
     LINEARISATIONS,
+    LINEARISE_EVERY,
     N_CARRIED,
     PROPAGATOR_STEP,
     TOLERANCE_DIVISOR,
@@ -467,19 +468,34 @@ def test_the_decay_an_interval_is_how_much_of_each_mode_the_propagator_keeps(cas
 
 def test_a_linearisation_keeps_the_propagator_while_the_jacobian_moves_less_than_1e_3() -> None:
     """On the pump under ship motion the Jacobian moves 1.6e-5–1.0e-4 between linearisations:
-    within JACOBIAN_KEEP (1e-3) the propagator is computed once, with 1e-6 at every one; the
-    estimate is the same within 1 %, and the propagator held is exp(h·J) of the Jacobian held
-    (scipy's exponential)."""
-    kept, fresh = (
-        _estimator_after("pump_ship_motion", jacobian_keep=keep) for keep in (JACOBIAN_KEEP, 1e-6)
+    within JACOBIAN_KEEP (1e-3) the propagator is computed once, and the span to the next
+    linearisation doubles each time, to LINEARISE_MAX check periods; with 1e-6 the propagator
+    is computed at every one, and the span stays LINEARISE_EVERY, as it does where it may not
+    grow. The estimate is the same within 1 %, and the propagator held is exp(h·J) of the
+    Jacobian held (scipy's exponential)."""
+    kept, fresh, fixed = (
+        _estimator_after("pump_ship_motion", **settings)
+        for settings in (
+            {"jacobian_keep": JACOBIAN_KEEP},
+            {"jacobian_keep": 1e-6},
+            {"linearise_max": LINEARISE_EVERY},
+        )
     )
-    assert kept.state[LINEARISATIONS] == fresh.state[LINEARISATIONS] > 20
+    assert fresh.state[LINEARISATIONS] == fixed.state[LINEARISATIONS] > 20
+    assert kept.state[LINEARISATIONS] <= fixed.state[LINEARISATIONS] / 3
     assert kept.state[EXPONENTIALS] <= 2
     assert fresh.state[EXPONENTIALS] >= fresh.state[LINEARISATIONS]
     np.testing.assert_allclose(kept.e, fresh.e, rtol=1e-2, atol=1e-2 * abs(fresh.e).max())
     h, nc = float(kept.state[PROPAGATOR_STEP]), int(kept.state[N_CARRIED])
     jac, prop = kept.jac[: nc * nc].reshape(nc, nc), kept.prop[: nc * nc].reshape(nc, nc)
     np.testing.assert_allclose(prop.T, scipy.linalg.expm(h * jac), rtol=1e-6, atol=1e-9)
+
+
+def test_the_core_refuses_a_span_cap_below_the_first_span() -> None:
+    """LINEARISE_MAX below LINEARISE_EVERY would shrink the span where the propagator holds:
+    the core refuses it by name before any interval."""
+    with pytest.raises(ValueError, match="LINEARISE_MAX >= LINEARISE_EVERY"):
+        _estimator_after("pump_ship_motion", linearise_max=LINEARISE_EVERY - 1)
 
 
 @pytest.mark.parametrize("case", ["rubber_on_snubbers", "pump_ship_motion"])

@@ -15,9 +15,12 @@ fan"). The estimate follows that recursion with
 - Φ ≈ exp(h·J): J = ∂f/∂y by forward differences at the twin's state over the carried states
   (the body's, and the mounts' internal states that move there: a Bouc–Wen z, a joint while it
   slips; not a stuck joint's), taken again after a mount's event, at every check while a mount
-  is engaged, and every LINEARISE_EVERY × CHECK_EVERY intervals of regular checks; its
-  exponential by scaling and squaring (`src/core/linalg.hpp`), computed again only where J
-  moved by more than JACOBIAN_KEEP; one matrix-vector product per interval;
+  is engaged, and every LINEARISE_EVERY × CHECK_EVERY intervals of regular checks, a span that
+  doubles at each linearisation that finds J within JACOBIAN_KEEP of the one the propagator
+  came from, up to LINEARISE_MAX × CHECK_EVERY (on the pump under ship motion 7 linearisations
+  in 5 s where there were 32, and the estimate the same); its exponential by scaling and
+  squaring (`src/core/linalg.hpp`), computed again only where J moved by more than
+  JACOBIAN_KEEP; one matrix-vector product per interval;
 - ℓ measured, not modelled: from the twin's state at the interval's start, a checking stepper
   (the twin's method, the exponential one for a Rosenbrock twin: CHECKED_BY; at rtol and atol
   over TOLERANCE_DIVISOR, less below rtol 1e-8: `check_divisor`; at least MIN_STEPS steps)
@@ -158,9 +161,13 @@ SPIKE_RATIO = _core.SPIKE_RATIO
 """An interval whose twin's error norm is above this multiple of its running mean is measured
 on its own (the core's constant)."""
 LINEARISE_EVERY = 2
-"""Check periods (CHECK_EVERY intervals) of regular checks between linearisations: two checks
-32 apart, or the early ones that stand for as many intervals (a mount's event linearises at
-once)."""
+"""Check periods (CHECK_EVERY intervals) of regular checks between linearisations at first: two
+checks 32 apart, or the early ones that stand for as many intervals (a mount's event linearises
+at once)."""
+LINEARISE_MAX = 16
+"""... and at most: each linearisation that finds the propagator held (the Jacobian within
+JACOBIAN_KEEP of the one it came from) doubles the span to the next, one that does not sets it
+back to LINEARISE_EVERY (src/core/engine/estimator.hpp `linearise_span`)."""
 JACOBIAN_KEEP = 1e-3
 """A linearisation keeps the propagator held (and the decay) while its fresh Jacobian is within
 this share of the one they came from (Frobenius norms; the same carried states, the same
@@ -171,7 +178,9 @@ of the engine's samples under perf (src/core/engine/estimator.hpp `propagator_ho
 (
     CHECK_EVERY_SLOT,
     LINEARISE_EVERY_SLOT,
+    LINEARISE_MAX_SLOT,
     JACOBIAN_KEEP_SLOT,
+    LINEARISE_SPAN,
     PENDING,
     PENDING_NORM,
     PROPAGATOR_STEP,
@@ -187,6 +196,7 @@ of the engine's samples under perf (src/core/engine/estimator.hpp `propagator_ho
 ) = _core.ESTIMATOR_SLOTS
 """Slots of `Estimator.state` (src/core/engine/estimator.hpp says what each keeps)."""
 KEPT = [
+    LINEARISE_SPAN,
     PENDING,
     PENDING_NORM,
     PROPAGATOR_STEP,
@@ -253,12 +263,14 @@ def new_estimator(
     n_mounts: int,
     check_every: int = CHECK_EVERY,
     jacobian_keep: float = JACOBIAN_KEEP,
+    linearise_max: int = LINEARISE_MAX,
 ) -> Estimator:
     """The estimate of a twin integrated by `method` (a name, or AUTO: then `switch` it with
     the twin) at tolerances rtol, atol; `scratch`: fresh work arrays of the model (its n
     states); n_free: the body's free coordinates; check_every: see CHECK_EVERY (1 measures
     every interval: the reference the sampling is tested against); jacobian_keep: see
-    JACOBIAN_KEEP (0 computes the propagator at every linearisation)."""
+    JACOBIAN_KEEP (0 computes the propagator at every linearisation); linearise_max: see
+    LINEARISE_MAX (LINEARISE_EVERY keeps the span where it starts)."""
     n = scratch.sink.shape[0]
     check = CHECKED_BY.get(method, method)
     own = tighter_arrays(check, n, rtol, atol, max_substeps, check_divisor(rtol), MIN_STEPS)
@@ -268,6 +280,7 @@ def new_estimator(
     state = np.zeros(N_SLOTS)
     state[CHECK_EVERY_SLOT] = check_every
     state[LINEARISE_EVERY_SLOT] = LINEARISE_EVERY
+    state[LINEARISE_MAX_SLOT] = linearise_max
     state[JACOBIAN_KEEP_SLOT] = jacobian_keep
     return Estimator(
         *own,

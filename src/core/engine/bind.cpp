@@ -61,9 +61,10 @@ engine::Watch watch(py::handle obj, idx k, idx n_state) {
 void check_estimator_state(const engine::Estimator& c) {
   const double nc = c.state[engine::N_CARRIED];
   if (!(c.state[engine::CHECK_EVERY] >= 1.0) || !(c.state[engine::LINEARISE_EVERY] >= 1.0) ||
+      !(c.state[engine::LINEARISE_MAX] >= c.state[engine::LINEARISE_EVERY]) ||
       !(nc >= 0.0 && nc <= static_cast<double>(c.carried.n))) {
     throw py::value_error("Estimator.state: CHECK_EVERY and LINEARISE_EVERY must be >= 1, "
-                          "N_CARRIED within the slots");
+                          "LINEARISE_MAX >= LINEARISE_EVERY, N_CARRIED within the slots");
   }
 }
 
@@ -213,8 +214,8 @@ struct Loop {
 
 void bind_engine(py::module_& mod) {
   mod.attr("ESTIMATOR_SLOTS") = py::make_tuple(
-      int(engine::CHECK_EVERY), int(engine::LINEARISE_EVERY), int(engine::JACOBIAN_KEEP),
-      int(engine::PENDING), int(engine::PENDING_NORM),
+      int(engine::CHECK_EVERY), int(engine::LINEARISE_EVERY), int(engine::LINEARISE_MAX),
+      int(engine::JACOBIAN_KEEP), int(engine::LINEARISE_SPAN), int(engine::PENDING), int(engine::PENDING_NORM),
       int(engine::PROPAGATOR_STEP), int(engine::FASTEST_RATE), int(engine::ERROR_NORM_MEAN),
       int(engine::SINCE_LINEARISED),
       int(engine::N_CARRIED), int(engine::CHECKS), int(engine::LINEARISATIONS),

@@ -18,12 +18,14 @@
 namespace mt::engine {
 
 /// Slots of the estimator's small state vector (engine/estimator.py: the same names): its
-/// settings (CHECK_EVERY, LINEARISE_EVERY, JACOBIAN_KEEP, set once), then what it keeps
-/// between intervals.
+/// settings (CHECK_EVERY, LINEARISE_EVERY, LINEARISE_MAX, JACOBIAN_KEEP, set once), then what
+/// it keeps between intervals.
 enum EstimatorSlot : int {
   CHECK_EVERY = 0,    // a measured interval counts for at most this many
-  LINEARISE_EVERY,    // check periods (CHECK_EVERY intervals) between linearisations
+  LINEARISE_EVERY,    // check periods (CHECK_EVERY intervals) between linearisations, at first
+  LINEARISE_MAX,      // ... and at most, doubled from LINEARISE_EVERY while the propagator holds
   JACOBIAN_KEEP,      // the propagator is kept while the Jacobian moves less than this share
+  LINEARISE_SPAN,     // check periods between linearisations now (0: LINEARISE_EVERY)
   PENDING,            // intervals not measured since the last check
   PENDING_NORM,       // the twin's error norms of those intervals, summed
   PROPAGATOR_STEP,    // s, the interval the propagator is for (0: none held)
@@ -184,6 +186,16 @@ inline idx choose_carried(Estimator& est, bool& same) {
   return left_out;
 }
 
+/// Check periods of regular checks from one linearisation to the next: LINEARISE_SPAN, or
+/// LINEARISE_EVERY before the first (`linearise_at` sets it). Where the Jacobian barely moves
+/// (the pump under ship motion: 1.6e-5–1.0e-4 of itself between linearisations two periods
+/// apart) its differences were a fifth of the estimate's cost, and each found the propagator
+/// held; a Jacobian that moved past JACOBIAN_KEEP since the propagator's came from brings the
+/// span back to LINEARISE_EVERY (engine/estimator.py LINEARISE_MAX says what it read).
+inline double linearise_span(const Vec st) {
+  return py_max(st[LINEARISE_SPAN], st[LINEARISE_EVERY]);
+}
+
 /// Whether the propagator held serves a fresh Jacobian `fresh` (nc², over the same carried
 /// states) for an interval of h: it is for h (STEP_MATCH), and the Jacobian it came from
 /// (est.jac) is within JACOBIAN_KEEP of `fresh` (Frobenius norms). A relative change δ of the
@@ -211,7 +223,9 @@ inline bool propagator_holds(const Estimator& est, const Mat fresh, double h) {
 /// Jacobian and output sensitivities at (t, est.y) by forward differences (the steppers'
 /// JAC_STEP) over the carried states, chosen afresh, then the propagator over h, unless the
 /// one held serves (`propagator_holds`: the Jacobian, differenced into est.work, then stays
-/// the one the propagator came from). False if an evaluation failed (off the chart).
+/// the one the propagator came from, and the span to the next linearisation doubles, up to
+/// LINEARISE_MAX check periods; where it does not, the span is LINEARISE_EVERY again). False
+/// if an evaluation failed (off the chart).
 inline bool linearise_at(const Model& m, Estimator& est, Vec u, double t, double h) {
   Scratch& s = est.s;
   const Vec y = est.y;
@@ -240,9 +254,14 @@ inline bool linearise_at(const Model& m, Estimator& est, Vec u, double t, double
     }
     for (idx r = 0; r < n_out; ++r) sens_t(c, r) = (est.out1[r] - est.out0[r]) / d;
   }
-  est.state[SINCE_LINEARISED] = 0.0;
-  est.state[LINEARISATIONS] += 1.0;
-  if (same && propagator_holds(est, fresh, h)) return true;
+  const Vec st = est.state;
+  st[SINCE_LINEARISED] = 0.0;
+  st[LINEARISATIONS] += 1.0;
+  if (same && propagator_holds(est, fresh, h)) {
+    st[LINEARISE_SPAN] = py_min(2.0 * linearise_span(st), st[LINEARISE_MAX]);
+    return true;
+  }
+  st[LINEARISE_SPAN] = st[LINEARISE_EVERY];
   for (idx i = 0; i < nc * nc; ++i) est.jac[i] = est.work[i];
   return propagator(est, h);
 }
@@ -413,7 +432,7 @@ inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, 
     if (regular) st[SINCE_LINEARISED] += st[PENDING] / every;  // an early check, its share
     st[PENDING] = special ? st[PENDING] - 1.0 : 0.0;
     if (!special) st[PENDING_NORM] = 0.0;
-    if (changed || engaged || !linearised || st[SINCE_LINEARISED] >= st[LINEARISE_EVERY]) {
+    if (changed || engaged || !linearised || st[SINCE_LINEARISED] >= linearise_span(st)) {
       copy(y, est.y);
       if (!linearise_at(m, est, u, t1, h)) st[PROPAGATOR_STEP] = 0.0;
     }
