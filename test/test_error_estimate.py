@@ -42,11 +42,14 @@ from mount_twin.engine.estimator import (
     CHECK_RTOL_FLOOR,
     CHECKS,
     EXPONENTIALS,
+    FASTEST_RATE,
     FLOOR_DIVISOR,
     JACOBIAN_KEEP,
     LINEARISATIONS,
     LINEARISE_EVERY,
     N_CARRIED,
+    OUTPUT_STRIDE_MAX,
+    OUTPUT_TURN,
     PROPAGATOR_STEP,
     TOLERANCE_DIVISOR,
     Estimator,
@@ -489,6 +492,26 @@ def test_a_linearisation_keeps_the_propagator_while_the_jacobian_moves_less_than
     h, nc = float(kept.state[PROPAGATOR_STEP]), int(kept.state[N_CARRIED])
     jac, prop = kept.jac[: nc * nc].reshape(nc, nc), kept.prop[: nc * nc].reshape(nc, nc)
     np.testing.assert_allclose(prop.T, scipy.linalg.expm(h * jac), rtol=1e-6, atol=1e-9)
+
+
+def test_the_outputs_errors_folded_each_half_radian_of_the_fastest_mode_keep_their_peaks() -> None:
+    """On the pump at 1 kHz the fastest mode, bounded at 157 rad/s from the Jacobian held, turns
+    OUTPUT_TURN (0.5 rad) in 3 intervals: the outputs' errors are folded every third interval
+    (and at every interval measured), and read at least cos(0.25) of what folding every
+    interval reads, never more (the same error, sampled)."""
+    est = _estimator_after("pump_ship_motion")
+    h, rate = float(est.state[PROPAGATOR_STEP]), float(est.state[FASTEST_RATE])
+    assert 2 <= math.floor(OUTPUT_TURN / (h * rate)) <= OUTPUT_STRIDE_MAX
+    scene, samples = CASES["pump_ship_motion"][0]()
+    strided = run_at(scene, samples, 1e-6, 100_000).estimate
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(driver_module, "new_estimator", partial(new_estimator, output_turn=0.0))
+        every = run_at(scene, samples, 1e-6, 100_000).estimate
+    assert strided is not None and every is not None
+    for name in ("force_error_n", "attitude_error_rad"):
+        ratio = getattr(strided, name) / getattr(every, name)
+        assert math.cos(0.5 * OUTPUT_TURN) <= ratio <= 1.0, (name, ratio)
+    assert strided.force_error_n != every.force_error_n
 
 
 def test_the_core_refuses_a_span_cap_below_the_first_span() -> None:

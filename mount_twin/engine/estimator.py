@@ -75,9 +75,11 @@ fan"). The estimate follows that recursion with
   count check periods, not checks). On the stiff scene the estimate's cost fell from 1.3–1.4×
   to 1.14–1.15× the engine (bench/error_estimate.py).
 
-The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities differenced with J).
-Cost per interval: two matrix-vector products (the propagator's over the carried states, the
-output sensitivities'; both held transposed, so the rows' sums advance side by side); per
+The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities differenced with J),
+folded into the figures every OUTPUT_TURN of the fastest mode's turn.
+Cost per interval: one matrix-vector product (the propagator's over the carried states), and
+every few the output sensitivities' (both held transposed, so the rows' sums advance side by
+side); per
 check, the check's steps and k products by the body's D (nf × nf); per linearisation, n + 1
 right-hand sides, and two exponentials (the propagator's, D's) where J moved.
 Engine time with it over without: 1.15–1.19× on the pump (1.16–1.24× before JACOBIAN_KEEP,
@@ -168,6 +170,14 @@ LINEARISE_MAX = 16
 """... and at most: each linearisation that finds the propagator held (the Jacobian within
 JACOBIAN_KEEP of the one it came from) doubles the span to the next, one that does not sets it
 back to LINEARISE_EVERY (src/core/engine/estimator.hpp `linearise_span`)."""
+OUTPUT_STRIDE_MAX = _core.OUTPUT_STRIDE_MAX
+"""The most intervals from one folding of the outputs' estimated errors to the next (the core's
+constant)."""
+OUTPUT_TURN = 0.5
+"""rad: the outputs' estimated errors are folded into the figures each time the fastest mode
+(bounded from the Jacobian held) has turned by this much, at most every OUTPUT_STRIDE_MAX
+intervals, and at every interval measured: a peak is read at cos(0.25) = 0.97 of its size at
+least (src/core/engine/estimator.hpp `output_stride`; the pump at 1 kHz every 3 intervals)."""
 JACOBIAN_KEEP = 1e-3
 """A linearisation keeps the propagator held (and the decay) while its fresh Jacobian is within
 this share of the one they came from (Frobenius norms; the same carried states, the same
@@ -180,7 +190,9 @@ of the engine's samples under perf (src/core/engine/estimator.hpp `propagator_ho
     LINEARISE_EVERY_SLOT,
     LINEARISE_MAX_SLOT,
     JACOBIAN_KEEP_SLOT,
+    OUTPUT_TURN_SLOT,
     LINEARISE_SPAN,
+    OUTPUT_PENDING,
     PENDING,
     PENDING_NORM,
     PROPAGATOR_STEP,
@@ -197,6 +209,7 @@ of the engine's samples under perf (src/core/engine/estimator.hpp `propagator_ho
 """Slots of `Estimator.state` (src/core/engine/estimator.hpp says what each keeps)."""
 KEPT = [
     LINEARISE_SPAN,
+    OUTPUT_PENDING,
     PENDING,
     PENDING_NORM,
     PROPAGATOR_STEP,
@@ -264,13 +277,15 @@ def new_estimator(
     check_every: int = CHECK_EVERY,
     jacobian_keep: float = JACOBIAN_KEEP,
     linearise_max: int = LINEARISE_MAX,
+    output_turn: float = OUTPUT_TURN,
 ) -> Estimator:
     """The estimate of a twin integrated by `method` (a name, or AUTO: then `switch` it with
     the twin) at tolerances rtol, atol; `scratch`: fresh work arrays of the model (its n
     states); n_free: the body's free coordinates; check_every: see CHECK_EVERY (1 measures
     every interval: the reference the sampling is tested against); jacobian_keep: see
     JACOBIAN_KEEP (0 computes the propagator at every linearisation); linearise_max: see
-    LINEARISE_MAX (LINEARISE_EVERY keeps the span where it starts)."""
+    LINEARISE_MAX (LINEARISE_EVERY keeps the span where it starts); output_turn: see
+    OUTPUT_TURN (0 folds the outputs' errors at every interval)."""
     n = scratch.sink.shape[0]
     check = CHECKED_BY.get(method, method)
     own = tighter_arrays(check, n, rtol, atol, max_substeps, check_divisor(rtol), MIN_STEPS)
@@ -281,6 +296,7 @@ def new_estimator(
     state[CHECK_EVERY_SLOT] = check_every
     state[LINEARISE_EVERY_SLOT] = LINEARISE_EVERY
     state[LINEARISE_MAX_SLOT] = linearise_max
+    state[OUTPUT_TURN_SLOT] = output_turn
     state[JACOBIAN_KEEP_SLOT] = jacobian_keep
     return Estimator(
         *own,

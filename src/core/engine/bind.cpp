@@ -62,9 +62,11 @@ void check_estimator_state(const engine::Estimator& c) {
   const double nc = c.state[engine::N_CARRIED];
   if (!(c.state[engine::CHECK_EVERY] >= 1.0) || !(c.state[engine::LINEARISE_EVERY] >= 1.0) ||
       !(c.state[engine::LINEARISE_MAX] >= c.state[engine::LINEARISE_EVERY]) ||
+      !(c.state[engine::OUTPUT_TURN] >= 0.0) ||
       !(nc >= 0.0 && nc <= static_cast<double>(c.carried.n))) {
     throw py::value_error("Estimator.state: CHECK_EVERY and LINEARISE_EVERY must be >= 1, "
-                          "LINEARISE_MAX >= LINEARISE_EVERY, N_CARRIED within the slots");
+                          "LINEARISE_MAX >= LINEARISE_EVERY, OUTPUT_TURN >= 0, N_CARRIED "
+                          "within the slots");
   }
 }
 
@@ -215,7 +217,8 @@ struct Loop {
 void bind_engine(py::module_& mod) {
   mod.attr("ESTIMATOR_SLOTS") = py::make_tuple(
       int(engine::CHECK_EVERY), int(engine::LINEARISE_EVERY), int(engine::LINEARISE_MAX),
-      int(engine::JACOBIAN_KEEP), int(engine::LINEARISE_SPAN), int(engine::PENDING), int(engine::PENDING_NORM),
+      int(engine::JACOBIAN_KEEP), int(engine::OUTPUT_TURN), int(engine::LINEARISE_SPAN),
+      int(engine::OUTPUT_PENDING), int(engine::PENDING), int(engine::PENDING_NORM),
       int(engine::PROPAGATOR_STEP), int(engine::FASTEST_RATE), int(engine::ERROR_NORM_MEAN),
       int(engine::SINCE_LINEARISED),
       int(engine::N_CARRIED), int(engine::CHECKS), int(engine::LINEARISATIONS),
@@ -239,6 +242,7 @@ void bind_engine(py::module_& mod) {
   mod.attr("PERIOD_SHARE") = engine::PERIOD_SHARE;
   mod.attr("BOUND_PERIOD_SHARE") = engine::BOUND_PERIOD_SHARE;
   mod.attr("SPIKE_RATIO") = engine::SPIKE_RATIO;
+  mod.attr("OUTPUT_STRIDE_MAX") = engine::OUTPUT_STRIDE_MAX;
   py::class_<Loop>(mod, "Loop",
                    "The per-sample loop's arrays (`run_samples`): each is converted and "
                    "checked (dtype, shape against the model) here, once; the Loop holds them, "

@@ -18,14 +18,16 @@
 namespace mt::engine {
 
 /// Slots of the estimator's small state vector (engine/estimator.py: the same names): its
-/// settings (CHECK_EVERY, LINEARISE_EVERY, LINEARISE_MAX, JACOBIAN_KEEP, set once), then what
-/// it keeps between intervals.
+/// settings (CHECK_EVERY, LINEARISE_EVERY, LINEARISE_MAX, JACOBIAN_KEEP, OUTPUT_TURN, set
+/// once), then what it keeps between intervals.
 enum EstimatorSlot : int {
   CHECK_EVERY = 0,    // a measured interval counts for at most this many
   LINEARISE_EVERY,    // check periods (CHECK_EVERY intervals) between linearisations, at first
   LINEARISE_MAX,      // ... and at most, doubled from LINEARISE_EVERY while the propagator holds
   JACOBIAN_KEEP,      // the propagator is kept while the Jacobian moves less than this share
+  OUTPUT_TURN,        // rad: the fastest mode's turn between foldings of the outputs' errors
   LINEARISE_SPAN,     // check periods between linearisations now (0: LINEARISE_EVERY)
+  OUTPUT_PENDING,     // intervals since the outputs' errors were last folded into the figures
   PENDING,            // intervals not measured since the last check
   PENDING_NORM,       // the twin's error norms of those intervals, summed
   PROPAGATOR_STEP,    // s, the interval the propagator is for (0: none held)
@@ -64,6 +66,8 @@ constexpr double SPIKE_RATIO = 4.0;
 constexpr double STEP_MATCH = 1e-6;
 /// Weight of the newest interval in the running mean of the twin's error norm.
 constexpr double MEAN_WEIGHT = 0.1;
+/// The most intervals from one folding of the outputs' estimated errors to the next.
+constexpr double OUTPUT_STRIDE_MAX = 8.0;
 
 /// The estimator's arrays (engine/estimator.py Estimator). n states; at most np_max carried:
 /// the body's and the internal states that move where it last linearised (`carried`).
@@ -146,6 +150,20 @@ inline double period_spacing(const Vec st, double h, double share) {
   const double period = 2.0 * M_PI / (st[FASTEST_RATE] * h);
   if (!(period >= 1.0)) return INFINITY;
   return py_max(1.0, std::floor(share * period));
+}
+
+/// Intervals of h from one folding of the outputs' estimated errors into the figures to the
+/// next (an interval whose local error was measured is folded besides): as many as the fastest
+/// mode (FASTEST_RATE, the propagator's bound) takes to turn by OUTPUT_TURN rad, at least 1, at
+/// most OUTPUT_STRIDE_MAX; 1 where no propagator is held. Between checks the estimated error is
+/// the free motion of the linearised modes, none faster than that bound, so a peak lies within
+/// half a stride of a folded interval and is read at cos(OUTPUT_TURN/2) of its size at least
+/// (0.97 at 0.5 rad: a signal of no frequency above ω keeps cos(ωτ) of a peak τ from it). Those
+/// products and maxima were half the estimate's cost on the pump, whose stride is 3 at 1 kHz.
+inline double output_stride(const Vec st, double h) {
+  if (!(st[PROPAGATOR_STEP] > 0.0)) return 1.0;
+  const double stride = std::floor(st[OUTPUT_TURN] / (h * st[FASTEST_RATE]));
+  return py_min(py_max(1.0, stride), OUTPUT_STRIDE_MAX);
 }
 
 /// The propagator over an interval of h from the Jacobian held, and the decay with it; false
@@ -391,7 +409,8 @@ inline void carry(Estimator& est) {
 /// `period_spacing`; it then counts for them); linearise again at
 /// the twin's state y after a mount's event, at every check while one is engaged, and every
 /// LINEARISE_EVERY check periods of regular checks (CHECK_EVERY intervals each: an early check
-/// counts for its share); fold the estimated errors of the outputs into the figures.
+/// counts for its share); fold the estimated errors of the outputs into the figures every
+/// `output_stride` intervals and at a measured one (the twin's largest force, every interval).
 /// A regular check may come early, from a quarter of CHECK_EVERY pending, where it can take the
 /// exponential twin's linearisation (`twin_linearisation_fits`: the twin renews its Jacobian
 /// every 20 intervals at most, so one such interval falls in every window of that length).
@@ -422,7 +441,8 @@ inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, 
   }
   const bool cheap = st[PENDING] >= 0.25 * every && twin_linearisation_fits(twin, est, h);
   const bool regular = !special && (st[PENDING] >= every || cheap);
-  if (special || regular || !linearised) {
+  const bool measured = special || regular || !linearised;
+  if (measured) {
     if (local_error(m, est, u, t0, t1, twin)) {
       const double weight = special ? 1.0 : stands_for(st[PENDING], st[PENDING_NORM], err);
       add_local_error(est, weight, linearised);
@@ -437,19 +457,21 @@ inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, 
       if (!linearise_at(m, est, u, t1, h)) st[PROPAGATOR_STEP] = 0.0;
     }
   }
+  double scale = fig[FORCE_SCALE];
+  for (idx a = 0; a < nm; ++a) {
+    for (int b = 0; b < 3; ++b) scale = py_max(scale, std::fabs(wrenches(a, b)));
+  }
+  fig[FORCE_SCALE] = scale;
+  st[OUTPUT_PENDING] += 1.0;
+  if (!measured && st[OUTPUT_PENDING] < output_stride(st, h)) return;
+  st[OUTPUT_PENDING] = 0.0;
   const idx nc = static_cast<idx>(st[N_CARRIED]);
   for (idx c = 0; c < nc; ++c) est.ec[c] = e[static_cast<idx>(est.carried[c])];
   linalg::matvec_t(Mat{est.sens.d, nc, n_out}, est.ec.d, est.out1.d);
-  double force = fig[FORCE_ERROR], scale = fig[FORCE_SCALE], attitude = fig[ATTITUDE_ERROR];
-  for (idx a = 0; a < nm; ++a) {
-    for (int b = 0; b < 3; ++b) {
-      force = py_max(force, std::fabs(est.out1[3 * a + b]));
-      scale = py_max(scale, std::fabs(wrenches(a, b)));
-    }
-  }
+  double force = fig[FORCE_ERROR], attitude = fig[ATTITUDE_ERROR];
+  for (idx i = 0; i < 3 * nm; ++i) force = py_max(force, std::fabs(est.out1[i]));
   for (idx i = 3 * nm; i < n_out; ++i) attitude = py_max(attitude, std::fabs(est.out1[i]));
   fig[FORCE_ERROR] = force;
-  fig[FORCE_SCALE] = scale;
   fig[ATTITUDE_ERROR] = attitude;
 }
 
