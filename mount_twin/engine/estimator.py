@@ -17,10 +17,10 @@ fan"). The estimate follows that recursion with
   slips; not a stuck joint's), taken again after a mount's event, at every check while a mount
   is engaged, and every LINEARISE_EVERY × CHECK_EVERY intervals of regular checks, a span that
   doubles at each linearisation that finds J within JACOBIAN_KEEP of the one the propagator
-  came from, up to LINEARISE_MAX × CHECK_EVERY (on the pump under ship motion 7 linearisations
-  in 5 s where there were 32, and the estimate the same); its exponential by scaling and
-  squaring (`src/core/linalg.hpp`), computed again only where J moved by more than
-  JACOBIAN_KEEP; one matrix-vector product per interval;
+  came from, up to LINEARISE_MAX × CHECK_EVERY (the bundled pump under its 5 s of ship motion
+  linearises 12 times where it did 79, the estimate the same to three figures); its
+  exponential by scaling and squaring (`src/core/linalg.hpp`), computed again only where J
+  moved by more than JACOBIAN_KEEP; one matrix-vector product per interval;
 - ℓ measured, not modelled: from the twin's state at the interval's start, a checking stepper
   (the twin's method, the exponential one for a Rosenbrock twin: CHECKED_BY; at rtol and atol
   over TOLERANCE_DIVISOR, less below rtol 1e-8: `check_divisor`; at least MIN_STEPS steps)
@@ -76,19 +76,19 @@ fan"). The estimate follows that recursion with
   to 1.14–1.15× the engine (bench/error_estimate.py).
 
 The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities differenced with J),
-folded into the figures every OUTPUT_TURN of the fastest mode's turn.
-Cost per interval: one matrix-vector product (the propagator's over the carried states), and
-every few the output sensitivities' (both held transposed, so the rows' sums advance side by
-side); per
+folded into the figures every OUTPUT_TURN of the fastest mode's turn. Cost per interval: one
+matrix-vector product (the propagator's over the carried states), and every few intervals the
+output sensitivities' (both held transposed, so the rows' sums advance side by side); per
 check, the check's steps and k products by the body's D (nf × nf); per linearisation, n + 1
-right-hand sides, and two exponentials (the propagator's, D's) where J moved.
-Engine time with it over without: 1.15–1.19× on the pump (1.16–1.24× before JACOBIAN_KEEP,
-when under perf the interval's bookkeeping and products were 5 % of the samples and the
-linearisations' exponentials 3 %; 2026-11-26),
-2.1–2.8× where the twin rejects steps every interval (docs/scene.md "Error estimate",
-bench/error_estimate.py). The engaged-mount and internal-state handling below works for any
-model (measured on the non-linear scenes above) though the engine gives those the companion.
-It never touches the twin's state: the published numbers are identical with it on or off
+right-hand sides, and two exponentials (the propagator's, D's) where J moved. Engine time with
+it over without: 1.15–1.18× on the pump since the span and the stride above (1.23–1.27× before
+them, alternating, 2026-11-29; `python3 bench/bench_engine.py`), 1.15–1.19× earlier
+(1.16–1.24× before JACOBIAN_KEEP, when under perf the interval's bookkeeping and products were
+5 % of the samples and the linearisations' exponentials 3 %; 2026-11-26), 2.1–2.8× where the
+twin rejects steps every interval (docs/scene.md "Error estimate", bench/error_estimate.py).
+The engaged-mount and internal-state handling below works for any model (measured on the
+non-linear scenes above) though the engine gives those the companion. It never touches the
+twin's state: the published numbers are identical with it on or off
 (test/test_error_estimate.py).
 
 What it does not see: an overdamped mode (ζ > 1, more damping than mounts have) keeps its

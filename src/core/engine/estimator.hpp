@@ -408,7 +408,7 @@ inline void carry(Estimator& est) {
 /// (ENGAGED_CHECK_EVERY while a mount is engaged, a share of the fastest mode's period:
 /// `period_spacing`; it then counts for them); linearise again at
 /// the twin's state y after a mount's event, at every check while one is engaged, and every
-/// LINEARISE_EVERY check periods of regular checks (CHECK_EVERY intervals each: an early check
+/// `linearise_span` check periods of regular checks (CHECK_EVERY intervals each: an early check
 /// counts for its share); fold the estimated errors of the outputs into the figures every
 /// `output_stride` intervals and at a measured one (the twin's largest force, every interval).
 /// A regular check may come early, from a quarter of CHECK_EVERY pending, where it can take the
