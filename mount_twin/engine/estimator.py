@@ -177,7 +177,9 @@ OUTPUT_TURN = 0.5
 """rad: the outputs' estimated errors are folded into the figures each time the fastest mode
 (bounded from the Jacobian held) has turned by this much, at most every OUTPUT_STRIDE_MAX
 intervals, and at every interval measured: a peak is read at cos(0.25) = 0.97 of its size at
-least (src/core/engine/estimator.hpp `output_stride`; the pump at 1 kHz every 3 intervals)."""
+least, cos(0.5) = 0.88 in the intervals after the last folding of a run or before a restart,
+which are not folded (src/core/engine/estimator.hpp `output_stride`; the pump at 1 kHz every 3
+intervals)."""
 JACOBIAN_KEEP = 1e-3
 """A linearisation keeps the propagator held (and the decay) while its fresh Jacobian is within
 this share of the one they came from (Frobenius norms; the same carried states, the same

@@ -158,8 +158,10 @@ inline double period_spacing(const Vec st, double h, double share) {
 /// most OUTPUT_STRIDE_MAX; 1 where no propagator is held. Between checks the estimated error is
 /// the free motion of the linearised modes, none faster than that bound, so a peak lies within
 /// half a stride of a folded interval and is read at cos(OUTPUT_TURN/2) of its size at least
-/// (0.97 at 0.5 rad: a signal of no frequency above ω keeps cos(ωτ) of a peak τ from it). Those
-/// products and maxima were half the estimate's cost on the pump, whose stride is 3 at 1 kHz.
+/// (0.97 at 0.5 rad: a signal of no frequency above ω keeps cos(ωτ) of a peak τ from it). The
+/// intervals since the last folding when a run ends or restarts are not folded: a peak there is
+/// read at cos(OUTPUT_TURN) at least (0.88), from the folding before. Those products and maxima
+/// were half the estimate's cost on the pump, whose stride is 3 at 1 kHz.
 inline double output_stride(const Vec st, double h) {
   if (!(st[PROPAGATOR_STEP] > 0.0)) return 1.0;
   const double stride = std::floor(st[OUTPUT_TURN] / (h * st[FASTEST_RATE]));
