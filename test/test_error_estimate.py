@@ -396,10 +396,11 @@ def test_measuring_every_interval_comes_within_ten_percent(case: str) -> None:
     assert 0.9 < acc.est_force_error / acc.force_error < 1.1, acc
 
 
-def _estimator_after(case: str, **settings: float) -> Estimator:
-    """The estimator's arrays after the case's run as configured (`new_estimator`'s keyword
-    `settings` changed)."""
-    scene, samples = CASES[case][0]()
+def _run_keeping_estimator(
+    model: Model, samples: SampleBatch, **settings: float
+) -> tuple[TwinEngine, Estimator]:
+    """The engine after its run of `samples` on `model`, and its estimator's arrays
+    (`new_estimator`'s keyword `settings` changed)."""
     made: list[Estimator] = []
 
     def keep(*args, **kwargs) -> Estimator:
@@ -408,8 +409,16 @@ def _estimator_after(case: str, **settings: float) -> Estimator:
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(driver_module, "new_estimator", keep)
-        TwinEngine(assemble(scene)).run(samples)
-    return made[0]
+        engine = TwinEngine(model)
+        engine.run(samples)
+    return engine, made[0]
+
+
+def _estimator_after(case: str, **settings: float) -> Estimator:
+    """The estimator's arrays after the case's run as configured (`new_estimator`'s keyword
+    `settings` changed)."""
+    scene, samples = CASES[case][0]()
+    return _run_keeping_estimator(assemble(scene), samples, **settings)[1]
 
 
 def _checks_of(case: str) -> tuple[float, float]:
@@ -512,6 +521,32 @@ def test_the_outputs_errors_folded_each_half_radian_of_the_fastest_mode_keep_the
         ratio = getattr(strided, name) / getattr(every, name)
         assert math.cos(0.5 * OUTPUT_TURN) <= ratio <= 1.0, (name, ratio)
     assert strided.force_error_n != every.force_error_n
+
+
+def test_a_runs_last_intervals_are_folded_as_it_ends() -> None:
+    """The outputs' errors are folded every OUTPUT_TURN of the fastest mode's turn; as a run
+    ends, those of the intervals since the last folding are folded too (estimator.hpp
+    `close_run`): the run's figures are at least what its last state's error gives,
+    ∂(forces, angles)/∂y · e over the carried states, here taken by numpy from the estimator's
+    arrays. The pump's runs of its first 15 to 26 samples of ship motion end at every phase of
+    the stride (3 intervals); in some the last state's error is the run's largest."""
+    scene, samples = _pump()
+    model = assemble(scene)
+    largest_at_the_end = 0
+    for n in range(15, 27):
+        engine, est = _run_keeping_estimator(model, samples.part(slice(0, n)))
+        nc, n_out = int(est.state[N_CARRIED]), est.out1.shape[0]
+        sens = est.sens[: nc * n_out].reshape(nc, n_out)
+        last = np.abs(sens.T @ est.e[est.carried[:nc].astype(int)])
+        estimate = engine.error_estimate
+        assert estimate is not None
+        for figure, error in (
+            (estimate.force_error_n, last[:-3].max()),
+            (estimate.attitude_error_rad, last[-3:].max()),
+        ):
+            assert figure >= error * (1.0 - 1e-12), (n, figure, error)
+            largest_at_the_end += figure <= error * (1.0 + 1e-12)
+    assert largest_at_the_end >= 2
 
 
 def test_the_core_refuses_a_span_cap_below_the_first_span() -> None:

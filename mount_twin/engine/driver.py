@@ -36,6 +36,7 @@ from mount_twin.engine.kernel import (
     Published,
     RunOptions,
     Samples,
+    close_estimate,
     new_watch,
     run_samples,
 )
@@ -346,9 +347,7 @@ class CoreDriver:
         done, status = run_samples(self._bound(), segment, buf)
         events = self._drain_events()
         self._counts["substeps"] += self._health.add_steps(buf.step_log[1 : done + 1])
-        if self.estimator is not None:
-            self._health.add_estimate(self.estimator.figures)
-            self.estimator.figures[:] = 0.0
+        self._take_figures()
         if done > 0:
             # copies: the segment's rows may be the push's frame, which a later push reuses
             self.last = (float(segment.t[done]), segment.f[done].copy(), segment.w[done].copy())
@@ -364,6 +363,13 @@ class CoreDriver:
             published = Rows(index[keep - 1], buf.pose[keep], buf.wrenches[keep], peaks)
         return Stepped(done, status, published, events)
 
+    def _take_figures(self) -> None:
+        """The error estimate's figures since the last take into the health window (running
+        maxima: the core's start again from nothing)."""
+        if self.estimator is not None:
+            self._health.add_estimate(self.estimator.figures)
+            self.estimator.figures[:] = 0.0
+
     @property
     def tail_pending(self) -> bool:
         """Whether the last sample done is unpublished (decimation): `close_run` gives it."""
@@ -373,7 +379,11 @@ class CoreDriver:
         """End the run (a restart follows, or the stream ends): the outputs of its last sample
         done where decimation left it unpublished, its pose row (1, WIDTH) and as wrenches
         (1, n_mounts, 6) each component's largest magnitude since the row before; None where
-        that sample was published. Decimation then counts afresh."""
+        that sample was published. Decimation then counts afresh. The sampled estimate folds
+        the outputs' errors its stride left unfolded into the figures (`kernel.close_estimate`)."""
+        if isinstance(self.estimator, Estimator):
+            close_estimate(self._bound())
+            self._take_figures()
         if not self._counter[0]:
             return None
         pose, wrenches = self._tail_pose[None].copy(), self._peak[None].copy()

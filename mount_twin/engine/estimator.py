@@ -76,9 +76,10 @@ fan"). The estimate follows that recursion with
   to 1.14–1.15× the engine (bench/error_estimate.py).
 
 The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities differenced with J),
-folded into the figures every OUTPUT_TURN of the fastest mode's turn. Cost per interval: one
-matrix-vector product (the propagator's over the carried states), and every few intervals the
-output sensitivities' (both held transposed, so the rows' sums advance side by side); per
+folded into the figures every OUTPUT_TURN of the fastest mode's turn and as a run ends. Cost
+per interval: one matrix-vector product (the propagator's over the carried states), and every
+few intervals the output sensitivities' (both held transposed, so the rows' sums advance side
+by side); per
 check, the check's steps and k products by the body's D (nf × nf); per linearisation, n + 1
 right-hand sides, and two exponentials (the propagator's, D's) where J moved. Engine time with
 it over without: 1.15–1.18× on the pump since the span and the stride above (1.23–1.27× before
@@ -176,10 +177,9 @@ constant)."""
 OUTPUT_TURN = 0.5
 """rad: the outputs' estimated errors are folded into the figures each time the fastest mode
 (bounded from the Jacobian held) has turned by this much, at most every OUTPUT_STRIDE_MAX
-intervals, and at every interval measured: a peak is read at cos(0.25) = 0.97 of its size at
-least, cos(0.5) = 0.88 in the intervals after the last folding of a run or before a restart,
-which are not folded (src/core/engine/estimator.hpp `output_stride`; the pump at 1 kHz every 3
-intervals)."""
+intervals, at every interval measured, and as a run ends (a restart, the stream's end:
+`kernel.close_estimate`): a peak is read at cos(0.25) = 0.97 of its size at least
+(src/core/engine/estimator.hpp `output_stride`; the pump at 1 kHz every 3 intervals)."""
 JACOBIAN_KEEP = 1e-3
 """A linearisation keeps the propagator held (and the decay) while its fresh Jacobian is within
 this share of the one they came from (Frobenius norms; the same carried states, the same

@@ -157,3 +157,8 @@ Returns:
     at that sample because it logged an event that may stiffen the scene, past
     watch.stop_after; else the stepper's failure at the next sample).
 """
+close_estimate = _core.close_estimate
+"""close_estimate(loop): the run the loop advanced ends (a restart follows, or the stream ends).
+The sampled estimate (`engine.estimator`) folds the outputs' errors of the intervals since it
+last did into its figures (src/core/engine/estimator.hpp `close_run`); the companion folds at
+every interval, and without an estimate there is nothing to fold."""

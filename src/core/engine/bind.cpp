@@ -295,6 +295,17 @@ void bind_engine(py::module_& mod) {
       "failure).",
       py::arg("loop"), py::arg("samples"), py::arg("out"));
   mod.def(
+      "close_estimate",
+      [](Loop& loop) {
+        if (loop.ep == nullptr) return;
+        loop.refresh();
+        engine::close_run(*loop.ep);
+      },
+      "A run ends (a restart follows, or the stream ends): the sampled estimate (engine."
+      "estimator) folds the outputs' errors of the intervals since it last did into its "
+      "figures; nothing for the companion (it folds at every interval) or without an estimate.",
+      py::arg("loop"));
+  mod.def(
       "expm",
       [](py::handle a_, double scale) {
         const Mat a = convert::mat(a_, "a");

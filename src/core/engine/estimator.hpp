@@ -158,10 +158,9 @@ inline double period_spacing(const Vec st, double h, double share) {
 /// most OUTPUT_STRIDE_MAX; 1 where no propagator is held. Between checks the estimated error is
 /// the free motion of the linearised modes, none faster than that bound, so a peak lies within
 /// half a stride of a folded interval and is read at cos(OUTPUT_TURN/2) of its size at least
-/// (0.97 at 0.5 rad: a signal of no frequency above ω keeps cos(ωτ) of a peak τ from it). The
-/// intervals since the last folding when a run ends or restarts are not folded: a peak there is
-/// read at cos(OUTPUT_TURN) at least (0.88), from the folding before. Those products and maxima
-/// were half the estimate's cost on the pump, whose stride is 3 at 1 kHz.
+/// (0.97 at 0.5 rad: a signal of no frequency above ω keeps cos(ωτ) of a peak τ from it); a
+/// run's last intervals are folded as it ends (`close_run`). Those products and maxima were
+/// half the estimate's cost on the pump, whose stride is 3 at 1 kHz.
 inline double output_stride(const Vec st, double h) {
   if (!(st[PROPAGATOR_STEP] > 0.0)) return 1.0;
   const double stride = std::floor(st[OUTPUT_TURN] / (h * st[FASTEST_RATE]));
@@ -404,6 +403,21 @@ inline void carry(Estimator& est) {
   for (idx c = 0; c < nc; ++c) est.e[static_cast<idx>(est.carried[c])] = est.pc[c];
 }
 
+/// The outputs' estimated errors, ∂(forces, α γ δ)/∂y · e over the carried states, folded
+/// into the figures' running maxima (N, rad); none pending after.
+inline void fold_outputs(Estimator& est) {
+  const Vec st = est.state, fig = est.figures;
+  const idx nc = static_cast<idx>(st[N_CARRIED]), n_out = est.out1.n, n_forces = n_out - 3;
+  st[OUTPUT_PENDING] = 0.0;
+  for (idx c = 0; c < nc; ++c) est.ec[c] = est.e[static_cast<idx>(est.carried[c])];
+  linalg::matvec_t(Mat{est.sens.d, nc, n_out}, est.ec.d, est.out1.d);
+  double force = fig[FORCE_ERROR], attitude = fig[ATTITUDE_ERROR];
+  for (idx i = 0; i < n_forces; ++i) force = py_max(force, std::fabs(est.out1[i]));
+  for (idx i = n_forces; i < n_out; ++i) attitude = py_max(attitude, std::fabs(est.out1[i]));
+  fig[FORCE_ERROR] = force;
+  fig[ATTITUDE_ERROR] = attitude;
+}
+
 /// One input interval [t0, t1] of the estimate, after the twin's step: carry the error over
 /// it; measure the twin's local error where the interval is special (`watched` CHANGED, or the
 /// twin rejected a step, or its error norm spiked) or where CHECK_EVERY intervals are pending
@@ -422,8 +436,8 @@ inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, 
                               int watched, const Integrator& twin, M6 wrenches, Vec y) {
   const Vec twin_result = twin.result;
   const bool changed = (watched & CHANGED) != 0, engaged = (watched & ENGAGED) != 0;
-  const Vec st = est.state, fig = est.figures, e = est.e;
-  const idx nm = wrenches.rows, n_out = est.out1.n;
+  const Vec st = est.state, fig = est.figures;
+  const idx nm = wrenches.rows;
   const double h = t1 - t0;
   bool linearised = st[PROPAGATOR_STEP] > 0.0;
   if (linearised && std::fabs(h - st[PROPAGATOR_STEP]) > STEP_MATCH * h) {
@@ -465,16 +479,16 @@ inline void estimate_interval(const Model& m, Estimator& est, Vec u, double t0, 
   }
   fig[FORCE_SCALE] = scale;
   st[OUTPUT_PENDING] += 1.0;
-  if (!measured && st[OUTPUT_PENDING] < output_stride(st, h)) return;
-  st[OUTPUT_PENDING] = 0.0;
-  const idx nc = static_cast<idx>(st[N_CARRIED]);
-  for (idx c = 0; c < nc; ++c) est.ec[c] = e[static_cast<idx>(est.carried[c])];
-  linalg::matvec_t(Mat{est.sens.d, nc, n_out}, est.ec.d, est.out1.d);
-  double force = fig[FORCE_ERROR], attitude = fig[ATTITUDE_ERROR];
-  for (idx i = 0; i < 3 * nm; ++i) force = py_max(force, std::fabs(est.out1[i]));
-  for (idx i = 3 * nm; i < n_out; ++i) attitude = py_max(attitude, std::fabs(est.out1[i]));
-  fig[FORCE_ERROR] = force;
-  fig[ATTITUDE_ERROR] = attitude;
+  if (measured || st[OUTPUT_PENDING] >= output_stride(st, h)) fold_outputs(est);
+}
+
+/// A run ends (a restart follows, or the stream ends): the intervals since the outputs'
+/// errors were last folded are folded now, at the run's last state, so that a peak there is
+/// read at cos(OUTPUT_TURN/2) of its size at least, as everywhere else (`output_stride`).
+/// The run's end is where the input puts it, not where a batch of it ends: the figures do not
+/// depend on how the input is batched.
+inline void close_run(Estimator& est) {
+  if (est.state[OUTPUT_PENDING] > 0.0) fold_outputs(est);
 }
 
 }  // namespace mt::engine
