@@ -79,14 +79,14 @@ The published outputs' errors are ∂(forces, angles)/∂y · e (sensitivities d
 folded into the figures every OUTPUT_TURN of the fastest mode's turn and as a run ends. Cost
 per interval: one matrix-vector product (the propagator's over the carried states), and every
 few intervals the output sensitivities' (both held transposed, so the rows' sums advance side
-by side); per
-check, the check's steps and k products by the body's D (nf × nf); per linearisation, n + 1
-right-hand sides, and two exponentials (the propagator's, D's) where J moved. Engine time with
-it over without: 1.15–1.18× on the pump since the span and the stride above (1.23–1.27× before
-them, alternating, 2026-11-29; `python3 bench/bench_engine.py`), 1.15–1.19× earlier
-(1.16–1.24× before JACOBIAN_KEEP, when under perf the interval's bookkeeping and products were
-5 % of the samples and the linearisations' exponentials 3 %; 2026-11-26), 2.1–2.8× where the
-twin rejects steps every interval (docs/scene.md "Error estimate", bench/error_estimate.py).
+by side); per check, the check's steps and k products by the body's D (nf × nf); per
+linearisation, n + 1 right-hand sides, and two exponentials (the propagator's, D's) where J
+moved. Engine time with it over without: 1.15–1.18× on the pump since the span and the stride
+above (1.23–1.27× before them, alternating, 2026-11-29; `python3 bench/bench_engine.py`),
+1.15–1.19× earlier (1.16–1.24× before JACOBIAN_KEEP, when under perf the interval's
+bookkeeping and products were 5 % of the samples and the linearisations' exponentials 3 %;
+2026-11-26), 2.1–2.8× where the twin rejects steps every interval (docs/scene.md "Error
+estimate", bench/error_estimate.py).
 The engaged-mount and internal-state handling below works for any model (measured on the
 non-linear scenes above) though the engine gives those the companion. It never touches the
 twin's state: the published numbers are identical with it on or off
