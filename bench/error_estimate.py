@@ -19,10 +19,12 @@ The cost is one run each way; with `--repeats N`, the best of N runs each way, a
 
 `--sampled` gives every scene the sampled estimator (`engine.estimator`), the non-linear ones
 included, which the engine gives the companion (`engine.companion`): how honest and how dear
-the cheaper method is where mounts slip, open and hit their stops. The cases `hysteretic_N` (N = 4,
-16, 64, 256 Bouc–Wen elastomers on a grid under the same 200 kg body, together as stiff as
-four, 2 s of the pump's ship motion: how the estimate's cost grows with the mounts) are run
-only when named in `--cases`.
+the cheaper method is where mounts slip, open and hit their stops. `--integrated` has the
+companion integrated at every interval, never carried: what the carried error's shortcuts
+cost in honesty. The cases `hysteretic_N` (N = 4, 16, 64, 256 Bouc–Wen elastomers on a grid
+under the same 200 kg body, together as stiff as four, 2 s of the pump's ship motion: how the
+estimate's cost grows with the mounts; their hysteresis's β and γ 120 and 80, or
+`--hysteresis BETA GAMMA`) are run only when named in `--cases`.
 """
 
 from __future__ import annotations
@@ -38,9 +40,17 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test"))
 from test_error_estimate import CASES, _bouc_wen_grid
 
 from mount_twin.analysis.accuracy import RESOLVED, measure, reference_run, resolution, run_at
-from mount_twin.engine import driver
+from mount_twin.engine import companion, driver
+from mount_twin.engine.companion import CARRYING, _reset_carry
 
 HYSTERETIC_COUNTS = (4, 16, 64, 256)
+
+
+def _integrated(carry, method):
+    """`companion._reset_carry` with the companion never carried (`--integrated`)."""
+    reset = _reset_carry(carry, method)
+    reset[CARRYING] = 0.0
+    return reset
 
 
 def _sampled(model, n_watched):
@@ -61,21 +71,35 @@ def _best_cost(scene, samples, rtol: float, repeats: int) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rtol", type=float, nargs="+", default=[1e-3, 1e-4, 1e-5, 1e-6, 1e-7])
+    parser.add_argument("--sampled", action="store_true", help="the sampled estimator on all")
+    parser.add_argument(
+        "--integrated", action="store_true", help="the companion integrated, never carried"
+    )
+    parser.add_argument(
+        "--hysteresis",
+        nargs=2,
+        type=float,
+        default=[120.0, 80.0],
+        metavar=("BETA", "GAMMA"),
+        help="Bouc–Wen β and γ of the hysteretic_N cases",
+    )
     builds = {name: build for name, (build, _) in CASES.items()}
-    for n in HYSTERETIC_COUNTS:
-        builds[f"hysteretic_{n}"] = partial(_bouc_wen_grid, n)
+    names = [*builds, *(f"hysteretic_{n}" for n in HYSTERETIC_COUNTS)]
     parser.add_argument(
         "--cases",
         nargs="+",
-        choices=list(builds),
+        choices=names,
         metavar="NAME",
-        help=f"case names (default: the test's cases): {', '.join(builds)}",
+        help=f"case names (default: the test's cases): {', '.join(names)}",
     )
-    parser.add_argument("--sampled", action="store_true", help="the sampled estimator on all")
     parser.add_argument("--repeats", type=int, default=1, help="runs per cost figure (best)")
     args = parser.parse_args()
+    for n in HYSTERETIC_COUNTS:
+        builds[f"hysteretic_{n}"] = partial(_bouc_wen_grid, n, *args.hysteresis)
     if args.sampled:
         driver._new_estimator = _sampled  # a bench's what-if: the engine's choice replaced
+    if args.integrated:
+        companion._reset_carry = _integrated  # a bench's what-if: never carried
     print(
         f"{'case':<20} {'rtol':>6} {'force err':>10} {'estimate':>10} {'ratio':>6} "
         f"{'attitude rad':>12} {'estimate':>10} {'substeps':>8} {'cost':>6}"

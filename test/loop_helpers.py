@@ -39,6 +39,7 @@ def companion_of(
         np.zeros((k, N_EVENTS)) if treatments is None else treatments,
         kick_rate,
         linear_stiffness=model.linear_stiffness,
+        kinked=model.kinked,
     )
 
 

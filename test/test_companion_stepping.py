@@ -94,3 +94,21 @@ def test_the_loop_refuses_an_exact_method_the_companions_arrays_do_not_hold() ->
     watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
     with pytest.raises(ValueError, match=r"Companion\.exact_method"):
         step_one_interval(model, y, g, watch, chain=False, estimate=comp)
+
+
+@pytest.mark.parametrize(
+    ("method", "steps"), [("dopri54", 0), ("dopri54", 1.5), ("ros34pw2", 1), ("exprb32", 2)]
+)
+def test_the_loop_refuses_a_check_it_cannot_take(method: str, steps: float) -> None:
+    """A carried interval's check takes `check_method` at `check_steps` equal steps: the loop
+    refuses, by name and before any step, a count that is not a whole number of at least one,
+    and a method that is not explicit first-same-as-last (whose stages the chained first one
+    would not fit) or not in the companion's arrays."""
+    model = assemble(load_scene_file(GENSET))
+    g = np.array([0.0, 0.0, model.scene.input.g])
+    y = initial_state(model, g)
+    check = {"check_method": METHODS[method].id, "check_steps": steps}
+    comp = companion_of(model, "dopri54")._replace(**check)
+    watch = new_watch(len(model.nonlinear_slots), N_EVENTS, model.n_state)
+    with pytest.raises(ValueError, match=r"Companion\.check_method"):
+        step_one_interval(model, y, g, watch, chain=False, estimate=comp)

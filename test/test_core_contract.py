@@ -191,6 +191,7 @@ def test_the_loop_refuses_a_companion_switching_to_a_method_its_stage_does_not_s
         np.zeros((k, N_EVENTS)),
         1.0,
         linear_stiffness=model.linear_stiffness,
+        kinked=model.kinked,
     )
     args = (model.arrays, model.new_scratch(), u, initial_state(model, u[1:4]))
     integ = kernel.Integrator(twin.method, twin.settings, twin.work2d, twin.work1d, twin.result)

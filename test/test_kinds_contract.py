@@ -297,6 +297,7 @@ def fake_kind(name: str = "end_stop") -> ModuleType:
     module.carry = lambda p, y, y0, yt, o, d, dt: None
     module.nominal_tangent = lambda m: ((1.0e6,) * 3 + (0.0,) * 3, ("stiffness",) * 6)
     module.piecewise = lambda m: True
+    module.kinked = lambda m: False
     return module
 
 

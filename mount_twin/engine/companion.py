@@ -52,13 +52,15 @@ Windermere's fan", *ibid.* §II.3), instead of integrated a second time:
   interval, none rejected, the check is the stepper's fewest steps, every one taken
   (`integrate.stepper.advance_fixed`): a step of Verner's 6th order as long as the twin's
   accepted 5th-order one, or two of the twin's own method half as long (error 1/64 of the
-  twin's), the same argument as one integrated step an interval below. Held to its tolerance
-  (rtol/8 on its 5th-order estimate, not on the error it has), the check took 4 steps a check on
-  256 Bouc–Wen mounts, 169 of its 523 rejected, and cost the estimate 0.15× of the engine's time
-  (1.44× → 1.30×). Added where it is committed, ℓ is then carried by Φ like the rest, damped and
-  turned as the motion damps and turns it. Counting the skipped intervals into the next measured
-  ℓ instead, in phase, read 0.46–0.53 of the true error under the real 47 g record at rtol 1e-3
-  and 1e-5 (checks 8 and 32 apart), by their number 1.8–9.3 times it.
+  twin's), the same argument as one integrated step an interval below; two of the twin's own
+  half as long where a mount's law has kinks no event marks (a Bouc–Wen state's rate turns with
+  |ẋ|: there one Verner step's own error is no small share of the twin's, KINKED_CHECK). Held to
+  its tolerance (rtol/8 on its 5th-order estimate, not on the error it has), the check took 4
+  steps a check on 256 Bouc–Wen mounts, 169 of its 523 rejected, and cost the estimate 0.15× of
+  the engine's time (1.44× → 1.30×). Added where it is committed, ℓ is then carried by Φ like
+  the rest, damped and turned as the motion damps and turns it. Counting the skipped intervals
+  into the next measured ℓ instead, in phase, read 0.46–0.53 of the true error under the real
+  47 g record at rtol 1e-3 and 1e-5 (checks 8 and 32 apart), by their number 1.8–9.3 times it.
 
 Where the twin runs a linearising method, where the interval is too long for the kick, where
 the kick meets a stiffness past its reach on some coordinate k of the body (h²·|Δaₖ| over
@@ -213,6 +215,22 @@ TOLERANCE_DIVISOR = 8.0
 """The companion's rtol and atol are the twin's over this (see the module docstring)."""
 MIN_STEPS = 2
 """The companion's fewest steps per input interval where it runs the twin's own method."""
+KINKED_CHECK = (DOPRI54, 2)
+"""A carried interval's check (method id, equal steps) where the twin took the interval in one
+step and a mount's law has kinks no event marks (`Model.kinked`: a Bouc–Wen state's rate turns
+with |ẋ| wherever a hysteretic axis's deflection rate turns): two of the twin's own steps of
+half the length. One Verner step as long as the twin's, elsewhere the check, is not there the
+small share of the twin's error its order promises, and the local error it measures falls
+short: 16 and 64 Bouc–Wen elastomers under ship motion (β = 120, γ = 80) read 0.67 of their
+true force error and 0.57 of their attitude error at rtol 1e-6, and 16 with β = 200, γ = 0 (the
+|ẋ| term alone) 0.54 of the attitude error, where the companion integrated at every interval
+read 0.94–1.08 and 0.97–1.12. Two Dormand–Prince half steps (error a quarter of the twin's
+across a kink, 1/32 of it elsewhere) read 0.93, 0.98 and 1.14 there; over 4 to 256
+elastomers and five β, γ settings 0.93–1.52 of the force error and 0.98–1.39 of the attitude
+error, where one Verner step read 0.66–1.20 and 0.54–1.16, two Verner half steps 0.85–1.27 and
+0.93–1.28 (16 right-hand sides a check, where these take 12 and one Verner step 8; 2026-11-29,
+docs/benchmarks.md). Scenes without such a law keep Verner's one step (on the genset two would
+add 1.3 ms to its core)."""
 (
     Y_START,
     ERROR,
@@ -273,6 +291,14 @@ def exact_method(twin: int, linear_stiffness: bool) -> int:
     return -1 if exact == own_method(twin, linear_stiffness)[0] else exact
 
 
+def fixed_check(kinked: bool) -> tuple[int, int]:
+    """(method id, equal steps) of a carried interval's check where the twin took the interval
+    in one step, on a scene whose mounts' laws have kinks no event marks or not (`kinked`,
+    `Model.kinked`): KINKED_CHECK, else one step of Verner's 6th order (HIGHER's of the twin's
+    Dormand–Prince, the only twin beside which the error is carried)."""
+    return KINKED_CHECK if kinked else (HIGHER[DOPRI54], 1)
+
+
 def switching_method(twin: int, linear_stiffness: bool) -> tuple[int, int]:
     """(method id, fewest steps per input interval) of the companion of a twin running the
     method `twin` (an id) over an interval where a bolted joint's faces switch inside the
@@ -295,6 +321,9 @@ class Companion(NamedTuple):
     those steps across an event's crossing (`switching_method`).
     exact_method: the method (an id) it takes at one step, with the same arrays, over an
     interval whose twin steps passed over the body's fastest mode (`exact_method`; -1: none).
+    check_method, check_steps: the method (an id, explicit) and equal steps, every one taken, of
+    a carried interval's check where the twin took the interval in one step: Verner's at one,
+    or KINKED_CHECK where a mount's law has kinks no event marks (`fixed_check`).
     y: (n_state,) its state; s: its scratch (its angles at the last sample: s.q[3:6]);
     y_prev, g, util: its mount monitors' arrays (its switches are taken with them); g_prev:
     g at a carried interval's start, while its end is monitored (the interval is integrated
@@ -319,6 +348,8 @@ class Companion(NamedTuple):
     switching_method: int
     switching_min_steps: int
     exact_method: int
+    check_method: int
+    check_steps: int
     y: np.ndarray
     s: Scratch
     y_prev: np.ndarray
@@ -346,6 +377,7 @@ def new_companion(
     kick_rate: float,
     *,
     linear_stiffness: bool,
+    kinked: bool,
 ) -> Companion:
     """A companion of a twin of n states integrated by `method` (a name, or AUTO: then
     `switch` it with the twin) at the twin's tolerances rtol, atol; `scratch`: fresh work
@@ -353,7 +385,8 @@ def new_companion(
     event functions, how the companion takes an interval that starts with the event holding
     (`Companion.treatments`); kick_rate: the body's fastest mode on its mounts' tangents (rad/s,
     `Model.tangent_rate`; 0 where unknown: then never carried); linear_stiffness: whether the
-    scene's stiff modes are its linear mounts' (`Model.linear_stiffness`)."""
+    scene's stiff modes are its linear mounts' (`Model.linear_stiffness`); kinked: whether a
+    mount's law has kinks no event marks (`Model.kinked`: its checks, `fixed_check`)."""
     twin = METHODS["dopri54" if method == AUTO else method].id
     own, min_steps = own_method(twin, linear_stiffness)
     exact = exact_method(twin, linear_stiffness)
@@ -380,6 +413,7 @@ def new_companion(
         *arrays[1:],
         *switching_method(twin, linear_stiffness),
         exact,
+        *fixed_check(kinked),
         np.zeros(n),
         scratch,
         np.zeros(n),

@@ -131,6 +131,7 @@ def _new_estimator(model: Model, treatments: np.ndarray) -> Estimator | Companio
             treatments,
             model.tangent_rate,
             linear_stiffness=model.linear_stiffness,
+            kinked=model.kinked,
         )
     return sampled_estimator(model)
 

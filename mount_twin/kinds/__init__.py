@@ -16,7 +16,9 @@ rate-independent states, a face's stick point, carried and returned onto its bou
 `engine.companion`) and its stiffness at the unstressed pose (`nominal_tangent`: statics, modes
 and `auto`'s first choice read it), and whether a mount's law has pieces its motion moves
 between (`piecewise`: a contact, a joint's faces; `auto` and the error estimate's companion
-take the exponential method only for scenes with none, `Model.linear_stiffness`). A module's
+take the exponential method only for scenes with none, `Model.linear_stiffness`), and whether it
+has kinks no event marks (`kinked`: a Bouc–Wen rate's |ẋ|; the companion's checks then take
+shorter steps, `engine.companion`). A module's
 `load`, `monitor`, `update` and `carry` are plain Python: the reference the compiled core's
 port of the kind (src/core/kinds/<kind>.hpp) is held to; `settle` runs only in Python, at
 starts.
@@ -88,6 +90,7 @@ MODULE_NAMES = (
     "carry",
     "nominal_tangent",
     "piecewise",
+    "kinked",
 )
 """What a kind module defines (see the module docstring of any kind)."""
 COMPANION_TREATMENTS: dict[str, int] = _core.TREATMENTS

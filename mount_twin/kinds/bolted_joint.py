@@ -196,6 +196,12 @@ def piecewise(j: BoltedJoint) -> bool:
     return True
 
 
+def kinked(j: BoltedJoint) -> bool:
+    """Whether the mount's law has kinks inside an interval that none of its events marks
+    (`Model.kinked`): none, its faces' and its bolt's switches are its events."""
+    return False
+
+
 def nominal_tangent(j: BoltedJoint) -> tuple[tuple[float, ...], tuple[str, ...]]:
     """Stiffness at the unstressed pose, (kx, ky, kz) N/m then (krx, kry, krz) N·m/rad (none: a
     joint has no rotational law), and the scene key each value comes from: the stuck face's

@@ -254,6 +254,13 @@ def hysteretic(e: Elastomer) -> bool:
     return e.hysteresis is not None and bool(e.hysteresis.axes)
 
 
+def kinked(e: Elastomer) -> bool:
+    """Whether the mount's law has kinks inside an interval that none of its events marks
+    (`Model.kinked`): a Bouc–Wen state's rate turns with |ẋ|, wherever a hysteretic axis's
+    deflection rate turns."""
+    return hysteretic(e)
+
+
 def state_names(e: Elastomer) -> tuple[str, ...]:
     """Bouc–Wen z per hysteretic axis (none without hysteresis)."""
     if e.hysteresis is None:

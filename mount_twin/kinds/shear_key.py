@@ -100,6 +100,12 @@ def piecewise(k: ShearKey) -> bool:
     return True
 
 
+def kinked(k: ShearKey) -> bool:
+    """Whether the mount's law has kinks inside an interval that none of its events marks
+    (`Model.kinked`): none, its bearing's switch is its event."""
+    return False
+
+
 def nominal_tangent(k: ShearKey) -> tuple[tuple[float, ...], tuple[str, ...]]:
     """Stiffness at the unstressed pose, (kx, ky, kz) N/m then (krx, kry, krz) N·m/rad (none: a
     key has no rotational law), and the scene key each value comes from: its bearing stiffness

@@ -81,6 +81,13 @@ class Model:
         return any(KINDS[m.kind].piecewise(m) for m in self._nonlinear_mounts)
 
     @cached_property
+    def kinked(self) -> bool:
+        """Whether some mount's law has kinks inside an interval that none of its events marks
+        (its kind's `kinked`: a Bouc–Wen state's rate, with |ẋ|; `engine.companion`
+        KINKED_CHECK)."""
+        return any(KINDS[m.kind].kinked(m) for m in self._nonlinear_mounts)
+
+    @cached_property
     def linear_stiffness(self) -> bool:
         """Whether the body's stiff modes are its linear mounts': no mount's law has pieces
         (`piecewise`), and on its non-linear mounts alone the body's fastest mode is at most

@@ -1,6 +1,7 @@
 // Python bindings of the per-sample loop and the gyro filter (engine/kernel.py,
 // engine/gyro_filter.py re-export them). Every tuple the engine passes is converted field by
 // field with its shape checked against the model, so a wrong array raises naming the field.
+#include <cmath>
 #include <string>
 
 #include "../bind.hpp"
@@ -130,6 +131,17 @@ engine::Companion companion(py::handle obj, idx n_state, idx n_mounts,
                           "or under 1 step");
   }
   c.exact_method = field(obj, "exact_method").cast<int>();  // -1: none
+  c.check_method = field(obj, "check_method").cast<int>();
+  c.check_steps = field(obj, "check_steps").cast<double>();
+  const idx check_rows = integrate::work_rows(c.check_method, n_state);
+  if (!fsal(c.check_method) || c.integ.work2d.rows < check_rows || !(c.check_steps >= 1.0) ||
+      c.check_steps != std::floor(c.check_steps)) {
+    throw py::value_error("Companion.check_method " + std::to_string(c.check_method) + " at " +
+                          std::to_string(c.check_steps) + " steps in " +
+                          std::to_string(c.integ.work2d.rows) +
+                          " work rows: not an explicit first-same-as-last method they hold, or "
+                          "not a whole number of steps, at least 1");
+  }
   const idx exact_rows = c.exact_method < 0 ? 0 : integrate::work_rows(c.exact_method, n_state);
   if (exact_rows < 0 || c.integ.work2d.rows < exact_rows) {
     throw py::value_error("Companion.exact_method " + std::to_string(c.exact_method) + " in " +

@@ -63,6 +63,9 @@ struct Companion {
   double switching_min_steps;  // ... this method, at least this many steps, in integ's arrays
   int exact_method;  // where the twin's steps passed over the body's fastest mode, this one at
                      // one step at least, in integ's arrays (-1: none; `stepped_over`)
+  int check_method;     // a carried interval's check where the twin took one step: this
+  double check_steps;   // explicit method at this many equal steps, every one taken
+                        // (`add_local_error`), in integ's arrays
   Vec y;
   Scratch s;
   Vec y_prev;
@@ -354,8 +357,9 @@ inline bool carries(const Companion& c, int twin_method, double t0, double t1, b
 /// twin, so the check's end state less the twin's: added the other way round, the companion
 /// was the twin's mirror image, its error the twin's with the sign turned, which only a linear
 /// carry leaves alone; where it was integrated next, from the mirror, the two halves cancelled,
-/// docs/benchmarks.md): measured (one step of the companion's stepper from the twin's start
-/// state, less the twin's end state y) where the interval is special (the twin rejected a step,
+/// docs/benchmarks.md): measured (c.check_method at c.check_steps steps, or the companion's
+/// stepper at its tolerance where the twin's was bound by it, from the twin's start state, less
+/// the twin's end state y) where the interval is special (the twin rejected a step,
 /// its error norm passed SPIKE_RATIO times its running mean, or none was measured since a
 /// restart), and every CARRY_CHECK_EVERY intervals or half a period of the fastest tangent
 /// mode (KICK_RATE), whichever is fewer; between, the last measured one scaled by the twin's
@@ -386,12 +390,19 @@ inline bool add_local_error(const Model& m, Companion& c, Vec u, double t0, doub
     // which `carry_interval` holds before it comes here), one right-hand side a check saved
     copy(c.error_rows.row(TWIN_RATE), c.integ.work2d.row(0));
     settings[CHAINED] = 1.0;
-    // the twin took one step over the interval, none rejected: the check's fewest steps, of a
-    // higher order or shorter, every one taken (engine/companion.py says why); else its
-    // stepper at its tolerance
-    const auto step = twin_bound(twin_result) ? integrate::advance : integrate::advance_fixed;
-    const int status = step(c.integ.method, check, t0, t1, settings, m, c.s, u, c.integ.work2d,
-                            c.integ.work1d, c.integ.result);
+    // the twin took one step over the interval, none rejected: c.check_method's c.check_steps
+    // equal steps, every one taken (one of a higher order, or two of the twin's own half as long
+    // where a law has kinks no event marks: engine/companion.py says why); else its stepper at
+    // its tolerance
+    const double min_steps = settings[MIN_STEPS];
+    const bool bound = twin_bound(twin_result);
+    if (!bound) settings[MIN_STEPS] = c.check_steps;
+    const int status =
+        bound ? integrate::advance(c.integ.method, check, t0, t1, settings, m, c.s, u,
+                                   c.integ.work2d, c.integ.work1d, c.integ.result)
+              : integrate::advance_fixed(c.check_method, check, t0, t1, settings, m, c.s, u,
+                                         c.integ.work2d, c.integ.work1d, c.integ.result);
+    settings[MIN_STEPS] = min_steps;
     if (status != 0) return false;
     if (by_event && last >= 0.0) {  // its own error, not the scaled one's template
       for (idx i = 0; i < y.n; ++i) e[i] += check[i] - y[i];
