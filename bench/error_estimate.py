@@ -23,8 +23,8 @@ the cheaper method is where mounts slip, open and hit their stops. `--integrated
 companion integrated at every interval, never carried: what the carried error's shortcuts
 cost in honesty. The cases `hysteretic_N` (N = 4, 16, 64, 256 Bouc–Wen elastomers on a grid
 under the same 200 kg body, together as stiff as four, 2 s of the pump's ship motion: how the
-estimate's cost grows with the mounts; their hysteresis's β and γ 120 and 80, or
-`--hysteresis BETA GAMMA`) are run only when named in `--cases`.
+estimate's cost grows with the mounts; their hysteresis the test's, or `--hysteresis BETA
+GAMMA`) are run only when named in `--cases`.
 """
 
 from __future__ import annotations
@@ -79,9 +79,9 @@ def main() -> None:
         "--hysteresis",
         nargs=2,
         type=float,
-        default=[120.0, 80.0],
+        default=[],
         metavar=("BETA", "GAMMA"),
-        help="Bouc–Wen β and γ of the hysteretic_N cases",
+        help="Bouc–Wen β and γ of the hysteretic_N cases (default: the test's grid's)",
     )
     builds = {name: build for name, (build, _) in CASES.items()}
     names = [*builds, *(f"hysteretic_{n}" for n in HYSTERETIC_COUNTS)]
