@@ -17,6 +17,7 @@
 #include "../views.hpp"
 #include "control.hpp"
 #include "fd_jacobian.hpp"
+#include "linearised_loop.hpp"
 #include "phi.hpp"
 
 namespace mt::integrate::exprb32 {
@@ -48,96 +49,60 @@ inline idx work_rows(idx n) { return ROWS + BLOCKS * n; }
 
 /// Advance y (in place) from t0 to t1 s with input u held over the interval: the signature and
 /// statuses of explicit_rk::advance (k: work_rows(n) × n; settings[PHI_STEP]: the step, s, the φ
-/// functions held were computed for, 0 for none; settings[CHAINED] is left at 0).
+/// functions held were computed for, 0 for none; settings[CHAINED] is left at 0), by the
+/// linearising methods' loop (`advance_linearised`).
 inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Scratch& s, Vec u,
                    Mat k, Vec y_new, Vec result) {
   const Interval iv = interval(settings, t0, t1);
-  const double rtol = iv.rtol, atol = iv.atol, max_steps = iv.max_steps, span = iv.span;
-  const double h_max = iv.h_max;
-  double h = iv.h;
+  const double rtol = iv.rtol, atol = iv.atol;
   const idx n = y.n;
   const phi::Blocks blocks{J0, J0 + n, J0 + 4 * n, SCALE};
   const idx p1 = blocks.p1, p2 = blocks.p1 + n, p3 = blocks.p1 + 2 * n;
-  settings[CHAINED] = 0.0;
-  double t = t0;
-  double err_max = 0.0;
-  idx n_acc = 0, n_rej = 0;
-  const JacRows rows{F, FTMP, FT, J0};
-  if (!linearise(y, t, m, s, u, k, TYPICAL, rows, settings, JACOBIAN_MAX_AGE)) {
-    record(settings, result, h, err_max, n_acc, n_rej);
-    return LEFT_CHART;
-  }
-  bool not_finite = false, off_chart = false;  // what the last rejection was for
-  bool retried = false;                         // the last step tried was rejected
-  while (t < t1) {
-    const bool too_small = h < MIN_STEP_FRACTION * span;
-    const int status = give_up(n_acc + n_rej, max_steps, too_small, not_finite, off_chart);
-    if (status != SUCCESS) {
-      record(settings, result, h, err_max, n_acc, n_rej);
-      return status;
-    }
+  const auto try_step = [&](double t, double h) -> StepTry {
     // the rest of the interval in equal steps no longer than the proposal: one set of φ
     // functions serves them all (math.ceil gives an int: fptosi of the float ceiling)
     const double rest = t1 - t;
     const double count = py_max(
         1.0, static_cast<double>(static_cast<std::int64_t>(
-                 std::ceil(rest / py_min(h, h_max) * (1.0 - 1e-12)))));
+                 std::ceil(rest / py_min(h, iv.h_max) * (1.0 - 1e-12)))));
     const bool last = count == 1.0;
     const double step = last ? rest : on_grid(t, rest / count);
-    bool ok = true;
     if (std::fabs(step - settings[PHI_STEP]) > PHI_REUSE * step) {
       bool halved = false;
-      ok = phi::phi_functions(k, n, step, blocks, J0 + HALF_P1 * n, &halved);
+      const bool ok = phi::phi_functions(k, n, step, blocks, J0 + HALF_P1 * n, &halved);
       settings[PHI_STEP] = ok ? step : 0.0;
       k(HALF, 0) = ok && halved ? 0.5 * step : 0.0;
+      if (!ok) return {step, last, Tried::NOT_FINITE, INFINITY};
     }
-    not_finite = !ok;
-    if (ok) {
-      for (idx r = 0; r < n; ++r) {
-        double acc = y[r];
-        for (idx c = 0; c < n; ++c) {
-          acc += step * k(p1 + r, c) * k(F, c) + step * step * k(p2 + r, c) * k(FT, c);
-        }
-        k(U, r) = acc;
+    for (idx r = 0; r < n; ++r) {
+      double acc = y[r];
+      for (idx c = 0; c < n; ++c) {
+        acc += step * k(p1 + r, c) * k(F, c) + step * step * k(p2 + r, c) * k(FT, c);
       }
-      ok = physics::rhs(t + step, k.row(U), m, s, u, k.row(FTMP)) == 0;
-      off_chart = !ok;
+      k(U, r) = acc;
     }
-    double err = INFINITY;
-    if (ok) {
-      for (idx r = 0; r < n; ++r) {
-        double acc = k(FTMP, r) - k(F, r) - step * k(FT, r);
-        for (idx c = 0; c < n; ++c) acc -= k(J0 + r, c) * (k(U, c) - y[c]);
-        k(DIFF, r) = acc;
-      }
-      err = 0.0;
-      for (idx r = 0; r < n; ++r) {
-        double e = 0.0;
-        for (idx c = 0; c < n; ++c) e += k(p3 + r, c) * k(DIFF, c);
-        e *= 2.0 * step;
-        y_new[r] = k(U, r) + e;
-        const double scale = atol + rtol * py_max(std::fabs(y[r]), std::fabs(y_new[r]));
-        const double x = e / scale;
-        err += x * x;  // numba's x ** 2 (a literal integer exponent): x·x
-      }
-      err = std::sqrt(err / static_cast<double>(n));
-      not_finite = !std::isfinite(err);
+    if (physics::rhs(t + step, k.row(U), m, s, u, k.row(FTMP)) != 0) {
+      return {step, last, Tried::OFF_CHART, INFINITY};
     }
-    if (!(err <= 1.0)) renew_if_stale(y, t, m, s, u, k, TYPICAL, rows, settings);
-    if (!ok) {
-      h = step * OFF_CHART_SHRINK;
-      n_rej += 1;
-      retried = true;
-      continue;
+    for (idx r = 0; r < n; ++r) {
+      double acc = k(FTMP, r) - k(F, r) - step * k(FT, r);
+      for (idx c = 0; c < n; ++c) acc -= k(J0 + r, c) * (k(U, c) - y[c]);
+      k(DIFF, r) = acc;
     }
-    const Concluded done = conclude(y, y_new, t, t1, step, h, last, err, not_finite, ORDER,
-                                    growth_limit(settings, retried, MAX_FACTOR), m, s, u, k, F,
-                                    FTMP);
-    take(done, err, t, h, err_max, n_acc, n_rej);
-    retried = !done.accepted;
-  }
-  record(settings, result, h, err_max, n_acc, n_rej);
-  return SUCCESS;
+    double err = 0.0;
+    for (idx r = 0; r < n; ++r) {
+      double e = 0.0;
+      for (idx c = 0; c < n; ++c) e += k(p3 + r, c) * k(DIFF, c);
+      e *= 2.0 * step;
+      y_new[r] = k(U, r) + e;
+      const double scale = atol + rtol * py_max(std::fabs(y[r]), std::fabs(y_new[r]));
+      const double x = e / scale;
+      err += x * x;  // numba's x ** 2 (a literal integer exponent): x·x
+    }
+    return {step, last, Tried::TRIED, std::sqrt(err / static_cast<double>(n))};
+  };
+  return advance_linearised(iv, {{F, FTMP, FT, J0}, TYPICAL, JACOBIAN_MAX_AGE, ORDER, MAX_FACTOR},
+                            y, t0, t1, settings, m, s, u, k, y_new, result, try_step);
 }
 
 }  // namespace mt::integrate::exprb32

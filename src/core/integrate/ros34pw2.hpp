@@ -15,6 +15,7 @@
 #include "../views.hpp"
 #include "control.hpp"
 #include "fd_jacobian.hpp"
+#include "linearised_loop.hpp"
 
 namespace mt::integrate::ros34pw2 {
 
@@ -99,6 +100,16 @@ inline bool lu_factor(Mat a, idx first, idx n, Vec piv_row) {
   return true;
 }
 
+/// Whether the n×n block of `a` starting at row `first` is finite.
+inline bool all_finite(Mat a, idx first, idx n) {
+  for (idx r = 0; r < n; ++r) {
+    for (idx c = 0; c < n; ++c) {
+      if (!std::isfinite(a(first + r, c))) return false;
+    }
+  }
+  return true;
+}
+
 /// Solve (LU)·x = b in place (b overwritten by x).
 inline void lu_solve(Mat a, idx first, idx n, Vec piv_row, Vec b) {
   for (idx c = 0; c < n; ++c) {
@@ -122,47 +133,30 @@ inline void lu_solve(Mat a, idx first, idx n, Vec piv_row, Vec b) {
 }
 
 /// Advance y (in place) from t0 to t1 s with input u held over the interval: the signature and
-/// statuses of explicit_rk::advance (k: work_rows(n) × n; settings[CHAINED] is left at 0).
+/// statuses of explicit_rk::advance (k: work_rows(n) × n; settings[CHAINED] is left at 0), by
+/// the linearising methods' loop (`advance_linearised`).
 inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Scratch& s, Vec u,
                    Mat k, Vec y_new, Vec result) {
   const Interval iv = interval(settings, t0, t1);
-  const double rtol = iv.rtol, atol = iv.atol, max_steps = iv.max_steps, span = iv.span;
-  const double h_max = iv.h_max;
-  double h = iv.h;
+  const double rtol = iv.rtol, atol = iv.atol;
   const idx n = y.n;
-  settings[CHAINED] = 0.0;
-  double t = t0;
-  double err_max = 0.0;
-  idx n_acc = 0, n_rej = 0;
   const idx lu0 = J0 + n;
   const double typical = py_min(py_max(atol / rtol, 1e-6), 1.0);  // where rtol and atol meet
-  // W-method: a Jacobian serves up to JACOBIAN_MAX_AGE intervals, and is taken afresh at the
-  // first rejected step of an interval it did not start
-  const JacRows rows{F, FTMP, FT, J0};
-  if (!linearise(y, t, m, s, u, k, typical, rows, settings, JACOBIAN_MAX_AGE)) {
-    record(settings, result, h, err_max, n_acc, n_rej);
-    return LEFT_CHART;
-  }
-  bool not_finite = false, off_chart = false;  // what the last rejection was for
-  bool retried = false;                         // the last step tried was rejected
   const Vec piv = k.row(PIV);
-  while (t < t1) {
-    const bool too_small = h < MIN_STEP_FRACTION * span;
-    const int status = give_up(n_acc + n_rej, max_steps, too_small, not_finite, off_chart);
-    if (status != SUCCESS) {
-      record(settings, result, h, err_max, n_acc, n_rej);
-      return status;
-    }
-    const Trial trial = trial_step(t, t1, h, h_max, span);
+  const auto try_step = [&](double t, double h) -> StepTry {
+    const Trial trial = trial_step(t, t1, h, iv.h_max, iv.span);
     const double step = trial.step;
-    const bool last = trial.last;
     for (idx r = 0; r < n; ++r) {  // W = I − hγJ
       for (idx c = 0; c < n; ++c) k(lu0 + r, c) = -step * GAMMA * k(J0 + r, c);
       k(lu0 + r, r) += 1.0;
     }
-    bool ok = lu_factor(k, lu0, n, piv);
-    int stage = 0;
-    while (ok && stage < STAGES) {
+    // LU failed: J is not finite (a NaN in the state), else W is singular at this step, which
+    // a shorter one is not (W → I)
+    if (!lu_factor(k, lu0, n, piv)) {
+      return {step, trial.last, all_finite(k, J0, n) ? Tried::OFF_CHART : Tried::NOT_FINITE,
+              INFINITY};
+    }
+    for (int stage = 0; stage < STAGES; ++stage) {
       for (idx r = 0; r < n; ++r) {
         double ys = y[r], acc = 0.0;
         for (int j = 0; j < stage; ++j) {
@@ -175,8 +169,7 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
       if (stage == 0) {
         for (idx r = 0; r < n; ++r) k(FTMP, r) = k(F, r);
       } else if (physics::rhs(t + C[stage] * step, k.row(YS), m, s, u, k.row(FTMP)) != 0) {
-        ok = false;
-        break;
+        return {step, trial.last, Tried::OFF_CHART, INFINITY};
       }
       for (idx r = 0; r < n; ++r) {
         double jacc = 0.0;
@@ -184,43 +177,23 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
         k(stage, r) = step * (k(FTMP, r) + jacc + step * D[stage] * k(FT, r));
       }
       lu_solve(k, lu0, n, piv, k.row(stage));
-      stage += 1;
     }
-    double err = INFINITY;
-    if (ok) {
-      err = 0.0;
-      for (idx r = 0; r < n; ++r) {
-        double yn = y[r], e = 0.0;
-        for (int j = 0; j < STAGES; ++j) {
-          yn += B[j] * k(j, r);
-          e += (B[j] - B_HAT[j]) * k(j, r);
-        }
-        y_new[r] = yn;
-        const double scale = atol + rtol * py_max(std::fabs(y[r]), std::fabs(yn));
-        const double x = e / scale;
-        err += x * x;  // numba's x ** 2 (a literal integer exponent): x·x
+    double err = 0.0;
+    for (idx r = 0; r < n; ++r) {
+      double yn = y[r], e = 0.0;
+      for (int j = 0; j < STAGES; ++j) {
+        yn += B[j] * k(j, r);
+        e += (B[j] - B_HAT[j]) * k(j, r);
       }
-      err = std::sqrt(err / static_cast<double>(n));
+      y_new[r] = yn;
+      const double scale = atol + rtol * py_max(std::fabs(y[r]), std::fabs(yn));
+      const double x = e / scale;
+      err += x * x;  // numba's x ** 2 (a literal integer exponent): x·x
     }
-    not_finite = ok && !std::isfinite(err);
-    off_chart = !ok;
-    if (!(err <= 1.0)) {  // err is inf where a stage failed
-      renew_if_stale(y, t, m, s, u, k, typical, rows, settings);
-    }
-    if (!ok) {
-      h = step * OFF_CHART_SHRINK;
-      n_rej += 1;
-      retried = true;
-      continue;
-    }
-    const Concluded done = conclude(y, y_new, t, t1, step, h, last, err, not_finite, ORDER,
-                                    growth_limit(settings, retried, MAX_FACTOR), m, s, u, k, F,
-                                    FTMP);
-    take(done, err, t, h, err_max, n_acc, n_rej);
-    retried = !done.accepted;
-  }
-  record(settings, result, h, err_max, n_acc, n_rej);
-  return SUCCESS;
+    return {step, trial.last, Tried::TRIED, std::sqrt(err / static_cast<double>(n))};
+  };
+  return advance_linearised(iv, {{F, FTMP, FT, J0}, typical, JACOBIAN_MAX_AGE, ORDER, MAX_FACTOR},
+                            y, t0, t1, settings, m, s, u, k, y_new, result, try_step);
 }
 
 }  // namespace mt::integrate::ros34pw2
