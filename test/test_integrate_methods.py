@@ -15,6 +15,7 @@ from types import ModuleType
 
 import numpy as np
 import pytest
+from io_helpers import default_model
 from physics_helpers import base_scene, build, gravity_u, mount
 
 from mount_twin.errors import ModelError, SceneError
@@ -190,6 +191,111 @@ def test_an_unknown_method_id_is_a_status_with_its_text() -> None:
     status, y, _ = run_advance(max(m.id for m in METHODS.values()) + 1, model, y0, u, 1e-3)
     assert status == UNKNOWN_METHOD and STATUS_TEXT[status] == "unknown stepper"
     np.testing.assert_array_equal(y, y0)
+
+
+# ------------------------------------------------------------------- failures and their status
+
+
+def tilted(tilt_margin: float, tilt_rate: float = 0.0) -> tuple:
+    """The default scene's body at rest on its mounts but tilted (γ) to tilt_margin rad short of
+    the α/γ/δ chart's edge at π/2, turning toward it at tilt_rate rad/s: (model, y, u)."""
+    model = default_model()
+    u = gravity_u()
+    y = initial_state(model, u[1:4])
+    y[model.state_names.index("gamma")] = 0.5 * math.pi - tilt_margin
+    y[model.state_names.index("gamma_dot")] = tilt_rate
+    return model, y, u
+
+
+def advance_from(
+    name: str, model, y: np.ndarray, u, t1: float, rtol=1e-6, atol=1e-9, max_sub=10_000
+):
+    """One call of `name`'s advance from (0, y) to t1 s at these settings: (status, y, result)."""
+    st = stepper.new_stepper(name, model.n_state, rtol, atol, max_sub)
+    y = y.copy()
+    args = (y, 0.0, t1, st.settings, model.arrays, model.new_scratch(), u)
+    status = stepper.advance(METHODS[name].id, *args, st.work2d, st.work1d, st.result)
+    return int(status), y, st.result.copy()
+
+
+def _start_off_the_chart(name: str) -> tuple:
+    return advance_from(name, *tilted(0.0), 1e-3)
+
+
+def _nan_in_the_state(name: str) -> tuple:
+    model, y, u = tilted(0.5 * math.pi)
+    y[model.state_names.index("z")] = math.nan
+    return advance_from(name, model, y, u, 1e-3)
+
+
+def _one_substep_allowed(name: str) -> tuple:
+    model, y, u = tilted(0.5 * math.pi)
+    y[model.state_names.index("z")] += 1e-3
+    return advance_from(name, model, y, u, 1e-3, rtol=1e-12, atol=1e-15, max_sub=1)
+
+
+def _a_tolerance_no_step_meets(name: str) -> tuple:
+    model, y, u = tilted(0.5 * math.pi)
+    y[model.state_names.index("z")] += 1e-3  # rounding alone is 1e-19 m, 1e131 atol
+    return advance_from(name, model, y, u, 1e-3, rtol=1e-150, atol=1e-150)
+
+
+def _the_motion_leaves_the_chart(name: str) -> tuple:
+    return advance_from(name, *tilted(2e-3, tilt_rate=10.0), 1e-3)  # the edge at 0.2 ms
+
+
+@pytest.mark.parametrize("name", list(METHODS))
+@pytest.mark.parametrize(
+    ("make", "expected", "some_accepted"),
+    [
+        pytest.param(make, expected, accepted, id=make.__name__.strip("_"))
+        for make, expected, accepted in (
+            (_start_off_the_chart, methods.LEFT_CHART, False),
+            (_nan_in_the_state, methods.NOT_FINITE, False),
+            (_one_substep_allowed, methods.TOO_MANY_STEPS, False),
+            (_a_tolerance_no_step_meets, methods.STEP_TOO_SMALL, False),
+            (_the_motion_leaves_the_chart, methods.LEFT_CHART, True),
+        )
+    ],
+)
+def test_every_method_gives_up_with_the_status_of_its_cause(name, make, expected, some_accepted):
+    """Each way a stepper can fail ends in the status that names it, whatever the method: the
+    start state off the chart (nothing tried), a NaN in the state (not the chart: a singular or
+    NaN matrix of a Rosenbrock step once read as off it), too many substeps, a step too small,
+    and a motion that reaches the chart's edge after steps that were accepted."""
+    status, y, result = make(name)
+    assert (STATUS_TEXT[status], result[1] > 0) == (STATUS_TEXT[expected], some_accepted)
+    if expected == methods.LEFT_CHART and some_accepted:  # y left at the last accepted time
+        gamma = y[default_model().state_names.index("gamma")]
+        assert 0.5 * math.pi - 2e-3 < gamma < 0.5 * math.pi
+
+
+@pytest.mark.parametrize("name", list(METHODS))
+def test_a_first_step_whose_stage_leaves_the_chart_is_retried_shorter(name: str) -> None:
+    """A body 0.05 rad short of the chart's edge, at rest, over one 50 ms interval: the mounts'
+    pull on it is violent and a first step as long as the interval puts a stage past the edge,
+    where the motion itself stays on the chart. It is retried shorter like any other step
+    (an explicit method once gave up there, LEFT_CHART, as if its start state were off the
+    chart), and ends where the same start integrated in 500 intervals of 0.1 ms at rtol 1e-11
+    does."""
+    model, y0, u = tilted(0.05)
+    reference = stepper.new_stepper("dopri54", model.n_state, 1e-11, 1e-14, 100_000)
+    y_ref = y0.copy()
+    for j in range(500):
+        args = (y_ref, j * 1e-4, (j + 1) * 1e-4, reference.settings, model.arrays)
+        status = stepper.advance(
+            METHODS["dopri54"].id,
+            *args,
+            model.new_scratch(),
+            u,
+            reference.work2d,
+            reference.work1d,
+            reference.result,
+        )
+        assert status == methods.SUCCESS
+    status, y, result = advance_from(name, model, y0, u, 0.05)
+    assert STATUS_TEXT[status] == STATUS_TEXT[methods.SUCCESS] and result[2] > 0
+    np.testing.assert_allclose(y, y_ref, rtol=0.0, atol=1e-3 * np.abs(y_ref).max())
 
 
 # ----------------------------------------------------------------------------- the tables

@@ -137,16 +137,18 @@ inline int advance(Vec y, double t0, double t1, Vec settings, const Model& m, Sc
   double t = t0;
   double err_max = 0.0;
   idx n_acc = 0, n_rej = 0;
-  bool rhs_failed = false;
+  bool rhs_failed = false;  // the start state's right-hand side, then the last step's stages
   bool not_finite = false;  // the last rejection was for NaN or inf (stage state or error norm)
   bool retried = false;     // the last step tried was rejected
   if (settings[CHAINED] == 0.0) {  // else the caller put dy/dt at (t0, y) for this input in k[0]
     rhs_failed = physics::rhs(t, y, m, s, u, k.row(0)) != 0;
   }
+  const bool start_failed = rhs_failed;  // off the chart at t0 itself: no step can help
   settings[CHAINED] = 0.0;  // set again below on success: k[0] is then dy/dt at (t1, y)
   while (t < t1) {
-    // a step too small, or the start state itself off the chart (no step can help)
-    const bool too_small = h < MIN_STEP_FRACTION * span || (rhs_failed && n_acc == 0 && t == t0);
+    // a step too small, or the start state itself off the chart (a stage of the first step off
+    // it is retried shorter, as any step's: the motion itself may stay on it)
+    const bool too_small = h < MIN_STEP_FRACTION * span || start_failed;
     const int status = give_up(n_acc + n_rej, max_steps, too_small, not_finite, rhs_failed);
     if (status != SUCCESS) {
       record(settings, result, h, err_max, n_acc, n_rej);
