@@ -29,7 +29,13 @@ from mount_twin.physics.jacobian import central_columns
 from mount_twin.physics.rotations import rpy_matrices, rpy_matrix
 from mount_twin.scene.built import check_built
 from mount_twin.scene.description import DOF_NAMES, LinearMount, Mount, Scene
-from mount_twin.scene.statics import loose_dofs, statics
+from mount_twin.scene.statics import (
+    fastest_rate,
+    linear_stiffness,
+    loose_dofs,
+    piecewise_mounts,
+    statics,
+)
 
 
 @dataclass(frozen=True)
@@ -76,9 +82,9 @@ class Model:
 
     @cached_property
     def piecewise(self) -> bool:
-        """Whether some mount's force law has pieces its motion moves between (its kind's
-        `piecewise`: a contact, a joint's faces; linear mounts have none)."""
-        return any(KINDS[m.kind].piecewise(m) for m in self._nonlinear_mounts)
+        """Whether some mount's force law has pieces its motion moves between
+        (`scene.statics.piecewise_mounts`)."""
+        return bool(piecewise_mounts(self.scene))
 
     @cached_property
     def kinked(self) -> bool:
@@ -89,18 +95,12 @@ class Model:
 
     @cached_property
     def linear_stiffness(self) -> bool:
-        """Whether the body's stiff modes are its linear mounts': no mount's law has pieces
-        (`piecewise`), and on its non-linear mounts alone the body's fastest mode is at most
-        NONLINEAR_SHARE of its fastest on all of them (nominal tangents, `tangent_rate`).
-        The exponential method is exact on the linear part and steps the non-linear remainder
-        explicitly: `auto` takes it for a stiff scene only where this holds, and the error
-        estimate's companion beside a Rosenbrock twin too (`engine.companion.own_method`)."""
-        if self.piecewise:
-            return False
-        if not self.nonlinear_slots:
-            return True
-        alone = fastest_rate(replace(self.scene, mounts=self._nonlinear_mounts))
-        return alone <= NONLINEAR_SHARE * self.tangent_rate
+        """Whether the body's stiff modes are its linear mounts' (`scene.statics.
+        linear_stiffness`): the exponential method is exact on the linear part and steps the
+        non-linear remainder explicitly, so `auto` takes it for a stiff scene only where this
+        holds, and the error estimate's companion beside a Rosenbrock twin too
+        (`engine.companion.own_method`)."""
+        return linear_stiffness(self.scene)
 
     @property
     def _nonlinear_mounts(self) -> tuple[Mount, ...]:
@@ -115,27 +115,6 @@ class Model:
         weighs it at every start (`engine.auto_method`): taken once per model, not at each
         engine's start (0.1–0.2 ms each)."""
         return fastest_rate(self.scene)
-
-
-NONLINEAR_SHARE = 0.1
-"""`Model.linear_stiffness`: the non-linear mounts alone move the body at most this share of its
-fastest rate. 10 kg on 4 × 1e9 N/m beside a 1e4 N/m Bouc–Wen elastomer (a share of 1.6e-3) is
-4.2e-9 of the largest force off by the exponential method at rtol 1e-3 … 1e-9, 4.0e-4 … 2.8e-7 by
-the Rosenbrock; on four 1e9 N/m Bouc–Wen elastomers of strong hysteresis (share 1) the
-exponential method's estimate read 0.06 of its error at rtol 1e-3, and at 1e-9 it was 3.6e-6 off
-where the Rosenbrock was 3.3e-7 (docs/scene.md)."""
-
-
-def fastest_rate(scene: Scene) -> float:
-    """The fastest mode (rad/s) of the body of `scene` on its mounts' nominal tangents
-    (`scene.statics`), free DOFs only; 0 if it is not a number."""
-    st = statics(scene)
-    if not st.finite:
-        return 0.0
-    free = [DOF_NAMES.index(d) for d in scene.dofs]
-    k, m = st.elastic[np.ix_(free, free)], st.mass[np.ix_(free, free)]
-    omega2 = np.linalg.eigvals(np.linalg.solve(m, k))
-    return float(np.sqrt(np.abs(omega2).max()))
 
 
 def _inverse(rated: tuple[float, ...]) -> list[float]:

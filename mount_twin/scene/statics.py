@@ -33,7 +33,7 @@ Nominal tangent of each kind (`nominal_tangent`), what a kind counts as at its u
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -142,6 +142,51 @@ def statics(scene: Scene) -> Statics:
         deflection=np.einsum("nji,nj->ni", axes, deflection),
         force=np.einsum("nji,nj->ni", axes, force),
     )
+
+
+def fastest_rate(scene: Scene) -> float:
+    """The fastest mode (rad/s) of the body of `scene` on its mounts' nominal tangents
+    (`statics`), free DOFs only; 0 if it is not a number."""
+    st = statics(scene)
+    if not st.finite:
+        return 0.0
+    free = [DOF_NAMES.index(d) for d in scene.dofs]
+    k, m = st.elastic[np.ix_(free, free)], st.mass[np.ix_(free, free)]
+    omega2 = np.linalg.eigvals(np.linalg.solve(m, k))
+    return float(np.sqrt(np.abs(omega2).max()))
+
+
+NONLINEAR_SHARE = 0.1
+"""`linear_stiffness`: the non-linear mounts alone move the body at most this share of its
+fastest rate. 10 kg on 4 × 1e9 N/m beside a 1e4 N/m Bouc–Wen elastomer (a share of 1.6e-3) is
+4.2e-9 of the largest force off by the exponential method at rtol 1e-3 … 1e-9, 4.0e-4 … 2.8e-7 by
+the Rosenbrock; on four 1e9 N/m Bouc–Wen elastomers of strong hysteresis (share 1) the
+exponential method's estimate read 0.06 of its error at rtol 1e-3, and at 1e-9 it was 3.6e-6 off
+where the Rosenbrock was 3.3e-7 (docs/scene.md)."""
+
+
+def piecewise_mounts(scene: Scene) -> list[int]:
+    """The mounts whose force law has pieces their motion moves between (their kind's
+    `piecewise`: a contact, a joint's faces; linear mounts have none), by index."""
+    return [
+        i
+        for i, m in enumerate(scene.mounts)
+        if not isinstance(m, LinearMount) and KINDS[m.kind].piecewise(m)
+    ]
+
+
+def linear_stiffness(scene: Scene) -> bool:
+    """Whether the body's stiff modes are its linear mounts': no mount's law has pieces
+    (`piecewise_mounts`), and on its non-linear mounts alone the body's fastest mode is at most
+    NONLINEAR_SHARE of its fastest on all of them (`fastest_rate`). Where it holds the
+    exponential method is exact on the stiff part (`Model.linear_stiffness`)."""
+    if piecewise_mounts(scene):
+        return False
+    nonlinear = tuple(m for m in scene.mounts if not isinstance(m, LinearMount))
+    if not nonlinear:
+        return True
+    alone = fastest_rate(replace(scene, mounts=nonlinear))
+    return alone <= NONLINEAR_SHARE * fastest_rate(scene)
 
 
 def loose_dofs(st: Statics, dofs: tuple[str, ...]) -> tuple[dict[str, float], dict[str, float]]:
