@@ -18,6 +18,10 @@ Qᵢ·diag(k_r)·Qᵢᵀ its tangents in F:
   elastic stiffness and the geometric stiffness has no component along it (a body on mounts
   all at one point turns freely about the vertical through it). A direction along which the
   total stiffness is negative is overturned: the weight topples the body there.
+- the body's fastest mode on the tangents (`fastest_rate`), and whether its stiff modes are its
+  linear mounts' alone (`linear_stiffness`: no law with pieces, the non-linear mounts soft),
+  the rule by which `integration.method: auto` takes the exponential method and the loader
+  warns where it is asked for by name against it.
 
 Nominal tangent of each kind (`nominal_tangent`), what a kind counts as at its unstressed pose:
 - linear: its stiffness;
