@@ -196,12 +196,17 @@ def test_an_unknown_method_id_is_a_status_with_its_text() -> None:
 # ------------------------------------------------------------------- failures and their status
 
 
-def tilted(tilt_margin: float, tilt_rate: float = 0.0) -> tuple:
-    """The default scene's body at rest on its mounts but tilted (γ) to tilt_margin rad short of
-    the α/γ/δ chart's edge at π/2, turning toward it at tilt_rate rad/s: (model, y, u)."""
+def at_rest() -> tuple:
+    """The default scene's body at rest on its mounts under gravity: (model, y, u)."""
     model = default_model()
     u = gravity_u()
-    y = initial_state(model, u[1:4])
+    return model, initial_state(model, u[1:4]), u
+
+
+def tilted(tilt_margin: float, tilt_rate: float = 0.0) -> tuple:
+    """The body of `at_rest` tilted (γ) to tilt_margin rad short of the α/γ/δ chart's edge at
+    π/2, turning toward it at tilt_rate rad/s: (model, y, u)."""
+    model, y, u = at_rest()
     y[model.state_names.index("gamma")] = 0.5 * math.pi - tilt_margin
     y[model.state_names.index("gamma_dot")] = tilt_rate
     return model, y, u
@@ -223,19 +228,19 @@ def _start_off_the_chart(name: str) -> tuple:
 
 
 def _nan_in_the_state(name: str) -> tuple:
-    model, y, u = tilted(0.5 * math.pi)
+    model, y, u = at_rest()
     y[model.state_names.index("z")] = math.nan
     return advance_from(name, model, y, u, 1e-3)
 
 
 def _one_substep_allowed(name: str) -> tuple:
-    model, y, u = tilted(0.5 * math.pi)
+    model, y, u = at_rest()
     y[model.state_names.index("z")] += 1e-3
     return advance_from(name, model, y, u, 1e-3, rtol=1e-12, atol=1e-15, max_sub=1)
 
 
 def _a_tolerance_no_step_meets(name: str) -> tuple:
-    model, y, u = tilted(0.5 * math.pi)
+    model, y, u = at_rest()
     y[model.state_names.index("z")] += 1e-3  # rounding alone is 1e-19 m, 1e131 atol
     return advance_from(name, model, y, u, 1e-3, rtol=1e-150, atol=1e-150)
 
