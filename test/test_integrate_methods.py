@@ -162,11 +162,14 @@ def oscillator(omega: float = 2.0 * math.pi * 50.0) -> tuple:
     return model, initial_state(model, u[1:4]), u
 
 
-def run_advance(method: int, model, y: np.ndarray, u, t1: float, module=None):
+def run_advance(
+    method: int, model, y: np.ndarray, u, t1: float, module=None, tolerances=(1e-13, 1.0, 1)
+):
     """One call of stepper.advance (or module.advance) from 0 to t1 with the work arrays of
-    the method of that id (dopri54's for an unknown id); (status, y, result)."""
+    the method of that id (dopri54's for an unknown id) at `tolerances` (rtol, atol,
+    max_substeps); (status, y, result)."""
     name = next((n for n, m in METHODS.items() if m.id == method), "dopri54")
-    st = stepper.new_stepper(name, model.n_state, 1e-13, 1.0, 1)
+    st = stepper.new_stepper(name, model.n_state, *tolerances)
     y = y.copy()
     s = model.new_scratch()
     args = (y, 0.0, t1, st.settings, model.arrays, s, u, st.work2d, st.work1d, st.result)
@@ -214,13 +217,9 @@ def tilted(tilt_margin: float, tilt_rate: float = 0.0) -> tuple:
 
 def advance_from(
     name: str, model, y: np.ndarray, u, t1: float, rtol=1e-6, atol=1e-9, max_sub=10_000
-):
-    """One call of `name`'s advance from (0, y) to t1 s at these settings: (status, y, result)."""
-    st = stepper.new_stepper(name, model.n_state, rtol, atol, max_sub)
-    y = y.copy()
-    args = (y, 0.0, t1, st.settings, model.arrays, model.new_scratch(), u)
-    status = stepper.advance(METHODS[name].id, *args, st.work2d, st.work1d, st.result)
-    return int(status), y, st.result.copy()
+) -> tuple:
+    """`run_advance` of the method `name` at these settings: (status, y, result)."""
+    return run_advance(METHODS[name].id, model, y, u, t1, tolerances=(rtol, atol, max_sub))
 
 
 def _start_off_the_chart(name: str) -> tuple:
@@ -241,7 +240,7 @@ def _one_substep_allowed(name: str) -> tuple:
 
 def _a_tolerance_no_step_meets(name: str) -> tuple:
     model, y, u = at_rest()
-    y[model.state_names.index("z")] += 1e-3  # rounding alone is 1e-19 m, 1e131 atol
+    y[model.state_names.index("z")] += 1e-3  # its rounding alone, 1e-19 m, is 1e131 atol
     return advance_from(name, model, y, u, 1e-3, rtol=1e-150, atol=1e-150)
 
 
@@ -265,8 +264,8 @@ def _the_motion_leaves_the_chart(name: str) -> tuple:
 )
 def test_every_method_gives_up_with_the_status_of_its_cause(name, make, expected, some_accepted):
     """Each way a stepper can fail ends in the status that names it, whatever the method: the
-    start state off the chart (nothing tried), a NaN in the state (not the chart: a singular or
-    NaN matrix of a Rosenbrock step once read as off it), too many substeps, a step too small,
+    start state off the chart (nothing tried), a NaN in the state (not the chart: a NaN matrix
+    of a Rosenbrock step once read as off it), too many substeps, a step too small,
     and a motion that reaches the chart's edge after steps that were accepted."""
     status, y, result = make(name)
     assert (STATUS_TEXT[status], result[1] > 0) == (STATUS_TEXT[expected], some_accepted)
