@@ -161,6 +161,10 @@ def run_live(
     try:
         assert wait_for_node(pub, node), node.failed()
         assert wait_for(lambda: all(peer.connected(t) for t in topics), 10.0)
+        # the node's side too: the latched scene comes once its writer has matched the reader
+        # recorded last, and discovery announces the peer's readers in order, reliably (a pose
+        # published before the node's writer matched the peer's reader is not sent to it)
+        assert peer.take_until(lambda: bool(peer.got[SCENE]), 30.0), node.failed()
         publish_paced(pub, raws, rate_hz, peer)
         rate = 1e9 / (_stamp(raws[1]) - _stamp(raws[0]))
         before = expect_outputs - delay_samples(scene.input, rate)  # the rest come at shutdown
