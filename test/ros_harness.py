@@ -25,6 +25,7 @@ from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
+from mount_twin.io.scene_record import STRING
 from mount_twin.ros.outputs import message_class
 from mount_twin.ros.rclpy_private import take_waiting
 
@@ -211,6 +212,15 @@ class Peer:
     def connected(self, topic: str) -> bool:
         """True once the recorder's subscription to `topic` has a publisher."""
         return self._subs[topic].get_publisher_count() > 0
+
+    def matched_by(self, scene_topic: str, timeout: float) -> bool:
+        """Whether the node that publishes its latched scene on `scene_topic` has matched, on
+        its side, every reader this peer made before this call (`connected` proves this side
+        only, and a message published before the node's writer matched a reader is not sent to
+        it): a latched reader made now, after them, gets the scene once the node's writer has
+        matched it, and discovery announces this peer's readers reliably and in order."""
+        self.record({scene_topic: STRING}, latched=True)
+        return self.take_until(lambda: bool(self.got[scene_topic]), timeout)
 
 
 LOSSLESS = [

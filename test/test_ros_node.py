@@ -153,7 +153,6 @@ def run_live(
     peer = Peer(domain)
     topics = live_topics(scene)
     peer.record(topics)
-    peer.record({SCENE: STRING}, latched=True)  # published once, at the node's start
     node = NodeProcess(domain, [*ros_args, *LOSSLESS])
     pub = peer.publisher(IMU, "/deck/imu")
     pose = resolve("~/pose", NODE_NAME)
@@ -161,10 +160,9 @@ def run_live(
     try:
         assert wait_for_node(pub, node), node.failed()
         assert wait_for(lambda: all(peer.connected(t) for t in topics), 10.0)
-        # the node's side too: the latched scene comes once its writer has matched the reader
-        # recorded last, and discovery announces the peer's readers in order, reliably (a pose
-        # published before the node's writer matched the peer's reader is not sent to it)
-        assert peer.take_until(lambda: bool(peer.got[SCENE]), 30.0), node.failed()
+        assert peer.matched_by(SCENE, 30.0), (
+            node.failed()
+        )  # its side too; the scene published once
         publish_paced(pub, raws, rate_hz, peer)
         rate = 1e9 / (_stamp(raws[1]) - _stamp(raws[0]))
         before = expect_outputs - delay_samples(scene.input, rate)  # the rest come at shutdown
@@ -689,6 +687,7 @@ def test_a_renamed_namespaced_node_takes_the_bundled_params_file() -> None:
         pub = peer.publisher(IMU, "/deck/imu")
         assert wait_for_node(pub, node), node.failed()
         assert wait_for(lambda: peer.connected(topic), 10.0)
+        assert peer.matched_by(resolve("~/scene", "twin2", "/ship"), 30.0), node.failed()
         publish_paced(pub, _imu(*_at_rest(100)), 1000.0, peer)
         # the last GYRO_DELAY samples are answered as the node shuts down
         assert peer.take_until(lambda: len(peer.got[topic]) >= 100 - GYRO_DELAY, 10.0)
@@ -815,10 +814,11 @@ def test_tf_static_is_latched_for_a_late_subscriber_and_tf_carries_the_pose() ->
     try:
         assert wait_for_node(pub, node), node.stop()
         assert wait_for(lambda: peer.connected(TF_TOPIC) and peer.connected(pose), 10.0)
+        assert peer.matched_by(SCENE, 30.0), node.stop()
         stamps, accel = _at_rest(300)
         publish_paced(pub, _imu(stamps, accel), 1000.0, peer)
         # the last GYRO_DELAY samples are answered as the node shuts down
-        answered = lambda: min(map(len, peer.got.values()))  # noqa: E731
+        answered = lambda: min(len(peer.got[t]) for t in (TF_TOPIC, pose))  # noqa: E731
         assert peer.take_until(lambda: answered() >= 300 - GYRO_DELAY, 60.0)
         late.record({TF_STATIC_TOPIC: TF}, latched=True)  # the node published it at its start
         volatile.record({TF_STATIC_TOPIC: TF})
@@ -1038,6 +1038,7 @@ def test_a_diagnostics_period_longer_than_a_timer_can_wait_runs_the_node() -> No
     pub = peer.publisher(IMU, "/deck/imu")
     try:
         assert wait_for_node(pub, node), node.failed()
+        assert peer.matched_by(SCENE, 30.0), node.failed()
         publish_paced(pub, _imu(*_at_rest(100)), 1000.0, peer)
         peer.take_until(lambda: len(peer.got["/mount_twin/pose"]) >= 100 - GYRO_DELAY, 60.0)
         code = stop_and_take(node, peer, lambda: len(peer.got["/mount_twin/pose"]) >= 100)
