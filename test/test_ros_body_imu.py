@@ -99,6 +99,8 @@ def test_the_live_body_imu_comparison_equals_the_replays(tmp_path: Path, loops: 
     does (both streams' stamps jump back: the body comparison restarts with the twin; the
     replay's bag holds the loops' messages by stamp, interleaved, hence compared in order of
     stamps)."""
+    from rclpy.duration import Duration
+
     scene_path = _scene_file(tmp_path)
     scene = load_scene_file(scene_path)
     loop = _inputs()
@@ -132,9 +134,13 @@ def test_the_live_body_imu_comparison_equals_the_replays(tmp_path: Path, loops: 
         assert wait_for_node(pubs["/deck/imu"], node), node.failed()
         assert wait_for(lambda: pubs[BODY_TOPIC].get_subscription_count() > 0, 30.0)
         assert wait_for(lambda: all(peer.connected(t) for t in body_topics), 30.0)
+        assert peer.matched_by(resolve("~/scene", NODE_NAME), 30.0), node.failed()
         for topic, _, raw in inputs:
             pubs[topic].publish(raw)
             peer.take()
+        # every input in the node's queue before the stop (`_send_when_connected`'s `acked`:
+        # one still in flight was lost, and the deck's last changed the tail's predictions)
+        assert all(p.wait_for_all_acked(Duration(seconds=60.0)) for p in pubs.values())
         # the last samples' predictions wait for the twin's rows the gyro filter holds
         held = delay_samples(scene.input, RATE) + 3
         before = len(want[body_topics[1]]) - held
