@@ -138,8 +138,9 @@ def test_the_live_body_imu_comparison_equals_the_replays(tmp_path: Path, loops: 
         for topic, _, raw in inputs:
             pubs[topic].publish(raw)
             peer.take()
-        # every input in the node's queue before the stop (`_send_when_connected`'s `acked`:
-        # one still in flight was lost, and the deck's last changed the tail's predictions)
+        # every input in the node's queue before the stop (`_send_when_connected`'s `acked`: a
+        # message still in flight at the stop is lost; CI once had the predictions of the
+        # tail, which the last deck samples decide, one short and moved)
         assert all(p.wait_for_all_acked(Duration(seconds=60.0)) for p in pubs.values())
         # the last samples' predictions wait for the twin's rows the gyro filter holds
         held = delay_samples(scene.input, RATE) + 3
