@@ -255,8 +255,8 @@ def _ageing_statuses_live(
 
 
 def _send_when_connected(node: NodeProcess, peer: Peer, inputs: list, acked: bool = False) -> None:
-    """Publish `inputs` ((topic, stamp, raw) in order) once the node hears both topics and the
-    peer hears its /diagnostics; with `acked`, return only once the node's (reliable)
+    """Publish `inputs` ((topic, stamp, raw) in order) once the node hears both topics and
+    its /diagnostics writer has matched the peer (`Peer.matched_by`); with `acked`, return only once the node's (reliable)
     subscriptions have acknowledged every one, so that a stop then finds them all in its
     queue (a stop while the last were in flight lost them: 597 of 600 counted in a loaded
     CI run)."""
@@ -266,6 +266,7 @@ def _send_when_connected(node: NodeProcess, peer: Peer, inputs: list, acked: boo
     assert wait_for_node(pubs["/deck/imu"], node), node.failed()
     assert wait_for(lambda: pubs[BODY_TOPIC].get_subscription_count() > 0, 30.0)
     assert wait_for(lambda: peer.connected("/diagnostics"), 30.0)
+    assert peer.matched_by(resolve("~/scene", NODE_NAME), 30.0), node.failed()
     for topic, _, raw in inputs:
         pubs[topic].publish(raw)
         peer.take()
