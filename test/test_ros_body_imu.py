@@ -256,10 +256,10 @@ def _ageing_statuses_live(
 
 def _send_when_connected(node: NodeProcess, peer: Peer, inputs: list, acked: bool = False) -> None:
     """Publish `inputs` ((topic, stamp, raw) in order) once the node hears both topics and
-    its /diagnostics writer has matched the peer (`Peer.matched_by`); with `acked`, return only once the node's (reliable)
-    subscriptions have acknowledged every one, so that a stop then finds them all in its
-    queue (a stop while the last were in flight lost them: 597 of 600 counted in a loaded
-    CI run)."""
+    its /diagnostics writer has matched the peer (`Peer.matched_by`); with `acked`, return
+    only once the node's (reliable) subscriptions have acknowledged every one, so that a stop
+    then finds them all in its queue (a stop while the last were in flight lost them: 597 of
+    600 counted in a loaded CI run)."""
     from rclpy.duration import Duration
 
     pubs = {t: peer.publisher(IMU, t) for t in ("/deck/imu", BODY_TOPIC)}
