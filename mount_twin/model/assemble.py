@@ -100,7 +100,7 @@ class Model:
         non-linear remainder explicitly, so `auto` takes it for a stiff scene only where this
         holds, and the error estimate's companion beside a Rosenbrock twin too
         (`engine.companion.own_method`)."""
-        return linear_stiffness(self.scene)
+        return linear_stiffness(self.scene, self.tangent_rate)
 
     @property
     def _nonlinear_mounts(self) -> tuple[Mount, ...]:

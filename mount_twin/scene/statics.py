@@ -179,18 +179,19 @@ def piecewise_mounts(scene: Scene) -> list[int]:
     ]
 
 
-def linear_stiffness(scene: Scene) -> bool:
+def linear_stiffness(scene: Scene, fastest: float | None = None) -> bool:
     """Whether the body's stiff modes are its linear mounts': no mount's law has pieces
     (`piecewise_mounts`), and on its non-linear mounts alone the body's fastest mode is at most
-    NONLINEAR_SHARE of its fastest on all of them (`fastest_rate`). Where it holds the
-    exponential method is exact on the stiff part (`Model.linear_stiffness`)."""
+    NONLINEAR_SHARE of its fastest on all of them (`fastest`, rad/s, where the caller holds
+    it; else `fastest_rate`). Where it holds the exponential method is exact on the stiff part
+    (`Model.linear_stiffness`)."""
     if piecewise_mounts(scene):
         return False
     nonlinear = tuple(m for m in scene.mounts if not isinstance(m, LinearMount))
     if not nonlinear:
         return True
     alone = fastest_rate(replace(scene, mounts=nonlinear))
-    return alone <= NONLINEAR_SHARE * fastest_rate(scene)
+    return alone <= NONLINEAR_SHARE * (fastest_rate(scene) if fastest is None else fastest)
 
 
 def loose_dofs(st: Statics, dofs: tuple[str, ...]) -> tuple[dict[str, float], dict[str, float]]:
